@@ -1,0 +1,61 @@
+"""The plant interface: anything that turns knob angles into tip angles and knob torques.
+
+Users plug their own catheter model in with ``module:factory`` and keyword parameters.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
+
+
+@dataclass(frozen=True)
+class PlantStep:
+    """Result of one plant step.
+
+    ``tip_deg`` is the bending angle of the tip in the two planes (ground truth, what an EM
+    tracker sees); ``knob_torque_Nm`` is the load each knob puts on its motor.
+    """
+
+    tip_deg: NDArray[np.float64]
+    knob_torque_Nm: NDArray[np.float64]
+
+
+@runtime_checkable
+class Plant(Protocol):
+    """A catheter driven by two knobs (phi1 anterior-posterior, phi2 right-left)."""
+
+    def reset(self) -> None:
+        """Return to the straight, unloaded state."""
+
+    def step(self, dt_s: float, knob_deg: NDArray[np.float64]) -> PlantStep:
+        """Advance by ``dt_s``; ``knob_deg`` (shape (2,)) is where the knobs are at its end."""
+
+
+class PlantLoadError(ValueError):
+    """The configured plant factory could not be loaded or built."""
+
+
+def load_plant(spec: str, params: dict[str, Any] | None = None) -> Plant:
+    """Build a plant from ``"package.module:factory"`` and keyword parameters."""
+    module_name, sep, attr = spec.partition(":")
+    if not sep or not module_name or not attr:
+        raise PlantLoadError(f"plant factory {spec!r} must look like 'package.module:factory'")
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise PlantLoadError(f"cannot import plant module {module_name!r}: {exc}") from exc
+    factory = getattr(module, attr, None)
+    if not callable(factory):
+        raise PlantLoadError(f"{module_name!r} has no callable {attr!r}")
+    try:
+        plant = factory(**(params or {}))
+    except TypeError as exc:
+        raise PlantLoadError(f"plant factory {spec!r} rejected its parameters: {exc}") from exc
+    if not isinstance(plant, Plant):
+        raise PlantLoadError(f"{spec!r} returned {type(plant).__name__}, which is not a Plant")
+    return plant

@@ -1,0 +1,5 @@
+import sys
+
+from tsmd.cli import main
+
+sys.exit(main())

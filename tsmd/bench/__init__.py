@@ -1,0 +1,1 @@
+"""Benchmarks behind `tsmd bench NAME`: each prints figures; none asserts a timing."""

@@ -1,0 +1,63 @@
+"""The ``tsmd`` command: a thin dispatcher onto one module per subcommand.
+
+Each command module under :mod:`tsmd.commands` provides ``add_arguments(parser)`` and
+``main(args) -> int``. Errors meant for the user become one line on stderr and exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from drivers.drive import DriveError
+from drivers.plant.base import PlantLoadError
+from tsmd.errors import TsmdError
+
+COMMANDS: dict[str, tuple[str, str]] = {
+    "run": ("tsmd.commands.run", "run the daemon (loop, drives, socket API)"),
+    "sim": ("tsmd.commands.sim", "run the simulated rig as its own process on a CAN interface"),
+    "calibrate": ("tsmd.commands.calibrate", "calibrate a catheter from motor current"),
+    "replay": ("tsmd.commands.replay", "run a trajectory through the full stack and record it"),
+    "gap": ("tsmd.commands.gap", "diagnose the sim-to-real gap from real recordings"),
+    "bench": ("tsmd.commands.bench", "benchmarks that print figures (bus, loop, accuracy, ...)"),
+}
+
+USER_ERRORS: tuple[type[BaseException], ...] = (TsmdError, DriveError, PlantLoadError)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="tsmd", description="Driver daemon for tendon-sheath-driven robotic catheters.")
+    parser.add_argument("--version", action="version", version=_version())
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name, (module_name, help_text) in COMMANDS.items():
+        module = importlib.import_module(module_name)
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        module.add_arguments(p)
+        p.set_defaults(_module=module)
+    return parser
+
+
+def _version() -> str:
+    from tsmd import __version__
+
+    return f"tsmd {__version__}"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args._module.main(args))
+    except USER_ERRORS as exc:
+        print(f"tsmd {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"tsmd {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

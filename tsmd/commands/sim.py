@@ -1,0 +1,15 @@
+"""`tsmd sim`: not built yet (see the open issue)."""
+
+from __future__ import annotations
+
+import argparse
+
+from tsmd.errors import TsmdError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("rest", nargs=argparse.REMAINDER)
+
+
+def main(args: argparse.Namespace) -> int:
+    raise TsmdError("'tsmd sim' is not implemented yet")

@@ -1,0 +1,89 @@
+"""The configuration file: defaults, and every kind of mistake refused with its key path."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from tsmd.config import ConfigError, TsmdConfig, default_sim_config, drive_configs, load_config
+
+
+def write(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "tsmd.yaml"
+    path.write_text(text)
+    return path
+
+
+def test_an_empty_file_gives_every_default(tmp_path: Path) -> None:
+    config = load_config(write(tmp_path, ""))
+    assert config == TsmdConfig()
+    assert config.loop.rate_hz == 250.0
+    assert config.api.socket_path == "/run/tsmd/tsmd.sock"
+    assert config.api.socket_mode == 0o660
+
+
+def test_the_packaged_sim_config_is_valid_and_builds_two_drive_configs() -> None:
+    config = default_sim_config()
+    assert config.bus.interface == "virtual"
+    drives = drive_configs(config)
+    assert [d.node_id for d in drives] == [1, 2]
+
+
+@pytest.mark.parametrize(("text", "key", "reason"), [
+    ("loop: {rate_hz: 2000}", "loop.rate_hz", "out of range"),
+    ("loop: {rate_hz: fast}", "loop.rate_hz", "expected a number"),
+    ("loop: {rate_hz: .nan}", "loop.rate_hz", "finite"),
+    ("loop: {rate_hz: true}", "loop.rate_hz", "expected a number"),
+    ("loop: {rte_hz: 100}", "loop.rte_hz", "unknown key"),
+    ("loop: {realtime: {priority: 120}}", "loop.realtime.priority", "out of range"),
+    ("loop: {overrun_fault_streak: 2.5}", "loop.overrun_fault_streak", "integer"),
+    ("bus: {bitrate: null}", "bus.bitrate", "null"),
+    ("compensation: {method: magic}", "compensation.method", "not one of"),
+    ("api: [1, 2]", "api", "mapping"),
+    ("limits: {phi1: {min_deg: 10, max_deg: 0}}", "limits.phi1", "below max_deg"),
+    ("drives: [{node_id: 1}, {node_id: 300}]", "drives[1]", "node_id"),
+    ("drives: [{node_id: 1}, {gear_ratio: 10}]", "drives[1]", "missing"),
+    ("drives: [{node_id: 1}]", "drives", "expected 2"),
+    ("recording: {flush_interval_s: 0}", "recording.flush_interval_s", "out of range"),
+    ("foo: 1", "foo", "unknown key"),
+])
+def test_bad_value_is_refused_naming_key_and_reason(tmp_path: Path, text: str, key: str,
+                                                    reason: str) -> None:
+    with pytest.raises(ConfigError) as exc:
+        load_config(write(tmp_path, text))
+    message = str(exc.value)
+    assert f"{key}:" in message or f"{key} " in message
+    assert reason in message
+
+
+def test_limits_wider_than_the_drive_are_refused(tmp_path: Path) -> None:
+    text = yaml.safe_dump({"drives": [{"node_id": 1, "max_deg": 60}, {"node_id": 2}]})
+    with pytest.raises(ConfigError, match=r"limits\.phi1.*drives\[0\]"):
+        load_config(write(tmp_path, text))
+
+
+def test_invalid_yaml_names_the_line(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="line 2"):
+        load_config(write(tmp_path, "loop:\n  rate_hz: 1: 2\n"))
+
+
+def test_missing_file_is_a_clear_error(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="cannot read"):
+        load_config(tmp_path / "absent.yaml")
+
+
+def test_top_level_must_be_a_mapping(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError, match="top level"):
+        load_config(write(tmp_path, "- 1\n- 2\n"))
+
+
+def test_nested_values_are_read(tmp_path: Path) -> None:
+    config = load_config(write(tmp_path, "loop: {rate_hz: 1000, realtime: {cpu: 1}}\n"
+                                         "sim: {params: {coupling: false}, seed: 7}\n"))
+    assert config.loop.rate_hz == 1000.0
+    assert config.loop.period_s == pytest.approx(0.001)
+    assert config.loop.realtime.cpu == 1
+    assert config.sim.params == {"coupling": False}
+    assert config.sim.seed == 7

@@ -1,0 +1,1 @@
+"""The local socket API: newline-delimited JSON on a Unix stream socket (docs/api.md)."""

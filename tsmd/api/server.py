@@ -1,0 +1,277 @@
+"""The Unix-socket server: asyncio in its own thread, so no client can delay a tick.
+
+Per client: lines are cut at ``max_line_bytes`` (longer ones are answered with ``too_long``
+and skipped to the next newline), requests are rate-limited by a token bucket (a flooding
+client is slowed down by back-pressure, not answered faster), and a client that stops reading
+is dropped once its send buffer stays full. Streams (``subscribe``, calibration progress)
+drop samples rather than queue them without bound.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import os
+import stat
+import threading
+import time
+from collections.abc import Awaitable, Callable
+from pathlib import Path
+from typing import Any
+
+from tsmd.api.protocol import (
+    ApiError,
+    Request,
+    decode_line,
+    encode,
+    error,
+    parse_request,
+    request_id,
+)
+from tsmd.errors import TsmdError
+
+STREAM_HIGH_WATER_BYTES = 64 * 1024
+DRAIN_TIMEOUT_S = 5.0
+READ_CHUNK_BYTES = 64 * 1024
+
+
+class ApiServerError(TsmdError):
+    """The socket could not be created (path, permissions); the message says which."""
+
+
+class Connection:
+    """One client: replies in order, optional streams that drop when the client is slow."""
+
+    def __init__(self, writer: asyncio.StreamWriter) -> None:
+        self.writer = writer
+        self.tasks: dict[str, asyncio.Task[Any]] = {}
+        self.dropped = 0
+        self.closed = False
+
+    async def reply(self, message: dict[str, Any]) -> None:
+        if self.closed:
+            return
+        self.writer.write(encode(message))
+        try:
+            await asyncio.wait_for(self.writer.drain(), DRAIN_TIMEOUT_S)
+        except (TimeoutError, ConnectionError):
+            self.close()
+
+    def send_event(self, message: dict[str, Any]) -> bool:
+        """Stream one event without waiting; dropped (and counted) if the client lags."""
+        if self.closed:
+            return False
+        transport = self.writer.transport
+        if transport.is_closing() or transport.get_write_buffer_size() > STREAM_HIGH_WATER_BYTES:
+            self.dropped += 1
+            return False
+        self.writer.write(encode(message))
+        return True
+
+    def start_task(self, name: str, coro: Awaitable[Any]) -> None:
+        self.cancel_task(name)
+        self.tasks[name] = asyncio.ensure_future(coro)
+
+    def cancel_task(self, name: str) -> bool:
+        task = self.tasks.pop(name, None)
+        if task is None:
+            return False
+        task.cancel()
+        return True
+
+    def close(self) -> None:
+        if self.closed:
+            return
+        self.closed = True
+        for name in list(self.tasks):
+            self.cancel_task(name)
+        self.writer.close()
+
+
+Handler = Callable[[Request, Connection], Awaitable[dict[str, Any]]]
+
+
+class TokenBucket:
+    def __init__(self, rate_per_s: float, burst: float) -> None:
+        self.rate = rate_per_s
+        self.burst = burst
+        self.tokens = burst
+        self.t = time.monotonic()
+
+    def wait_s(self) -> float:
+        """Take one token; how long to wait first when none is left."""
+        now = time.monotonic()
+        self.tokens = min(self.burst, self.tokens + (now - self.t) * self.rate)
+        self.t = now
+        self.tokens -= 1.0
+        return 0.0 if self.tokens >= 0 else -self.tokens / self.rate
+
+
+class ApiServer:
+    """Serves :data:`Handler` on a Unix stream socket from a background thread."""
+
+    def __init__(self, socket_path: str | os.PathLike[str], handler: Handler, *,
+                 mode: int = 0o660, max_line_bytes: int = 4096, max_clients: int = 16,
+                 requests_per_s: float = 2000.0, on_event: Callable[..., None] | None = None
+                 ) -> None:
+        self.socket_path = Path(socket_path)
+        self.handler = handler
+        self.mode = mode
+        self.max_line_bytes = max_line_bytes
+        self.max_clients = max_clients
+        self.requests_per_s = requests_per_s
+        self._on_event = on_event
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self._thread: threading.Thread | None = None
+        self._server: asyncio.AbstractServer | None = None
+        self._connections: set[Connection] = set()
+        self._started = threading.Event()
+        self._start_error: BaseException | None = None
+        self.requests = 0
+        self.refused = 0
+        self.background_commands: frozenset[str] = frozenset({"calibrate"})
+        """Commands answered from their own task, so the client can still send ``cancel``."""
+
+    @property
+    def client_count(self) -> int:
+        return len(self._connections)
+
+    def start(self) -> None:
+        """Bind the socket (mode applied before anyone can connect) and serve in a thread."""
+        self._thread = threading.Thread(target=self._run, name="tsmd-api", daemon=True)
+        self._thread.start()
+        self._started.wait(10.0)
+        if self._start_error is not None:
+            raise self._start_error
+
+    def _run(self) -> None:
+        loop = asyncio.new_event_loop()
+        self.loop = loop
+        try:
+            loop.run_until_complete(self._bind())
+        except BaseException as exc:  # reported to start()'s caller
+            self._start_error = exc
+            self._started.set()
+            loop.close()
+            return
+        self._started.set()
+        try:
+            loop.run_forever()
+        finally:
+            loop.run_until_complete(self._shutdown())
+            loop.close()
+
+    async def _bind(self) -> None:
+        path = self.socket_path
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ApiServerError(f"cannot create socket directory {path.parent}: "
+                                 f"{exc.strerror or exc}") from None
+        if path.exists() or path.is_symlink():
+            if not stat.S_ISSOCK(path.lstat().st_mode):
+                raise ApiServerError(f"{path} exists and is not a socket; refusing to replace it")
+            path.unlink()
+        old_umask = os.umask(0o777 & ~self.mode)
+        try:
+            self._server = await asyncio.start_unix_server(self._client, path=str(path))
+        except OSError as exc:
+            raise ApiServerError(f"cannot listen on {path}: {exc.strerror or exc}") from None
+        finally:
+            os.umask(old_umask)
+        os.chmod(path, self.mode)
+
+    async def _shutdown(self) -> None:
+        if self._server is not None:
+            self._server.close()
+        for conn in list(self._connections):
+            conn.close()
+        with contextlib.suppress(OSError):
+            self.socket_path.unlink()
+
+    def stop(self) -> None:
+        loop = self.loop
+        if loop is None or self._thread is None:
+            return
+        with contextlib.suppress(RuntimeError):
+            loop.call_soon_threadsafe(loop.stop)
+        self._thread.join(5.0)
+
+    async def _client(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        conn = Connection(writer)
+        if len(self._connections) >= self.max_clients:
+            self.refused += 1
+            await conn.reply(error(None, "too_many_clients",
+                                   f"at most {self.max_clients} clients at a time"))
+            conn.close()
+            return
+        self._connections.add(conn)
+        bucket = TokenBucket(self.requests_per_s, burst=min(self.requests_per_s, 200.0))
+        buf = bytearray()
+        discarding = False
+        try:
+            while not conn.closed:
+                data = await reader.read(READ_CHUNK_BYTES)
+                if not data:
+                    break
+                buf += data
+                while not conn.closed:
+                    nl = buf.find(b"\n")
+                    if nl < 0:
+                        if len(buf) > self.max_line_bytes:
+                            if not discarding:
+                                await conn.reply(self._too_long())
+                            discarding = True
+                            buf.clear()
+                        break
+                    line = bytes(buf[:nl])
+                    del buf[:nl + 1]
+                    if discarding:
+                        discarding = False
+                        continue
+                    if len(line) > self.max_line_bytes:
+                        await conn.reply(self._too_long())
+                        continue
+                    if not line.strip():
+                        continue
+                    delay = bucket.wait_s()
+                    if delay > 0:
+                        await asyncio.sleep(delay)
+                    response = await self._dispatch(line, conn)
+                    if response is not None:
+                        await conn.reply(response)
+        except (ConnectionError, asyncio.IncompleteReadError):
+            pass
+        finally:
+            self._connections.discard(conn)
+            conn.close()
+
+    def _too_long(self) -> dict[str, Any]:
+        return error(None, "too_long", f"request line longer than {self.max_line_bytes} bytes")
+
+    async def _dispatch(self, line: bytes, conn: Connection) -> dict[str, Any] | None:
+        """The response, or None when a long command answers later from its own task."""
+        self.requests += 1
+        obj: Any = None
+        try:
+            obj = decode_line(line)
+            request = parse_request(obj)
+        except ApiError as exc:
+            return error(request_id(obj), exc.code, exc.message)
+        if request.cmd in self.background_commands:
+            conn.start_task(f"{request.cmd}:{request.id}", self._answer_later(request, conn))
+            return None
+        return await self._handle(request, conn)
+
+    async def _answer_later(self, request: Request, conn: Connection) -> None:
+        await conn.reply(await self._handle(request, conn))
+
+    async def _handle(self, request: Request, conn: Connection) -> dict[str, Any]:
+        try:
+            return await self.handler(request, conn)
+        except ApiError as exc:
+            return error(request.id, exc.code, exc.message)
+        except Exception as exc:  # a handler bug must not end the server
+            if self._on_event is not None:
+                self._on_event("error", "api handler failed", error=repr(exc))
+            return error(request.id, "internal", f"internal error: {exc}")

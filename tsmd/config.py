@@ -1,0 +1,338 @@
+"""The daemon's configuration: a YAML file read into frozen dataclasses, strictly.
+
+Every key is known, typed and range-checked; a bad file is refused with a
+:class:`ConfigError` naming the key path (``loop.rate_hz``, ``drives[1].node_id``) and the
+reason, before anything touches a drive. Every key is documented in docs/configuration.md.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+
+from tsmd.errors import TsmdError
+
+DEFAULT_CONFIG_PATH = Path("/etc/tsmd/tsmd.yaml")
+
+CompensationMethod = Literal["none", "paper", "ours"]
+CanLogFormat = Literal["none", "blf", "asc"]
+
+
+class ConfigError(TsmdError, ValueError):
+    """The configuration is not valid; the message names the key path and the reason."""
+
+
+def _range(lo: float | None = None, hi: float | None = None) -> dict[str, Any]:
+    return {"range": (lo, hi)}
+
+
+@dataclass(frozen=True)
+class RealtimeConfig:
+    """Real-time scheduling of the loop thread; each item degrades to a warning if refused."""
+
+    priority: int = field(default=80, metadata=_range(0, 99))
+    """SCHED_FIFO priority of the loop thread; 0 keeps the normal scheduler."""
+    cpu: int | None = field(default=None, metadata=_range(0, 1023))
+    """CPU the loop thread is pinned to; null: no affinity change."""
+    lock_memory: bool = True
+    """mlockall(MCL_CURRENT | MCL_FUTURE) so the hot path never page-faults."""
+
+
+@dataclass(frozen=True)
+class LoopConfig:
+    rate_hz: float = field(default=250.0, metadata=_range(10.0, 1000.0))
+    realtime: RealtimeConfig = field(default_factory=RealtimeConfig)
+    overrun_fault_streak: int = field(default=5, metadata=_range(1, 10_000))
+    """This many overruns in a row put the loop into FAULT."""
+    stale_feedback_syncs: int = field(default=3, metadata=_range(1, 1000))
+    """Feedback older than this many SYNCs while enabled is a fault."""
+
+    @property
+    def period_s(self) -> float:
+        return 1.0 / self.rate_hz
+
+
+@dataclass(frozen=True)
+class BusConfig:
+    interface: str = "socketcan"
+    """python-can interface name (socketcan in production, virtual in tests)."""
+    channel: str = "can0"
+    bitrate: int = field(default=1_000_000, metadata=_range(10_000, 1_000_000))
+    log_format: CanLogFormat = "none"
+    """Log the CAN traffic with python-can's own writer (BLF or ASC) into recording.dir."""
+
+
+@dataclass(frozen=True)
+class KnobLimitsConfig:
+    min_deg: float = field(default=-90.0, metadata=_range(-360.0, 360.0))
+    max_deg: float = field(default=90.0, metadata=_range(-360.0, 360.0))
+    max_velocity_deg_s: float = field(default=120.0, metadata=_range(1e-3, 10_000.0))
+    max_accel_deg_s2: float = field(default=2000.0, metadata=_range(1e-3, 1e6))
+
+
+@dataclass(frozen=True)
+class ApiConfig:
+    socket_path: str = "/run/tsmd/tsmd.sock"
+    socket_mode: int = field(default=0o660, metadata=_range(0, 0o777))
+    max_line_bytes: int = field(default=4096, metadata=_range(64, 1 << 20))
+    max_clients: int = field(default=16, metadata=_range(1, 1024))
+    max_subscribe_hz: float = field(default=250.0, metadata=_range(0.1, 1000.0))
+
+
+@dataclass(frozen=True)
+class ProfilesConfig:
+    dir: str = "/var/lib/tsmd/profiles"
+    active: str | None = None
+    """Catheter id loaded at start; null: no profile (compensation 'none' until one is loaded)."""
+    device_model: str | None = None
+    """Device model YAML (data-sheet constants) used by calibration; null: the packaged one."""
+
+
+@dataclass(frozen=True)
+class CompensationConfig:
+    method: CompensationMethod = "ours"
+    enabled: bool = True
+
+
+@dataclass(frozen=True)
+class RecordingConfig:
+    enabled: bool = False
+    dir: str = "/var/lib/tsmd/recordings"
+    flush_interval_s: float = field(default=1.0, metadata=_range(0.01, 3600.0))
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    plant: str = "drivers.plant.tendon_sheath:make_tendon_sheath_plant"
+    """``module:factory`` of the simulated catheter (drivers.plant.base.load_plant)."""
+    params: dict[str, Any] = field(default_factory=dict)
+    seed: int = field(default=0, metadata=_range(0, 2**32 - 1))
+    tracker_noise_deg: float = field(default=0.2, metadata=_range(0.0, 10.0))
+
+
+@dataclass(frozen=True)
+class LimitsConfig:
+    phi1: KnobLimitsConfig = field(default_factory=KnobLimitsConfig)
+    phi2: KnobLimitsConfig = field(default_factory=KnobLimitsConfig)
+
+    def knobs(self) -> tuple[KnobLimitsConfig, KnobLimitsConfig]:
+        return (self.phi1, self.phi2)
+
+
+@dataclass(frozen=True)
+class TsmdConfig:
+    loop: LoopConfig = field(default_factory=LoopConfig)
+    bus: BusConfig = field(default_factory=BusConfig)
+    drives: list[dict[str, Any]] = field(default_factory=list)
+    """One mapping per knob drive, validated against drivers.units.DriveConfig."""
+    limits: LimitsConfig = field(default_factory=LimitsConfig)
+    api: ApiConfig = field(default_factory=ApiConfig)
+    profiles: ProfilesConfig = field(default_factory=ProfilesConfig)
+    compensation: CompensationConfig = field(default_factory=CompensationConfig)
+    recording: RecordingConfig = field(default_factory=RecordingConfig)
+    sim: SimConfig = field(default_factory=SimConfig)
+
+    def replace(self, **changes: Any) -> TsmdConfig:
+        return dataclasses.replace(self, **changes)
+
+
+# --- strict loading -------------------------------------------------------------------------
+
+
+def _type_name(tp: Any) -> str:
+    origin = typing.get_origin(tp)
+    if origin is Literal:
+        return " | ".join(repr(a) for a in typing.get_args(tp))
+    if origin in (typing.Union, types.UnionType):
+        return " or ".join(_type_name(a) for a in typing.get_args(tp))
+    if tp is type(None):
+        return "null"
+    if dataclasses.is_dataclass(tp):
+        return "mapping"
+    if origin is not None:
+        return getattr(origin, "__name__", str(origin))
+    return getattr(tp, "__name__", str(tp))
+
+
+def _convert(tp: Any, value: Any, path: str) -> Any:
+    origin = typing.get_origin(tp)
+    if tp is Any:
+        return value
+    if origin in (typing.Union, types.UnionType):
+        args = typing.get_args(tp)
+        if value is None:
+            if type(None) in args:
+                return None
+            raise ConfigError(f"{path}: must not be null")
+        errors = []
+        for arg in args:
+            if arg is type(None):
+                continue
+            try:
+                return _convert(arg, value, path)
+            except ConfigError as exc:
+                errors.append(exc)
+        raise errors[0]
+    if origin is Literal:
+        allowed = typing.get_args(tp)
+        if value not in allowed or isinstance(value, bool):
+            raise ConfigError(
+                f"{path}: {value!r} is not one of {', '.join(repr(a) for a in allowed)}")
+        return value
+    if dataclasses.is_dataclass(tp):
+        return _build(tp, value, path)  # type: ignore[arg-type]
+    if origin is list:
+        (item_tp,) = typing.get_args(tp)
+        if not isinstance(value, list):
+            raise ConfigError(f"{path}: expected a list, got {type(value).__name__}")
+        return [_convert(item_tp, v, f"{path}[{i}]") for i, v in enumerate(value)]
+    if origin is dict:
+        _key_tp, val_tp = typing.get_args(tp)
+        if not isinstance(value, Mapping):
+            raise ConfigError(f"{path}: expected a mapping, got {type(value).__name__}")
+        out = {}
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise ConfigError(f"{path}: key {k!r} must be a string")
+            out[k] = _convert(val_tp, v, f"{path}.{k}")
+        return out
+    if value is None:
+        raise ConfigError(f"{path}: must not be null (expected {_type_name(tp)})")
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"{path}: expected true or false, got {value!r}")
+        return value
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{path}: expected an integer, got {value!r}")
+        return value
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ConfigError(f"{path}: expected a number, got {value!r}")
+        if not math.isfinite(value):
+            raise ConfigError(f"{path}: must be a finite number, got {value!r}")
+        return float(value)
+    if tp is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"{path}: expected a string, got {value!r}")
+        return value
+    raise ConfigError(f"{path}: unsupported type {_type_name(tp)}")
+
+
+def _check_range(value: Any, f: dataclasses.Field[Any], path: str) -> None:
+    bounds = f.metadata.get("range")
+    if bounds is None or value is None:
+        return
+    lo, hi = bounds
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        raise ConfigError(f"{path}: {value!r} is out of range [{lo}, {hi}]")
+
+
+def _build(cls: type[Any], data: Any, path: str) -> Any:
+    """Build dataclass ``cls`` from a mapping, refusing unknown keys and wrong types."""
+    if data is None:
+        data = {}
+    if not isinstance(data, Mapping):
+        where = path or "top level"
+        raise ConfigError(f"{where}: expected a mapping, got {type(data).__name__}")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    prefix = f"{path}." if path else ""
+    for key in data:
+        if key not in fields:
+            known = ", ".join(sorted(fields))
+            raise ConfigError(f"{prefix}{key}: unknown key (known keys: {known})")
+    kwargs = {}
+    for name, f in fields.items():
+        key_path = f"{prefix}{name}"
+        if name not in data:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                raise ConfigError(f"{key_path}: missing (required)")
+            continue
+        value = _convert(hints[name], data[name], key_path)
+        _check_range(value, f, key_path)
+        kwargs[name] = value
+    try:
+        return cls(**kwargs)
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"{path or 'top level'}: {exc}") from None
+
+
+def _validate(config: TsmdConfig) -> None:
+    for name, knob in (("phi1", config.limits.phi1), ("phi2", config.limits.phi2)):
+        if knob.min_deg >= knob.max_deg:
+            raise ConfigError(
+                f"limits.{name}: min_deg ({knob.min_deg}) must be below max_deg ({knob.max_deg})")
+    if config.drives and len(config.drives) != 2:
+        raise ConfigError(f"drives: expected 2 drives (phi1, phi2), got {len(config.drives)}")
+    drives = drive_configs(config)
+    for i, (drive, name) in enumerate(zip(drives, ("phi1", "phi2"), strict=False)):
+        knob = getattr(config.limits, name)
+        if knob.min_deg < drive.min_deg or knob.max_deg > drive.max_deg:
+            raise ConfigError(
+                f"limits.{name}: [{knob.min_deg}, {knob.max_deg}] deg exceeds the range of "
+                f"drives[{i}] [{drive.min_deg}, {drive.max_deg}]")
+        if knob.max_velocity_deg_s > drive.max_velocity_deg_s:
+            raise ConfigError(
+                f"limits.{name}.max_velocity_deg_s: {knob.max_velocity_deg_s} exceeds "
+                f"drives[{i}].max_velocity_deg_s {drive.max_velocity_deg_s}")
+    if not config.api.socket_path:
+        raise ConfigError("api.socket_path: must not be empty")
+
+
+def parse_config(data: Any, source: str = "<config>") -> TsmdConfig:
+    """Validate an already-parsed YAML document."""
+    try:
+        config = _build(TsmdConfig, data, "")
+        _validate(config)
+    except ConfigError as exc:
+        raise ConfigError(f"{source}: {exc}") from None
+    return typing.cast(TsmdConfig, config)
+
+
+def load_config(path: str | Path = DEFAULT_CONFIG_PATH) -> TsmdConfig:
+    """Read and validate a YAML configuration file."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(f"{p}: cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{p}: not UTF-8 text ({exc.reason})") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" line {mark.line + 1}" if mark is not None else ""
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise ConfigError(f"{p}:{where}: not valid YAML: {problem}") from None
+    return parse_config(data, source=str(p))
+
+
+def default_sim_config() -> TsmdConfig:
+    """The packaged configuration of the in-process simulated rig (tsmd/data/sim.yaml)."""
+    text = resources.files("tsmd").joinpath("data/sim.yaml").read_text(encoding="utf-8")
+    return parse_config(yaml.safe_load(text), source="tsmd/data/sim.yaml")
+
+
+def drive_configs(config: TsmdConfig) -> list[Any]:
+    """The ``drives`` entries as ``drivers.units.DriveConfig`` objects, validated."""
+    from drivers.drive import DriveError
+    from drivers.units import DriveConfig
+
+    out = []
+    for i, entry in enumerate(config.drives):
+        try:
+            out.append(DriveConfig.from_dict(entry))
+        except (DriveError, TypeError, ValueError) as exc:
+            raise ConfigError(f"drives[{i}]: {exc}") from None
+    return out

@@ -1,0 +1,527 @@
+"""The control loop: one :meth:`ControlLoop.tick` per period, owned by a single thread.
+
+A tick reads the drives' feedback, takes the latest setpoint (or the next sample of a
+trajectory being played), clamps it into the knob limits, compensates it (the compensator sees
+both knobs, so each knob's dead zone and backlash follow the other knob's angle), applies the
+rate/position limiter last, writes the targets, sends SYNC and records the row.
+
+Nothing else touches the drives: the API thread posts :class:`LoopCommand` objects that the
+loop executes between ticks, and reads :attr:`ControlLoop.latest_sample`, which the loop
+replaces atomically each tick. Who calls :meth:`tick` decides the time base: the real-time
+scheduler (:mod:`tsmd.rt`) on the monotonic clock, or a lockstep driver on the rig's SimClock.
+"""
+
+from __future__ import annotations
+
+import collections
+import enum
+import math
+import queue
+import threading
+from collections.abc import Callable, Sequence
+from concurrent.futures import Future
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from drivers.clock import Clock
+from drivers.drive import DriveError, DriveFeedback, DriveState, FaultEvent, KnobDrives
+from tsmd.errors import TsmdError
+
+Array = NDArray[np.float64]
+
+ROW_COLUMNS: tuple[str, ...] = (
+    "t", "q1", "q2", "cmd1", "cmd2", "pos1", "pos2", "cur1", "cur2", "tip1", "tip2",
+)
+"""The recording columns every tick produces (tsmd.recording.REQUIRED_COLUMNS)."""
+
+
+class LoopState(enum.Enum):
+    DISABLED = "DISABLED"
+    ENABLED = "ENABLED"
+    FAULT = "FAULT"
+
+
+class LoopError(TsmdError):
+    """A loop command could not be carried out; the message says why."""
+
+    def __init__(self, code: str, message: str) -> None:
+        super().__init__(message)
+        self.code = code
+
+
+class Compensator(Protocol):
+    """tsmd.compensation.Compensator: desired knob angles -> motor command, once per tick."""
+
+    def reset(self, q_deg: Array) -> None: ...
+
+    def command(self, q_deg: Array) -> Array: ...
+
+
+class CommandLimiter(Protocol):
+    """Position/velocity/acceleration limiter applied to the command last (stateful)."""
+
+    def reset(self, cmd_deg: Array) -> None: ...
+
+    def limit(self, cmd_deg: Array) -> Array: ...
+
+
+class TickRecorder(Protocol):
+    def append(self, row: tuple[float, ...]) -> None: ...
+
+
+@dataclass(frozen=True)
+class KnobRange:
+    min_deg: float
+    max_deg: float
+
+
+@dataclass(frozen=True)
+class Sample:
+    """What one tick did; published to the API (``get``, ``subscribe``)."""
+
+    tick: int
+    t_s: float
+    state: LoopState
+    q_deg: tuple[float, float]
+    cmd_deg: tuple[float, float]
+    pos_deg: tuple[float, float]
+    current_A: tuple[float, float]
+    tip_deg: tuple[float, float]
+    fault: str | None
+
+    def as_dict(self) -> dict[str, Any]:
+        def clean(values: tuple[float, float]) -> list[float | None]:
+            return [v if math.isfinite(v) else None for v in values]
+
+        return {"tick": self.tick, "t": self.t_s, "state": self.state.value,
+                "q": clean(self.q_deg), "cmd": clean(self.cmd_deg), "pos": clean(self.pos_deg),
+                "cur": clean(self.current_A), "tip": clean(self.tip_deg), "fault": self.fault}
+
+
+class LatestSetpoint:
+    """The one value the API writes and the loop reads: replaced whole, never mutated."""
+
+    def __init__(self) -> None:
+        self._value: tuple[float, float] | None = None
+        self.version = 0
+
+    def set(self, q_deg: tuple[float, float]) -> None:
+        self._value = (float(q_deg[0]), float(q_deg[1]))
+        self.version += 1
+
+    def clear(self) -> None:
+        self._value = None
+
+    def get(self) -> tuple[float, float] | None:
+        return self._value
+
+
+@dataclass
+class LoopCommand:
+    """A request from another thread, executed by the loop thread between two ticks."""
+
+    name: str
+    args: dict[str, Any] = field(default_factory=dict)
+    future: Future[Any] = field(default_factory=Future)
+
+
+@dataclass
+class Playback:
+    """A trajectory the loop plays one sample per tick, recording each tick into ``rows``."""
+
+    q_deg: Array
+    compensate: bool
+    cancel: threading.Event | None = None
+    rows: list[tuple[float, ...]] = field(default_factory=list)
+    index: int = 0
+    done: threading.Event = field(default_factory=threading.Event)
+    error: str | None = None
+
+    @property
+    def progress(self) -> float:
+        return self.index / max(len(self.q_deg), 1)
+
+
+@dataclass
+class LoopStats:
+    ticks: int = 0
+    overruns: int = 0
+    overrun_streak: int = 0
+    faults: int = 0
+
+
+class MemoryRecorder:
+    """Keeps every row in memory (replay, tests)."""
+
+    def __init__(self) -> None:
+        self.rows: list[tuple[float, ...]] = []
+
+    def append(self, row: tuple[float, ...]) -> None:
+        self.rows.append(row)
+
+
+class ControlLoop:
+    """Fixed-period feed-forward control of the knob drives; see the module docstring."""
+
+    def __init__(self, drives: KnobDrives, compensator: Compensator, limiter: CommandLimiter,
+                 ranges: Sequence[KnobRange], period_s: float, clock: Clock, *,
+                 stale_feedback_syncs: int = 3, overrun_fault_streak: int = 5,
+                 compensation_label: str = "none",
+                 tip_source: Callable[[], Sequence[float]] | None = None,
+                 after_sync: Callable[[], None] | None = None,
+                 recorder: TickRecorder | None = None,
+                 on_event: Callable[..., None] | None = None) -> None:
+        if drives.count != 2:
+            raise ValueError(f"the loop drives two knobs, got {drives.count} drives")
+        self.drives = drives
+        self.period_s = period_s
+        self.clock = clock
+        self.stale_feedback_syncs = stale_feedback_syncs
+        self.overrun_fault_streak = overrun_fault_streak
+        self._compensator = compensator
+        self._compensation_label = compensation_label
+        self._no_compensation: Compensator | None = None
+        self._limiter = limiter
+        self._min = np.array([r.min_deg for r in ranges], dtype=float)
+        self._max = np.array([r.max_deg for r in ranges], dtype=float)
+        self._tip_source = tip_source
+        self._after_sync = after_sync
+        self.recorder = recorder
+        self._on_event = on_event
+        self.setpoint = LatestSetpoint()
+        self.commands: queue.Queue[LoopCommand] = queue.Queue(maxsize=64)
+        self.state = LoopState.DISABLED
+        self.fault_reason: str | None = None
+        self.stats = LoopStats()
+        self.latest_sample: Sample | None = None
+        self.last_events: collections.deque[FaultEvent] = collections.deque(maxlen=16)
+        self.schedule_reset = False
+        """Set after a command that blocked (enable): the scheduler re-anchors its deadlines."""
+        self._playback: Playback | None = None
+        self._q = np.zeros(2)
+        self._last_cmd = np.zeros(2)
+        self._nan2 = (math.nan, math.nan)
+
+    # --- configuration read by the API -----------------------------------------------------
+
+    @property
+    def compensation_label(self) -> str:
+        return self._compensation_label
+
+    def ranges(self) -> list[KnobRange]:
+        return [KnobRange(float(lo), float(hi)) for lo, hi in zip(self._min, self._max,
+                                                                   strict=True)]
+
+    # --- the tick --------------------------------------------------------------------------
+
+    def tick(self) -> Sample:
+        """One period: commands, supervision, setpoint, compensation, targets, SYNC, record."""
+        self._run_commands()
+        t_s = self.clock.now_s()
+        self.drives.pump()
+        events = self.drives.poll_events()
+        feedback = self.drives.feedback()
+        pos = np.array([f.position_deg for f in feedback], dtype=float)
+        if events:
+            self.last_events.extend(events)
+        if self.state is LoopState.ENABLED:
+            reason = self._supervise(events, feedback, pos)
+            if reason is not None:
+                self._fault(reason)
+        if self.state is LoopState.ENABLED:
+            q, cmd = self._command(pos)
+        else:
+            q = cmd = pos if np.all(np.isfinite(pos)) else self._last_cmd
+        if np.all(np.isfinite(cmd)):
+            self._last_cmd = cmd
+        self.drives.write_targets([float(cmd[0]), float(cmd[1])])
+        self.drives.sync()
+        if self._after_sync is not None:
+            self._after_sync()
+            self.drives.pump()
+            feedback = self.drives.feedback()
+        tip = tuple(self._tip_source()) if self._tip_source is not None else self._nan2
+        row = (t_s, float(q[0]), float(q[1]), float(cmd[0]), float(cmd[1]),
+               feedback[0].position_deg, feedback[1].position_deg,
+               feedback[0].current_A, feedback[1].current_A, float(tip[0]), float(tip[1]))
+        self._record(row)
+        self.stats.ticks += 1
+        sample = Sample(self.stats.ticks, t_s, self.state, (row[1], row[2]), (row[3], row[4]),
+                        (row[5], row[6]), (row[7], row[8]), (row[9], row[10]), self.fault_reason)
+        self.latest_sample = sample
+        return sample
+
+    def _supervise(self, events: list[FaultEvent], feedback: list[DriveFeedback],
+                   pos: Array) -> str | None:
+        if events:
+            ev = events[0]
+            return f"drive {ev.drive}: {ev.kind.value}: {ev.message}"
+        for i, fb in enumerate(feedback):
+            if fb.state is not DriveState.OPERATION_ENABLED:
+                return f"drive {i}: left OPERATION ENABLED (state {fb.state.value})"
+            if fb.age_syncs > self.stale_feedback_syncs:
+                return f"drive {i}: stale feedback ({fb.age_syncs} SYNCs without an answer)"
+            if not (math.isfinite(fb.position_deg) and math.isfinite(fb.current_A)):
+                return f"drive {i}: non-finite feedback (position {fb.position_deg}, " \
+                       f"current {fb.current_A})"
+        if self.stats.overrun_streak >= self.overrun_fault_streak:
+            return f"{self.stats.overrun_streak} overruns in a row"
+        return None
+
+    def _command(self, pos: Array) -> tuple[Array, Array]:
+        playback = self._playback
+        compensator = self._compensator
+        if playback is not None:
+            if playback.cancel is not None and playback.cancel.is_set():
+                self._end_playback("cancelled")
+                q_raw: Any = self._q
+            else:
+                q_raw = playback.q_deg[playback.index]
+                if not playback.compensate:
+                    compensator = self._uncompensated()
+        else:
+            q_raw = self.setpoint.get()
+        q = np.array(q_raw if q_raw is not None else self._q, dtype=float)
+        if not np.all(np.isfinite(q)):
+            self._fault(f"non-finite setpoint {q.tolist()}")
+            return self._q, self._last_cmd
+        q = np.minimum(np.maximum(q, self._min), self._max)
+        self._q = q
+        cmd = np.asarray(compensator.command(q), dtype=float)
+        if cmd.shape != (2,) or not np.all(np.isfinite(cmd)):
+            self._fault(f"compensator gave {cmd.tolist()} for q {q.tolist()}")
+            return q, self._last_cmd
+        cmd = np.asarray(self._limiter.limit(cmd), dtype=float)
+        if cmd.shape != (2,) or not np.all(np.isfinite(cmd)):
+            self._fault(f"limiter gave {cmd.tolist()} for q {q.tolist()}")
+            return q, self._last_cmd
+        cmd = np.minimum(np.maximum(cmd, self._min), self._max)
+        return q, cmd
+
+    def _record(self, row: tuple[float, ...]) -> None:
+        if self.recorder is not None:
+            self.recorder.append(row)
+        playback = self._playback
+        if playback is not None and self.state is LoopState.ENABLED:
+            playback.rows.append(row)
+            playback.index += 1
+            if playback.index >= len(playback.q_deg):
+                self._end_playback(None)
+
+    def _uncompensated(self) -> Compensator:
+        if self._no_compensation is None:
+            self._no_compensation = _Identity()
+        return self._no_compensation
+
+    def _end_playback(self, error: str | None) -> None:
+        playback = self._playback
+        if playback is None:
+            return
+        self._playback = None
+        playback.error = error
+        self.setpoint.set((float(self._q[0]), float(self._q[1])))
+        self._compensator.reset(self._q)
+        playback.done.set()
+
+    # --- faults ----------------------------------------------------------------------------
+
+    def note_overrun(self, overran: bool) -> None:
+        """Called by the scheduler after each tick: counts overruns and their streak."""
+        if overran:
+            self.stats.overruns += 1
+            self.stats.overrun_streak += 1
+        else:
+            self.stats.overrun_streak = 0
+
+    def _fault(self, reason: str) -> None:
+        """Quick stop, state FAULT with the reason (once per fault)."""
+        if self.state is LoopState.FAULT:
+            return
+        self.state = LoopState.FAULT
+        self.fault_reason = reason
+        self.stats.faults += 1
+        self.setpoint.clear()
+        try:
+            self.drives.quick_stop()
+        except DriveError as exc:
+            reason = f"{reason}; quick stop failed: {exc}"
+            self.fault_reason = reason
+        self._end_playback(f"fault: {reason}")
+        self._emit("error", "fault", reason=reason)
+
+    def _emit(self, level: str, event: str, **fields: Any) -> None:
+        if self._on_event is not None:
+            self._on_event(level, event, **fields)
+
+    # --- commands (executed in the loop thread) --------------------------------------------
+
+    def post(self, name: str, **args: Any) -> Future[Any]:
+        """Queue a command for the loop thread; raises LoopError('busy') when the queue is full."""
+        command = LoopCommand(name, args)
+        try:
+            self.commands.put_nowait(command)
+        except queue.Full:
+            raise LoopError("busy", "the loop has too many pending commands") from None
+        return command.future
+
+    def execute(self, name: str, **args: Any) -> Any:
+        """Run a command now, in the calling thread (only when no other thread ticks)."""
+        return getattr(self, f"_cmd_{name}")(**args)
+
+    def _run_commands(self) -> None:
+        while True:
+            try:
+                command = self.commands.get_nowait()
+            except queue.Empty:
+                return
+            if not command.future.set_running_or_notify_cancel():
+                continue
+            try:
+                result = self.execute(command.name, **command.args)
+            except (LoopError, DriveError) as exc:
+                command.future.set_exception(exc)
+            except Exception as exc:  # a command must never kill the loop
+                command.future.set_exception(LoopError("internal", f"{command.name}: {exc}"))
+            else:
+                command.future.set_result(result)
+
+    def _hold_position(self) -> Array:
+        pos = np.array([f.position_deg for f in self.drives.feedback()], dtype=float)
+        if not np.all(np.isfinite(pos)):
+            raise LoopError("feedback", f"no valid position feedback ({pos.tolist()})")
+        return np.minimum(np.maximum(pos, self._min), self._max)
+
+    def _cmd_enable(self) -> str:
+        if self.state is LoopState.FAULT:
+            raise LoopError("fault", f"in FAULT ({self.fault_reason}); send reset first")
+        if self.state is LoopState.ENABLED:
+            return self.state.value
+        self.schedule_reset = True
+        try:
+            self.drives.enable()
+        except DriveError as exc:
+            self._emit("warning", "enable failed", reason=str(exc))
+            raise LoopError("drive", f"enable failed: {exc}") from None
+        self.drives.pump()
+        pos = self._hold_position()
+        self._q = pos
+        self._last_cmd = pos
+        self._compensator.reset(pos)
+        self._limiter.reset(pos)
+        self.setpoint.set((float(pos[0]), float(pos[1])))
+        self.stats.overrun_streak = 0
+        self.state = LoopState.ENABLED
+        self._emit("info", "enabled", position_deg=pos.tolist())
+        return self.state.value
+
+    def _cmd_disable(self) -> str:
+        self.schedule_reset = True
+        self._end_playback("disabled")
+        self.drives.disable()
+        self.setpoint.clear()
+        if self.state is LoopState.ENABLED:
+            self.state = LoopState.DISABLED
+        self._emit("info", "disabled")
+        return self.state.value
+
+    def _cmd_stop(self) -> str:
+        """Quick stop; the loop goes to DISABLED (enable again to move)."""
+        self._end_playback("stopped")
+        self.drives.quick_stop()
+        self.setpoint.clear()
+        if self.state is LoopState.ENABLED:
+            self.state = LoopState.DISABLED
+        self._emit("warning", "quick stop")
+        return self.state.value
+
+    def _cmd_reset(self) -> str:
+        """Clear FAULT once its cause is gone; the loop is DISABLED afterwards."""
+        if self.state is not LoopState.FAULT:
+            return self.state.value
+        self.schedule_reset = True
+        self.drives.fault_reset()
+        self.drives.disable()
+        self.drives.pump()
+        pending = self.drives.poll_events()
+        if pending:
+            ev = pending[0]
+            raise LoopError("fault", f"cause still present: drive {ev.drive}: "
+                                     f"{ev.kind.value}: {ev.message}")
+        for i, fb in enumerate(self.drives.feedback()):
+            if fb.age_syncs > self.stale_feedback_syncs:
+                raise LoopError("fault", f"cause still present: drive {i} feedback is stale "
+                                         f"({fb.age_syncs} SYNCs)")
+            if fb.state in (DriveState.FAULT, DriveState.FAULT_REACTION_ACTIVE):
+                raise LoopError("fault", f"cause still present: drive {i} is in {fb.state.value}")
+        self.state = LoopState.DISABLED
+        self.fault_reason = None
+        self.stats.overrun_streak = 0
+        self._emit("info", "fault reset")
+        return self.state.value
+
+    def _cmd_set_compensator(self, compensator: Compensator, label: str) -> str:
+        compensator.reset(self._q)
+        self._compensator = compensator
+        self._compensation_label = label
+        self._emit("info", "compensation", method=label)
+        return label
+
+    def _cmd_play(self, playback: Playback) -> None:
+        if self.state is not LoopState.ENABLED:
+            raise LoopError("not_enabled", f"cannot play a trajectory in state {self.state.value}")
+        if self._playback is not None:
+            raise LoopError("busy", "a trajectory is already playing")
+        if playback.compensate:
+            self._compensator.reset(self._q)
+        self._playback = playback
+
+    def _cmd_shutdown(self) -> str:
+        """Quick stop then disable: what SIGTERM does."""
+        self._end_playback("shutdown")
+        if self.state is LoopState.ENABLED:
+            try:
+                self.drives.quick_stop()
+            except DriveError as exc:
+                self._emit("error", "quick stop failed", reason=str(exc))
+        try:
+            self.drives.disable()
+        except DriveError as exc:
+            self._emit("error", "disable failed", reason=str(exc))
+        self.setpoint.clear()
+        if self.state is LoopState.ENABLED:
+            self.state = LoopState.DISABLED
+        return self.state.value
+
+
+class _Identity:
+    """The uncompensated path used while a trajectory asks for ``compensate=False``."""
+
+    def reset(self, q_deg: Array) -> None:
+        pass
+
+    def command(self, q_deg: Array) -> Array:
+        return np.asarray(q_deg, dtype=float)
+
+
+class KnobLimiter:
+    """:class:`CommandLimiter` over ``tsmd.compensation.safety.limit_step``, one per knob."""
+
+    def __init__(self, limits: Sequence[Any], dt_s: float) -> None:
+        from tsmd.compensation.safety import LimiterState, limit_step
+
+        self._step = limit_step
+        self._state_cls = LimiterState
+        self.limits = list(limits)
+        self.dt_s = dt_s
+        self._states = [LimiterState(0.0) for _ in self.limits]
+
+    def reset(self, cmd_deg: Array) -> None:
+        self._states = [self._state_cls(float(q)) for q in cmd_deg]
+
+    def limit(self, cmd_deg: Array) -> Array:
+        self._states = [self._step(s, float(c), lim, self.dt_s)
+                        for s, c, lim in zip(self._states, cmd_deg, self.limits, strict=True)]
+        return np.array([s.q_deg for s in self._states])

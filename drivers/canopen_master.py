@@ -1,0 +1,654 @@
+"""CANopen master for CiA 402 knob drives in Cyclic Synchronous Position mode.
+
+Per tick it sends one RPDO per drive (controlword + target position) and a SYNC; each drive
+answers with one TPDO (statusword + position actual + current actual): 5 frames for two drives.
+
+The cyclic path and the SDO client are our own and never block on another thread: frames are
+read by :meth:`CanOpenDrives.pump`, either straight from the bus (``receive="poll"``, lockstep
+and deterministic) or from a python-can ``Notifier`` queue (``receive="notifier"``, real time).
+While boot and the state machine wait for an answer they call the ``idle`` hook (the simulated
+rig's ``exchange`` in lockstep) or sleep a little in real time. canopen supplies the object
+dictionary (our EDS) used to encode SDO values.
+"""
+
+from __future__ import annotations
+
+import collections
+import math
+import struct
+import threading
+import time
+from collections.abc import Callable, Sequence
+from typing import Any, Literal
+
+import can
+from canopen.objectdictionary import ODVariable
+
+from drivers import cia402
+from drivers import od as o
+from drivers.clock import Clock, MonotonicClock
+from drivers.drive import (
+    DriveError,
+    DriveFeedback,
+    DriveState,
+    FaultEvent,
+    FaultKind,
+    KnobDrives,
+)
+from drivers.units import DriveConfig, interpolation_period
+
+_RPDO = struct.Struct(o.RPDO1_FORMAT)
+_TPDO = struct.Struct(o.TPDO1_FORMAT)
+_EMCY = struct.Struct("<HB5s")
+_NMT_NAMES = {0x00: "boot-up", 0x04: "STOPPED", 0x05: "OPERATIONAL", 0x7F: "PRE-OPERATIONAL"}
+
+
+class _Drive:
+    """Master-side image of one drive (plain attributes: this is the hot path)."""
+
+    def __init__(self, index: int, config: DriveConfig) -> None:
+        self.index = index
+        self.config = config
+        self.node_id = config.node_id
+        self.name = f"drive {index} (node {config.node_id})"
+        self.cpd = config.counts_per_deg
+        self.scale_A = config.current_scale_A
+        self.min_counts = config.deg_to_counts(config.min_deg)
+        self.max_counts = config.deg_to_counts(config.max_deg)
+        self.controlword = 0
+        self.target_counts = 0
+        self.statusword = 0
+        self.position_counts = 0
+        self.current_raw = 0
+        self.state = DriveState.UNKNOWN
+        self.age_syncs = 0
+        self.has_feedback = False
+        self.stale_reported = False
+        self.last_heartbeat_s: float | None = None
+        self.nmt_state: int | None = None
+        self.heartbeat_lost = False
+        self.supervised = False
+        self.last_emcy: int | None = None
+        self.sdo_response: bytes | None = None
+        self.rpdo = can.Message(arbitration_id=0x200 + self.node_id, is_extended_id=False,
+                                data=bytearray(_RPDO.size))
+
+    def pack_rpdo(self) -> can.Message:
+        _RPDO.pack_into(self.rpdo.data, 0, self.controlword, self.target_counts)
+        return self.rpdo
+
+
+class CanOpenDrives(KnobDrives):
+    """N CiA 402 drives on one python-can bus (``socketcan``/``can0`` or ``virtual``)."""
+
+    def __init__(
+        self,
+        bus: can.BusABC,
+        configs: Sequence[DriveConfig],
+        period_s: float,
+        *,
+        clock: Clock | None = None,
+        idle: Callable[[], None] | None = None,
+        receive: Literal["poll", "notifier"] = "poll",
+        master_node_id: int = 127,
+        master_heartbeat_ms: int = 50,
+        sdo_timeout_s: float = 0.5,
+        state_timeout_s: float = 0.5,
+        boot_timeout_s: float = 2.0,
+        own_bus: bool = False,
+    ) -> None:
+        if not configs:
+            raise DriveError("no drives configured")
+        ids = [c.node_id for c in configs]
+        if len(set(ids)) != len(ids) or master_node_id in ids:
+            raise DriveError(f"node ids must be unique and differ from the master's "
+                             f"({master_node_id}): {ids}")
+        self.bus = bus
+        self.period_s = period_s
+        self.interpolation = interpolation_period(period_s)
+        self.clock: Clock = clock if clock is not None else MonotonicClock()
+        self.idle = idle
+        self.master_node_id = master_node_id
+        self.master_heartbeat_s = master_heartbeat_ms * 1e-3
+        self.sdo_timeout_s = sdo_timeout_s
+        self.state_timeout_s = state_timeout_s
+        self.boot_timeout_s = boot_timeout_s
+        self._own_bus = own_bus
+        self._od = o.load_od()
+        self._drives = [_Drive(i, c) for i, c in enumerate(configs)]
+        self._events: list[FaultEvent] = []
+        self._unknown_ids: set[int] = set()
+        self._send_failing = False
+        self._sync_msg = can.Message(arbitration_id=0x080, is_extended_id=False, data=b"")
+        self._hb_msg = can.Message(arbitration_id=0x700 + master_node_id, is_extended_id=False,
+                                   data=bytes((0x05,)))
+        self._next_heartbeat_s: float | None = None
+        self.frames_sent = 0
+        self.frames_received = 0
+        self.syncs_sent = 0
+        self._handlers: dict[int, Callable[[bytearray], None]] = {}
+        for d in self._drives:
+            self._handlers[0x180 + d.node_id] = self._tpdo_handler(d)
+            self._handlers[0x700 + d.node_id] = self._heartbeat_handler(d)
+            self._handlers[0x080 + d.node_id] = self._emcy_handler(d)
+            self._handlers[0x580 + d.node_id] = self._sdo_handler(d)
+        self._queue: collections.deque[can.Message] | None = None
+        self._notifier: can.Notifier | None = None
+        if receive == "notifier":
+            self._queue = collections.deque()
+            self._notifier = can.Notifier(bus, [_QueueListener(self._queue, self._on_bus_error)],
+                                          timeout=0.05)
+        elif receive != "poll":
+            raise DriveError(f"receive must be 'poll' or 'notifier', not {receive!r}")
+        self._lock = threading.Lock()
+
+    @classmethod
+    def open(cls, interface: str, channel: str, configs: Sequence[DriveConfig], period_s: float,
+             bitrate: int = 1_000_000, **kwargs: object) -> CanOpenDrives:
+        """Open a python-can bus (e.g. ``socketcan``/``can0``) and the master on it."""
+        try:
+            bus = can.Bus(interface=interface, channel=channel, bitrate=bitrate)
+        except (can.CanError, OSError, ValueError, ImportError) as exc:
+            raise DriveError(f"cannot open CAN interface {interface!r} channel {channel!r}: "
+                             f"{exc}") from exc
+        kwargs.setdefault("receive", "notifier")
+        return cls(bus, configs, period_s, own_bus=True, **kwargs)  # type: ignore[arg-type]
+
+    # -- KnobDrives ------------------------------------------------------------------------
+    @property
+    def count(self) -> int:
+        return len(self._drives)
+
+    @property
+    def configs(self) -> list[DriveConfig]:
+        return [d.config for d in self._drives]
+
+    def boot(self) -> None:
+        for d in self._drives:
+            d.supervised = False
+            d.has_feedback = False
+            d.nmt_state = None
+            self._send(0x000, bytes((0x81, d.node_id)))
+        self._wait_until(lambda d: d.nmt_state is not None, self.boot_timeout_s,
+                         "boot-up message after NMT reset node")
+        for d in self._drives:
+            self._configure(d)
+        for d in self._drives:
+            d.nmt_state = None
+            self._send(0x000, bytes((0x01, d.node_id)))
+        self._wait_until(lambda d: d.nmt_state == 0x05, self.boot_timeout_s,
+                         "heartbeat in OPERATIONAL after NMT start")
+        now = self.clock.now_s()
+        for d in self._drives:
+            d.supervised = True
+            d.heartbeat_lost = False
+            d.last_heartbeat_s = now
+            d.controlword = 0
+            d.age_syncs = 0
+            d.stale_reported = False
+
+    def enable(self) -> None:
+        def command(d: _Drive) -> int | None:
+            if d.state is DriveState.FAULT:
+                raise DriveError(f"{d.name}: cannot enable, drive is in FAULT "
+                                 f"({self._emcy_text(d)}); call fault_reset first")
+            return cia402.next_command_to_enable(d.state, d.config.quick_stop_option)
+
+        self._walk({DriveState.OPERATION_ENABLED}, command, "enable", raise_on_timeout=True)
+
+    def disable(self) -> None:
+        self._walk({DriveState.SWITCH_ON_DISABLED, DriveState.FAULT},
+                   lambda d: cia402.CW_DISABLE_VOLTAGE, "disable", raise_on_timeout=True)
+
+    def quick_stop(self) -> None:
+        """Quick stop; never raises: a drive that does not answer becomes a STATE_TIMEOUT event."""
+        self._walk({DriveState.QUICK_STOP_ACTIVE, DriveState.SWITCH_ON_DISABLED,
+                    DriveState.FAULT}, lambda d: cia402.CW_QUICK_STOP, "quick stop",
+                   raise_on_timeout=False)
+
+    def halt(self, on: bool) -> None:
+        for d in self._drives:
+            d.controlword = (d.controlword | cia402.CW_HALT) if on else (
+                d.controlword & ~cia402.CW_HALT)
+            self._send_msg(d.pack_rpdo())
+
+    def fault_reset(self) -> None:
+        faulty = [d for d in self._drives if d.state is DriveState.FAULT]
+        if not faulty:
+            return
+        for d in faulty:
+            d.controlword = cia402.CW_DISABLE_VOLTAGE
+        self._cycle()
+        self._walk({DriveState.SWITCH_ON_DISABLED, DriveState.READY_TO_SWITCH_ON,
+                    DriveState.SWITCHED_ON, DriveState.OPERATION_ENABLED},
+                   lambda d: cia402.CW_FAULT_RESET, "fault reset", raise_on_timeout=True,
+                   only=faulty)
+        for d in faulty:
+            d.controlword = cia402.CW_DISABLE_VOLTAGE
+            d.last_emcy = None
+
+    def write_targets(self, knob_deg: Sequence[float]) -> None:
+        drives = self._drives
+        if len(knob_deg) != len(drives):
+            raise DriveError(f"write_targets needs {len(drives)} knob angles, "
+                             f"got {len(knob_deg)}")
+        for d, deg in zip(drives, knob_deg, strict=True):
+            counts = deg * d.cpd
+            if not math.isfinite(counts):
+                raise DriveError(f"{d.name}: target {deg!r} deg is not a finite number")
+            c = round(counts)
+            d.target_counts = d.min_counts if c < d.min_counts else (
+                d.max_counts if c > d.max_counts else c)
+            self._send_msg(d.pack_rpdo())
+
+    def sync(self) -> None:
+        now = self.clock.now_s()
+        nxt = self._next_heartbeat_s
+        if nxt is None or now >= nxt - 1e-9:
+            self._next_heartbeat_s = now + self.master_heartbeat_s
+            self._send_msg(self._hb_msg)
+        self._send_msg(self._sync_msg)
+        self.syncs_sent += 1
+        for d in self._drives:
+            d.age_syncs += 1
+
+    def pump(self) -> None:
+        handle = self._on_message
+        queue = self._queue
+        try:
+            if queue is None:
+                recv = self.bus.recv
+                while (msg := recv(0)) is not None:
+                    handle(msg)
+            else:
+                popleft = queue.popleft
+                while queue:
+                    handle(popleft())
+        except can.CanError as exc:
+            self._event(FaultKind.BUS_ERROR, -1, f"CAN receive failed: {exc}")
+        self._supervise()
+
+    def feedback(self) -> list[DriveFeedback]:
+        return [DriveFeedback(position_deg=d.position_counts / d.cpd,
+                              current_A=d.current_raw * d.scale_A, statusword=d.statusword,
+                              state=d.state, age_syncs=d.age_syncs) for d in self._drives]
+
+    def poll_events(self) -> list[FaultEvent]:
+        with self._lock:
+            events, self._events = self._events, []
+        return events
+
+    def close(self) -> None:
+        if self._notifier is not None:
+            self._notifier.stop()
+            self._notifier = None
+        if self._own_bus:
+            self.bus.shutdown()
+
+    # -- SDO client (expedited + segmented upload) ----------------------------------------
+    def sdo_read(self, drive: int, index: int, subindex: int = 0) -> Any:
+        """Read one object by SDO, decoded with our EDS's data type."""
+        d = self._drives[drive]
+        var = self._variable(d, index, subindex)
+        return var.decode_raw(self.sdo_upload(drive, index, subindex))
+
+    def sdo_write(self, drive: int, index: int, subindex: int, value: int) -> None:
+        """Write one object by SDO, encoded with our EDS's data type."""
+        d = self._drives[drive]
+        var = self._variable(d, index, subindex)
+        try:
+            data = var.encode_raw(value)
+        except (struct.error, ValueError, TypeError) as exc:
+            raise DriveError(f"{d.name}: value {value!r} does not fit 0x{index:04X}:"
+                             f"{subindex:02X} ({var.name}): {exc}") from exc
+        self.sdo_download(drive, index, subindex, data)
+
+    def sdo_upload(self, drive: int, index: int, subindex: int = 0) -> bytes:
+        d = self._drives[drive]
+        what = f"upload 0x{index:04X}:{subindex:02X}"
+        resp = self._sdo_transfer(d, struct.pack("<BHB4x", 0x40, index, subindex), what)
+        cs = resp[0]
+        if cs & 0xE0 != 0x40:
+            raise DriveError(f"{d.name}: SDO {what}: unexpected response 0x{cs:02X}")
+        self._check_mux(d, resp, index, subindex, what)
+        if cs & 0x02:
+            size = 4 - ((cs >> 2) & 0x3) if cs & 0x01 else 4
+            return bytes(resp[4:4 + size])
+        total = struct.unpack_from("<I", resp, 4)[0] if cs & 0x01 else None
+        data = bytearray()
+        toggle = 0
+        while True:
+            seg = self._sdo_transfer(d, bytes((0x60 | toggle,)) + bytes(7), what)
+            if seg[0] & 0xE0 != 0x00 or seg[0] & 0x10 != toggle:
+                raise DriveError(f"{d.name}: SDO {what}: bad segment 0x{seg[0]:02X}")
+            unused = (seg[0] >> 1) & 0x7
+            data += seg[1:8 - unused]
+            if seg[0] & 0x01:
+                break
+            toggle ^= 0x10
+        if total is not None and len(data) != total:
+            raise DriveError(f"{d.name}: SDO {what}: got {len(data)} bytes, announced {total}")
+        return bytes(data)
+
+    def sdo_download(self, drive: int, index: int, subindex: int, data: bytes) -> None:
+        d = self._drives[drive]
+        what = f"download 0x{index:04X}:{subindex:02X}"
+        if not 1 <= len(data) <= 4:
+            raise DriveError(f"{d.name}: SDO {what}: only 1..4 byte values are supported")
+        cs = 0x23 | ((4 - len(data)) << 2)
+        request = struct.pack("<BHB", cs, index, subindex) + bytes(data).ljust(4, b"\x00")
+        resp = self._sdo_transfer(d, request, what)
+        if resp[0] != 0x60:
+            raise DriveError(f"{d.name}: SDO {what}: unexpected response 0x{resp[0]:02X}")
+        self._check_mux(d, resp, index, subindex, what)
+
+    def _sdo_transfer(self, d: _Drive, request: bytes, what: str) -> bytes:
+        d.sdo_response = None
+        self._send(0x600 + d.node_id, request)
+        deadline = self.clock.now_s() + self.sdo_timeout_s
+        while d.sdo_response is None:
+            if self.clock.now_s() > deadline:
+                raise DriveError(f"{d.name}: SDO {what} timed out after {self.sdo_timeout_s} s "
+                                 f"(no answer from node {d.node_id})")
+            self._wait()
+        resp = d.sdo_response
+        if len(resp) != 8:
+            raise DriveError(f"{d.name}: SDO {what}: malformed response of {len(resp)} bytes")
+        if resp[0] == 0x80:
+            code = struct.unpack_from("<I", resp, 4)[0]
+            raise DriveError(f"{d.name}: SDO {what} aborted with 0x{code:08X}: "
+                             f"{o.abort_meaning(code)}")
+        return resp
+
+    @staticmethod
+    def _check_mux(d: _Drive, resp: bytes, index: int, subindex: int, what: str) -> None:
+        got = struct.unpack_from("<HB", resp, 1)
+        if got != (index, subindex):
+            raise DriveError(f"{d.name}: SDO {what}: answer is for 0x{got[0]:04X}:{got[1]:02X}")
+
+    def _variable(self, d: _Drive, index: int, subindex: int) -> ODVariable:
+        try:
+            obj = self._od[index]
+            return obj if isinstance(obj, ODVariable) else obj[subindex]
+        except KeyError:
+            raise DriveError(f"{d.name}: object 0x{index:04X}:{subindex:02X} is not in our "
+                             f"EDS ({o.EDS_PATH.name})") from None
+
+    # -- boot configuration ----------------------------------------------------------------
+    def _configure(self, d: _Drive) -> None:
+        c = d.config
+        i = d.index
+        device_type = int(self.sdo_read(i, o.DEVICE_TYPE))
+        if device_type & 0xFFFF != o.DEVICE_PROFILE_402:
+            self._boot_failed(d, f"device type 0x{device_type:08X} is not a CiA 402 drive")
+        vendor = int(self.sdo_read(i, o.IDENTITY, 1))
+        product = int(self.sdo_read(i, o.IDENTITY, 2))
+        if (c.vendor_id and vendor != c.vendor_id) or (c.product_code and
+                                                        product != c.product_code):
+            self._boot_failed(d, f"identity 0x1018 is vendor 0x{vendor:08X} product "
+                                 f"0x{product:08X}, config expects vendor 0x{c.vendor_id:08X} "
+                                 f"product 0x{c.product_code:08X}")
+        rated_mA = int(self.sdo_read(i, o.MOTOR_RATED_CURRENT))
+        if abs(rated_mA - c.rated_current_mA) > 0.01 * c.rated_current_mA:
+            self._boot_failed(d, f"motor rated current 0x6075 is {rated_mA} mA but "
+                                 f"current_scale_A={c.current_scale_A} implies "
+                                 f"{c.rated_current_mA} mA")
+        n = d.node_id
+        value, exponent = self.interpolation
+        cpd = d.cpd
+        writes: list[tuple[int, int, int]] = [
+            (o.RPDO1_COMM, 1, 0x80000000 | (0x200 + n)),
+            (o.RPDO1_COMM, 2, 1),
+            (o.RPDO1_MAP, 0, 0),
+            *[(o.RPDO1_MAP, k + 1, o.mapping_entry(*m)) for k, m in enumerate(o.RPDO1_MAPPING)],
+            (o.RPDO1_MAP, 0, len(o.RPDO1_MAPPING)),
+            (o.RPDO1_COMM, 1, 0x200 + n),
+            (o.RPDO2_COMM, 1, 0x80000000 | (0x300 + n)),
+            (o.TPDO1_COMM, 1, 0x80000000 | (0x180 + n)),
+            (o.TPDO1_COMM, 2, 1),
+            (o.TPDO1_MAP, 0, 0),
+            *[(o.TPDO1_MAP, k + 1, o.mapping_entry(*m)) for k, m in enumerate(o.TPDO1_MAPPING)],
+            (o.TPDO1_MAP, 0, len(o.TPDO1_MAPPING)),
+            (o.TPDO1_COMM, 1, 0x180 + n),
+            (o.TPDO2_COMM, 1, 0x80000000 | (0x280 + n)),
+            (o.CYCLE_PERIOD, 0, round(self.period_s * 1e6)),
+            (o.INTERPOLATION_PERIOD, 1, value),
+            (o.INTERPOLATION_PERIOD, 2, exponent),
+            (o.MODES_OF_OPERATION, 0, o.CSP_MODE),
+            (o.SOFTWARE_POSITION_LIMIT, 1, d.min_counts),
+            (o.SOFTWARE_POSITION_LIMIT, 2, d.max_counts),
+            (o.MAX_PROFILE_VELOCITY, 0, round(c.max_velocity_deg_s * cpd)),
+            (o.QUICK_STOP_DECELERATION, 0, round(c.max_accel_deg_s2 * cpd)),
+            (o.FOLLOWING_ERROR_WINDOW, 0, round(c.following_error_deg * cpd)),
+            (o.FOLLOWING_ERROR_TIMEOUT, 0, c.following_error_timeout_ms),
+            (o.QUICK_STOP_OPTION, 0, c.quick_stop_option),
+            (o.ABORT_CONNECTION_OPTION, 0, c.abort_connection_option),
+            (o.PRODUCER_HEARTBEAT, 0, c.heartbeat_producer_ms),
+            (o.CONSUMER_HEARTBEAT, 1, (self.master_node_id << 16) | c.master_heartbeat_timeout_ms),
+        ]
+        for index, subindex, val in writes:
+            self.sdo_write(i, index, subindex, val)
+
+    def _boot_failed(self, d: _Drive, reason: str) -> None:
+        self._event(FaultKind.BOOT_FAILED, d.index, f"{d.name}: {reason}")
+        raise DriveError(f"{d.name}: boot failed: {reason}")
+
+    # -- state machine ---------------------------------------------------------------------
+    def _walk(self, goal: set[DriveState], command: Callable[[_Drive], int | None], what: str,
+              raise_on_timeout: bool, only: Sequence[_Drive] | None = None) -> None:
+        """Cycle (RPDO, SYNC, answer) until every drive is in a goal state, or time out."""
+        drives = list(only) if only is not None else self._drives
+        start = self.clock.now_s()
+        while True:
+            pending = []
+            for d in drives:
+                fresh = d.has_feedback and d.age_syncs == 0
+                if fresh and d.state in goal:
+                    continue
+                pending.append(d)
+                if not fresh:
+                    continue
+                cw = command(d)
+                if cw is None:
+                    raise DriveError(f"{d.name}: cannot {what} from state {d.state.value} "
+                                     f"(statusword 0x{d.statusword:04X})")
+                if d.state is not DriveState.OPERATION_ENABLED:
+                    d.target_counts = d.position_counts
+                d.controlword = cw | (d.controlword & cia402.CW_HALT)
+            if not pending:
+                return
+            if self.clock.now_s() - start > self.state_timeout_s:
+                for d in pending:
+                    reason = (f"{d.name}: {what} timed out after {self.state_timeout_s} s in "
+                              f"state {d.state.value} (statusword 0x{d.statusword:04X}, "
+                              f"feedback {d.age_syncs} SYNCs old)")
+                    self._event(FaultKind.STATE_TIMEOUT, d.index, reason)
+                if raise_on_timeout:
+                    raise DriveError(reason)
+                return
+            self._cycle()
+
+    def _cycle(self) -> None:
+        """One tick with the current controlwords and targets (used while walking states)."""
+        for d in self._drives:
+            self._send_msg(d.pack_rpdo())
+        self.sync()
+        self._wait()
+
+    def _wait(self) -> None:
+        """Let the other side answer: the lockstep idle hook, else a short sleep."""
+        if self.idle is not None:
+            self.idle()
+        else:
+            time.sleep(min(self.period_s, 0.001))
+        now = self.clock.now_s()
+        nxt = self._next_heartbeat_s
+        if nxt is None or now >= nxt - 1e-9:
+            self._next_heartbeat_s = now + self.master_heartbeat_s
+            self._send_msg(self._hb_msg)
+        self.pump()
+
+    def _wait_until(self, done: Callable[[_Drive], bool], timeout_s: float, what: str) -> None:
+        deadline = self.clock.now_s() + timeout_s
+        while not all(done(d) for d in self._drives):
+            if self.clock.now_s() > deadline:
+                missing = [d for d in self._drives if not done(d)]
+                for d in missing:
+                    self._event(FaultKind.BOOT_FAILED, d.index,
+                                f"{d.name}: no {what} within {timeout_s} s")
+                raise DriveError(f"{missing[0].name}: boot failed: no {what} within "
+                                 f"{timeout_s} s")
+            self._wait()
+
+    # -- receive path ----------------------------------------------------------------------
+    def _on_message(self, msg: can.Message) -> None:
+        self.frames_received += 1
+        if msg.is_error_frame:
+            self._event(FaultKind.BUS_ERROR, -1, "CAN error frame received")
+            return
+        handler = self._handlers.get(msg.arbitration_id)
+        if handler is None or msg.is_extended_id or msg.is_remote_frame:
+            self._unknown(msg)
+            return
+        handler(msg.data)
+
+    def _tpdo_handler(self, d: _Drive) -> Callable[[bytearray], None]:
+        unpack = _TPDO.unpack
+        size = _TPDO.size
+        decode = cia402.decode_state
+
+        def on_tpdo(data: bytearray) -> None:
+            if len(data) != size:
+                self._event(FaultKind.BUS_ERROR, d.index,
+                            f"{d.name}: malformed TPDO1 0x{0x180 + d.node_id:03X} with "
+                            f"{len(data)} bytes, its mapping (0x6041, 0x6064, 0x6078) needs "
+                            f"{size}")
+                return
+            sw, d.position_counts, d.current_raw = unpack(data)
+            d.age_syncs = 0
+            d.has_feedback = True
+            d.stale_reported = False
+            if sw != d.statusword:
+                d.statusword = sw
+                state = decode(sw)
+                if state is DriveState.FAULT and d.state is not DriveState.FAULT:
+                    self._event(FaultKind.DRIVE_FAULT, d.index,
+                                f"{d.name}: drive entered FAULT ({self._emcy_text(d)})",
+                                d.last_emcy)
+                d.state = state
+
+        return on_tpdo
+
+    def _heartbeat_handler(self, d: _Drive) -> Callable[[bytearray], None]:
+        def on_heartbeat(data: bytearray) -> None:
+            if len(data) != 1:
+                self._event(FaultKind.BUS_ERROR, d.index,
+                            f"{d.name}: malformed heartbeat with {len(data)} bytes")
+                return
+            state = data[0] & 0x7F
+            if d.supervised and state != 0x05 and d.nmt_state == 0x05:
+                self._event(FaultKind.DRIVE_FAULT, d.index,
+                            f"{d.name}: left OPERATIONAL, NMT state is now "
+                            f"{_NMT_NAMES.get(state, hex(state))}")
+            d.nmt_state = state
+            d.last_heartbeat_s = self.clock.now_s()
+            d.heartbeat_lost = False
+
+        return on_heartbeat
+
+    def _emcy_handler(self, d: _Drive) -> Callable[[bytearray], None]:
+        def on_emcy(data: bytearray) -> None:
+            if len(data) != 8:
+                self._event(FaultKind.BUS_ERROR, d.index,
+                            f"{d.name}: malformed EMCY with {len(data)} bytes")
+                return
+            code, register, _ = _EMCY.unpack(data)
+            if code == 0:
+                d.last_emcy = None
+                return
+            d.last_emcy = code
+            self._event(FaultKind.EMCY, d.index,
+                        f"{d.name}: EMCY 0x{code:04X} {o.emcy_meaning(code)} "
+                        f"(error register 0x{register:02X})", code)
+
+        return on_emcy
+
+    def _sdo_handler(self, d: _Drive) -> Callable[[bytearray], None]:
+        def on_sdo(data: bytearray) -> None:
+            d.sdo_response = bytes(data)
+
+        return on_sdo
+
+    def _unknown(self, msg: can.Message) -> None:
+        cob = msg.arbitration_id
+        if cob in self._unknown_ids:
+            return
+        self._unknown_ids.add(cob)
+        self._event(FaultKind.BUS_ERROR, -1,
+                    f"unexpected CAN frame 0x{cob:03X} ({len(msg.data)} bytes"
+                    f"{', extended id' if msg.is_extended_id else ''}"
+                    f"{', remote' if msg.is_remote_frame else ''}): no configured drive "
+                    f"object uses this COB-ID")
+
+    def _supervise(self) -> None:
+        now = self.clock.now_s()
+        for d in self._drives:
+            if not d.supervised:
+                continue
+            last = d.last_heartbeat_s
+            if (not d.heartbeat_lost and last is not None
+                    and now - last > d.config.heartbeat_timeout_ms * 1e-3):
+                d.heartbeat_lost = True
+                self._event(FaultKind.HEARTBEAT_LOST, d.index,
+                            f"{d.name}: no heartbeat for {now - last:.3f} s "
+                            f"(timeout {d.config.heartbeat_timeout_ms} ms)")
+            if d.age_syncs >= d.config.stale_after_syncs and not d.stale_reported:
+                d.stale_reported = True
+                self._event(FaultKind.STALE_FEEDBACK, d.index,
+                            f"{d.name}: TPDO not refreshed by the last {d.age_syncs} SYNCs")
+
+    # -- send path -------------------------------------------------------------------------
+    def _send(self, can_id: int, data: bytes) -> None:
+        self._send_msg(can.Message(arbitration_id=can_id, is_extended_id=False, data=data))
+
+    def _send_msg(self, msg: can.Message) -> None:
+        try:
+            self.bus.send(msg)
+        except can.CanError as exc:
+            if not self._send_failing:
+                self._send_failing = True
+                self._event(FaultKind.BUS_ERROR, -1,
+                            f"CAN send of 0x{msg.arbitration_id:03X} failed: {exc}")
+            return
+        self._send_failing = False
+        self.frames_sent += 1
+
+    def _on_bus_error(self, exc: Exception) -> None:
+        self._event(FaultKind.BUS_ERROR, -1, f"CAN notifier stopped on error: {exc}")
+
+    def _event(self, kind: FaultKind, drive: int, message: str, code: int | None = None) -> None:
+        event = FaultEvent(kind=kind, drive=drive, t_s=self.clock.now_s(), message=message,
+                           code=code)
+        with self._lock:
+            self._events.append(event)
+
+    @staticmethod
+    def _emcy_text(d: _Drive) -> str:
+        if d.last_emcy is None:
+            return "no EMCY received"
+        return f"EMCY 0x{d.last_emcy:04X} {o.emcy_meaning(d.last_emcy)}"
+
+
+class _QueueListener(can.Listener):
+    """Notifier thread -> deque; errors of the receive thread become BUS_ERROR events."""
+
+    def __init__(self, queue: collections.deque[can.Message],
+                 on_error: Callable[[Exception], None]) -> None:
+        self._queue = queue
+        self._on_error = on_error
+
+    def on_message_received(self, msg: can.Message) -> None:
+        self._queue.append(msg)
+
+    def on_error(self, exc: Exception) -> None:
+        self._on_error(exc)

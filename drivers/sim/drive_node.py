@@ -1,0 +1,488 @@
+"""A simulated CiA 402 drive as a CANopen slave: what canopen's ``LocalNode`` leaves out.
+
+It owns its object values (typed by our EDS), serves SDO through canopen's ``SdoServer``, and adds
+what a real drive does on the bus: NMT, boot-up and heartbeat producer, heartbeat consumer with the
+0x6007 reaction, SYNC-latched RPDOs, SYNC-triggered TPDOs, EMCY, the power state machine with fault
+and quick stop, and Cyclic Synchronous Position tracking through :class:`Motor`.
+
+The node never reads a clock or a bus itself: the rig hands it frames and the time, so a lockstep
+run is a pure function of its inputs.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Callable
+from typing import Any
+
+import canopen
+from canopen.objectdictionary import ODVariable
+from canopen.sdo import SdoAbortedError, SdoServer
+
+from drivers import cia402
+from drivers import od as o
+from drivers.drive import DriveState
+from drivers.sim.motor import Motor
+
+SendFn = Callable[[int, bytes], None]
+
+NMT_INITIALISING = 0x00
+NMT_STOPPED = 0x04
+NMT_OPERATIONAL = 0x05
+NMT_PRE_OPERATIONAL = 0x7F
+
+_FORMATS = {1: "?", 2: "b", 3: "h", 4: "i", 5: "B", 6: "H", 7: "I"}
+_QS_HOLD_OPTIONS = (5, 6, 7, 8)
+
+# PDO-mappable live values: object index -> attribute of SimDriveNode
+_LIVE: dict[int, str] = {
+    o.STATUSWORD: "statusword",
+    o.POSITION_ACTUAL: "position_counts",
+    o.CURRENT_ACTUAL: "current_raw",
+    o.VELOCITY_ACTUAL: "velocity_counts_s",
+    o.FOLLOWING_ERROR_ACTUAL: "following_error_counts",
+    o.MODES_OF_OPERATION_DISPLAY: "mode_display",
+    o.ERROR_CODE: "error_code",
+    o.ERROR_REGISTER: "error_register",
+    o.CONTROLWORD: "controlword",
+    o.TARGET_POSITION: "target_counts",
+}
+
+
+class _ServerLink:
+    """What canopen's SdoServer needs from a network: a way to send its response."""
+
+    def __init__(self, send: SendFn) -> None:
+        self._send = send
+
+    def send_message(self, can_id: int, data: bytes, remote: bool = False) -> None:
+        self._send(can_id, bytes(data))
+
+
+class SimDriveNode:
+    """One simulated knob drive (CiA 301 slave + CiA 402 device, CSP only)."""
+
+    def __init__(self, node_id: int, motor: Motor, counts_per_deg: float, send: SendFn,
+                 *, vendor_id: int = 0, product_code: int = 0x402,
+                 rated_current_mA: int = 2000) -> None:
+        self.node_id = node_id
+        self.motor = motor
+        self.counts_per_deg = counts_per_deg
+        self._send = send
+        self.od = o.load_od(node_id)
+        self.object_dictionary = self.od
+        self._defaults: dict[tuple[int, int], Any] = {}
+        self._defaults[(o.IDENTITY, 1)] = vendor_id
+        self._defaults[(o.IDENTITY, 2)] = product_code
+        self._defaults[(o.MOTOR_RATED_CURRENT, 0)] = rated_current_mA
+        self.sdo = SdoServer(0x600 + node_id, 0x580 + node_id, self)
+        self.sdo.network = _ServerLink(send)  # type: ignore[assignment]
+        # fault injection
+        self.silent = False
+        self.heartbeat_stopped = False
+        self.corrupt_next_tpdo = False
+        self.nmt_state = NMT_INITIALISING
+        self.reset(0.0)
+
+    # -- NMT ------------------------------------------------------------------------------
+    def reset(self, now_s: float) -> None:
+        """Power-on / NMT reset node: defaults back, state machine to SWITCH ON DISABLED."""
+        self.values: dict[tuple[int, int], Any] = {}
+        self.controlword = 0
+        self.target_counts = 0
+        self.mode = 0
+        self.mode_display = 0
+        self.error_code = 0
+        self.error_register = 0
+        self.state = DriveState.SWITCH_ON_DISABLED
+        self.halted = False
+        self.internal_limit = False
+        self.following_error = False
+        self.velocity_counts_s = 0
+        self.following_error_counts = 0
+        self.current_raw = 0
+        self.statusword = 0
+        self._fe_since_s: float | None = None
+        self._sync_count = 0
+        self._rpdo_pending: bytes | bytearray | None = None
+        self._master_hb_s: float | None = None
+        self._master_lost = False
+        self._internal_target_deg = self.motor.position_deg
+        self._qs_velocity_deg_s = 0.0
+        self.position_counts = round(self.motor.position_deg * self.counts_per_deg)
+        self._configure_pdos()
+        self._update_statusword()
+        self.nmt_state = NMT_PRE_OPERATIONAL
+        self._next_heartbeat_s = now_s
+        self._emit(0x700 + self.node_id, b"\x00")  # boot-up
+
+    def _nmt_command(self, data: bytes | bytearray, now_s: float) -> None:
+        if len(data) != 2 or data[1] not in (0, self.node_id):
+            return
+        cs = data[0]
+        if cs == 0x01:
+            self._configure_pdos()
+            self.nmt_state = NMT_OPERATIONAL
+        elif cs == 0x02:
+            self.nmt_state = NMT_STOPPED
+        elif cs == 0x80:
+            self.nmt_state = NMT_PRE_OPERATIONAL
+        elif cs in (0x81, 0x82):
+            self.reset(now_s)
+
+    # -- frames ---------------------------------------------------------------------------
+    def on_frame(self, can_id: int, data: bytes | bytearray, now_s: float) -> None:
+        """Handle one received frame (SYNC is handled by :meth:`on_sync`)."""
+        if can_id == self._rpdo_cob:
+            if self.nmt_state == NMT_OPERATIONAL:
+                if len(data) != self._rpdo_len:
+                    self.emcy(0x8210, fault=False)
+                elif self._rpdo_sync:
+                    self._rpdo_pending = data
+                else:
+                    self._apply_rpdo(data, now_s)
+        elif can_id == 0x600 + self.node_id:
+            if self.nmt_state != NMT_STOPPED and not self.silent:
+                self.sdo.on_request(can_id, data, now_s)
+        elif can_id == 0:
+            self._nmt_command(data, now_s)
+        elif can_id == self._master_hb_cob:
+            self._master_hb_s = now_s
+            self._master_lost = False
+
+    def on_sync(self, now_s: float) -> None:
+        """SYNC: latch the buffered RPDO (applied before the motion of this period)."""
+        if self.nmt_state != NMT_OPERATIONAL:
+            return
+        self._sync_count += 1
+        if self._rpdo_pending is not None:
+            self._apply_rpdo(self._rpdo_pending, now_s)
+            self._rpdo_pending = None
+
+    def _apply_rpdo(self, data: bytes | bytearray, now_s: float) -> None:
+        for attr, value in zip(self._rpdo_attrs, self._rpdo_struct.unpack(data), strict=True):
+            if attr == "controlword":
+                self.write_controlword(value)
+            elif attr == "mode":
+                self.mode = value
+            else:
+                setattr(self, attr, value)
+
+    # -- CiA 402 power state machine ------------------------------------------------------
+    def write_controlword(self, cw: int) -> None:
+        rising_reset = bool(cw & 0x80) and not self.controlword & 0x80
+        self.controlword = cw
+        halted = bool(cw & cia402.CW_HALT)
+        if halted and not self.halted:
+            self._qs_velocity_deg_s = self.motor.velocity_deg_s
+        self.halted = halted
+        s = self.state
+        S = DriveState
+        if s is S.FAULT:
+            if rising_reset:
+                self.error_code = 0
+                self.error_register = 0
+                self.following_error = False
+                self._set_state(S.SWITCH_ON_DISABLED)
+                self.emcy(0x0000, fault=False)
+            return
+        if s is S.FAULT_REACTION_ACTIVE or cw & 0x80:
+            return
+        if cw & 0x02 == 0:  # disable voltage
+            if s is not S.SWITCH_ON_DISABLED:
+                self._set_state(S.SWITCH_ON_DISABLED)
+        elif cw & 0x06 == 0x02:  # quick stop
+            if s is S.OPERATION_ENABLED:
+                self._start_quick_stop()
+            elif s in (S.READY_TO_SWITCH_ON, S.SWITCHED_ON):
+                self._set_state(S.SWITCH_ON_DISABLED)
+        elif cw & 0x07 == 0x06:  # shutdown
+            if s in (S.SWITCH_ON_DISABLED, S.SWITCHED_ON, S.OPERATION_ENABLED):
+                self._set_state(S.READY_TO_SWITCH_ON)
+        elif cw & 0x0F == 0x07:  # switch on / disable operation
+            if s in (S.READY_TO_SWITCH_ON, S.OPERATION_ENABLED):
+                self._set_state(S.SWITCHED_ON)
+        elif cw & 0x0F == 0x0F and (s in (S.READY_TO_SWITCH_ON, S.SWITCHED_ON) or (
+                s is S.QUICK_STOP_ACTIVE
+                and self._value(o.QUICK_STOP_OPTION, 0) in _QS_HOLD_OPTIONS)):
+            self._set_state(S.OPERATION_ENABLED)  # enable operation
+
+    def _set_state(self, state: DriveState) -> None:
+        powered_before = self.powered
+        self.state = state
+        if state is DriveState.OPERATION_ENABLED:
+            self.motor.hold()
+            self._internal_target_deg = self.motor.position_deg
+            self.target_counts = self.position_counts
+            self.mode_display = self.mode
+        elif not self.powered and powered_before:
+            self.velocity_counts_s = 0
+        self._update_statusword()
+
+    def _start_quick_stop(self) -> None:
+        self._qs_velocity_deg_s = self.motor.velocity_deg_s
+        option = self._value(o.QUICK_STOP_OPTION, 0)
+        self._set_state(DriveState.SWITCH_ON_DISABLED if option == 0
+                        else DriveState.QUICK_STOP_ACTIVE)
+
+    def fault(self, code: int) -> None:
+        """Enter FAULT REACTION ACTIVE with ``code`` in 0x603F and send the EMCY."""
+        if self.state in (DriveState.FAULT, DriveState.FAULT_REACTION_ACTIVE):
+            return
+        self.error_code = code
+        self._qs_velocity_deg_s = self.motor.velocity_deg_s
+        self.emcy(code, fault=True)
+        self._set_state(DriveState.FAULT_REACTION_ACTIVE)
+
+    def emcy(self, code: int, fault: bool = True, register: int | None = None) -> None:
+        """Send an EMCY frame (code, error register, 5 manufacturer bytes)."""
+        if fault:
+            self.error_register |= 0x01 | (0x10 if code >> 12 == 0x8 else 0)
+        reg = self.error_register if register is None else register
+        self._emit(0x80 + self.node_id, struct.pack("<HB5s", code, reg, b"\x00" * 5))
+
+    @property
+    def powered(self) -> bool:
+        return self.state in (DriveState.OPERATION_ENABLED, DriveState.QUICK_STOP_ACTIVE,
+                              DriveState.FAULT_REACTION_ACTIVE)
+
+    def _update_statusword(self) -> None:
+        sw = cia402.STATE_BITS[self.state] | cia402.SW_REMOTE
+        if self.state not in (DriveState.SWITCH_ON_DISABLED, DriveState.NOT_READY_TO_SWITCH_ON,
+                              DriveState.FAULT) or self.powered:
+            sw |= cia402.SW_VOLTAGE_ENABLED
+        if self.state not in (DriveState.QUICK_STOP_ACTIVE, DriveState.SWITCH_ON_DISABLED,
+                              DriveState.FAULT, DriveState.FAULT_REACTION_ACTIVE,
+                              DriveState.NOT_READY_TO_SWITCH_ON):
+            sw |= cia402.SW_QUICK_STOP
+        if self.state is DriveState.OPERATION_ENABLED and not self.halted:
+            sw |= cia402.SW_FOLLOWS_TARGET
+        if self.internal_limit:
+            sw |= cia402.SW_INTERNAL_LIMIT
+        if self.following_error:
+            sw |= cia402.SW_FOLLOWING_ERROR
+        if self.error_register:
+            sw |= cia402.SW_WARNING if self.state is not DriveState.FAULT else 0
+        self.statusword = sw
+
+    # -- one period of motion -------------------------------------------------------------
+    def motion_target_deg(self) -> float:
+        """Where the motor goes this period (called after SYNC, before the physics step)."""
+        S = DriveState
+        dt = self.motor.dt_s
+        if self.state is S.OPERATION_ENABLED and not self.halted:
+            target = self.target_counts
+            lo = self._value(o.SOFTWARE_POSITION_LIMIT, 1)
+            hi = self._value(o.SOFTWARE_POSITION_LIMIT, 2)
+            limited = target < lo or target > hi
+            if limited:
+                target = lo if target < lo else hi
+            target_deg = target / self.counts_per_deg
+            vmax = self._value(o.MAX_PROFILE_VELOCITY, 0) / self.counts_per_deg
+            step = target_deg - self._internal_target_deg
+            if step > vmax * dt or step < -vmax * dt:
+                target_deg = self._internal_target_deg + (vmax * dt if step > 0 else -vmax * dt)
+                limited = True
+            self.internal_limit = limited
+            self._internal_target_deg = target_deg
+            return target_deg
+        if self.powered:  # quick stop, halt, fault reaction: ramp to standstill
+            decel = self._value(o.QUICK_STOP_DECELERATION, 0) / self.counts_per_deg
+            v = self._qs_velocity_deg_s
+            dv = decel * dt
+            v = 0.0 if abs(v) <= dv else v - dv if v > 0 else v + dv
+            self._qs_velocity_deg_s = v
+            self._internal_target_deg += v * dt
+            return self._internal_target_deg
+        return self.motor.position_deg
+
+    def end_of_period(self, knob_torque_Nm: float, measured_current_A: float, now_s: float
+                      ) -> None:
+        """After the physics step: actual values, following error, state timers, heartbeat."""
+        motor = self.motor
+        cpd = self.counts_per_deg
+        self.position_counts = round(motor.position_deg * cpd)
+        self.velocity_counts_s = round(motor.velocity_deg_s * cpd)
+        rated_A = self._value(o.MOTOR_RATED_CURRENT, 0) * 1e-3
+        raw = round(measured_current_A / rated_A * 1000.0) if self.powered else 0
+        self.current_raw = -32768 if raw < -32768 else 32767 if raw > 32767 else raw
+        S = DriveState
+        state = self.state
+        if state is S.OPERATION_ENABLED and not self.halted:
+            err = round((self._internal_target_deg - motor.position_deg) * cpd)
+            self.following_error_counts = err
+            window = self._value(o.FOLLOWING_ERROR_WINDOW, 0)
+            if abs(err) > window:
+                if self._fe_since_s is None:
+                    self._fe_since_s = now_s
+                elif now_s - self._fe_since_s >= self._value(o.FOLLOWING_ERROR_TIMEOUT, 0) * 1e-3:
+                    self.following_error = True
+                    self.fault(0x8611)
+            else:
+                self._fe_since_s = None
+        else:
+            self._fe_since_s = None
+        if state is S.FAULT_REACTION_ACTIVE and self._qs_velocity_deg_s == 0.0:
+            self._set_state(S.FAULT)
+        elif state is S.QUICK_STOP_ACTIVE and self._qs_velocity_deg_s == 0.0 and (
+                self._value(o.QUICK_STOP_OPTION, 0) in (1, 2)):
+            self._set_state(S.SWITCH_ON_DISABLED)
+        self._supervise_master(now_s)
+        self._update_statusword()
+
+    def _supervise_master(self, now_s: float) -> None:
+        setting = self._value(o.CONSUMER_HEARTBEAT, 1)
+        timeout_s = (setting & 0xFFFF) * 1e-3
+        if not timeout_s or self._master_hb_s is None or self._master_lost:
+            return
+        if now_s - self._master_hb_s > timeout_s:
+            self._master_lost = True
+            self.emcy(0x8130, fault=False)
+            self.error_register |= 0x10
+            if self.state is DriveState.OPERATION_ENABLED:
+                action = self._value(o.ABORT_CONNECTION_OPTION, 0)
+                if action == 1:
+                    self.fault(0x8130)
+                elif action == 2:
+                    self._set_state(DriveState.SWITCH_ON_DISABLED)
+                elif action == 3:
+                    self._start_quick_stop()
+
+    def transmit(self, sync_seen: bool, now_s: float) -> None:
+        """Send the TPDO due on this SYNC and the heartbeat when due."""
+        if sync_seen and self.nmt_state == NMT_OPERATIONAL and self._tpdo_cob is not None:
+            every = self._tpdo_every
+            if every and self._sync_count % every == 0:
+                data = self._tpdo_struct.pack(*[getattr(self, a) for a in self._tpdo_attrs])
+                if self.corrupt_next_tpdo:
+                    self.corrupt_next_tpdo = False
+                    data = data[:-3]
+                self._emit(self._tpdo_cob, data)
+        period_ms = self._value(o.PRODUCER_HEARTBEAT, 0)
+        if period_ms and now_s >= self._next_heartbeat_s - 1e-9:
+            self._next_heartbeat_s = now_s + period_ms * 1e-3
+            if not self.heartbeat_stopped:
+                self._emit(0x700 + self.node_id, bytes((self.nmt_state,)))
+        elif not period_ms:
+            self._next_heartbeat_s = now_s
+
+    def _emit(self, can_id: int, data: bytes) -> None:
+        if not self.silent:
+            self._send(can_id, data)
+
+    # -- PDO configuration ----------------------------------------------------------------
+    def _configure_pdos(self) -> None:
+        """Compile the RPDO1/TPDO1 layouts from 0x1400/0x1600 and 0x1800/0x1A00."""
+        hb = self._value(o.CONSUMER_HEARTBEAT, 1)
+        self._master_hb_cob = 0x700 + ((hb >> 16) & 0x7F) if hb else -1
+        cob = self._value(o.RPDO1_COMM, 1)
+        self._rpdo_cob = -1 if cob & 0x80000000 else cob & 0x7FF
+        self._rpdo_sync = self._value(o.RPDO1_COMM, 2) <= 240
+        fmt, attrs = self._layout(o.RPDO1_MAP, rpdo=True)
+        self._rpdo_struct = struct.Struct(fmt)
+        self._rpdo_len = self._rpdo_struct.size
+        self._rpdo_attrs = attrs
+        cob = self._value(o.TPDO1_COMM, 1)
+        self._tpdo_cob = None if cob & 0x80000000 else cob & 0x7FF
+        trans = self._value(o.TPDO1_COMM, 2)
+        self._tpdo_every = trans if 1 <= trans <= 240 else 0
+        fmt, attrs = self._layout(o.TPDO1_MAP, rpdo=False)
+        self._tpdo_struct = struct.Struct(fmt)
+        self._tpdo_attrs = attrs
+
+    def _layout(self, map_index: int, rpdo: bool) -> tuple[str, list[str]]:
+        fmt = "<"
+        attrs: list[str] = []
+        for sub in range(1, self._value(map_index, 0) + 1):
+            entry = self._value(map_index, sub)
+            index, subindex = entry >> 16, (entry >> 8) & 0xFF
+            var = self._variable(index, subindex)
+            fmt += _FORMATS[int(var.data_type or 0)]
+            attrs.append("mode" if index == o.MODES_OF_OPERATION else _LIVE[index])
+        return fmt, attrs
+
+    # -- object store (canopen's SdoServer calls these) ------------------------------------
+    def _variable(self, index: int, subindex: int) -> ODVariable:
+        if index not in self.od:
+            raise SdoAbortedError(0x06020000)
+        obj = self.od[index]
+        if not isinstance(obj, ODVariable):
+            if subindex not in obj:
+                raise SdoAbortedError(0x06090011)
+            obj = obj[subindex]
+        return obj
+
+    def _value(self, index: int, subindex: int) -> Any:
+        key = (index, subindex)
+        if key in self.values:
+            return self.values[key]
+        if key in self._defaults:
+            return self._defaults[key]
+        var = self._variable(index, subindex)
+        return var.default
+
+    def get_data(self, index: int, subindex: int, check_readable: bool = False) -> bytes:
+        var = self._variable(index, subindex)
+        if check_readable and not var.readable:
+            raise SdoAbortedError(0x06010001)
+        if index == o.MODES_OF_OPERATION:
+            return var.encode_raw(self.mode)
+        attr = _LIVE.get(index)
+        value = getattr(self, attr) if attr is not None else self._value(index, subindex)
+        return var.encode_raw(value)
+
+    def set_data(self, index: int, subindex: int, data: bytes,
+                 check_writable: bool = False) -> None:
+        var = self._variable(index, subindex)
+        if check_writable and not var.writable:
+            raise SdoAbortedError(0x06010002)
+        if var.data_type in canopen.objectdictionary.NUMBER_TYPES and 8 * len(data) != len(var):
+            raise SdoAbortedError(0x06070010)
+        value: Any = var.decode_raw(data)
+        if var.min is not None and value < var.min:
+            raise SdoAbortedError(0x06090032)
+        if var.max is not None and value > var.max:
+            raise SdoAbortedError(0x06090031)
+        if index in (o.RPDO1_MAP, o.TPDO1_MAP) and subindex >= 1:
+            self._check_mappable(value, rpdo=index == o.RPDO1_MAP)
+        if index in (o.RPDO1_MAP, o.TPDO1_MAP) and subindex == 0:
+            self._check_mapping_length(index, value)
+        if index == o.MODES_OF_OPERATION and value not in (0, o.CSP_MODE):
+            raise SdoAbortedError(0x06090030)
+        if index == o.CONTROLWORD:
+            self.write_controlword(value)
+            return
+        if index == o.TARGET_POSITION:
+            self.target_counts = value
+            return
+        if index == o.MODES_OF_OPERATION:
+            self.mode = value
+            return
+        self.values[(index, subindex)] = value
+        if index in (o.RPDO1_COMM, o.RPDO1_MAP, o.TPDO1_COMM, o.TPDO1_MAP,
+                     o.CONSUMER_HEARTBEAT):
+            self._configure_pdos()
+
+    def _check_mappable(self, entry: int, rpdo: bool) -> None:
+        if entry == 0:
+            return
+        index, subindex, bits = entry >> 16, (entry >> 8) & 0xFF, entry & 0xFF
+        try:
+            var = self._variable(index, subindex)
+        except SdoAbortedError:
+            raise SdoAbortedError(0x06040041) from None
+        live_ok = index == o.MODES_OF_OPERATION or index in _LIVE
+        if not var.pdo_mappable or not live_ok or bits != len(var) or (
+                rpdo and index not in (o.CONTROLWORD, o.TARGET_POSITION,
+                                       o.MODES_OF_OPERATION)):
+            raise SdoAbortedError(0x06040041)
+
+    def _check_mapping_length(self, map_index: int, count: int) -> None:
+        bits = 0
+        for sub in range(1, count + 1):
+            entry = self._value(map_index, sub)
+            if entry == 0:
+                raise SdoAbortedError(0x06040043)
+            bits += entry & 0xFF
+        if bits > 64:
+            raise SdoAbortedError(0x06040042)

@@ -1,0 +1,280 @@
+"""The simulated rig: drive nodes + motors + catheter plant + EM tracker on a python-can bus.
+
+Lockstep (default): nothing runs by itself. Each :meth:`SimRig.exchange` reads every pending
+frame, advances the motors and the plant by one period on the rig's :class:`SimClock`, and sends
+the TPDOs due on the SYNC it saw, so a run is bit-for-bit repeatable for a given seed.
+Real time (``lockstep=False``): a thread serves the bus and steps the physics at each SYNC.
+"""
+
+from __future__ import annotations
+
+import importlib
+import itertools
+import os
+import threading
+from collections.abc import Callable, Sequence
+from typing import Any, Protocol
+
+import can
+import numpy as np
+from numpy.typing import NDArray
+
+from drivers.canopen_master import CanOpenDrives
+from drivers.clock import Clock, MonotonicClock, SimClock
+from drivers.plant.base import Plant, load_plant
+from drivers.sim.drive_node import SimDriveNode
+from drivers.sim.motor import Motor, MotorParams
+from drivers.units import DriveConfig
+
+DEFAULT_PLANT = "drivers.plant.tendon_sheath:make_tendon_sheath_plant"
+_CHANNELS = itertools.count()
+
+
+class CurrentMeasurement(Protocol):
+    """Turns the true motor current into what the drive's current sensor reports."""
+
+    def measure(self, dt_s: float, current_A: float) -> float: ...
+
+
+class IdealCurrentSensor:
+    """No lag, offset or noise (used when the plant package provides no sensor model)."""
+
+    def measure(self, dt_s: float, current_A: float) -> float:
+        return current_A
+
+
+class _NoiseFreeTracker:
+    def measure(self, tip_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+        return tip_deg
+
+
+def default_drive_configs() -> list[DriveConfig]:
+    """Two knob drives, node ids 1 (phi1 anterior-posterior) and 2 (phi2 right-left)."""
+    return [DriveConfig(node_id=1), DriveConfig(node_id=2)]
+
+
+class SimRig:
+    """Simulated drives, plant and tracker serving one python-can bus."""
+
+    def __init__(self, bus: can.BusABC, plant: Plant, drive_configs: Sequence[DriveConfig],
+                 period_s: float, seed: int = 0, *, lockstep: bool = True,
+                 motor: MotorParams | None = None,
+                 sensors: Sequence[CurrentMeasurement] | None = None,
+                 tracker: Any | None = None, own_bus: bool = True) -> None:
+        if len(drive_configs) != 2:
+            raise ValueError(f"the rig drives two knobs, got {len(drive_configs)} drive configs")
+        self.bus = bus
+        self.plant = plant
+        self.period_s = period_s
+        self.seed = seed
+        self.lockstep = lockstep
+        self.clock: Clock = SimClock() if lockstep else MonotonicClock()
+        self._sim_clock = self.clock if isinstance(self.clock, SimClock) else None
+        self._own_bus = own_bus
+        params = motor or MotorParams()
+        self.motors = [Motor(params, c.gear_ratio, period_s) for c in drive_configs]
+        self.nodes = [
+            SimDriveNode(c.node_id, m, c.counts_per_deg, self._send, vendor_id=c.vendor_id,
+                         product_code=c.product_code or 0x402,
+                         rated_current_mA=c.rated_current_mA)
+            for c, m in zip(drive_configs, self.motors, strict=True)]
+        self.sensors = list(sensors) if sensors is not None else _default_sensors(seed)
+        self.tracker = tracker if tracker is not None else _default_tracker(seed)
+        self.plant.reset()
+        self._knob = np.zeros(2)
+        self._tip = np.zeros(2)
+        self._torque = [0.0, 0.0]
+        self.ticks = 0
+        self._thread: threading.Thread | None = None
+        self._stop = threading.Event()
+        self.error: BaseException | None = None
+
+    # -- lockstep --------------------------------------------------------------------------
+    def exchange(self) -> None:
+        """Process all pending frames, advance one period, send the TPDOs due."""
+        recv = self.bus.recv
+        nodes = self.nodes
+        now = self.clock.now_s()
+        sync = False
+        while (msg := recv(0)) is not None:
+            cid = msg.arbitration_id
+            if cid == 0x080:
+                sync = True
+                for n in nodes:
+                    n.on_sync(now)
+            elif not (msg.is_error_frame or msg.is_remote_frame or msg.is_extended_id):
+                data = msg.data
+                for n in nodes:
+                    n.on_frame(cid, data, now)
+        self._advance(sync)
+
+    def _advance(self, sync: bool) -> None:
+        dt = self.period_s
+        nodes = self.nodes
+        knob = self._knob
+        for i, n in enumerate(nodes):
+            knob[i] = n.motor.step(n.motion_target_deg(), n.powered)
+        step = self.plant.step(dt, knob)
+        self._tip = step.tip_deg
+        torque = step.knob_torque_Nm
+        if self._sim_clock is not None:
+            self._sim_clock.advance(dt)
+        now = self.clock.now_s()
+        for i, n in enumerate(nodes):
+            tau = float(torque[i])
+            powered = n.powered
+            current = n.motor.set_load(tau, powered)
+            measured = self.sensors[i].measure(dt, current)
+            n.end_of_period(tau, measured, now)
+            n.transmit(sync, now)
+        self.ticks += 1
+
+    def _send(self, can_id: int, data: bytes) -> None:
+        self.bus.send(can.Message(arbitration_id=can_id, data=data, is_extended_id=False))
+
+    # -- evaluation ------------------------------------------------------------------------
+    def tip_deg(self) -> NDArray[np.float64]:
+        """EM tracker reading of the tip angle (ground truth for evaluation, with its noise)."""
+        return np.asarray(self.tracker.measure(np.array(self._tip, dtype=float)), dtype=float)
+
+    def true_tip_deg(self) -> NDArray[np.float64]:
+        """Noise-free tip angle."""
+        return np.array(self._tip, dtype=float)
+
+    def knob_deg(self) -> NDArray[np.float64]:
+        """True knob angles (motor positions)."""
+        return self._knob.copy()
+
+    # -- fault injection -------------------------------------------------------------------
+    def inject_fault(self, kind: str, drive: int = 0, **kwargs: Any) -> None:
+        """Make drive ``drive`` misbehave.
+
+        ``emcy`` (``code``, default 0x2310 over-current): drive faults and sends the EMCY;
+        ``following_error``: the motor jams until ``clear_fault``, the drive detects it;
+        ``heartbeat_stop``: heartbeats stop, PDOs go on; ``silent``: the node sends nothing;
+        ``corrupt``: the next TPDO is sent truncated; ``frame``: send a raw frame
+        (``can_id``, ``data``) on the rig's side of the bus.
+        """
+        node = self.nodes[drive]
+        if kind == "emcy":
+            node.fault(int(kwargs.get("code", 0x2310)))
+        elif kind == "following_error":
+            node.motor.jammed = True
+        elif kind == "heartbeat_stop":
+            node.heartbeat_stopped = True
+        elif kind == "silent":
+            node.silent = True
+        elif kind == "corrupt":
+            node.corrupt_next_tpdo = True
+        elif kind == "frame":
+            self._send(int(kwargs["can_id"]), bytes(kwargs.get("data", b"")))
+        else:
+            raise ValueError(f"unknown fault kind {kind!r}; one of emcy, following_error, "
+                             f"heartbeat_stop, silent, corrupt, frame")
+
+    def clear_fault(self, drive: int = 0) -> None:
+        """Undo every injected fault on ``drive`` (the drive's own FAULT state stays)."""
+        node = self.nodes[drive]
+        node.motor.jammed = False
+        node.heartbeat_stopped = False
+        node.silent = False
+        node.corrupt_next_tpdo = False
+
+    # -- real time -------------------------------------------------------------------------
+    def start(self) -> None:
+        """Serve the bus from a thread (real-time mode): physics steps at each SYNC."""
+        if self.lockstep:
+            raise RuntimeError("a lockstep rig is driven by exchange(), not a thread")
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._serve, name="sim-rig", daemon=True)
+        self._thread.start()
+
+    def _serve(self) -> None:
+        try:
+            idle_after_s = 2.0 * self.period_s
+            last_step = self.clock.now_s()
+            while not self._stop.is_set():
+                msg = self.bus.recv(self.period_s / 4)
+                now = self.clock.now_s()
+                if msg is not None:
+                    cid = msg.arbitration_id
+                    if cid == 0x080:
+                        for n in self.nodes:
+                            n.on_sync(now)
+                        self._advance(True)
+                        last_step = now
+                    elif not (msg.is_error_frame or msg.is_remote_frame
+                              or msg.is_extended_id):
+                        for n in self.nodes:
+                            n.on_frame(cid, msg.data, now)
+                if now - last_step > idle_after_s:  # no SYNC: keep heartbeats and timers going
+                    self._advance(False)
+                    last_step = now
+        except BaseException as exc:  # surfaced by stop()
+            self.error = exc
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=2.0)
+            self._thread = None
+        if self.error is not None:
+            raise RuntimeError(f"simulated rig thread failed: {self.error}") from self.error
+
+    def close(self) -> None:
+        if self._thread is not None:
+            self.stop()
+        if self._own_bus:
+            self.bus.shutdown()
+
+
+def _default_sensors(seed: int) -> list[CurrentMeasurement]:
+    try:
+        current_sensor = importlib.import_module("drivers.plant.current_sensor")
+    except ImportError:
+        return [IdealCurrentSensor(), IdealCurrentSensor()]
+    factory: Callable[..., Any] | None = getattr(current_sensor, "CurrentSensor", None)
+    if factory is None:
+        return [IdealCurrentSensor(), IdealCurrentSensor()]
+    return [_adapt_sensor(factory, seed + 1000 * (i + 1)) for i in range(2)]
+
+
+def _adapt_sensor(factory: Callable[..., Any], seed: int) -> CurrentMeasurement:
+    sensor: CurrentMeasurement = factory(seed=seed)
+    return sensor
+
+
+def _default_tracker(seed: int) -> Any:
+    try:
+        tracker = importlib.import_module("drivers.sim.tracker")
+    except ImportError:
+        return _NoiseFreeTracker()
+    return tracker.EmTracker(noise_deg=0.3, seed=seed + 7)
+
+
+def open_sim_rig(plant: Plant | None, drive_configs: Sequence[DriveConfig] | None,
+                 period_s: float, seed: int = 0, lockstep: bool = True,
+                 channel: str | None = None, **master_kwargs: Any
+                 ) -> tuple[CanOpenDrives, SimRig]:
+    """A master and a simulated rig on a fresh ``virtual`` python-can channel.
+
+    Neither is booted: call ``drives.boot(); drives.enable()``. In lockstep the master's clock
+    is ``rig.clock`` and its idle hook is ``rig.exchange``; per tick run
+    ``drives.write_targets(cmd); drives.sync(); rig.exchange(); drives.pump()``.
+    """
+    configs = list(drive_configs) if drive_configs is not None else default_drive_configs()
+    if plant is None:
+        plant = load_plant(DEFAULT_PLANT)
+    if channel is None:
+        channel = f"tsmd-sim-{os.getpid()}-{next(_CHANNELS)}"
+    rig_bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
+    master_bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
+    rig = SimRig(rig_bus, plant, configs, period_s, seed, lockstep=lockstep)
+    if lockstep:
+        drives = CanOpenDrives(master_bus, configs, period_s, clock=rig.clock, idle=rig.exchange,
+                               own_bus=True, **master_kwargs)
+    else:
+        master_kwargs.setdefault("receive", "notifier")
+        drives = CanOpenDrives(master_bus, configs, period_s, own_bus=True, **master_kwargs)
+        rig.start()
+    return drives, rig

@@ -1,0 +1,108 @@
+"""Replay knob motion through a plant, and the motor-current map from knob torque.
+
+The plant is driven directly with the recorded actual knob angles (no CAN, no drive model): the
+gap diagnosis compares physics, not the bus. Simulating every row of a 250 Hz recording costs a
+Python call per row, so rows the fit does not score are thinned (see :func:`eval_grid`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import signal
+
+from drivers.plant.base import Plant
+
+PlantFactory = Callable[[dict[str, float]], Plant]
+"""Builds a fresh plant from the base parameters being fitted (the others are fixed)."""
+
+
+def simulate(plant: Plant, t_s: NDArray[np.float64],
+             knob_deg: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Step ``plant`` through the knob angles at times ``t_s``; return tip (N,2), torque (N,2)."""
+    n = len(t_s)
+    tip = np.empty((n, 2))
+    torque = np.empty((n, 2))
+    plant.reset()
+    dt = np.diff(t_s, prepend=t_s[0] - (t_s[1] - t_s[0] if n > 1 else 0.01))
+    step = plant.step
+    for k in range(n):
+        out = step(float(dt[k]), knob_deg[k])
+        tip[k] = out.tip_deg
+        torque[k] = out.knob_torque_Nm
+    return tip, torque
+
+
+def fit_grid(n: int, stride: int) -> NDArray[np.int64]:
+    """Every ``stride``-th row (and the last): what the fits simulate and score."""
+    idx = np.arange(0, n, max(stride, 1))
+    if idx[-1] != n - 1:
+        idx = np.append(idx, n - 1)
+    return idx
+
+
+def eval_grid(held_out: NDArray[np.bool_], stride: int) -> NDArray[np.int64]:
+    """Every held-out row plus every ``stride``-th training row (to carry the plant's state)."""
+    n = len(held_out)
+    keep = held_out.copy()
+    keep[fit_grid(n, stride)] = True
+    return np.flatnonzero(keep)
+
+
+def smooth_velocity(t_s: NDArray[np.float64], x: NDArray[np.float64],
+                    window_s: float = 0.2) -> NDArray[np.float64]:
+    """Knob velocity (deg/s) by central differences, then a moving average over ``window_s``."""
+    if len(t_s) < 3:
+        return np.zeros_like(x)
+    v = np.gradient(x, t_s, axis=0)
+    dt = float(np.median(np.diff(t_s)))
+    w = max(round(window_s / dt), 1)
+    if w <= 1:
+        return v
+    kernel = np.ones(w) / w
+    if v.ndim == 1:
+        return np.convolve(v, kernel, mode="same")
+    return np.column_stack([np.convolve(col, kernel, mode="same") for col in v.T])
+
+
+def lowpass(t_s: NDArray[np.float64], x: NDArray[np.float64], tau_s: float) -> NDArray[np.float64]:
+    """First-order lag with time constant ``tau_s``, exact for uneven steps (x is (N,) or (N,k))."""
+    if tau_s <= 0:
+        return x.copy()
+    dts = np.diff(t_s)
+    if len(dts) and np.ptp(dts) <= 1e-6 * float(dts.mean()):
+        a0 = float(np.exp(-dts.mean() / tau_s))
+        zi = a0 * x[0] if x.ndim == 1 else (a0 * x[0])[None, :]
+        y_u, _ = signal.lfilter([1.0 - a0], [1.0, -a0], x, axis=0, zi=np.atleast_1d(zi))
+        return np.asarray(y_u)
+    a = np.exp(-dts / tau_s)
+    y = np.empty_like(x)
+    y[0] = x[0]
+    for k in range(1, len(x)):
+        y[k] = a[k - 1] * y[k - 1] + (1.0 - a[k - 1]) * x[k]
+    return y
+
+
+@dataclass(frozen=True)
+class CurrentMap:
+    """Motor current from knob torque: ``i = gain*torque + offset + coulomb*s(v) + viscous*v``.
+
+    ``s(v) = tanh(v / v0)`` smooths the Coulomb sign; per knob, fitted by linear least squares.
+    This is the simple motor model of the gap diagnosis, not the drive's.
+    """
+
+    gain_A_per_Nm: tuple[float, float]
+    offset_A: tuple[float, float]
+    coulomb_A: tuple[float, float]
+    viscous_A_s_per_deg: tuple[float, float]
+    v0_deg_s: float
+
+
+def current_regressors(torque_Nm: NDArray[np.float64], vel_deg_s: NDArray[np.float64],
+                       v0_deg_s: float) -> NDArray[np.float64]:
+    """Columns (torque, 1, tanh(v/v0), v) for one knob: the base current map's regressors."""
+    return np.column_stack([torque_Nm, np.ones_like(torque_Nm),
+                            np.tanh(vel_deg_s / v0_deg_s), vel_deg_s])

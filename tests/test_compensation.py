@@ -1,0 +1,168 @@
+"""Compensators for two knobs, the parameter grids and the output limiter."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from test_profile import ROOT, make_profile
+
+from tsmd.compensation import (
+    CompensationError,
+    Compensator,
+    KnobLimits,
+    NoCompensation,
+    build_compensator,
+)
+from tsmd.compensation.grid import ParameterField
+from tsmd.compensation.safety import LimiterState, limit_step
+from tsmd.profile import load_profile
+
+LIMITS = KnobLimits(-100.0, 100.0, 180.0, 2000.0)
+DT = 0.004
+
+
+def sine(n: int = 2500, amp: float = 60.0) -> np.ndarray:
+    t = np.arange(n) * DT
+    return np.column_stack([amp * np.sin(2 * np.pi * 0.4 * t), 30 * np.sin(2 * np.pi * 0.8 * t)])
+
+
+def run(comp: Compensator, q: np.ndarray) -> np.ndarray:
+    comp.reset(q[0])
+    return np.array([comp.command(row) for row in q])
+
+
+@pytest.mark.parametrize("method", ["none", "paper", "ours"])
+def test_every_method_is_a_compensator(method: str) -> None:
+    comp = build_compensator(make_profile(), method, DT)
+    assert isinstance(comp, Compensator)
+    assert run(comp, sine(50)).shape == (50, 2)
+
+
+def test_no_compensation_passes_desired_angles_through() -> None:
+    q = sine(100)
+    assert np.array_equal(run(NoCompensation(), q), q)
+
+
+def test_non_finite_setpoint_holds_the_last_command() -> None:
+    for method in ("none", "paper", "ours"):
+        comp = build_compensator(make_profile(), method, DT)
+        comp.reset(np.zeros(2))
+        a = comp.command(np.array([10.0, 5.0]))
+        b = comp.command(np.array([math.nan, math.inf]))
+        assert np.array_equal(a, b), method
+
+
+def test_unknown_method_and_missing_profile_are_refused() -> None:
+    with pytest.raises(CompensationError, match="'magic' is not one of"):
+        build_compensator(make_profile(), "magic", DT)
+    with pytest.raises(CompensationError, match="needs a catheter profile"):
+        build_compensator(None, "paper", DT)
+
+
+def test_ours_without_its_parameters_is_refused_with_advice() -> None:
+    profile = make_profile()
+    knob = profile.knobs[0]
+    object.__setattr__(knob, "ours", None)
+    with pytest.raises(CompensationError, match="no 'ours' parameters for phi1"):
+        build_compensator(profile, "ours", DT)
+
+
+def test_paper_compensation_adds_the_dead_zone_when_moving_out() -> None:
+    comp = build_compensator(make_profile(d0=20.0), "paper", DT)
+    comp.reset(np.zeros(2))
+    cmd = comp.command(np.array([13.0, 0.0]))
+    knob = make_profile().knobs[0]
+    assert cmd[0] == pytest.approx(20.0 + (13.0 - knob.height_pos_deg) / knob.omega)
+
+
+def test_paper_parameters_follow_the_other_knob() -> None:
+    comp = build_compensator(make_profile(d0=20.0), "paper", DT)
+    comp.reset(np.array([0.0, 90.0]))
+    cmd = comp.command(np.array([13.0, 90.0]))
+    knob = make_profile().knobs[0]
+    assert cmd[0] == pytest.approx(17.0 + (13.0 - knob.height_pos_deg) / knob.omega)
+
+
+def test_ours_with_neutral_parameters_matches_the_paper_in_one_dof() -> None:
+    q = sine(1500)
+    q[:, 1] = 0.0
+    paper = run(build_compensator(make_profile(), "paper", DT), q)
+    ours = run(build_compensator(make_profile(), "ours", DT), q)
+    on_plateau = np.abs(q[:, 0] - make_profile().knobs[0].height_pos_deg) < 1e-6  # any x is exact
+    assert np.max(np.abs(paper - ours)[~on_plateau]) < 0.05
+
+
+def test_limited_output_never_leaves_knob_limits() -> None:
+    comp = build_compensator(make_profile(), "paper", DT, [LIMITS, LIMITS])
+    q = sine(2000, amp=150.0)
+    out = run(comp, q)
+    assert out.min() >= LIMITS.min_deg and out.max() <= LIMITS.max_deg
+
+
+def test_limited_output_respects_velocity_and_acceleration() -> None:
+    comp = build_compensator(make_profile(), "paper", DT, [LIMITS, LIMITS])
+    out = run(comp, sine(2500))
+    v = np.diff(out, axis=0) / DT
+    assert np.abs(v).max() <= LIMITS.max_velocity_deg_s + 1e-6
+    assert np.abs(np.diff(v, axis=0)).max() <= LIMITS.max_accel_deg_s2 * DT + 1e-6
+
+
+targets = st.lists(st.one_of(st.floats(-500, 500), st.sampled_from([math.nan, math.inf])),
+                   min_size=1, max_size=80)
+
+
+@settings(max_examples=200, deadline=None)
+@given(targets, st.floats(-100, 100), st.floats(-180, 180))
+def test_limiter_respects_every_limit_for_any_targets(
+        seq: list[float], q0: float, v0: float) -> None:
+    state = LimiterState(q0, v0)
+    for target in seq:
+        nxt = limit_step(state, target, LIMITS, DT)
+        assert LIMITS.min_deg <= nxt.q_deg <= LIMITS.max_deg
+        assert abs(nxt.v_deg_s) <= LIMITS.max_velocity_deg_s + 1e-9
+        hits_bound = nxt.q_deg in (LIMITS.min_deg, LIMITS.max_deg)
+        if not hits_bound:
+            assert abs(nxt.v_deg_s - state.v_deg_s) <= LIMITS.max_accel_deg_s2 * DT + 1e-9
+        state = nxt
+
+
+def test_limiter_settles_on_a_reachable_target_without_real_overshoot() -> None:
+    state = LimiterState(0.0)
+    trace = []
+    for _ in range(500):
+        state = limit_step(state, 40.0, LIMITS, DT)
+        trace.append(state.q_deg)
+    assert max(trace) <= 40.0 + 0.01 and trace[-1] == pytest.approx(40.0)
+
+
+def test_parameter_field_holds_end_values_outside_the_grid() -> None:
+    f = ParameterField([-90, 0, 90], np.array([[1.0], [3.0], [2.0]]), "pchip")
+    assert f.at(-120)[0] == 1.0 and f.at(200)[0] == 2.0
+
+
+@pytest.mark.parametrize("method", ["pchip", "linear", "cubic"])
+def test_parameter_field_passes_through_grid_points(method: str) -> None:
+    grid = [-90, -60, -30, 0, 30, 60, 90]
+    vals = np.array([[14.0 + abs(g) / 10, -14.0 - abs(g) / 10] for g in grid])
+    f = ParameterField(grid, vals, method)
+    for g, v in zip(grid, vals, strict=True):
+        assert np.allclose(f.at(g), v)
+
+
+def test_pchip_does_not_overshoot_between_grid_points() -> None:
+    grid = [-90, -60, -30, 0, 30, 60, 90]
+    vals = np.array([[10.0], [10.0], [10.0], [20.0], [20.0], [20.0], [20.0]])
+    f = ParameterField(grid, vals, "pchip")
+    xs = np.linspace(-90, 90, 361)
+    ys = np.array([f.at(x)[0] for x in xs])
+    assert ys.min() >= 10.0 - 1e-12 and ys.max() <= 20.0 + 1e-12
+
+
+def test_example_profile_builds_every_method() -> None:
+    profile = load_profile(ROOT / "profiles" / "example-sim.yaml")
+    for method in ("none", "paper", "ours"):
+        build_compensator(profile, method, DT, [LIMITS, LIMITS])

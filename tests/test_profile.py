@@ -1,0 +1,181 @@
+"""Catheter profiles and device models: validation, round trip, atomic save (tsmd.profile)."""
+
+from __future__ import annotations
+
+import copy
+import os
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from tsmd.compensation.ours import OursParams
+from tsmd.profile import (
+    CatheterProfile,
+    ProfileError,
+    ProfileStore,
+    load_device_model,
+    load_profile,
+    make_knob_profile,
+    profile_from_mapping,
+    profile_to_mapping,
+    save_profile,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+DEVICE = ROOT / "profiles" / "devices" / "sim-catheter.yaml"
+GRID = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
+
+
+def make_profile(catheter_id: str = "sim-001", d0: float = 20.0) -> CatheterProfile:
+    device = load_device_model(DEVICE)
+    knobs = tuple(
+        make_knob_profile(k, GRID, [d0 - abs(g) / 30 for g in GRID],
+                          [-d0 + abs(g) / 30 for g in GRID], [15.0] * 7, [16.0] * 7,
+                          OursParams.neutral(7))
+        for k in device.knobs)
+    return CatheterProfile(catheter_id, device.device_model, "2026-11-22T03:00:00Z",
+                           "tsmd 0.1.0", "pchip", (knobs[0], knobs[1]),
+                           quality={"cycle_agreement_deg": 0.4})
+
+
+def mapping() -> dict[str, Any]:
+    return profile_to_mapping(make_profile())
+
+
+def test_round_trip_keeps_every_value(tmp_path: Path) -> None:
+    profile = make_profile()
+    path = tmp_path / "p.yaml"
+    save_profile(profile, path)
+    assert load_profile(path) == profile
+
+
+def test_height_follows_reference_point_and_dead_zone_at_zero() -> None:
+    knob = make_profile(d0=20.0).knobs[0]
+    assert knob.height_pos_deg == pytest.approx(
+        knob.reference_pos.tip_deg - knob.omega * (knob.reference_pos.knob_deg - 20.0))
+
+
+def test_example_profile_and_device_model_load() -> None:
+    assert load_profile(ROOT / "profiles" / "example-sim.yaml").device_model == "sim-catheter"
+    assert load_device_model(DEVICE).limits[0].max_deg > 0
+
+
+@pytest.mark.parametrize(("edit", "message"), [
+    (lambda m: m.pop("catheter_id"), "catheter_id: missing key"),
+    (lambda m: m["knobs"]["phi1"].pop("backlash_pos_deg"), "knobs.phi1.backlash_pos_deg: missing"),
+    (lambda m: m["knobs"].pop("phi2"), "knobs.phi2: missing key"),
+    (lambda m: m.update(schema_version=2), "unknown schema version 2"),
+    (lambda m: m.update(schema_version="1"), "schema_version: must be an integer"),
+    (lambda m: m["knobs"]["phi1"]["dead_zone_pos_deg"].__setitem__(2, float("nan")),
+     r"dead_zone_pos_deg\[2\]: is NaN"),
+    (lambda m: m["knobs"]["phi1"]["backlash_neg_deg"].__setitem__(0, float("inf")),
+     r"backlash_neg_deg\[0\]: is infinite"),
+    (lambda m: m["knobs"]["phi2"].__setitem__("other_knob_deg", [-90, -30, -60, 0, 30, 60, 90]),
+     "not sorted"),
+    (lambda m: m["knobs"]["phi1"].__setitem__("omega", 0.023), "omega: .* outside"),
+    (lambda m: m["knobs"]["phi1"]["dead_zone_pos_deg"].__setitem__(1, 0.35), None),
+    (lambda m: m["knobs"]["phi1"]["dead_zone_neg_deg"].__setitem__(1, 12.0),
+     r"dead_zone_neg_deg\[1\]: 12.0 deg is outside"),
+    (lambda m: m["knobs"]["phi1"]["backlash_pos_deg"].pop(), "must have 7 values"),
+    (lambda m: m["knobs"]["phi1"]["backlash_pos_deg"].__setitem__(0, "15"), "must be a number"),
+    (lambda m: m.update(interpolation="spline9"), "interpolation: 'spline9' is not one of"),
+    (lambda m: m["knobs"].update(phi3={}), "knobs.phi3: unknown knob"),
+    (lambda m: m["knobs"]["phi1"]["reference_pos"].__setitem__("knob_deg", -90.0),
+     "reference_pos.knob_deg must be > 0"),
+    (lambda m: m["knobs"]["phi1"]["ours"].__setitem__("lag_s", -0.1), r"ours: lag_s\[0\]"),
+    (lambda m: m["knobs"]["phi1"]["ours"].pop("shape_pos"), "ours: shape_pos: missing key"),
+    (lambda m: m["knobs"]["phi1"]["ours"]["shape_neg"][3].reverse(),
+     "shape must be non-decreasing"),
+    (lambda m: m.update(catheter_id="../etc/passwd"), "catheter_id"),
+])
+def test_bad_profile_is_refused_naming_the_problem(edit: Any, message: str | None) -> None:
+    m = copy.deepcopy(mapping())
+    edit(m)
+    if message is None:  # a plausible edit stays valid
+        profile_from_mapping(m)
+        return
+    with pytest.raises(ProfileError, match=message):
+        profile_from_mapping(m, "p.yaml")
+
+
+def test_profile_that_is_not_a_mapping_is_refused() -> None:
+    with pytest.raises(ProfileError, match="must be a mapping"):
+        profile_from_mapping([1, 2, 3])
+
+
+def test_invalid_yaml_names_the_file(tmp_path: Path) -> None:
+    path = tmp_path / "broken.yaml"
+    path.write_text("knobs: [unclosed\n")
+    with pytest.raises(ProfileError, match="broken.yaml: not valid YAML"):
+        load_profile(path)
+
+
+def test_missing_file_is_a_profile_error(tmp_path: Path) -> None:
+    with pytest.raises(ProfileError, match="no such file"):
+        load_profile(tmp_path / "absent.yaml")
+
+
+def test_save_keeps_previous_profile_as_backup(tmp_path: Path) -> None:
+    path = tmp_path / "p.yaml"
+    save_profile(make_profile(d0=20.0), path)
+    save_profile(make_profile(d0=22.0), path)
+    assert load_profile(path).knobs[0].dead_zone_pos_deg[3] == pytest.approx(22.0)
+    assert load_profile(path.with_name("p.yaml.bak")).knobs[0].dead_zone_pos_deg[3] == 20.0
+
+
+def test_save_interrupted_before_rename_leaves_old_profile_intact(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    path = tmp_path / "p.yaml"
+    save_profile(make_profile(d0=20.0), path)
+    before = path.read_bytes()
+
+    def crash(*args: object, **kwargs: object) -> None:
+        raise OSError("power lost")
+
+    monkeypatch.setattr(os, "replace", crash)
+    with pytest.raises(OSError, match="power lost"):
+        save_profile(make_profile(d0=25.0), path)
+    assert path.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir() if p.name.endswith(".tmp")] == []
+
+
+def test_save_refuses_an_invalid_profile_before_touching_disk(tmp_path: Path) -> None:
+    path = tmp_path / "p.yaml"
+    save_profile(make_profile(), path)
+    before = path.read_bytes()
+    bad = make_profile()
+    object.__setattr__(bad, "interpolation", "nope")
+    with pytest.raises(ProfileError):
+        save_profile(bad, path)
+    assert path.read_bytes() == before
+
+
+def test_saved_file_is_plain_yaml(tmp_path: Path) -> None:
+    path = tmp_path / "p.yaml"
+    save_profile(make_profile(), path)
+    data = yaml.safe_load(path.read_text())
+    assert data["schema_version"] == 1 and data["knobs"]["phi1"]["other_knob_deg"][0] == -90.0
+
+
+def test_store_lists_saves_and_loads_by_catheter_id(tmp_path: Path) -> None:
+    store = ProfileStore(tmp_path / "profiles")
+    assert store.list() == []
+    store.save(make_profile("cath-a"))
+    store.save(make_profile("cath-b"))
+    assert store.list() == ["cath-a", "cath-b"]
+    assert store.load("cath-b").catheter_id == "cath-b"
+    with pytest.raises(ProfileError, match="no profile for catheter 'cath-c'"):
+        store.load("cath-c")
+    with pytest.raises(ProfileError, match="must be letters"):
+        store.load("../x")
+
+
+def test_bad_device_model_is_refused(tmp_path: Path) -> None:
+    data = yaml.safe_load(DEVICE.read_text())
+    data["knobs"]["phi2"]["limits"]["max_deg"] = -10.0
+    path = tmp_path / "dev.yaml"
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(ProfileError, match=r"knobs.phi2.limits.max_deg"):
+        load_device_model(path)

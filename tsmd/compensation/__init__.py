@@ -1,0 +1,142 @@
+"""Feed-forward dead-zone + backlash compensation: desired knob angles -> motor commands.
+
+``build_compensator(profile, method, period_s, limits)`` gives a :class:`Compensator`:
+``"none"`` passes the desired angles through, ``"paper"`` is the published piecewise-linear
+inverse (:mod:`tsmd.compensation.paper`), ``"ours"`` removes its named weaknesses
+(:mod:`tsmd.compensation.ours`). With ``limits`` the output goes through the rate and position
+limiter of :mod:`tsmd.compensation.safety` last, so it never leaves the knobs' range.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tsmd.compensation.grid import ParameterField
+from tsmd.compensation.ours import OursCompensator, OursKnob
+from tsmd.compensation.paper import PaperCompensator, PaperKnob
+from tsmd.compensation.safety import KnobLimits, LimiterState, limit_step
+from tsmd.errors import TsmdError
+
+if TYPE_CHECKING:
+    from tsmd.profile import CatheterProfile
+
+METHODS: tuple[str, ...] = ("none", "paper", "ours")
+
+__all__ = [
+    "METHODS",
+    "CompensationError",
+    "Compensator",
+    "KnobLimits",
+    "LimitedCompensator",
+    "NoCompensation",
+    "build_compensator",
+]
+
+
+class CompensationError(TsmdError, ValueError):
+    """The compensator cannot be built as asked (unknown method, no profile, missing params)."""
+
+
+@runtime_checkable
+class Compensator(Protocol):
+    """Stateful map from desired knob angles to motor commands, called once per tick."""
+
+    def reset(self, q_deg: NDArray[np.float64]) -> None:
+        """Start from rest at desired angles ``q_deg`` (shape (2,))."""
+
+    def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The motor command (shape (2,), degrees) for this tick's desired angles."""
+
+
+class NoCompensation:
+    """Sends the desired angles as they are (non-finite values hold the last command)."""
+
+    def __init__(self) -> None:
+        self._last = np.zeros(2)
+
+    def reset(self, q_deg: NDArray[np.float64]) -> None:
+        q = np.asarray(q_deg, dtype=float)
+        self._last = np.where(np.isfinite(q), q, 0.0)
+
+    def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+        q = np.asarray(q_deg, dtype=float)
+        self._last = np.where(np.isfinite(q), q, self._last)
+        return self._last.copy()
+
+
+class LimitedCompensator:
+    """Any compensator followed by the position/velocity/acceleration limiter per knob."""
+
+    def __init__(self, inner: Compensator, limits: Sequence[KnobLimits], period_s: float) -> None:
+        if len(limits) != 2:
+            raise CompensationError(f"need limits for 2 knobs, got {len(limits)}")
+        self.inner = inner
+        self.limits = tuple(limits)
+        self.period_s = period_s
+        self._states = [LimiterState(0.0) for _ in self.limits]
+        self.last_unlimited = np.zeros(2)
+
+    def reset(self, q_deg: NDArray[np.float64]) -> None:
+        self.inner.reset(q_deg)
+        q = np.asarray(q_deg, dtype=float)
+        start = self.inner.command(q)
+        self.inner.reset(q_deg)
+        self._states = [LimiterState(lim.clip(float(x)) if np.isfinite(x) else 0.0)
+                        for x, lim in zip(start, self.limits, strict=True)]
+
+    def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+        raw = self.inner.command(q_deg)
+        self.last_unlimited = np.asarray(raw, dtype=float).copy()
+        self._states = [limit_step(s, float(x), lim, self.period_s)
+                        for s, x, lim in zip(self._states, raw, self.limits, strict=True)]
+        return np.array([s.q_deg for s in self._states])
+
+
+def paper_compensator(profile: CatheterProfile) -> PaperCompensator:
+    knobs = tuple(PaperKnob(ParameterField(k.other_knob_deg, k.grid_array(), profile.interpolation),
+                            k.height_pos_deg, k.height_neg_deg, k.omega)
+                  for k in profile.knobs)
+    return PaperCompensator((knobs[0], knobs[1]))
+
+
+def ours_compensator(profile: CatheterProfile, period_s: float) -> OursCompensator:
+    knobs = []
+    for name, k in zip(("phi1", "phi2"), profile.knobs, strict=True):
+        if k.ours is None:
+            raise CompensationError(
+                f"profile {profile.catheter_id!r} has no 'ours' parameters for {name}; "
+                "recalibrate with this tsmd version or use method 'paper'")
+        values = np.column_stack([k.grid_array(), np.asarray(k.ours.backlash_blend_deg)])
+        method = profile.interpolation
+        knobs.append(OursKnob(
+            ParameterField(k.other_knob_deg, values, method),
+            ParameterField(k.other_knob_deg, np.asarray(k.ours.shape_pos, float), method),
+            ParameterField(k.other_knob_deg, np.asarray(k.ours.shape_neg, float), method),
+            np.asarray(k.ours.shape_u_deg, float), k.height_pos_deg, k.height_neg_deg, k.omega,
+            k.ours.lag_s))
+    return OursCompensator((knobs[0], knobs[1]), period_s)
+
+
+def build_compensator(profile: CatheterProfile | None, method: str, period_s: float,
+                      limits: Sequence[KnobLimits] | None = None) -> Compensator:
+    """The compensator for ``method`` ("none" | "paper" | "ours"), limited when ``limits``."""
+    if method not in METHODS:
+        raise CompensationError(f"compensation method {method!r} is not one of {list(METHODS)}")
+    if not period_s > 0:
+        raise CompensationError(f"period_s must be positive, got {period_s}")
+    inner: Compensator
+    if method == "none":
+        inner = NoCompensation()
+    elif profile is None:
+        raise CompensationError(f"compensation method {method!r} needs a catheter profile")
+    elif method == "paper":
+        inner = paper_compensator(profile)
+    else:
+        inner = ours_compensator(profile, period_s)
+    if limits is None:
+        return inner
+    return LimitedCompensator(inner, limits, period_s)

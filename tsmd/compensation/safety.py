@@ -1,0 +1,65 @@
+"""The last stage before the drives: position limits, velocity and acceleration limits.
+
+An inverse hysteresis model jumps across the dead zone and the backlash; a real motor cannot.
+The limiter turns any command into one the knob can follow: it never leaves the knob's range,
+its speed never exceeds ``max_velocity_deg_s`` and its speed changes by at most
+``max_accel_deg_s2 * dt_s`` per tick; it brakes in time to stop on the target without overshoot.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class KnobLimits:
+    """One knob's motion limits (data-sheet constants of the device)."""
+
+    min_deg: float
+    max_deg: float
+    max_velocity_deg_s: float
+    max_accel_deg_s2: float
+
+    def __post_init__(self) -> None:
+        values = (self.min_deg, self.max_deg, self.max_velocity_deg_s, self.max_accel_deg_s2)
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"knob limits must be finite, got {values}")
+        if self.min_deg >= self.max_deg:
+            raise ValueError(f"min_deg {self.min_deg} must be below max_deg {self.max_deg}")
+        if self.max_velocity_deg_s <= 0 or self.max_accel_deg_s2 <= 0:
+            raise ValueError("max_velocity_deg_s and max_accel_deg_s2 must be positive")
+
+    def clip(self, q_deg: float) -> float:
+        return min(max(q_deg, self.min_deg), self.max_deg)
+
+
+@dataclass(frozen=True)
+class LimiterState:
+    """Where the limited command is and how fast it moves."""
+
+    q_deg: float
+    v_deg_s: float = 0.0
+
+
+def limit_step(state: LimiterState, target_deg: float, limits: KnobLimits,
+               dt_s: float) -> LimiterState:
+    """One tick of the limiter: move toward ``target_deg`` as fast as the limits allow.
+
+    A non-finite target holds the current position (it never reaches the motor).
+    """
+    if dt_s <= 0:
+        raise ValueError(f"dt_s must be positive, got {dt_s}")
+    a = limits.max_accel_deg_s2
+    target = limits.clip(target_deg) if math.isfinite(target_deg) else state.q_deg
+    d = target - state.q_deg
+    # The fastest speed from which the discrete decelerating sequence still stops on the target.
+    v_stop = math.sqrt(0.25 * a * a * dt_s * dt_s + 2.0 * a * abs(d)) - 0.5 * a * dt_s
+    v_want = math.copysign(min(abs(d) / dt_s, v_stop, limits.max_velocity_deg_s), d)
+    v = min(max(v_want, state.v_deg_s - a * dt_s), state.v_deg_s + a * dt_s)
+    v = min(max(v, -limits.max_velocity_deg_s), limits.max_velocity_deg_s)
+    q = state.q_deg + v * dt_s
+    if q < limits.min_deg or q > limits.max_deg:  # position first, whatever the speed
+        q = limits.clip(q)
+        v = (q - state.q_deg) / dt_s
+    return LimiterState(q, v)

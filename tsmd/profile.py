@@ -1,0 +1,492 @@
+"""Per-catheter profiles and device models (YAML, versioned schema).
+
+A *device model* holds the data-sheet constants of a catheter type (slope omega, the reference
+points of design assumption 1, knob limits). A *profile* holds what calibration identified for one
+catheter: per knob the dead zone and backlash grids over the other knob's angle, H, the
+interpolation method, the parameters of our compensator and the quality figures.
+
+Loading validates everything and raises :class:`ProfileError` naming the file, the key and the
+reason. Saving is atomic and keeps the previous profile as ``<file>.bak``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import math
+import os
+import re
+import shutil
+import tempfile
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from tsmd.compensation.grid import CALIBRATION_GRID_DEG, INTERPOLATION_METHODS
+from tsmd.compensation.ours import OursParams, ours_params_from_mapping, ours_params_to_mapping
+from tsmd.compensation.safety import KnobLimits
+from tsmd.errors import TsmdError
+
+PROFILE_SCHEMA_VERSION = 1
+DEVICE_SCHEMA_VERSION = 1
+KNOB_NAMES: tuple[str, str] = ("phi1", "phi2")
+ANGLE_RANGE_DEG = 360.0
+"""Every angle in a profile (knob or tip) must lie within +-ANGLE_RANGE_DEG: a larger value is
+almost certainly in the wrong unit (radians are caught by the omega and range checks instead)."""
+OMEGA_RANGE: tuple[float, float] = (0.2, 5.0)
+"""Plausible tip-per-knob slopes; outside this the value is a unit or sign mistake."""
+_ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+
+
+class ProfileError(TsmdError, ValueError):
+    """A profile or device model is missing, malformed or implausible; the message says why."""
+
+
+@dataclass(frozen=True)
+class ReferencePoint:
+    """A knob angle and the tip angle it gives (design assumption 1: other knob at 0 deg)."""
+
+    knob_deg: float
+    tip_deg: float
+
+
+@dataclass(frozen=True)
+class DeviceKnob:
+    """Data-sheet constants of one knob."""
+
+    omega: float
+    reference_pos: ReferencePoint
+    reference_neg: ReferencePoint
+    limits: KnobLimits
+
+
+@dataclass(frozen=True)
+class DeviceModel:
+    """Data-sheet constants of a catheter type (omega, reference points, limits)."""
+
+    device_model: str
+    knobs: tuple[DeviceKnob, DeviceKnob]
+    description: str = ""
+    schema_version: int = DEVICE_SCHEMA_VERSION
+
+    @property
+    def limits(self) -> tuple[KnobLimits, KnobLimits]:
+        return (self.knobs[0].limits, self.knobs[1].limits)
+
+
+@dataclass(frozen=True)
+class KnobProfile:
+    """What calibration identified for one knob, over the other knob's angle."""
+
+    omega: float
+    reference_pos: ReferencePoint
+    reference_neg: ReferencePoint
+    height_pos_deg: float
+    height_neg_deg: float
+    other_knob_deg: tuple[float, ...]
+    dead_zone_pos_deg: tuple[float, ...]
+    dead_zone_neg_deg: tuple[float, ...]
+    backlash_pos_deg: tuple[float, ...]
+    backlash_neg_deg: tuple[float, ...]
+    ours: OursParams | None = None
+
+    def grid_array(self) -> np.ndarray:
+        """(n, 4) array: D_pos, D_neg, B_pos, B_neg per grid point."""
+        return np.column_stack([self.dead_zone_pos_deg, self.dead_zone_neg_deg,
+                                self.backlash_pos_deg, self.backlash_neg_deg]).astype(float)
+
+
+@dataclass(frozen=True)
+class CatheterProfile:
+    """One catheter's calibration: everything the compensators need."""
+
+    catheter_id: str
+    device_model: str
+    calibrated_at: str
+    software_version: str
+    interpolation: str
+    knobs: tuple[KnobProfile, KnobProfile]
+    source: str = "calibration"
+    quality: dict[str, float] = field(default_factory=dict)
+    schema_version: int = PROFILE_SCHEMA_VERSION
+
+
+# ----------------------------------------------------------------------------------------------
+# Validation helpers: each names the key path and the reason.
+
+
+class _Reader:
+    def __init__(self, origin: str) -> None:
+        self.origin = origin
+
+    def fail(self, key: str, reason: str) -> ProfileError:
+        return ProfileError(f"{self.origin}: {key}: {reason}")
+
+    def mapping(self, data: Any, key: str) -> Mapping[str, Any]:
+        if not isinstance(data, Mapping):
+            raise self.fail(key, f"must be a mapping, got {type(data).__name__}")
+        return data
+
+    def get(self, data: Mapping[str, Any], name: str, path: str) -> Any:
+        if name not in data:
+            raise self.fail(f"{path}{name}", "missing key")
+        return data[name]
+
+    def number(self, value: Any, key: str, lo: float | None = None, hi: float | None = None,
+               unit: str = "") -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.fail(key, f"must be a number{' in ' + unit if unit else ''}, got {value!r}")
+        v = float(value)
+        if math.isnan(v):
+            raise self.fail(key, "is NaN")
+        if math.isinf(v):
+            raise self.fail(key, "is infinite")
+        if (lo is not None and v < lo) or (hi is not None and v > hi):
+            raise self.fail(key, f"{v} {unit} is outside the plausible range [{lo}, {hi}]".replace(
+                "  ", " "))
+        return v
+
+    def text(self, value: Any, key: str) -> str:
+        if not isinstance(value, str) or not value.strip():
+            raise self.fail(key, f"must be a non-empty string, got {value!r}")
+        return value
+
+    def numbers(self, value: Any, key: str, n: int | None, lo: float, hi: float,
+                unit: str) -> tuple[float, ...]:
+        if not isinstance(value, Sequence) or isinstance(value, str):
+            raise self.fail(key, f"must be a list of numbers, got {type(value).__name__}")
+        if n is not None and len(value) != n:
+            raise self.fail(key, f"must have {n} values (one per grid point), got {len(value)}")
+        return tuple(self.number(v, f"{key}[{i}]", lo, hi, unit) for i, v in enumerate(value))
+
+    def version(self, data: Mapping[str, Any], supported: int) -> int:
+        v = self.get(data, "schema_version", "")
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise self.fail("schema_version", f"must be an integer, got {v!r}")
+        if v != supported:
+            raise self.fail("schema_version",
+                            f"unknown schema version {v} (this tsmd reads version {supported})")
+        return v
+
+    def reference(self, data: Any, key: str) -> ReferencePoint:
+        m = self.mapping(data, key)
+        return ReferencePoint(
+            self.number(self.get(m, "knob_deg", key + "."), key + ".knob_deg",
+                        -ANGLE_RANGE_DEG, ANGLE_RANGE_DEG, "deg"),
+            self.number(self.get(m, "tip_deg", key + "."), key + ".tip_deg",
+                        -ANGLE_RANGE_DEG, ANGLE_RANGE_DEG, "deg"))
+
+    def omega(self, value: Any, key: str) -> float:
+        return self.number(value, key, OMEGA_RANGE[0], OMEGA_RANGE[1], "tip deg per knob deg")
+
+    def knob_map(self, data: Mapping[str, Any], path: str) -> list[tuple[str, Any]]:
+        knobs = self.mapping(self.get(data, "knobs", path), path + "knobs")
+        for name in knobs:
+            if name not in KNOB_NAMES:
+                raise self.fail(f"{path}knobs.{name}", f"unknown knob (expected {KNOB_NAMES})")
+        return [(name, self.get(knobs, name, f"{path}knobs.")) for name in KNOB_NAMES]
+
+
+def _check_references(r: _Reader, key: str, pos: ReferencePoint, neg: ReferencePoint) -> None:
+    if not (pos.knob_deg > 0 > neg.knob_deg):
+        raise r.fail(key, "reference_pos.knob_deg must be > 0 and reference_neg.knob_deg < 0")
+    if not pos.tip_deg > neg.tip_deg:
+        raise r.fail(key, "reference_pos.tip_deg must be above reference_neg.tip_deg")
+
+
+# ----------------------------------------------------------------------------------------------
+# Device model
+
+
+def device_model_from_mapping(data: Any, origin: str = "device model") -> DeviceModel:
+    r = _Reader(origin)
+    m = r.mapping(data, "top level")
+    version = r.version(m, DEVICE_SCHEMA_VERSION)
+    name = r.text(r.get(m, "device_model", ""), "device_model")
+    knobs: list[DeviceKnob] = []
+    for knob_name, raw in r.knob_map(m, ""):
+        key = f"knobs.{knob_name}"
+        k = r.mapping(raw, key)
+        lim = r.mapping(r.get(k, "limits", key + "."), key + ".limits")
+        lk = key + ".limits."
+        try:
+            limits = KnobLimits(
+                r.number(r.get(lim, "min_deg", lk), lk + "min_deg", -ANGLE_RANGE_DEG, 0, "deg"),
+                r.number(r.get(lim, "max_deg", lk), lk + "max_deg", 0, ANGLE_RANGE_DEG, "deg"),
+                r.number(r.get(lim, "max_velocity_deg_s", lk), lk + "max_velocity_deg_s",
+                         1e-3, 1e4, "deg/s"),
+                r.number(r.get(lim, "max_accel_deg_s2", lk), lk + "max_accel_deg_s2",
+                         1e-3, 1e6, "deg/s^2"))
+        except ValueError as exc:
+            if isinstance(exc, ProfileError):
+                raise
+            raise r.fail(key + ".limits", str(exc)) from None
+        pos = r.reference(r.get(k, "reference_pos", key + "."), key + ".reference_pos")
+        neg = r.reference(r.get(k, "reference_neg", key + "."), key + ".reference_neg")
+        _check_references(r, key, pos, neg)
+        knobs.append(DeviceKnob(r.omega(r.get(k, "omega", key + "."), key + ".omega"),
+                                pos, neg, limits))
+    desc = m.get("description", "")
+    return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
+
+
+def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
+    knobs: dict[str, Any] = {}
+    for name, k in zip(KNOB_NAMES, device.knobs, strict=True):
+        knobs[name] = {
+            "omega": k.omega,
+            "reference_pos": _ref_map(k.reference_pos),
+            "reference_neg": _ref_map(k.reference_neg),
+            "limits": {"min_deg": k.limits.min_deg, "max_deg": k.limits.max_deg,
+                       "max_velocity_deg_s": k.limits.max_velocity_deg_s,
+                       "max_accel_deg_s2": k.limits.max_accel_deg_s2},
+        }
+    return {"schema_version": device.schema_version, "device_model": device.device_model,
+            "description": device.description, "knobs": knobs}
+
+
+def load_device_model(path: str | os.PathLike[str]) -> DeviceModel:
+    """Read and validate a device model (data-sheet constants) from YAML."""
+    return device_model_from_mapping(_read_yaml(Path(path)), str(path))
+
+
+# ----------------------------------------------------------------------------------------------
+# Profile
+
+
+def _ref_map(p: ReferencePoint) -> dict[str, float]:
+    return {"knob_deg": p.knob_deg, "tip_deg": p.tip_deg}
+
+
+def _knob_from_mapping(r: _Reader, raw: Any, key: str) -> KnobProfile:
+    k = r.mapping(raw, key)
+    p = key + "."
+    omega = r.omega(r.get(k, "omega", p), p + "omega")
+    pos = r.reference(r.get(k, "reference_pos", p), p + "reference_pos")
+    neg = r.reference(r.get(k, "reference_neg", p), p + "reference_neg")
+    _check_references(r, key, pos, neg)
+    h_pos = r.number(r.get(k, "height_pos_deg", p), p + "height_pos_deg", -90, 90, "deg")
+    h_neg = r.number(r.get(k, "height_neg_deg", p), p + "height_neg_deg", -90, 90, "deg")
+    grid = r.numbers(r.get(k, "other_knob_deg", p), p + "other_knob_deg", None,
+                     -ANGLE_RANGE_DEG, ANGLE_RANGE_DEG, "deg")
+    if len(grid) < 2:
+        raise r.fail(p + "other_knob_deg", "needs at least two grid points")
+    if any(b <= a for a, b in itertools.pairwise(grid)):
+        raise r.fail(p + "other_knob_deg", f"grid is not sorted strictly increasing: {list(grid)}")
+    n = len(grid)
+    d_pos = r.numbers(r.get(k, "dead_zone_pos_deg", p), p + "dead_zone_pos_deg", n, 0, 90, "deg")
+    d_neg = r.numbers(r.get(k, "dead_zone_neg_deg", p), p + "dead_zone_neg_deg", n, -90, 0, "deg")
+    b_pos = r.numbers(r.get(k, "backlash_pos_deg", p), p + "backlash_pos_deg", n, 0, 90, "deg")
+    b_neg = r.numbers(r.get(k, "backlash_neg_deg", p), p + "backlash_neg_deg", n, 0, 90, "deg")
+    ours = None
+    if k.get("ours") is not None:
+        ours = _ours_from_mapping(r, k["ours"], p + "ours", n)
+    return KnobProfile(omega, pos, neg, h_pos, h_neg, grid, d_pos, d_neg, b_pos, b_neg, ours)
+
+
+def _ours_from_mapping(r: _Reader, raw: Any, key: str, n: int) -> OursParams:
+    m = r.mapping(raw, key)
+    try:
+        return ours_params_from_mapping(m, n)
+    except (KeyError, ValueError, TypeError) as exc:
+        raise r.fail(key, str(exc).strip("'\"")) from None
+
+
+def profile_from_mapping(data: Any, origin: str = "profile") -> CatheterProfile:
+    """Validate a parsed YAML document and build the profile (ProfileError on any problem)."""
+    r = _Reader(origin)
+    m = r.mapping(data, "top level")
+    version = r.version(m, PROFILE_SCHEMA_VERSION)
+    catheter_id = r.text(r.get(m, "catheter_id", ""), "catheter_id")
+    if not _ID_PATTERN.match(catheter_id):
+        raise r.fail("catheter_id", f"{catheter_id!r} must be letters, digits, '.', '_' or '-'")
+    device = r.text(r.get(m, "device_model", ""), "device_model")
+    calibrated_at = r.text(str(r.get(m, "calibrated_at", "")), "calibrated_at")
+    software = r.text(r.get(m, "software_version", ""), "software_version")
+    method = r.get(m, "interpolation", "")
+    if method not in INTERPOLATION_METHODS:
+        raise r.fail("interpolation", f"{method!r} is not one of {list(INTERPOLATION_METHODS)}")
+    source = str(m.get("source", "calibration"))
+    quality_raw = r.mapping(m.get("quality", {}) or {}, "quality")
+    quality = {str(q): r.number(v, f"quality.{q}") for q, v in quality_raw.items()}
+    knobs = [_knob_from_mapping(r, raw, f"knobs.{name}") for name, raw in r.knob_map(m, "")]
+    return CatheterProfile(catheter_id, device, calibrated_at, software, method,
+                           (knobs[0], knobs[1]), source, quality, version)
+
+
+def profile_to_mapping(profile: CatheterProfile) -> dict[str, Any]:
+    knobs: dict[str, Any] = {}
+    for name, k in zip(KNOB_NAMES, profile.knobs, strict=True):
+        entry: dict[str, Any] = {
+            "omega": k.omega,
+            "reference_pos": _ref_map(k.reference_pos),
+            "reference_neg": _ref_map(k.reference_neg),
+            "height_pos_deg": k.height_pos_deg,
+            "height_neg_deg": k.height_neg_deg,
+            "other_knob_deg": list(k.other_knob_deg),
+            "dead_zone_pos_deg": list(k.dead_zone_pos_deg),
+            "dead_zone_neg_deg": list(k.dead_zone_neg_deg),
+            "backlash_pos_deg": list(k.backlash_pos_deg),
+            "backlash_neg_deg": list(k.backlash_neg_deg),
+        }
+        if k.ours is not None:
+            entry["ours"] = ours_params_to_mapping(k.ours)
+        knobs[name] = entry
+    return {
+        "schema_version": profile.schema_version,
+        "catheter_id": profile.catheter_id,
+        "device_model": profile.device_model,
+        "calibrated_at": profile.calibrated_at,
+        "software_version": profile.software_version,
+        "source": profile.source,
+        "interpolation": profile.interpolation,
+        "quality": dict(profile.quality),
+        "knobs": knobs,
+    }
+
+
+def _plain(obj: Any) -> Any:
+    """numpy scalars -> Python floats so the YAML stays readable by safe_load."""
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+def _read_yaml(path: Path) -> Any:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ProfileError(f"{path}: no such file") from None
+    except OSError as exc:
+        raise ProfileError(f"{path}: cannot read: {exc.strerror}") from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ProfileError(f"{path}: not valid YAML: {exc}") from None
+
+
+def load_profile(path: str | os.PathLike[str]) -> CatheterProfile:
+    """Read and validate a catheter profile."""
+    return profile_from_mapping(_read_yaml(Path(path)), str(path))
+
+
+def dump_profile(profile: CatheterProfile) -> str:
+    header = (f"# tsmd catheter profile, schema version {profile.schema_version}\n"
+              f"# source: {profile.source}\n")
+    return header + yaml.safe_dump(_plain(profile_to_mapping(profile)), sort_keys=False,
+                                   default_flow_style=None, width=100)
+
+
+def save_profile(profile: CatheterProfile, path: str | os.PathLike[str]) -> None:
+    """Write atomically: temp file in the same directory, fsync, keep the old file as .bak,
+    rename over, fsync the directory. A crash at any point leaves a complete profile on disk."""
+    target = Path(path)
+    text = dump_profile(profile)
+    profile_from_mapping(yaml.safe_load(text), str(target))  # never write what we cannot read
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        if target.exists():
+            backup = target.with_name(target.name + ".bak")
+            # A hard link keeps the old profile under the backup name while the target name
+            # still points at it; replace() then swaps the target in one step.
+            with contextlib.suppress(FileNotFoundError):
+                backup.unlink()
+            try:
+                os.link(target, backup)
+            except OSError:  # no hard links on this file system: copy instead
+                shutil.copy2(target, backup)
+        os.replace(tmp_name, target)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp_name)
+        raise
+    _fsync_dir(target.parent)
+
+
+def _fsync_dir(directory: Path) -> None:
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+class ProfileStore:
+    """Profiles kept as ``<dir>/<catheter_id>.yaml``."""
+
+    def __init__(self, directory: str | os.PathLike[str]) -> None:
+        self.directory = Path(directory)
+
+    def path(self, catheter_id: str) -> Path:
+        if not _ID_PATTERN.match(catheter_id):
+            raise ProfileError(
+                f"catheter id {catheter_id!r} must be letters, digits, '.', '_' or '-'")
+        return self.directory / f"{catheter_id}.yaml"
+
+    def load(self, catheter_id: str) -> CatheterProfile:
+        path = self.path(catheter_id)
+        if not path.exists():
+            raise ProfileError(f"no profile for catheter {catheter_id!r} in {self.directory}")
+        profile = load_profile(path)
+        if profile.catheter_id != catheter_id:
+            raise ProfileError(f"{path}: catheter_id is {profile.catheter_id!r}, "
+                               f"expected {catheter_id!r}")
+        return profile
+
+    def save(self, profile: CatheterProfile) -> Path:
+        path = self.path(profile.catheter_id)
+        save_profile(profile, path)
+        return path
+
+    def list(self) -> list[str]:
+        if not self.directory.is_dir():
+            return []
+        return sorted(p.stem for p in self.directory.glob("*.yaml") if _ID_PATTERN.match(p.stem))
+
+
+def standard_grid() -> tuple[float, ...]:
+    """The paper's calibration grid of the other knob's angle."""
+    return CALIBRATION_GRID_DEG
+
+
+def make_knob_profile(device_knob: DeviceKnob, other_knob_deg: Sequence[float],
+                      dead_zone_pos_deg: Sequence[float], dead_zone_neg_deg: Sequence[float],
+                      backlash_pos_deg: Sequence[float], backlash_neg_deg: Sequence[float],
+                      ours: OursParams | None = None) -> KnobProfile:
+    """A knob's profile from identified grids and the data sheet.
+
+    H_pos/H_neg follow design assumptions 1-3: the line of slope omega through the reference point
+    (other knob at 0 deg) meets the dead-zone edge D(0) at height H; H is then constant.
+    """
+    grid = np.asarray(other_knob_deg, dtype=float)
+    d_pos0 = float(np.interp(0.0, grid, np.asarray(dead_zone_pos_deg, dtype=float)))
+    d_neg0 = float(np.interp(0.0, grid, np.asarray(dead_zone_neg_deg, dtype=float)))
+    k = device_knob
+    h_pos = k.reference_pos.tip_deg - k.omega * (k.reference_pos.knob_deg - d_pos0)
+    h_neg = k.reference_neg.tip_deg - k.omega * (k.reference_neg.knob_deg - d_neg0)
+
+    def floats(values: Sequence[float]) -> tuple[float, ...]:
+        return tuple(float(v) for v in values)
+
+    return KnobProfile(k.omega, k.reference_pos, k.reference_neg, float(h_pos), float(h_neg),
+                       floats(other_knob_deg), floats(dead_zone_pos_deg),
+                       floats(dead_zone_neg_deg), floats(backlash_pos_deg),
+                       floats(backlash_neg_deg), ours)

@@ -1,0 +1,152 @@
+"""Ground truth from a sweep: dead zone, backlash and slope measured on the tip angle.
+
+These helpers look only at the knob and tip arrays of a sweep (the EM tracker's view), never at
+plant parameters, so they measure what a catheter actually does. Definitions follow the paper's
+piecewise-linear model (see ``docs/plant.md``):
+
+- ``dead_zone_pos_deg`` (``D_pos``): on a rising pass, the knob angle at which the tip leaves the
+  dead-zone plateau upwards (rises more than ``threshold_deg`` above the plateau level).
+- ``dead_zone_neg_deg`` (``D_neg``, signed, normally negative): the same on a falling pass.
+- ``backlash_pos_deg`` (``B_pos``): knob travel after a reversal at the positive extreme before the
+  tip has moved back by ``threshold_deg``.
+- ``backlash_neg_deg`` (``B_neg``): the same after a reversal at the negative extreme.
+
+Each value is the median over all complete passes (a pass runs from one reversal to the next;
+the stretch before the first reversal is ignored).
+"""
+
+from __future__ import annotations
+
+import itertools
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
+
+class DeadZoneBacklash(NamedTuple):
+    """Dead zone and backlash of one knob, knob degrees (``D_neg`` signed)."""
+
+    dead_zone_pos_deg: float
+    dead_zone_neg_deg: float
+    backlash_pos_deg: float
+    backlash_neg_deg: float
+
+
+class SweepAnalysisError(ValueError):
+    """The arrays do not hold a sweep these measures are defined on."""
+
+
+def split_passes(knob_deg: ArrayLike) -> list[tuple[int, int, int]]:
+    """Monotone passes of a sweep as ``(start, stop, direction)`` index ranges.
+
+    A pass starts at a reversal and ends at the next one (the stretches before the first and
+    after the last reversal are dropped: they need not span the range); samples where the knob
+    does not move belong to the pass they interrupt.
+    """
+    q = np.asarray(knob_deg, dtype=np.float64)
+    dq = np.diff(q)
+    moving = np.flatnonzero(dq != 0.0)
+    if moving.size == 0:
+        return []
+    direction = np.sign(dq[moving])
+    turns = np.flatnonzero(direction[1:] != direction[:-1])
+    # Reversal sample = the last sample of the previous direction (the extreme).
+    edges = [int(moving[i] + 1) for i in turns]
+    passes = []
+    for a, b in itertools.pairwise(edges):
+        passes.append((a, b + 1, int(np.sign(q[b] - q[a]))))
+    return [p for p in passes if p[1] - p[0] >= 3 and p[2] != 0]
+
+
+def _rising_pass_measures(q: FloatArray, tip: FloatArray, thr: float) -> tuple[float, float]:
+    """(backlash, dead zone edge) of a pass with the knob increasing."""
+    rising_max = np.maximum.accumulate(tip)
+    start = tip[0]
+    left = np.flatnonzero(rising_max > start + thr)
+    if left.size == 0:
+        return float("nan"), float("nan")
+    i_left = int(left[0])
+    backlash = float(q[i_left] - q[0])
+    # Dead-zone plateau: the sample from which the knob must travel farthest before the tip
+    # rises by the threshold; the plateau ends where that happens.
+    qs = q[i_left:]
+    cm = rising_max[i_left:]
+    ts = tip[i_left:]
+    j = np.searchsorted(cm, ts + thr, side="right")
+    valid = j < qs.size
+    if not np.any(valid):
+        return backlash, float("nan")
+    travel = np.where(valid, qs[np.minimum(j, qs.size - 1)] - qs, -np.inf)
+    i_best = int(np.argmax(travel))
+    return backlash, float(qs[j[i_best]])
+
+
+def measure_dead_zone_backlash(
+    knob_deg: ArrayLike, tip_deg: ArrayLike, threshold_deg: float = 1.0
+) -> DeadZoneBacklash:
+    """Measure ``D_pos, D_neg, B_pos, B_neg`` (knob degrees) from a sweep's tip angle.
+
+    ``knob_deg`` is the actual knob angle and ``tip_deg`` the tip angle (true or tracked) of a
+    periodic sweep through both dead-zone edges; at least one complete pass each way is needed.
+    ``threshold_deg`` is the tip motion that counts as "the tip moves": above the tracker noise,
+    small against the loaded slope. NaN marks a quantity that never occurred (no plateau).
+    """
+    q = np.asarray(knob_deg, dtype=np.float64)
+    y = np.asarray(tip_deg, dtype=np.float64)
+    if q.ndim != 1 or q.shape != y.shape:
+        raise SweepAnalysisError(
+            f"knob_deg and tip_deg must be 1-D arrays of one length, got {q.shape} and {y.shape}"
+        )
+    if not threshold_deg > 0.0:
+        raise SweepAnalysisError(f"threshold_deg must be > 0, got {threshold_deg!r}")
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(y))):
+        raise SweepAnalysisError("knob_deg and tip_deg must be finite (drop NaN samples first)")
+    up: list[tuple[float, float]] = []
+    down: list[tuple[float, float]] = []
+    for a, b, direction in split_passes(q):
+        if direction > 0:
+            up.append(_rising_pass_measures(q[a:b], y[a:b], threshold_deg))
+        else:
+            bl, dz = _rising_pass_measures(-q[a:b], -y[a:b], threshold_deg)
+            down.append((bl, -dz))
+    if not up or not down:
+        raise SweepAnalysisError("need at least one complete rising and one falling pass")
+    b_neg, d_pos = np.nanmedian(np.array(up), axis=0) if _finite(up) else (np.nan, np.nan)
+    b_pos, d_neg = np.nanmedian(np.array(down), axis=0) if _finite(down) else (np.nan, np.nan)
+    return DeadZoneBacklash(float(d_pos), float(d_neg), float(b_pos), float(b_neg))
+
+
+def _finite(rows: list[tuple[float, float]]) -> bool:
+    return bool(np.any(np.isfinite(np.array(rows))))
+
+
+def loaded_slope(
+    knob_deg: ArrayLike, tip_deg: ArrayLike, lo_deg: float, hi_deg: float
+) -> tuple[float, float]:
+    """Tip/knob slope of the loading branches, (positive side, negative side).
+
+    Fits a line to the samples moving away from zero with ``lo_deg <= |knob| <= hi_deg`` (the
+    tendon is being pulled there once ``lo_deg`` is past the dead zone).
+    """
+    q = np.asarray(knob_deg, dtype=np.float64)
+    y = np.asarray(tip_deg, dtype=np.float64)
+    dq = np.gradient(q)
+    out = []
+    for side in (1.0, -1.0):
+        sel = (side * q >= lo_deg) & (side * q <= hi_deg) & (side * dq > 0.0)
+        if np.count_nonzero(sel) < 3:
+            raise SweepAnalysisError(f"no loading samples between {lo_deg} and {hi_deg} deg")
+        out.append(float(np.polyfit(q[sel], y[sel], 1)[0]))
+    return out[0], out[1]
+
+
+def releasing_slope(
+    knob_deg: ArrayLike, tip_deg: ArrayLike, lo_deg: float, hi_deg: float
+) -> tuple[float, float]:
+    """Tip/knob slope of the releasing branches (moving towards zero), like :func:`loaded_slope`."""
+    q = np.asarray(knob_deg, dtype=np.float64)
+    y = np.asarray(tip_deg, dtype=np.float64)
+    return loaded_slope(q[::-1], y[::-1], lo_deg, hi_deg)

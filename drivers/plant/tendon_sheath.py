@@ -1,0 +1,335 @@
+"""The built-in catheter plant: physics of two antagonistic tendon-sheath pairs.
+
+Per knob, a pulley of radius ``r`` draws in one tendon and pays out its antagonist. Each tendon
+has slack between pulley and sheath (the dead zone), is elastic, and runs through a sheath
+discretised into elements with capstan friction (stick/slip per element, so the backlash has
+curved transitions). At the distal end both tendons act on a bending section made of joints
+with stiffness and Coulomb friction; its stiffness straightens the tip when the tendons release.
+Equilibrium is solved exactly every step (see :mod:`drivers.plant.tendon`), so the plant is
+quasi-static, stable at any step size and cheap.
+
+The knob torque is the tendon torque plus the handle's own friction (knob bearings, friction
+brake). Optional unmodelled effects, all off by default, are described in ``docs/plant.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, fields, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from drivers.plant.base import PlantLoadError, PlantStep
+from drivers.plant.tendon import TendonGeometry, apply_pull, residual_m, solve_pull
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class KnobParams:
+    """Mechanical constants of one knob's tendon pair (units in the names)."""
+
+    pulley_radius_mm: float = 6.0
+    slack_pos_mm: float = 1.9
+    """Slack of the tendon pulled by positive knob rotation."""
+    slack_neg_mm: float = 2.1
+    tendon_offset_mm: float = 3.0
+    """Moment arm of the tendons in the bending section."""
+    tendon_stiffness_N: float = 10000.0
+    """Axial stiffness EA of the tendon."""
+    sheath_length_m: float = 1.0
+    free_length_m: float = 0.05
+    """Tendon length between pulley and sheath entry (no friction)."""
+    sheath_friction: float = 0.15
+    """Coulomb friction coefficient tendon/sheath."""
+    sheath_wrap_deg: float = 420.0
+    """Total wrap angle of the tendon in the (straight) sheath: coil helix and lumen contact."""
+    sheath_drag_N: float = 0.4
+    """Tension-independent friction summed over the sheath (preload of the coil sheath, tendon
+    bending stiffness in its lumen); it gives a load-independent part of the backlash."""
+    bend_stiffness_Nm_per_rad: float = 0.025
+    bend_friction_Nm: float = 0.0015
+    """Mean Coulomb friction moment of the bending joints (spread 0.4x..1.6x over the joints)."""
+    handle_friction_Nm: float = 0.008
+    """Friction torque of the knob itself (bearings, friction brake)."""
+
+    def validated(self, where: str) -> KnobParams:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not isinstance(value, int | float) or isinstance(value, bool):
+                raise PlantLoadError(f"{where}.{f.name} must be a number, got {value!r}")
+            if not math.isfinite(value):
+                raise PlantLoadError(f"{where}.{f.name} must be finite, got {value!r}")
+        positive = (
+            "pulley_radius_mm",
+            "tendon_offset_mm",
+            "tendon_stiffness_N",
+            "sheath_length_m",
+            "bend_stiffness_Nm_per_rad",
+        )
+        for name in positive:
+            if getattr(self, name) <= 0.0:
+                raise PlantLoadError(f"{where}.{name} must be > 0, got {getattr(self, name)!r}")
+        for f in fields(self):
+            if f.name not in positive and getattr(self, f.name) < 0.0:
+                raise PlantLoadError(
+                    f"{where}.{f.name} must be >= 0, got {getattr(self, f.name)!r}"
+                )
+        return self
+
+
+# The anterior-posterior and right-left knobs of one catheter differ slightly.
+DEFAULT_KNOBS = (
+    KnobParams(),
+    KnobParams(slack_pos_mm=2.2, slack_neg_mm=1.8, sheath_wrap_deg=400.0, tendon_offset_mm=2.95),
+)
+
+
+@dataclass(frozen=True)
+class Effects:
+    """Strength of the switchable unmodelled effects; 0 switches an effect off."""
+
+    coupling: float = 0.0
+    """Scale of the cross-knob coupling (1.0 = nominal, see the two constants below)."""
+    coupling_tendon_twist_deg: float = 8.0
+    """Angular misplacement of the tendons from the ideal orthogonal lumens: bending the other
+    plane changes their path length in opposite senses, shifting the dead zone linearly."""
+    coupling_shortening_mm_per_rad2: float = 0.45
+    """Axial shortening of the bending section when bent in the other plane (adds slack to both
+    tendons, widening the dead zone quadratically)."""
+    rate_dependence: float = 0.0
+    """Relative rise of the sheath friction per ``rate_reference_deg_s`` of knob speed."""
+    rate_reference_deg_s: float = 50.0
+    tendon_compliance: float = 0.0
+    """Extra tendon compliance relative to the nominal one (1.0 doubles it)."""
+    sheath_curvature_deg: float = 0.0
+    """Total bend of the sheath path (e.g. 180 for a U loop): adds wrap angle and slack."""
+    lumen_clearance_mm: float = 0.35
+    """Radial play of the tendon in its lumen; a curved sheath shortens the path by this much
+    per radian of curvature."""
+    creep_mm_per_N_s: float = 0.0
+    """Tendon creep: slack grows by this much per newton of tension per second."""
+
+    def validated(self) -> Effects:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not isinstance(value, int | float) or isinstance(value, bool):
+                raise PlantLoadError(f"{f.name} must be a number, got {value!r}")
+            if not math.isfinite(value) or value < 0.0:
+                raise PlantLoadError(f"{f.name} must be finite and >= 0, got {value!r}")
+        if self.rate_reference_deg_s <= 0.0:
+            raise PlantLoadError(
+                f"rate_reference_deg_s must be > 0, got {self.rate_reference_deg_s!r}"
+            )
+        return self
+
+
+class _Knob:
+    """Mutable state and cached constants of one knob."""
+
+    def __init__(self, p: KnobParams, eff: Effects, n_elements: int, n_joints: int) -> None:
+        self.p = p
+        compliance = (1.0 + eff.tendon_compliance) / p.tendon_stiffness_N
+        seg = p.sheath_length_m / n_elements
+        spread = np.linspace(0.4, 1.6, n_joints) if n_joints > 1 else np.ones(1)
+        self.geom = TendonGeometry(
+            free_compliance_m_per_N=p.free_length_m * compliance,
+            element_compliance_m_per_N=np.full(n_elements, seg * compliance),
+            offset_m=p.tendon_offset_mm * 1e-3,
+            joint_stiffness_Nm_per_rad=np.full(n_joints, p.bend_stiffness_Nm_per_rad * n_joints),
+            joint_friction_Nm=p.bend_friction_Nm * spread,
+        )
+        wrap_rad = math.radians(p.sheath_wrap_deg + eff.sheath_curvature_deg)
+        self.wrap_per_element_rad = np.full(n_elements, wrap_rad / n_elements)
+        self.radius_m = p.pulley_radius_mm * 1e-3
+        curvature_slack_m = eff.lumen_clearance_mm * 1e-3 * math.radians(eff.sheath_curvature_deg)
+        self.slack_m = np.array(
+            [p.slack_pos_mm * 1e-3 + curvature_slack_m, p.slack_neg_mm * 1e-3 + curvature_slack_m]
+        )
+        self.n_elements = n_elements
+        self.n_joints = n_joints
+        self.drag_per_element_N = np.full(n_elements, p.sheath_drag_N / n_elements)
+        self.friction_static = self._friction(p.sheath_friction)
+        self.reset()
+
+    def _friction(self, mu: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """(G, H) for pulling and for the mirrored release."""
+        gain = np.exp(-np.cumsum(mu * self.wrap_per_element_rad))
+        inv = 1.0 / gain
+        h = self.drag_per_element_N
+        return gain, gain * np.cumsum(h * inv), inv, inv * np.cumsum(h * gain)
+
+    def reset(self) -> None:
+        self.tension_N = np.zeros((2, self.n_elements))
+        self.proximal_N = np.zeros(2)
+        self.joints_rad = np.zeros(self.n_joints)
+        self.creep_m = np.zeros(2)
+        self.knob_rad: float | None = None
+
+    @property
+    def tip_rad(self) -> float:
+        return float(self.joints_rad.sum())
+
+    def step(
+        self, dt_s: float, knob_rad: float, other_tip_rad: float, eff: Effects
+    ) -> tuple[float, float]:
+        """Advance to ``knob_rad``; returns (tip angle rad, knob torque Nm)."""
+        prev = knob_rad if self.knob_rad is None else self.knob_rad
+        speed = (knob_rad - prev) / dt_s if dt_s > 0.0 else 0.0
+        self.knob_rad = knob_rad
+        friction = self.friction_static
+        if eff.rate_dependence > 0.0:
+            rel = eff.rate_dependence * abs(math.degrees(speed)) / eff.rate_reference_deg_s
+            friction = self._friction(self.p.sheath_friction * (1.0 + rel))
+
+        slack = self.slack_m + self.creep_m
+        if eff.coupling > 0.0:
+            rb = self.geom.offset_m
+            twist = rb * math.sin(math.radians(eff.coupling_tendon_twist_deg)) * other_tip_rad
+            short = eff.coupling_shortening_mm_per_rad2 * 1e-3 * other_tip_rad**2
+            slack = slack + eff.coupling * np.array([short - twist, short + twist])
+
+        for side, sign in ((0, 1.0), (1, -1.0)):
+            self._solve_tendon(side, sign, sign * self.radius_m * knob_rad - slack[side], friction)
+
+        if eff.creep_mm_per_N_s > 0.0 and dt_s > 0.0:
+            self.creep_m += eff.creep_mm_per_N_s * 1e-3 * self.proximal_N * dt_s
+        torque = self.radius_m * (self.proximal_N[0] - self.proximal_N[1])
+        torque += self.p.handle_friction_Nm * math.tanh(math.degrees(speed) / 0.5)
+        return self.tip_rad, float(torque)
+
+    def _solve_tendon(
+        self,
+        side: int,
+        sign: float,
+        target_m: float,
+        friction: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+    ) -> None:
+        tension = self.tension_N[side]
+        joints = sign * self.joints_rad
+        other = float(self.tension_N[1 - side, -1])
+        t_p = float(self.proximal_N[side])
+        f0 = residual_m(self.geom, tension, t_p, joints, target_m)
+        if f0 == 0.0 or (t_p == 0.0 and f0 > 0.0):
+            return  # in equilibrium, or slack and staying slack
+        rho = 1.0 if f0 < 0.0 else -1.0
+        g, h = (friction[0], friction[1]) if rho > 0.0 else (friction[2], friction[3])
+        t_new, prof, jnt = solve_pull(
+            self.geom, g, h, rho * tension, rho * joints, rho * other, rho * target_m
+        )
+        if rho * t_new < 0.0:  # a tendon cannot push: it goes slack
+            t_new = 0.0
+            prof, jnt = apply_pull(self.geom, g, h, rho * tension, rho * joints, rho * other, 0.0)
+        self.proximal_N[side] = rho * t_new
+        self.tension_N[side] = rho * prof
+        self.joints_rad = (sign * rho) * jnt
+
+
+class TendonSheathPlant:
+    """Two knobs (phi1 anterior-posterior, phi2 right-left), each an antagonistic tendon pair.
+
+    Implements :class:`drivers.plant.base.Plant`. Build it with :func:`make_tendon_sheath_plant`.
+    """
+
+    def __init__(
+        self,
+        knobs: Sequence[KnobParams] = DEFAULT_KNOBS,
+        effects: Effects | None = None,
+        n_elements: int = 24,
+        n_joints: int = 6,
+    ) -> None:
+        if len(knobs) != 2:
+            raise PlantLoadError(f"knobs must list 2 knobs, got {len(knobs)}")
+        self.knob_params = tuple(k.validated(f"knobs[{i}]") for i, k in enumerate(knobs))
+        self.effects = (effects or Effects()).validated()
+        if not isinstance(n_elements, int) or not 2 <= n_elements <= 400:
+            raise PlantLoadError(f"n_elements must be an integer in 2..400, got {n_elements!r}")
+        if not isinstance(n_joints, int) or not 1 <= n_joints <= 50:
+            raise PlantLoadError(f"n_joints must be an integer in 1..50, got {n_joints!r}")
+        self._knobs = [_Knob(p, self.effects, n_elements, n_joints) for p in self.knob_params]
+
+    def reset(self) -> None:
+        """Straight tip, slack tendons, no creep."""
+        for k in self._knobs:
+            k.reset()
+
+    def step(self, dt_s: float, knob_deg: NDArray[np.float64]) -> PlantStep:
+        """Move the knobs to ``knob_deg`` (degrees, shape (2,)) and settle."""
+        if not dt_s >= 0.0:
+            raise ValueError(f"dt_s must be >= 0, got {dt_s!r}")
+        q = np.asarray(knob_deg, dtype=np.float64)
+        if q.shape != (2,) or not np.all(np.isfinite(q)):
+            raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}")
+        tips = (self._knobs[0].tip_rad, self._knobs[1].tip_rad)
+        tip0, tau0 = self._knobs[0].step(dt_s, math.radians(q[0]), tips[1], self.effects)
+        tip1, tau1 = self._knobs[1].step(dt_s, math.radians(q[1]), tips[0], self.effects)
+        return PlantStep(
+            tip_deg=np.array([math.degrees(tip0), math.degrees(tip1)]),
+            knob_torque_Nm=np.array([tau0, tau1]),
+        )
+
+    def tendon_tension_N(self) -> NDArray[np.float64]:
+        """Proximal tension of the four tendons, shape (2 knobs, 2 sides: pos, neg)."""
+        return np.array([k.proximal_N.copy() for k in self._knobs])
+
+
+_EFFECT_NAMES = {f.name for f in fields(Effects)}
+_KNOB_NAMES = {f.name for f in fields(KnobParams)}
+
+
+def make_tendon_sheath_plant(
+    knobs: Sequence[Mapping[str, Any]] | None = None,
+    n_elements: int = 24,
+    n_joints: int = 6,
+    unit_variation: float = 0.0,
+    seed: int = 0,
+    **effects: float,
+) -> TendonSheathPlant:
+    """Build the default plant; keyword parameters switch the unmodelled effects on.
+
+    ``knobs`` overrides per-knob constants (``[{"slack_pos_mm": 2.5}, {}]``), the other keywords
+    are :class:`Effects` fields. ``unit_variation`` (e.g. 0.1 = +-10 %) draws catheter-to-catheter
+    variation of slacks, friction and stiffness from ``seed``, so a seed names one catheter.
+    """
+    unknown = sorted(set(effects) - _EFFECT_NAMES)
+    if unknown:
+        raise PlantLoadError(
+            f"unknown plant parameter {unknown[0]!r}; known: "
+            f"knobs, n_elements, n_joints, unit_variation, seed, {', '.join(sorted(_EFFECT_NAMES))}"
+        )
+    overrides = list(knobs) if knobs is not None else [{}, {}]
+    if len(overrides) != 2:
+        raise PlantLoadError(f"knobs must list 2 knobs, got {len(overrides)}")
+    if not isinstance(unit_variation, int | float) or not 0.0 <= unit_variation < 0.5:
+        raise PlantLoadError(f"unit_variation must be in [0, 0.5), got {unit_variation!r}")
+    rng = np.random.default_rng(seed)
+    built = []
+    for i, (base, over) in enumerate(zip(DEFAULT_KNOBS, overrides, strict=True)):
+        if not isinstance(over, Mapping):
+            raise PlantLoadError(f"knobs[{i}] must be a mapping, got {over!r}")
+        bad = sorted(set(over) - _KNOB_NAMES)
+        if bad:
+            raise PlantLoadError(f"knobs[{i}]: unknown parameter {bad[0]!r}")
+        params = replace(base, **dict(over)).validated(f"knobs[{i}]")
+        if unit_variation > 0.0:
+            varied = {
+                name: asdict(params)[name] * (1.0 + unit_variation * rng.uniform(-1.0, 1.0))
+                for name in (
+                    "slack_pos_mm",
+                    "slack_neg_mm",
+                    "sheath_friction",
+                    "bend_stiffness_Nm_per_rad",
+                    "bend_friction_Nm",
+                    "handle_friction_Nm",
+                )
+            }
+            params = replace(params, **varied)
+        built.append(params)
+    try:
+        eff = Effects(**effects)
+    except TypeError as exc:  # pragma: no cover - names are checked above
+        raise PlantLoadError(str(exc)) from exc
+    return TendonSheathPlant(built, eff, n_elements=n_elements, n_joints=n_joints)

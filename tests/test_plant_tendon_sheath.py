@@ -1,0 +1,131 @@
+"""The built-in tendon-sheath plant shows the paper's signatures on a +-90 deg, 0.04 Hz sweep."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from drivers.plant.analysis import loaded_slope, measure_dead_zone_backlash
+from drivers.plant.base import Plant, load_plant
+from drivers.plant.tendon_sheath import TendonSheathPlant, make_tendon_sheath_plant
+
+DT_S = 0.004  # 250 Hz ticks
+
+
+@dataclass
+class Sweep:
+    t_s: np.ndarray
+    knob_deg: np.ndarray
+    tip_deg: np.ndarray
+    torque_Nm: np.ndarray
+
+
+def run_sweep(
+    plant: Plant,
+    knob: int = 0,
+    freq_hz: float = 0.04,
+    amp_deg: float = 90.0,
+    cycles: float = 2.0,
+    other_deg: float = 0.0,
+) -> Sweep:
+    t = np.arange(0.0, cycles / freq_hz, DT_S)
+    q = amp_deg * np.sin(2.0 * np.pi * freq_hz * t)
+    tip = np.empty_like(t)
+    tau = np.empty_like(t)
+    cmd = np.zeros(2)
+    cmd[1 - knob] = other_deg
+    for i, qi in enumerate(q):
+        cmd[knob] = qi
+        step = plant.step(DT_S, cmd)
+        tip[i] = step.tip_deg[knob]
+        tau[i] = step.knob_torque_Nm[knob]
+    return Sweep(t, q, tip, tau)
+
+
+@pytest.fixture(scope="module", params=[0, 1], ids=["phi1", "phi2"])
+def default_sweep(request: pytest.FixtureRequest) -> Sweep:
+    return run_sweep(make_tendon_sheath_plant(), knob=request.param)
+
+
+def test_factory_builds_a_plant_through_the_config_loader() -> None:
+    plant = load_plant("drivers.plant.tendon_sheath:make_tendon_sheath_plant", {"coupling": 1.0})
+    assert isinstance(plant, TendonSheathPlant)
+    assert isinstance(plant, Plant)
+
+
+def test_straight_and_unloaded_at_rest() -> None:
+    step = make_tendon_sheath_plant().step(DT_S, np.zeros(2))
+    assert np.allclose(step.tip_deg, 0.0)
+    assert np.allclose(step.knob_torque_Nm, 0.0)
+
+
+def test_sweep_shows_a_dead_zone_on_both_sides(default_sweep: Sweep) -> None:
+    m = measure_dead_zone_backlash(default_sweep.knob_deg, default_sweep.tip_deg)
+    assert 15.0 <= m.dead_zone_pos_deg <= 25.0
+    assert -25.0 <= m.dead_zone_neg_deg <= -15.0
+
+
+def test_sweep_shows_backlash_after_both_reversals(default_sweep: Sweep) -> None:
+    m = measure_dead_zone_backlash(default_sweep.knob_deg, default_sweep.tip_deg)
+    assert 15.0 <= m.backlash_pos_deg <= 25.0
+    assert 15.0 <= m.backlash_neg_deg <= 25.0
+
+
+def test_tip_slope_in_the_loaded_region_is_about_1_3(default_sweep: Sweep) -> None:
+    pos, neg = loaded_slope(default_sweep.knob_deg, default_sweep.tip_deg, 40.0, 85.0)
+    assert 1.2 <= pos <= 1.45
+    assert 1.2 <= neg <= 1.45
+
+
+def test_backlash_transitions_are_curved_not_straight(default_sweep: Sweep) -> None:
+    """After the tip leaves the backlash its slope builds up over several degrees."""
+    s = default_sweep
+    falling = (np.gradient(s.knob_deg) < 0) & (s.knob_deg > 30.0) & (s.t_s > 12.5)
+    q, y = s.knob_deg[falling], s.tip_deg[falling]
+    slope = np.gradient(y, q)
+    moving = np.flatnonzero(slope > 0.05)
+    first = moving[0]
+    # Just after it starts to move the slope is well below the one of the released branch.
+    assert slope[first] < 0.7 * np.median(slope[moving])
+
+
+def test_torque_is_flat_and_small_in_the_dead_zone(default_sweep: Sweep) -> None:
+    s = default_sweep
+    rising_dz = (np.gradient(s.knob_deg) > 0) & (np.abs(s.knob_deg) < 10.0) & (s.t_s > 12.5)
+    tau = s.torque_Nm[rising_dz]
+    peak = np.max(np.abs(s.torque_Nm))
+    assert np.ptp(tau) < 0.02 * peak
+    assert np.max(np.abs(tau)) < 0.06 * peak
+
+
+def test_torque_rises_once_the_tendon_engages(default_sweep: Sweep) -> None:
+    s = default_sweep
+    second_cycle = s.t_s > 25.0
+    loading = (
+        second_cycle & (np.gradient(s.knob_deg) > 0) & (s.knob_deg > 35.0) & (s.knob_deg < 88.0)
+    )
+    q, tau = s.knob_deg[loading], s.torque_Nm[loading]
+    assert np.all(np.diff(tau) > 0.0)
+    assert tau.max() > 0.05
+    assert np.corrcoef(q, tau)[0, 1] > 0.99
+
+
+def test_knob_torque_is_of_order_0_05_to_0_3_Nm(default_sweep: Sweep) -> None:
+    assert 0.05 <= np.max(np.abs(default_sweep.torque_Nm)) <= 0.3
+
+
+def test_torque_changes_sign_after_a_reversal_and_stays_near_zero_while_released(
+    default_sweep: Sweep,
+) -> None:
+    s = default_sweep
+    peak = np.max(s.torque_Nm)
+    m = measure_dead_zone_backlash(s.knob_deg, s.tip_deg)
+    i_rev = int(np.argmax(s.knob_deg[: int(25.0 / DT_S)]))
+    after = slice(i_rev, i_rev + int(12.0 / DT_S))
+    q, tau = s.knob_deg[after], s.torque_Nm[after]
+    released = (q < 90.0 - m.backlash_pos_deg - 2.0) & (q > m.dead_zone_pos_deg + 5.0)
+    assert tau[0] > 0.8 * peak
+    assert np.any(tau < 0.0)  # the sign changes
+    assert np.max(np.abs(tau[released])) < 0.1 * peak

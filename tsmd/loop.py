@@ -163,6 +163,46 @@ class MemoryRecorder:
         self.rows.append(row)
 
 
+class BackgroundRecorder:
+    """Per-tick rows to a recording file, written by a thread every ``flush_interval_s``.
+
+    The hot path only appends a tuple to a deque; formatting, writing and fsync happen in the
+    writer thread. :meth:`close` writes what is left, so a clean stop loses nothing.
+    """
+
+    def __init__(self, path: str, metadata: dict[str, object], flush_interval_s: float) -> None:
+        from tsmd.recording import RecordingWriter
+
+        self.path = path
+        self._writer = RecordingWriter(path, metadata)
+        self._rows: collections.deque[tuple[float, ...]] = collections.deque()
+        self._interval_s = flush_interval_s
+        self._stop = threading.Event()
+        self.rows_written = 0
+        self._thread = threading.Thread(target=self._run, name="tsmd-recorder", daemon=True)
+        self._thread.start()
+
+    def append(self, row: tuple[float, ...]) -> None:
+        self._rows.append(row)
+
+    def _drain(self) -> None:
+        rows = self._rows
+        while rows:
+            self._writer.write_row(rows.popleft())
+            self.rows_written += 1
+        self._writer.flush()
+
+    def _run(self) -> None:
+        while not self._stop.wait(self._interval_s):
+            self._drain()
+
+    def close(self) -> None:
+        self._stop.set()
+        self._thread.join()
+        self._drain()
+        self._writer.close()
+
+
 class ControlLoop:
     """Fixed-period feed-forward control of the knob drives; see the module docstring."""
 
@@ -170,7 +210,7 @@ class ControlLoop:
                  ranges: Sequence[KnobRange], period_s: float, clock: Clock, *,
                  stale_feedback_syncs: int = 3, overrun_fault_streak: int = 5,
                  compensation_label: str = "none",
-                 tip_source: Callable[[], Sequence[float]] | None = None,
+                 tip_source: Callable[[], Any] | None = None,
                  after_sync: Callable[[], None] | None = None,
                  recorder: TickRecorder | None = None,
                  on_event: Callable[..., None] | None = None) -> None:

@@ -1,0 +1,371 @@
+"""The socket API: every command, every error, and clients that misbehave."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import socket
+import stat
+import subprocess
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_loop_fakes import FakeDrives
+
+from drivers.clock import MonotonicClock
+from tsmd.api.client import ApiClient, ApiClientError
+from tsmd.api.handlers import ApiHandlers
+from tsmd.api.server import ApiServer
+from tsmd.config import TsmdConfig
+from tsmd.daemon import CompensationChoice, Controller, knob_limits, make_compensator
+from tsmd.loop import ControlLoop, KnobLimiter, KnobRange, LoopState
+from tsmd.rt import FixedRateScheduler
+
+PERIOD_S = 0.004
+
+
+@dataclass
+class Stack:
+    drives: FakeDrives
+    loop: ControlLoop
+    server: ApiServer
+    path: Path
+    stop: threading.Event
+    thread: threading.Thread
+
+    def client(self) -> ApiClient:
+        return ApiClient(self.path, timeout_s=10.0)
+
+    def wait_ticks(self, n: int) -> None:
+        target = self.loop.stats.ticks + n
+        deadline = time.monotonic() + 10.0
+        while self.loop.stats.ticks < target and time.monotonic() < deadline:
+            time.sleep(0.005)
+
+
+def start_stack(tmp_path: Path, *, max_line_bytes: int = 4096, max_clients: int = 16,
+                profiles_dir: Path | None = None) -> Stack:
+    config = TsmdConfig()
+    drives = FakeDrives()
+    loop = ControlLoop(drives, make_compensator(None, "none", config),
+                       KnobLimiter(knob_limits(config), PERIOD_S),
+                       [KnobRange(-90.0, 90.0)] * 2, PERIOD_S, MonotonicClock())
+    controller = Controller(config, loop, None, CompensationChoice(True, "ours"),
+                            profiles_dir=profiles_dir or tmp_path / "profiles")
+    path = tmp_path / "run" / "tsmd.sock"
+    server = ApiServer(path, ApiHandlers(controller), max_line_bytes=max_line_bytes,
+                       max_clients=max_clients)
+    server.start()
+    stop = threading.Event()
+    scheduler = FixedRateScheduler(PERIOD_S, loop.tick, on_tick_end=loop.note_overrun)
+    thread = threading.Thread(target=scheduler.run, args=(stop,), daemon=True)
+    thread.start()
+    stack = Stack(drives, loop, server, path, stop, thread)
+    stack.wait_ticks(2)
+    return stack
+
+
+@pytest.fixture
+def stack(tmp_path: Path) -> Iterator[Stack]:
+    s = start_stack(tmp_path)
+    yield s
+    s.stop.set()
+    s.thread.join(5)
+    s.server.stop()
+
+
+def error_code(response: dict[str, object]) -> str:
+    assert response["ok"] is False, response
+    err = response["error"]
+    assert isinstance(err, dict) and err["message"]
+    return str(err["code"])
+
+
+def raw(client: ApiClient, line: bytes) -> dict[str, object]:
+    client.send_raw(line + b"\n")
+    return client.read_message()
+
+
+def all_targets_inside_limits(drives: FakeDrives) -> bool:
+    t = drives.targets_array()
+    return bool(np.all(np.isfinite(t)) and t.min() >= -90.0 and t.max() <= 90.0)
+
+
+# --- the socket ------------------------------------------------------------------------------
+
+def test_socket_has_mode_0660(stack: Stack) -> None:
+    assert stat.S_IMODE(os.stat(stack.path).st_mode) == 0o660
+
+
+def test_a_regular_file_at_the_socket_path_is_not_replaced(tmp_path: Path) -> None:
+    from tsmd.api.server import ApiServerError
+
+    path = tmp_path / "tsmd.sock"
+    path.write_text("precious")
+
+    async def handler(*_: object) -> dict[str, object]:
+        return {}
+
+    with pytest.raises(ApiServerError, match="not a socket"):
+        ApiServer(path, handler).start()
+    assert path.read_text() == "precious"
+
+
+# --- every command ---------------------------------------------------------------------------
+
+def test_status_reports_state_rate_and_counters(stack: Stack) -> None:
+    with stack.client() as c:
+        r = c.call("status")
+    assert r["state"] == "DISABLED"
+    assert r["rate_hz"] == pytest.approx(250.0)
+    assert r["ticks"] > 0 and r["overruns"] >= 0
+    assert r["compensation"]["active"] == "none"
+
+
+def test_id_is_echoed_whatever_its_type(stack: Stack) -> None:
+    with stack.client() as c:
+        assert raw(c, b'{"id": "abc", "cmd": "status"}')["id"] == "abc"
+        assert raw(c, b'{"id": 42, "cmd": "status"}')["id"] == 42
+        assert raw(c, b'{"cmd": "status"}')["id"] is None
+
+
+def test_enable_set_get_moves_the_knobs(stack: Stack) -> None:
+    with stack.client() as c:
+        assert c.call("enable")["state"] == "ENABLED"
+        assert c.call("set", q=[20.0, -10.5])["q"] == [20.0, -10.5]
+        deadline = time.monotonic() + 5
+        while time.monotonic() < deadline:
+            sample = c.call("get")["sample"]
+            if sample["pos"] == pytest.approx([20.0, -10.5]):
+                break
+            time.sleep(0.02)
+        assert sample["q"] == pytest.approx([20.0, -10.5])
+        assert sample["pos"] == pytest.approx([20.0, -10.5])
+        assert sample["state"] == "ENABLED"
+
+
+def test_disable_takes_the_drives_to_switch_on_disabled(stack: Stack) -> None:
+    with stack.client() as c:
+        c.call("enable")
+        assert c.call("disable")["state"] == "DISABLED"
+    assert stack.drives.calls[-1] == "disable"
+
+
+def test_stop_quick_stops_and_further_sets_are_refused(stack: Stack) -> None:
+    with stack.client() as c:
+        c.call("enable")
+        assert c.call("stop")["state"] == "DISABLED"
+        assert "quick_stop" in stack.drives.calls
+        assert error_code(c.request("set", q=[1.0, 1.0])) == "not_enabled"
+
+
+def test_fault_is_reported_and_reset_recovers(stack: Stack) -> None:
+    with stack.client() as c:
+        c.call("enable")
+        stack.drives.emcy(0)
+        stack.wait_ticks(3)
+        status = c.call("status")
+        assert status["state"] == "FAULT"
+        assert "emcy" in status["fault"]
+        assert error_code(c.request("enable")) == "fault"
+        assert error_code(c.request("set", q=[0, 0])) == "not_enabled"
+        assert c.call("reset")["state"] == "DISABLED"
+        assert c.call("enable")["state"] == "ENABLED"
+
+
+def test_reset_is_refused_while_the_cause_persists(stack: Stack) -> None:
+    with stack.client() as c:
+        c.call("enable")
+        stack.drives.silent = True
+        stack.wait_ticks(8)
+        assert c.call("status")["state"] == "FAULT"
+        response = c.request("reset")
+        assert error_code(response) == "fault"
+        assert "stale" in response["error"]["message"]
+        stack.drives.silent = False
+        stack.wait_ticks(2)
+        assert c.call("reset")["state"] == "DISABLED"
+
+
+def test_subscribe_streams_samples_until_unsubscribe(stack: Stack) -> None:
+    with stack.client() as c:
+        r = c.request("subscribe", rate_hz=100)
+        assert r["ok"] is True
+        events = [c.read_message() for _ in range(10)]
+        assert all(e["event"] == "sample" and e["id"] == r["id"] for e in events)
+        ticks = [e["sample"]["tick"] for e in events]
+        assert ticks == sorted(ticks) and len(set(ticks)) == 10
+        assert c.call("unsubscribe")["unsubscribed"] is True
+
+
+def test_subscribe_rate_out_of_range_is_refused(stack: Stack) -> None:
+    with stack.client() as c:
+        assert error_code(c.request("subscribe", rate_hz=0)) == "out_of_range"
+        assert error_code(c.request("subscribe", rate_hz=1e6)) == "out_of_range"
+
+
+def test_compensation_can_be_switched_off_and_asks_for_a_profile_to_switch_on(
+        stack: Stack) -> None:
+    with stack.client() as c:
+        r = c.call("compensation", enabled=False)
+        assert r["enabled"] is False and r["active"] == "none"
+        assert error_code(c.request("compensation", enabled=True)) == "no_profile"
+        assert c.call("compensation")["enabled"] is False
+        assert error_code(c.request("compensation", method="magic")) == "bad_param"
+
+
+def test_profile_unknown_catheter_is_a_clear_error(stack: Stack) -> None:
+    with stack.client() as c:
+        response = c.request("profile", catheter="nope-42")
+        assert error_code(response) == "profile"
+        assert "nope-42" in response["error"]["message"]
+        assert error_code(c.request("profile", catheter="../etc/passwd")) == "bad_param"
+
+
+def test_profile_without_id_lists_the_store(stack: Stack) -> None:
+    with stack.client() as c:
+        r = c.call("profile")
+    assert r["profile"] is None and r["available"] == []
+
+
+def test_calibrate_without_a_device_model_is_unavailable(stack: Stack) -> None:
+    with stack.client() as c:
+        assert error_code(c.request("calibrate", catheter="cath-1")) == "unavailable"
+        assert c.call("cancel")["cancelled"] is False
+
+
+# --- refused input ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize(("line", "code"), [
+    (b"not json", "bad_json"),
+    (b'{"cmd": "set", "q": [NaN, 0]}', "bad_json"),
+    (b'{"cmd": "set", "q": [Infinity, 0]}', "bad_json"),
+    (b'{"cmd": "set", "q": [1e400, 0]}', "bad_param"),
+    (b'{"cmd": "set", "q": [1, 2, 3]}', "bad_param"),
+    (b'{"cmd": "set", "q": "10,10"}', "bad_param"),
+    (b'{"cmd": "set", "q": [true, 0]}', "bad_param"),
+    (b'{"cmd": "set", "q": [null, 0]}', "bad_param"),
+    (b'{"cmd": "set"}', "bad_param"),
+    (b'{"cmd": "set", "q": [0, 0], "speed": 3}', "bad_param"),
+    (b'{"cmd": "launch"}', "unknown_command"),
+    (b'{"q": [0, 0]}', "bad_request"),
+    (b'{"cmd": 7}', "bad_request"),
+    (b"[1, 2]", "bad_request"),
+    (b'{"id": [1], "cmd": "status"}', "bad_request"),
+    (b'{"id": true, "cmd": "status"}', "bad_request"),
+    (b"\xff\xfe{}", "bad_json"),
+    (b"[" * 1500 + b"]" * 1500, "bad_json"),
+], ids=lambda v: repr(v)[:24])
+def test_malformed_request_is_refused_with_its_code(stack: Stack, line: bytes,
+                                                    code: str) -> None:
+    with stack.client() as c:
+        c.call("enable")
+        assert error_code(raw(c, line)) == code
+    assert all_targets_inside_limits(stack.drives)
+
+
+def test_out_of_range_setpoint_is_refused_and_never_reaches_the_drives(stack: Stack) -> None:
+    with stack.client() as c:
+        c.call("enable")
+        response = c.request("set", q=[95.0, 0.0])
+        assert error_code(response) == "out_of_range"
+        assert "q[0]" in response["error"]["message"]
+        stack.wait_ticks(5)
+    assert all_targets_inside_limits(stack.drives)
+    assert stack.loop.setpoint.get() == (0.0, 0.0)
+
+
+def test_oversized_line_is_refused_and_the_connection_still_works(tmp_path: Path) -> None:
+    s = start_stack(tmp_path, max_line_bytes=256)
+    try:
+        with s.client() as c:
+            c.send_raw(b'{"cmd": "status", "pad": "' + b"x" * 100_000 + b'"}\n')
+            assert error_code(c.read_message()) == "too_long"
+            assert c.call("status")["state"] == "DISABLED"
+    finally:
+        s.stop.set()
+        s.server.stop()
+
+
+def test_clients_beyond_the_maximum_are_turned_away(tmp_path: Path) -> None:
+    s = start_stack(tmp_path, max_clients=2)
+    try:
+        a, b = s.client(), s.client()
+        a.call("status")
+        b.call("status")
+        with s.client() as c:
+            assert error_code(c.read_message()) == "too_many_clients"
+        a.close()
+        b.close()
+    finally:
+        s.stop.set()
+        s.server.stop()
+
+
+# --- clients that misbehave do not disturb the loop ------------------------------------------
+
+def test_a_client_that_disconnects_mid_request_does_not_disturb_the_loop(stack: Stack) -> None:
+    for _ in range(20):
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        sock.connect(str(stack.path))
+        sock.sendall(b'{"cmd": "stat')
+        sock.close()
+    ticks = stack.loop.stats.ticks
+    stack.wait_ticks(10)
+    assert stack.loop.stats.ticks >= ticks + 10
+    with stack.client() as c:
+        assert c.call("status")["ok"]
+
+
+def test_a_stalled_subscriber_and_a_flooding_client_leave_others_served(stack: Stack) -> None:
+    stalled = stack.client()
+    stalled.send_raw(b'{"cmd": "subscribe", "rate_hz": 250}\n')  # and never read
+    flooder = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    flooder.connect(str(stack.path))
+    flooder.setblocking(False)
+    request = b'{"cmd": "status"}\n' * 1000
+    sent = 0
+    deadline = time.monotonic() + 1.0
+    while time.monotonic() < deadline:
+        try:
+            sent += flooder.send(request)
+        except BlockingIOError:
+            time.sleep(0.001)
+    ticks = stack.loop.stats.ticks
+    with stack.client() as c:
+        c.call("enable")
+        c.call("set", q=[5.0, 5.0])
+        stack.wait_ticks(20)
+        assert c.call("get")["sample"]["q"] == [5.0, 5.0]
+    assert stack.loop.stats.ticks >= ticks + 20
+    assert stack.loop.state is LoopState.ENABLED
+    assert sent > 0
+    flooder.close()
+    stalled.close()
+
+
+# --- socat as a client -----------------------------------------------------------------------
+
+def test_socat_client_gets_one_response_per_request(stack: Stack) -> None:
+    socat = shutil.which("socat")
+    if socat is None:
+        pytest.skip("socat is not installed")
+    lines = b'{"id":1,"cmd":"status"}\n{"id":2,"cmd":"nope"}\n'
+    out = subprocess.run([socat, "-t", "2", "-", f"UNIX-CONNECT:{stack.path}"], input=lines,
+                         capture_output=True, timeout=20, check=True).stdout
+    responses = [json.loads(line) for line in out.splitlines()]
+    assert [r["id"] for r in responses] == [1, 2]
+    assert responses[0]["ok"] is True
+    assert responses[1]["error"]["code"] == "unknown_command"
+
+
+def test_client_error_carries_the_code(stack: Stack) -> None:
+    with stack.client() as c, pytest.raises(ApiClientError) as exc:
+        c.call("set", q=[0, 0])
+    assert exc.value.code == "not_enabled"

@@ -1,0 +1,212 @@
+"""Running a trajectory through the full stack (drives + loop) and recording every tick.
+
+Two :class:`TrajectoryRunner` implementations, used by replay, the accuracy benchmark and the
+calibration: :class:`LockstepRunner` builds the in-process simulated rig and ticks the loop in
+lockstep with the rig's SimClock (deterministic, much faster than real time);
+:class:`LiveTrajectoryRunner` hands the trajectory to the running daemon's loop, which plays it
+one sample per tick in real time. Both return a :class:`tsmd.recording.Recording`.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections.abc import Callable, Sequence
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from tsmd import __version__
+from tsmd.config import TsmdConfig, default_sim_config, drive_configs
+from tsmd.errors import TsmdError
+from tsmd.loop import ROW_COLUMNS, ControlLoop, KnobLimiter, KnobRange, LoopError, Playback
+from tsmd.recording import Recording
+
+ProgressFn = Callable[[float], None]
+
+
+class ReplayError(TsmdError):
+    """A trajectory could not be run (bad input, a fault on the way, cancelled)."""
+
+
+class TrajectoryCancelledError(ReplayError):
+    """The cancel event was set; the knobs hold where they were."""
+
+
+class TrajectoryRunner(Protocol):
+    """Plays desired knob angles ``q_deg`` (N, 2) at times ``t_s`` and records each tick."""
+
+    def run(self, t_s: ArrayLike, q_deg: ArrayLike, compensate: bool,
+            cancel: threading.Event | None = None,
+            progress: ProgressFn | None = None) -> Recording: ...
+
+
+def resample(t_s: ArrayLike, q_deg: ArrayLike, period_s: float
+             ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The trajectory at the loop's tick times ``t0 + k * period`` (linear interpolation)."""
+    t = np.asarray(t_s, dtype=float)
+    q = np.asarray(q_deg, dtype=float)
+    if t.ndim != 1 or t.size < 1:
+        raise ReplayError("trajectory: t_s must be a non-empty 1-D array")
+    if q.shape != (t.size, 2):
+        raise ReplayError(f"trajectory: q_deg must have shape ({t.size}, 2), got {q.shape}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(q))):
+        raise ReplayError("trajectory: t_s and q_deg must be finite")
+    if t.size > 1 and np.any(np.diff(t) <= 0):
+        raise ReplayError("trajectory: t_s must be strictly increasing")
+    n = math.floor((t[-1] - t[0]) / period_s + 1e-9) + 1
+    ticks = t[0] + np.arange(n) * period_s
+    if t.size == 1:
+        return ticks, q.copy()
+    out = np.column_stack([np.interp(ticks, t, q[:, j]) for j in range(2)])
+    return ticks, out
+
+
+def rows_to_recording(rows: Sequence[tuple[float, ...]], t_ticks: NDArray[np.float64],
+                      metadata: dict[str, str]) -> Recording:
+    """Rows from the loop as a recording whose ``t`` is the trajectory's own time."""
+    data = np.asarray(rows, dtype=float).reshape(-1, len(ROW_COLUMNS))
+    columns = {name: data[:, j].copy() for j, name in enumerate(ROW_COLUMNS)}
+    columns["t"] = t_ticks[: len(data)].copy()
+    return Recording(columns, metadata)
+
+
+def _limits_and_ranges(config: TsmdConfig) -> tuple[Any, list[KnobRange]]:
+    from tsmd.daemon import knob_limits
+
+    limits = knob_limits(config)
+    return limits, [KnobRange(k.min_deg, k.max_deg) for k in config.limits.knobs()]
+
+
+def configure_tracker(rig: Any, noise_deg: float, seed: int) -> None:
+    """Give the rig an EM tracker with the configured noise (when the tracker model exists)."""
+    try:
+        from drivers.sim.tracker import EmTracker
+    except ImportError:
+        return
+    rig.tracker = EmTracker(noise_deg=noise_deg, seed=seed + 7)
+
+
+class LockstepRunner:
+    """The full stack on the in-process simulated rig, ticked in lockstep (deterministic).
+
+    The rig and the loop live as long as the runner: consecutive runs continue from where the
+    knobs are, as on the device (calibration runs many sweeps back to back).
+    """
+
+    def __init__(self, config: TsmdConfig | None = None, profile: Any = None,
+                 method: str = "none", seed: int = 0, plant: Any = None) -> None:
+        from drivers.plant.base import load_plant
+        from drivers.sim.rig import open_sim_rig
+        from tsmd.daemon import make_compensator
+
+        self.config = config if config is not None else default_sim_config()
+        cfg = self.config
+        if method not in ("none", "paper", "ours"):
+            raise ReplayError(f"method must be none, paper or ours, got {method!r}")
+        if method != "none" and profile is None:
+            raise ReplayError(f"method {method!r} needs a catheter profile")
+        self.method = method
+        self.profile = profile
+        self.seed = seed
+        if plant is None:
+            plant = load_plant(cfg.sim.plant, cfg.sim.params)
+        period_s = cfg.loop.period_s
+        self.drives, self.rig = open_sim_rig(plant, drive_configs(cfg), period_s, seed,
+                                             lockstep=True)
+        configure_tracker(self.rig, cfg.sim.tracker_noise_deg, seed)
+        limits, ranges = _limits_and_ranges(cfg)
+        self.loop = ControlLoop(
+            self.drives, make_compensator(profile, method, cfg), KnobLimiter(limits, period_s),
+            ranges, period_s, self.rig.clock,
+            stale_feedback_syncs=cfg.loop.stale_feedback_syncs,
+            overrun_fault_streak=cfg.loop.overrun_fault_streak, compensation_label=method,
+            tip_source=self.rig.tip_deg, after_sync=self.rig.exchange)
+        try:
+            self.drives.boot()
+            self.loop.tick()
+            self.loop.execute("enable")
+        except (LoopError, TsmdError) as exc:
+            self.close()
+            raise ReplayError(f"the simulated rig did not start: {exc}") from None
+
+    def run(self, t_s: ArrayLike, q_deg: ArrayLike, compensate: bool,
+            cancel: threading.Event | None = None,
+            progress: ProgressFn | None = None) -> Recording:
+        loop = self.loop
+        ticks, q = resample(t_s, q_deg, loop.period_s)
+        if loop.state.value != "ENABLED":
+            raise ReplayError(f"the loop is {loop.state.value} ({loop.fault_reason})")
+        playback = Playback(q, compensate and self.method != "none", cancel)
+        loop.execute("play", playback=playback)
+        every = max(len(q) // 100, 1)
+        while not playback.done.is_set():
+            loop.tick()
+            if progress is not None and playback.index % every == 0:
+                progress(playback.progress)
+        return self._finish(playback, ticks)
+
+    def _finish(self, playback: Playback, ticks: NDArray[np.float64]) -> Recording:
+        if playback.error == "cancelled":
+            raise TrajectoryCancelledError("trajectory cancelled")
+        if playback.error is not None:
+            raise ReplayError(f"trajectory stopped after {playback.index} of "
+                              f"{len(playback.q_deg)} ticks: {playback.error}")
+        meta = {"source": "tsmd replay (lockstep sim)", "version": __version__,
+                "rate_hz": f"{1.0 / self.loop.period_s:g}",
+                "compensation": self.method if playback.compensate else "none",
+                "profile": str(getattr(self.profile, "catheter_id", "none")),
+                "seed": str(self.seed), "plant": self.config.sim.plant}
+        return rows_to_recording(playback.rows, ticks, meta)
+
+    def close(self) -> None:
+        for obj in (self.drives, self.rig):
+            close = getattr(obj, "close", None)
+            if close is not None:
+                close()
+
+    def __enter__(self) -> LockstepRunner:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def run_trajectory(t_s: ArrayLike, q_deg: ArrayLike, *, config: TsmdConfig | None = None,
+                   profile: Any = None, method: str = "none", seed: int = 0,
+                   plant: Any = None) -> Recording:
+    """Run one trajectory in lockstep on a fresh simulated rig and return its recording."""
+    with LockstepRunner(config, profile, method, seed, plant) as runner:
+        return runner.run(t_s, q_deg, compensate=method != "none")
+
+
+class LiveTrajectoryRunner:
+    """Plays trajectories on the daemon's running loop (real time), for calibration."""
+
+    def __init__(self, loop: ControlLoop, poll_s: float = 0.05) -> None:
+        self.loop = loop
+        self.poll_s = poll_s
+
+    def run(self, t_s: ArrayLike, q_deg: ArrayLike, compensate: bool,
+            cancel: threading.Event | None = None,
+            progress: ProgressFn | None = None) -> Recording:
+        loop = self.loop
+        ticks, q = resample(t_s, q_deg, loop.period_s)
+        playback = Playback(q, compensate, cancel)
+        try:
+            loop.post("play", playback=playback).result(timeout=5.0)
+        except LoopError as exc:
+            raise ReplayError(str(exc)) from None
+        while not playback.done.wait(self.poll_s):
+            if progress is not None:
+                progress(playback.progress)
+        if playback.error == "cancelled":
+            raise TrajectoryCancelledError("trajectory cancelled")
+        if playback.error is not None:
+            raise ReplayError(f"trajectory stopped after {playback.index} of {len(q)} ticks: "
+                              f"{playback.error}")
+        meta = {"source": "tsmd daemon (live)", "version": __version__,
+                "rate_hz": f"{1.0 / loop.period_s:g}",
+                "compensation": loop.compensation_label if compensate else "none"}
+        return rows_to_recording(playback.rows, ticks, meta)

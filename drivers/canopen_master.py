@@ -164,6 +164,7 @@ class CanOpenDrives(KnobDrives):
         return [d.config for d in self._drives]
 
     def boot(self) -> None:
+        self.pump()  # frames from before the reset (an earlier boot-up) must not count
         for d in self._drives:
             d.supervised = False
             d.has_feedback = False
@@ -192,7 +193,8 @@ class CanOpenDrives(KnobDrives):
             if d.state is DriveState.FAULT:
                 raise DriveError(f"{d.name}: cannot enable, drive is in FAULT "
                                  f"({self._emcy_text(d)}); call fault_reset first")
-            return cia402.next_command_to_enable(d.state, d.config.quick_stop_option)
+            return cia402.next_command_to_enable(d.state, d.config.quick_stop_option,
+                                                d.controlword)
 
         self._walk({DriveState.OPERATION_ENABLED}, command, "enable", raise_on_timeout=True)
 

@@ -70,13 +70,17 @@ def decode_state(statusword: int) -> DriveState:
     return state
 
 
-def next_command_to_enable(state: DriveState, quick_stop_option: int = 6) -> int | None:
+def next_command_to_enable(state: DriveState, quick_stop_option: int = 6,
+                           controlword: int = 0) -> int | None:
     """Controlword that moves one step towards OPERATION ENABLED (None: cannot, e.g. FAULT).
 
-    From QUICK STOP ACTIVE the drive may go straight back (options 5..8) or must pass through
-    SWITCH ON DISABLED.
+    From QUICK STOP ACTIVE the drive may go straight back (options 5..8) on a fresh
+    "enable operation" command, so a controlword still saying "enable" is first turned into
+    "quick stop"; otherwise it must pass through SWITCH ON DISABLED.
     """
     if state is DriveState.QUICK_STOP_ACTIVE and quick_stop_option in (5, 6, 7, 8):
+        if controlword & 0x0F == CW_ENABLE_OPERATION:
+            return CW_QUICK_STOP
         return CW_ENABLE_OPERATION
     return {
         DriveState.SWITCH_ON_DISABLED: CW_SHUTDOWN,

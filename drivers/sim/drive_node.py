@@ -33,6 +33,8 @@ NMT_PRE_OPERATIONAL = 0x7F
 
 _FORMATS = {1: "?", 2: "b", 3: "h", 4: "i", 5: "B", 6: "H", 7: "I"}
 _QS_HOLD_OPTIONS = (5, 6, 7, 8)
+_POWERED = frozenset((DriveState.OPERATION_ENABLED, DriveState.QUICK_STOP_ACTIVE,
+                      DriveState.FAULT_REACTION_ACTIVE))
 
 # PDO-mappable live values: object index -> attribute of SimDriveNode
 _LIVE: dict[int, str] = {
@@ -95,6 +97,7 @@ class SimDriveNode:
         self.error_code = 0
         self.error_register = 0
         self.state = DriveState.SWITCH_ON_DISABLED
+        self.powered = False
         self.halted = False
         self.internal_limit = False
         self.following_error = False
@@ -170,6 +173,11 @@ class SimDriveNode:
 
     # -- CiA 402 power state machine ------------------------------------------------------
     def write_controlword(self, cw: int) -> None:
+        """Apply a controlword (level-triggered, except fault reset and QUICK STOP -> ENABLED,
+        which need a change of the controlword)."""
+        previous = self.controlword
+        if cw == previous and self.state is DriveState.OPERATION_ENABLED:
+            return
         rising_reset = bool(cw & 0x80) and not self.controlword & 0x80
         self.controlword = cw
         halted = bool(cw & cia402.CW_HALT)
@@ -203,13 +211,14 @@ class SimDriveNode:
             if s in (S.READY_TO_SWITCH_ON, S.OPERATION_ENABLED):
                 self._set_state(S.SWITCHED_ON)
         elif cw & 0x0F == 0x0F and (s in (S.READY_TO_SWITCH_ON, S.SWITCHED_ON) or (
-                s is S.QUICK_STOP_ACTIVE
+                s is S.QUICK_STOP_ACTIVE and cw != previous
                 and self._value(o.QUICK_STOP_OPTION, 0) in _QS_HOLD_OPTIONS)):
             self._set_state(S.OPERATION_ENABLED)  # enable operation
 
     def _set_state(self, state: DriveState) -> None:
         powered_before = self.powered
         self.state = state
+        self.powered = state in _POWERED
         if state is DriveState.OPERATION_ENABLED:
             self.motor.hold()
             self._internal_target_deg = self.motor.position_deg
@@ -241,10 +250,6 @@ class SimDriveNode:
         reg = self.error_register if register is None else register
         self._emit(0x80 + self.node_id, struct.pack("<HB5s", code, reg, b"\x00" * 5))
 
-    @property
-    def powered(self) -> bool:
-        return self.state in (DriveState.OPERATION_ENABLED, DriveState.QUICK_STOP_ACTIVE,
-                              DriveState.FAULT_REACTION_ACTIVE)
 
     def _update_statusword(self) -> None:
         sw = cia402.STATE_BITS[self.state] | cia402.SW_REMOTE
@@ -272,13 +277,13 @@ class SimDriveNode:
         dt = self.motor.dt_s
         if self.state is S.OPERATION_ENABLED and not self.halted:
             target = self.target_counts
-            lo = self._value(o.SOFTWARE_POSITION_LIMIT, 1)
-            hi = self._value(o.SOFTWARE_POSITION_LIMIT, 2)
+            lo = self._limit_lo
+            hi = self._limit_hi
             limited = target < lo or target > hi
             if limited:
                 target = lo if target < lo else hi
             target_deg = target / self.counts_per_deg
-            vmax = self._value(o.MAX_PROFILE_VELOCITY, 0) / self.counts_per_deg
+            vmax = self._vmax_deg_s
             step = target_deg - self._internal_target_deg
             if step > vmax * dt or step < -vmax * dt:
                 target_deg = self._internal_target_deg + (vmax * dt if step > 0 else -vmax * dt)
@@ -287,7 +292,7 @@ class SimDriveNode:
             self._internal_target_deg = target_deg
             return target_deg
         if self.powered:  # quick stop, halt, fault reaction: ramp to standstill
-            decel = self._value(o.QUICK_STOP_DECELERATION, 0) / self.counts_per_deg
+            decel = self._qs_decel_deg_s2
             v = self._qs_velocity_deg_s
             dv = decel * dt
             v = 0.0 if abs(v) <= dv else v - dv if v > 0 else v + dv
@@ -303,7 +308,7 @@ class SimDriveNode:
         cpd = self.counts_per_deg
         self.position_counts = round(motor.position_deg * cpd)
         self.velocity_counts_s = round(motor.velocity_deg_s * cpd)
-        rated_A = self._value(o.MOTOR_RATED_CURRENT, 0) * 1e-3
+        rated_A = self._rated_A
         raw = round(measured_current_A / rated_A * 1000.0) if self.powered else 0
         self.current_raw = -32768 if raw < -32768 else 32767 if raw > 32767 else raw
         S = DriveState
@@ -311,11 +316,11 @@ class SimDriveNode:
         if state is S.OPERATION_ENABLED and not self.halted:
             err = round((self._internal_target_deg - motor.position_deg) * cpd)
             self.following_error_counts = err
-            window = self._value(o.FOLLOWING_ERROR_WINDOW, 0)
+            window = self._fe_window
             if abs(err) > window:
                 if self._fe_since_s is None:
                     self._fe_since_s = now_s
-                elif now_s - self._fe_since_s >= self._value(o.FOLLOWING_ERROR_TIMEOUT, 0) * 1e-3:
+                elif now_s - self._fe_since_s >= self._fe_timeout_s:
                     self.following_error = True
                     self.fault(0x8611)
             else:
@@ -358,7 +363,7 @@ class SimDriveNode:
                     self.corrupt_next_tpdo = False
                     data = data[:-3]
                 self._emit(self._tpdo_cob, data)
-        period_ms = self._value(o.PRODUCER_HEARTBEAT, 0)
+        period_ms = self._hb_period_ms
         if period_ms and now_s >= self._next_heartbeat_s - 1e-9:
             self._next_heartbeat_s = now_s + period_ms * 1e-3
             if not self.heartbeat_stopped:
@@ -372,7 +377,16 @@ class SimDriveNode:
 
     # -- PDO configuration ----------------------------------------------------------------
     def _configure_pdos(self) -> None:
-        """Compile the RPDO1/TPDO1 layouts from 0x1400/0x1600 and 0x1800/0x1A00."""
+        """Compile the PDO layouts (0x1400/0x1600, 0x1800/0x1A00) and cache hot parameters."""
+        cpd = self.counts_per_deg
+        self._limit_lo = self._value(o.SOFTWARE_POSITION_LIMIT, 1)
+        self._limit_hi = self._value(o.SOFTWARE_POSITION_LIMIT, 2)
+        self._vmax_deg_s = self._value(o.MAX_PROFILE_VELOCITY, 0) / cpd
+        self._qs_decel_deg_s2 = self._value(o.QUICK_STOP_DECELERATION, 0) / cpd
+        self._rated_A = self._value(o.MOTOR_RATED_CURRENT, 0) * 1e-3
+        self._fe_window = self._value(o.FOLLOWING_ERROR_WINDOW, 0)
+        self._fe_timeout_s = self._value(o.FOLLOWING_ERROR_TIMEOUT, 0) * 1e-3
+        self._hb_period_ms = self._value(o.PRODUCER_HEARTBEAT, 0)
         hb = self._value(o.CONSUMER_HEARTBEAT, 1)
         self._master_hb_cob = 0x700 + ((hb >> 16) & 0x7F) if hb else -1
         cob = self._value(o.RPDO1_COMM, 1)
@@ -456,12 +470,10 @@ class SimDriveNode:
             self.target_counts = value
             return
         if index == o.MODES_OF_OPERATION:
-            self.mode = value
+            self.mode = self.mode_display = value
             return
         self.values[(index, subindex)] = value
-        if index in (o.RPDO1_COMM, o.RPDO1_MAP, o.TPDO1_COMM, o.TPDO1_MAP,
-                     o.CONSUMER_HEARTBEAT):
-            self._configure_pdos()
+        self._configure_pdos()
 
     def _check_mappable(self, entry: int, rpdo: bool) -> None:
         if entry == 0:

@@ -12,7 +12,7 @@ import importlib
 import itertools
 import os
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Protocol
 
 import can
@@ -23,6 +23,7 @@ from drivers.canopen_master import CanOpenDrives
 from drivers.clock import Clock, MonotonicClock, SimClock
 from drivers.plant.base import Plant, load_plant
 from drivers.sim.drive_node import SimDriveNode
+from drivers.sim.lockstep_bus import LockstepBus
 from drivers.sim.motor import Motor, MotorParams
 from drivers.units import DriveConfig
 
@@ -60,7 +61,9 @@ class SimRig:
                  period_s: float, seed: int = 0, *, lockstep: bool = True,
                  motor: MotorParams | None = None,
                  sensors: Sequence[CurrentMeasurement] | None = None,
-                 tracker: Any | None = None, own_bus: bool = True) -> None:
+                 current_sensor: Mapping[str, float] | None = None,
+                 tracker: Any | None = None, tracker_noise_deg: float = 0.1,
+                 own_bus: bool = True) -> None:
         if len(drive_configs) != 2:
             raise ValueError(f"the rig drives two knobs, got {len(drive_configs)} drive configs")
         self.bus = bus
@@ -71,6 +74,7 @@ class SimRig:
         self.clock: Clock = SimClock() if lockstep else MonotonicClock()
         self._sim_clock = self.clock if isinstance(self.clock, SimClock) else None
         self._own_bus = own_bus
+        self._send_owned = bus.send_owned if isinstance(bus, LockstepBus) else None
         params = motor or MotorParams()
         self.motors = [Motor(params, c.gear_ratio, period_s) for c in drive_configs]
         self.nodes = [
@@ -78,8 +82,10 @@ class SimRig:
                          product_code=c.product_code or 0x402,
                          rated_current_mA=c.rated_current_mA)
             for c, m in zip(drive_configs, self.motors, strict=True)]
-        self.sensors = list(sensors) if sensors is not None else _default_sensors(seed)
-        self.tracker = tracker if tracker is not None else _default_tracker(seed)
+        self.sensors = (list(sensors) if sensors is not None
+                        else _default_sensors(seed, current_sensor))
+        self.tracker = (tracker if tracker is not None
+                        else _default_tracker(seed, tracker_noise_deg))
         self.plant.reset()
         self._knob = np.zeros(2)
         self._tip = np.zeros(2)
@@ -130,7 +136,11 @@ class SimRig:
         self.ticks += 1
 
     def _send(self, can_id: int, data: bytes) -> None:
-        self.bus.send(can.Message(arbitration_id=can_id, data=data, is_extended_id=False))
+        msg = can.Message(arbitration_id=can_id, data=data, is_extended_id=False, check=False)
+        if self._send_owned is not None:
+            self._send_owned(msg)
+        else:
+            self.bus.send(msg)
 
     # -- evaluation ------------------------------------------------------------------------
     def tip_deg(self) -> NDArray[np.float64]:
@@ -228,48 +238,64 @@ class SimRig:
             self.bus.shutdown()
 
 
-def _default_sensors(seed: int) -> list[CurrentMeasurement]:
+DEFAULT_CURRENT_SENSOR: dict[str, float] = {
+    "lag_s": 0.001, "offset_A": 0.002, "noise_A": 0.003, "spike_rate_hz": 0.2, "spike_A": 0.05}
+"""Drive current measurement: 1 ms lag, 2 mA offset, 3 mA noise, rare 50 mA spikes."""
+
+
+def _default_sensors(seed: int, params: Mapping[str, float] | None) -> list[CurrentMeasurement]:
+    """The plant package's current-sensor model, one per drive with its own seed."""
     try:
-        current_sensor = importlib.import_module("drivers.plant.current_sensor")
+        module = importlib.import_module("drivers.plant.current_sensor")
     except ImportError:
         return [IdealCurrentSensor(), IdealCurrentSensor()]
-    factory: Callable[..., Any] | None = getattr(current_sensor, "CurrentSensor", None)
-    if factory is None:
-        return [IdealCurrentSensor(), IdealCurrentSensor()]
-    return [_adapt_sensor(factory, seed + 1000 * (i + 1)) for i in range(2)]
+    factory: Callable[..., CurrentMeasurement] = module.CurrentSensor
+    kwargs = dict(DEFAULT_CURRENT_SENSOR if params is None else params)
+    return [factory(seed=seed + 1000 * (i + 1), **kwargs) for i in range(2)]
 
 
-def _adapt_sensor(factory: Callable[..., Any], seed: int) -> CurrentMeasurement:
-    sensor: CurrentMeasurement = factory(seed=seed)
-    return sensor
-
-
-def _default_tracker(seed: int) -> Any:
+def _default_tracker(seed: int, noise_deg: float) -> Any:
     try:
         tracker = importlib.import_module("drivers.sim.tracker")
     except ImportError:
         return _NoiseFreeTracker()
-    return tracker.EmTracker(noise_deg=0.3, seed=seed + 7)
+    return tracker.EmTracker(noise_deg=noise_deg, seed=seed + 7)
 
 
 def open_sim_rig(plant: Plant | None, drive_configs: Sequence[DriveConfig] | None,
                  period_s: float, seed: int = 0, lockstep: bool = True,
-                 channel: str | None = None, **master_kwargs: Any
-                 ) -> tuple[CanOpenDrives, SimRig]:
-    """A master and a simulated rig on a fresh ``virtual`` python-can channel.
+                 channel: str | None = None, interface: str | None = None,
+                 rig_kwargs: Mapping[str, Any] | None = None,
+                 **master_kwargs: Any) -> tuple[CanOpenDrives, SimRig]:
+    """A master and a simulated rig on a fresh in-process bus channel.
 
     Neither is booted: call ``drives.boot(); drives.enable()``. In lockstep the master's clock
     is ``rig.clock`` and its idle hook is ``rig.exchange``; per tick run
     ``drives.write_targets(cmd); drives.sync(); rig.exchange(); drives.pump()``.
+    ``interface`` is ``"lockstep"`` (default in lockstep: :class:`LockstepBus`, no copies, no
+    threads) or ``"virtual"`` (python-can's, default in real time). ``rig_kwargs`` go to
+    :class:`SimRig` (``motor``, ``current_sensor``, ``tracker_noise_deg``...), the rest to
+    :class:`CanOpenDrives`.
     """
     configs = list(drive_configs) if drive_configs is not None else default_drive_configs()
     if plant is None:
         plant = load_plant(DEFAULT_PLANT)
     if channel is None:
         channel = f"tsmd-sim-{os.getpid()}-{next(_CHANNELS)}"
-    rig_bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
-    master_bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
-    rig = SimRig(rig_bus, plant, configs, period_s, seed, lockstep=lockstep)
+    if interface is None:
+        interface = "lockstep" if lockstep else "virtual"
+    if interface == "lockstep":
+        if not lockstep:
+            raise ValueError("the lockstep bus is single-threaded; use interface='virtual'")
+        rig_bus: can.BusABC = LockstepBus(channel)
+        master_bus: can.BusABC = LockstepBus(channel)
+    elif interface == "virtual":
+        rig_bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
+        master_bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)
+    else:
+        raise ValueError(f"sim rig interface must be 'lockstep' or 'virtual', not {interface!r}")
+    rig = SimRig(rig_bus, plant, configs, period_s, seed, lockstep=lockstep,
+                 **dict(rig_kwargs or {}))
     if lockstep:
         drives = CanOpenDrives(master_bus, configs, period_s, clock=rig.clock, idle=rig.exchange,
                                own_bus=True, **master_kwargs)

@@ -1,0 +1,74 @@
+"""An in-process python-can bus for lockstep simulation: no threads, no copies beyond the data.
+
+python-can's ``virtual`` bus deep-copies every frame into a thread-safe queue, which costs more
+than all of a tick's CANopen logic. Lockstep runs are single-threaded by design, so this bus
+hands each peer a fresh :class:`can.Message` with its own data bytes through a plain deque.
+It behaves like ``virtual`` otherwise: buses on the same channel name see each other's frames,
+not their own. Use ``virtual`` (or a real interface) for anything threaded.
+"""
+
+from __future__ import annotations
+
+import collections
+import time
+from typing import Any
+
+import can
+
+_CHANNELS: dict[str, list[LockstepBus]] = {}
+
+
+class LockstepBus(can.BusABC):
+    """A ``virtual``-like bus for one thread; ``recv`` with a timeout only sleeps-and-polls."""
+
+    def __init__(self, channel: str, **kwargs: Any) -> None:
+        super().__init__(channel=channel, **kwargs)
+        self.channel_info = f"lockstep channel {channel!r}"
+        self._name = channel
+        self._queue: collections.deque[can.Message] = collections.deque()
+        self._peers = _CHANNELS.setdefault(channel, [])
+        self._peers.append(self)
+        self._open = True
+
+    def send(self, msg: can.Message, timeout: float | None = None) -> None:
+        if not self._open:
+            raise can.CanOperationError(f"lockstep bus {self._name!r} is shut down")
+        data = bytes(msg.data)
+        for peer in self._peers:
+            if peer is not self:
+                peer._queue.append(can.Message(
+                    arbitration_id=msg.arbitration_id, data=data,
+                    is_extended_id=msg.is_extended_id, is_remote_frame=msg.is_remote_frame,
+                    is_error_frame=msg.is_error_frame, dlc=msg.dlc, check=False))
+
+    def send_owned(self, msg: can.Message) -> None:
+        """Send a frame the caller will never touch again: peers get the object itself."""
+        if not self._open:
+            raise can.CanOperationError(f"lockstep bus {self._name!r} is shut down")
+        for peer in self._peers:
+            if peer is not self:
+                peer._queue.append(msg)
+
+    def recv(self, timeout: float | None = None) -> can.Message | None:
+        queue = self._queue
+        if queue:
+            return queue.popleft()
+        if not timeout:
+            return None
+        deadline = time.monotonic() + timeout
+        while not queue:
+            if time.monotonic() >= deadline:
+                return None
+            time.sleep(0.0002)
+        return queue.popleft()
+
+    def _recv_internal(self, timeout: float | None) -> tuple[can.Message | None, bool]:
+        return self.recv(timeout), True
+
+    def shutdown(self) -> None:
+        if self._open:
+            self._open = False
+            self._peers.remove(self)
+            if not self._peers:
+                _CHANNELS.pop(self._name, None)
+        super().shutdown()

@@ -471,11 +471,26 @@ class CanOpenDrives(KnobDrives):
             self._cycle()
 
     def _cycle(self) -> None:
-        """One tick with the current controlwords and targets (used while walking states)."""
+        """One tick with the current controlwords and targets (used while walking states).
+
+        Lockstep: one idle call is one period. Real time: wait for the answers, at most a period.
+        """
         for d in self._drives:
             self._send_msg(d.pack_rpdo())
         self.sync()
-        self._wait()
+        if self.idle is not None:
+            self._wait()
+            return
+        end = self.clock.now_s() + self.period_s
+        while True:
+            self._wait()
+            if self.clock.now_s() >= end:
+                return
+            if all(d.age_syncs == 0 for d in self._drives):
+                remaining = end - self.clock.now_s()
+                if remaining > 0:
+                    time.sleep(remaining)
+                return
 
     def _wait(self) -> None:
         """Let the other side answer: the lockstep idle hook, else a short sleep."""

@@ -119,3 +119,21 @@ def test_at_most_five_cyclic_frames_per_tick(rig_pair):
     heartbeats = 3 * ticks * PERIOD_S / 0.05
     assert sent + received <= 5 * ticks + heartbeats + 3
     assert received >= 2 * ticks
+
+
+def test_default_plant_is_the_tendon_sheath_physics():
+    from drivers.plant.tendon_sheath import TendonSheathPlant
+
+    drives, rig = open_sim_rig(None, None, PERIOD_S, seed=0)
+    try:
+        assert isinstance(rig.plant, TendonSheathPlant)
+        drives.boot()
+        drives.enable()
+        run(drives, rig, np.linspace([0.0, 0.0], [70.0, 0.0], 500))
+        # pulling a tendon past the dead zone loads the motor; the idle knob stays near zero
+        cur = [f.current_A for f in drives.feedback()]
+        assert abs(cur[0]) > 0.02
+        assert abs(rig.true_tip_deg()[0]) > 5.0
+    finally:
+        drives.close()
+        rig.close()

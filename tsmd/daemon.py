@@ -415,6 +415,11 @@ class Daemon:
         self._loop_thread = threading.Thread(target=run, name="tsmd-loop", daemon=True)
         self._loop_thread.start()
         started.wait(5.0)
+        deadline = time.monotonic() + 5.0
+        while loop.latest_sample is None and time.monotonic() < deadline:
+            time.sleep(loop.period_s)  # READY means the loop is ticking
+        if loop.latest_sample is None:
+            raise DaemonError("the control loop did not start ticking", "loop")
         for warning in self.rt_report.warnings if self.rt_report else []:
             self.log.warning("real-time setting not applied", reason=warning)
 

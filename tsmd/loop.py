@@ -533,6 +533,7 @@ class ControlLoop:
         self.setpoint.clear()
         if self.state is LoopState.ENABLED:
             self.state = LoopState.DISABLED
+        self._emit("info", "shutdown: drives quick-stopped and disabled")
         return self.state.value
 
 

@@ -1,0 +1,150 @@
+"""The daemon process: start-up, systemd notification, SIGTERM mid-motion, bad config."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+from tsmd.api.client import ApiClient
+from tsmd.daemon import resolve_socket_path
+from tsmd.notify import Notifier, watchdog_interval_s
+from tsmd.recording import read_recording
+
+SIM_YAML = Path(__file__).resolve().parent.parent / "tsmd" / "data" / "sim.yaml"
+
+
+def sim_config(tmp_path: Path, **recording: object) -> Path:
+    data = yaml.safe_load(SIM_YAML.read_text())
+    data["recording"] = {"enabled": True, "dir": str(tmp_path / "rec"),
+                         "flush_interval_s": 0.2, **recording}
+    path = tmp_path / "tsmd.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def notify_socket(tmp_path: Path) -> socket.socket:
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+    sock.bind(str(tmp_path / "notify.sock"))
+    sock.settimeout(30.0)
+    return sock
+
+
+def read_notifications(sock: socket.socket, until: str, timeout_s: float = 30.0) -> list[str]:
+    seen: list[str] = []
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        seen.extend(sock.recv(4096).decode().splitlines())
+        if until in seen:
+            return seen
+    raise AssertionError(f"no {until} in {seen}")
+
+
+def test_sigterm_mid_motion_stops_disables_flushes_and_exits_0(tmp_path: Path) -> None:
+    notify = notify_socket(tmp_path)
+    sock_path = tmp_path / "tsmd.sock"
+    env = dict(os.environ, NOTIFY_SOCKET=str(tmp_path / "notify.sock"), WATCHDOG_USEC="2000000")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "tsmd", "run", "--sim", "--config", str(sim_config(tmp_path)),
+         "--socket", str(sock_path), "--log-format", "json", "--demo"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=env)
+    try:
+        seen = read_notifications(notify, "READY=1")
+        with ApiClient(sock_path) as client:
+            deadline = time.monotonic() + 20
+            moving = False
+            while time.monotonic() < deadline and not moving:
+                sample = client.call("get")["sample"]
+                moving = sample["state"] == "ENABLED" and abs(sample["pos"][0]) > 5.0
+                time.sleep(0.05)
+            assert moving, sample
+        seen += read_notifications(notify, "WATCHDOG=1")
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert "final state DISABLED" in out
+    assert "shutdown: drives quick-stopped and disabled" in err
+    assert any(line.startswith("STATUS=") for line in seen)
+    assert not sock_path.exists()
+    recordings = list((tmp_path / "rec").glob("*.csv"))
+    assert len(recordings) == 1
+    rec = read_recording(recordings[0])
+    assert len(rec) > 100
+    assert abs(rec["pos1"]).max() > 5.0
+    assert rec.metadata["sim"] == "True"
+
+
+def test_run_sim_with_duration_exits_0_with_a_summary(tmp_path: Path) -> None:
+    proc = subprocess.run(
+        [sys.executable, "-m", "tsmd", "run", "--sim", "--duration", "3", "--socket",
+         str(tmp_path / "s.sock")], capture_output=True, text=True, timeout=60, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "ticks at 250 Hz" in proc.stdout
+    assert "demo, compensation none" in proc.stdout
+
+
+def test_bad_config_is_refused_with_key_and_reason(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("loop:\n  rate_hz: 5000\n")
+    proc = subprocess.run([sys.executable, "-m", "tsmd", "run", "--config", str(bad)],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2
+    assert "loop.rate_hz" in proc.stderr and "out of range" in proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+def test_socket_falls_back_when_its_directory_cannot_be_used(tmp_path: Path,
+                                                             monkeypatch: pytest.MonkeyPatch
+                                                             ) -> None:
+    monkeypatch.delenv("RUNTIME_DIRECTORY", raising=False)
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    path, warning = resolve_socket_path(str(blocker / "tsmd" / "tsmd.sock"))
+    assert path == tmp_path / f"tsmd-{os.getuid()}" / "tsmd.sock"
+    assert warning is not None and "instead" in warning
+
+
+def test_runtime_directory_from_systemd_holds_the_socket(tmp_path: Path,
+                                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("RUNTIME_DIRECTORY", str(tmp_path))
+    assert resolve_socket_path("/run/tsmd/tsmd.sock") == (tmp_path / "tsmd.sock", None)
+
+
+def test_notifier_sends_datagrams_to_the_abstract_or_path_socket(tmp_path: Path) -> None:
+    sock = notify_socket(tmp_path)
+    notifier = Notifier(str(tmp_path / "notify.sock"))
+    assert notifier.ready(status="up")
+    assert sock.recv(100) == b"READY=1\nSTATUS=up"
+    assert notifier.watchdog()
+    assert sock.recv(100) == b"WATCHDOG=1"
+    abstract = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+    abstract.bind(f"\0tsmd-test-{os.getpid()}")
+    assert Notifier(f"@tsmd-test-{os.getpid()}").stopping()
+    assert abstract.recv(100) == b"STOPPING=1"
+
+
+def test_notifier_without_notify_socket_is_a_no_op(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("NOTIFY_SOCKET", raising=False)
+    notifier = Notifier()
+    assert not notifier.enabled
+    assert notifier.ready() is False
+
+
+def test_watchdog_interval_is_half_of_watchdog_usec(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("WATCHDOG_USEC", "3000000")
+    monkeypatch.delenv("WATCHDOG_PID", raising=False)
+    assert watchdog_interval_s() == pytest.approx(1.5)
+    monkeypatch.setenv("WATCHDOG_PID", "1")
+    assert watchdog_interval_s() is None

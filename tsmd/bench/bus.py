@@ -1,0 +1,261 @@
+"""`tsmd bench bus`: CAN traffic and timing of the drive layer.
+
+Figures: frames per tick, bus load at the configured bit rate (frame bits counted exactly,
+stuff bits included, from the real frames), master CPU time per tick, SYNC-to-last-TPDO latency
+in real time (virtual bus, rig thread), and lockstep speed (simulated seconds per wall second).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import can
+import numpy as np
+
+PERIOD_S = 0.004
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--ticks", type=int, default=5000,
+                        help="lockstep ticks for frames, bus load and master CPU (default 5000)")
+    parser.add_argument("--latency-ticks", type=int, default=1000,
+                        help="real-time SYNCs for the latency figure (default 1000)")
+    parser.add_argument("--speed-seconds", type=float, default=700.0,
+                        help="simulated seconds for the lockstep speed figure (default 700: "
+                             "the calibration protocol)")
+    parser.add_argument("--rate-hz", type=float, default=250.0)
+    parser.add_argument("--bitrate", type=int, default=1_000_000)
+    parser.add_argument("--seed", type=int, default=0)
+
+
+def main(args: argparse.Namespace) -> int:
+    period_s = 1.0 / args.rate_hz
+    print(f"tsmd bench bus: 2 drives, {args.rate_hz:g} Hz ({period_s * 1e3:g} ms), "
+          f"{args.bitrate / 1e6:g} Mbit/s")
+    traffic = measure_traffic(args.ticks, period_s, args.bitrate, args.seed)
+    for line in traffic:
+        print(line)
+    for line in measure_latency(args.latency_ticks, period_s, args.seed):
+        print(line)
+    for line in measure_speed(args.speed_seconds, period_s, args.seed):
+        print(line)
+    return 0
+
+
+# -- CAN frame bits ---------------------------------------------------------------------------
+def _crc15(bits: list[int]) -> int:
+    crc = 0
+    for b in bits:
+        nxt = b ^ ((crc >> 14) & 1)
+        crc = (crc << 1) & 0x7FFF
+        if nxt:
+            crc ^= 0x4599
+    return crc
+
+
+def frame_bits(can_id: int, data: bytes) -> int:
+    """Bits a classic base-format data frame occupies on the wire, stuff bits and IFS included."""
+    bits = [0]  # SOF
+    bits += [(can_id >> i) & 1 for i in range(10, -1, -1)]
+    bits += [0, 0, 0]  # RTR, IDE, r0
+    bits += [(len(data) >> i) & 1 for i in range(3, -1, -1)]
+    for byte in data:
+        bits += [(byte >> i) & 1 for i in range(7, -1, -1)]
+    crc = _crc15(bits)
+    bits += [(crc >> i) & 1 for i in range(14, -1, -1)]
+    stuffed = 0
+    run_bit, run_len = bits[0], 1
+    for b in bits[1:]:
+        if b == run_bit:
+            run_len += 1
+            if run_len == 5:
+                stuffed += 1
+                run_bit, run_len = 1 - b, 1  # the stuff bit starts a new run
+                continue
+        else:
+            run_bit, run_len = b, 1
+    # CRC delimiter, ACK slot + delimiter, EOF (7), intermission (3)
+    return len(bits) + stuffed + 1 + 2 + 7 + 3
+
+
+def worst_case_frame_bits(dlc: int) -> int:
+    """Upper bound with maximal stuffing (CiA / Davis et al. formula)."""
+    return 47 + 8 * dlc + (34 + 8 * dlc - 1) // 4
+
+
+# -- measurements ------------------------------------------------------------------------------
+class _Tap:
+    """Counts every frame the master sends and receives during a window."""
+
+    def __init__(self) -> None:
+        self.frames: list[tuple[int, bytes]] = []
+
+    def wrap(self, bus: can.BusABC) -> None:
+        send = bus.send
+        recv = bus.recv
+        frames = self.frames
+
+        def tapped_send(msg: can.Message, timeout: float | None = None) -> None:
+            frames.append((msg.arbitration_id, bytes(msg.data)))
+            send(msg, timeout)
+
+        def tapped_recv(timeout: float | None = None) -> can.Message | None:
+            msg = recv(timeout)
+            if msg is not None:
+                frames.append((msg.arbitration_id, bytes(msg.data)))
+            return msg
+
+        bus.send = tapped_send  # type: ignore[method-assign]
+        bus.recv = tapped_recv  # type: ignore[method-assign]
+
+
+def _spring() -> object:
+    from drivers.plant.base import PlantStep
+
+    class Spring:
+        def reset(self) -> None:
+            pass
+
+        def step(self, dt_s: float, knob_deg: np.ndarray) -> PlantStep:
+            return PlantStep(tip_deg=1.3 * knob_deg, knob_torque_Nm=0.002 * knob_deg)
+
+    return Spring()
+
+
+def _trajectory(n: int, period_s: float) -> np.ndarray:
+    t = np.arange(n) * period_s
+    q = 60.0 * np.sin(2 * np.pi * 0.04 * t)
+    return np.stack([q, -0.5 * q], axis=1)
+
+
+def measure_traffic(ticks: int, period_s: float, bitrate: int, seed: int) -> list[str]:
+    from drivers.sim.rig import open_sim_rig
+
+    drives, rig = open_sim_rig(None, None, period_s, seed=seed)
+    try:
+        drives.boot()
+        drives.enable()
+        tap = _Tap()
+        tap.wrap(drives.bus)
+        q = _trajectory(ticks, period_s)
+        per_tick: list[int] = []
+        cpu_ns: list[int] = []
+        clock = time.thread_time_ns
+        for k in range(ticks):
+            before = len(tap.frames)
+            c0 = clock()
+            drives.write_targets(q[k])
+            drives.sync()
+            c1 = clock()
+            rig.exchange()
+            c2 = clock()
+            drives.pump()
+            drives.feedback()
+            c3 = clock()
+            cpu_ns.append((c1 - c0) + (c3 - c2))
+            per_tick.append(len(tap.frames) - before)
+        frames = tap.frames
+        heartbeat = [f for f in frames if 0x701 <= f[0] <= 0x77F]
+        cyclic = len(frames) - len(heartbeat)
+        bits = sum(frame_bits(cid, data) for cid, data in frames)
+        worst = sum(worst_case_frame_bits(len(data)) for _, data in frames)
+        duration_s = ticks * period_s
+        load = bits / (duration_s * bitrate)
+        load_worst = worst / (duration_s * bitrate)
+        cpu_us = np.array(cpu_ns) / 1e3
+        events = drives.poll_events()
+    finally:
+        drives.close()
+        rig.close()
+    return [
+        f"frames per tick: cyclic {cyclic / ticks:.2f} (SYNC + 2 RPDO + 2 TPDO), with heartbeats "
+        f"mean {len(frames) / ticks:.3f}, max {max(per_tick)} in one tick ({ticks} ticks)",
+        f"bus load: {100 * load:.1f} % ({bits / ticks:.0f} bits/tick with exact stuffing; "
+        f"worst-case stuffing {100 * load_worst:.1f} %)",
+        f"master CPU per tick (write_targets+sync+pump+feedback, lockstep): mean "
+        f"{cpu_us.mean():.1f} us, p99 {np.percentile(cpu_us, 99):.1f} us, max "
+        f"{cpu_us.max():.1f} us",
+        f"fault events during the run: {len(events)}",
+    ]
+
+
+def measure_latency(ticks: int, period_s: float, seed: int) -> list[str]:
+    """Real time on python-can's virtual bus: SYNC sent -> both TPDOs seen by the master."""
+    from drivers.sim.rig import open_sim_rig
+
+    drives, rig = open_sim_rig(_spring(), None, period_s, seed=seed,  # type: ignore[arg-type]
+                               lockstep=False, receive="poll")
+    latencies: list[float] = []
+    missed = 0
+    try:
+        drives.boot()
+        drives.enable()
+        q = _trajectory(ticks, period_s)
+        fb_age = drives._drives  # master-side images: age_syncs goes to 0 on each TPDO
+        next_t = time.perf_counter()
+        for k in range(ticks):
+            drives.write_targets(q[k])
+            t0 = time.perf_counter()
+            drives.sync()
+            deadline = t0 + period_s
+            while True:
+                drives.pump()
+                now = time.perf_counter()
+                if all(d.age_syncs == 0 for d in fb_age):
+                    latencies.append(now - t0)
+                    break
+                if now > deadline:
+                    missed += 1
+                    break
+            next_t += period_s
+            time.sleep(max(0.0, next_t - time.perf_counter()))
+    finally:
+        drives.close()
+        rig.close()
+    if not latencies:
+        return ["SYNC-to-last-TPDO latency: no answer within a period"]
+    lat_us = np.array(latencies) * 1e6
+    return [f"SYNC-to-last-TPDO latency (real time, virtual bus, rig thread, master polling): "
+            f"median {statistics.median(lat_us):.0f} us, p99 {np.percentile(lat_us, 99):.0f} us, "
+            f"max {lat_us.max():.0f} us; {missed} of {ticks} SYNCs unanswered within a period"]
+
+
+def measure_speed(seconds: float, period_s: float, seed: int) -> list[str]:
+    from drivers.plant.base import load_plant
+    from drivers.sim.rig import DEFAULT_PLANT, open_sim_rig
+
+    ticks = round(seconds / period_s)
+    q = _trajectory(ticks, period_s)
+    lines = []
+    for label, plant in (("spring stand-in plant", _spring()),
+                         ("tendon-sheath plant", load_plant(DEFAULT_PLANT))):
+        drives, rig = open_sim_rig(plant, None, period_s, seed=seed)  # type: ignore[arg-type]
+        try:
+            drives.boot()
+            drives.enable()
+            w0 = time.perf_counter()
+            for k in range(ticks):
+                drives.write_targets(q[k])
+                drives.sync()
+                rig.exchange()
+                drives.pump()
+                drives.feedback()
+            wall = time.perf_counter() - w0
+        finally:
+            drives.close()
+            rig.close()
+        lines.append(f"lockstep speed, {label}: {ticks} ticks ({seconds:g} simulated s) in "
+                     f"{wall:.2f} s wall = {seconds / wall:.0f} simulated s per wall s "
+                     f"({wall / ticks * 1e6:.1f} us/tick)")
+    plant = load_plant(DEFAULT_PLANT)
+    knob = np.zeros(2)
+    n = min(ticks, 20000)
+    w0 = time.perf_counter()
+    for k in range(n):
+        knob[:] = q[k]
+        plant.step(period_s, knob)
+    lines.append(f"  of which the tendon-sheath plant.step alone: "
+                 f"{(time.perf_counter() - w0) / n * 1e6:.1f} us/tick")
+    return lines

@@ -11,6 +11,7 @@ run is a pure function of its inputs.
 
 from __future__ import annotations
 
+import operator
 import struct
 from collections.abc import Callable
 from typing import Any
@@ -49,6 +50,31 @@ _LIVE: dict[int, str] = {
     o.CONTROLWORD: "controlword",
     o.TARGET_POSITION: "target_counts",
 }
+
+
+def _statusword(state: DriveState, halted: bool, internal_limit: bool, following_error: bool,
+                error: bool) -> int:
+    """Statusword for a state and the flag bits (CiA 402 bit definitions)."""
+    sw = cia402.STATE_BITS[state] | cia402.SW_REMOTE
+    if state not in (DriveState.SWITCH_ON_DISABLED, DriveState.NOT_READY_TO_SWITCH_ON,
+                     DriveState.FAULT) or state in _POWERED:
+        sw |= cia402.SW_VOLTAGE_ENABLED
+    if state not in (DriveState.QUICK_STOP_ACTIVE, DriveState.SWITCH_ON_DISABLED,
+                     DriveState.FAULT, DriveState.FAULT_REACTION_ACTIVE,
+                     DriveState.NOT_READY_TO_SWITCH_ON):
+        sw |= cia402.SW_QUICK_STOP
+    if state is DriveState.OPERATION_ENABLED and not halted:
+        sw |= cia402.SW_FOLLOWS_TARGET
+    if internal_limit:
+        sw |= cia402.SW_INTERNAL_LIMIT
+    if following_error:
+        sw |= cia402.SW_FOLLOWING_ERROR
+    if error and state is not DriveState.FAULT:
+        sw |= cia402.SW_WARNING
+    return sw
+
+
+_STATUSWORDS: dict[tuple[DriveState, bool, bool, bool, bool], int] = {}
 
 
 class _ServerLink:
@@ -252,22 +278,11 @@ class SimDriveNode:
 
 
     def _update_statusword(self) -> None:
-        sw = cia402.STATE_BITS[self.state] | cia402.SW_REMOTE
-        if self.state not in (DriveState.SWITCH_ON_DISABLED, DriveState.NOT_READY_TO_SWITCH_ON,
-                              DriveState.FAULT) or self.powered:
-            sw |= cia402.SW_VOLTAGE_ENABLED
-        if self.state not in (DriveState.QUICK_STOP_ACTIVE, DriveState.SWITCH_ON_DISABLED,
-                              DriveState.FAULT, DriveState.FAULT_REACTION_ACTIVE,
-                              DriveState.NOT_READY_TO_SWITCH_ON):
-            sw |= cia402.SW_QUICK_STOP
-        if self.state is DriveState.OPERATION_ENABLED and not self.halted:
-            sw |= cia402.SW_FOLLOWS_TARGET
-        if self.internal_limit:
-            sw |= cia402.SW_INTERNAL_LIMIT
-        if self.following_error:
-            sw |= cia402.SW_FOLLOWING_ERROR
-        if self.error_register:
-            sw |= cia402.SW_WARNING if self.state is not DriveState.FAULT else 0
+        key = (self.state, self.halted, self.internal_limit, self.following_error,
+               bool(self.error_register))
+        sw = _STATUSWORDS.get(key)
+        if sw is None:
+            sw = _STATUSWORDS[key] = _statusword(*key)
         self.statusword = sw
 
     # -- one period of motion -------------------------------------------------------------
@@ -308,8 +323,7 @@ class SimDriveNode:
         cpd = self.counts_per_deg
         self.position_counts = round(motor.position_deg * cpd)
         self.velocity_counts_s = round(motor.velocity_deg_s * cpd)
-        rated_A = self._rated_A
-        raw = round(measured_current_A / rated_A * 1000.0) if self.powered else 0
+        raw = round(measured_current_A * self._raw_per_A) if self.powered else 0
         self.current_raw = -32768 if raw < -32768 else 32767 if raw > 32767 else raw
         S = DriveState
         state = self.state
@@ -336,8 +350,7 @@ class SimDriveNode:
         self._update_statusword()
 
     def _supervise_master(self, now_s: float) -> None:
-        setting = self._value(o.CONSUMER_HEARTBEAT, 1)
-        timeout_s = (setting & 0xFFFF) * 1e-3
+        timeout_s = self._master_timeout_s
         if not timeout_s or self._master_hb_s is None or self._master_lost:
             return
         if now_s - self._master_hb_s > timeout_s:
@@ -358,7 +371,7 @@ class SimDriveNode:
         if sync_seen and self.nmt_state == NMT_OPERATIONAL and self._tpdo_cob is not None:
             every = self._tpdo_every
             if every and self._sync_count % every == 0:
-                data = self._tpdo_struct.pack(*[getattr(self, a) for a in self._tpdo_attrs])
+                data = self._tpdo_struct.pack(*self._tpdo_values(self))
                 if self.corrupt_next_tpdo:
                     self.corrupt_next_tpdo = False
                     data = data[:-3]
@@ -383,7 +396,8 @@ class SimDriveNode:
         self._limit_hi = self._value(o.SOFTWARE_POSITION_LIMIT, 2)
         self._vmax_deg_s = self._value(o.MAX_PROFILE_VELOCITY, 0) / cpd
         self._qs_decel_deg_s2 = self._value(o.QUICK_STOP_DECELERATION, 0) / cpd
-        self._rated_A = self._value(o.MOTOR_RATED_CURRENT, 0) * 1e-3
+        self._raw_per_A = 1e6 / max(1, self._value(o.MOTOR_RATED_CURRENT, 0))
+        self._master_timeout_s = (self._value(o.CONSUMER_HEARTBEAT, 1) & 0xFFFF) * 1e-3
         self._fe_window = self._value(o.FOLLOWING_ERROR_WINDOW, 0)
         self._fe_timeout_s = self._value(o.FOLLOWING_ERROR_TIMEOUT, 0) * 1e-3
         self._hb_period_ms = self._value(o.PRODUCER_HEARTBEAT, 0)
@@ -403,6 +417,9 @@ class SimDriveNode:
         fmt, attrs = self._layout(o.TPDO1_MAP, rpdo=False)
         self._tpdo_struct = struct.Struct(fmt)
         self._tpdo_attrs = attrs
+        get = operator.attrgetter(*attrs) if attrs else (lambda node: ())
+        self._tpdo_values: Callable[[SimDriveNode], Any] = (
+            (lambda node: (get(node),)) if len(attrs) == 1 else get)
 
     def _layout(self, map_index: int, rpdo: bool) -> tuple[str, list[str]]:
         fmt = "<"

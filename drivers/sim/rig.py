@@ -122,16 +122,15 @@ class SimRig:
             knob[i] = n.motor.step(n.motion_target_deg(), n.powered)
         step = self.plant.step(dt, knob)
         self._tip = step.tip_deg
-        torque = step.knob_torque_Nm
+        torque = step.knob_torque_Nm.tolist()
         if self._sim_clock is not None:
             self._sim_clock.advance(dt)
         now = self.clock.now_s()
+        sensors = self.sensors
         for i, n in enumerate(nodes):
-            tau = float(torque[i])
-            powered = n.powered
-            current = n.motor.set_load(tau, powered)
-            measured = self.sensors[i].measure(dt, current)
-            n.end_of_period(tau, measured, now)
+            tau = torque[i]
+            current = n.motor.set_load(tau, n.powered)
+            n.end_of_period(tau, sensors[i].measure(dt, current), now)
             n.transmit(sync, now)
         self.ticks += 1
 

@@ -80,15 +80,16 @@ def test_tip_slope_in_the_loaded_region_is_about_1_3(default_sweep: Sweep) -> No
 
 
 def test_backlash_transitions_are_curved_not_straight(default_sweep: Sweep) -> None:
-    """After the tip leaves the backlash its slope builds up over several degrees."""
+    """After the backlash the tip speeds up over several degrees instead of snapping to a line."""
     s = default_sweep
-    falling = (np.gradient(s.knob_deg) < 0) & (s.knob_deg > 30.0) & (s.t_s > 12.5)
+    falling = (s.t_s > 31.25) & (s.t_s < 37.5) & (s.knob_deg > 30.0)
     q, y = s.knob_deg[falling], s.tip_deg[falling]
-    slope = np.gradient(y, q)
-    moving = np.flatnonzero(slope > 0.05)
-    first = moving[0]
-    # Just after it starts to move the slope is well below the one of the released branch.
-    assert slope[first] < 0.7 * np.median(slope[moving])
+    start = np.flatnonzero(y < y[0] - 0.05)[0]
+    early = (y[start] - np.interp(q[start] - 2.0, q[::-1], y[::-1])) / 2.0
+    later = (
+        np.interp(q[start] - 12.0, q[::-1], y[::-1]) - np.interp(q[start] - 17.0, q[::-1], y[::-1])
+    ) / 5.0
+    assert early < 0.7 * later
 
 
 def test_torque_is_flat_and_small_in_the_dead_zone(default_sweep: Sweep) -> None:
@@ -107,7 +108,7 @@ def test_torque_rises_once_the_tendon_engages(default_sweep: Sweep) -> None:
         second_cycle & (np.gradient(s.knob_deg) > 0) & (s.knob_deg > 35.0) & (s.knob_deg < 88.0)
     )
     q, tau = s.knob_deg[loading], s.torque_Nm[loading]
-    assert np.all(np.diff(tau) > 0.0)
+    assert np.all(np.diff(tau) > -0.01 * tau.max())  # at most a slight stick-slip ripple
     assert tau.max() > 0.05
     assert np.corrcoef(q, tau)[0, 1] > 0.99
 

@@ -23,7 +23,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from drivers.plant.base import PlantLoadError, PlantStep
-from drivers.plant.tendon import TendonGeometry, apply_pull, residual_m, solve_pull
+from drivers.plant.tendon import (
+    TendonGeometry,
+    apply_pull,
+    residual_m,
+    settle_breakaway,
+    solve_pull,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -33,28 +39,40 @@ class KnobParams:
     """Mechanical constants of one knob's tendon pair (units in the names)."""
 
     pulley_radius_mm: float = 6.0
-    slack_pos_mm: float = 1.9
+    slack_pos_mm: float = 2.3
     """Slack of the tendon pulled by positive knob rotation."""
-    slack_neg_mm: float = 2.1
-    tendon_offset_mm: float = 3.0
+    slack_neg_mm: float = 2.5
+    tendon_offset_mm: float = 2.8
     """Moment arm of the tendons in the bending section."""
-    tendon_stiffness_N: float = 10000.0
+    tendon_stiffness_N: float = 2000.0
     """Axial stiffness EA of the tendon."""
     sheath_length_m: float = 1.0
-    free_length_m: float = 0.05
+    free_length_m: float = 0.01
     """Tendon length between pulley and sheath entry (no friction)."""
     sheath_friction: float = 0.15
     """Coulomb friction coefficient tendon/sheath."""
-    sheath_wrap_deg: float = 420.0
+    sheath_wrap_deg: float = 240.0
     """Total wrap angle of the tendon in the (straight) sheath: coil helix and lumen contact."""
+    routing_wrap_deg: float = 360.0
+    """Wrap of the tendon over guide pins in the handle, right after the pulley."""
+    routing_friction: float = 0.25
+    """Friction coefficient on the handle guide pins."""
     sheath_drag_N: float = 0.4
     """Tension-independent friction summed over the sheath (preload of the coil sheath, tendon
     bending stiffness in its lumen); it gives a load-independent part of the backlash."""
-    bend_stiffness_Nm_per_rad: float = 0.025
+    bend_stiffness_Nm_per_rad: float = 0.0069
     bend_friction_Nm: float = 0.0015
     """Mean Coulomb friction moment of the bending joints (spread 0.4x..1.6x over the joints)."""
-    handle_friction_Nm: float = 0.008
-    """Friction torque of the knob itself (bearings, friction brake)."""
+    bend_stiction_ratio: float = 1.0
+    """Static over kinetic friction of the bending joints (>= 1); breaking loose after a
+    reversal gives the small current peak at the end of the backlash."""
+    handle_friction_Nm: float = 0.012
+    """Kinetic friction torque of the knob itself (bearings, friction brake)."""
+    handle_stiction_Nm: float = 0.04
+    """Friction torque of the knob when it starts to slide after a reversal or a stop."""
+    handle_slip_deg: float = 3.0
+    """Knob travel over which the handle friction falls from static to kinetic (the friction
+    contact renews itself over a characteristic slip distance, as in rate-and-state friction)."""
 
     def validated(self, where: str) -> KnobParams:
         for f in fields(self):
@@ -69,6 +87,7 @@ class KnobParams:
             "tendon_stiffness_N",
             "sheath_length_m",
             "bend_stiffness_Nm_per_rad",
+            "handle_slip_deg",
         )
         for name in positive:
             if getattr(self, name) <= 0.0:
@@ -84,7 +103,7 @@ class KnobParams:
 # The anterior-posterior and right-left knobs of one catheter differ slightly.
 DEFAULT_KNOBS = (
     KnobParams(),
-    KnobParams(slack_pos_mm=2.2, slack_neg_mm=1.8, sheath_wrap_deg=400.0, tendon_offset_mm=2.95),
+    KnobParams(slack_pos_mm=2.5, slack_neg_mm=2.25, sheath_wrap_deg=225.0, tendon_offset_mm=2.75),
 )
 
 
@@ -127,6 +146,50 @@ class Effects:
         return self
 
 
+class _FastPath:
+    """What the last full solve of a tendon found, to extend it cheaply while nothing changes.
+
+    While the pulley keeps moving the same way, every element keeps sliding and no further joint
+    reaches its threshold, the residual is linear in the proximal tension with a known slope.
+    """
+
+    __slots__ = (
+        "friction",
+        "joint_friction_Nm",
+        "joints",
+        "limit_N",
+        "other_N",
+        "rho",
+        "slope",
+        "t_p",
+        "target_m",
+    )
+
+    def __init__(
+        self,
+        rho: float,
+        t_p: float,
+        target_m: float,
+        slope: float,
+        limit_N: float,
+        other_N: float,
+        friction: tuple[FloatArray, FloatArray],
+        joint_friction_Nm: FloatArray,
+    ) -> None:
+        self.rho = rho
+        self.t_p = t_p
+        self.target_m = target_m
+        self.joints: FloatArray | None = None
+        self.slope = slope
+        self.limit_N = limit_N
+        self.other_N = other_N
+        self.friction = friction
+        self.joint_friction_Nm = joint_friction_Nm
+
+
+Friction = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
+
+
 class _Knob:
     """Mutable state and cached constants of one knob."""
 
@@ -140,10 +203,13 @@ class _Knob:
             element_compliance_m_per_N=np.full(n_elements, seg * compliance),
             offset_m=p.tendon_offset_mm * 1e-3,
             joint_stiffness_Nm_per_rad=np.full(n_joints, p.bend_stiffness_Nm_per_rad * n_joints),
-            joint_friction_Nm=p.bend_friction_Nm * spread,
         )
+        self.kinetic_Nm = p.bend_friction_Nm * spread
+        self.static_Nm = self.kinetic_Nm * max(1.0, p.bend_stiction_ratio)
         wrap_rad = math.radians(p.sheath_wrap_deg + eff.sheath_curvature_deg)
-        self.wrap_per_element_rad = np.full(n_elements, wrap_rad / n_elements)
+        # Friction exponent mu * wrap per element; the handle routing sits at the sheath entry.
+        self.friction_exponent = np.full(n_elements, p.sheath_friction * wrap_rad / n_elements)
+        self.friction_exponent[0] += p.routing_friction * math.radians(p.routing_wrap_deg)
         self.radius_m = p.pulley_radius_mm * 1e-3
         curvature_slack_m = eff.lumen_clearance_mm * 1e-3 * math.radians(eff.sheath_curvature_deg)
         self.slack_m = np.array(
@@ -152,12 +218,12 @@ class _Knob:
         self.n_elements = n_elements
         self.n_joints = n_joints
         self.drag_per_element_N = np.full(n_elements, p.sheath_drag_N / n_elements)
-        self.friction_static = self._friction(p.sheath_friction)
+        self.friction_static = self._friction(1.0)
         self.reset()
 
-    def _friction(self, mu: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        """(G, H) for pulling and for the mirrored release."""
-        gain = np.exp(-np.cumsum(mu * self.wrap_per_element_rad))
+    def _friction(self, scale: float) -> Friction:
+        """(G, H) for pulling and for the mirrored release, friction scaled by ``scale``."""
+        gain = np.exp(-np.cumsum(scale * self.friction_exponent))
         inv = 1.0 / gain
         h = self.drag_per_element_N
         return gain, gain * np.cumsum(h * inv), inv, inv * np.cumsum(h * gain)
@@ -166,12 +232,15 @@ class _Knob:
         self.tension_N = np.zeros((2, self.n_elements))
         self.proximal_N = np.zeros(2)
         self.joints_rad = np.zeros(self.n_joints)
+        self.joint_dir = np.zeros(self.n_joints)
+        """Direction each joint slid in during the last step (0: stuck, static friction)."""
+        self.tip_rad = 0.0
         self.creep_m = np.zeros(2)
         self.knob_rad: float | None = None
-
-    @property
-    def tip_rad(self) -> float:
-        return float(self.joints_rad.sum())
+        self.handle_dir = 0.0
+        self.handle_slip_deg = 0.0
+        self._last: list[tuple[float, float, FloatArray] | None] = [None, None]
+        self._fast: list[_FastPath | None] = [None, None]
 
     def step(
         self, dt_s: float, knob_rad: float, other_tip_rad: float, eff: Effects
@@ -183,49 +252,129 @@ class _Knob:
         friction = self.friction_static
         if eff.rate_dependence > 0.0:
             rel = eff.rate_dependence * abs(math.degrees(speed)) / eff.rate_reference_deg_s
-            friction = self._friction(self.p.sheath_friction * (1.0 + rel))
+            friction = self._friction(1.0 + rel)
 
-        slack = self.slack_m + self.creep_m
+        slack_pos = float(self.slack_m[0] + self.creep_m[0])
+        slack_neg = float(self.slack_m[1] + self.creep_m[1])
         if eff.coupling > 0.0:
             rb = self.geom.offset_m
             twist = rb * math.sin(math.radians(eff.coupling_tendon_twist_deg)) * other_tip_rad
             short = eff.coupling_shortening_mm_per_rad2 * 1e-3 * other_tip_rad**2
-            slack = slack + eff.coupling * np.array([short - twist, short + twist])
+            slack_pos += eff.coupling * (short - twist)
+            slack_neg += eff.coupling * (short + twist)
 
-        for side, sign in ((0, 1.0), (1, -1.0)):
-            self._solve_tendon(side, sign, sign * self.radius_m * knob_rad - slack[side], friction)
+        before = self.joints_rad
+        draw_in = self.radius_m * knob_rad
+        self._solve_tendon(0, 1.0, draw_in - slack_pos, friction)
+        self._solve_tendon(1, -1.0, -draw_in - slack_neg, friction)
+        if self.joints_rad is not before:
+            self.joint_dir = np.sign(self.joints_rad - before)
+            self.tip_rad = float(self.joints_rad.sum())
+        elif self.joint_dir.any():
+            self.joint_dir = np.zeros(self.n_joints)
 
         if eff.creep_mm_per_N_s > 0.0 and dt_s > 0.0:
             self.creep_m += eff.creep_mm_per_N_s * 1e-3 * self.proximal_N * dt_s
-        torque = self.radius_m * (self.proximal_N[0] - self.proximal_N[1])
-        torque += self.p.handle_friction_Nm * math.tanh(math.degrees(speed) / 0.5)
-        return self.tip_rad, float(torque)
+        torque = self.radius_m * float(self.proximal_N[0] - self.proximal_N[1])
+        torque += self._handle_friction_Nm(math.degrees(knob_rad - prev), math.degrees(speed))
+        return self.tip_rad, torque
 
-    def _solve_tendon(
-        self,
-        side: int,
-        sign: float,
-        target_m: float,
-        friction: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+    def _handle_friction_Nm(self, step_deg: float, speed_deg_s: float) -> float:
+        """Knob friction: static after a reversal or stop, kinetic after some slip."""
+        p = self.p
+        if step_deg == 0.0:
+            self.handle_slip_deg = 0.0
+        elif (step_deg > 0.0) != (self.handle_dir > 0.0):
+            self.handle_dir = 1.0 if step_deg > 0.0 else -1.0
+            self.handle_slip_deg = abs(step_deg)
+        else:
+            self.handle_slip_deg += abs(step_deg)
+        level = p.handle_friction_Nm + (p.handle_stiction_Nm - p.handle_friction_Nm) * math.exp(
+            -self.handle_slip_deg / p.handle_slip_deg
+        )
+        return level * math.tanh(speed_deg_s / 0.2)
+
+    def _solve_tendon(self, side: int, sign: float, target_m: float, friction: Friction) -> None:
+        """Bring one tendon (``sign`` +1: pulled by positive rotation) into equilibrium."""
+        other = float(self.tension_N[1 - side, -1])
+        last = self._last[side]
+        if (
+            last is not None
+            and last[0] == target_m
+            and last[1] == other
+            and last[2] is self.joints_rad
+            and friction is self.friction_static
+        ):
+            return  # nothing acting on this tendon changed
+        if not self._extend_fast(side, sign, target_m, other, friction):
+            self._fast[side] = None
+            self._full_solve(side, sign, target_m, other, friction)
+        self._last[side] = (target_m, other, self.joints_rad)
+        fast = self._fast[side]
+        if fast is not None:
+            fast.joints = self.joints_rad
+
+    def _full_solve(
+        self, side: int, sign: float, target_m: float, other: float, friction: Friction
     ) -> None:
         tension = self.tension_N[side]
         joints = sign * self.joints_rad
-        other = float(self.tension_N[1 - side, -1])
         t_p = float(self.proximal_N[side])
         f0 = residual_m(self.geom, tension, t_p, joints, target_m)
         if f0 == 0.0 or (t_p == 0.0 and f0 > 0.0):
             return  # in equilibrium, or slack and staying slack
         rho = 1.0 if f0 < 0.0 else -1.0
         g, h = (friction[0], friction[1]) if rho > 0.0 else (friction[2], friction[3])
-        t_new, prof, jnt = solve_pull(
-            self.geom, g, h, rho * tension, rho * joints, rho * other, rho * target_m
-        )
+        # A joint already sliding this way needs only kinetic friction, a stuck one static.
+        sliding = self.joint_dir == sign * rho
+        mf = np.where(sliding, self.kinetic_Nm, self.static_Nm)
+        other_r = rho * other
+        sol = solve_pull(self.geom, g, h, rho * tension, rho * joints, mf, other_r, rho * target_m)
+        t_new, prof, jnt = sol.proximal_N, sol.tension_N, sol.joints_rad
         if rho * t_new < 0.0:  # a tendon cannot push: it goes slack
             t_new = 0.0
-            prof, jnt = apply_pull(self.geom, g, h, rho * tension, rho * joints, rho * other, 0.0)
+            prof, jnt = apply_pull(self.geom, g, h, rho * tension, rho * joints, mf, other_r, 0.0)
+        elif sol.all_slip:
+            freed = (jnt != rho * joints) & ~sliding
+            if freed.any():
+                t_new, prof, jnt = settle_breakaway(
+                    self.geom, g, h, jnt, freed, self.kinetic_Nm, other_r, rho * target_m
+                )
+            else:
+                fast_mf = np.where(jnt != rho * joints, self.kinetic_Nm, mf)
+                self._fast[side] = _FastPath(
+                    rho, t_new, target_m, sol.slope_m_per_N, sol.limit_N, other, (g, h), fast_mf
+                )
         self.proximal_N[side] = rho * t_new
         self.tension_N[side] = rho * prof
         self.joints_rad = (sign * rho) * jnt
+
+    def _extend_fast(
+        self, side: int, sign: float, target_m: float, other: float, friction: Friction
+    ) -> bool:
+        fast = self._fast[side]
+        if (
+            fast is None
+            or fast.joints is not self.joints_rad
+            or friction is not self.friction_static
+            or other != fast.other_N
+        ):
+            return False
+        rho = fast.rho
+        t_new = fast.t_p + rho * (target_m - fast.target_m) / fast.slope
+        if not (fast.t_p < t_new <= fast.limit_N) or rho * t_new < 0.0:
+            return False  # reversal, a new threshold, or the tendon goes slack: solve in full
+        g, h = fast.friction
+        prof = t_new * g - h
+        k = self.geom.joint_stiffness_Nm_per_rad
+        turned = (self.geom.offset_m * (float(prof[-1]) - rho * other) - fast.joint_friction_Nm) / k
+        jnt = np.maximum((sign * rho) * self.joints_rad, turned)
+        self.proximal_N[side] = rho * t_new
+        self.tension_N[side] = rho * prof
+        self.joints_rad = (sign * rho) * jnt
+        fast.t_p = t_new
+        fast.target_m = target_m
+        return True
 
 
 class TendonSheathPlant:

@@ -1,15 +1,167 @@
-"""`tsmd gap`: not built yet (see the open issue)."""
+"""`tsmd gap`: diagnose the sim-to-real gap from real recordings (see docs/gap.md).
+
+``tsmd gap RECORDING...`` writes ``gap_report.md``, ``gap_report.json`` and PNG plots to
+``--out``. ``tsmd gap selftest`` runs the blind self-test on data made by the built-in plant.
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
+from pathlib import Path
+from typing import Any
 
-from tsmd.errors import TsmdError
+import yaml
+
+from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
+from tsmd.gap.diagnose import GapConfig, diagnose
+from tsmd.gap.errors import GapError
+from tsmd.gap.model import ParamSpec
+from tsmd.gap.report import write_report
+from tsmd.gap.selftest import BUILTIN_FIT_SPECS, BUILTIN_PLANT, EFFECTS
+from tsmd.recording import Recording, read_recording
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("rest", nargs=argparse.REMAINDER)
+    parser.add_argument("recordings", nargs="+", metavar="RECORDING",
+                        help="recording CSV files (tsmd recording format; with --tee raw TEE "
+                             "CSVs), or the word 'selftest'")
+    parser.add_argument("--plant", default=BUILTIN_PLANT,
+                        help="simulator plant 'module:factory' (default: the built-in plant)")
+    parser.add_argument("--params", default=None,
+                        help="plant parameters: a JSON/YAML file or an inline JSON object")
+    parser.add_argument("--fit", action="append", default=None, metavar="NAME=LO:HI[@KNOB]",
+                        help="a plant parameter to fit (dotted path, bounds, knob 1 or 2 whose "
+                             "channels judge it); repeat. Default for the built-in plant: "
+                             "slack per side and sheath friction of each knob")
+    parser.add_argument("--holdout", default="0.3",
+                        help="held-out fraction of interleaved time blocks, or comma-separated "
+                             "recording file names held out whole (default 0.3)")
+    parser.add_argument("--block-s", type=float, default=None,
+                        help="time block length in s (default: total duration / 48, >= 1 s)")
+    parser.add_argument("--out", default="gap-report", help="output directory")
+    parser.add_argument("--seed", type=int, default=0, help="bootstrap seed")
+    parser.add_argument("--fit-rows", type=int, default=3000,
+                        help="rows simulated per fit evaluation (thinning; default 3000)")
+    parser.add_argument("--tee", action="store_true",
+                        help="inputs are raw TEE acquisitions (converted by tsmd.tee)")
+    parser.add_argument("--sizes", default="120,300",
+                        help="selftest: recording lengths in s (comma-separated)")
+    parser.add_argument("--seeds", default="0,1", help="selftest: noise/unit seeds")
+    parser.add_argument("--cases", default=",".join(EFFECTS),
+                        help=f"selftest: cases ({', '.join(EFFECTS)})")
+    parser.add_argument("--rate-hz", type=float, default=50.0, help="selftest: sample rate")
+
+
+def _load_params(text: str | None) -> dict[str, Any]:
+    if text is None:
+        return {}
+    path = Path(text)
+    try:
+        raw = path.read_text(encoding="utf-8") if path.exists() else text
+        data = yaml.safe_load(raw)
+    except (OSError, yaml.YAMLError) as exc:
+        raise GapError(f"--params {text!r}: cannot read as a JSON/YAML mapping: {exc}") from exc
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise GapError(f"--params {text!r}: must be a mapping of plant parameters")
+    return data
+
+
+def parse_fit_spec(text: str) -> ParamSpec:
+    """``NAME=LO:HI`` or ``NAME=LO:HI@KNOB`` (knob 1 or 2)."""
+    name, sep, rest = text.partition("=")
+    knob: int | None = None
+    if "@" in rest:
+        rest, _, knob_text = rest.partition("@")
+        if knob_text not in ("1", "2"):
+            raise GapError(f"--fit {text!r}: knob after '@' must be 1 or 2")
+        knob = int(knob_text) - 1
+    lo_text, sep2, hi_text = rest.partition(":")
+    try:
+        lo, hi = float(lo_text), float(hi_text)
+    except ValueError:
+        raise GapError(f"--fit {text!r}: expected NAME=LO:HI[@KNOB]") from None
+    if not sep or not sep2 or not name.strip() or not lo < hi:
+        raise GapError(f"--fit {text!r}: expected NAME=LO:HI[@KNOB] with LO < HI")
+    return ParamSpec(name.strip(), lo, hi, knob)
+
+
+def _load_recording(path: str, tee: bool) -> GapSeries:
+    if tee:
+        from tsmd.tee import load_tee_acquisition
+
+        rec: Recording = load_tee_acquisition(path)
+    else:
+        rec = read_recording(path, required=("t",))
+    return series_from_recording(rec, Path(path).name)
+
+
+def _factory(spec: str, fixed: dict[str, Any]) -> Any:
+    from drivers.plant.base import load_plant
+
+    load_plant(spec, fixed)  # fail early, with the loader's message
+
+    def factory(params: dict[str, Any]) -> Any:
+        return load_plant(spec, params)
+
+    return factory
 
 
 def main(args: argparse.Namespace) -> int:
-    raise TsmdError("'tsmd gap' is not implemented yet")
+    if args.recordings[0] == "selftest":
+        return _selftest(args)
+    series = [_load_recording(p, args.tee) for p in args.recordings]
+    names = [s.name for s in series]
+    if len(set(names)) != len(names):
+        raise GapError(f"recording file names must differ: {names}")
+    params = _load_params(args.params)
+    if args.fit is not None:
+        specs = tuple(parse_fit_spec(t) for t in args.fit)
+    elif args.plant == BUILTIN_PLANT:
+        specs = BUILTIN_FIT_SPECS
+    else:
+        specs = ()
+    holdout = parse_holdout(args.holdout)
+    config = GapConfig(fit_specs=specs,
+                       holdout=holdout if isinstance(holdout, float) else tuple(holdout),
+                       block_s=args.block_s, fit_max_rows=max(args.fit_rows, 200),
+                       seed=args.seed)
+    result = diagnose(series, _factory(args.plant, params), params, config)
+    out = Path(args.out)
+    md, js = write_report(result, out, ", ".join(names),
+                          {"plant": args.plant, "recordings": names})
+    print(f"verdict: {result.verdict}")
+    print(result.summary)
+    print(f"report: {md}  data: {js}  ({result.timing_s['total']:.1f} s)")
+    return 0
+
+
+def _selftest(args: argparse.Namespace) -> int:
+    from tsmd.gap.selftest import run_selftest, selftest_markdown
+
+    cases = [c.strip() for c in args.cases.split(",") if c.strip()]
+    unknown = [c for c in cases if c not in EFFECTS]
+    if unknown:
+        raise GapError(f"unknown selftest case(s) {unknown}; known: {', '.join(EFFECTS)}")
+    try:
+        sizes = [float(x) for x in args.sizes.split(",")]
+        seeds = [int(x) for x in args.seeds.split(",")]
+    except ValueError:
+        raise GapError("--sizes and --seeds take comma-separated numbers") from None
+
+    def progress(c: Any) -> None:
+        print(f"  {c.case:<11} {c.duration_s:5.0f} s seed {c.seed}: {c.verdict:<26} "
+              f"top={c.top or 'none':<11} ({c.wall_s:.1f} s)", flush=True)
+
+    result = run_selftest(cases, sizes, seeds, args.rate_hz, progress=progress)
+    text = selftest_markdown(result)
+    print(text)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "gap_selftest.md").write_text(text + "\n", encoding="utf-8")
+    (out / "gap_selftest.json").write_text(json.dumps(
+        {"summary": result.summary(), "confusion": result.confusion(),
+         "cases": [vars(c) for c in result.cases]}, indent=2), encoding="utf-8")
+    return 0

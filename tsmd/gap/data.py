@@ -32,6 +32,9 @@ class GapSeries:
     current_A: NDArray[np.float64]
     tip_deg: NDArray[np.float64]
     knob_source: str
+    channel_valid: tuple[bool, bool, bool, bool] = (True, True, True, True)
+    """Per channel (tip1, tip2, cur1, cur2): False when it never changes in this recording
+    (a sensor that was not connected); such a channel is left out of fits and scores."""
 
     def __len__(self) -> int:
         return len(self.t_s)
@@ -94,12 +97,15 @@ def series_from_recording(rec: Recording, name: str) -> GapSeries:
         raise GapError(f"{name}: column 't' is not strictly increasing at data row {k + 2}")
     assert knob[0] is not None and knob[1] is not None
     assert tips[0] is not None and tips[1] is not None
+    valid = tuple(bool(np.ptp(c) > 0) for c in (tips[0], tips[1], cols["cur1"], cols["cur2"]))
+    if not (valid[0] or valid[1]):
+        raise GapError(f"{name}: tip1 and tip2 never change: no tip measurement to compare with")
     return GapSeries(
         name=name, t_s=t.copy(),
         knob_deg=np.column_stack([knob[0], knob[1]]),
         current_A=np.column_stack([cols["cur1"], cols["cur2"]]),
         tip_deg=np.column_stack([tips[0], tips[1]]),
-        knob_source=knob_source)
+        knob_source=knob_source, channel_valid=valid)  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,7 @@ it removes, with a bootstrap confidence interval over held-out time blocks.
 
 from __future__ import annotations
 
+import copy
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -30,6 +31,7 @@ from tsmd.gap.model import (
     build_views,
     fit_base,
     fit_candidate,
+    get_param,
 )
 from tsmd.gap.simulate import PlantFactory
 from tsmd.gap.stats import bootstrap_ratio_ci, noise_variance, pooled_ljung_box, ptpe, rmse
@@ -43,9 +45,10 @@ class GapConfig:
     fit_specs: tuple[ParamSpec, ...] = ()
     holdout: float | tuple[str, ...] = 0.3
     block_s: float | None = None
-    fit_rate_hz: float = 25.0
-    base_evals: int = 30
-    candidate_evals: int = 10
+    fit_max_rows: int = 3000
+    rank_max_rows: int = 6000
+    base_evals: int = 31
+    candidate_evals: int = 8
     seed: int = 0
     n_boot: int = 2000
     ci_level: float = 0.9
@@ -77,7 +80,8 @@ class GapResult:
     verdict: str
     summary: str
     split: str
-    base_params: dict[str, float]
+    base_params: dict[str, Any]
+    fitted_params: dict[str, float]
     noise_std: dict[str, float]
     gap_ratio: tuple[float, float, float]
     before: dict[str, float]
@@ -97,7 +101,8 @@ class GapResult:
     def to_json(self) -> dict[str, Any]:
         return {
             "verdict": self.verdict, "summary": self.summary, "split": self.split,
-            "base_params": self.base_params, "noise_std": self.noise_std,
+            "base_params": self.base_params, "fitted_params": self.fitted_params,
+            "noise_std": self.noise_std,
             "gap_ratio": {"point": self.gap_ratio[0], "ci": list(self.gap_ratio[1:])},
             "before": self.before, "after_top": self.after_top,
             "after_combined": self.after_combined, "top": self.top, "combined": self.combined,
@@ -117,12 +122,10 @@ class GapResult:
         }
 
 
-def _strides(series: Sequence[GapSeries], fit_rate_hz: float) -> list[int]:
-    out = []
-    for s in series:
-        fs = 1.0 / float(np.median(np.diff(s.t_s)))
-        out.append(max(round(fs / fit_rate_hz), 1))
-    return out
+def _strides(series: Sequence[GapSeries], max_rows: int) -> list[int]:
+    """One row stride for all series so that at most about ``max_rows`` rows are simulated."""
+    total = sum(len(s) for s in series)
+    return [max(-(-total // max_rows), 1)] * len(series)
 
 
 def _noise_var(series: Sequence[GapSeries], split: Split) -> NDArray[np.float64]:
@@ -131,8 +134,10 @@ def _noise_var(series: Sequence[GapSeries], split: Split) -> NDArray[np.float64]
         parts = []
         for s, ho in zip(series, split.held_out, strict=True):
             y = s.tip_deg[:, c] if c < 2 else s.current_A[:, c - 2]
-            parts.append(y[~ho])
-        var[c] = float(np.median([noise_variance(p) for p in parts if len(p) > 10]))
+            if s.channel_valid[c]:
+                parts.append(y[~ho])
+        found = [noise_variance(p) for p in parts if len(p) > 10]
+        var[c] = float(np.median(found)) if found else 1.0
     return var
 
 
@@ -143,15 +148,16 @@ def _block_costs(views: Sequence[View], pred: Prediction, split: Split,
     for i, mask_full in split.test_blocks():
         v = views[i]
         m = mask_full[v.rows]
-        r = (pred.values[i] - v.measured)[m]
+        r = (pred.values[i] - v.measured)[m] * v.valid
         costs.append(float(np.sum(r * r / noise_var)))
-        counts.append(float(r.size))
+        counts.append(float(m.sum() * v.valid.sum()))
     return np.array(costs), np.array(counts)
 
 
 def _metrics(views: Sequence[View], pred: Prediction) -> dict[str, float]:
     """Held-out RMSE and PTPE of tip (deg) and RMSE of current (A), per knob."""
-    r = np.vstack([(p - v.measured)[v.test] for v, p in zip(views, pred.values, strict=True)])
+    r = np.vstack([np.where(v.valid, p - v.measured, np.nan)[v.test]
+                   for v, p in zip(views, pred.values, strict=True)])
     return {"tip1_rmse_deg": rmse(r[:, 0]), "tip2_rmse_deg": rmse(r[:, 1]),
             "tip1_ptpe_deg": ptpe(r[:, 0]), "tip2_ptpe_deg": ptpe(r[:, 1]),
             "cur1_rmse_A": rmse(r[:, 2]), "cur2_rmse_A": rmse(r[:, 3])}
@@ -160,7 +166,8 @@ def _metrics(views: Sequence[View], pred: Prediction) -> dict[str, float]:
 def _whiteness(views: Sequence[View], pred: Prediction) -> dict[str, float]:
     out = {}
     for c, name in enumerate(CHANNELS):
-        segs = [(p - v.measured)[v.test, c] for v, p in zip(views, pred.values, strict=True)]
+        segs = [(p - v.measured)[v.test, c] for v, p in zip(views, pred.values, strict=True)
+                if v.valid[c]]
         out[name] = pooled_ljung_box(segs)[0]
     return out
 
@@ -181,13 +188,15 @@ def _where(views: Sequence[View], pred: Prediction) -> tuple[dict[str, dict[str,
         r = p - v.measured
         run_s = v.series.duration_s
         for j in range(2):
+            if not (v.valid[j] or v.valid[2 + j]):
+                continue
             lab = label_knob(v.t_s, v.knob_deg[:, j], v.knob_deg[:, 1 - j], v.vel_deg_s[:, j],
                              v.base_tip[:, j], v.t_s - v.series.t_s[0], run_s, edges)
             sub = type(lab)({k: a[v.test] for k, a in lab.labels.items()})
-            resid["tip"].append(r[v.test, j])
-            labels["tip"].append(sub)
-            resid["current"].append(r[v.test, 2 + j])
-            labels["current"].append(sub)
+            for group, c in (("tip", j), ("current", 2 + j)):
+                if v.valid[c]:
+                    resid[group].append(r[v.test, c])
+                    labels[group].append(sub)
     shares, bins = {}, {}
     for group in ("tip", "current"):
         shares[group], bins[group] = breakdown(resid[group], labels[group])
@@ -195,7 +204,7 @@ def _where(views: Sequence[View], pred: Prediction) -> tuple[dict[str, dict[str,
 
 
 def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
-             plant_params: dict[str, float], config: GapConfig | None = None) -> GapResult:
+             plant_params: dict[str, Any], config: GapConfig | None = None) -> GapResult:
     """Run the five stages on recordings already checked by ``series_from_recording``."""
     cfg = config or GapConfig()
     clock = time.perf_counter
@@ -203,30 +212,34 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     t0 = clock()
     holdout = cfg.holdout if isinstance(cfg.holdout, float) else list(cfg.holdout)
     split = make_split(series, holdout, cfg.block_s)
-    strides = _strides(series, cfg.fit_rate_hz)
+    strides = _strides(series, cfg.fit_max_rows)
+    n_held = sum(int(h.sum()) for h in split.held_out)
+    rank_stride = [max(-(-n_held // cfg.rank_max_rows), 1)] * len(series)
     fit_views = build_views(series, split, strides, "fit")
-    eval_views = build_views(series, split, strides, "eval")
+    rank_views = build_views(series, split, strides, "eval", rank_stride)
+    final_views = build_views(series, split, strides, "eval")
     noise_var = _noise_var(series, split)
     v0 = np.maximum(0.05 * np.percentile(
         np.abs(np.vstack([v.vel_deg_s for v in fit_views])), 95, axis=0), 0.1)
-    ev = Evaluator(factory, dict(plant_params), noise_var, v0)
+    ev = Evaluator(factory, copy.deepcopy(plant_params), noise_var, v0)
 
     # (2) base fit on training rows of the thinned grid
     base_params, base_cost = fit_base(ev, fit_views, cfg.fit_specs, cfg.base_evals)
     base_fit = ev.predict(fit_views, [])
     timing["base_fit"] = clock() - t0
 
-    # (1) replay at full rate on held-out rows, with the linear terms from the fit
+    # (1) replay every held-out row, with the linear terms from the fit
     t1 = clock()
-    base_eval = ev.predict(eval_views, [], coefs=base_fit.coefs)
-    base_blocks, counts = _block_costs(eval_views, base_eval, split, noise_var)
+    base_final = ev.predict(final_views, [], coefs=base_fit.coefs)
+    base_rank = ev.predict(rank_views, [], coefs=base_fit.coefs)
+    base_blocks, counts = _block_costs(rank_views, base_rank, split, noise_var)
     excess = base_blocks - counts
     gap_ratio = bootstrap_ratio_ci(base_blocks, counts, cfg.seed, cfg.n_boot, cfg.ci_level)
     timing["replay"] = clock() - t1
 
     # (3) where
     t2 = clock()
-    where_shares, where_bins = _where(eval_views, base_eval)
+    where_shares, where_bins = _where(final_views, base_final)
     timing["where"] = clock() - t2
 
     # (4) which
@@ -238,13 +251,13 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     gap_present = float(excess.sum()) > cfg.gap_floor * float(base_blocks.sum())
     scores: list[CandidateScore] = []
     fitted: dict[str, tuple[Candidate, NDArray[np.float64]]] = {}
-    preds: dict[str, Prediction] = {}
     for cand in cands:
-        theta, cost = fit_candidate(ev, fit_views, cand, max_evals=cfg.candidate_evals)
+        theta, cost = fit_candidate(ev, fit_views, cand,
+                                    max_evals=cfg.candidate_evals * max(len(cand.param_names), 1))
         active: Active = [(cand, theta)]
         coefs = ev.predict(fit_views, active).coefs
-        pred = ev.predict(eval_views, active, coefs=coefs)
-        blocks, _ = _block_costs(eval_views, pred, split, noise_var)
+        pred = ev.predict(rank_views, active, coefs=coefs)
+        blocks, _ = _block_costs(rank_views, pred, split, noise_var)
         share, lo, hi = bootstrap_ratio_ci(base_blocks - blocks, excess, cfg.seed, cfg.n_boot,
                                            cfg.ci_level)
         significant = bool(gap_present and lo > 0 and share >= cfg.min_share)
@@ -253,51 +266,53 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
             {n: float(x) for n, x in zip(cand.param_names, theta, strict=True)},
             share, (lo, hi), significant,
             (base_cost - cost) / base_cost if base_cost > 0 else 0.0,
-            _whiteness(eval_views, pred), _metrics(eval_views, pred)))
+            _whiteness(rank_views, pred), _metrics(rank_views, pred)))
         fitted[cand.name] = (cand, theta)
-        preds[cand.name] = pred
     scores.sort(key=lambda c: -c.share)
     timing["candidates"] = clock() - t3
 
-    # (5) how far: top effect and the significant top effects together
+    # (5) how far, on every held-out row: top effect and the significant top effects together
     t4 = clock()
     sig = [c for c in scores if c.significant]
     top = [sig[0].name] if sig else []
     combined = [c.name for c in sig[: cfg.max_combined]]
-    after_top = _metrics(eval_views, preds[top[0]]) if top else None
-    after_combined = None
+    after_top = after_combined = None
     combined_share = None
+    top_pred = comb_pred = None
+    if top:
+        active = [fitted[top[0]]]
+        top_pred = ev.predict(final_views, active, coefs=ev.predict(fit_views, active).coefs)
+        after_top = after_combined = _metrics(final_views, top_pred)
+        combined_share = (sig[0].share, *sig[0].ci)
     if len(combined) > 1:
         active = [fitted[n] for n in combined]
         coefs = ev.predict(fit_views, active).coefs
-        pred = ev.predict(eval_views, active, coefs=coefs)
-        blocks, _ = _block_costs(eval_views, pred, split, noise_var)
+        comb_rank = ev.predict(rank_views, active, coefs=coefs)
+        blocks, _ = _block_costs(rank_views, comb_rank, split, noise_var)
         combined_share = bootstrap_ratio_ci(base_blocks - blocks, excess, cfg.seed, cfg.n_boot,
                                             cfg.ci_level)
-        after_combined = _metrics(eval_views, pred)
-        preds["+".join(combined)] = pred
-    elif top:
-        combined_share = (sig[0].share, *sig[0].ci)
-        after_combined = after_top
+        comb_pred = ev.predict(final_views, active, coefs=coefs)
+        after_combined = _metrics(final_views, comb_pred)
     timing["how_far"] = clock() - t4
 
     verdict, summary = _verdict(cfg, gap_present, gap_ratio, sig, combined, combined_share)
     timing["total"] = clock() - t0
     result = GapResult(
         verdict=verdict, summary=summary, split=split.description, base_params=base_params,
+        fitted_params={sp.name: float(get_param(base_params, sp.name) or 0.0)
+                       for sp in cfg.fit_specs},
         noise_std={n: float(np.sqrt(v)) for n, v in zip(CHANNELS, noise_var, strict=True)},
-        gap_ratio=gap_ratio, before=_metrics(eval_views, base_eval), after_top=after_top,
+        gap_ratio=gap_ratio, before=_metrics(final_views, base_final), after_top=after_top,
         after_combined=after_combined, top=top, combined=combined,
         combined_share=combined_share, candidates=scores, where_shares=where_shares,
-        where_bins=where_bins, ljung_box_base=_whiteness(eval_views, base_eval),
+        where_bins=where_bins, ljung_box_base=_whiteness(rank_views, base_rank),
         timing_s=timing,
-        rows={"total": int(sum(len(s) for s in series)),
-              "held_out": int(sum(int(h.sum()) for h in split.held_out)),
+        rows={"total": int(sum(len(s) for s in series)), "held_out": n_held,
+              "held_out_ranked": int(sum(int(v.test.sum()) for v in rank_views)),
               "simulated": int(ev.sim_rows), "model_evaluations": int(ev.evaluations),
-              "fit_stride_max": int(max(strides))})
-    result.plot_data = {"views": eval_views, "base": base_eval,
-                        "top": preds[top[0]] if top else None,
-                        "combined": preds.get("+".join(combined)) if len(combined) > 1 else None}
+              "fit_stride": int(strides[0])})
+    result.plot_data = {"views": final_views, "base": base_final, "top": top_pred,
+                        "combined": comb_pred}
     return result
 
 
@@ -313,8 +328,8 @@ def _verdict(cfg: GapConfig, gap_present: bool, gap_ratio: tuple[float, float, f
         return "unexplained", (
             f"The held-out residual is {ratio:.1f}x the noise level, but no candidate effect "
             f"reduces it significantly: the gap is unexplained by the catalogue.")
-    best = combined_share[0] if combined_share is not None else sig[0].share
-    names = " + ".join(combined)
+    best = max(sig[0].share, combined_share[0] if combined_share is not None else 0.0)
+    names = " + ".join(combined) if best > sig[0].share else sig[0].name
     if best < cfg.explained_share:
         return "unexplained", (
             f"Best candidates ({names}) remove only {best:.0%} of the excess held-out gap "

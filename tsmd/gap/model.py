@@ -9,8 +9,10 @@ parameters) by a bounded derivative-free search with a small evaluation budget.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -51,17 +53,27 @@ class View:
         return self.series.knob_deg[self.rows]
 
     @property
+    def valid(self) -> NDArray[np.bool_]:
+        """(4,): which channels this series measured."""
+        return np.array(self.series.channel_valid, dtype=bool)
+
+    @property
     def measured(self) -> NDArray[np.float64]:
         """(n, 4): tip1, tip2, cur1, cur2."""
         return np.column_stack([self.series.tip_deg[self.rows], self.series.current_A[self.rows]])
 
 
 def build_views(series: Sequence[GapSeries], split: Split, strides: Sequence[int],
-                kind: str) -> list[View]:
-    """Views for the fit grid (``kind='fit'``) or the evaluation grid (``'eval'``)."""
+                kind: str, held_out_strides: Sequence[int] | None = None) -> list[View]:
+    """Views for the fit grid (``kind='fit'``) or an evaluation grid (``'eval'``).
+
+    The evaluation grid holds every ``held_out_strides[i]``-th held-out row (1 = all of them).
+    """
     views = []
-    for s, blk, ho, stride in zip(series, split.block, split.held_out, strides, strict=True):
-        rows = fit_grid(len(s), stride) if kind == "fit" else eval_grid(ho, stride)
+    ho_strides = held_out_strides or [1] * len(series)
+    for s, blk, ho, stride, ho_stride in zip(series, split.block, split.held_out, strides,
+                                             ho_strides, strict=True):
+        rows = fit_grid(len(s), stride) if kind == "fit" else eval_grid(ho, stride, ho_stride)
         vel = smooth_velocity(s.t_s, s.knob_deg)
         views.append(View(s, rows, ~ho[rows], ho[rows], blk[rows], vel[rows]))
     return views
@@ -114,6 +126,7 @@ class Prediction:
     values: list[NDArray[np.float64]]
     coefs: list[NDArray[np.float64]]
     cost: float
+    channel_cost: NDArray[np.float64]
 
 
 @dataclass
@@ -121,7 +134,7 @@ class Evaluator:
     """Evaluates models on a set of views; caches the base plant simulation."""
 
     factory: PlantFactory
-    plant_params: dict[str, float]
+    plant_params: dict[str, Any]
     noise_var: NDArray[np.float64]
     v0_deg_s: NDArray[np.float64]
     evaluations: int = 0
@@ -184,17 +197,21 @@ class Evaluator:
         if coefs is None:
             coefs = []
             for c in range(4):
-                a = np.vstack([d[c][v.train] for d, v in zip(designs, views, strict=True)])
-                b = np.concatenate([v.measured[v.train, c] for v in views])
+                used = [(d, v) for d, v in zip(designs, views, strict=True) if v.valid[c]]
+                if not used:
+                    coefs.append(np.zeros(designs[0][c].shape[1]))
+                    continue
+                a = np.vstack([d[c][v.train] for d, v in used])
+                b = np.concatenate([v.measured[v.train, c] for _, v in used])
                 scale = np.maximum(np.abs(a).max(axis=0), 1e-12)
                 sol, *_ = np.linalg.lstsq(a / scale, b, rcond=None)
                 coefs.append(sol / scale)
         values = [np.column_stack([d[c] @ coefs[c] for c in range(4)]) for d in designs]
-        cost = 0.0
+        channel = np.zeros(4)
         for v, y in zip(views, values, strict=True):
-            r = (y - v.measured)[v.train]
-            cost += float(np.sum(r * r / self.noise_var))
-        return Prediction(values, coefs, cost)
+            r = (y - v.measured)[v.train] * v.valid
+            channel += np.sum(r * r, axis=0) / self.noise_var
+        return Prediction(values, coefs, float(channel.sum()), channel)
 
 
 def _search(cost: Callable[[NDArray[np.float64]], float], lower: NDArray[np.float64],
@@ -225,35 +242,156 @@ def _search(cost: Callable[[NDArray[np.float64]], float], lower: NDArray[np.floa
 
 @dataclass(frozen=True)
 class ParamSpec:
-    """A plant base parameter to fit: factory keyword and its bounds."""
+    """A plant base parameter to fit: factory keyword path, bounds, and the knob it belongs to.
+
+    ``name`` may be a dotted path into nested parameters (``knobs.0.slack_pos_mm``: key
+    ``knobs``, list item 0, key ``slack_pos_mm``). ``knob`` (0 or 1) says whose channels (tip
+    and current of that knob) judge it; ``None`` = all channels.
+    """
 
     name: str
     lower: float
     upper: float
+    knob: int | None = None
+
+
+def set_param(params: dict[str, Any], path: str, value: float) -> dict[str, Any]:
+    """A copy of ``params`` with the dotted ``path`` set to ``value`` (lists/dicts created)."""
+    out = copy.deepcopy(params)
+    keys = path.split(".")
+    node: Any = out
+    for i, key in enumerate(keys):
+        last = i == len(keys) - 1
+        nxt = keys[i + 1] if not last else None
+        if isinstance(node, list):
+            idx = int(key)
+            while len(node) <= idx:
+                node.append({})
+            if last:
+                node[idx] = value
+            else:
+                if not isinstance(node[idx], dict | list):
+                    node[idx] = [] if nxt is not None and nxt.isdigit() else {}
+                node = node[idx]
+        else:
+            if last:
+                node[key] = value
+            else:
+                if key not in node or not isinstance(node[key], dict | list):
+                    node[key] = [] if nxt is not None and nxt.isdigit() else {}
+                node = node[key]
+    return out
+
+
+def get_param(params: dict[str, Any], path: str) -> float | None:
+    node: Any = params
+    for key in path.split("."):
+        try:
+            node = node[int(key)] if isinstance(node, list) else node[key]
+        except (KeyError, IndexError, ValueError, TypeError):
+            return None
+    return float(node) if isinstance(node, int | float) else None
+
+
+def _groups(specs: Sequence[ParamSpec]) -> list[list[ParamSpec]]:
+    """Specs searched together: the i-th spec of knob 0 with the i-th of knob 1; others alone."""
+    per_knob: dict[int, list[ParamSpec]] = {0: [], 1: []}
+    groups: list[list[ParamSpec]] = []
+    for s in specs:
+        if s.knob in (0, 1):
+            per_knob[int(s.knob)].append(s)
+        else:
+            groups.append([s])
+    for i in range(max(len(per_knob[0]), len(per_knob[1]))):
+        groups.append([lst[i] for lst in per_knob.values() if i < len(lst)])
+    return groups
+
+
+def _vertex(x: NDArray[np.float64], y: NDArray[np.float64], k: int) -> float:
+    """Minimum of the parabola through the grid minimum ``k`` and its neighbours."""
+    if k == 0 or k == len(x) - 1:
+        return float(x[k])
+    x0, x1, x2 = x[k - 1], x[k], x[k + 1]
+    y0, y1, y2 = y[k - 1], y[k], y[k + 1]
+    denom = (x0 - x1) * (x0 - x2) * (x1 - x2)
+    a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / denom
+    b = (x2**2 * (y0 - y1) + x1**2 * (y2 - y0) + x0**2 * (y1 - y2)) / denom
+    if a <= 0:
+        return float(x1)
+    return float(np.clip(-b / (2 * a), x0, x2))
 
 
 def fit_base(evaluator: Evaluator, views: Sequence[View], specs: Sequence[ParamSpec],
-             max_evals: int) -> tuple[dict[str, float], float]:
-    """Fit the plant's base parameters on training rows; sets ``evaluator.plant_params``."""
-    params = dict(evaluator.plant_params)
+             max_evals: int) -> tuple[dict[str, Any], float]:
+    """Fit the plant's base parameters on training rows; sets ``evaluator.plant_params``.
+
+    Coordinate search: each group (a parameter, for both knobs at once) is tried at 5 points
+    across its current interval; each knob keeps the value that is best for its own channels,
+    then the interval shrinks around it. Rounds repeat while the evaluation budget lasts. Knob
+    parameters mostly act on their own knob, so one plant run tunes both knobs.
+    """
+    params = copy.deepcopy(evaluator.plant_params)
     if not specs:
-        return params, evaluator.predict(views, []).cost
-    lower = np.array([s.lower for s in specs])
-    upper = np.array([s.upper for s in specs])
-    start = np.array([float(params.get(s.name, 0.5 * (s.lower + s.upper))) for s in specs])
-    start = np.clip(start, lower, upper)
-
-    def cost(x: NDArray[np.float64]) -> float:
-        trial = {**params, **{s.name: float(v) for s, v in zip(specs, x, strict=True)}}
-        evaluator.plant_params = trial
         evaluator._base_cache.clear()
-        return evaluator.predict(views, []).cost
+        return params, evaluator.predict(views, []).cost
+    value = {s.name: float(np.clip(get_param(params, s.name) or 0.5 * (s.lower + s.upper),
+                                   s.lower, s.upper)) for s in specs}
+    lo = {s.name: s.lower for s in specs}
+    hi = {s.name: s.upper for s in specs}
 
-    x, best = _search(cost, lower, upper, start, max_evals)
-    params.update({s.name: float(v) for s, v in zip(specs, x, strict=True)})
-    evaluator.plant_params = params
+    def build(vals: dict[str, float]) -> dict[str, Any]:
+        out = params
+        for name, v in vals.items():
+            out = set_param(out, name, v)
+        return out
+
+    def run(vals: dict[str, float]) -> Prediction:
+        evaluator.plant_params = build(vals)
+        evaluator._base_cache.clear()
+        return evaluator.predict(views, [])
+
+    def judge(pred: Prediction, spec: ParamSpec) -> float:
+        c = pred.channel_cost
+        return float(c.sum() if spec.knob is None else c[spec.knob] + c[2 + spec.knob])
+
+    best = run(value)
+    evals = 1
+    groups = _groups(specs)
+    fractions = np.linspace(0.0, 1.0, 5)
+    while evals + len(fractions) <= max_evals:
+        for group in groups:
+            if evals + len(fractions) > max_evals:
+                break
+            trials = []
+            for f in fractions:
+                vals = dict(value)
+                for s in group:
+                    vals[s.name] = lo[s.name] + f * (hi[s.name] - lo[s.name])
+                trials.append((vals, run(vals)))
+                evals += 1
+            grid_best: dict[str, tuple[float, float]] = {}
+            for s in group:
+                scores = np.array([judge(p, s) for _, p in trials])
+                k = int(np.argmin(scores))
+                x = np.array([t[0][s.name] for t in trials])
+                grid_best[s.name] = (float(x[k]), float(scores[k]))
+                value[s.name] = _vertex(x, scores, k)
+                quarter = 0.25 * (hi[s.name] - lo[s.name])
+                lo[s.name] = max(s.lower, value[s.name] - quarter)
+                hi[s.name] = min(s.upper, value[s.name] + quarter)
+            best = run(value)
+            evals += 1
+            reverted = False
+            for s in group:
+                if judge(best, s) > grid_best[s.name][1]:
+                    value[s.name] = grid_best[s.name][0]
+                    reverted = True
+            if reverted:
+                best = run(value)
+                evals += 1
+    evaluator.plant_params = build(value)
     evaluator._base_cache.clear()
-    return params, best
+    return evaluator.plant_params, best.cost
 
 
 def fit_candidate(evaluator: Evaluator, views: Sequence[View], cand: Candidate,

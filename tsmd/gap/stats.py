@@ -10,12 +10,15 @@ from scipy import stats
 
 
 def rmse(err: NDArray[np.float64]) -> float:
-    return float(np.sqrt(np.mean(np.square(err)))) if err.size else float("nan")
+    """Root mean square of the finite errors (NaN marks a channel that was not measured)."""
+    e = err[np.isfinite(err)]
+    return float(np.sqrt(np.mean(np.square(e)))) if e.size else float("nan")
 
 
 def ptpe(err: NDArray[np.float64]) -> float:
     """Peak-to-peak error: highest minus lowest error (the paper's PTPE)."""
-    return float(np.max(err) - np.min(err)) if err.size else float("nan")
+    e = err[np.isfinite(err)]
+    return float(np.max(e) - np.min(e)) if e.size else float("nan")
 
 
 def noise_variance(y: NDArray[np.float64]) -> float:

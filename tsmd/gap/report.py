@@ -1,0 +1,207 @@
+"""The gap report: Markdown for a controls engineer, JSON with the same figures, PNG plots."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tsmd.gap.diagnose import GapResult
+from tsmd.gap.model import Prediction, View
+
+
+def _f(x: float | None, digits: int = 3) -> str:
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "-"
+    return f"{x:.{digits}g}"
+
+
+def _pct(x: float) -> str:
+    return "-" if math.isnan(x) else f"{100 * x:.0f} %"
+
+
+METRICS: tuple[tuple[str, str], ...] = (
+    ("tip1_rmse_deg", "tip 1 RMSE (deg)"), ("tip1_ptpe_deg", "tip 1 PTPE (deg)"),
+    ("tip2_rmse_deg", "tip 2 RMSE (deg)"), ("tip2_ptpe_deg", "tip 2 PTPE (deg)"),
+    ("cur1_rmse_A", "current 1 RMSE (A)"), ("cur2_rmse_A", "current 2 RMSE (A)"))
+
+
+def markdown(result: GapResult, title: str, plots: dict[str, str]) -> str:
+    """The five-minute report."""
+    r = result
+    lines = [f"# Sim-to-real gap: {title}", "",
+             f"**Verdict: {r.verdict}.** {r.summary}", ""]
+    lines += ["## How far (held-out data)", "",
+              "| figure | base simulator | + top effect | + top effects together |",
+              "| --- | ---: | ---: | ---: |"]
+    top_name = r.top[0] if r.top else "none"
+    comb_name = " + ".join(r.combined) if r.combined else "none"
+    for key, label in METRICS:
+        after = r.after_top or {}
+        comb = r.after_combined or {}
+        lines.append(f"| {label} | {_f(r.before[key])} | {_f(after.get(key))} | "
+                     f"{_f(comb.get(key))} |")
+    share = ("-" if r.combined_share is None else
+             f"{_pct(r.combined_share[0])} (90 % CI {_pct(r.combined_share[1])}.."
+             f"{_pct(r.combined_share[2])})")
+    lines += ["", f"Top effect: **{top_name}**; together: **{comb_name}**, removing {share} of "
+              f"the excess gap. Held-out residual / noise before: {r.gap_ratio[0]:.2f} "
+              f"(90 % CI {r.gap_ratio[1]:.2f}..{r.gap_ratio[2]:.2f}; 1 = noise only).", ""]
+    if "timeseries" in plots:
+        lines += [f"![held-out time series]({plots['timeseries']})", ""]
+    lines += ["## Which effect (candidates fitted on training data, scored on held-out)", "",
+              "| rank | effect | share of excess gap | 90 % CI | significant | fitted | "
+              "Ljung-Box Q tip1/cur1 |", "| ---: | --- | ---: | --- | --- | --- | --- |"]
+    for i, c in enumerate(r.candidates, 1):
+        params = ", ".join(f"{k}={v:.3g}" for k, v in c.params.items()) or "linear terms"
+        lines.append(
+            f"| {i} | {c.title} | {_pct(c.share)} | {_pct(c.ci[0])}..{_pct(c.ci[1])} | "
+            f"{'yes' if c.significant else 'no'} | {params} | "
+            f"{_f(c.ljung_box_q['tip1'])} / {_f(c.ljung_box_q['cur1'])} |")
+    lines += ["", f"Base simulator Ljung-Box Q tip1/cur1: {_f(r.ljung_box_base['tip1'])} / "
+              f"{_f(r.ljung_box_base['cur1'])} (20 lags; smaller = whiter residual).", ""]
+    if "candidates" in plots:
+        lines += [f"![candidate ranking]({plots['candidates']})", ""]
+    lines += ["## Where the gap is (base simulator, held-out residuals)", "",
+              "Share of the residual sum of squares that is a systematic offset per bin of "
+              "each factor:", "", "| factor | tip | current |", "| --- | ---: | ---: |"]
+    for factor in r.where_shares["tip"]:
+        lines.append(f"| {factor.replace('_', ' ')} | {_pct(r.where_shares['tip'][factor])} | "
+                     f"{_pct(r.where_shares['current'][factor])} |")
+    for group in ("tip", "current"):
+        shares = r.where_shares[group]
+        factor = max(shares, key=lambda k: shares[k])
+        lines += ["", f"{group.capitalize()} residual by {factor.replace('_', ' ')} "
+                  f"(largest factor):", "",
+                  "| bin | share of rows | share of gap | RMS | mean |",
+                  "| --- | ---: | ---: | ---: | ---: |"]
+        for b in r.where_bins[group]:
+            if b.factor == factor:
+                lines.append(f"| {b.bin} | {_pct(b.share_rows)} | {_pct(b.share_gap)} | "
+                             f"{_f(b.rms)} | {_f(b.mean)} |")
+    if "where" in plots:
+        lines += ["", f"![where the gap is]({plots['where']})"]
+    lines += ["", "## Base fit", "",
+              f"- Split: {r.split}; {r.rows['held_out']} of {r.rows['total']} rows held out.",
+              "- Fitted plant parameters: " + (", ".join(
+                  f"{k}={v:.4g}" for k, v in r.fitted_params.items()) or "none"),
+              "- Noise floor (from the measurements): " + ", ".join(
+                  f"{k} {v:.3g}" for k, v in r.noise_std.items()),
+              f"- Wall time {r.timing_s['total']:.1f} s; {r.rows['simulated']} plant steps, "
+              f"{r.rows['model_evaluations']} model evaluations.", "",
+              "How to read: see docs/gap.md. Shares are of the *excess* gap (held-out residual "
+              "above the noise floor, in noise units, summed over tip and current). An effect is "
+              "significant when its 90 % bootstrap interval over held-out time blocks excludes "
+              "zero and it removes at least 5 %.", ""]
+    return "\n".join(lines)
+
+
+def _held_out_segment(view: View) -> np.ndarray:
+    """Row indices (within the view) of the longest held-out stretch."""
+    test = view.test.astype(int)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], test, [0]])))
+    starts, stops = edges[::2], edges[1::2]
+    k = int(np.argmax(stops - starts))
+    return np.arange(starts[k], stops[k])
+
+
+def plots(result: GapResult, out_dir: Path, prefix: str = "gap") -> dict[str, str]:
+    """Write the PNGs; return name -> file name (relative to ``out_dir``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    files: dict[str, str] = {}
+    views: list[View] = result.plot_data.get("views", [])
+    base: Prediction | None = result.plot_data.get("base")
+    top: Prediction | None = result.plot_data.get("top")
+    cands = [v for v in views if v.test.any()]
+    if cands and base is not None:
+        i = max(range(len(views)), key=lambda j: float(np.ptp(views[j].knob_deg[views[j].test])))
+        v = views[i]
+        seg = _held_out_segment(v)
+        t = v.t_s[seg] - v.series.t_s[0]
+        knob = int(np.argmax(np.ptp(v.knob_deg[seg], axis=0)))
+        fig, axes = plt.subplots(3, 1, figsize=(7, 6), sharex=True)
+        meas = v.measured[seg]
+        axes[0].plot(t, meas[:, knob], "k.", ms=1.5, label="measured")
+        axes[0].plot(t, base.values[i][seg, knob], label="base sim")
+        if top is not None:
+            axes[0].plot(t, top.values[i][seg, knob], label=f"+ {result.top[0]}")
+        axes[0].set_ylabel(f"tip {knob + 1} (deg)")
+        axes[0].legend(fontsize=7)
+        axes[1].plot(t, meas[:, 2 + knob], "k.", ms=1.5)
+        axes[1].plot(t, base.values[i][seg, 2 + knob])
+        if top is not None:
+            axes[1].plot(t, top.values[i][seg, 2 + knob])
+        axes[1].set_ylabel(f"current {knob + 1} (A)")
+        axes[2].plot(t, v.knob_deg[seg, knob], color="gray")
+        axes[2].set_ylabel(f"knob {knob + 1} (deg)")
+        axes[2].set_xlabel(f"time in {v.series.name} (s), held-out stretch")
+        fig.tight_layout()
+        name = f"{prefix}_timeseries.png"
+        fig.savefig(out_dir / name, dpi=80)
+        plt.close(fig)
+        files["timeseries"] = name
+    if result.candidates:
+        fig, ax = plt.subplots(figsize=(6, 2.8))
+        names = [c.name for c in result.candidates][::-1]
+        share = np.array([c.share for c in result.candidates][::-1])
+        lo = np.array([c.ci[0] for c in result.candidates][::-1])
+        hi = np.array([c.ci[1] for c in result.candidates][::-1])
+        colors = ["tab:green" if c.significant else "tab:gray" for c in result.candidates][::-1]
+        ax.barh(names, share, color=colors,
+                xerr=np.vstack([np.maximum(share - lo, 0), np.maximum(hi - share, 0)]))
+        ax.axvline(0, color="k", lw=0.8)
+        ax.set_xlabel("share of held-out excess gap removed (90 % CI)")
+        fig.tight_layout()
+        name = f"{prefix}_candidates.png"
+        fig.savefig(out_dir / name, dpi=80)
+        plt.close(fig)
+        files["candidates"] = name
+    if result.where_shares:
+        fig, ax = plt.subplots(figsize=(6, 2.8))
+        factors = list(result.where_shares["tip"])
+        x = np.arange(len(factors))
+        ax.bar(x - 0.2, [result.where_shares["tip"][f] for f in factors], 0.4, label="tip")
+        ax.bar(x + 0.2, [result.where_shares["current"][f] for f in factors], 0.4,
+               label="current")
+        ax.set_xticks(x, [f.replace("_", "\n") for f in factors], fontsize=7)
+        ax.set_ylabel("share of gap held")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        name = f"{prefix}_where.png"
+        fig.savefig(out_dir / name, dpi=80)
+        plt.close(fig)
+        files["where"] = name
+    return files
+
+
+def write_report(result: GapResult, out_dir: Path, title: str,
+                 extra: dict[str, Any] | None = None) -> tuple[Path, Path]:
+    """Write ``gap_report.md``, ``gap_report.json`` and the plots into ``out_dir``."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    files = plots(result, out_dir)
+    md = out_dir / "gap_report.md"
+    md.write_text(markdown(result, title, files), encoding="utf-8")
+    data = result.to_json()
+    data["title"] = title
+    data["plots"] = files
+    if extra:
+        data.update(extra)
+    js = out_dir / "gap_report.json"
+    js.write_text(json.dumps(data, indent=2, default=_jsonable), encoding="utf-8")
+    return md, js
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    raise TypeError(f"not JSON serialisable: {type(x).__name__}")

@@ -1,0 +1,257 @@
+"""Self-test: diagnose 'real' data made by the built-in plant with one effect the simulator lacks.
+
+The data are made by driving the plant (``drivers.plant.tendon_sheath``) directly with a knob
+trajectory, bypassing CAN and the drive: the knob follows the command exactly, the tip is read
+by the simulated EM tracker and the motor current is ``torque / (gear * kt)`` plus motor Coulomb
+friction, read through the plant package's :class:`CurrentSensor` (noise, offset and, for the
+``sensor`` case, lag). Each 'real' catheter is a different unit (slack and sheath friction
+drawn +-15 % around the defaults, see :func:`unit_knobs`), so the diagnosed simulator (the same
+plant with default constants, effects off) must fit its base parameters first. The plant's
+effects are written independently of the candidates in :mod:`tsmd.gap.candidates`: the
+diagnosis has to recognise them by their signature.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from drivers.plant.base import load_plant
+from drivers.plant.current_sensor import CurrentSensor
+from drivers.sim.tracker import EmTracker
+from tsmd.gap.data import series_from_recording
+from tsmd.gap.diagnose import GapConfig, GapResult, diagnose
+from tsmd.gap.model import ParamSpec
+from tsmd.recording import Recording
+
+BUILTIN_PLANT = "drivers.plant.tendon_sheath:make_tendon_sheath_plant"
+
+BUILTIN_FIT_SPECS: tuple[ParamSpec, ...] = tuple(
+    ParamSpec(f"knobs.{k}.{name}", lo, hi, knob=k)
+    for name, lo, hi in (("slack_pos_mm", 0.5, 4.0), ("slack_neg_mm", 0.5, 4.0),
+                         ("sheath_friction", 0.05, 0.35))
+    for k in (0, 1))
+"""Base parameters fitted for the built-in plant: dead zone (slack per side) and friction."""
+
+EFFECTS: dict[str, tuple[dict[str, float], float, str | None]] = {
+    "none": ({}, 0.0, None),
+    "coupling": ({"coupling": 1.0}, 0.0, "coupling"),
+    "rate": ({"rate_dependence": 1.0}, 0.0, "rate"),
+    "compliance": ({"tendon_compliance": 1.0}, 0.0, "compliance"),
+    "curvature": ({"sheath_curvature_deg": 180.0}, 0.0, "curvature"),
+    "sensor": ({}, 0.1, "sensor"),
+    "creep": ({"creep_mm_per_N_s": 2e-4}, 0.0, "drift"),
+}
+"""Case -> (plant effect keywords, current-sensor lag s, the candidate that should win).
+
+Strengths are the plant's nominal values (coupling 1.0 = its documented constants, friction
+doubling at 50 deg/s, twice the tendon compliance, a U-shaped sheath, a 0.1 s current filter,
+slack creep of 0.2 um per newton-second)."""
+
+GEAR_RATIO = 50.0
+KT_NM_PER_A = 0.03
+MOTOR_COULOMB_A = 0.01
+
+
+def trajectory(duration_s: float, rate_hz: float) -> tuple[NDArray[np.float64],
+                                                            NDArray[np.float64]]:
+    """Knob 1 sweeps +-60..85 deg at periods from 12 to 40 s; knob 2 a slower +-60 deg sine.
+
+    Varying speed and the other knob's angle make rate dependence and coupling observable.
+    """
+    t = np.arange(0.0, duration_s, 1.0 / rate_hz)
+    period = 26.0 + 14.0 * np.sin(2 * np.pi * t / 110.0)
+    phase = 2 * np.pi * np.cumsum(1.0 / period) / rate_hz
+    amp = 72.0 + 13.0 * np.sin(2 * np.pi * t / 83.0)
+    q1 = amp * (2 / np.pi) * np.arcsin(np.sin(phase))
+    q2 = 60.0 * np.sin(2 * np.pi * t / 47.0 + 0.4)
+    return t, np.column_stack([q1, q2])
+
+
+def unit_knobs(seed: int, variation: float) -> list[dict[str, float]]:
+    """One catheter unit: slack per side and sheath friction off the defaults by +-variation.
+
+    Only the base parameters the diagnosis fits are varied, so that what remains after the base
+    fit is the effect put in (plus noise).
+    """
+    rng = np.random.default_rng(1000 + seed)
+    defaults = ({"slack_pos_mm": 1.9, "slack_neg_mm": 2.1, "sheath_friction": 0.15},
+                {"slack_pos_mm": 2.2, "slack_neg_mm": 1.8, "sheath_friction": 0.15})
+    return [{k: v * (1.0 + variation * rng.uniform(-1, 1)) for k, v in d.items()}
+            for d in defaults]
+
+
+def make_real_recording(case: str, duration_s: float, rate_hz: float, seed: int,
+                        unit_variation: float = 0.15, tip_noise_deg: float = 0.1,
+                        current_noise_A: float = 0.004) -> Recording:
+    """A 'real' recording of one case (see the module docstring for how it is made)."""
+    effects, lag_s, _ = EFFECTS[case]
+    plant = load_plant(BUILTIN_PLANT, {"knobs": unit_knobs(seed, unit_variation), **effects})
+    t, q = trajectory(duration_s, rate_hz)
+    tracker = EmTracker(noise_deg=tip_noise_deg, seed=seed)
+    sensors = [CurrentSensor(lag_s=lag_s, offset_A=0.003 * (1 - 2 * k), noise_A=current_noise_A,
+                             seed=seed * 7 + k) for k in range(2)]
+    dt = 1.0 / rate_hz
+    tip = np.empty_like(q)
+    cur = np.empty_like(q)
+    prev = q[0].copy()
+    for k in range(len(t)):
+        out = plant.step(dt, q[k])
+        vel = (q[k] - prev) / dt
+        prev = q[k]
+        true_A = (out.knob_torque_Nm / (GEAR_RATIO * KT_NM_PER_A)
+                  + MOTOR_COULOMB_A * np.tanh(vel / 0.5))
+        tip[k] = tracker.measure(out.tip_deg)
+        cur[k] = [sensors[j].measure(dt, float(true_A[j])) for j in range(2)]
+    cols = {"t": t, "q1": q[:, 0], "q2": q[:, 1], "cmd1": q[:, 0], "cmd2": q[:, 1],
+            "pos1": q[:, 0], "pos2": q[:, 1], "cur1": cur[:, 0], "cur2": cur[:, 1],
+            "tip1": tip[:, 0], "tip2": tip[:, 1]}
+    return Recording({k: np.array(v, dtype=float) for k, v in cols.items()},
+                     {"source": f"gap selftest case {case} seed {seed}",
+                      "note": "plant driven directly, CAN and drive bypassed"})
+
+
+def builtin_factory(base_params: dict[str, Any] | None = None) -> Callable[[dict[str, Any]],
+                                                                              Any]:
+    """Factory of the diagnosed simulator: the built-in plant with the given parameters."""
+    fixed = dict(base_params or {})
+
+    def factory(params: dict[str, Any]) -> Any:
+        return load_plant(BUILTIN_PLANT, {**fixed, **params})
+
+    return factory
+
+
+@dataclass
+class SelftestCase:
+    case: str
+    duration_s: float
+    seed: int
+    expected: str | None
+    verdict: str
+    top: str | None
+    share: float | None
+    tip_rmse_before: float
+    tip_rmse_after: float | None
+    cur_rmse_before: float
+    cur_rmse_after: float | None
+    wall_s: float
+
+    @property
+    def correct(self) -> bool:
+        return self.top == self.expected
+
+
+@dataclass
+class SelftestResult:
+    cases: list[SelftestCase] = field(default_factory=list)
+
+    def confusion(self) -> dict[str, dict[str, int]]:
+        """Rows: effect put in the data; columns: top-1 diagnosis ('none' = nothing significant)."""
+        out: dict[str, dict[str, int]] = {}
+        for c in self.cases:
+            row = out.setdefault(c.case, {})
+            key = c.top or "none"
+            row[key] = row.get(key, 0) + 1
+        return out
+
+    def summary(self) -> dict[str, Any]:
+        effect_cases = [c for c in self.cases if c.expected is not None]
+        null_cases = [c for c in self.cases if c.expected is None]
+        shrink = [1 - c.tip_rmse_after / c.tip_rmse_before for c in effect_cases
+                  if c.correct and c.tip_rmse_after is not None and c.tip_rmse_before > 0]
+        cur_shrink = [1 - c.cur_rmse_after / c.cur_rmse_before for c in effect_cases
+                      if c.correct and c.cur_rmse_after is not None and c.cur_rmse_before > 0]
+        return {
+            "top1_accuracy": (sum(c.correct for c in effect_cases) / len(effect_cases)
+                              if effect_cases else float("nan")),
+            "n_effect_cases": len(effect_cases),
+            "false_alarms": sum(c.top is not None for c in null_cases),
+            "n_null_cases": len(null_cases),
+            "median_tip_rmse_shrink_when_correct": float(np.median(shrink)) if shrink
+            else float("nan"),
+            "median_current_rmse_shrink_when_correct": float(np.median(cur_shrink))
+            if cur_shrink else float("nan"),
+            "median_wall_s": float(np.median([c.wall_s for c in self.cases])),
+        }
+
+
+def _tip_rmse(m: dict[str, float] | None) -> float | None:
+    if m is None:
+        return None
+    return float(np.sqrt(np.nanmean([m["tip1_rmse_deg"] ** 2, m["tip2_rmse_deg"] ** 2])))
+
+
+def _cur_rmse(m: dict[str, float] | None) -> float | None:
+    if m is None:
+        return None
+    return float(np.sqrt(np.nanmean([m["cur1_rmse_A"] ** 2, m["cur2_rmse_A"] ** 2])))
+
+
+def run_case(case: str, duration_s: float, seed: int, rate_hz: float = 50.0,
+             config: GapConfig | None = None) -> tuple[SelftestCase, GapResult]:
+    """Make one 'real' recording and diagnose it blind (the case is not passed on)."""
+    rec = make_real_recording(case, duration_s, rate_hz, seed)
+    series = series_from_recording(rec, f"{case}-{seed}")
+    cfg = config or GapConfig(fit_specs=BUILTIN_FIT_SPECS, seed=seed)
+    start = time.perf_counter()
+    result = diagnose([series], builtin_factory(), {}, cfg)
+    wall = time.perf_counter() - start
+    top = result.top[0] if result.top else None
+    share = next((c.share for c in result.candidates if c.name == top), None)
+    before_tip = _tip_rmse(result.before)
+    before_cur = _cur_rmse(result.before)
+    assert before_tip is not None and before_cur is not None
+    return SelftestCase(case, duration_s, seed, EFFECTS[case][2], result.verdict, top, share,
+                        before_tip, _tip_rmse(result.after_top), before_cur,
+                        _cur_rmse(result.after_top), wall), result
+
+
+def run_selftest(cases: Sequence[str], sizes_s: Sequence[float], seeds: Sequence[int],
+                 rate_hz: float = 50.0, config: GapConfig | None = None,
+                 progress: Callable[[SelftestCase], None] | None = None) -> SelftestResult:
+    result = SelftestResult()
+    for size in sizes_s:
+        for seed in seeds:
+            for case in cases:
+                c, _ = run_case(case, size, seed, rate_hz, config)
+                result.cases.append(c)
+                if progress is not None:
+                    progress(c)
+    return result
+
+
+def selftest_markdown(result: SelftestResult) -> str:
+    s = result.summary()
+    lines = ["| figure | value |", "| --- | ---: |",
+             f"| top-1 accuracy (effect cases) | {s['top1_accuracy']:.0%} "
+             f"({sum(c.correct for c in result.cases if c.expected)}/{s['n_effect_cases']}) |",
+             f"| false alarms (no-effect cases) | {s['false_alarms']}/{s['n_null_cases']} |",
+             f"| median held-out tip RMSE shrink, correct cases | "
+             f"{s['median_tip_rmse_shrink_when_correct']:.0%} |",
+             f"| median held-out current RMSE shrink, correct cases | "
+             f"{s['median_current_rmse_shrink_when_correct']:.0%} |",
+             f"| median wall time per diagnosis | {s['median_wall_s']:.1f} s |", "",
+             "Confusion matrix (rows: effect in the data; columns: top-1 diagnosis):", ""]
+    conf = result.confusion()
+    cols = sorted({k for row in conf.values() for k in row} | {"none"})
+    lines += ["| data \\ diagnosis | " + " | ".join(cols) + " |",
+              "| --- |" + " ---: |" * len(cols)]
+    for case, row in conf.items():
+        lines.append(f"| {case} | " + " | ".join(str(row.get(c, 0)) for c in cols) + " |")
+    lines += ["", "| case | size (s) | seed | verdict | top-1 | share | tip RMSE before -> after "
+              "(deg) | current RMSE before -> after (A) | wall (s) |",
+              "| --- | ---: | ---: | --- | --- | ---: | --- | --- | ---: |"]
+    for c in result.cases:
+        after_tip = "-" if c.tip_rmse_after is None else f"{c.tip_rmse_after:.3f}"
+        after_cur = "-" if c.cur_rmse_after is None else f"{c.cur_rmse_after:.4f}"
+        share = "-" if c.share is None else f"{c.share:.0%}"
+        lines.append(f"| {c.case} | {c.duration_s:.0f} | {c.seed} | {c.verdict} | "
+                     f"{c.top or 'none'} | {share} | {c.tip_rmse_before:.3f} -> {after_tip} | "
+                     f"{c.cur_rmse_before:.4f} -> {after_cur} | {c.wall_s:.1f} |")
+    return "\n".join(lines)

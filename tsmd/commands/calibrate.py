@@ -1,15 +1,239 @@
-"""`tsmd calibrate`: not built yet (see the open issue)."""
+"""`tsmd calibrate`: calibrate a catheter from motor current and save its profile.
+
+Three ways to run it, one identification code path:
+
+* through the running daemon (default): asks over the socket (API command ``calibrate``),
+  shows the streamed progress; Ctrl-C asks the daemon to cancel (knobs back to 0, nothing saved);
+* ``--sim``: in-process on the simulated rig in lockstep (full CAN stack, faster than real time);
+* ``--from-recording FILE...``: offline from logged sweeps (one sweep per file; real TEE
+  acquisitions are read directly, see docs/calibration.md).
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
+import signal
+import socket
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
 
 from tsmd.errors import TsmdError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("rest", nargs=argparse.REMAINDER)
+    parser.add_argument("--catheter", required=True, metavar="ID",
+                        help="catheter id: the profile is saved as <profiles dir>/<ID>.yaml")
+    parser.add_argument("--sim", action="store_true",
+                        help="run in-process on the simulated rig (lockstep), not via the daemon")
+    parser.add_argument("--config", metavar="FILE",
+                        help="tsmd config (default: /etc/tsmd/tsmd.yaml, or the sim default "
+                             "with --sim)")
+    parser.add_argument("--fast", action="store_true",
+                        help="the fast protocol (210 s of triangle sweeps) instead of the "
+                             "paper's (700 s of sine sweeps); --sim and recordings only")
+    parser.add_argument("--report", metavar="DIR",
+                        help="write a calibration report (Markdown + PNG plots) into DIR")
+    parser.add_argument("--from-recording", nargs="+", metavar="FILE",
+                        help="identify from logged sweeps (recording CSVs or TEE acquisitions)")
+    parser.add_argument("--device", metavar="FILE",
+                        help="device model YAML (default: profiles.device_model of the config)")
+    parser.add_argument("--profiles", metavar="DIR",
+                        help="where to save the profile (default: profiles.dir of the config)")
+    parser.add_argument("--save-sweeps", metavar="DIR",
+                        help="also write each sweep's recording (CSV) into DIR (--sim)")
+    parser.add_argument("--steps-per-knob-deg", type=float, default=None,
+                        help="TEE acquisitions: motor steps per knob degree (assumed; "
+                             "default 16, see docs/calibration.md)")
+    parser.add_argument("--no-save", action="store_true",
+                        help="identify and check, print the result, do not save a profile")
+    parser.add_argument("--seed", type=int, default=0, help="--sim: noise seed")
 
 
 def main(args: argparse.Namespace) -> int:
-    raise TsmdError("'tsmd calibrate' is not implemented yet")
+    if args.from_recording:
+        return _from_recordings(args)
+    if args.sim:
+        return _sim(args)
+    if args.fast:
+        raise TsmdError("--fast needs --sim or --from-recording (the daemon runs its own "
+                        "protocol)")
+    return _via_daemon(args)
+
+
+# --- shared helpers -----------------------------------------------------------------------
+
+
+def _config(args: argparse.Namespace, sim: bool) -> Any:
+    from tsmd.config import default_sim_config, load_config
+
+    if args.config:
+        return load_config(args.config)
+    if sim:
+        return default_sim_config()
+    return load_config("/etc/tsmd/tsmd.yaml")
+
+
+def _device(args: argparse.Namespace, config: Any) -> Any:
+    from tsmd.profile import load_device_model
+
+    path = args.device or getattr(config.profiles, "device_model", None)
+    if path is None:
+        raise TsmdError("no device model: pass --device FILE or set profiles.device_model")
+    from tsmd.daemon import resolve_data_path
+
+    return load_device_model(resolve_data_path(str(path)))
+
+
+def _save(args: argparse.Namespace, config: Any, cal: Any) -> None:
+    from tsmd.profile import ProfileStore
+
+    _print_result(cal)
+    if args.report:
+        from tsmd.calibration.report import write_report
+
+        index = write_report(cal, Path(args.report))
+        print(f"report: {index}")
+    if args.no_save:
+        print("not saved (--no-save)")
+        return
+    directory = args.profiles or (config.profiles.dir if config is not None else None)
+    if directory is None:
+        raise TsmdError("no profiles directory: pass --profiles DIR or --config FILE")
+    path = ProfileStore(directory).save(cal.profile)
+    print(f"saved profile {cal.profile.catheter_id!r} to {path}")
+
+
+def _print_result(cal: Any) -> None:
+    from tsmd.calibration.report import grid_table
+
+    print(grid_table(cal))
+    if cal.sweep_time_s:
+        print(f"protocol {cal.protocol_name}: {cal.sweep_time_s:.0f} s sweeping, "
+              f"{cal.motion_time_s:.0f} s of motion, {cal.wall_time_s:.1f} s wall")
+
+
+class _Bar:
+    """A one-line progress bar on a terminal (plain lines otherwise)."""
+
+    def __init__(self) -> None:
+        self.tty = sys.stderr.isatty()
+        self.last = ""
+
+    def __call__(self, fraction: float, text: str) -> None:
+        width = 30
+        filled = round(fraction * width)
+        line = f"[{'#' * filled}{'.' * (width - filled)}] {fraction * 100:5.1f}% {text}"
+        if self.tty:
+            sys.stderr.write("\r" + line[:150].ljust(len(self.last)))
+            sys.stderr.flush()
+        elif text.split(";")[0] != self.last.split(";")[0].split("% ", 1)[-1]:
+            sys.stderr.write(line + "\n")
+        self.last = line
+
+    def done(self) -> None:
+        if self.tty and self.last:
+            sys.stderr.write("\n")
+
+
+# --- the three paths ----------------------------------------------------------------------
+
+
+def _sim(args: argparse.Namespace) -> int:
+    from tsmd.calibration import fast_protocol, paper_protocol, run_calibration
+    from tsmd.recording import write_recording
+    from tsmd.replay import LockstepRunner
+
+    config = _config(args, sim=True)
+    device = _device(args, config)
+    protocol = fast_protocol() if args.fast else paper_protocol()
+    cancel = threading.Event()
+    bar = _Bar()
+    previous = signal.signal(signal.SIGINT, lambda *_: cancel.set())
+    try:
+        with LockstepRunner(config, seed=args.seed) as runner:
+            cal = run_calibration(runner, args.catheter, device, protocol=protocol,
+                                  period_s=config.loop.period_s, progress=bar, cancel=cancel)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        bar.done()
+    if args.save_sweeps:
+        out = Path(args.save_sweeps)
+        out.mkdir(parents=True, exist_ok=True)
+        for i, point in enumerate(cal.points):
+            if point.recording is not None:
+                write_recording(out / f"sweep{i + 1:02d}.csv", point.recording)
+        print(f"sweeps written to {out}")
+    _save(args, config, cal)
+    return 0
+
+
+def _from_recordings(args: argparse.Namespace) -> int:
+    from tsmd.calibration.offline import identification_table, read_sweep_file
+    from tsmd.calibration.run import calibration_from_points, identify_recording
+
+    config = _config(args, sim=False) if args.config else None
+    device = _device(args, config)
+    points = [identify_recording(read_sweep_file(f, args.steps_per_knob_deg), source=str(f))
+              for f in args.from_recording]
+    print(identification_table(points))
+    cal = calibration_from_points(points, args.catheter, device)
+    _save(args, config, cal)
+    return 0
+
+
+def _via_daemon(args: argparse.Namespace) -> int:
+    config = _config(args, sim=False)
+    path = config.api.socket_path
+    bar = _Bar()
+    try:
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        sock.connect(path)
+    except OSError as exc:
+        raise TsmdError(f"cannot reach the daemon at {path}: {exc.strerror or exc} "
+                        "(is 'tsmd run' running? use --sim for the simulator)") from None
+    request = {"id": "calibrate", "cmd": "calibrate", "params": {"catheter": args.catheter}}
+    sock.sendall((json.dumps(request) + "\n").encode())
+    stream = sock.makefile("rb")
+    cancelled = False
+    try:
+        while True:
+            try:
+                line = stream.readline()
+            except KeyboardInterrupt:
+                if not cancelled:
+                    cancelled = True
+                    sys.stderr.write("\ncancelling: the knobs return to 0...\n")
+                    _send_cancel(path)
+                continue
+            if not line:
+                raise TsmdError("the daemon closed the connection during calibration")
+            message = json.loads(line)
+            if message.get("event") == "progress":
+                info = message.get("info") or []
+                bar(float(message.get("progress", 0.0)), str(info[0]) if info else "")
+                continue
+            if message.get("id") != "calibrate":
+                continue
+            bar.done()
+            if message.get("ok"):
+                print(f"saved profile {message.get('profile')!r} to {message.get('path')}")
+                return 0
+            error = message.get("error", {})
+            raise TsmdError(f"{error.get('code', 'error')}: {error.get('message', message)}")
+    finally:
+        sock.close()
+
+
+def _send_cancel(path: str) -> None:
+    try:
+        with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as s:
+            s.settimeout(5.0)
+            s.connect(path)
+            s.sendall(b'{"id": "cancel", "cmd": "cancel"}\n')
+            s.recv(4096)
+    except OSError:
+        time.sleep(0.1)

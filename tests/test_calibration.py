@@ -1,0 +1,278 @@
+"""Calibration from motor current: identification, bad data, protocol, cancel, profile.
+
+Sweeps come from the built-in tendon-sheath plant (physics, not the compensator's model) driven
+by a small lockstep runner (tests/test_calibration_helpers.py); the truth is measured on the
+plant's noise-free tip with the plant package's own analysis, never read from its parameters.
+"""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_calibration_helpers import LockstepPlantRunner
+
+from drivers.plant.analysis import measure_dead_zone_backlash
+from drivers.plant.tendon_sheath import make_tendon_sheath_plant
+from tsmd.calibration import (
+    CalibrationCancelledError,
+    CalibrationError,
+    Protocol,
+    QualityLimits,
+    Sweep,
+    fast_protocol,
+    identify_recording,
+    identify_sweep,
+    paper_protocol,
+    run_calibration,
+)
+from tsmd.calibration.identify import SweepResult
+from tsmd.calibration.protocol import sweep_run
+from tsmd.calibration.run import sweep_metadata
+from tsmd.calibration.signal import lowpass
+from tsmd.profile import ProfileStore, load_device_model
+from tsmd.recording import Recording, read_recording, write_recording
+
+PERIOD_S = 0.004
+DEVICE = Path(__file__).resolve().parent.parent / "profiles" / "devices" / "sim-catheter.yaml"
+SHORT_SWEEP = Sweep(0, 0.0, 90.0, 0.1, 1.5, "triangle")
+
+
+def _sweep(sweep: Sweep, runner: LockstepPlantRunner | None = None) -> Recording:
+    runner = runner or LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
+    run = sweep_run(sweep, np.zeros(2), PERIOD_S, Protocol("t", (sweep,)))
+    rec = runner.run(run.t_s, run.q_deg)
+    rec.metadata.update(sweep_metadata(sweep, float(run.t_s[run.sweep_start])))
+    return rec
+
+
+@pytest.fixture(scope="module")
+def sweep_rec() -> Recording:
+    return _sweep(SHORT_SWEEP)
+
+
+def _identify(rec: Recording, current: np.ndarray | None = None) -> SweepResult:
+    cur = rec["cur1"] if current is None else current
+    return identify_sweep(rec["t"], rec["cmd1"], rec["pos1"], cur,
+                          sweep_start_s=float(rec.metadata["calibration_sweep_start_s"]))
+
+
+def _truth(rec: Recording):
+    start = float(rec.metadata["calibration_sweep_start_s"]) - 1.0  # include the way down
+    m = rec["t"] >= start
+    return measure_dead_zone_backlash(rec["pos1"][m], rec["tip1"][m], threshold_deg=0.5)
+
+
+# --- identification ---------------------------------------------------------------------------
+
+
+def test_dead_zone_edges_from_current_are_near_the_tips(sweep_rec: Recording) -> None:
+    # The current rises where the tendon starts to load, the tip a little later (tendon stretch
+    # against joint friction): the paper's definition, compared with the tip in the benchmark.
+    result = _identify(sweep_rec)
+    truth = _truth(sweep_rec)
+    for name in ("dead_zone_pos_deg", "dead_zone_neg_deg"):
+        assert abs(result.estimate(name) - getattr(truth, name)) < 5.0, name
+
+
+def test_backlash_is_found_after_every_reversal_and_agrees_across_cycles(
+        sweep_rec: Recording) -> None:
+    result = _identify(sweep_rec)
+    reversals = [h for h in result.half_cycles if h.after_reversal]
+    assert len(reversals) == 3
+    assert all(h.backlash_end_index is not None for h in reversals)
+    assert result.spread("backlash_neg_deg") < 3.0
+    assert all(0.0 <= b < 60.0 for n in ("backlash_pos_deg", "backlash_neg_deg")
+               for b in result.values[n])
+
+
+def test_dead_zone_edges_are_on_either_side_of_zero(sweep_rec: Recording) -> None:
+    result = _identify(sweep_rec)
+    assert result.estimate("dead_zone_pos_deg") > 5.0
+    assert result.estimate("dead_zone_neg_deg") < -5.0
+
+
+def test_noise_and_spikes_in_the_current_do_not_move_the_result(sweep_rec: Recording) -> None:
+    clean = _identify(sweep_rec)
+    rng = np.random.default_rng(3)
+    cur = sweep_rec["cur1"] + rng.normal(0.0, 0.004, len(sweep_rec))
+    spikes = rng.random(len(sweep_rec)) < 0.01
+    cur = cur + spikes * rng.choice([-1.0, 1.0], len(sweep_rec)) * 0.08
+    noisy = _identify(sweep_rec, cur)
+    assert any("spikes removed" in n for n in noisy.data.notes)
+    for name in clean.values:
+        assert abs(noisy.estimate(name) - clean.estimate(name)) < 1.5, name
+
+
+def test_short_runs_of_missing_samples_are_interpolated(sweep_rec: Recording) -> None:
+    cur = sweep_rec["cur1"].copy()
+    cur[1000:1010] = np.nan
+    cur[2500:2503] = np.nan
+    result = _identify(sweep_rec, cur)
+    assert any("13 missing current samples" in n for n in result.data.notes)
+    assert abs(result.estimate("dead_zone_pos_deg")
+               - _identify(sweep_rec).estimate("dead_zone_pos_deg")) < 1.0
+
+
+def test_a_long_gap_is_refused_with_where_it_is(sweep_rec: Recording) -> None:
+    cur = sweep_rec["cur1"].copy()
+    cur[1000:1500] = np.nan
+    with pytest.raises(CalibrationError, match=r"current is missing 500 samples from t="):
+        _identify(sweep_rec, cur)
+
+
+def test_time_gaps_in_the_log_are_refused_when_long(sweep_rec: Recording) -> None:
+    keep = np.ones(len(sweep_rec), dtype=bool)
+    keep[2000:2300] = False
+    r = sweep_rec
+    with pytest.raises(CalibrationError, match="no sample between"):
+        identify_sweep(r["t"][keep], r["cmd1"][keep], r["pos1"][keep], r["cur1"][keep])
+
+
+def test_a_stalled_motor_is_refused() -> None:
+    runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S, stall_after_s=0.0)
+    rec = _sweep(SHORT_SWEEP, runner)
+    with pytest.raises(CalibrationError, match="stalled"):
+        _identify(rec)
+
+
+def test_a_sweep_that_never_leaves_the_dead_zone_gives_no_edge_and_says_why() -> None:
+    small = Sweep(0, 0.0, 12.0, 0.1, 1.5, "triangle")
+    rec = _sweep(small)
+    result = _identify(rec)
+    assert result.values["dead_zone_pos_deg"] == ()
+    assert any("never leave the dead zone" in p for p in result.problems)
+
+
+def test_constant_current_is_refused_as_no_feedback(sweep_rec: Recording) -> None:
+    with pytest.raises(CalibrationError, match="no current feedback"):
+        _identify(sweep_rec, np.full(len(sweep_rec), 0.02))
+
+
+def test_the_low_pass_is_skipped_with_the_reason_when_sampling_is_too_slow() -> None:
+    x = np.random.default_rng(0).normal(size=500)
+    out, note = lowpass(x, sample_rate_hz=30.0, cutoff_hz=20.0)
+    assert note is not None and "cannot carry a 20 Hz cutoff" in note
+    np.testing.assert_array_equal(out, x)
+    _, note = lowpass(x, sample_rate_hz=250.0)
+    assert note is None
+
+
+def test_mismatched_arrays_are_refused() -> None:
+    with pytest.raises(CalibrationError, match="same length"):
+        identify_sweep(np.arange(100.0), np.zeros(100), np.zeros(99), np.zeros(100))
+
+
+def test_a_logged_sweep_identifies_the_same_after_a_round_trip(sweep_rec: Recording,
+                                                                tmp_path: Path) -> None:
+    path = tmp_path / "sweep.csv"
+    write_recording(path, sweep_rec)
+    point = identify_recording(read_recording(path))
+    assert point.knob == 0 and point.other_deg == 0.0
+    direct = _identify(sweep_rec)
+    for name, values in direct.values.items():
+        np.testing.assert_allclose(point.result.values[name], values, atol=1e-6)
+
+
+def test_a_recording_moving_both_knobs_is_refused(sweep_rec: Recording) -> None:
+    rec = sweep_rec.slice(0, len(sweep_rec))
+    rec.columns["cmd2"] = np.linspace(0, 30, len(rec))
+    with pytest.raises(CalibrationError, match="both knobs move"):
+        identify_recording(rec)
+
+
+# --- protocol ----------------------------------------------------------------------------------
+
+
+def test_the_paper_protocol_sweeps_700_s_and_the_fast_one_at_most_a_third() -> None:
+    paper = paper_protocol()
+    assert len(paper.sweeps) == 14 and paper.sweep_time_s == pytest.approx(700.0)
+    assert {s.other_deg for s in paper.sweeps} == {-90, -60, -30, 0, 30, 60, 90}
+    assert fast_protocol().sweep_time_s <= 700.0 / 3
+
+
+def test_a_protocol_beyond_the_knob_limits_is_refused() -> None:
+    proto = Protocol("wide", (Sweep(0, 0.0, 130.0),))
+    with pytest.raises(CalibrationError, match="exceeds the knob limits"):
+        proto.validate(((-120.0, 120.0), (-120.0, 120.0)))
+
+
+def test_each_sweep_starts_at_minus_a_after_coming_down() -> None:
+    proto = paper_protocol()
+    run = sweep_run(proto.sweeps[0], np.zeros(2), PERIOD_S, proto)
+    knob = run.q_deg[:, 0]
+    assert knob[run.sweep_start - 1] == pytest.approx(-90.0)
+    assert knob[: run.sweep_start].max() == pytest.approx(90.0, abs=1e-6)
+    assert np.abs(np.diff(run.q_deg, axis=0)).max() < 1.0
+
+
+# --- a whole calibration ----------------------------------------------------------------------
+
+SMALL = Protocol("small", tuple(Sweep(k, o, 90.0, 0.1, 1.5, "triangle")
+                                for k in (0, 1) for o in (-30.0, 0.0, 30.0)))
+
+
+def test_a_small_calibration_builds_a_profile_that_saves_and_loads(tmp_path: Path) -> None:
+    device = load_device_model(DEVICE)
+    runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
+    seen: list[tuple[float, str]] = []
+    cal = run_calibration(runner, "cat-1", device, protocol=SMALL, period_s=PERIOD_S,
+                          progress=lambda f, text: seen.append((f, text)),
+                          limits=QualityLimits(max_cycle_spread_deg=10.0))
+    assert cal.profile.knobs[0].other_knob_deg == (-30.0, 0.0, 30.0)
+    assert seen[-1][0] == pytest.approx(1.0)
+    assert "sweep 6/6" in seen[-1][1]
+    assert np.allclose(runner.trajectories[-1][-1], 0.0)
+    store = ProfileStore(tmp_path)
+    store.save(cal.profile)
+    loaded = store.load("cat-1")
+    assert loaded.knobs[1].dead_zone_pos_deg == cal.profile.knobs[1].dead_zone_pos_deg
+
+
+class _CancelAfter(LockstepPlantRunner):
+    def __init__(self, runs_before_cancel: int, cancel: threading.Event) -> None:
+        super().__init__(make_tendon_sheath_plant(), PERIOD_S)
+        self.before = runs_before_cancel
+        self.cancel_event = cancel
+
+    def run(self, t_s, q_deg, compensate=False, cancel=None, progress=None):
+        if self.runs == self.before:
+            self.cancel_event.set()
+        return super().run(t_s, q_deg, compensate, cancel, progress)
+
+
+def test_a_cancelled_calibration_returns_the_knobs_to_zero_and_saves_nothing(
+        tmp_path: Path) -> None:
+    device = load_device_model(DEVICE)
+    cancel = threading.Event()
+    runner = _CancelAfter(1, cancel)
+    with pytest.raises(CalibrationCancelledError, match="knobs returned to 0, nothing saved"):
+        run_calibration(runner, "cat-2", device, protocol=SMALL, period_s=PERIOD_S,
+                        cancel=cancel)
+    assert np.allclose(runner.pos, 0.0, atol=0.5)
+    assert np.allclose(runner.trajectories[-1][-1], 0.0)
+    assert ProfileStore(tmp_path).list() == []
+
+
+def test_cycles_that_disagree_are_refused_with_the_spread() -> None:
+    from tsmd.calibration.assemble import GridPoint, check_quality
+    base = _identify(_sweep(SHORT_SWEEP))
+    values = dict(base.values)
+    d = values["dead_zone_pos_deg"]
+    values["dead_zone_pos_deg"] = (d[0], d[0] + 9.0)
+    bad = SweepResult(base.data, base.half_cycles, values)
+    report = check_quality([GridPoint(0, 0.0, bad), GridPoint(0, 30.0, base),
+                            GridPoint(1, 0.0, base), GridPoint(1, 30.0, base)])
+    with pytest.raises(CalibrationError, match=r"cycles disagree on dead_zone_pos_deg by 9\.0"):
+        report.raise_if_bad()
+
+
+def test_a_grid_without_the_zero_sweep_is_refused() -> None:
+    from tsmd.calibration.assemble import GridPoint, check_quality
+
+    base = _identify(_sweep(SHORT_SWEEP))
+    report = check_quality([GridPoint(k, o, base) for k in (0, 1) for o in (-30.0, 30.0)])
+    with pytest.raises(CalibrationError, match="design assumption 1"):
+        report.raise_if_bad()

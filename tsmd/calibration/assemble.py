@@ -1,0 +1,167 @@
+"""From identified sweeps to a catheter profile: quality checks, H from the data sheet, grids.
+
+The quality checks refuse to build a profile that would be wrong and say why: a parameter no
+half-cycle could give, cycles that disagree, values outside the plausible range, a weak signal, a
+grid without the sweep at 0 deg that design assumption 1 needs.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+
+import numpy as np
+
+from tsmd.calibration.errors import CalibrationError
+from tsmd.calibration.identify import PARAMETERS, SweepResult
+from tsmd.compensation.paper import height_from_reference
+from tsmd.profile import KNOB_NAMES, CatheterProfile, DeviceModel, KnobProfile
+from tsmd.recording import Recording
+
+KNOB_LABELS = ("phi1", "phi2")
+
+
+@dataclass(frozen=True)
+class GridPoint:
+    """One identified sweep: which knob, where the other knob was, what was found."""
+
+    knob: int
+    other_deg: float
+    result: SweepResult
+    recording: Recording | None = None
+    label: str = ""
+
+    @property
+    def name(self) -> str:
+        return self.label or (f"{KNOB_LABELS[self.knob]} sweep, {KNOB_LABELS[1 - self.knob]} at "
+                              f"{self.other_deg:+.0f} deg")
+
+
+@dataclass(frozen=True)
+class QualityLimits:
+    """What a trustworthy calibration must show."""
+
+    max_cycle_spread_deg: float = 3.0
+    """Largest disagreement allowed between the cycles of one sweep, per parameter."""
+    max_backlash_deg: float = 60.0
+    max_dead_zone_fraction: float = 0.8
+    """A dead-zone edge beyond this fraction of the sweep amplitude is implausible."""
+    min_snr: float = 4.0
+
+
+@dataclass
+class QualityReport:
+    """Figures the profile keeps and the problems that stop a calibration."""
+
+    figures: dict[str, float] = field(default_factory=dict)
+    problems: list[str] = field(default_factory=list)
+
+    def raise_if_bad(self) -> None:
+        if self.problems:
+            head = f"calibration refused ({len(self.problems)} problem"
+            head += "s): " if len(self.problems) > 1 else "): "
+            raise CalibrationError(head + "; ".join(self.problems))
+
+
+def check_quality(points: Sequence[GridPoint], limits: QualityLimits | None = None,
+                  amplitude_deg: float = 90.0) -> QualityReport:
+    """Check every grid point; collect all problems (not just the first)."""
+    lim = limits or QualityLimits()
+    report = QualityReport()
+    for knob in (0, 1):
+        mine = [p for p in points if p.knob == knob]
+        label = KNOB_LABELS[knob]
+        if not mine:
+            report.problems.append(f"{label}: no sweep")
+            continue
+        grid = sorted(p.other_deg for p in mine)
+        if len(set(grid)) != len(grid):
+            report.problems.append(f"{label}: two sweeps at the same other-knob angle")
+        if len(grid) < 2:
+            report.problems.append(f"{label}: needs sweeps at >= 2 other-knob angles, got {grid}")
+        if not any(abs(g) < 1e-6 for g in grid):
+            report.problems.append(
+                f"{label}: no sweep with the other knob at 0 deg (design assumption 1 needs it)")
+        spreads: list[float] = []
+        snrs: list[float] = []
+        for p in mine:
+            _check_point(p, lim, amplitude_deg, report.problems, spreads)
+            if math.isfinite(p.result.snr):
+                snrs.append(p.result.snr)
+        report.figures[f"{label}_max_cycle_spread_deg"] = max(spreads) if spreads else 0.0
+        report.figures[f"{label}_min_snr"] = min(snrs) if snrs else 0.0
+        report.figures[f"{label}_sweeps"] = float(len(mine))
+    return report
+
+
+def _check_point(p: GridPoint, lim: QualityLimits, amplitude_deg: float, problems: list[str],
+                 spreads: list[float]) -> None:
+    r = p.result
+    for name in PARAMETERS:
+        values = r.values.get(name, ())
+        if not values:
+            why = "; ".join(r.problems) or "no half-cycle gave it"
+            problems.append(f"{p.name}: no {name} ({why})")
+            continue
+        if len(values) > 1:
+            spread = r.spread(name)
+            spreads.append(spread)
+            if spread > lim.max_cycle_spread_deg:
+                problems.append(f"{p.name}: cycles disagree on {name} by {spread:.1f} deg "
+                                f"(values {', '.join(f'{v:.1f}' for v in values)}; "
+                                f"allowed {lim.max_cycle_spread_deg:g})")
+    d_pos, d_neg = r.estimate("dead_zone_pos_deg"), r.estimate("dead_zone_neg_deg")
+    b_pos, b_neg = r.estimate("backlash_pos_deg"), r.estimate("backlash_neg_deg")
+    edge_max = lim.max_dead_zone_fraction * amplitude_deg
+    if math.isfinite(d_pos) and not 0.0 < d_pos < edge_max:
+        problems.append(f"{p.name}: dead_zone_pos_deg {d_pos:.1f} outside (0, {edge_max:g})")
+    if math.isfinite(d_neg) and not -edge_max < d_neg < 0.0:
+        problems.append(f"{p.name}: dead_zone_neg_deg {d_neg:.1f} outside ({-edge_max:g}, 0)")
+    for name, b in (("backlash_pos_deg", b_pos), ("backlash_neg_deg", b_neg)):
+        if math.isfinite(b) and not 0.0 <= b <= lim.max_backlash_deg:
+            problems.append(f"{p.name}: {name} {b:.1f} outside [0, {lim.max_backlash_deg:g}]")
+    snr = r.snr
+    if math.isfinite(snr) and snr < lim.min_snr:
+        problems.append(f"{p.name}: current signal too weak (SNR {snr:.1f} < {lim.min_snr:g})")
+
+
+def knob_grid(points: Sequence[GridPoint], knob: int) -> tuple[tuple[float, ...],
+                                                                  dict[str, tuple[float, ...]]]:
+    """The other-knob grid (sorted) and each parameter's estimate on it."""
+    mine = sorted((p for p in points if p.knob == knob), key=lambda p: p.other_deg)
+    grid = tuple(float(p.other_deg) for p in mine)
+    values = {name: tuple(float(p.result.estimate(name)) for p in mine) for name in PARAMETERS}
+    return grid, values
+
+
+def build_profile(catheter_id: str, device: DeviceModel, points: Sequence[GridPoint], *,
+                  quality: QualityReport, software_version: str,
+                  ours: Sequence[object | None] = (None, None), interpolation: str = "pchip",
+                  source: str = "calibration from motor current") -> CatheterProfile:
+    """The profile: grids per knob, H from the reference points at D(0) (assumptions 1-3)."""
+    quality.raise_if_bad()
+    knobs: list[KnobProfile] = []
+    for knob in (0, 1):
+        grid, values = knob_grid(points, knob)
+        dev = device.knobs[knob]
+        zero = int(np.argmin(np.abs(np.asarray(grid))))
+        h_pos = height_from_reference(dev.reference_pos.knob_deg, dev.reference_pos.tip_deg,
+                                      values["dead_zone_pos_deg"][zero], dev.omega)
+        h_neg = height_from_reference(dev.reference_neg.knob_deg, dev.reference_neg.tip_deg,
+                                      values["dead_zone_neg_deg"][zero], dev.omega)
+        knobs.append(KnobProfile(
+            omega=dev.omega, reference_pos=dev.reference_pos, reference_neg=dev.reference_neg,
+            height_pos_deg=float(h_pos), height_neg_deg=float(h_neg), other_knob_deg=grid,
+            dead_zone_pos_deg=values["dead_zone_pos_deg"],
+            dead_zone_neg_deg=values["dead_zone_neg_deg"],
+            backlash_pos_deg=values["backlash_pos_deg"],
+            backlash_neg_deg=values["backlash_neg_deg"],
+            ours=ours[knob]))  # type: ignore[arg-type]
+    assert len(KNOB_NAMES) == 2
+    return CatheterProfile(
+        catheter_id=catheter_id, device_model=device.device_model,
+        calibrated_at=datetime.now(UTC).replace(microsecond=0).isoformat(),
+        software_version=software_version, interpolation=interpolation,
+        knobs=(knobs[0], knobs[1]), source=source, quality=dict(quality.figures))

@@ -1,0 +1,338 @@
+"""Dead zone and backlash of one knob from one sweep, using motor position and current only.
+
+The paper's identification (section "Parameter Identification"): after each reversal the current
+jumps, makes a small peak and settles to a constant level while the tendon slack is taken up
+(backlash, ``B``); it stays constant through the dead zone and starts to rise (or fall) where the
+tendon loads the tip again (dead-zone edge, ``D``). Here, per monotonic half-cycle:
+
+* the peak after the reversal: :func:`scipy.signal.find_peaks` on the direction-signed current;
+* the backlash end: where the current has settled on the constant level after that peak;
+* the dead-zone edge: the change point from constant to rising current, found by
+  :mod:`ruptures` (continuous piecewise-linear cost on the current against knob angle).
+
+Increasing half-cycles (after the reversal at the negative end) give ``B_neg`` and ``D_pos``;
+decreasing ones (after the positive end) give ``B_pos`` and ``D_neg``, as in the paper's model
+(``D̂_neg = (H_neg - H_pos)/ω + D_pos - B_pos``: ``B_pos`` is the backlash on the way down).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import ruptures as rpt
+from numpy.typing import NDArray
+from scipy.signal import find_peaks
+
+from tsmd.calibration.errors import CalibrationError
+from tsmd.calibration.signal import Conditioned, FloatArray, condition, robust_sigma
+
+PARAMETERS: tuple[str, ...] = (
+    "dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_pos_deg", "backlash_neg_deg")
+
+
+@dataclass(frozen=True)
+class IdentifyOptions:
+    """Tuning of the identification; the defaults follow the paper where it says something."""
+
+    cutoff_hz: float = 20.0
+    filter_order: int = 3
+    max_gap_s: float = 0.5
+    min_reversal_deg: float = 10.0
+    """Direction changes smaller than this are jitter, not reversals."""
+    grid_step_deg: float = 0.25
+    """The current is resampled on this knob-angle grid for change-point detection."""
+    min_snr: float = 4.0
+    """The current must rise by this many noise sigmas past the dead-zone edge."""
+    edge_margin_deg: float = 3.0
+    """An edge closer than this to the end of a half-cycle was not reached."""
+    peak_noise_k: float = 3.0
+    """A peak after a reversal must stand out of the noise by this many sigmas."""
+    flat_slope_fraction: float = 0.2
+    """"Constant" current: rising slower than this fraction of the loaded ramp's slope."""
+    penalty_k: float = 20.0
+    """Change-point penalty in units of noise variance x log(n) (PELT)."""
+    max_tracking_error_deg: float = 10.0
+    min_follow_ratio: float = 0.5
+    """The knob must travel at least this fraction of the commanded travel (else: stalled)."""
+
+
+@dataclass(frozen=True)
+class HalfCycle:
+    """One monotonic stretch between reversals and what was found in it (indices into arrays)."""
+
+    direction: int
+    start: int
+    stop: int
+    after_reversal: bool
+    peak_index: int | None = None
+    backlash_end_index: int | None = None
+    edge_index: int | None = None
+    backlash_deg: float = math.nan
+    edge_deg: float = math.nan
+    plateau_A: float = math.nan
+    rise_A: float = math.nan
+    snr: float = math.nan
+    problems: tuple[str, ...] = ()
+
+    @property
+    def backlash_name(self) -> str:
+        return "backlash_neg_deg" if self.direction > 0 else "backlash_pos_deg"
+
+    @property
+    def edge_name(self) -> str:
+        return "dead_zone_pos_deg" if self.direction > 0 else "dead_zone_neg_deg"
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """Everything one sweep gave: conditioned signals, half-cycles, values per parameter."""
+
+    data: Conditioned
+    half_cycles: tuple[HalfCycle, ...]
+    values: dict[str, tuple[float, ...]] = field(default_factory=dict)
+    """Each parameter's value from every half-cycle that gave one, in time order."""
+
+    def estimate(self, name: str) -> float:
+        """Median over the half-cycles (NaN when none gave a value)."""
+        v = self.values.get(name, ())
+        return float(np.median(v)) if v else math.nan
+
+    def spread(self, name: str) -> float:
+        """Largest minus smallest value over the half-cycles (0 with one value)."""
+        v = self.values.get(name, ())
+        return float(np.ptp(v)) if v else math.nan
+
+    @property
+    def snr(self) -> float:
+        values = [h.snr for h in self.half_cycles if math.isfinite(h.snr)]
+        return float(min(values)) if values else math.nan
+
+    @property
+    def problems(self) -> tuple[str, ...]:
+        return tuple(p for h in self.half_cycles for p in h.problems)
+
+
+def find_reversals(cmd_deg: FloatArray, min_reversal_deg: float) -> list[int]:
+    """Indices where the commanded position turns by more than ``min_reversal_deg`` (zigzag)."""
+    reversals: list[int] = []
+    direction = 0
+    extreme = 0
+    for i in range(1, cmd_deg.size):
+        x = cmd_deg[i]
+        if direction == 0:
+            if abs(x - cmd_deg[0]) > min_reversal_deg:
+                direction = 1 if x > cmd_deg[0] else -1
+                extreme = i
+        elif direction * (x - cmd_deg[extreme]) >= 0:
+            extreme = i
+        elif direction * (cmd_deg[extreme] - x) > min_reversal_deg:
+            reversals.append(extreme)
+            direction, extreme = -direction, i
+    return reversals
+
+
+def _moving_start(cmd_deg: FloatArray) -> int:
+    """First index where the command has left its starting value (skips a still lead-in)."""
+    moved = np.flatnonzero(np.abs(cmd_deg - cmd_deg[0]) > 1e-6)
+    return int(moved[0]) - 1 if moved.size else 0
+
+
+def split_half_cycles(cmd_deg: FloatArray,
+                      min_reversal_deg: float) -> list[tuple[int, int, int, bool]]:
+    """(direction, start, stop, after_reversal) for each monotonic stretch of the command."""
+    reversals = find_reversals(cmd_deg, min_reversal_deg)
+    bounds = [_moving_start(cmd_deg), *reversals, cmd_deg.size - 1]
+    out = []
+    for k in range(len(bounds) - 1):
+        a, b = bounds[k], bounds[k + 1]
+        travel = cmd_deg[b] - cmd_deg[a]
+        if abs(travel) < min_reversal_deg:
+            continue
+        out.append((1 if travel > 0 else -1, a, b + 1, k > 0))
+    return out
+
+
+def _resample_on_angle(x: FloatArray, y: FloatArray, direction: int,
+                       step_deg: float) -> tuple[FloatArray, FloatArray]:
+    """y on a uniform grid of the direction-signed angle ``direction * x`` (made monotonic)."""
+    s = np.maximum.accumulate(direction * x)
+    grid = np.arange(s[0], s[-1], step_deg)
+    if grid.size < 2:
+        return grid, np.interp(grid, s, y)
+    # np.interp needs increasing abscissae: flat stretches keep their last value.
+    keep = np.concatenate([np.diff(s) > 0, [True]])
+    return grid, np.interp(grid, s[keep], y[keep])
+
+
+def _change_points(y: FloatArray, n_bkps: int, min_size: int) -> list[int]:
+    """Breakpoints of a continuous piecewise-linear fit (ruptures, exact dynamic programming)."""
+    if y.size < (n_bkps + 1) * min_size:
+        return []
+    algo = rpt.Dynp(model="clinear", min_size=min_size, jump=max(1, y.size // 200)).fit(y)
+    return [int(b) for b in algo.predict(n_bkps=n_bkps)[:-1]]
+
+
+def _slope(y: FloatArray, step: float) -> float:
+    if y.size < 2:
+        return 0.0
+    return float(np.polyfit(np.arange(y.size) * step, y, 1)[0])
+
+
+def _pieces(yg: FloatArray, noise: float, opts: IdentifyOptions) -> list[tuple[int, int]]:
+    """Linear pieces of the current against angle (ruptures PELT, continuous linear cost)."""
+    penalty = max(opts.penalty_k * noise ** 2 * math.log(max(yg.size, 2)), 1e-15)
+    jump = max(1, yg.size // 400)
+    algo = rpt.Pelt(model="clinear", min_size=2, jump=jump).fit(yg)
+    bkps = [int(b) for b in algo.predict(pen=penalty)]
+    return list(zip([0, *bkps[:-1]], bkps, strict=True))
+
+
+def _plateau(yg: FloatArray, step: float, noise: float,
+             opts: IdentifyOptions) -> tuple[int, int] | None:
+    """The constant-current stretch: the longest run of flat pieces (start, stop on the grid).
+
+    The reference is the loaded ramp: the slope over the last quarter of the travel. A piece is
+    flat when the current rises slower than ``flat_slope_fraction`` of that, or falls gently
+    (a fall as steep as the ramp is the peak after a reversal coming down, not a plateau).
+    """
+    tail = yg[int(0.75 * yg.size):]
+    loaded = _slope(tail, step)
+    if loaded <= 0:
+        return None
+    pieces = _pieces(yg, noise, opts)
+    slopes = [_slope(yg[a:b], step) for a, b in pieces]
+    flat = [-loaded < s < opts.flat_slope_fraction * loaded for s in slopes]
+    best: tuple[int, int] | None = None
+    k = 0
+    while k < len(pieces):
+        if not flat[k]:
+            k += 1
+            continue
+        j = k
+        while j + 1 < len(pieces) and flat[j + 1]:
+            j += 1
+        run = (pieces[k][0], pieces[j][1])
+        if best is None or run[1] - run[0] > best[1] - best[0]:
+            best = run
+        k = j + 1
+    return best
+
+
+def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
+                       after_reversal: bool, opts: IdentifyOptions) -> HalfCycle:
+    """Peak, backlash end and dead-zone edge in one monotonic stretch."""
+    pos = data.pos_deg[start:stop]
+    y = direction * data.current_filtered_A[start:stop]
+    problems: list[str] = []
+    sign = "+" if direction > 0 else "-"
+    where = f"{sign} half-cycle at t={data.t_s[start]:.1f}-{data.t_s[stop - 1]:.1f} s"
+    span = abs(pos[-1] - pos[0])
+    step = opts.grid_step_deg
+    noise = max(data.filtered_noise_A, 1e-12)
+
+    grid, yg = _resample_on_angle(pos, y, direction, step)
+    min_size = max(2, round(2.0 / step))
+    if grid.size < 3 * min_size:
+        return HalfCycle(direction, start, stop, after_reversal,
+                         problems=(f"{where}: only {span:.1f} deg of travel",))
+    # The last degrees before the next reversal belong to the motor's deceleration: left out.
+    end = max(3 * min_size, yg.size - round(opts.edge_margin_deg / step))
+    plateau_run = _plateau(yg[:end], step, noise, opts)
+    if plateau_run is None:
+        plateau_run = (0, end)
+        problems.append(f"{where}: no stretch of constant current")
+
+    peak: int | None = None
+    settle = 0
+    backlash_deg = math.nan
+    if after_reversal:
+        settle = plateau_run[0]
+        backlash_deg = float(grid[settle] - grid[0])
+        # The small peak after the reversal (reported; the backlash counts from the reversal).
+        peaks, _ = find_peaks(yg[:max(settle, 1) + 1], prominence=opts.peak_noise_k * noise)
+        peak = int(peaks[0]) if peaks.size else None
+
+    # The dead-zone edge: where the constant-current stretch ends and the current rises.
+    edge_k: int | None = plateau_run[1] if plateau_run[1] < end else None
+    plateau = float(np.median(yg[plateau_run[0]:plateau_run[1]]))
+    rise = float(np.median(yg[max(end - min_size, plateau_run[0]):end]) - plateau)
+    snr = rise / noise
+    edge_deg = math.nan
+    if snr < opts.min_snr:
+        problems.append(
+            f"{where}: no current rise out of the dead zone (rise {rise * 1e3:.1f} mA = "
+            f"{snr:.1f} x noise < {opts.min_snr:g}); the sweep may never leave the dead zone")
+    elif edge_k is None or (grid[end - 1] - grid[edge_k]) < opts.edge_margin_deg:
+        problems.append(f"{where}: the current rises only at the end of the travel; "
+                        "the dead-zone edge was not reached")
+    else:
+        edge_deg = float(direction * grid[edge_k])
+
+    def index_at(k: int | None) -> int | None:
+        if k is None:
+            return None
+        target = direction * grid[min(k, grid.size - 1)]
+        hits = np.flatnonzero(direction * (pos - target) >= 0)
+        return start + int(hits[0]) if hits.size else stop - 1
+
+    return HalfCycle(
+        direction=direction, start=start, stop=stop, after_reversal=after_reversal,
+        peak_index=index_at(peak),
+        backlash_end_index=index_at(settle) if after_reversal and math.isfinite(backlash_deg)
+        else None,
+        edge_index=index_at(edge_k) if math.isfinite(edge_deg) else None,
+        backlash_deg=backlash_deg, edge_deg=edge_deg, plateau_A=direction * plateau,
+        rise_A=rise, snr=snr, problems=tuple(problems))
+
+
+def check_following(data: Conditioned, opts: IdentifyOptions) -> None:
+    """A stalled or lagging knob makes the current meaningless: refuse it, saying how much."""
+    commanded = float(np.ptp(data.cmd_deg))
+    actual = float(np.ptp(data.pos_deg))
+    if commanded > opts.min_reversal_deg and actual < opts.min_follow_ratio * commanded:
+        raise CalibrationError(
+            f"the knob did not follow the command (moved {actual:.1f} deg of {commanded:.1f} "
+            f"deg commanded): motor stalled or blocked")
+    error = float(np.max(np.abs(data.cmd_deg - data.pos_deg)))
+    if error > opts.max_tracking_error_deg:
+        k = int(np.argmax(np.abs(data.cmd_deg - data.pos_deg)))
+        raise CalibrationError(
+            f"the knob lags the command by {error:.1f} deg at t={data.t_s[k]:.2f} s "
+            f"(> {opts.max_tracking_error_deg:g} deg): motor stalled or too slow")
+
+
+def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
+                   pos_deg: NDArray[np.floating], current_A: NDArray[np.floating],
+                   options: IdentifyOptions | None = None,
+                   sweep_start_s: float | None = None) -> SweepResult:
+    """Identify D and B of the swept knob from its position and current (never the tip).
+
+    With ``sweep_start_s``, only the half-cycles from the reversal at the sweep's start on are
+    used (the moves that bring the knobs there are not part of the sweep); without it, every
+    half-cycle is, and the first one (not after a reversal) gives only a dead-zone edge.
+    """
+    opts = options or IdentifyOptions()
+    data = condition(np.asarray(t_s, float), np.asarray(cmd_deg, float),
+                     np.asarray(pos_deg, float), np.asarray(current_A, float),
+                     cutoff_hz=opts.cutoff_hz, order=opts.filter_order,
+                     max_gap_s=opts.max_gap_s)
+    check_following(data, opts)
+    if robust_sigma(data.current_A) == 0 and np.ptp(data.current_A) == 0:
+        raise CalibrationError("the current is constant: no current feedback from the drive")
+    stretches = split_half_cycles(data.cmd_deg, opts.min_reversal_deg)
+    if sweep_start_s is not None:
+        first = int(np.searchsorted(data.t_s, sweep_start_s)) - 2
+        stretches = [s for s in stretches if s[1] >= first]
+    if not stretches:
+        raise CalibrationError(
+            f"the command never moves more than {opts.min_reversal_deg:g} deg: nothing to identify")
+    halves = tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches)
+    values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
+    for h in halves:
+        if math.isfinite(h.backlash_deg):
+            values[h.backlash_name].append(h.backlash_deg)
+        if math.isfinite(h.edge_deg):
+            values[h.edge_name].append(h.edge_deg)
+    return SweepResult(data, halves, {k: tuple(v) for k, v in values.items()})

@@ -1,0 +1,175 @@
+"""Calibration protocols: which sweeps to run, and the knob trajectories that run them.
+
+The paper's protocol: for each knob, a sinusoidal sweep over +-90 deg at 0.04 Hz, two cycles,
+with the other knob held at each of -90..90 deg in 30 deg steps (2 x 7 x 50 s = 700 s of
+sweeping). Each sweep starts at -A (reached moving down, so the first rise follows a reversal)
+and the knob is sent there by a smooth move; repositioning moves are not counted as sweeping.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tsmd.calibration.errors import CalibrationError
+
+GRID_DEG: tuple[float, ...] = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
+WAVEFORMS: tuple[str, ...] = ("sine", "triangle")
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """One knob swept between -A and +A while the other knob is held at ``other_deg``."""
+
+    knob: int
+    """0 for phi1, 1 for phi2."""
+    other_deg: float
+    amplitude_deg: float = 90.0
+    frequency_hz: float = 0.04
+    cycles: float = 2.0
+    waveform: str = "sine"
+
+    @property
+    def duration_s(self) -> float:
+        return self.cycles / self.frequency_hz
+
+    @property
+    def label(self) -> str:
+        return f"phi{self.knob + 1} sweep, phi{2 - self.knob} at {self.other_deg:+.0f} deg"
+
+    def position_deg(self, t_s: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Knob angle over the sweep, starting and (for whole cycles) ending at -A."""
+        phase = (self.frequency_hz * t_s) % 1.0
+        if self.waveform == "sine":
+            return np.asarray(-self.amplitude_deg * np.cos(2 * np.pi * phase), dtype=float)
+        tri = np.where(phase < 0.5, 4.0 * phase - 1.0, 3.0 - 4.0 * phase)
+        return np.asarray(self.amplitude_deg * tri, dtype=float)
+
+
+@dataclass(frozen=True)
+class Protocol:
+    """An ordered list of sweeps plus how the knobs move between them."""
+
+    name: str
+    sweeps: tuple[Sweep, ...]
+    move_speed_deg_s: float = 45.0
+    settle_s: float = 0.5
+
+    @property
+    def sweep_time_s(self) -> float:
+        """Time spent sweeping (what the paper's 700 s counts)."""
+        return float(sum(s.duration_s for s in self.sweeps))
+
+    def validate(self, limits_deg: tuple[tuple[float, float], tuple[float, float]]) -> None:
+        """Refuse a protocol that would command a knob outside its limits."""
+        if not self.sweeps:
+            raise CalibrationError(f"protocol {self.name!r} has no sweeps")
+        for s in self.sweeps:
+            if s.knob not in (0, 1):
+                raise CalibrationError(f"{s.label}: knob must be 0 or 1")
+            if s.waveform not in WAVEFORMS:
+                raise CalibrationError(f"{s.label}: waveform {s.waveform!r} not in {WAVEFORMS}")
+            if not (s.frequency_hz > 0 and s.cycles >= 1 and s.amplitude_deg > 0):
+                raise CalibrationError(f"{s.label}: frequency, cycles and amplitude must be > 0")
+            lo, hi = limits_deg[s.knob]
+            if -s.amplitude_deg < lo or s.amplitude_deg > hi:
+                raise CalibrationError(
+                    f"{s.label}: +-{s.amplitude_deg:g} deg exceeds the knob limits [{lo}, {hi}]")
+            olo, ohi = limits_deg[1 - s.knob]
+            if not olo <= s.other_deg <= ohi:
+                raise CalibrationError(
+                    f"{s.label}: the other knob at {s.other_deg:g} deg is outside [{olo}, {ohi}]")
+
+
+def paper_protocol(grid_deg: tuple[float, ...] = GRID_DEG,
+                   amplitude_deg: float = 90.0) -> Protocol:
+    """The published protocol: sine, 0.04 Hz, two cycles, each knob at each grid point."""
+    sweeps = tuple(Sweep(knob, other, amplitude_deg, 0.04, 2.0, "sine")
+                   for knob in (0, 1) for other in grid_deg)
+    return Protocol("paper", sweeps)
+
+
+def fast_protocol(grid_deg: tuple[float, ...] = GRID_DEG, amplitude_deg: float = 90.0,
+                  frequency_hz: float = 0.1, cycles: float = 1.5) -> Protocol:
+    """Beyond the paper: constant-speed triangle sweeps, 1.5 cycles at 0.1 Hz (210 s in all).
+
+    Identification works on current against knob angle, so the time per degree only has to be
+    long against the current sensor's lag; a triangle spends equal time on every degree (a sine
+    rushes through the middle, where the dead-zone edges are). 1.5 cycles still give each
+    dead-zone edge twice (agreement check) and each backlash once per direction.
+    """
+    sweeps = tuple(Sweep(knob, other, amplitude_deg, frequency_hz, cycles, "triangle")
+                   for knob in (0, 1) for other in grid_deg)
+    return Protocol("fast", sweeps)
+
+
+PROTOCOLS = {"paper": paper_protocol, "fast": fast_protocol}
+
+
+def move_trajectory(start_deg: NDArray[np.float64], end_deg: NDArray[np.float64],
+                    period_s: float, speed_deg_s: float) -> NDArray[np.float64]:
+    """A smooth (raised-cosine) move of both knobs; peak speed at most ``speed_deg_s``."""
+    start = np.asarray(start_deg, dtype=float)
+    end = np.asarray(end_deg, dtype=float)
+    distance = float(np.max(np.abs(end - start)))
+    if distance < 1e-9:
+        return np.empty((0, 2))
+    duration = max(0.5, math.pi / 2 * distance / speed_deg_s)
+    n = max(2, math.ceil(duration / period_s))
+    s = 0.5 - 0.5 * np.cos(np.pi * np.arange(1, n + 1) / n)
+    return np.asarray(start + s[:, None] * (end - start), dtype=float)
+
+
+@dataclass(frozen=True)
+class SweepRun:
+    """The trajectory that runs one sweep from wherever the knobs are."""
+
+    sweep: Sweep
+    t_s: NDArray[np.float64]
+    q_deg: NDArray[np.float64]
+    sweep_start: int
+    """Index where the sweep proper starts (after the move and settle)."""
+
+
+def sweep_run(sweep: Sweep, start_deg: NDArray[np.float64], period_s: float,
+              protocol: Protocol) -> SweepRun:
+    """Move to (+A, other) and down to (-A, other) (or, already at -A, move the other knob
+    only), wait ``settle_s``, sweep."""
+    first = np.zeros(2)
+    first[sweep.knob] = -sweep.amplitude_deg
+    first[1 - sweep.knob] = sweep.other_deg
+    start = np.asarray(start_deg, dtype=float)
+    if abs(start[sweep.knob] + sweep.amplitude_deg) < 1e-6:
+        # The previous sweep of this knob ended at -A going down: only the other knob moves.
+        parts = [move_trajectory(start, first, period_s, protocol.move_speed_deg_s)]
+    else:
+        # Precondition: visit +A, then come down to -A. The tendons then have a full loading
+        # history (the first stroke after rest differs) and the sweep's first rise follows a
+        # reversal. Moves are not identified and not counted as sweeping time.
+        top = first.copy()
+        top[sweep.knob] = sweep.amplitude_deg
+        parts = [move_trajectory(start, top, period_s, protocol.move_speed_deg_s),
+                 move_trajectory(top, first, period_s, protocol.move_speed_deg_s)]
+    n_settle = round(protocol.settle_s / period_s)
+    parts.append(np.repeat(first[None, :], n_settle, axis=0))
+    move = np.concatenate(parts)
+    n_sweep = round(sweep.duration_s / period_s)
+    ts = np.arange(1, n_sweep + 1, dtype=float) * float(period_s)
+    sweep_q = np.empty((n_sweep, 2))
+    sweep_q[:, sweep.knob] = sweep.position_deg(ts)
+    sweep_q[:, 1 - sweep.knob] = sweep.other_deg
+    q = np.concatenate([move, sweep_q])
+    t = np.arange(1, len(q) + 1, dtype=float) * float(period_s)
+    return SweepRun(sweep, t, q, len(move))
+
+
+def return_to_zero(start_deg: NDArray[np.float64], period_s: float,
+                   speed_deg_s: float = 45.0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(t, q) of a smooth move of both knobs back to 0 (end of a calibration or a cancel)."""
+    q = move_trajectory(np.asarray(start_deg, dtype=float), np.zeros(2), period_s, speed_deg_s)
+    if len(q) == 0:
+        q = np.zeros((1, 2))
+    return np.arange(1, len(q) + 1, dtype=float) * float(period_s), q

@@ -1,0 +1,313 @@
+"""Running a calibration: the protocol over a trajectory runner, or logged sweeps offline.
+
+Both paths go through :func:`identify_recording` (one recording = one sweep) and
+:func:`finish`: the quality checks, H from the data sheet, our compensator's fit, the profile.
+Nothing is saved here: the caller saves the returned profile (so a cancelled or refused
+calibration never leaves a half-written profile).
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tsmd import __version__
+from tsmd.calibration.assemble import (
+    KNOB_LABELS,
+    GridPoint,
+    QualityLimits,
+    QualityReport,
+    build_profile,
+    check_quality,
+)
+from tsmd.calibration.errors import CalibrationCancelledError, CalibrationError
+from tsmd.calibration.identify import IdentifyOptions, identify_sweep
+from tsmd.calibration.ours_fit import fit_ours_for_knob
+from tsmd.calibration.protocol import Protocol as SweepProtocol
+from tsmd.calibration.protocol import Sweep, paper_protocol, return_to_zero, sweep_run
+from tsmd.errors import TsmdError
+from tsmd.profile import CatheterProfile, DeviceModel
+from tsmd.recording import Recording
+
+ProgressCallback = Callable[[float, str], None]
+"""Called with the overall fraction done (0..1) and a line such as
+``"sweep 3/14: phi1 sweep, phi2 at -30 deg; 412 s left"``."""
+
+
+class TrajectoryRunner(Protocol):
+    """Contract 4 (the daemon's side): play a trajectory, one sample per loop tick, record it.
+
+    On cancel the runner stops early and returns what it recorded so far.
+    """
+
+    def run(self, t_s: NDArray[np.float64], q_deg: NDArray[np.float64], compensate: bool,
+            cancel: threading.Event | None,
+            progress: Callable[[float], None] | None) -> Recording: ...
+
+
+@dataclass
+class Calibration:
+    """A finished calibration: the profile and everything that went into it (for the report)."""
+
+    profile: CatheterProfile
+    points: list[GridPoint]
+    quality: QualityReport
+    protocol_name: str = ""
+    sweep_time_s: float = 0.0
+    """Simulated or real time spent sweeping (what the paper's 700 s counts)."""
+    motion_time_s: float = 0.0
+    """All knob motion including moves between sweeps."""
+    wall_time_s: float = 0.0
+    notes: list[str] = field(default_factory=list)
+
+
+def sweep_metadata(sweep: Sweep, sweep_start_s: float) -> dict[str, str]:
+    """The keys a sweep recording carries so that it can be identified offline."""
+    return {
+        "calibration_knob": KNOB_LABELS[sweep.knob],
+        "calibration_other_deg": repr(float(sweep.other_deg)),
+        "calibration_sweep_start_s": repr(float(sweep_start_s)),
+        "calibration_amplitude_deg": repr(float(sweep.amplitude_deg)),
+        "calibration_waveform": sweep.waveform,
+        "calibration_frequency_hz": repr(float(sweep.frequency_hz)),
+        "calibration_cycles": repr(float(sweep.cycles)),
+    }
+
+
+def _meta_float(rec: Recording, key: str) -> float | None:
+    text = rec.metadata.get(key)
+    if text is None:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise CalibrationError(f"metadata {key!r} is not a number: {text!r}") from None
+    if not math.isfinite(value):
+        raise CalibrationError(f"metadata {key!r} is not finite: {text!r}")
+    return value
+
+
+def identify_recording(rec: Recording, options: IdentifyOptions | None = None,
+                       source: str = "recording") -> GridPoint:
+    """One recording holding one sweep -> a grid point (swept knob and other angle inferred
+    from the metadata when present, else from which knob moved)."""
+    for col in ("t", "cmd1", "cmd2", "pos1", "pos2", "cur1", "cur2"):
+        if col not in rec.columns:
+            raise CalibrationError(f"{source}: no column {col!r}")
+    knob_name = rec.metadata.get("calibration_knob")
+    if knob_name is not None:
+        if knob_name not in KNOB_LABELS:
+            raise CalibrationError(f"{source}: calibration_knob {knob_name!r} not in "
+                                   f"{KNOB_LABELS}")
+        knob = KNOB_LABELS.index(knob_name)
+    else:
+        spans = [float(np.nanmax(rec[f"cmd{k}"]) - np.nanmin(rec[f"cmd{k}"])) for k in (1, 2)]
+        knob = int(np.argmax(spans))
+    start_s = _meta_float(rec, "calibration_sweep_start_s")
+    other_cmd = rec[f"cmd{2 - knob}"]
+    t = rec["t"]
+    in_sweep = t >= start_s if start_s is not None else np.ones(len(t), dtype=bool)
+    other = _meta_float(rec, "calibration_other_deg")
+    held = other_cmd[in_sweep & np.isfinite(other_cmd)]
+    if held.size == 0:
+        raise CalibrationError(f"{source}: no valid sample of the other knob")
+    if float(np.ptp(held)) > 1.0:
+        raise CalibrationError(
+            f"{source}: both knobs move (the other knob spans {np.ptp(held):.1f} deg); "
+            "a calibration sweep holds the other knob still")
+    if other is None:
+        other = float(np.round(np.median(held), 1))
+    k = knob + 1
+    try:
+        result = identify_sweep(t, rec[f"cmd{k}"], rec[f"pos{k}"], rec[f"cur{k}"], options,
+                                sweep_start_s=start_s)
+    except CalibrationError as exc:
+        raise CalibrationError(f"{source} ({KNOB_LABELS[knob]} sweep): {exc}") from None
+    return GridPoint(knob, other, result, rec)
+
+
+def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
+           limits: QualityLimits | None = None, amplitude_deg: float = 90.0,
+           source: str = "calibration from motor current") -> tuple[CatheterProfile,
+                                                                   QualityReport]:
+    """Quality checks, our compensator's fit and the profile (CalibrationError if refused)."""
+    report = check_quality(points, limits, amplitude_deg)
+    report.raise_if_bad()
+    ours = []
+    for knob in (0, 1):
+        try:
+            ours.append(fit_ours_for_knob([p for p in points if p.knob == knob], device, knob))
+        except (ValueError, ArithmeticError) as exc:
+            raise CalibrationError(f"{KNOB_LABELS[knob]}: our compensator's fit failed: "
+                                   f"{exc}") from None
+    profile = build_profile(catheter_id, device, points, quality=report,
+                            software_version=__version__, ours=ours, source=source)
+    return profile, report
+
+
+class _Progress:
+    """Turns per-run fractions into overall progress with a time-left estimate."""
+
+    def __init__(self, callback: ProgressCallback | None, durations_s: Sequence[float]) -> None:
+        self.callback = callback
+        self.durations = list(durations_s)
+        self.total = float(sum(self.durations)) or 1.0
+        self.started = time.monotonic()
+        self.index = 0
+        self.label = ""
+        self.fraction = 0.0
+
+    def begin(self, index: int, label: str) -> None:
+        self.index = index
+        self.label = label
+        self.report(0.0)
+
+    def overall(self, fraction: float) -> float:
+        done = sum(self.durations[:self.index]) + fraction * self.durations[self.index]
+        return min(1.0, done / self.total)
+
+    def report(self, fraction: float, phase: str = "") -> None:
+        self.fraction = fraction
+        if self.callback is None:
+            return
+        overall = self.overall(fraction)
+        elapsed = time.monotonic() - self.started
+        text = f"sweep {self.index + 1}/{len(self.durations)}: {self.label}"
+        if phase:
+            text += f" ({phase})"
+        if overall > 1e-3:
+            text += f"; {elapsed * (1.0 - overall) / overall:.0f} s left"
+        self.callback(overall, text)
+
+
+def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *,
+                    protocol: SweepProtocol | None = None, period_s: float = 0.004,
+                    progress: ProgressCallback | None = None,
+                    cancel: threading.Event | None = None,
+                    options: IdentifyOptions | None = None,
+                    limits: QualityLimits | None = None) -> Calibration:
+    """Run every sweep, identify each as it ends, return the knobs to 0, build the profile.
+
+    Any failure or a cancel sends the knobs back to 0 first; then CalibrationError (or
+    CalibrationCancelledError) is raised and nothing is returned to be saved.
+    """
+    proto = protocol or paper_protocol()
+    proto.validate(tuple((k.limits.min_deg, k.limits.max_deg)  # type: ignore[arg-type]
+                         for k in device.knobs))
+    wall0 = time.monotonic()
+    q_now = np.zeros(2)
+    runs_durations = []
+    plan = []
+    for sweep in proto.sweeps:
+        run = sweep_run(sweep, q_now, period_s, proto)
+        plan.append(run)
+        runs_durations.append(len(run.q_deg) * period_s)
+        q_now = run.q_deg[-1].copy()
+    tracker = _Progress(progress, runs_durations)
+    points: list[GridPoint] = []
+    motion_s = 0.0
+    q_last = np.zeros(2)
+    try:
+        for i, planned in enumerate(plan):
+            if cancel is not None and cancel.is_set():
+                raise CalibrationCancelledError(f"cancelled before sweep {i + 1} of {len(plan)}")
+            # Re-plan from where the knobs really are.
+            run = sweep_run(planned.sweep, q_last, period_s, proto) if i else planned
+            tracker.begin(i, run.sweep.label)
+            try:
+                rec = runner.run(run.t_s, run.q_deg, False, cancel, tracker.report)
+            except TsmdError as exc:
+                q_last = _where_now(runner, run.q_deg, tracker.fraction)
+                if cancel is not None and cancel.is_set():
+                    raise CalibrationCancelledError(
+                        f"cancelled during sweep {i + 1} of {len(plan)} ({run.sweep.label})"
+                    ) from None
+                raise CalibrationError(f"{run.sweep.label}: {exc}") from None
+            motion_s += len(rec) * period_s
+            q_last = _last_command(rec, run.q_deg)
+            if cancel is not None and cancel.is_set():
+                raise CalibrationCancelledError(
+                    f"cancelled during sweep {i + 1} of {len(plan)} ({run.sweep.label})")
+            if len(rec) < len(run.q_deg):
+                raise CalibrationError(f"{run.sweep.label}: the runner stopped after "
+                                       f"{len(rec)} of {len(run.q_deg)} ticks")
+            t0 = float(rec["t"][0]) - float(run.t_s[0])
+            rec.metadata.update(sweep_metadata(run.sweep, t0 + float(run.t_s[run.sweep_start])))
+            tracker.report(1.0, "identifying")
+            points.append(identify_recording(rec, options, run.sweep.label))
+    except BaseException as exc:
+        motion_s += _return_to_zero(runner, q_last, period_s)
+        if isinstance(exc, CalibrationCancelledError):
+            raise CalibrationCancelledError(f"{exc}; knobs returned to 0, nothing saved") from None
+        raise
+    motion_s += _return_to_zero(runner, q_last, period_s)
+    profile, report = finish(catheter_id, device, points, limits=limits,
+                             amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
+    return Calibration(profile, points, report, proto.name, proto.sweep_time_s, motion_s,
+                       time.monotonic() - wall0)
+
+
+def calibrate(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *,
+              protocol: SweepProtocol | None = None, period_s: float = 0.004,
+              progress: ProgressCallback | None = None,
+              cancel: threading.Event | None = None) -> CatheterProfile:
+    """Contract 5: calibrate one catheter over a trajectory runner; the caller saves it."""
+    return run_calibration(runner, catheter_id, device, protocol=protocol, period_s=period_s,
+                           progress=progress, cancel=cancel).profile
+
+
+def calibrate_from_recordings(recordings: Sequence[tuple[str, Recording]], catheter_id: str,
+                              device: DeviceModel, *,
+                              options: IdentifyOptions | None = None,
+                              limits: QualityLimits | None = None) -> Calibration:
+    """Offline: the same identification and checks on logged sweeps (one sweep per recording)."""
+    points = [identify_recording(rec, options, name) for name, rec in recordings]
+    return calibration_from_points(points, catheter_id, device, limits=limits)
+
+
+def calibration_from_points(points: list[GridPoint], catheter_id: str, device: DeviceModel, *,
+                            limits: QualityLimits | None = None) -> Calibration:
+    """Quality checks and profile from sweeps already identified (logged or just run)."""
+    if not points:
+        raise CalibrationError("no sweeps given")
+    amplitude = max(float(np.nanmax(np.abs(p.result.data.cmd_deg))) for p in points)
+    profile, report = finish(catheter_id, device, points, limits=limits, amplitude_deg=amplitude,
+                             source="calibration from logged motor current")
+    return Calibration(profile, points, report, "recordings")
+
+
+def _last_command(rec: Recording, planned: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Where the knobs were last sent (from the recording; the plan's start if it is empty)."""
+    if len(rec) == 0:
+        return np.asarray(planned[0], dtype=float).copy()
+    last = np.array([rec["cmd1"][-1], rec["cmd2"][-1]], dtype=float)
+    if not np.all(np.isfinite(last)):
+        last = np.array([rec["pos1"][-1], rec["pos2"][-1]], dtype=float)
+    return last
+
+
+def _where_now(runner: TrajectoryRunner, planned: NDArray[np.float64],
+               fraction: float) -> NDArray[np.float64]:
+    """Where the knobs were last commanded when a run ended without a recording: the loop's
+    latest sample when the runner exposes its loop, else the plan at the last progress."""
+    sample = getattr(getattr(runner, "loop", None), "latest_sample", None)
+    cmd = getattr(sample, "cmd_deg", None)
+    if cmd is not None and np.all(np.isfinite(np.asarray(cmd, dtype=float))):
+        return np.asarray(cmd, dtype=float).copy()
+    k = min(len(planned) - 1, max(0, round(fraction * len(planned))))
+    return np.asarray(planned[k], dtype=float).copy()
+
+
+def _return_to_zero(runner: TrajectoryRunner, q_deg: NDArray[np.float64],
+                    period_s: float) -> float:
+    """Smoothly bring both knobs back to 0 (never cancelled: this is the safe end)."""
+    t, q = return_to_zero(q_deg, period_s)
+    runner.run(t, q, False, None, None)
+    return len(q) * period_s

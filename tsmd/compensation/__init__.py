@@ -110,14 +110,11 @@ def ours_compensator(profile: CatheterProfile, period_s: float) -> OursCompensat
             raise CompensationError(
                 f"profile {profile.catheter_id!r} has no 'ours' parameters for {name}; "
                 "recalibrate with this tsmd version or use method 'paper'")
-        values = np.column_stack([k.grid_array(), np.asarray(k.ours.backlash_blend_deg)])
-        method = profile.interpolation
-        knobs.append(OursKnob(
-            ParameterField(k.other_knob_deg, values, method),
-            ParameterField(k.other_knob_deg, np.asarray(k.ours.shape_pos, float), method),
-            ParameterField(k.other_knob_deg, np.asarray(k.ours.shape_neg, float), method),
-            np.asarray(k.ours.shape_u_deg, float), k.height_pos_deg, k.height_neg_deg, k.omega,
-            k.ours.lag_s))
+        values = np.column_stack([
+            k.dead_zone_pos_deg, k.dead_zone_neg_deg, k.ours.release_slope_pos,
+            k.ours.release_slope_neg, k.ours.backlash_blend_deg]).astype(float)
+        knobs.append(OursKnob(ParameterField(k.other_knob_deg, values, profile.interpolation),
+                              k.height_pos_deg, k.height_neg_deg, k.omega, k.ours.lag_s))
     return OursCompensator((knobs[0], knobs[1]), period_s)
 
 

@@ -1,27 +1,24 @@
 """Our compensator: the paper's play structure with the weaknesses the paper names removed.
 
-1. Curved branches instead of straight lines. The loaded branch of each direction is a
-   tabulated shape ``s(u)`` (tip = H + omega * s(u), u = knob angle past the dead-zone edge),
-   identified from the motor current: once the tendon is engaged the current is proportional to
-   the tendon tension, hence to the bending moment, hence to the tip angle; so the current's shape
-   along the sweep is the tip's shape. The scale comes from the data sheet (the reference point).
-   ``s(u) = max(u, 0)`` gives back the paper's lines exactly.
-2. No jerk at transitions. The dead-zone edges are rounded by the same identified shapes, and the
-   end of the backlash is a C1 blend (width ``backlash_blend_deg``) instead of a corner, so the
-   inverse's command is continuous in slope wherever the model is.
-3. Knob coupling. Each knob's parameters follow the other knob's *commanded* angle (where that
-   knob really is), not its desired angle: the calibration grid is indexed by the knob angle, and
-   with compensation the two differ by up to the dead zone plus the backlash.
+1. Straight lines where the catheter is not. Friction along the sheath makes the backlash grow
+   with the load at the reversal (a reversal at 60 deg tip loses less knob travel than one at
+   90 deg), and the released tendon's branch is steeper than the loaded one. The paper draws the
+   release branch parallel to the loaded one, shifted by the backlash measured at the calibration
+   amplitude, so every smaller reversal is over-compensated. Here each release branch is a line
+   through its tendon's slack point (the dead-zone edge) with a slope fitted so that it passes
+   through the backlash the current showed at the calibration amplitude: one line per side, from
+   the same current-only data (:func:`release_slope`, :func:`fit_ours_knob`).
+2. Jerk at transitions. Smaller backlash jumps for smaller reversals; the backlash end can be a
+   C1 blend (``backlash_blend_deg``) instead of a corner. Jumps left go through the rate limiter.
+3. Knob coupling. Each knob's parameters follow the grid coordinate at which calibration saw
+   the other tip where it is now wanted: the other knob's loaded-branch angle for the other
+   tip's desired angle (the paper uses the other knob's desired angle, up to D + B off).
 4. Drive lag. The drive follows its target with a lag identified from commanded vs actual
    position; the compensator inverts the model at the desired angle predicted ``lag_s`` ahead.
-
-All of it is identified from the calibration sweeps alone (commanded and actual knob position,
-motor current, data-sheet constants): :func:`fit_ours_knob`.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -32,30 +29,31 @@ from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
 
-SHAPE_U_DEG: tuple[float, ...] = tuple(float(u) for u in range(-20, 125, 5))
-"""Default knob-angle offsets from the dead-zone edge at which the branch shapes are sampled."""
-
-_TABLE_X_DEG = np.linspace(-200.0, 200.0, 801)
+_TABLE_X_DEG = np.linspace(-200.0, 200.0, 1601)
 _FLAT_SLOPE = 1e-6  # makes the envelopes strictly increasing so that they can be inverted
 _MAX_LEAD_DEG = 10.0
+RELEASE_SLOPE_RANGE: tuple[float, float] = (0.2, 10.0)
 
 
 @dataclass(frozen=True)
 class OursParams:
-    """Our compensator's extra parameters for one knob (grids over the other knob's angle)."""
+    """Our compensator's extra parameters for one knob (grids over the other knob's angle).
+
+    ``release_slope_pos``: tip/knob slope of the branch on which the positive-side tendon
+    releases (moving down above the dead zone); ``release_slope_neg`` likewise below it.
+    ``backlash_blend_deg``: half-width of the C1 blend at the end of the backlash (0 = corner).
+    ``lag_s``: delay of the drive's actual position behind its target.
+    """
 
     lag_s: float
+    release_slope_pos: tuple[float, ...]
+    release_slope_neg: tuple[float, ...]
     backlash_blend_deg: tuple[float, ...]
-    shape_u_deg: tuple[float, ...]
-    shape_pos: tuple[tuple[float, ...], ...]  # (n_grid, n_u): s of the rising loaded branch
-    shape_neg: tuple[tuple[float, ...], ...]  # (n_grid, n_u): s of the falling loaded branch
 
     @staticmethod
-    def neutral(n_grid: int, u_deg: Sequence[float] = SHAPE_U_DEG) -> OursParams:
-        """The parameters that make ours behave like the paper's lines (no lag, no blend)."""
-        u = tuple(float(v) for v in u_deg)
-        row = tuple(max(v, 0.0) for v in u)
-        return OursParams(0.0, (0.0,) * n_grid, u, (row,) * n_grid, (row,) * n_grid)
+    def parallel(omega: float, n_grid: int) -> OursParams:
+        """Release branches parallel to the loaded ones and no blend or lag: the paper's lines."""
+        return OursParams(0.0, (omega,) * n_grid, (omega,) * n_grid, (0.0,) * n_grid)
 
 
 def _row(values: Any, name: str, n: int, lo: float, hi: float) -> tuple[float, ...]:
@@ -76,39 +74,29 @@ def _row(values: Any, name: str, n: int, lo: float, hi: float) -> tuple[float, .
     return tuple(out)
 
 
+_OURS_KEYS = ("lag_s", "release_slope_pos", "release_slope_neg", "backlash_blend_deg")
+
+
 def ours_params_from_mapping(m: Mapping[str, Any], n_grid: int) -> OursParams:
     """Validate the ``ours`` block of a profile knob (ValueError naming the key)."""
-    known = {"lag_s", "backlash_blend_deg", "shape_u_deg", "shape_pos", "shape_neg"}
     for key in m:
-        if key not in known:
+        if key not in _OURS_KEYS:
             raise ValueError(f"{key}: unknown key")
-    for key in known:
+    for key in _OURS_KEYS:
         if key not in m:
             raise ValueError(f"{key}: missing key")
     lag = _row([m["lag_s"]], "lag_s", 1, 0.0, 1.0)[0]
-    blend = _row(m["backlash_blend_deg"], "backlash_blend_deg", n_grid, 0.0, 45.0)
-    u_raw = m["shape_u_deg"]
-    u = _row(u_raw, "shape_u_deg", len(u_raw) if isinstance(u_raw, Sequence) else -1,
-             -90.0, 270.0)
-    if len(u) < 3 or any(b <= a for a, b in itertools.pairwise(u)):
-        raise ValueError("shape_u_deg: must be at least 3 strictly increasing values")
-    shapes = []
-    for key in ("shape_pos", "shape_neg"):
-        rows = m[key]
-        if isinstance(rows, str) or not isinstance(rows, Sequence) or len(rows) != n_grid:
-            raise ValueError(f"{key}: must be {n_grid} rows (one per grid point)")
-        table = tuple(_row(r, f"{key}[{i}]", len(u), -10.0, 400.0) for i, r in enumerate(rows))
-        for i, r in enumerate(table):
-            if any(b < a for a, b in itertools.pairwise(r)):
-                raise ValueError(f"{key}[{i}]: shape must be non-decreasing")
-        shapes.append(table)
-    return OursParams(lag, blend, u, shapes[0], shapes[1])
+    lo, hi = RELEASE_SLOPE_RANGE
+    return OursParams(lag,
+                      _row(m["release_slope_pos"], "release_slope_pos", n_grid, lo, hi),
+                      _row(m["release_slope_neg"], "release_slope_neg", n_grid, lo, hi),
+                      _row(m["backlash_blend_deg"], "backlash_blend_deg", n_grid, 0.0, 45.0))
 
 
 def ours_params_to_mapping(p: OursParams) -> dict[str, Any]:
-    return {"lag_s": p.lag_s, "backlash_blend_deg": list(p.backlash_blend_deg),
-            "shape_u_deg": list(p.shape_u_deg), "shape_pos": [list(r) for r in p.shape_pos],
-            "shape_neg": [list(r) for r in p.shape_neg]}
+    return {"lag_s": p.lag_s, "release_slope_pos": list(p.release_slope_pos),
+            "release_slope_neg": list(p.release_slope_neg),
+            "backlash_blend_deg": list(p.backlash_blend_deg)}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -162,35 +150,45 @@ def _inverse(y: float, ys: NDArray[np.float64], xs: NDArray[np.float64], omega: 
     return float(np.interp(y, ys, xs))
 
 
-def _shape(u: NDArray[np.float64], u_grid: NDArray[np.float64],
-           s: NDArray[np.float64]) -> NDArray[np.float64]:
-    """s(u) from the table; 0 below it, continued with the last slope above it."""
-    out = np.interp(u, u_grid, s, left=0.0)
-    slope = (s[-1] - s[-2]) / (u_grid[-1] - u_grid[-2])
-    above = u > u_grid[-1]
-    out[above] = s[-1] + slope * (u[above] - u_grid[-1])
-    return out
+def envelopes(dead_zone_pos_deg: float, dead_zone_neg_deg: float, height_pos_deg: float,
+              height_neg_deg: float, omega: float, release_slope_pos: float,
+              release_slope_neg: float, blend_deg: float) -> Envelopes:
+    """The rising and falling branches, with release lines of their own slope.
 
-
-def envelopes(dead_zone_pos_deg: float, dead_zone_neg_deg: float, backlash_pos_deg: float,
-              backlash_neg_deg: float, height_pos_deg: float, height_neg_deg: float,
-              omega: float, u_deg: NDArray[np.float64], shape_pos: NDArray[np.float64],
-              shape_neg: NDArray[np.float64], blend_deg: float) -> Envelopes:
-    """Rising = H_pos + omega*(s_pos(x - D_pos) - s_neg(D_hat_pos - x)); falling likewise.
-
-    With s(u) = max(u, 0) these are exactly the paper's L2/L3/L4 and L6/L7/L8 (Eq. D_hats).
+    Loaded parts as in the paper: slope omega from the dead-zone edges D at heights H. A tendon
+    goes slack where it engaged, so each release line pivots on its own dead-zone edge (at the
+    height of the plateau it falls onto) and its slope makes it pass through the end of the
+    backlash measured at the calibration amplitude (:func:`release_slope`). The backlash then
+    grows with the load at the reversal, as friction along the sheath makes it do, instead of
+    being the same width for every reversal.
     """
-    d_hat_pos = (height_pos_deg - height_neg_deg) / omega + dead_zone_neg_deg + backlash_neg_deg
-    d_hat_neg = (height_neg_deg - height_pos_deg) / omega + dead_zone_pos_deg - backlash_pos_deg
     x = _TABLE_X_DEG
-    rising = height_pos_deg + omega * (_shape(x - dead_zone_pos_deg, u_deg, shape_pos)
-                                       - _shape(d_hat_pos - x, u_deg, shape_neg))
-    falling = height_neg_deg + omega * (_shape(x - d_hat_neg, u_deg, shape_pos)
-                                        - _shape(dead_zone_neg_deg - x, u_deg, shape_neg))
-    ramp = _FLAT_SLOPE * omega * x
-    rising = np.maximum.accumulate(rising) + ramp
-    falling = np.maximum.accumulate(falling) + ramp
-    return Envelopes(x, rising, falling, omega, omega * blend_deg)
+    rising = (height_pos_deg + omega * np.maximum(x - dead_zone_pos_deg, 0.0)
+              + release_slope_neg * np.minimum(x - dead_zone_neg_deg, 0.0))
+    falling = (height_neg_deg + release_slope_pos * np.maximum(x - dead_zone_pos_deg, 0.0)
+               + omega * np.minimum(x - dead_zone_neg_deg, 0.0))
+    lower = np.minimum(rising, falling) + _FLAT_SLOPE * omega * x
+    upper = np.maximum(rising, falling) + _FLAT_SLOPE * omega * x
+    return Envelopes(x, lower, upper, omega, omega * blend_deg)
+
+
+def release_slope(amplitude_deg: float, dead_zone_deg: float, backlash_deg: float,
+                  height_loaded_deg: float, height_released_deg: float, omega: float) -> float:
+    """Slope of the release line through the pivot (D, H_released) and the backlash end.
+
+    For the positive side: a sweep to ``amplitude_deg`` reaches H_pos + omega*(A - D_pos) on the
+    loaded line; after the reversal the tip holds for B_pos, so the release line passes through
+    (A - B_pos, that height). Negative side: pass the negative amplitude and D_neg, B_neg.
+    Returns omega when the numbers cannot define a line (backlash as wide as the travel).
+    """
+    sign = 1.0 if amplitude_deg > 0 else -1.0
+    y_end = height_loaded_deg + omega * (amplitude_deg - dead_zone_deg)
+    run = (amplitude_deg - sign * backlash_deg) - dead_zone_deg
+    if sign * run <= 1.0:
+        return omega
+    slope = (y_end - height_released_deg) / run
+    lo, hi = RELEASE_SLOPE_RANGE
+    return float(min(max(slope, lo), hi))
 
 
 @dataclass(frozen=True)
@@ -247,27 +245,36 @@ def ours_inverse_step(state: OursState, y_desired_deg: float, env: Envelopes) ->
 
 @dataclass(frozen=True)
 class OursKnob:
-    """One knob of our compensator: main and extra parameters over the other knob's angle."""
+    """One knob of our compensator: parameters over the other knob's angle + constants."""
 
-    field: ParameterField  # D_pos, D_neg, B_pos, B_neg, blend
-    shape_pos: ParameterField
-    shape_neg: ParameterField
-    u_deg: NDArray[np.float64]
+    field: ParameterField  # D_pos, D_neg, release_slope_pos, release_slope_neg, blend
     height_pos_deg: float
     height_neg_deg: float
     omega: float
     lag_s: float
 
     def envelopes(self, other_deg: float) -> Envelopes:
-        d_pos, d_neg, b_pos, b_neg, blend = self.field.at(other_deg)
-        return envelopes(float(d_pos), float(d_neg), max(float(b_pos), 0.0),
-                         max(float(b_neg), 0.0), self.height_pos_deg, self.height_neg_deg,
-                         self.omega, self.u_deg, self.shape_pos.at(other_deg),
-                         self.shape_neg.at(other_deg), max(float(blend), 0.0))
+        d_pos, d_neg, s_pos, s_neg, blend = self.field.at(other_deg)
+        return envelopes(float(d_pos), float(d_neg), self.height_pos_deg, self.height_neg_deg,
+                         self.omega, float(s_pos), float(s_neg), max(float(blend), 0.0))
+
+    def loaded_knob_deg(self, tip_deg: float, other_deg: float) -> float:
+        """The knob angle that gives ``tip_deg`` on a loaded branch (how calibration held it)."""
+        d_pos, d_neg = (float(v) for v in self.field.at(other_deg)[:2])
+        h_hi = max(self.height_pos_deg, self.height_neg_deg)
+        h_lo = min(self.height_pos_deg, self.height_neg_deg)
+        if tip_deg >= h_hi:
+            return d_pos + (tip_deg - h_hi) / self.omega
+        if tip_deg <= h_lo:
+            return d_neg + (tip_deg - h_lo) / self.omega
+        # on the plateau the knob can be anywhere in the dead zone: interpolate, stay continuous
+        return d_neg + (d_pos - d_neg) * (tip_deg - h_lo) / (h_hi - h_lo)
 
 
 class OursCompensator:
-    """Two knobs; each follows the other knob's commanded angle and leads by the drive lag."""
+    """Two knobs. Each knob's parameters follow where the other knob would sit on its loaded
+    branch for the other tip's desired angle (the coupling acts through the bent section, and
+    calibration held the other knob on its loaded branch); each leads by its drive's lag."""
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float) -> None:
         if not period_s > 0:
@@ -277,16 +284,27 @@ class OursCompensator:
         self._states: list[OursState] = []
         self._q_prev = np.zeros(2)
         self._v_deg_s = np.zeros(2)
+        self._axis = np.zeros(2)  # grid coordinate of each knob as seen by the other
         self.reset(np.zeros(2))
+
+    def _update_axis(self, q: NDArray[np.float64]) -> None:
+        axis = self._axis.copy()
+        for i, knob in enumerate(self.knobs):
+            if math.isfinite(q[i]):
+                axis[i] = knob.loaded_knob_deg(float(q[i]), float(self._axis[1 - i]))
+        self._axis = axis
 
     def reset(self, q_deg: NDArray[np.float64]) -> None:
         q = np.asarray(q_deg, dtype=float).copy()
         q[~np.isfinite(q)] = 0.0
         self._q_prev = q.copy()
         self._v_deg_s = np.zeros(2)
+        self._axis = np.zeros(2)
+        for _ in range(3):  # settle the mutual dependence
+            self._update_axis(q)
         states = []
         for i, knob in enumerate(self.knobs):
-            env = knob.envelopes(float(q[1 - i]))
+            env = knob.envelopes(float(self._axis[1 - i]))
             lo, hi = env.falling_inverse(q[i]), env.rising_inverse(q[i])
             if lo <= 0.0 <= hi:
                 x, d = 0.0, 1
@@ -298,23 +316,21 @@ class OursCompensator:
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         q = np.asarray(q_deg, dtype=float)
         ok = np.isfinite(q)
+        q_ok = np.where(ok, q, self._q_prev)
         # velocity of the desired trajectory, lightly filtered, for the lag lead
-        v = np.where(ok, (np.where(ok, q, self._q_prev) - self._q_prev) / self.period_s, 0.0)
-        self._v_deg_s = 0.7 * self._v_deg_s + 0.3 * v
-        target = q.copy()
-        for i, knob in enumerate(self.knobs):
-            lead = float(np.clip(knob.lag_s * self._v_deg_s[i], -_MAX_LEAD_DEG, _MAX_LEAD_DEG))
-            target[i] = q[i] + lead
-        other = np.array([s.x_deg for s in self._states])
+        self._v_deg_s = 0.7 * self._v_deg_s + 0.3 * (q_ok - self._q_prev) / self.period_s
+        self._update_axis(q_ok)
         out = np.empty(2)
         for i, knob in enumerate(self.knobs):
             state = self._states[i]
             if ok[i]:
-                env = knob.envelopes(float(other[1 - i]))
-                state = ours_inverse_step(state, float(target[i]), env)
+                lead = float(np.clip(knob.lag_s * self._v_deg_s[i], -_MAX_LEAD_DEG,
+                                     _MAX_LEAD_DEG))
+                env = knob.envelopes(float(self._axis[1 - i]))
+                state = ours_inverse_step(state, float(q[i]) + lead, env)
                 self._states[i] = state
             out[i] = state.x_deg
-        self._q_prev = np.where(ok, q, self._q_prev)
+        self._q_prev = q_ok
         return out
 
 
@@ -357,3 +373,64 @@ def estimate_lag_s(t_s: NDArray[np.float64], cmd_deg: NDArray[np.float64],
     errors = [float(np.mean((np.interp(t - lag, t, cmd) - pos)[t > t[0] + max_lag_s] ** 2))
               for lag in lags]
     return float(lags[int(np.argmin(errors))])
+
+
+def heights_from_sweeps(sweeps: Sequence[SweepData], device_knob: Any) -> tuple[float, float]:
+    """H_pos, H_neg by design assumptions 1-3: the data sheet's reference points and slope with
+    the dead-zone edges identified with the other knob at 0 deg (interpolated over the sweeps)."""
+    order = sorted(sweeps, key=lambda s: s.other_knob_deg)
+    grid = [s.other_knob_deg for s in order]
+    d_pos0 = float(np.interp(0.0, grid, [s.dead_zone_pos_deg for s in order]))
+    d_neg0 = float(np.interp(0.0, grid, [s.dead_zone_neg_deg for s in order]))
+    k = device_knob
+    h_pos = k.reference_pos.tip_deg - k.omega * (k.reference_pos.knob_deg - d_pos0)
+    h_neg = k.reference_neg.tip_deg - k.omega * (k.reference_neg.knob_deg - d_neg0)
+    return float(h_pos), float(h_neg)
+
+
+def fit_ours_knob(sweeps: Sequence[SweepData], device_knob: Any,
+                  other_knob_deg: Sequence[float] | None = None) -> OursParams:
+    """Our extra parameters for one knob from its calibration sweeps (current-only data).
+
+    ``sweeps``: every sweep of this knob, each tagged with the other knob's angle and the D/B the
+    paper's identification found in its current. ``device_knob``: the data sheet's
+    :class:`tsmd.profile.DeviceKnob` (omega, reference points) that also gives the profile's H.
+    ``other_knob_deg``: the profile's grid (default: the sweeps' other-knob angles, sorted); each
+    grid point needs a sweep within 1 deg (several are combined by the median).
+
+    Release slopes: from each sweep's amplitude (actual knob position), D and B
+    (:func:`release_slope`). Lag: commanded vs actual position, median over the sweeps. The
+    backlash blend is 0 (corners): its identification is not built yet.
+    """
+    if not sweeps:
+        raise ValueError("fit_ours_knob needs at least one sweep")
+    for s in sweeps:
+        values = (s.dead_zone_pos_deg, s.dead_zone_neg_deg, s.backlash_pos_deg,
+                  s.backlash_neg_deg)
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"sweep at {s.other_knob_deg} deg has no finite D/B: {values}")
+    omega = float(device_knob.omega)
+    h_pos, h_neg = heights_from_sweeps(sweeps, device_knob)
+    grid = sorted({float(s.other_knob_deg) for s in sweeps}) if other_knob_deg is None else list(
+        other_knob_deg)
+    slopes_pos: list[float] = []
+    slopes_neg: list[float] = []
+    for g in grid:
+        near = [s for s in sweeps if abs(s.other_knob_deg - g) <= 1.0]
+        if not near:
+            raise ValueError(f"no sweep with the other knob at {g} deg")
+        sp, sn = [], []
+        for s in near:
+            pos = np.asarray(s.pos_deg, float)
+            pos = pos[np.isfinite(pos)]
+            if pos.size == 0:
+                raise ValueError(f"sweep at {g} deg has no finite position")
+            sp.append(release_slope(float(pos.max()), s.dead_zone_pos_deg, s.backlash_pos_deg,
+                                    h_pos, h_neg, omega))
+            sn.append(release_slope(float(pos.min()), s.dead_zone_neg_deg, s.backlash_neg_deg,
+                                    h_neg, h_pos, omega))
+        slopes_pos.append(float(np.median(sp)))
+        slopes_neg.append(float(np.median(sn)))
+    lag = float(np.median([estimate_lag_s(s.t_s, s.cmd_deg, s.pos_deg) for s in sweeps]))
+    n = len(slopes_pos)
+    return OursParams(min(lag, 1.0), tuple(slopes_pos), tuple(slopes_neg), (0.0,) * n)

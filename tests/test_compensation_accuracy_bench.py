@@ -1,0 +1,52 @@
+"""The accuracy benchmark's protocol and metrics (tsmd.bench.accuracy), without simulating."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tsmd.bench.accuracy import PERIOD_S, scenarios, tracking_errors
+
+
+def test_protocol_has_the_papers_scenarios() -> None:
+    groups = {s.group for s in scenarios()}
+    assert groups == {"1-DOF periodic", "1-DOF non-periodic", "2-DOF periodic",
+                      "2-DOF non-periodic"}
+    fixed = sorted({s.q_deg[0, 1] for s in scenarios() if s.group == "1-DOF periodic"
+                    and s.knobs == (0,)})
+    assert fixed == [-60.0, -30.0, 0.0, 30.0, 60.0]
+
+
+def test_periodic_input_is_60_deg_at_0_04_hz() -> None:
+    s = next(s for s in scenarios() if s.group == "1-DOF periodic")
+    q = s.q_deg[:, s.knobs[0]]
+    assert q.max() == pytest.approx(60.0, abs=0.01)
+    crossings = np.flatnonzero(np.diff(np.sign(q)) > 0)
+    assert (crossings[1] - crossings[0]) * PERIOD_S == pytest.approx(25.0, abs=0.01)
+
+
+def test_two_dof_second_knob_runs_twice_as_fast() -> None:
+    s = next(s for s in scenarios() if s.group == "2-DOF periodic")
+    ups = [np.count_nonzero(np.diff(np.sign(s.q_deg[:, k])) > 0) for k in (0, 1)]
+    assert ups[1] == pytest.approx(2 * ups[0], abs=1)
+
+
+def test_non_periodic_input_sums_two_incommensurate_sines() -> None:
+    s = next(s for s in scenarios() if s.group == "1-DOF non-periodic")
+    t = s.t_s
+    expected = (30 * np.sin(2 * math.pi * 0.02 * t)
+                + 30 * np.sin(2 * math.pi * 0.02 * math.sqrt(3) * t))
+    assert np.allclose(s.q_deg[:, 0], expected)
+
+
+def test_quick_protocol_is_shorter() -> None:
+    full = sum(s.t_s.size for s in scenarios())
+    quick = sum(s.t_s.size for s in scenarios(quick=True))
+    assert quick < full / 3
+
+
+def test_ptpe_and_rmse() -> None:
+    ptpe, rmse = tracking_errors(np.array([1.0, -1.0, 3.0, math.nan]), np.zeros(4))
+    assert ptpe == 4.0 and rmse == pytest.approx(math.sqrt(11.0 / 3.0))

@@ -1,0 +1,173 @@
+"""Our compensator (tsmd.compensation.ours): release lines, blend, coupling axis, fitting."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from test_profile import make_profile
+
+from tsmd.compensation import build_compensator
+from tsmd.compensation.ours import (
+    OursState,
+    SweepData,
+    envelopes,
+    estimate_lag_s,
+    fit_ours_knob,
+    ours_inverse_step,
+    ours_model_step,
+    release_slope,
+    smooth_max_excess,
+    smooth_max_excess_inverse,
+)
+from tsmd.profile import DeviceKnob, KnobLimits, ReferencePoint
+
+OMEGA = 1.3
+D_POS, D_NEG, H_POS, H_NEG = 20.0, -20.0, -2.0, 2.0
+
+
+def env(b_deg: float = 18.0, blend: float = 0.0):  # type: ignore[no-untyped-def]
+    s_pos = release_slope(90.0, D_POS, b_deg, H_POS, H_NEG, OMEGA)
+    s_neg = release_slope(-90.0, D_NEG, b_deg, H_NEG, H_POS, OMEGA)
+    return envelopes(D_POS, D_NEG, H_POS, H_NEG, OMEGA, s_pos, s_neg, blend)
+
+
+def backlash_after_reversal_at(x_rev: float, e) -> float:  # type: ignore[no-untyped-def]
+    """Knob travel back from x_rev before the output drops by 1e-6."""
+    state = OursState(x_rev, e.rising(x_rev), 1, e.rising(x_rev), 0.0)
+    y0 = state.y_deg
+    for x in np.arange(x_rev, x_rev - 80.0, -0.01):
+        state = ours_model_step(state, float(x), e)
+        if state.y_deg < y0 - 1e-6:
+            return x_rev - float(x)
+    return math.inf
+
+
+def test_release_line_reproduces_the_backlash_at_the_calibration_amplitude() -> None:
+    assert backlash_after_reversal_at(90.0, env(18.0)) == pytest.approx(18.0, abs=0.05)
+
+
+def test_backlash_shrinks_with_the_load_at_the_reversal() -> None:
+    e = env(18.0)
+    widths = [backlash_after_reversal_at(x, e) for x in (40.0, 60.0, 90.0)]
+    assert widths[0] < widths[1] < widths[2]
+
+
+def test_release_slope_is_steeper_than_the_loaded_slope() -> None:
+    assert release_slope(90.0, D_POS, 18.0, H_POS, H_NEG, OMEGA) > OMEGA
+
+
+def test_release_slope_falls_back_to_omega_when_backlash_eats_the_travel() -> None:
+    assert release_slope(30.0, 20.0, 15.0, 0.0, 0.0, OMEGA) == OMEGA
+
+
+def test_smooth_max_inverse_inverts() -> None:
+    for w in (0.0, 0.5, 3.0):
+        for z in (0.01, 0.4, 2.0, 10.0):
+            assert smooth_max_excess(smooth_max_excess_inverse(z, w), w) == pytest.approx(z)
+
+
+def test_blend_keeps_the_output_continuous_at_the_reversal() -> None:
+    e = env(18.0, blend=3.0)
+    state = OursState(60.0, e.rising(60.0), 1, e.rising(60.0), 0.0)
+    after = ours_model_step(state, 60.0 - 1e-6, e)
+    assert after.y_deg == pytest.approx(state.y_deg, abs=1e-6)
+
+
+def test_blend_rounds_the_backlash_corner() -> None:
+    e = env(18.0, blend=4.0)
+    state = OursState(90.0, e.rising(90.0), 1, e.rising(90.0), 0.0)
+    xs = np.arange(90.0, 50.0, -0.05)
+    ys = []
+    for x in xs:
+        state = ours_model_step(state, float(x), e)
+        ys.append(state.y_deg)
+    slope = np.diff(ys) / np.diff(xs)
+    assert np.max(np.abs(np.diff(slope))) < 0.05  # no corner: the slope changes gradually
+
+
+params = st.tuples(st.floats(8, 30), st.floats(-30, -8), st.floats(-4, 4), st.floats(-4, 4),
+                   st.floats(0.9, 1.8), st.floats(0.9, 3.0), st.floats(0.9, 3.0),
+                   st.floats(0, 4))
+
+
+@settings(max_examples=80, deadline=None)
+@given(params, st.lists(st.floats(-30, 30), min_size=1, max_size=40))
+def test_inverse_then_model_gives_the_desired_output(p: tuple[float, ...],
+                                                      deltas: list[float]) -> None:
+    e = envelopes(*p)
+    y = np.clip(np.cumsum(deltas), -100, 100)
+    state = OursState(0.0, e.rising(0.0), 1, e.rising(0.0), 0.0)
+    model = state
+    for target in y:
+        state = ours_inverse_step(state, float(target), e)
+        model = ours_model_step(model, state.x_deg, e)
+        assert model.y_deg == pytest.approx(float(target), abs=1e-3)
+
+
+def test_ours_follows_the_other_tips_loaded_knob_angle() -> None:
+    profile = make_profile(d0=20.0)
+    comp = build_compensator(profile, "ours", 0.004)
+    comp.reset(np.array([0.0, 40.0]))
+    knob = comp.knobs[1]  # type: ignore[attr-defined]
+    axis = comp._axis  # type: ignore[attr-defined]
+    assert axis[1] == pytest.approx(knob.loaded_knob_deg(40.0, axis[0]), abs=0.01)
+    h_hi = max(knob.height_pos_deg, knob.height_neg_deg)
+    assert axis[1] == pytest.approx(20.0 + (40.0 - h_hi) / knob.omega, abs=0.3)
+
+
+def test_ours_leads_by_the_drive_lag() -> None:
+    profile = make_profile()
+    base = build_compensator(profile, "ours", 0.004)
+    lag_knobs = tuple(
+        type(k)(k.field, k.height_pos_deg, k.height_neg_deg, k.omega, 0.1)
+        for k in base.knobs)  # type: ignore[attr-defined]
+    lagged = type(base)(lag_knobs, 0.004)
+    q = np.column_stack([np.linspace(30, 40, 200), np.zeros(200)])
+    for c in (base, lagged):
+        c.reset(q[0])
+    out = [(base.command(r)[0], lagged.command(r)[0]) for r in q]
+    v = 10.0 / (199 * 0.004)
+    assert out[-1][1] - out[-1][0] == pytest.approx(0.1 * v / OMEGA, rel=0.05)
+
+
+def _sweep(d_pos: float, d_neg: float, b_pos: float, b_neg: float, other: float,
+           delay_s: float = 0.0) -> SweepData:
+    t = np.arange(0.0, 56.25, 0.004)
+    cmd = 90.0 * np.sin(2 * np.pi * 0.04 * t)
+    pos = np.interp(t - delay_s, t, cmd)
+    return SweepData(t, cmd, pos, np.zeros_like(t), other, d_pos, d_neg, b_pos, b_neg)
+
+
+DEVICE_KNOB = DeviceKnob(OMEGA, ReferencePoint(90.0, 90.0), ReferencePoint(-90.0, -90.0),
+                         KnobLimits(-90, 90, 120, 2000))
+
+
+def test_fit_gives_release_slopes_from_each_sweeps_amplitude_d_and_b() -> None:
+    sweeps = [_sweep(20.0, -20.0, 18.0, 17.0, g) for g in (-90.0, 0.0, 90.0)]
+    fit = fit_ours_knob(sweeps, DEVICE_KNOB)
+    h_pos = 90.0 - OMEGA * 70.0
+    h_neg = -90.0 + OMEGA * 70.0
+    assert fit.release_slope_pos[1] == pytest.approx(
+        release_slope(90.0, 20.0, 18.0, h_pos, h_neg, OMEGA), rel=1e-3)
+    assert fit.release_slope_neg[1] == pytest.approx(
+        release_slope(-90.0, -20.0, 17.0, h_neg, h_pos, OMEGA), rel=1e-3)
+    assert len(fit.backlash_blend_deg) == 3
+
+
+def test_fit_needs_a_sweep_for_every_grid_point() -> None:
+    with pytest.raises(ValueError, match="no sweep with the other knob at 30"):
+        fit_ours_knob([_sweep(20, -20, 18, 18, 0.0)], DEVICE_KNOB, (0.0, 30.0))
+
+
+def test_fit_refuses_sweeps_without_identified_parameters() -> None:
+    with pytest.raises(ValueError, match="no finite D/B"):
+        fit_ours_knob([_sweep(math.nan, -20, 18, 18, 0.0)], DEVICE_KNOB)
+
+
+def test_lag_estimate_recovers_a_known_delay() -> None:
+    s = _sweep(20, -20, 18, 18, 0.0, delay_s=0.02)
+    assert estimate_lag_s(s.t_s, s.cmd_deg, s.pos_deg) == pytest.approx(0.02, abs=0.002)

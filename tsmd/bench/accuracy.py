@@ -1,0 +1,488 @@
+"""`tsmd bench accuracy`: the paper's tracking protocol through the full stack on the sim rig.
+
+Every run goes through ``tsmd.replay.run_trajectory`` (simulated CiA 402 drives on the in-process
+CAN bus, the control loop, lockstep), and compares the tip angle from the simulated EM tracker
+with the desired angle. Compensators are calibrated by ``tsmd.calibration`` from motor current
+when that package provides ``calibrate``; otherwise (or with ``--profile-source ground-truth``)
+from D and B measured on the tracker's tip angle, and the output says so.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tsmd import __version__
+from tsmd.errors import TsmdError
+
+PERIOD_S = 0.004
+GRID_DEG = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
+METHODS = ("none", "paper", "ours")
+
+PAPER_IMPROVEMENT_PCT: dict[str, tuple[float, float]] = {
+    "1-DOF periodic": (63.8, 73.2),
+    "1-DOF non-periodic": (48.1, 63.8),
+    "2-DOF periodic": (40.5, 58.0),
+    "2-DOF non-periodic": (43.7, 55.3),
+}
+"""The paper's improvement rates (PTPE %, RMSE %), Tables 1d_all and 2d_all."""
+
+GOAL_RMSE_PCT = {"1-DOF": 85.0, "2-DOF": 75.0}
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One trajectory of the protocol; ``knobs`` are the knobs whose tracking is scored."""
+
+    group: str
+    name: str
+    t_s: NDArray[np.float64]
+    q_deg: NDArray[np.float64]
+    knobs: tuple[int, ...]
+
+
+def _settle(t: NDArray[np.float64], q: NDArray[np.float64], move_s: float = 2.0
+            ) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
+    """Prepend a smooth move from 0 to the first sample and a rest, like an operator would."""
+    n_move = round(move_s / PERIOD_S)
+    s = 0.5 - 0.5 * np.cos(np.linspace(0.0, math.pi, n_move))
+    pre = s[:, None] * q[0][None, :]
+    rest = np.repeat(q[:1], round(0.5 / PERIOD_S), axis=0)
+    head = np.vstack([pre, rest])
+    tt = np.arange(len(head) + len(t)) * PERIOD_S
+    full: NDArray[np.float64] = np.vstack([head, q]).astype(float)
+    return tt.astype(float), full, len(head)
+
+
+def scenarios(quick: bool = False) -> list[Scenario]:
+    """The paper's scenarios (section "Scenarios"): 1-DOF with the other knob fixed, 2-DOF."""
+    f1 = 0.04
+    cycles = 1 if quick else 2
+    t = np.arange(0.0, cycles / f1, PERIOD_S)
+    fixed = (0.0, 60.0) if quick else (-60.0, -30.0, 0.0, 30.0, 60.0)
+    out: list[Scenario] = []
+    periodic = 60.0 * np.sin(2 * math.pi * f1 * t)
+    for knob in (0, 1):
+        for other in fixed:
+            q = np.zeros((t.size, 2))
+            q[:, knob] = periodic
+            q[:, 1 - knob] = other
+            out.append(Scenario("1-DOF periodic", f"phi{knob + 1}, other at {other:+.0f}",
+                                t, q, (knob,)))
+    t_np = np.arange(0.0, (0.5 if quick else 1.0) / 0.02, PERIOD_S)
+
+    def nonperiodic(tt: NDArray[np.float64], scale: float) -> NDArray[np.float64]:
+        return (30.0 * np.sin(2 * math.pi * 0.02 * scale * tt)
+                + 30.0 * np.sin(2 * math.pi * 0.02 * math.sqrt(3.0) * scale * tt))
+
+    for knob in (0, 1):
+        q = np.zeros((t_np.size, 2))
+        q[:, knob] = nonperiodic(t_np, 1.0)
+        out.append(Scenario("1-DOF non-periodic", f"phi{knob + 1}, other at +0", t_np, q,
+                            (knob,)))
+    q2 = np.column_stack([periodic, 60.0 * np.sin(2 * math.pi * 2 * f1 * t)])
+    out.append(Scenario("2-DOF periodic", "phi1 0.04 Hz, phi2 0.08 Hz", t, q2, (0, 1)))
+    q2n = np.column_stack([nonperiodic(t_np, 1.0), nonperiodic(t_np, 2.0)])
+    out.append(Scenario("2-DOF non-periodic", "phi1 0.02+0.035 Hz, phi2 twice", t_np, q2n,
+                        (0, 1)))
+    return out
+
+
+def tracking_errors(tip_deg: NDArray[np.float64], q_deg: NDArray[np.float64]
+                    ) -> tuple[float, float]:
+    """(PTPE, RMSE) of tip against desired: peak-to-peak of the error and its RMS."""
+    e = np.asarray(tip_deg, float) - np.asarray(q_deg, float)
+    e = e[np.isfinite(e)]
+    if e.size == 0:
+        return math.nan, math.nan
+    return float(e.max() - e.min()), float(np.sqrt(np.mean(e * e)))
+
+
+# ----------------------------------------------------------------------------------------------
+# Profiles
+
+
+def _run(t: NDArray[np.float64], q: NDArray[np.float64], profile: Any, method: str, seed: int,
+         plant: Any) -> Any:
+    from tsmd.replay import run_trajectory
+
+    return run_trajectory(t, q, profile=profile, method=method, seed=seed, plant=plant)
+
+
+def make_plant(coupling: float) -> Any:
+    from drivers.plant.tendon_sheath import make_tendon_sheath_plant
+
+    return make_tendon_sheath_plant(coupling=coupling) if coupling > 0 else (
+        make_tendon_sheath_plant())
+
+
+def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: int = 1000,
+                         log: Callable[[str], None] = print) -> Any:
+    """A profile from sweeps scored on the tracker's tip angle (not from motor current).
+
+    The paper's calibration protocol (each knob +-90 deg at 0.04 Hz, two cycles, the other knob
+    held at each grid angle), uncompensated through the full stack; D and B measured on the tip
+    with ``drivers.plant.analysis`` (ground truth); our extra parameters from the same sweeps.
+    """
+    from drivers.plant.analysis import measure_dead_zone_backlash
+    from tsmd.compensation.ours import SweepData, fit_ours_knob
+    from tsmd.profile import CatheterProfile, make_knob_profile
+
+    t = np.arange(0.0, 2.25 / 0.04, PERIOD_S)
+    sweep = 90.0 * np.sin(2 * math.pi * 0.04 * t)
+    knobs = []
+    for knob in (0, 1):
+        sweeps = []
+        for other in GRID_DEG:
+            q = np.zeros((t.size, 2))
+            q[:, knob] = sweep
+            q[:, 1 - knob] = other
+            tt, qq, skip = _settle(t, q)
+            rec = _run(tt, qq, None, "none", seed, plant_factory())
+            pos = rec[f"pos{knob + 1}"][skip:]
+            tip = rec[f"tip{knob + 1}"][skip:]
+            m = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
+            sweeps.append(SweepData(rec["t"][skip:], rec[f"cmd{knob + 1}"][skip:], pos,
+                                    rec[f"cur{knob + 1}"][skip:], other, m.dead_zone_pos_deg,
+                                    m.dead_zone_neg_deg, m.backlash_pos_deg,
+                                    m.backlash_neg_deg))
+            log(f"  ground truth phi{knob + 1}, other {other:+.0f}: D {m.dead_zone_pos_deg:.1f}/"
+                f"{m.dead_zone_neg_deg:.1f}  B {m.backlash_pos_deg:.1f}/{m.backlash_neg_deg:.1f}")
+        dk = device.knobs[knob]
+        ours = fit_ours_knob(sweeps, dk, GRID_DEG)
+        knobs.append(make_knob_profile(
+            dk, GRID_DEG, [s.dead_zone_pos_deg for s in sweeps],
+            [s.dead_zone_neg_deg for s in sweeps], [s.backlash_pos_deg for s in sweeps],
+            [s.backlash_neg_deg for s in sweeps], ours))
+    return CatheterProfile(
+        "sim-ground-truth", device.device_model,
+        datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"), f"tsmd {__version__}", "pchip",
+        (knobs[0], knobs[1]), source="ground truth: D/B measured on the simulated tracker's tip")
+
+
+def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
+                             ) -> list[dict[str, float]]:
+    """What a manufacturer measures once per product with a tracker on the tip (design
+    assumptions 1-3): per knob, the loaded slope omega and the reference points (tip at the knob
+    at +-90 deg at the end of a sweep out from the other knob at 0 deg)."""
+    from drivers.plant.analysis import loaded_slope
+
+    t = np.arange(0.0, 2.25 / 0.04, PERIOD_S)
+    sweep = 90.0 * np.sin(2 * math.pi * 0.04 * t)
+    out = []
+    for knob in (0, 1):
+        q = np.zeros((t.size, 2))
+        q[:, knob] = sweep
+        tt, qq, skip = _settle(t, q)
+        rec = _run(tt, qq, None, "none", seed, plant_factory())
+        pos = rec[f"pos{knob + 1}"][skip:]
+        tip = rec[f"tip{knob + 1}"][skip:]
+        slope_pos, slope_neg = loaded_slope(pos, tip, 40.0, 85.0)
+        top = pos > 89.5
+        bottom = pos < -89.5
+        out.append({"omega": 0.5 * (slope_pos + slope_neg),
+                    "ref_pos_knob": 90.0, "ref_pos_tip": float(np.median(tip[top])),
+                    "ref_neg_knob": -90.0, "ref_neg_tip": float(np.median(tip[bottom]))})
+    return out
+
+
+def calibrated_profile(device: Any, plant_factory: Callable[[], Any], seed: int = 3000) -> Any:
+    """A profile from ``tsmd.calibration.calibrate`` (motor current only) on the lockstep sim.
+
+    Raises ImportError when the calibration package does not provide ``calibrate`` yet.
+    """
+    from tsmd.calibration import calibrate
+    from tsmd.replay import LockstepRunner
+
+    with LockstepRunner(None, None, "none", seed, plant_factory()) as runner:
+        return calibrate(runner, "sim-bench", device)
+
+
+# ----------------------------------------------------------------------------------------------
+# Measurements
+
+
+@dataclass
+class RunResult:
+    scenario: Scenario
+    method: str
+    seed: int
+    ptpe_deg: float
+    rmse_deg: float
+    t_s: NDArray[np.float64]
+    q_deg: NDArray[np.float64]
+    cmd_deg: NDArray[np.float64]
+    tip_deg: NDArray[np.float64]
+
+
+def run_scenario(s: Scenario, method: str, seed: int, profile: Any,
+                 plant_factory: Callable[[], Any]) -> RunResult:
+    tt, qq, skip = _settle(s.t_s, s.q_deg)
+    rec = _run(tt, qq, profile if method != "none" else None, method, seed, plant_factory())
+    tip = np.column_stack([rec["tip1"], rec["tip2"]])[skip:]
+    cmd = np.column_stack([rec["cmd1"], rec["cmd2"]])[skip:]
+    q = qq[skip:]
+    errs = [tracking_errors(tip[:, k], q[:, k]) for k in s.knobs]
+    return RunResult(s, method, seed, float(np.mean([e[0] for e in errs])),
+                     float(np.mean([e[1] for e in errs])), tt[skip:] - tt[skip], q, cmd, tip)
+
+
+def compute_time_us(profile: Any, method: str, n_ticks: int = 5000) -> tuple[float, float]:
+    """Median and p99 wall time of one ``command`` call for two knobs (microseconds)."""
+    from tsmd.compensation import build_compensator
+
+    comp = build_compensator(profile if method != "none" else None, method, PERIOD_S)
+    t = np.arange(n_ticks) * PERIOD_S
+    q = np.column_stack([60 * np.sin(2 * math.pi * 0.04 * t), 60 * np.sin(2 * math.pi * 0.08 * t)])
+    comp.reset(q[0])
+    times = np.empty(n_ticks)
+    for i, row in enumerate(q):
+        t0 = time.perf_counter_ns()
+        comp.command(row)
+        times[i] = time.perf_counter_ns() - t0
+    return float(np.median(times) / 1e3), float(np.percentile(times, 99) / 1e3)
+
+
+def limiter_cost(profile: Any, method: str, device: Any, scen: Sequence[Scenario]
+                 ) -> dict[str, float]:
+    """How far the rate/position limiter moves the compensator's command (same trajectories,
+    offline): RMS and max deviation and the share of ticks where it acted."""
+    from tsmd.compensation import LimitedCompensator, build_compensator
+
+    dev: list[NDArray[np.float64]] = []
+    for s in scen:
+        comp = build_compensator(profile, method, PERIOD_S)
+        lim = LimitedCompensator(comp, device.limits, PERIOD_S)
+        _, qq, _ = _settle(s.t_s, s.q_deg)
+        lim.reset(qq[0])
+        for row in qq:
+            out = lim.command(row)
+            dev.append(np.abs(out - lim.last_unlimited))
+    d = np.concatenate(dev)
+    return {"rms_deg": float(np.sqrt(np.mean(d * d))), "max_deg": float(d.max()),
+            "acting_pct": float(100.0 * np.mean(d > 1e-6))}
+
+
+def command_jerk(r: RunResult) -> float:
+    """p99 of |third difference| of the command, deg/s^3: how abrupt the motor's motion is."""
+    j = np.diff(r.cmd_deg, n=3, axis=0) / PERIOD_S**3
+    return float(np.percentile(np.abs(j[:, list(r.scenario.knobs)]), 99))
+
+
+# ----------------------------------------------------------------------------------------------
+# Output
+
+
+def _mean_std(values: Sequence[float]) -> tuple[float, float]:
+    a = np.asarray(values, float)
+    return float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else 0.0
+
+
+def summarise(results: Sequence[RunResult], key: Callable[[RunResult], str]
+              ) -> dict[str, dict[str, dict[str, tuple[float, float]]]]:
+    """{row: {method: {"ptpe"|"rmse": (mean, std over seeds)}}}; within a seed, the scenarios of
+    a row are averaged first (as the paper pools conditions)."""
+    table: dict[str, dict[str, dict[str, tuple[float, float]]]] = {}
+    rows = sorted({key(r) for r in results}, key=lambda k: list(PAPER_IMPROVEMENT_PCT).index(
+        k) if k in PAPER_IMPROVEMENT_PCT else 99)
+    for row in rows:
+        table[row] = {}
+        for method in METHODS:
+            chosen = [r for r in results if key(r) == row and r.method == method]
+            seeds = sorted({r.seed for r in chosen})
+            per_seed_p = [float(np.mean([r.ptpe_deg for r in chosen if r.seed == s]))
+                          for s in seeds]
+            per_seed_r = [float(np.mean([r.rmse_deg for r in chosen if r.seed == s]))
+                          for s in seeds]
+            table[row][method] = {"ptpe": _mean_std(per_seed_p), "rmse": _mean_std(per_seed_r)}
+    return table
+
+
+def _pct(none: float, other: float) -> float:
+    return 100.0 * (none - other) / none if none > 0 else math.nan
+
+
+def format_table(table: dict[str, dict[str, dict[str, tuple[float, float]]]],
+                 with_paper: bool) -> list[str]:
+    head = ("| scenario | none PTPE | none RMSE | paper PTPE | paper RMSE | ours PTPE | ours RMSE "
+            "| paper impr. PTPE/RMSE | ours impr. PTPE/RMSE |")
+    if with_paper:
+        head += " published impr. PTPE/RMSE | goal RMSE |"
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for row, m in table.items():
+        cells = [row]
+        for method in METHODS:
+            for metric in ("ptpe", "rmse"):
+                mean, std = m[method][metric]
+                cells.append(f"{mean:.2f} ± {std:.2f}")
+        for method in ("paper", "ours"):
+            cells.append(f"{_pct(m['none']['ptpe'][0], m[method]['ptpe'][0]):.1f} % / "
+                         f"{_pct(m['none']['rmse'][0], m[method]['rmse'][0]):.1f} %")
+        if with_paper:
+            pub = PAPER_IMPROVEMENT_PCT.get(row)
+            cells.append(f"{pub[0]:.1f} % / {pub[1]:.1f} %" if pub else "")
+            goal = GOAL_RMSE_PCT.get(row.split(" ")[0])
+            cells.append(f">= {goal:.0f} %" if goal else "")
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def plot_runs(runs: Sequence[RunResult], path: Path, title: str) -> None:
+    """Time and input-output curves (paper's Figs. result_1dof / result_2dof)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    knobs = runs[0].scenario.knobs
+    fig, axes = plt.subplots(2, len(knobs), figsize=(5.2 * len(knobs), 6.4), squeeze=False)
+    colours = {"none": "tab:blue", "paper": "tab:orange", "ours": "tab:red"}
+    for col, k in enumerate(knobs):
+        ax_t, ax_io = axes[0, col], axes[1, col]
+        ref = runs[0]
+        ax_t.plot(ref.t_s, ref.q_deg[:, k], "k:", lw=1.2, label="desired")
+        lim = float(np.max(np.abs(ref.q_deg[:, k]))) * 1.15
+        ax_io.plot([-lim, lim], [-lim, lim], "k:", lw=1.0)
+        for r in runs:
+            ax_t.plot(r.t_s, r.tip_deg[:, k], color=colours[r.method], lw=0.9, label=r.method)
+            ax_io.plot(r.q_deg[:, k], r.tip_deg[:, k], color=colours[r.method], lw=0.8)
+        ax_t.set_xlabel("time (s)")
+        ax_t.set_ylabel(f"tip phi{k + 1} (deg)")
+        ax_io.set_xlabel(f"desired phi{k + 1} (deg)")
+        ax_io.set_ylabel(f"tip phi{k + 1} (deg)")
+        for ax in (ax_t, ax_io):
+            ax.grid(alpha=0.3)
+        ax_t.legend(fontsize=7, loc="upper right")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=72)
+    plt.close(fig)
+
+
+# ----------------------------------------------------------------------------------------------
+# CLI
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--quick", action="store_true",
+                        help="1 seed, 1 cycle, fewer fixed angles (CI smoke test)")
+    parser.add_argument("--seeds", type=int, default=None, help="noise seeds (default 5)")
+    parser.add_argument("--profile-source", choices=("auto", "calibrate", "ground-truth"),
+                        default="auto", help="auto: tsmd calibrate when available, else the "
+                        "ground-truth tip (labelled)")
+    parser.add_argument("--profile", type=Path, default=None,
+                        help="use this profile file instead of calibrating")
+    parser.add_argument("--save-profile", type=Path, default=None,
+                        help="write the profile the benchmark used here")
+    parser.add_argument("--device", type=Path, default=Path("profiles/devices/sim-catheter.yaml"))
+    parser.add_argument("--coupling", type=float, default=0.0,
+                        help="plant knob-coupling strength (0 = the default simulated catheter)")
+    parser.add_argument("--plots", type=Path, default=None,
+                        help="directory for the PNG figures (none by default)")
+    parser.add_argument("--report", type=Path, default=None,
+                        help="write the tables as Markdown to this file")
+
+
+def main(args: argparse.Namespace) -> int:
+    from tsmd.profile import load_device_model, load_profile, save_profile
+
+    quick = bool(args.quick)
+    n_seeds = args.seeds if args.seeds is not None else (1 if quick else 5)
+    if n_seeds < 1:
+        raise TsmdError("--seeds must be at least 1")
+    device = load_device_model(args.device)
+    coupling = float(args.coupling)
+
+    def plant_factory() -> Any:
+        return make_plant(coupling)
+
+    t_start = time.perf_counter()
+    source = args.profile_source
+    if args.profile is not None:
+        profile = load_profile(args.profile)
+        label = f"profile file {args.profile} ({profile.source})"
+    else:
+        profile = None
+        if source in ("auto", "calibrate"):
+            try:
+                print("calibrating from motor current (tsmd.calibration) ...", flush=True)
+                profile = calibrated_profile(device, plant_factory)
+                label = "tsmd calibrate: motor current only"
+            except ImportError:
+                if source == "calibrate":
+                    raise TsmdError("tsmd.calibration.calibrate is not available") from None
+                print("tsmd.calibration.calibrate not available: using the ground truth")
+        if profile is None:
+            print("measuring D/B on the simulated tracker's tip (ground truth) ...", flush=True)
+            profile = ground_truth_profile(device, plant_factory)
+            label = "GROUND TRUTH: D/B measured on the tracked tip, not from motor current"
+    if profile is None:  # pragma: no cover - every branch above sets it or raises
+        raise TsmdError("no profile")
+    if args.save_profile is not None:
+        save_profile(profile, args.save_profile)
+    print(f"profile: {label}")
+
+    scen = scenarios(quick)
+    results: list[RunResult] = []
+    for seed in range(n_seeds):
+        for s in scen:
+            for method in METHODS:
+                results.append(run_scenario(s, method, seed, profile, plant_factory))
+        print(f"seed {seed + 1}/{n_seeds} done ({time.perf_counter() - t_start:.0f} s)",
+              flush=True)
+
+    groups = summarise(results, lambda r: r.scenario.group)
+    fixed = summarise([r for r in results if r.scenario.group == "1-DOF periodic"],
+                      lambda r: "other knob at " + ("0" if r.scenario.name.endswith("+0") else
+                                                     "±" + r.scenario.name.split()[-1][1:]))
+    lines = [f"Profile: {label}", f"Seeds: {n_seeds}; quick: {quick}; plant coupling: {coupling}",
+             "", "Tip against desired, degrees (mean ± std over seeds):", ""]
+    lines += format_table(groups, with_paper=True)
+    lines += ["", "1-DOF periodic by the other knob's fixed angle (paper's Table 1d_fixed):", ""]
+    lines += format_table(fixed, with_paper=False)
+    lines += ["", "Per-tick compute time of the compensator for two knobs (this machine):", "",
+              "| method | median µs | p99 µs |", "|---|---|---|"]
+    for method in METHODS:
+        med, p99 = compute_time_us(profile, method)
+        lines.append(f"| {method} | {med:.1f} | {p99:.1f} |")
+    lines += ["", "Rate/position limiter (device limits) on the compensators' commands, "
+              "same trajectories offline:", "",
+              "| method | RMS deviation deg | max deviation deg | ticks limited |",
+              "|---|---|---|---|"]
+    for method in ("paper", "ours"):
+        c = limiter_cost(profile, method, device, scen)
+        lines.append(f"| {method} | {c['rms_deg']:.3f} | {c['max_deg']:.2f} | "
+                     f"{c['acting_pct']:.1f} % |")
+    lines += ["", "Command jerk p99 (deg/s^3, seed 0, as run):", "",
+              "| scenario | none | paper | ours |", "|---|---|---|---|"]
+    for s in scen:
+        row = [command_jerk(r) for m in METHODS for r in results
+               if r.scenario is s and r.method == m and r.seed == 0]
+        lines.append(f"| {s.group}, {s.name} | " + " | ".join(f"{v:.3g}" for v in row) + " |")
+    lines += ["", f"Wall time: {time.perf_counter() - t_start:.0f} s"]
+    print("\n".join(lines))
+
+    if args.plots is not None:
+        for group, name, fname in (
+                ("1-DOF periodic", "phi1, other at +0", "accuracy-1dof-periodic.png"),
+                ("1-DOF non-periodic", "phi1, other at +0", "accuracy-1dof-nonperiodic.png"),
+                ("2-DOF periodic", None, "accuracy-2dof-periodic.png"),
+                ("2-DOF non-periodic", None, "accuracy-2dof-nonperiodic.png")):
+            runs = [r for r in results if r.seed == 0 and r.scenario.group == group
+                    and (name is None or r.scenario.name == name)]
+            if runs:
+                plot_runs(runs, args.plots / fname, f"{group}: {runs[0].scenario.name}")
+        print(f"figures in {args.plots}")
+    if args.report is not None:
+        args.report.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return 0

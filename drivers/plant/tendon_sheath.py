@@ -120,8 +120,9 @@ class Effects:
     """Axial shortening of the bending section when bent in the other plane (adds slack to both
     tendons, widening the dead zone quadratically)."""
     rate_dependence: float = 0.0
-    """Relative rise of the sheath friction per ``rate_reference_deg_s`` of knob speed."""
-    rate_reference_deg_s: float = 50.0
+    """Relative rise of the sheath friction per ``rate_reference_deg_s`` of knob speed
+    (viscous drag of the lubricated sheath; the handle guides are unaffected)."""
+    rate_reference_deg_s: float = 100.0
     tendon_compliance: float = 0.0
     """Extra tendon compliance relative to the nominal one (1.0 doubles it)."""
     sheath_curvature_deg: float = 0.0
@@ -208,8 +209,9 @@ class _Knob:
         self.static_Nm = self.kinetic_Nm * max(1.0, p.bend_stiction_ratio)
         wrap_rad = math.radians(p.sheath_wrap_deg + eff.sheath_curvature_deg)
         # Friction exponent mu * wrap per element; the handle routing sits at the sheath entry.
-        self.friction_exponent = np.full(n_elements, p.sheath_friction * wrap_rad / n_elements)
-        self.friction_exponent[0] += p.routing_friction * math.radians(p.routing_wrap_deg)
+        self.sheath_exponent = np.full(n_elements, p.sheath_friction * wrap_rad / n_elements)
+        self.routing_exponent = np.zeros(n_elements)
+        self.routing_exponent[0] = p.routing_friction * math.radians(p.routing_wrap_deg)
         self.radius_m = p.pulley_radius_mm * 1e-3
         curvature_slack_m = eff.lumen_clearance_mm * 1e-3 * math.radians(eff.sheath_curvature_deg)
         self.slack_m = np.array(
@@ -221,9 +223,9 @@ class _Knob:
         self.friction_static = self._friction(1.0)
         self.reset()
 
-    def _friction(self, scale: float) -> Friction:
-        """(G, H) for pulling and for the mirrored release, friction scaled by ``scale``."""
-        gain = np.exp(-np.cumsum(scale * self.friction_exponent))
+    def _friction(self, sheath_scale: float) -> Friction:
+        """(G, H) for pulling and for the mirrored release, sheath friction scaled."""
+        gain = np.exp(-np.cumsum(sheath_scale * self.sheath_exponent + self.routing_exponent))
         inv = 1.0 / gain
         h = self.drag_per_element_N
         return gain, gain * np.cumsum(h * inv), inv, inv * np.cumsum(h * gain)

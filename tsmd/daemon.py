@@ -10,6 +10,7 @@ loop thread, stop the loop, flush the recording, close the socket and the bus.
 from __future__ import annotations
 
 import contextlib
+import gc
 import importlib
 import os
 import sys
@@ -266,6 +267,7 @@ class Daemon:
         self._loop_thread: threading.Thread | None = None
         self._loop_error: BaseException | None = None
         self._stopped = False
+        self._can_writer: Any = None
         self.shutdown_requested = threading.Event()
 
     # --- start -----------------------------------------------------------------------------
@@ -285,6 +287,10 @@ class Daemon:
         except BaseException:
             self.stop()
             raise
+        # Everything built so far lives as long as the daemon: keep it out of the cyclic
+        # garbage collector, whose full passes over it would stall a tick for milliseconds.
+        gc.collect()
+        gc.freeze()
         self.notifier.ready(status=f"tsmd ready: {config.loop.rate_hz:g} Hz, socket "
                                    f"{self.socket_path}")
         self.log.info("ready", socket=str(self.socket_path), rate_hz=config.loop.rate_hz,
@@ -300,21 +306,71 @@ class Daemon:
 
             plant = load_plant(config.sim.plant, config.sim.params)
             self.drives, self.rig = open_sim_rig(plant, drive_cfgs, config.loop.period_s,
-                                                 config.sim.seed, lockstep=False)
+                                                 config.sim.seed, lockstep=False,
+                                                 receive="poll")
             from tsmd.replay import configure_tracker
 
             configure_tracker(self.rig, config.sim.tracker_noise_deg, config.sim.seed)
         else:
-            from drivers.canopen_master import CanOpenDrives
-
-            self.drives = CanOpenDrives.open(config.bus.interface, config.bus.channel,
-                                             drive_cfgs, config.loop.period_s,
-                                             bitrate=config.bus.bitrate)
+            self.drives = self._open_bus_drives(drive_cfgs)
         try:
             self.drives.boot()
         except DriveError as exc:
             raise DaemonError(f"drive boot failed: {exc}", "drive") from None
         self.log.info("drives booted", count=self.drives.count)
+
+    def _open_bus_drives(self, drive_cfgs: list[Any]) -> KnobDrives:
+        """The master on the configured bus; the loop thread polls it every tick.
+
+        Polling (no python-can notifier thread) leaves one thread touching the bus and one
+        fewer thread competing with the loop for the GIL.
+        """
+        import can
+
+        from drivers.canopen_master import CanOpenDrives
+
+        bus_cfg = self.config.bus
+        kwargs: dict[str, Any] = {}
+        if bus_cfg.interface == "udp_multicast":  # it echoes our own frames: accept only theirs
+            kwargs["can_filters"] = [{"can_id": base + c.node_id, "can_mask": 0x7FF}
+                                     for c in drive_cfgs for base in (0x080, 0x180, 0x580, 0x700)]
+        try:
+            bus = can.Bus(interface=bus_cfg.interface, channel=bus_cfg.channel,
+                          bitrate=bus_cfg.bitrate, **kwargs)
+        except (can.CanError, OSError, ValueError, ImportError) as exc:
+            raise DaemonError(f"cannot open CAN interface {bus_cfg.interface!r} channel "
+                              f"{bus_cfg.channel!r}: {exc}", "drive") from None
+        self._can_log(bus)
+        return CanOpenDrives(bus, drive_cfgs, self.config.loop.period_s, receive="poll",
+                             own_bus=True)
+
+    def _can_log(self, bus: Any) -> None:
+        """bus.log_format: every frame sent and received, in python-can's BLF or ASC writer."""
+        fmt = self.config.bus.log_format
+        if fmt == "none":
+            return
+        import can
+
+        directory = resolve_data_path(self.config.recording.dir)
+        directory.mkdir(parents=True, exist_ok=True)
+        stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
+        path = directory / f"tsmd-can-{stamp}.{fmt}"
+        writer = can.Logger(str(path))
+        self._can_writer = writer
+        recv, send = bus.recv, bus.send
+
+        def logged_recv(timeout: float | None = None) -> Any:
+            msg = recv(timeout)
+            if msg is not None:
+                writer.on_message_received(msg)
+            return msg
+
+        def logged_send(msg: Any, timeout: float | None = None) -> None:
+            send(msg, timeout)
+            writer.on_message_received(msg)
+
+        bus.recv, bus.send = logged_recv, logged_send
+        self.log.info("logging CAN traffic", path=str(path), format=fmt)
 
     def _load_profile(self) -> Any:
         from tsmd.profile import ProfileError, ProfileStore, load_profile
@@ -484,6 +540,8 @@ class Daemon:
                 self.drives.close()
         if self.rig is not None and hasattr(self.rig, "close"):
             self.rig.close()
+        if self._can_writer is not None:
+            self._can_writer.stop()
         summary = self.summary()
         self.events.close()
         self.notifier.close()

@@ -446,6 +446,12 @@ class ControlLoop:
             self._emit("warning", "enable failed", reason=str(exc))
             raise LoopError("drive", f"enable failed: {exc}") from None
         self.drives.pump()
+        # Findings from while the drives were walked to OPERATION ENABLED (feedback late
+        # during the walk) are history: enable() succeeded, so they are logged, not faults.
+        for event in self.drives.poll_events():
+            self.last_events.append(event)
+            self._emit("warning", "drive event during enable", drive=event.drive,
+                       kind=event.kind.value, message=event.message)
         pos = self._hold_position()
         self._q = pos
         self._last_cmd = pos

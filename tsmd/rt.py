@@ -157,6 +157,10 @@ class TickTimes:
         self.cpu_s[i] = cpu_s
         self.count += 1
 
+    def clear(self) -> None:
+        """Forget what was measured so far (a benchmark's warm-up)."""
+        self.count = self.overruns = self.missed_deadlines = 0
+
     def _ordered(self, a: NDArray[np.float64]) -> NDArray[np.float64]:
         if self.count <= self.capacity:
             return a[: self.count].copy()

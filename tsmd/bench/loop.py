@@ -295,8 +295,9 @@ def main(args: argparse.Namespace) -> int:
         print(f"{'loop CPU per tick':34} {result.cpu_per_tick_us.row()}")
         if ct is not None:
             print(f"{'cyclictest latency (machine limit)':34} {ct.lateness.row()}")
+            late_pct = 100.0 * ct.late_by_a_period / ct.samples
             print(f"  cyclictest {ct.command}: {ct.samples} samples, {ct.late_by_a_period} "
-                  f"woke more than a period late ({100.0 * ct.late_by_a_period / ct.samples:.3f} %)")
+                  f"woke more than a period late ({late_pct:.3f} %)")
             ratio = result.lateness.p99_us / max(ct.lateness.p99_us, 1.0)
             ok = ratio <= 1.5
             goals_ok &= ok

@@ -70,8 +70,10 @@ def _rising_pass_measures(q: FloatArray, tip: FloatArray, thr: float) -> tuple[f
         return float("nan"), float("nan")
     i_left = int(left[0])
     backlash = float(q[i_left] - q[0])
-    # Dead-zone plateau: the sample from which the knob must travel farthest before the tip
-    # rises by the threshold; the plateau ends where that happens.
+    # Dead-zone plateau: the stretch from which the knob must travel farthest before the tip
+    # rises by the threshold. Its level is the median tip over the middle of that stretch (so a
+    # start just below the plateau cannot bias it); the dead zone ends where the tip rises the
+    # threshold above that level.
     qs = q[i_left:]
     cm = rising_max[i_left:]
     ts = tip[i_left:]
@@ -81,7 +83,14 @@ def _rising_pass_measures(q: FloatArray, tip: FloatArray, thr: float) -> tuple[f
         return backlash, float("nan")
     travel = np.where(valid, qs[np.minimum(j, qs.size - 1)] - qs, -np.inf)
     i_best = int(np.argmax(travel))
-    return backlash, float(qs[j[i_best]])
+    q_a, q_b = qs[i_best], qs[j[i_best]]
+    middle = (qs >= q_a + 0.25 * (q_b - q_a)) & (qs <= q_a + 0.75 * (q_b - q_a))
+    level = float(np.median(ts[middle])) if np.any(middle) else float(ts[i_best])
+    mid = int(np.searchsorted(qs, 0.5 * (q_a + q_b)))
+    above = np.flatnonzero(cm[mid:] > level + thr)
+    if above.size == 0:
+        return backlash, float("nan")
+    return backlash, float(qs[mid + above[0]])
 
 
 def measure_dead_zone_backlash(

@@ -1,0 +1,94 @@
+"""Dead zone and backlash measured from the tip angle of a sweep (ground truth definitions)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from drivers.plant.analysis import (
+    SweepAnalysisError,
+    loaded_slope,
+    measure_dead_zone_backlash,
+    split_passes,
+)
+
+SLOPE = 1.3
+
+
+def play_dead_zone_sweep(
+    play_pos_deg: float, play_neg_deg: float, dead_pos_deg: float, dead_neg_deg: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """A textbook loop: a play (backlash) operator followed by a dead zone, 2 cycles +-90 deg.
+
+    Rising, the play output is ``q - play_neg``; falling it is ``q + play_pos`` (half-widths
+    may differ). The dead zone spans ``[-dead_neg, dead_pos]`` of the play output.
+    """
+    t = np.arange(0.0, 50.0, 0.004)
+    q = 90.0 * np.sin(2.0 * np.pi * 0.04 * t)
+    x = np.empty_like(q)
+    x[0] = 0.0
+    for i in range(1, q.size):
+        x[i] = min(max(x[i - 1], q[i] - play_neg_deg), q[i] + play_pos_deg)
+    tip = SLOPE * (np.maximum(x - dead_pos_deg, 0.0) + np.minimum(x + dead_neg_deg, 0.0))
+    return q, tip
+
+
+def test_passes_start_and_end_at_reversals() -> None:
+    q = np.r_[np.linspace(0, 90, 10), np.linspace(85, -90, 30), np.linspace(-85, 90, 30), 80.0]
+    passes = split_passes(q)
+    assert [p[2] for p in passes] == [-1, 1]
+    assert q[passes[0][0]] == 90.0
+    assert q[passes[1][0]] == -90.0
+
+
+def test_textbook_loop_gives_its_dead_zone_and_backlash() -> None:
+    q, tip = play_dead_zone_sweep(8.0, 10.0, 12.0, 6.0)
+    m = measure_dead_zone_backlash(q, tip, threshold_deg=0.01)
+    # Rising the play output is q - 10: the tip leaves the plateau at q = 12 + 10.
+    assert m.dead_zone_pos_deg == pytest.approx(22.0, abs=0.1)
+    # Falling it is q + 8: the tip leaves the plateau at q = -6 - 8.
+    assert m.dead_zone_neg_deg == pytest.approx(-14.0, abs=0.1)
+    # After a reversal the play takes its full width before the output moves.
+    assert m.backlash_pos_deg == pytest.approx(18.0, abs=0.1)
+    assert m.backlash_neg_deg == pytest.approx(18.0, abs=0.1)
+
+
+def test_threshold_adds_its_tip_travel_over_the_slope() -> None:
+    q, tip = play_dead_zone_sweep(8.0, 8.0, 12.0, 12.0)
+    m = measure_dead_zone_backlash(q, tip, threshold_deg=1.3)
+    assert m.dead_zone_pos_deg == pytest.approx(20.0 + 1.0, abs=0.1)
+    assert m.backlash_pos_deg == pytest.approx(16.0 + 1.0, abs=0.1)
+
+
+def test_measures_survive_tracker_noise() -> None:
+    q, tip = play_dead_zone_sweep(8.0, 8.0, 12.0, 12.0)
+    noisy = tip + np.random.default_rng(0).normal(0.0, 0.1, tip.size)
+    m = measure_dead_zone_backlash(q, noisy, threshold_deg=1.0)
+    exact = measure_dead_zone_backlash(q, tip, threshold_deg=1.0)
+    assert np.allclose(m, exact, atol=0.7)
+
+
+def test_loaded_slope_of_the_textbook_loop() -> None:
+    q, tip = play_dead_zone_sweep(8.0, 8.0, 12.0, 12.0)
+    assert loaded_slope(q, tip, 40.0, 85.0) == pytest.approx((SLOPE, SLOPE))
+
+
+def test_without_a_complete_pass_each_way_it_refuses() -> None:
+    q = np.linspace(-90.0, 90.0, 100)
+    with pytest.raises(SweepAnalysisError, match="complete rising and one falling"):
+        measure_dead_zone_backlash(q, q)
+
+
+@pytest.mark.parametrize(
+    ("knob", "tip", "threshold", "message"),
+    [
+        (np.zeros(5), np.zeros(4), 1.0, "one length"),
+        (np.zeros(5), np.zeros(5), 0.0, "threshold_deg"),
+        (np.r_[np.zeros(4), np.nan], np.zeros(5), 1.0, "finite"),
+    ],
+)
+def test_bad_input_is_refused_clearly(
+    knob: np.ndarray, tip: np.ndarray, threshold: float, message: str
+) -> None:
+    with pytest.raises(SweepAnalysisError, match=message):
+        measure_dead_zone_backlash(knob, tip, threshold_deg=threshold)

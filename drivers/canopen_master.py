@@ -119,6 +119,7 @@ class CanOpenDrives(KnobDrives):
         self._events: list[FaultEvent] = []
         self._unknown_ids: set[int] = set()
         self._send_failing = False
+        self._recv_failing = False
         self._sync_msg = can.Message(arbitration_id=0x080, is_extended_id=False, data=b"")
         self._hb_msg = can.Message(arbitration_id=0x700 + master_node_id, is_extended_id=False,
                                    data=bytes((0x05,)))
@@ -265,6 +266,7 @@ class CanOpenDrives(KnobDrives):
             else:
                 popleft = queue.popleft
                 while queue:
+                    self._recv_failing = False
                     handle(popleft())
         except can.CanError as exc:
             self._event(FaultKind.BUS_ERROR, -1, f"CAN receive failed: {exc}")
@@ -641,7 +643,11 @@ class CanOpenDrives(KnobDrives):
         self.frames_sent += 1
 
     def _on_bus_error(self, exc: Exception) -> None:
-        self._event(FaultKind.BUS_ERROR, -1, f"CAN notifier stopped on error: {exc}")
+        """Notifier thread: receiving failed. One event per run of failures, then throttle."""
+        if not self._recv_failing:
+            self._recv_failing = True
+            self._event(FaultKind.BUS_ERROR, -1, f"CAN receive failed in the notifier: {exc}")
+        time.sleep(0.01)  # a dead adapter fails every call: do not spin a core on it
 
     def _event(self, kind: FaultKind, drive: int, message: str, code: int | None = None) -> None:
         event = FaultEvent(kind=kind, drive=drive, t_s=self.clock.now_s(), message=message,

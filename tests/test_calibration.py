@@ -222,6 +222,7 @@ def test_a_small_calibration_builds_a_profile_that_saves_and_loads(tmp_path: Pat
                           progress=lambda f, text: seen.append((f, text)),
                           limits=QualityLimits(max_cycle_spread_deg=10.0))
     assert cal.profile.knobs[0].other_knob_deg == (-30.0, 0.0, 30.0)
+    assert all(k.ours is not None for k in cal.profile.knobs)  # our compensator's fit
     assert seen[-1][0] == pytest.approx(1.0)
     assert "sweep 6/6" in seen[-1][1]
     assert np.allclose(runner.trajectories[-1][-1], 0.0)

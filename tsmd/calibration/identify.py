@@ -49,7 +49,7 @@ class IdentifyOptions:
     """An edge closer than this to the end of a half-cycle was not reached."""
     peak_noise_k: float = 3.0
     """A peak after a reversal must stand out of the noise by this many sigmas."""
-    flat_slope_fraction: float = 0.2
+    flat_slope_fraction: float = 0.3
     """"Constant" current: rising slower than this fraction of the loaded ramp's slope."""
     penalty_k: float = 20.0
     """Change-point penalty in units of noise variance x log(n) (PELT)."""

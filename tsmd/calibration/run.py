@@ -187,6 +187,15 @@ class _Progress:
         self.callback(overall, text)
 
 
+@dataclass
+class SweepRuns:
+    """Every sweep of a protocol, run and identified (no quality check yet)."""
+
+    points: list[GridPoint]
+    motion_time_s: float
+    wall_time_s: float
+
+
 def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *,
                     protocol: SweepProtocol | None = None, period_s: float = 0.004,
                     progress: ProgressCallback | None = None,
@@ -201,6 +210,18 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
     proto = protocol or paper_protocol()
     proto.validate(tuple((k.limits.min_deg, k.limits.max_deg)  # type: ignore[arg-type]
                          for k in device.knobs))
+    runs = run_sweeps(runner, proto, period_s=period_s, progress=progress, cancel=cancel,
+                      options=options)
+    profile, report = finish(catheter_id, device, runs.points, limits=limits,
+                             amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
+    return Calibration(profile, runs.points, report, proto.name, proto.sweep_time_s,
+                       runs.motion_time_s, runs.wall_time_s)
+
+
+def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *, period_s: float = 0.004,
+               progress: ProgressCallback | None = None, cancel: threading.Event | None = None,
+               options: IdentifyOptions | None = None) -> SweepRuns:
+    """Run and identify each sweep in turn; the knobs end at 0 whatever happens."""
     wall0 = time.monotonic()
     q_now = np.zeros(2)
     runs_durations = []
@@ -248,10 +269,7 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
             raise CalibrationCancelledError(f"{exc}; knobs returned to 0, nothing saved") from None
         raise
     motion_s += _return_to_zero(runner, q_last, period_s)
-    profile, report = finish(catheter_id, device, points, limits=limits,
-                             amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
-    return Calibration(profile, points, report, proto.name, proto.sweep_time_s, motion_s,
-                       time.monotonic() - wall0)
+    return SweepRuns(points, motion_s, time.monotonic() - wall0)
 
 
 def calibrate(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *,

@@ -1,0 +1,207 @@
+"""`tsmd bench calibration`: identified D and B against the truth read off the tip.
+
+On the simulator: both protocols (the paper's and the fast one) run through the full stack in
+lockstep (drivers + loop, E's ``LockstepRunner``); the calibration sees only commanded/actual
+position and current. The truth per grid point is measured on the simulated EM tracker's tip
+angle by the plant package's own analysis (``drivers.plant.analysis``), never read from the
+plant's parameters. The tracker signal is low-passed with the same 20 Hz zero-phase Butterworth
+first (its 0.2 deg noise would otherwise cross the 1 deg threshold by itself).
+
+On the real TEE acquisitions: D and B from the current against D and B read off the tracked tip
+(same threshold definitions, per pass: the files hold one slow cycle each), reported as they are.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tsmd.calibration.assemble import KNOB_LABELS, GridPoint
+from tsmd.calibration.errors import CalibrationError
+from tsmd.calibration.identify import PARAMETERS, split_half_cycles
+from tsmd.calibration.offline import SHORT
+from tsmd.calibration.signal import lowpass
+
+TARGET_DEG = 2.0
+TIP_THRESHOLD_DEG = 1.0
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--protocol", choices=("paper", "fast", "both"), default="both")
+    parser.add_argument("--seed", type=int, default=0, help="simulator noise seed")
+    parser.add_argument("--config", metavar="FILE", help="tsmd config (default: the sim one)")
+    parser.add_argument("--no-sim", action="store_true", help="skip the simulator part")
+    parser.add_argument("--no-tee", action="store_true", help="skip the real TEE data")
+    parser.add_argument("--tee-dir", metavar="DIR",
+                        help="TEE data directory (default: $TSMD_TEE_DATA or ../shared/data/tee)")
+
+
+def main(args: argparse.Namespace) -> int:
+    if not args.no_sim:
+        protocols = ("paper", "fast") if args.protocol == "both" else (args.protocol,)
+        results = {name: sim_protocol(name, args.seed, args.config) for name in protocols}
+        for name, res in results.items():
+            print(f"\n## Simulator, {name} protocol (seed {args.seed})\n")
+            print(res["summary"])
+            print()
+            print(res["table"])
+        if len(results) == 2:
+            print("\n" + compare_protocols(results["paper"]["points"],
+                                           results["fast"]["points"]))
+    if not args.no_tee:
+        print("\n## Real TEE acquisitions\n")
+        print(tee_table(args.tee_dir))
+    return 0
+
+
+# --- simulator ----------------------------------------------------------------------------
+
+
+def tip_truth(point: GridPoint) -> dict[str, float]:
+    """D and B measured on the tracked tip of the sweep (the plant package's analysis)."""
+    from drivers.plant.analysis import SweepAnalysisError, measure_dead_zone_backlash
+
+    rec = point.recording
+    if rec is None:
+        return {}
+    k = point.knob + 1
+    start = float(rec.metadata["calibration_sweep_start_s"]) - 1.0  # include the way down to -A
+    m = rec["t"] >= start
+    t, pos, tip = rec["t"][m], rec[f"pos{k}"][m], rec[f"tip{k}"][m]
+    if not np.isfinite(tip).all():
+        return {}
+    rate = 1.0 / float(np.median(np.diff(t)))
+    tip_f, _ = lowpass(tip, rate)
+    try:
+        truth = measure_dead_zone_backlash(pos, tip_f, threshold_deg=TIP_THRESHOLD_DEG)
+    except SweepAnalysisError:
+        return {}
+    return dict(truth._asdict())
+
+
+def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any]:
+    from tsmd.calibration import fast_protocol, paper_protocol
+    from tsmd.calibration.run import finish, run_sweeps
+    from tsmd.config import default_sim_config, load_config
+    from tsmd.daemon import resolve_data_path
+    from tsmd.profile import load_device_model
+    from tsmd.replay import LockstepRunner
+
+    config = load_config(config_path) if config_path else default_sim_config()
+    proto = paper_protocol() if name == "paper" else fast_protocol()
+    t0 = time.monotonic()
+    with LockstepRunner(config, seed=seed) as runner:
+        runs = run_sweeps(runner, proto, period_s=config.loop.period_s)
+    wall = time.monotonic() - t0
+    verdict = "profile accepted by the quality checks"
+    device_path = config.profiles.device_model or "profiles/devices/sim-catheter.yaml"
+    try:
+        device = load_device_model(resolve_data_path(device_path))
+        finish("bench", device, runs.points, amplitude_deg=90.0)
+    except CalibrationError as exc:
+        verdict = f"profile REFUSED by the quality checks: {exc}"
+    rows = []
+    errors: list[float] = []
+    for p in sorted(runs.points, key=lambda q: (q.knob, q.other_deg)):
+        truth = tip_truth(p)
+        cells = [KNOB_LABELS[p.knob], f"{p.other_deg:+.0f}"]
+        for param in PARAMETERS:
+            ident = p.result.estimate(param)
+            true = truth.get(param, math.nan)
+            err = ident - true
+            if math.isfinite(err):
+                errors.append(abs(err))
+            cells.append(f"{ident:.1f} / {true:.1f} / {err:+.1f}")
+        rows.append(cells)
+    head = ["knob", "other (deg)", *(f"{SHORT[p]} id / tip / err" for p in PARAMETERS)]
+    table = "\n".join(["| " + " | ".join(head) + " |", "|" + "---|" * len(head),
+                       *("| " + " | ".join(r) + " |" for r in rows)])
+    n_total = len(runs.points) * len(PARAMETERS)
+    within = sum(e <= TARGET_DEG for e in errors)
+    summary = (f"- sweeping {proto.sweep_time_s:.0f} s, motion {runs.motion_time_s:.0f} s "
+               f"(simulated), wall {wall:.1f} s\n"
+               f"- |error| max {max(errors, default=math.nan):.1f} deg, mean "
+               f"{np.mean(errors) if errors else math.nan:.2f} deg; within {TARGET_DEG:g} deg: "
+               f"{within} of {n_total} values ({n_total - len(errors)} without a tip value)\n"
+               f"- {verdict}")
+    return {"points": runs.points, "table": table, "summary": summary, "wall_s": wall,
+            "errors": errors}
+
+
+def compare_protocols(paper: Sequence[GridPoint], fast: Sequence[GridPoint]) -> str:
+    """How far the fast protocol's values are from the paper protocol's, per parameter."""
+    lines = ["| parameter | max abs(fast - paper) (deg) | mean (deg) |", "|---|---|---|"]
+    by_key = {(p.knob, p.other_deg): p for p in paper}
+    for param in PARAMETERS:
+        diffs = [abs(f.result.estimate(param) - by_key[(f.knob, f.other_deg)].result.estimate(
+            param)) for f in fast if (f.knob, f.other_deg) in by_key]
+        diffs = [d for d in diffs if math.isfinite(d)]
+        lines.append(f"| {SHORT[param]} | {max(diffs, default=math.nan):.1f} | "
+                     f"{np.mean(diffs) if diffs else math.nan:.2f} |")
+    return "Fast against paper protocol:\n\n" + "\n".join(lines)
+
+
+# --- real TEE data ------------------------------------------------------------------------
+
+
+def tee_tip_measures(point: GridPoint) -> dict[str, list[float]]:
+    """Per pass on the tracked tip, with the plant analysis' threshold definitions."""
+    from drivers.plant.analysis import _rising_pass_measures
+
+    rec = point.recording
+    assert rec is not None
+    k = point.knob + 1
+    q, tip = rec[f"pos{k}"], rec[f"tip{k}"]
+    out: dict[str, list[float]] = {p: [] for p in PARAMETERS}
+    for direction, a, b, after_reversal in split_half_cycles(rec[f"cmd{k}"], 10.0):
+        if b >= len(q):
+            continue  # the acquisition ends mid-pass: no reversal, edges may not be reached
+        qs, ts = direction * q[a:b], direction * tip[a:b]
+        backlash, edge = _rising_pass_measures(qs, ts, TIP_THRESHOLD_DEG)
+        b_name = "backlash_neg_deg" if direction > 0 else "backlash_pos_deg"
+        d_name = "dead_zone_pos_deg" if direction > 0 else "dead_zone_neg_deg"
+        if after_reversal and math.isfinite(backlash):
+            out[b_name].append(backlash)
+        if math.isfinite(edge):
+            out[d_name].append(direction * edge)
+    return out
+
+
+def tee_table(directory: str | None) -> str:
+    from tsmd.calibration.run import identify_recording
+    from tsmd.tee import DEFAULT_STEPS_PER_KNOB_DEG, default_tee_dir, load_tee_acquisition
+
+    root = Path(directory) if directory else default_tee_dir()
+    files = sorted(root.glob("motor*_current60__*.csv")) if root.is_dir() else []
+    if not files:
+        return f"(no TEE data in {root}: skipped)"
+    head = ["acquisition", "knob", *(f"{SHORT[p]} current / tip" for p in PARAMETERS), "SNR"]
+    lines = [f"Assumed {DEFAULT_STEPS_PER_KNOB_DEG:g} motor steps per knob degree and 50 Hz "
+             "sampling (tsmd/tee.py). '-' = not found (reason in the report).", "",
+             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for f in files:
+        rec = load_tee_acquisition(f)
+        try:
+            point = identify_recording(rec, source=f.name)
+        except CalibrationError as exc:
+            lines.append(f"| {f.stem} | - | {exc} |")
+            continue
+        tip = tee_tip_measures(point)
+        cells = [f.stem.replace("_current60__", " "), f"phi{point.knob + 1}"]
+        for p in PARAMETERS:
+            cur = point.result.values.get(p, ())
+            cells.append(f"{_fmt(cur)} / {_fmt(tuple(tip[p]))}")
+        snr = point.result.snr
+        cells.append(f"{snr:.1f}" if math.isfinite(snr) else "-")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def _fmt(values: Sequence[float]) -> str:
+    return ", ".join(f"{v:.1f}" for v in values) if values else "-"

@@ -23,7 +23,7 @@ from drivers.canopen_master import CanOpenDrives
 from drivers.clock import Clock, MonotonicClock, SimClock
 from drivers.plant.base import Plant, load_plant
 from drivers.sim.drive_node import SimDriveNode
-from drivers.sim.lockstep_bus import LockstepBus
+from drivers.sim.lockstep_bus import LockstepBus, make_message
 from drivers.sim.motor import Motor, MotorParams
 from drivers.units import DriveConfig
 
@@ -135,11 +135,10 @@ class SimRig:
         self.ticks += 1
 
     def _send(self, can_id: int, data: bytes) -> None:
-        msg = can.Message(arbitration_id=can_id, data=data, is_extended_id=False, check=False)
         if self._send_owned is not None:
-            self._send_owned(msg)
+            self._send_owned(make_message(can_id, data))
         else:
-            self.bus.send(msg)
+            self.bus.send(can.Message(arbitration_id=can_id, data=data, is_extended_id=False))
 
     # -- evaluation ------------------------------------------------------------------------
     def tip_deg(self) -> NDArray[np.float64]:

@@ -22,8 +22,8 @@ _MESSAGE_SLOTS = {"__weakref__", "arbitration_id", "bitrate_switch", "channel", 
 _new_message = can.Message.__new__
 
 
-def _make_message(can_id: int, data: bytes, extended: bool = False, remote: bool = False,
-                  error: bool = False) -> can.Message:
+def _make_message(can_id: int, data: bytes | bytearray, extended: bool = False,
+                  remote: bool = False, error: bool = False) -> can.Message:
     """A received-frame ``Message`` without the constructor's argument checks (3x faster)."""
     msg = _new_message(can.Message)
     msg.timestamp = 0.0
@@ -36,13 +36,13 @@ def _make_message(can_id: int, data: bytes, extended: bool = False, remote: bool
     msg.is_rx = True
     msg.bitrate_switch = False
     msg.error_state_indicator = False
-    msg.data = data
+    msg.data = bytearray(data)
     msg.dlc = len(data)
     return msg
 
 
-def _checked_message(can_id: int, data: bytes, extended: bool = False, remote: bool = False,
-                     error: bool = False) -> can.Message:
+def _checked_message(can_id: int, data: bytes | bytearray, extended: bool = False,
+                     remote: bool = False, error: bool = False) -> can.Message:
     return can.Message(arbitration_id=can_id, data=data, is_extended_id=extended,
                        is_remote_frame=remote, is_error_frame=error, check=False)
 
@@ -67,7 +67,7 @@ class LockstepBus(can.BusABC):
     def send(self, msg: can.Message, timeout: float | None = None) -> None:
         if not self._open:
             raise can.CanOperationError(f"lockstep bus {self._name!r} is shut down")
-        data = bytes(msg.data)
+        data = msg.data
         for peer in self._peers:
             if peer is not self:
                 peer._queue.append(make_message(msg.arbitration_id, data, msg.is_extended_id,

@@ -39,12 +39,12 @@ class KnobParams:
     """Mechanical constants of one knob's tendon pair (units in the names)."""
 
     pulley_radius_mm: float = 6.0
-    slack_pos_mm: float = 2.3
+    slack_pos_mm: float = 2.0
     """Slack of the tendon pulled by positive knob rotation."""
-    slack_neg_mm: float = 2.5
-    tendon_offset_mm: float = 2.8
+    slack_neg_mm: float = 2.15
+    tendon_offset_mm: float = 2.47
     """Moment arm of the tendons in the bending section."""
-    tendon_stiffness_N: float = 2000.0
+    tendon_stiffness_N: float = 1830.0
     """Axial stiffness EA of the tendon."""
     sheath_length_m: float = 1.0
     free_length_m: float = 0.01
@@ -57,11 +57,11 @@ class KnobParams:
     """Wrap of the tendon over guide pins in the handle, right after the pulley."""
     routing_friction: float = 0.25
     """Friction coefficient on the handle guide pins."""
-    sheath_drag_N: float = 0.4
+    sheath_drag_N: float = 0.15
     """Tension-independent friction summed over the sheath (preload of the coil sheath, tendon
     bending stiffness in its lumen); it gives a load-independent part of the backlash."""
-    bend_stiffness_Nm_per_rad: float = 0.0069
-    bend_friction_Nm: float = 0.0015
+    bend_stiffness_Nm_per_rad: float = 0.0065
+    bend_friction_Nm: float = 0.0006
     """Mean Coulomb friction moment of the bending joints (spread 0.4x..1.6x over the joints)."""
     bend_stiction_ratio: float = 1.0
     """Static over kinetic friction of the bending joints (>= 1); breaking loose after a
@@ -103,7 +103,7 @@ class KnobParams:
 # The anterior-posterior and right-left knobs of one catheter differ slightly.
 DEFAULT_KNOBS = (
     KnobParams(),
-    KnobParams(slack_pos_mm=2.5, slack_neg_mm=2.25, sheath_wrap_deg=225.0, tendon_offset_mm=2.75),
+    KnobParams(slack_pos_mm=2.15, slack_neg_mm=1.95, sheath_wrap_deg=225.0, tendon_offset_mm=2.43),
 )
 
 

@@ -1,0 +1,211 @@
+"""Print (and plot) the signature of a plant on the paper's sweep: +-90 deg at 0.04 Hz.
+
+``python -m drivers.plant.report [--plot docs/img/plant_sweep.png] [--set coupling=1.0]``
+
+For each knob in turn (the other held at 0 deg) it runs two cycles at 250 Hz and reports the
+tip-based dead zone and backlash (:mod:`drivers.plant.analysis`), the tip slopes, the knob-torque
+signature and the plant's CPU time per step. Figures in ``docs/plant.md`` come from here.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from drivers.plant.analysis import (
+    DeadZoneBacklash,
+    loaded_slope,
+    measure_dead_zone_backlash,
+    releasing_slope,
+)
+from drivers.plant.base import Plant, PlantLoadError
+from drivers.plant.tendon_sheath import make_tendon_sheath_plant
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass
+class SweepRecord:
+    """One knob swept, the other held."""
+
+    t_s: FloatArray
+    knob_deg: FloatArray
+    tip_deg: FloatArray
+    torque_Nm: FloatArray
+    cpu_s: float
+
+
+def run_sweep(
+    plant: Plant,
+    knob: int,
+    freq_hz: float = 0.04,
+    amp_deg: float = 90.0,
+    cycles: float = 2.0,
+    dt_s: float = 0.004,
+    other_deg: float = 0.0,
+) -> SweepRecord:
+    """Sine sweep of one knob from 0 deg; CPU time counts the plant steps only."""
+    t = np.arange(0.0, cycles / freq_hz, dt_s)
+    q = amp_deg * np.sin(2.0 * np.pi * freq_hz * t)
+    tip = np.empty_like(t)
+    tau = np.empty_like(t)
+    cmd = np.zeros(2)
+    cmd[1 - knob] = other_deg
+    plant.reset()
+    cpu = 0.0
+    for i, qi in enumerate(q):
+        cmd[knob] = qi
+        c0 = time.process_time()
+        step = plant.step(dt_s, cmd)
+        cpu += time.process_time() - c0
+        tip[i] = step.tip_deg[knob]
+        tau[i] = step.knob_torque_Nm[knob]
+    return SweepRecord(t, q, tip, tau, cpu)
+
+
+@dataclass
+class Signature:
+    """What the paper's Figure (a)(b) show, measured on one sweep (knob degrees, Nm)."""
+
+    dz_bl: DeadZoneBacklash
+    loading_slope: tuple[float, float]
+    releasing_slope: tuple[float, float]
+    tip_range_deg: tuple[float, float]
+    torque_peak_Nm: float
+    dead_zone_torque_Nm: float
+    reversal_dip_Nm: float
+    released_torque_Nm: float
+
+
+def signature(rec: SweepRecord) -> Signature:
+    """Measure the sweep's signature; the torque figures are for the positive reversal."""
+    q, y, tau, t = rec.knob_deg, rec.tip_deg, rec.torque_Nm, rec.t_s
+    m = measure_dead_zone_backlash(q, y)
+    period = float(t[-1] + t[1] - t[0]) / 2.0  # two cycles
+    moving_up = np.gradient(q) > 0
+    in_dz = moving_up & (np.abs(q) < 10.0) & (t > period / 2)
+    # Second positive reversal: the torque dips below the released level right after it.
+    i_rev = int(np.argmax(np.where(t > period, q, -np.inf)))
+    after = (t > t[i_rev]) & (t < t[i_rev] + period / 4) & (q > m.dead_zone_pos_deg + 5.0)
+    released = after & (q < 90.0 - m.backlash_pos_deg - 2.0)
+    return Signature(
+        dz_bl=m,
+        loading_slope=loaded_slope(q, y, 40.0, 85.0),
+        releasing_slope=releasing_slope(q, y, 40.0, 70.0),
+        tip_range_deg=(float(y.min()), float(y.max())),
+        torque_peak_Nm=float(np.max(np.abs(tau))),
+        dead_zone_torque_Nm=float(np.median(tau[in_dz])),
+        reversal_dip_Nm=float(tau[after].min()),
+        released_torque_Nm=float(np.median(tau[released])),
+    )
+
+
+def _parse_set(items: Sequence[str]) -> dict[str, Any]:
+    params: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise PlantLoadError(f"--set expects KEY=VALUE, got {item!r}")
+        params[key] = json.loads(value)
+    return params
+
+
+def plot(records: Sequence[SweepRecord], sigs: Sequence[Signature], path: str) -> None:
+    """Tip vs knob and knob torque vs knob, one column per knob."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(9.0, 6.0), sharex=True)
+    for col, (rec, sig) in enumerate(zip(records, sigs, strict=True)):
+        m = sig.dz_bl
+        ax = axes[0, col]
+        ax.plot(rec.knob_deg, rec.tip_deg, lw=1.0)
+        ax.plot([-90, 90], [-90 * 1.3, 90 * 1.3], ":", color="grey", lw=0.8, label="slope 1.3")
+        for x in (m.dead_zone_pos_deg, m.dead_zone_neg_deg):
+            ax.axvline(x, color="tab:orange", lw=0.8, ls="--")
+        for x in (90.0 - m.backlash_pos_deg, -90.0 + m.backlash_neg_deg):
+            ax.axvline(x, color="tab:green", lw=0.8, ls="--")
+        ax.set_title(
+            f"knob {col + 1}: D {m.dead_zone_pos_deg:.1f}/{m.dead_zone_neg_deg:.1f}, "
+            f"B {m.backlash_pos_deg:.1f}/{m.backlash_neg_deg:.1f} deg",
+            fontsize=9,
+        )
+        ax.set_ylabel("tip angle (deg)")
+        ax.set_ylim(-120, 120)
+        ax.legend(loc="upper left", fontsize=8)
+        ax.grid(alpha=0.3)
+        ax = axes[1, col]
+        ax.plot(rec.knob_deg, rec.torque_Nm, lw=1.0, color="tab:red")
+        ax.axhline(0.0, color="grey", lw=0.6)
+        ax.set_xlabel("knob angle (deg)")
+        ax.set_ylabel("knob torque (Nm)")
+        ax.grid(alpha=0.3)
+    fig.suptitle("Default tendon-sheath plant, +-90 deg sine at 0.04 Hz, 2 cycles", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m drivers.plant.report", description=__doc__)
+    parser.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=JSON",
+        help="plant parameter, e.g. coupling=1.0 or knobs='[{...},{}]'",
+    )
+    parser.add_argument("--freq", type=float, default=0.04, help="sweep frequency (Hz)")
+    parser.add_argument("--other", type=float, default=0.0, help="other knob's angle (deg)")
+    parser.add_argument("--plot", metavar="PNG", help="write the sweep figure here")
+    args = parser.parse_args(argv)
+    try:
+        params = _parse_set(args.set)
+        records = [
+            run_sweep(make_tendon_sheath_plant(**params), k, args.freq, other_deg=args.other)
+            for k in (0, 1)
+        ]
+    except (PlantLoadError, json.JSONDecodeError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    sigs = [signature(r) for r in records]
+    for k, (rec, sig) in enumerate(zip(records, sigs, strict=True)):
+        m = sig.dz_bl
+        print(f"knob {k + 1}: sweep +-90 deg at {args.freq} Hz, other knob {args.other} deg")
+        print(
+            f"  dead zone D_pos/D_neg     {m.dead_zone_pos_deg:7.1f} {m.dead_zone_neg_deg:7.1f} deg"
+        )
+        print(
+            f"  backlash  B_pos/B_neg     {m.backlash_pos_deg:7.1f} {m.backlash_neg_deg:7.1f} deg"
+        )
+        print(
+            f"  loading slope +/-         {sig.loading_slope[0]:7.3f} {sig.loading_slope[1]:7.3f}"
+        )
+        rel = sig.releasing_slope
+        print(f"  releasing slope +/-       {rel[0]:7.3f} {rel[1]:7.3f}")
+        lo, hi = sig.tip_range_deg
+        print(f"  tip range                 {lo:7.1f} {hi:7.1f} deg")
+        print(f"  torque peak               {sig.torque_peak_Nm:7.3f} Nm")
+        print(f"  torque in dead zone       {sig.dead_zone_torque_Nm:7.4f} Nm")
+        print(f"  torque dip after reversal {sig.reversal_dip_Nm:7.4f} Nm")
+        print(f"  torque while released     {sig.released_torque_Nm:7.4f} Nm")
+        us = rec.cpu_s / rec.t_s.size * 1e6
+        print(f"  plant CPU time            {us:7.1f} us/step ({rec.t_s.size} steps)")
+    if args.plot:
+        plot(records, sigs, args.plot)
+        print(f"wrote {args.plot}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -53,6 +53,8 @@ class Motor:
         self.jammed = False
         self._reference_deg = position_deg
         self._load_Nm = 0.0
+        self._accel_rad_s2 = 0.0
+        self._saturated_Nm = 0.0
         self._rad_per_knob_deg = gear_ratio * math.pi / 180.0
         self._max_velocity_deg_s = params.max_speed_rpm * 6.0 / gear_ratio
         w = 2.0 * math.pi * params.bandwidth_hz
@@ -72,6 +74,8 @@ class Motor:
         v0 = self.velocity_deg_s
         if not powered or self.jammed:
             self.velocity_deg_s = 0.0
+            self._accel_rad_s2 = 0.0
+            self._saturated_Nm = 0.0
             self._reference_deg = target_deg if powered else x0
             return x0
         r0 = self._reference_deg
@@ -95,11 +99,13 @@ class Motor:
         drag = self._drag_Nm(v1 * k)
         torque_max = par.torque_constant_Nm_A * par.max_current_A
         needed = par.rotor_inertia_kgm2 * accel + drag + load
+        self._saturated_Nm = 0.0
         if needed > torque_max or needed < -torque_max:
             limit = torque_max if needed > 0 else -torque_max
             accel = (limit - drag - load) / par.rotor_inertia_kgm2
             v1 = v0 + accel / k * dt
             x1 = x0 + 0.5 * (v0 + v1) * dt
+            self._saturated_Nm = limit  # the drive delivers its peak current this period
         self.position_deg = x1
         self.velocity_deg_s = v1
         self._reference_deg = target_deg
@@ -118,9 +124,10 @@ class Motor:
         if self.jammed:
             torque = par.torque_constant_Nm_A * par.max_current_A * (
                 1.0 if self._reference_deg >= self.position_deg else -1.0)
+        elif self._saturated_Nm:
+            torque = self._saturated_Nm
         else:
-            accel = getattr(self, "_accel_rad_s2", 0.0)
-            torque = (par.rotor_inertia_kgm2 * accel + self._drag_Nm(v * k)
+            torque = (par.rotor_inertia_kgm2 * self._accel_rad_s2 + self._drag_Nm(v * k)
                       + self._load_torque_motor_Nm(knob_torque_Nm, v))
         current = torque / par.torque_constant_Nm_A
         imax = par.max_current_A

@@ -148,3 +148,32 @@ def test_watchdog_interval_is_half_of_watchdog_usec(monkeypatch: pytest.MonkeyPa
     assert watchdog_interval_s() == pytest.approx(1.5)
     monkeypatch.setenv("WATCHDOG_PID", "1")
     assert watchdog_interval_s() is None
+
+
+def test_calibrate_over_the_socket_streams_progress_and_cancel_saves_nothing(
+        tmp_path: Path) -> None:
+    import dataclasses
+
+    from tsmd.config import default_sim_config
+    from tsmd.daemon import Daemon
+
+    base = default_sim_config()
+    config = dataclasses.replace(base, profiles=dataclasses.replace(
+        base.profiles, dir=str(tmp_path / "profiles"), active=None))
+    daemon = Daemon(config, sim=True, socket_path=str(tmp_path / "d.sock"))
+    daemon.start()
+    try:
+        with ApiClient(tmp_path / "d.sock") as client, ApiClient(tmp_path / "d.sock") as other:
+            client.send_raw(b'{"id": "cal", "cmd": "calibrate", "catheter": "cath-7"}\n')
+            first = client.read_message()
+            assert first["id"] == "cal" and first["event"] == "progress", first
+            assert other.call("cancel")["cancelled"] is True
+            response = client.read_message()
+            while "event" in response:
+                response = client.read_message()
+            assert response["id"] == "cal"
+            assert response["error"]["code"] == "cancelled"
+            assert other.call("status")["state"] == "ENABLED"
+    finally:
+        daemon.stop()
+    assert not (tmp_path / "profiles" / "cath-7.yaml").exists()

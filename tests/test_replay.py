@@ -12,7 +12,7 @@ import pytest
 
 from tsmd.loop import LoopState
 from tsmd.recording import REQUIRED_COLUMNS, read_recording
-from tsmd.replay import LockstepRunner, ReplayError, TrajectoryCancelledError, run_trajectory
+from tsmd.replay import LockstepRunner, ReplayError, run_trajectory
 
 PERIOD_S = 0.004
 
@@ -93,7 +93,7 @@ def test_consecutive_runs_continue_from_where_the_knobs_are() -> None:
     assert second["pos1"][0] == pytest.approx(20.0, abs=1.0)
 
 
-def test_cancel_stops_the_trajectory() -> None:
+def test_cancel_stops_the_trajectory_and_returns_what_was_recorded() -> None:
     cancel = threading.Event()
 
     def progress(fraction: float) -> None:
@@ -101,8 +101,11 @@ def test_cancel_stops_the_trajectory() -> None:
             cancel.set()
 
     t, q = sine(2.0)
-    with LockstepRunner() as runner, pytest.raises(TrajectoryCancelledError):
-        runner.run(t, q, compensate=False, cancel=cancel, progress=progress)
+    with LockstepRunner() as runner:
+        rec = runner.run(t, q, compensate=False, cancel=cancel, progress=progress)
+        assert runner.loop.state is LoopState.ENABLED
+    assert 0.3 * 500 < len(rec) < 0.5 * 500
+    assert rec.metadata["cancelled"] == "true"
 
 
 @pytest.mark.parametrize(("kind", "expected"), [

@@ -205,25 +205,38 @@ class Controller:
 
     def calibrate(self, catheter: str, progress: Callable[[dict[str, Any]], None],
                   cancel: threading.Event) -> dict[str, Any]:
+        """Run the calibration protocol on the live loop; save and activate the profile."""
         try:
-            calibrate = importlib.import_module("tsmd.calibration").calibrate
-        except (ImportError, AttributeError):
+            calibration = importlib.import_module("tsmd.calibration")
+        except ImportError:
             raise DaemonError("calibration is not available in this build",
                               "unavailable") from None
         if self._runner_factory is None:
             raise DaemonError("calibration needs a running loop", "unavailable")
-        from tsmd.profile import load_device_model
-
         device_path = self.config.profiles.device_model
         if device_path is None:
             raise DaemonError("profiles.device_model is not configured", "unavailable")
-        device = load_device_model(resolve_data_path(device_path))
+        from tsmd.profile import ProfileError, load_device_model
+
+        try:
+            device = load_device_model(resolve_data_path(device_path))
+        except ProfileError as exc:
+            raise DaemonError(str(exc), "profile") from None
+        if self.loop.state.value == "DISABLED":
+            self._wait("enable")
         runner = self._runner_factory()
 
-        def on_progress(fraction: float, *info: Any) -> None:
-            progress({"progress": float(fraction), "info": [str(i) for i in info]})
+        def on_progress(fraction: float, line: str = "") -> None:
+            progress({"progress": round(float(fraction), 4), "status": str(line)})
 
-        profile = calibrate(runner, catheter, device, progress=on_progress, cancel=cancel)
+        try:
+            profile = calibration.calibrate(runner, catheter, device,
+                                            period_s=self.loop.period_s,
+                                            progress=on_progress, cancel=cancel)
+        except calibration.CalibrationCancelledError as exc:
+            raise DaemonError(f"calibration cancelled: {exc}", "cancelled") from None
+        except calibration.CalibrationError as exc:
+            raise DaemonError(f"calibration refused: {exc}", "calibration") from None
         path = self._store().save(profile)
         with self._lock:
             self._activate(profile, self.choice)

@@ -30,12 +30,12 @@ class ReplayError(TsmdError):
     """A trajectory could not be run (bad input, a fault on the way, cancelled)."""
 
 
-class TrajectoryCancelledError(ReplayError):
-    """The cancel event was set; the knobs hold where they were."""
-
-
 class TrajectoryRunner(Protocol):
-    """Plays desired knob angles ``q_deg`` (N, 2) at times ``t_s`` and records each tick."""
+    """Plays desired knob angles ``q_deg`` (N, 2) at times ``t_s`` and records each tick.
+
+    When ``cancel`` is set the run stops at the next tick and returns what it recorded so far
+    (metadata ``cancelled: true``); a fault on the way raises :class:`ReplayError`.
+    """
 
     def run(self, t_s: ArrayLike, q_deg: ArrayLike, compensate: bool,
             cancel: threading.Event | None = None,
@@ -148,9 +148,7 @@ class LockstepRunner:
         return self._finish(playback, ticks)
 
     def _finish(self, playback: Playback, ticks: NDArray[np.float64]) -> Recording:
-        if playback.error == "cancelled":
-            raise TrajectoryCancelledError("trajectory cancelled")
-        if playback.error is not None:
+        if playback.error is not None and playback.error != "cancelled":
             raise ReplayError(f"trajectory stopped after {playback.index} of "
                               f"{len(playback.q_deg)} ticks: {playback.error}")
         meta = {"source": "tsmd replay (lockstep sim)", "version": __version__,
@@ -158,6 +156,8 @@ class LockstepRunner:
                 "compensation": self.method if playback.compensate else "none",
                 "profile": str(getattr(self.profile, "catheter_id", "none")),
                 "seed": str(self.seed), "plant": self.config.sim.plant}
+        if playback.error == "cancelled":
+            meta["cancelled"] = "true"
         return rows_to_recording(playback.rows, ticks, meta)
 
     def close(self) -> None:
@@ -201,12 +201,12 @@ class LiveTrajectoryRunner:
         while not playback.done.wait(self.poll_s):
             if progress is not None:
                 progress(playback.progress)
-        if playback.error == "cancelled":
-            raise TrajectoryCancelledError("trajectory cancelled")
-        if playback.error is not None:
+        if playback.error is not None and playback.error != "cancelled":
             raise ReplayError(f"trajectory stopped after {playback.index} of {len(q)} ticks: "
                               f"{playback.error}")
         meta = {"source": "tsmd daemon (live)", "version": __version__,
                 "rate_hz": f"{1.0 / loop.period_s:g}",
                 "compensation": loop.compensation_label if compensate else "none"}
+        if playback.error == "cancelled":
+            meta["cancelled"] = "true"
         return rows_to_recording(playback.rows, ticks, meta)

@@ -115,7 +115,7 @@ class ApiHandlers:
         last_tick = -1
         loop = asyncio.get_running_loop()
         next_t = loop.time()
-        while not conn.closed:
+        while not conn.closed and not conn.writer.transport.is_closing():
             sample = self.loop.latest_sample
             if sample is not None and sample.tick != last_tick:
                 last_tick = sample.tick

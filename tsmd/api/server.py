@@ -240,6 +240,11 @@ class ApiServer:
                     response = await self._dispatch(line, conn)
                     if response is not None:
                         await conn.reply(response)
+            # The client closed its sending side: answer what runs (streams, calibration)
+            # until it closes the connection or the tasks end.
+            pending = [t for t in conn.tasks.values() if not t.done()]
+            if pending and not conn.closed:
+                await asyncio.gather(*pending, return_exceptions=True)
         except (ConnectionError, asyncio.IncompleteReadError):
             pass
         finally:

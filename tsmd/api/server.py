@@ -186,6 +186,10 @@ class ApiServer:
             self._server.close()
         for conn in list(self._connections):
             conn.close()
+        tasks = [t for t in asyncio.all_tasks() if t is not asyncio.current_task()]
+        for task in tasks:
+            task.cancel()
+        await asyncio.gather(*tasks, return_exceptions=True)
         with contextlib.suppress(OSError):
             self.socket_path.unlink()
 

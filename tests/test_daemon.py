@@ -177,3 +177,35 @@ def test_calibrate_over_the_socket_streams_progress_and_cancel_saves_nothing(
     finally:
         daemon.stop()
     assert not (tmp_path / "profiles" / "cath-7.yaml").exists()
+
+
+@pytest.mark.parametrize("fmt", ["blf", "asc"])
+def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: str) -> None:
+    import dataclasses
+
+    import can
+
+    from tsmd.config import TsmdConfig
+    from tsmd.daemon import Daemon
+
+    base = TsmdConfig()
+    config = dataclasses.replace(
+        base, bus=dataclasses.replace(base.bus, log_format=fmt),
+        recording=dataclasses.replace(base.recording, dir=str(tmp_path)))
+    daemon = Daemon(config)
+    channel = f"tsmd-canlog-{os.getpid()}-{fmt}"
+    bus = can.Bus(interface="virtual", channel=channel)
+    peer = can.Bus(interface="virtual", channel=channel)
+    try:
+        daemon._can_log(bus)
+        bus.send(can.Message(arbitration_id=0x080, data=b"", is_extended_id=False))
+        peer.send(can.Message(arbitration_id=0x181, data=b"\x27\x00", is_extended_id=False))
+        assert bus.recv(1.0) is not None
+        daemon._can_writer.stop()
+    finally:
+        bus.shutdown()
+        peer.shutdown()
+        daemon.events.close()
+    (log,) = tmp_path.glob(f"tsmd-can-*.{fmt}")
+    ids = [m.arbitration_id for m in can.LogReader(str(log))]
+    assert ids == [0x080, 0x181]

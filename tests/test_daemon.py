@@ -190,7 +190,7 @@ def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: 
 
     base = TsmdConfig()
     config = dataclasses.replace(
-        base, bus=dataclasses.replace(base.bus, log_format=fmt),
+        base, bus=dataclasses.replace(base.bus, log_format=fmt),  # type: ignore[arg-type]
         recording=dataclasses.replace(base.recording, dir=str(tmp_path)))
     daemon = Daemon(config)
     channel = f"tsmd-canlog-{os.getpid()}-{fmt}"

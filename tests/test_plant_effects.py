@@ -150,6 +150,7 @@ def test_unit_variation_draws_a_different_catheter_per_seed() -> None:
         ({"knobs": [{"pulley_radius_mm": 0.0}, {}]}, "pulley_radius_mm"),
         ({"knobs": [{}, {"slack_pos_mm": -1.0}]}, "slack_pos_mm"),
         ({"knobs": [{}, {"bogus_mm": 1.0}]}, "bogus_mm"),
+        ({"knobs": [{"bend_stiction_ratio": 0.5}, {}]}, "bend_stiction_ratio"),
         ({"knobs": [{}]}, "knobs"),
         ({"n_elements": 1}, "n_elements"),
         ({"n_joints": 2.5}, "n_joints"),

@@ -130,3 +130,50 @@ def test_torque_changes_sign_after_a_reversal_and_stays_near_zero_while_released
     assert tau[0] > 0.8 * peak
     assert np.any(tau < 0.0)  # the sign changes
     assert np.max(np.abs(tau[released])) < 0.1 * peak
+
+
+def test_reset_returns_to_the_straight_unloaded_state() -> None:
+    plant = make_tendon_sheath_plant()
+    first = run_sweep(plant, cycles=0.6)
+    plant.reset()
+    assert np.allclose(plant.step(DT_S, np.zeros(2)).tip_deg, 0.0)
+    plant.reset()
+    again = run_sweep(plant, cycles=0.6)
+    assert np.array_equal(first.tip_deg, again.tip_deg)
+    assert np.array_equal(first.torque_Nm, again.torque_Nm)
+
+
+def test_identical_parameters_give_identical_runs() -> None:
+    a = run_sweep(make_tendon_sheath_plant(coupling=1.0), cycles=0.6, other_deg=40.0)
+    b = run_sweep(make_tendon_sheath_plant(coupling=1.0), cycles=0.6, other_deg=40.0)
+    assert np.array_equal(a.tip_deg, b.tip_deg)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_random_two_knob_motion_keeps_tendons_pulling_and_the_tip_bounded(seed: int) -> None:
+    """Arbitrary simultaneous motion (all effects on): tendons never push, nothing diverges."""
+    rng = np.random.default_rng(seed)
+    plant = make_tendon_sheath_plant(
+        coupling=1.0, rate_dependence=0.5, tendon_compliance=0.3, sheath_curvature_deg=90.0
+    )
+    knots = rng.uniform(-90.0, 90.0, size=(12, 2))
+    t_knots = np.cumsum(rng.uniform(0.5, 3.0, 12))
+    t = np.arange(0.0, t_knots[-1], DT_S)
+    targets = np.column_stack([np.interp(t, t_knots, knots[:, k]) for k in (0, 1)])
+    q = np.zeros(2)
+    max_step = 60.0 * DT_S  # the drives' speed limit, 60 deg/s
+    for target in targets:
+        q = q + np.clip(target - q, -max_step, max_step)
+        qi = q
+        step = plant.step(DT_S, qi)
+        assert np.all(plant.tendon_tension_N() >= 0.0)
+        assert np.all(np.abs(step.tip_deg) < 150.0)
+        assert np.all(np.abs(step.knob_torque_Nm) < 1.0)
+
+
+def test_bad_step_input_is_refused() -> None:
+    plant = make_tendon_sheath_plant()
+    with pytest.raises(ValueError, match="knob_deg"):
+        plant.step(DT_S, np.array([np.nan, 0.0]))
+    with pytest.raises(ValueError, match="dt_s"):
+        plant.step(-1.0, np.zeros(2))

@@ -59,13 +59,13 @@ class KnobParams:
     """Friction coefficient on the handle guide pins."""
     sheath_drag_N: float = 0.15
     """Tension-independent friction summed over the sheath (preload of the coil sheath, tendon
-    bending stiffness in its lumen); it gives a load-independent part of the backlash."""
+    bending stiffness in its lumen); it traps some tension when released (residual bend)."""
     bend_stiffness_Nm_per_rad: float = 0.0065
     bend_friction_Nm: float = 0.0006
     """Mean Coulomb friction moment of the bending joints (spread 0.4x..1.6x over the joints)."""
     bend_stiction_ratio: float = 1.0
-    """Static over kinetic friction of the bending joints (>= 1); breaking loose after a
-    reversal gives the small current peak at the end of the backlash."""
+    """Static over kinetic friction of the bending joints (>= 1; 1 = off): with more, a joint
+    breaks loose with a small jump of the tip and of the tendon tension (stick-slip)."""
     handle_friction_Nm: float = 0.012
     """Kinetic friction torque of the knob itself (bearings, friction brake)."""
     handle_stiction_Nm: float = 0.04
@@ -92,6 +92,10 @@ class KnobParams:
         for name in positive:
             if getattr(self, name) <= 0.0:
                 raise PlantLoadError(f"{where}.{name} must be > 0, got {getattr(self, name)!r}")
+        if self.bend_stiction_ratio < 1.0:
+            raise PlantLoadError(
+                f"{where}.bend_stiction_ratio must be >= 1, got {self.bend_stiction_ratio!r}"
+            )
         for f in fields(self):
             if f.name not in positive and getattr(self, f.name) < 0.0:
                 raise PlantLoadError(
@@ -206,7 +210,7 @@ class _Knob:
             joint_stiffness_Nm_per_rad=np.full(n_joints, p.bend_stiffness_Nm_per_rad * n_joints),
         )
         self.kinetic_Nm = p.bend_friction_Nm * spread
-        self.static_Nm = self.kinetic_Nm * max(1.0, p.bend_stiction_ratio)
+        self.static_Nm = self.kinetic_Nm * p.bend_stiction_ratio
         wrap_rad = math.radians(p.sheath_wrap_deg + eff.sheath_curvature_deg)
         # Friction exponent mu * wrap per element; the handle routing sits at the sheath entry.
         self.sheath_exponent = np.full(n_elements, p.sheath_friction * wrap_rad / n_elements)

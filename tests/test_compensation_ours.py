@@ -19,7 +19,7 @@ from tsmd.compensation.ours import (
     fit_ours_knob,
     ours_inverse_step,
     ours_model_step,
-    release_slope,
+    release_line,
     smooth_max_excess,
     smooth_max_excess_inverse,
 )
@@ -30,9 +30,9 @@ D_POS, D_NEG, H_POS, H_NEG = 20.0, -20.0, -2.0, 2.0
 
 
 def env(b_deg: float = 18.0, blend: float = 0.0):  # type: ignore[no-untyped-def]
-    s_pos = release_slope(90.0, D_POS, b_deg, H_POS, H_NEG, OMEGA)
-    s_neg = release_slope(-90.0, D_NEG, b_deg, H_NEG, H_POS, OMEGA)
-    return envelopes(D_POS, D_NEG, H_POS, H_NEG, OMEGA, s_pos, s_neg, blend)
+    s_pos, p_pos = release_line(90.0, D_POS, b_deg, H_POS, H_NEG, OMEGA)
+    s_neg, p_neg = release_line(-90.0, D_NEG, b_deg, H_NEG, H_POS, OMEGA)
+    return envelopes(D_POS, D_NEG, H_POS, H_NEG, OMEGA, s_pos, s_neg, p_pos, p_neg, blend)
 
 
 def backlash_after_reversal_at(x_rev: float, e) -> float:  # type: ignore[no-untyped-def]
@@ -50,6 +50,11 @@ def test_release_line_reproduces_the_backlash_at_the_calibration_amplitude() -> 
     assert backlash_after_reversal_at(90.0, env(18.0)) == pytest.approx(18.0, abs=0.05)
 
 
+def test_data_sheet_release_constants_place_the_line_from_d_alone() -> None:
+    assert release_line(90.0, D_POS, 18.0, H_POS, H_NEG, OMEGA, 1.6, 7.0) == (1.6, D_POS + 7.0)
+    assert release_line(-90.0, D_NEG, 3.0, H_NEG, H_POS, OMEGA, 1.6, 7.0) == (1.6, D_NEG - 7.0)
+
+
 def test_backlash_shrinks_with_the_load_at_the_reversal() -> None:
     e = env(18.0)
     widths = [backlash_after_reversal_at(x, e) for x in (40.0, 60.0, 90.0)]
@@ -57,11 +62,11 @@ def test_backlash_shrinks_with_the_load_at_the_reversal() -> None:
 
 
 def test_release_slope_is_steeper_than_the_loaded_slope() -> None:
-    assert release_slope(90.0, D_POS, 18.0, H_POS, H_NEG, OMEGA) > OMEGA
+    assert release_line(90.0, D_POS, 18.0, H_POS, H_NEG, OMEGA)[0] > OMEGA
 
 
 def test_release_slope_falls_back_to_omega_when_backlash_eats_the_travel() -> None:
-    assert release_slope(30.0, 20.0, 15.0, 0.0, 0.0, OMEGA) == OMEGA
+    assert release_line(30.0, 20.0, 15.0, 0.0, 0.0, OMEGA) == (OMEGA, 20.0)
 
 
 def test_smooth_max_inverse_inverts() -> None:
@@ -91,7 +96,7 @@ def test_blend_rounds_the_backlash_corner() -> None:
 
 params = st.tuples(st.floats(8, 30), st.floats(-30, -8), st.floats(-4, 4), st.floats(-4, 4),
                    st.floats(0.9, 1.8), st.floats(0.9, 3.0), st.floats(0.9, 3.0),
-                   st.floats(0, 4))
+                   st.floats(10, 40), st.floats(-40, -10), st.floats(0, 4))
 
 
 @settings(max_examples=80, deadline=None)
@@ -151,11 +156,20 @@ def test_fit_gives_release_slopes_from_each_sweeps_amplitude_d_and_b() -> None:
     fit = fit_ours_knob(sweeps, DEVICE_KNOB)
     h_pos = 90.0 - OMEGA * 70.0
     h_neg = -90.0 + OMEGA * 70.0
-    assert fit.release_slope_pos[1] == pytest.approx(
-        release_slope(90.0, 20.0, 18.0, h_pos, h_neg, OMEGA), rel=1e-3)
-    assert fit.release_slope_neg[1] == pytest.approx(
-        release_slope(-90.0, -20.0, 17.0, h_neg, h_pos, OMEGA), rel=1e-3)
+    assert (fit.release_slope_pos[1], fit.release_pivot_pos_deg[1]) == pytest.approx(
+        release_line(90.0, 20.0, 18.0, h_pos, h_neg, OMEGA), rel=1e-3)
+    assert (fit.release_slope_neg[1], fit.release_pivot_neg_deg[1]) == pytest.approx(
+        release_line(-90.0, -20.0, 17.0, h_neg, h_pos, OMEGA), rel=1e-3)
     assert len(fit.backlash_blend_deg) == 3
+
+
+def test_fit_uses_the_data_sheet_release_slope() -> None:
+    import dataclasses
+
+    knob = dataclasses.replace(DEVICE_KNOB, release_omega=1.7, release_offset_deg=6.0)
+    fit = fit_ours_knob([_sweep(20.0, -21.0, 18.0, 17.0, 0.0)], knob)
+    assert fit.release_slope_pos == (1.7,) and fit.release_slope_neg == (1.7,)
+    assert fit.release_pivot_pos_deg == (26.0,) and fit.release_pivot_neg_deg == (-27.0,)
 
 
 def test_fit_needs_a_sweep_for_every_grid_point() -> None:

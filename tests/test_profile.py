@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import math
 import os
 from pathlib import Path
 from typing import Any
@@ -33,7 +34,7 @@ def make_profile(catheter_id: str = "sim-001", d0: float = 20.0) -> CatheterProf
     knobs = tuple(
         make_knob_profile(k, GRID, [d0 - abs(g) / 30 for g in GRID],
                           [-d0 + abs(g) / 30 for g in GRID], [15.0] * 7, [16.0] * 7,
-                          OursParams.parallel(1.3, 7))
+                          OursParams.pivot_at_dead_zone(k.omega, [20.0] * 7, [-20.0] * 7))
         for k in device.knobs)
     return CatheterProfile(catheter_id, device.device_model, "2026-11-22T03:00:00Z",
                            "tsmd 0.1.0", "pchip", (knobs[0], knobs[1]),
@@ -87,6 +88,8 @@ def test_example_profile_and_device_model_load() -> None:
     (lambda m: m["knobs"]["phi1"]["ours"].__setitem__("lag_s", -0.1), r"ours: lag_s\[0\]"),
     (lambda m: m["knobs"]["phi1"]["ours"].pop("release_slope_pos"),
      "ours: release_slope_pos: missing key"),
+    (lambda m: m["knobs"]["phi1"]["ours"]["release_pivot_neg_deg"].__setitem__(3, math.nan),
+     r"release_pivot_neg_deg\[3\]: is NaN"),
     (lambda m: m["knobs"]["phi1"]["ours"]["release_slope_neg"].__setitem__(3, 0.0),
      r"release_slope_neg\[3\]: 0.0 is outside"),
     (lambda m: m["knobs"]["phi1"]["ours"].update(extra=1), "ours: extra: unknown key"),

@@ -62,6 +62,10 @@ class DeviceKnob:
     reference_pos: ReferencePoint
     reference_neg: ReferencePoint
     limits: KnobLimits
+    release_omega: float | None = None
+    """Optional: tip/knob slope of the release branches (used by our compensator only)."""
+    release_offset_deg: float | None = None
+    """Optional: how far beyond the dead-zone edge the release branch meets the plateau."""
 
 
 @dataclass(frozen=True)
@@ -228,8 +232,15 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
         pos = r.reference(r.get(k, "reference_pos", key + "."), key + ".reference_pos")
         neg = r.reference(r.get(k, "reference_neg", key + "."), key + ".reference_neg")
         _check_references(r, key, pos, neg)
-        knobs.append(DeviceKnob(r.omega(r.get(k, "omega", key + "."), key + ".omega"),
-                                pos, neg, limits))
+        release = k.get("release_omega")
+        offset = k.get("release_offset_deg")
+        if (release is None) != (offset is None):
+            raise r.fail(key, "release_omega and release_offset_deg go together (both or none)")
+        knobs.append(DeviceKnob(
+            r.omega(r.get(k, "omega", key + "."), key + ".omega"), pos, neg, limits,
+            None if release is None else r.omega(release, key + ".release_omega"),
+            None if offset is None else r.number(offset, key + ".release_offset_deg", -45.0,
+                                                 45.0, "deg")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -245,6 +256,9 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
                        "max_velocity_deg_s": k.limits.max_velocity_deg_s,
                        "max_accel_deg_s2": k.limits.max_accel_deg_s2},
         }
+        if k.release_omega is not None:
+            knobs[name]["release_omega"] = k.release_omega
+            knobs[name]["release_offset_deg"] = k.release_offset_deg
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

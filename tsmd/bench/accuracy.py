@@ -172,9 +172,10 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
 def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
                              ) -> list[dict[str, float]]:
     """What a manufacturer measures once per product with a tracker on the tip (design
-    assumptions 1-3): per knob, the loaded slope omega and the reference points (tip at the knob
-    at +-90 deg at the end of a sweep out from the other knob at 0 deg)."""
-    from drivers.plant.analysis import loaded_slope
+    assumptions 1-3): per knob, the loaded slope omega, the reference points (tip at the knob's
+    +-90 deg turning points of a sweep with the other knob at 0 deg), and for our compensator
+    the release slope and how far beyond the dead-zone edge the release line meets the plateau."""
+    from drivers.plant.analysis import measure_dead_zone_backlash, split_passes
 
     t = np.arange(0.0, 2.25 / 0.04, PERIOD_S)
     sweep = 90.0 * np.sin(2 * math.pi * 0.04 * t)
@@ -186,12 +187,28 @@ def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
         rec = _run(tt, qq, None, "none", seed, plant_factory())
         pos = rec[f"pos{knob + 1}"][skip:]
         tip = rec[f"tip{knob + 1}"][skip:]
-        slope_pos, slope_neg = loaded_slope(pos, tip, 40.0, 85.0)
-        top = pos > 89.5
-        bottom = pos < -89.5
-        out.append({"omega": 0.5 * (slope_pos + slope_neg),
-                    "ref_pos_knob": 90.0, "ref_pos_tip": float(np.median(tip[top])),
-                    "ref_neg_knob": -90.0, "ref_neg_tip": float(np.median(tip[bottom]))})
+        dz = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
+        loaded, released, offsets = [], [], []
+        for a, b, direction in split_passes(pos):
+            x, y = direction * pos[a:b], direction * tip[a:b]  # mirror falling passes
+            # loaded: moving out of the dead zone; released: moving back towards it
+            sel_l = (x >= 40.0) & (x <= 85.0)
+            if np.count_nonzero(sel_l) > 10:
+                loaded.append(float(np.polyfit(x[sel_l], y[sel_l], 1)[0]))
+            xr, yr = -x, -y  # the same pass seen as releasing the other side's tendon
+            sel_r = (xr >= 35.0) & (xr <= 65.0)
+            plateau = yr[np.abs(xr) < 5.0]
+            if np.count_nonzero(sel_r) > 10 and plateau.size:
+                slope, icpt = np.polyfit(xr[sel_r], yr[sel_r], 1)
+                released.append(float(slope))
+                pivot = (float(np.median(plateau)) - icpt) / slope
+                edge = dz.dead_zone_pos_deg if direction < 0 else -dz.dead_zone_neg_deg
+                offsets.append(float(pivot - edge))
+        out.append({"omega": float(np.median(loaded)),
+                    "release_omega": float(np.median(released)),
+                    "release_offset_deg": float(np.median(offsets)),
+                    "ref_pos_knob": 90.0, "ref_pos_tip": float(np.median(tip[pos > 89.5])),
+                    "ref_neg_knob": -90.0, "ref_neg_tip": float(np.median(tip[pos < -89.5]))})
     return out
 
 

@@ -110,9 +110,10 @@ def ours_compensator(profile: CatheterProfile, period_s: float) -> OursCompensat
             raise CompensationError(
                 f"profile {profile.catheter_id!r} has no 'ours' parameters for {name}; "
                 "recalibrate with this tsmd version or use method 'paper'")
+        o = k.ours
         values = np.column_stack([
-            k.dead_zone_pos_deg, k.dead_zone_neg_deg, k.ours.release_slope_pos,
-            k.ours.release_slope_neg, k.ours.backlash_blend_deg]).astype(float)
+            k.dead_zone_pos_deg, k.dead_zone_neg_deg, o.release_slope_pos, o.release_slope_neg,
+            o.release_pivot_pos_deg, o.release_pivot_neg_deg, o.backlash_blend_deg]).astype(float)
         knobs.append(OursKnob(ParameterField(k.other_knob_deg, values, profile.interpolation),
                               k.height_pos_deg, k.height_neg_deg, k.omega, k.ours.lag_s))
     return OursCompensator((knobs[0], knobs[1]), period_s)

@@ -2,12 +2,14 @@
 
 1. Straight lines where the catheter is not. Friction along the sheath makes the backlash grow
    with the load at the reversal (a reversal at 60 deg tip loses less knob travel than one at
-   90 deg), and the released tendon's branch is steeper than the loaded one. The paper draws the
+   90 deg): the released tendon's branch is steeper than the loaded one. The paper draws the
    release branch parallel to the loaded one, shifted by the backlash measured at the calibration
    amplitude, so every smaller reversal is over-compensated. Here each release branch is a line
-   through its tendon's slack point (the dead-zone edge) with a slope fitted so that it passes
-   through the backlash the current showed at the calibration amplitude: one line per side, from
-   the same current-only data (:func:`release_slope`, :func:`fit_ours_knob`).
+   of its own slope meeting the released plateau a fixed distance beyond the dead-zone edge
+   (``release_omega``, ``release_offset_deg``: data-sheet constants measured once per product,
+   like omega and H), placed by the catheter's own D from its current. Without those constants
+   it goes through the end of the backlash the current showed at the calibration amplitude and
+   the tendon's slack point (:func:`release_line`, :func:`fit_ours_knob`).
 2. Jerk at transitions. Smaller backlash jumps for smaller reversals; the backlash end can be a
    C1 blend (``backlash_blend_deg``) instead of a corner. Jumps left go through the rate limiter.
 3. Knob coupling. Each knob's parameters follow the grid coordinate at which calibration saw
@@ -39,8 +41,9 @@ RELEASE_SLOPE_RANGE: tuple[float, float] = (0.2, 10.0)
 class OursParams:
     """Our compensator's extra parameters for one knob (grids over the other knob's angle).
 
-    ``release_slope_pos``: tip/knob slope of the branch on which the positive-side tendon
-    releases (moving down above the dead zone); ``release_slope_neg`` likewise below it.
+    The release line of the positive side (moving down above the dead zone, the tendon pulled by
+    positive rotation letting go) has slope ``release_slope_pos`` and meets the falling plateau
+    H_neg at knob angle ``release_pivot_pos_deg``; likewise ``*_neg`` below the dead zone.
     ``backlash_blend_deg``: half-width of the C1 blend at the end of the backlash (0 = corner).
     ``lag_s``: delay of the drive's actual position behind its target.
     """
@@ -48,12 +51,18 @@ class OursParams:
     lag_s: float
     release_slope_pos: tuple[float, ...]
     release_slope_neg: tuple[float, ...]
+    release_pivot_pos_deg: tuple[float, ...]
+    release_pivot_neg_deg: tuple[float, ...]
     backlash_blend_deg: tuple[float, ...]
 
     @staticmethod
-    def parallel(omega: float, n_grid: int) -> OursParams:
-        """Release branches parallel to the loaded ones and no blend or lag: the paper's lines."""
-        return OursParams(0.0, (omega,) * n_grid, (omega,) * n_grid, (0.0,) * n_grid)
+    def pivot_at_dead_zone(omega: float, dead_zone_pos_deg: Sequence[float],
+                           dead_zone_neg_deg: Sequence[float]) -> OursParams:
+        """Release lines parallel to the loaded ones from the dead-zone edges, no blend/lag."""
+        n = len(dead_zone_pos_deg)
+        return OursParams(0.0, (omega,) * n, (omega,) * n,
+                          tuple(float(v) for v in dead_zone_pos_deg),
+                          tuple(float(v) for v in dead_zone_neg_deg), (0.0,) * n)
 
 
 def _row(values: Any, name: str, n: int, lo: float, hi: float) -> tuple[float, ...]:
@@ -74,7 +83,8 @@ def _row(values: Any, name: str, n: int, lo: float, hi: float) -> tuple[float, .
     return tuple(out)
 
 
-_OURS_KEYS = ("lag_s", "release_slope_pos", "release_slope_neg", "backlash_blend_deg")
+_OURS_KEYS = ("lag_s", "release_slope_pos", "release_slope_neg", "release_pivot_pos_deg",
+              "release_pivot_neg_deg", "backlash_blend_deg")
 
 
 def ours_params_from_mapping(m: Mapping[str, Any], n_grid: int) -> OursParams:
@@ -90,12 +100,16 @@ def ours_params_from_mapping(m: Mapping[str, Any], n_grid: int) -> OursParams:
     return OursParams(lag,
                       _row(m["release_slope_pos"], "release_slope_pos", n_grid, lo, hi),
                       _row(m["release_slope_neg"], "release_slope_neg", n_grid, lo, hi),
+                      _row(m["release_pivot_pos_deg"], "release_pivot_pos_deg", n_grid, -90, 180),
+                      _row(m["release_pivot_neg_deg"], "release_pivot_neg_deg", n_grid, -180, 90),
                       _row(m["backlash_blend_deg"], "backlash_blend_deg", n_grid, 0.0, 45.0))
 
 
 def ours_params_to_mapping(p: OursParams) -> dict[str, Any]:
     return {"lag_s": p.lag_s, "release_slope_pos": list(p.release_slope_pos),
             "release_slope_neg": list(p.release_slope_neg),
+            "release_pivot_pos_deg": list(p.release_pivot_pos_deg),
+            "release_pivot_neg_deg": list(p.release_pivot_neg_deg),
             "backlash_blend_deg": list(p.backlash_blend_deg)}
 
 
@@ -152,43 +166,51 @@ def _inverse(y: float, ys: NDArray[np.float64], xs: NDArray[np.float64], omega: 
 
 def envelopes(dead_zone_pos_deg: float, dead_zone_neg_deg: float, height_pos_deg: float,
               height_neg_deg: float, omega: float, release_slope_pos: float,
-              release_slope_neg: float, blend_deg: float) -> Envelopes:
-    """The rising and falling branches, with release lines of their own slope.
+              release_slope_neg: float, release_pivot_pos_deg: float,
+              release_pivot_neg_deg: float, blend_deg: float) -> Envelopes:
+    """The rising and falling branches, with release lines of their own.
 
-    Loaded parts as in the paper: slope omega from the dead-zone edges D at heights H. A tendon
-    goes slack where it engaged, so each release line pivots on its own dead-zone edge (at the
-    height of the plateau it falls onto) and its slope makes it pass through the end of the
-    backlash measured at the calibration amplitude (:func:`release_slope`). The backlash then
-    grows with the load at the reversal, as friction along the sheath makes it do, instead of
-    being the same width for every reversal.
+    Loaded parts as in the paper: slope omega from the dead-zone edges D at heights H. Release
+    parts: the line of ``release_slope_*`` that meets the other plateau at ``release_pivot_*``
+    (:func:`release_line`). Because the release line is steeper than the loaded one, the
+    backlash grows with the load at the reversal, as friction along the sheath makes it do.
     """
     x = _TABLE_X_DEG
     rising = (height_pos_deg + omega * np.maximum(x - dead_zone_pos_deg, 0.0)
-              + release_slope_neg * np.minimum(x - dead_zone_neg_deg, 0.0))
-    falling = (height_neg_deg + release_slope_pos * np.maximum(x - dead_zone_pos_deg, 0.0)
+              + release_slope_neg * np.minimum(x - release_pivot_neg_deg, 0.0))
+    falling = (height_neg_deg + release_slope_pos * np.maximum(x - release_pivot_pos_deg, 0.0)
                + omega * np.minimum(x - dead_zone_neg_deg, 0.0))
     lower = np.minimum(rising, falling) + _FLAT_SLOPE * omega * x
     upper = np.maximum(rising, falling) + _FLAT_SLOPE * omega * x
     return Envelopes(x, lower, upper, omega, omega * blend_deg)
 
 
-def release_slope(amplitude_deg: float, dead_zone_deg: float, backlash_deg: float,
-                  height_loaded_deg: float, height_released_deg: float, omega: float) -> float:
-    """Slope of the release line through the pivot (D, H_released) and the backlash end.
+def release_line(amplitude_deg: float, dead_zone_deg: float, backlash_deg: float,
+                 height_loaded_deg: float, height_released_deg: float, omega: float,
+                 slope: float | None = None, offset_deg: float | None = None
+                 ) -> tuple[float, float]:
+    """(slope, pivot) of one side's release line.
 
-    For the positive side: a sweep to ``amplitude_deg`` reaches H_pos + omega*(A - D_pos) on the
-    loaded line; after the reversal the tip holds for B_pos, so the release line passes through
-    (A - B_pos, that height). Negative side: pass the negative amplitude and D_neg, B_neg.
-    Returns omega when the numbers cannot define a line (backlash as wide as the travel).
+    With the data sheet's release slope and pivot offset (device constants measured once, like
+    omega and H), the line has that slope and meets the released plateau at D +/- offset: the
+    catheter's own D (from its current) places it, the backlash B is not needed. Otherwise it is
+    built from the calibration sweep: a sweep to ``amplitude_deg`` ends on the loaded line at
+    H + omega*(A - D); after the reversal the tip holds for B, so the release line passes through
+    (A -/+ B, that height); the tendon is taken to go slack where it engaged (pivot = D) and the
+    point fixes the slope. For the negative side pass the negative amplitude, D_neg, B_neg, H_neg
+    as loaded and H_pos as released height.
     """
     sign = 1.0 if amplitude_deg > 0 else -1.0
-    y_end = height_loaded_deg + omega * (amplitude_deg - dead_zone_deg)
-    run = (amplitude_deg - sign * backlash_deg) - dead_zone_deg
-    if sign * run <= 1.0:
-        return omega
-    slope = (y_end - height_released_deg) / run
     lo, hi = RELEASE_SLOPE_RANGE
-    return float(min(max(slope, lo), hi))
+    if slope is not None and offset_deg is not None:
+        return float(min(max(slope, lo), hi)), float(dead_zone_deg + sign * offset_deg)
+    y_end = height_loaded_deg + omega * (amplitude_deg - dead_zone_deg)
+    x_end = amplitude_deg - sign * backlash_deg
+    run = x_end - dead_zone_deg
+    if sign * run <= 1.0:
+        return omega, float(dead_zone_deg)
+    s = float(min(max((y_end - height_released_deg) / run, lo), hi))
+    return s, float(x_end - (y_end - height_released_deg) / s)
 
 
 @dataclass(frozen=True)
@@ -247,16 +269,17 @@ def ours_inverse_step(state: OursState, y_desired_deg: float, env: Envelopes) ->
 class OursKnob:
     """One knob of our compensator: parameters over the other knob's angle + constants."""
 
-    field: ParameterField  # D_pos, D_neg, release_slope_pos, release_slope_neg, blend
+    field: ParameterField  # D_pos, D_neg, release slopes (pos, neg), pivots (pos, neg), blend
     height_pos_deg: float
     height_neg_deg: float
     omega: float
     lag_s: float
 
     def envelopes(self, other_deg: float) -> Envelopes:
-        d_pos, d_neg, s_pos, s_neg, blend = self.field.at(other_deg)
-        return envelopes(float(d_pos), float(d_neg), self.height_pos_deg, self.height_neg_deg,
-                         self.omega, float(s_pos), float(s_neg), max(float(blend), 0.0))
+        d_pos, d_neg, s_pos, s_neg, p_pos, p_neg, blend = (float(v) for v in
+                                                            self.field.at(other_deg))
+        return envelopes(d_pos, d_neg, self.height_pos_deg, self.height_neg_deg, self.omega,
+                         s_pos, s_neg, p_pos, p_neg, max(blend, 0.0))
 
     def loaded_knob_deg(self, tip_deg: float, other_deg: float) -> float:
         """The knob angle that gives ``tip_deg`` on a loaded branch (how calibration held it)."""
@@ -398,8 +421,9 @@ def fit_ours_knob(sweeps: Sequence[SweepData], device_knob: Any,
     ``other_knob_deg``: the profile's grid (default: the sweeps' other-knob angles, sorted); each
     grid point needs a sweep within 1 deg (several are combined by the median).
 
-    Release slopes: from each sweep's amplitude (actual knob position), D and B
-    (:func:`release_slope`). Lag: commanded vs actual position, median over the sweeps. The
+    Release lines: the data sheet's release slope and offset placed by each sweep's D, or,
+    without them, from the sweep's amplitude (actual knob position), D and B
+    (:func:`release_line`). Lag: commanded vs actual position, median over the sweeps. The
     backlash blend is 0 (corners): its identification is not built yet.
     """
     if not sweeps:
@@ -410,27 +434,30 @@ def fit_ours_knob(sweeps: Sequence[SweepData], device_knob: Any,
         if not all(math.isfinite(v) for v in values):
             raise ValueError(f"sweep at {s.other_knob_deg} deg has no finite D/B: {values}")
     omega = float(device_knob.omega)
+    release_omega = getattr(device_knob, "release_omega", None)
+    release_offset = getattr(device_knob, "release_offset_deg", None)
     h_pos, h_neg = heights_from_sweeps(sweeps, device_knob)
     grid = sorted({float(s.other_knob_deg) for s in sweeps}) if other_knob_deg is None else list(
         other_knob_deg)
-    slopes_pos: list[float] = []
-    slopes_neg: list[float] = []
+    columns: list[list[float]] = [[], [], [], []]
     for g in grid:
         near = [s for s in sweeps if abs(s.other_knob_deg - g) <= 1.0]
         if not near:
             raise ValueError(f"no sweep with the other knob at {g} deg")
-        sp, sn = [], []
+        lines: list[tuple[float, float, float, float]] = []
         for s in near:
             pos = np.asarray(s.pos_deg, float)
             pos = pos[np.isfinite(pos)]
             if pos.size == 0:
                 raise ValueError(f"sweep at {g} deg has no finite position")
-            sp.append(release_slope(float(pos.max()), s.dead_zone_pos_deg, s.backlash_pos_deg,
-                                    h_pos, h_neg, omega))
-            sn.append(release_slope(float(pos.min()), s.dead_zone_neg_deg, s.backlash_neg_deg,
-                                    h_neg, h_pos, omega))
-        slopes_pos.append(float(np.median(sp)))
-        slopes_neg.append(float(np.median(sn)))
+            sp, pp = release_line(float(pos.max()), s.dead_zone_pos_deg, s.backlash_pos_deg,
+                                  h_pos, h_neg, omega, release_omega, release_offset)
+            sn, pn = release_line(float(pos.min()), s.dead_zone_neg_deg, s.backlash_neg_deg,
+                                  h_neg, h_pos, omega, release_omega, release_offset)
+            lines.append((sp, sn, pp, pn))
+        for j in range(4):
+            columns[j].append(float(np.median([line[j] for line in lines])))
     lag = float(np.median([estimate_lag_s(s.t_s, s.cmd_deg, s.pos_deg) for s in sweeps]))
-    n = len(slopes_pos)
-    return OursParams(min(lag, 1.0), tuple(slopes_pos), tuple(slopes_neg), (0.0,) * n)
+    n = len(grid)
+    return OursParams(min(lag, 1.0), tuple(columns[0]), tuple(columns[1]), tuple(columns[2]),
+                      tuple(columns[3]), (0.0,) * n)

@@ -16,7 +16,6 @@ from __future__ import annotations
 import collections
 import enum
 import math
-import queue
 import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
@@ -36,6 +35,9 @@ ROW_COLUMNS: tuple[str, ...] = (
     "t", "q1", "q2", "cmd1", "cmd2", "pos1", "pos2", "cur1", "cur2", "tip1", "tip2",
 )
 """The recording columns every tick produces (tsmd.recording.REQUIRED_COLUMNS)."""
+
+
+_isfinite = math.isfinite
 
 
 class LoopState(enum.Enum):
@@ -227,12 +229,15 @@ class ControlLoop:
         self._limiter = limiter
         self._min = np.array([r.min_deg for r in ranges], dtype=float)
         self._max = np.array([r.max_deg for r in ranges], dtype=float)
+        self._min_f = tuple(float(v) for v in self._min)
+        self._max_f = tuple(float(v) for v in self._max)
         self._tip_source = tip_source
         self._after_sync = after_sync
         self.recorder = recorder
         self._on_event = on_event
         self.setpoint = LatestSetpoint()
-        self.commands: queue.Queue[LoopCommand] = queue.Queue(maxsize=64)
+        self.commands: collections.deque[LoopCommand] = collections.deque()
+        self.max_pending_commands = 64
         self.state = LoopState.DISABLED
         self.fault_reason: str | None = None
         self.stats = LoopStats()
@@ -264,7 +269,7 @@ class ControlLoop:
         self.drives.pump()
         events = self.drives.poll_events()
         feedback = self.drives.feedback()
-        pos = np.array([f.position_deg for f in feedback], dtype=float)
+        pos = [feedback[0].position_deg, feedback[1].position_deg]
         if events:
             self.last_events.extend(events)
         if self.state is LoopState.ENABLED:
@@ -274,8 +279,9 @@ class ControlLoop:
         if self.state is LoopState.ENABLED:
             q, cmd = self._command(pos)
         else:
-            q = cmd = pos if np.all(np.isfinite(pos)) else self._last_cmd
-        if np.all(np.isfinite(cmd)):
+            q = cmd = (np.array(pos) if _isfinite(pos[0]) and _isfinite(pos[1])
+                       else self._last_cmd)
+        if _isfinite(cmd[0]) and _isfinite(cmd[1]):
             self._last_cmd = cmd
         self.drives.write_targets([float(cmd[0]), float(cmd[1])])
         self.drives.sync()
@@ -295,7 +301,7 @@ class ControlLoop:
         return sample
 
     def _supervise(self, events: list[FaultEvent], feedback: list[DriveFeedback],
-                   pos: Array) -> str | None:
+                   pos: list[float]) -> str | None:
         if events:
             ev = events[0]
             return f"drive {ev.drive}: {ev.kind.value}: {ev.message}"
@@ -311,7 +317,7 @@ class ControlLoop:
             return f"{self.stats.overrun_streak} overruns in a row"
         return None
 
-    def _command(self, pos: Array) -> tuple[Array, Array]:
+    def _command(self, pos: list[float]) -> tuple[Array, Array]:
         playback = self._playback
         compensator = self._compensator
         if playback is not None:
@@ -324,22 +330,25 @@ class ControlLoop:
                     compensator = self._uncompensated()
         else:
             q_raw = self.setpoint.get()
-        q = np.array(q_raw if q_raw is not None else self._q, dtype=float)
-        if not np.all(np.isfinite(q)):
-            self._fault(f"non-finite setpoint {q.tolist()}")
+        if q_raw is None:
+            q_raw = self._q
+        q0, q1 = float(q_raw[0]), float(q_raw[1])
+        if not (_isfinite(q0) and _isfinite(q1)):
+            self._fault(f"non-finite setpoint {[q0, q1]}")
             return self._q, self._last_cmd
-        q = np.minimum(np.maximum(q, self._min), self._max)
+        lo, hi = self._min_f, self._max_f
+        q = np.array((min(max(q0, lo[0]), hi[0]), min(max(q1, lo[1]), hi[1])))
         self._q = q
         cmd = np.asarray(compensator.command(q), dtype=float)
-        if cmd.shape != (2,) or not np.all(np.isfinite(cmd)):
+        if cmd.shape != (2,) or not (_isfinite(cmd[0]) and _isfinite(cmd[1])):
             self._fault(f"compensator gave {cmd.tolist()} for q {q.tolist()}")
             return q, self._last_cmd
         cmd = np.asarray(self._limiter.limit(cmd), dtype=float)
-        if cmd.shape != (2,) or not np.all(np.isfinite(cmd)):
+        if cmd.shape != (2,) or not (_isfinite(cmd[0]) and _isfinite(cmd[1])):
             self._fault(f"limiter gave {cmd.tolist()} for q {q.tolist()}")
             return q, self._last_cmd
-        cmd = np.minimum(np.maximum(cmd, self._min), self._max)
-        return q, cmd
+        return q, np.array((min(max(float(cmd[0]), lo[0]), hi[0]),
+                            min(max(float(cmd[1]), lo[1]), hi[1])))
 
     def _record(self, row: tuple[float, ...]) -> None:
         if self.recorder is not None:
@@ -401,10 +410,9 @@ class ControlLoop:
     def post(self, name: str, **args: Any) -> Future[Any]:
         """Queue a command for the loop thread; raises LoopError('busy') when the queue is full."""
         command = LoopCommand(name, args)
-        try:
-            self.commands.put_nowait(command)
-        except queue.Full:
-            raise LoopError("busy", "the loop has too many pending commands") from None
+        if len(self.commands) >= self.max_pending_commands:
+            raise LoopError("busy", "the loop has too many pending commands")
+        self.commands.append(command)  # deque.append is atomic: no lock on the hot path
         return command.future
 
     def execute(self, name: str, **args: Any) -> Any:
@@ -412,11 +420,9 @@ class ControlLoop:
         return getattr(self, f"_cmd_{name}")(**args)
 
     def _run_commands(self) -> None:
-        while True:
-            try:
-                command = self.commands.get_nowait()
-            except queue.Empty:
-                return
+        commands = self.commands
+        while commands:
+            command = commands.popleft()
             if not command.future.set_running_or_notify_cancel():
                 continue
             try:

@@ -277,3 +277,17 @@ def test_a_grid_without_the_zero_sweep_is_refused() -> None:
     report = check_quality([GridPoint(k, o, base) for k in (0, 1) for o in (-30.0, 30.0)])
     with pytest.raises(CalibrationError, match="design assumption 1"):
         report.raise_if_bad()
+
+
+def test_the_knee_edge_lies_beyond_the_rise_and_nearer_the_tip(sweep_rec: Recording) -> None:
+    from tsmd.calibration import IdentifyOptions
+
+    rise = _identify(sweep_rec)
+    knee = identify_sweep(sweep_rec["t"], sweep_rec["cmd1"], sweep_rec["pos1"],
+                          sweep_rec["cur1"], IdentifyOptions(edge="knee"),
+                          sweep_start_s=float(sweep_rec.metadata["calibration_sweep_start_s"]))
+    truth = _truth(sweep_rec)
+    for name in ("dead_zone_pos_deg", "dead_zone_neg_deg"):
+        assert abs(knee.estimate(name)) >= abs(rise.estimate(name))
+        assert abs(knee.estimate(name) - getattr(truth, name)) <= abs(
+            rise.estimate(name) - getattr(truth, name)) + 0.5, name

@@ -129,3 +129,14 @@ def test_real_acquisition_converts_and_round_trips(path: Path, tmp_path: Path) -
     write_recording(out, rec)
     back = read_recording(out)
     np.testing.assert_allclose(back[f"tip{knob}"], tip)
+
+
+@needs_data
+@pytest.mark.realdata
+def test_real_acquisition_goes_through_the_identification() -> None:
+    from tsmd.calibration import identify_recording
+
+    path = _real_files()[0]
+    point = identify_recording(load_tee_acquisition(path), source=path.name)
+    assert point.knob == int(path.name[5]) - 1
+    assert point.result.values["backlash_pos_deg"]  # one reversal at the top: one value

@@ -24,7 +24,7 @@ import numpy as np
 
 from tsmd.calibration.assemble import KNOB_LABELS, GridPoint
 from tsmd.calibration.errors import CalibrationError
-from tsmd.calibration.identify import PARAMETERS, split_half_cycles
+from tsmd.calibration.identify import PARAMETERS, IdentifyOptions, split_half_cycles
 from tsmd.calibration.offline import SHORT
 from tsmd.calibration.signal import lowpass
 
@@ -87,7 +87,7 @@ def tip_truth(point: GridPoint) -> dict[str, float]:
 
 def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any]:
     from tsmd.calibration import fast_protocol, paper_protocol
-    from tsmd.calibration.run import finish, run_sweeps
+    from tsmd.calibration.run import finish, identify_recording, run_sweeps
     from tsmd.config import default_sim_config, load_config
     from tsmd.daemon import resolve_data_path
     from tsmd.profile import load_device_model
@@ -106,32 +106,49 @@ def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any
         finish("bench", device, runs.points, amplitude_deg=90.0)
     except CalibrationError as exc:
         verdict = f"profile REFUSED by the quality checks: {exc}"
+    knee = {(p.knob, p.other_deg): identify_recording(p.recording, IdentifyOptions(edge="knee"))
+            for p in runs.points if p.recording is not None}
     rows = []
-    errors: list[float] = []
+    errors: dict[str, list[float]] = {"paper": [], "knee": []}
     for p in sorted(runs.points, key=lambda q: (q.knob, q.other_deg)):
         truth = tip_truth(p)
         cells = [KNOB_LABELS[p.knob], f"{p.other_deg:+.0f}"]
         for param in PARAMETERS:
-            ident = p.result.estimate(param)
             true = truth.get(param, math.nan)
-            err = ident - true
-            if math.isfinite(err):
-                errors.append(abs(err))
-            cells.append(f"{ident:.1f} / {true:.1f} / {err:+.1f}")
+            ident = p.result.estimate(param)
+            errors["paper"].append(ident - true)
+            text = f"{ident:.1f}"
+            if param.startswith("dead_zone"):
+                k_ident = knee[(p.knob, p.other_deg)].result.estimate(param)
+                errors["knee"].append(k_ident - true)
+                text += f" / {k_ident:.1f}"
+            else:
+                errors["knee"].append(ident - true)
+            cells.append(f"{text} / {true:.1f}")
         rows.append(cells)
-    head = ["knob", "other (deg)", *(f"{SHORT[p]} id / tip / err" for p in PARAMETERS)]
+    head = ["knob", "other (deg)", "D_pos paper / knee / tip", "D_neg paper / knee / tip",
+            "B_pos current / tip", "B_neg current / tip"]
     table = "\n".join(["| " + " | ".join(head) + " |", "|" + "---|" * len(head),
                        *("| " + " | ".join(r) + " |" for r in rows)])
-    n_total = len(runs.points) * len(PARAMETERS)
-    within = sum(e <= TARGET_DEG for e in errors)
     summary = (f"- sweeping {proto.sweep_time_s:.0f} s, motion {runs.motion_time_s:.0f} s "
                f"(simulated), wall {wall:.1f} s\n"
-               f"- |error| max {max(errors, default=math.nan):.1f} deg, mean "
-               f"{np.mean(errors) if errors else math.nan:.2f} deg; within {TARGET_DEG:g} deg: "
-               f"{within} of {n_total} values ({n_total - len(errors)} without a tip value)\n"
-               f"- {verdict}")
+               f"- {verdict}\n" + _error_summary(errors["paper"], "paper identification")
+               + _error_summary(errors["knee"], "knee edges (beyond the paper)"))
     return {"points": runs.points, "table": table, "summary": summary, "wall_s": wall,
             "errors": errors}
+
+
+def _error_summary(signed: list[float], label: str) -> str:
+    """Per parameter kind: max |error|, and how many of all values are within the target."""
+    errs = np.abs(np.asarray(signed, dtype=float)).reshape(-1, len(PARAMETERS))
+    parts = []
+    for j, param in enumerate(PARAMETERS):
+        col = errs[:, j][np.isfinite(errs[:, j])]
+        parts.append(f"{SHORT[param]} max {col.max() if col.size else math.nan:.1f}")
+    finite = errs[np.isfinite(errs)]
+    within = int((finite <= TARGET_DEG).sum())
+    return (f"- {label}: |error| {', '.join(parts)} deg; within {TARGET_DEG:g} deg: {within} "
+            f"of {errs.size} values ({errs.size - finite.size} without a tip value)\n")
 
 
 def compare_protocols(paper: Sequence[GridPoint], fast: Sequence[GridPoint]) -> str:
@@ -160,15 +177,14 @@ def tee_tip_measures(point: GridPoint) -> dict[str, list[float]]:
     q, tip = rec[f"pos{k}"], rec[f"tip{k}"]
     out: dict[str, list[float]] = {p: [] for p in PARAMETERS}
     for direction, a, b, after_reversal in split_half_cycles(rec[f"cmd{k}"], 10.0):
-        if b >= len(q):
-            continue  # the acquisition ends mid-pass: no reversal, edges may not be reached
+        ends_mid_pass = b >= len(q)  # no reversal at the end: the edge may not be reached
         qs, ts = direction * q[a:b], direction * tip[a:b]
         backlash, edge = _rising_pass_measures(qs, ts, TIP_THRESHOLD_DEG)
         b_name = "backlash_neg_deg" if direction > 0 else "backlash_pos_deg"
         d_name = "dead_zone_pos_deg" if direction > 0 else "dead_zone_neg_deg"
         if after_reversal and math.isfinite(backlash):
             out[b_name].append(backlash)
-        if math.isfinite(edge):
+        if math.isfinite(edge) and not ends_mid_pass:
             out[d_name].append(direction * edge)
     return out
 
@@ -193,10 +209,13 @@ def tee_table(directory: str | None) -> str:
             lines.append(f"| {f.stem} | - | {exc} |")
             continue
         tip = tee_tip_measures(point)
+        knee = identify_recording(rec, IdentifyOptions(edge="knee"), source=f.name)
         cells = [f.stem.replace("_current60__", " "), f"phi{point.knob + 1}"]
         for p in PARAMETERS:
-            cur = point.result.values.get(p, ())
-            cells.append(f"{_fmt(cur)} / {_fmt(tuple(tip[p]))}")
+            cur = _fmt(point.result.values.get(p, ()))
+            if p.startswith("dead_zone"):
+                cur += f" (knee {_fmt(knee.result.values.get(p, ()))})"
+            cells.append(f"{cur} / {_fmt(tuple(tip[p]))}")
         snr = point.result.snr
         cells.append(f"{snr:.1f}" if math.isfinite(snr) else "-")
         lines.append("| " + " | ".join(cells) + " |")

@@ -53,6 +53,14 @@ class IdentifyOptions:
     """"Constant" current: rising slower than this fraction of the loaded ramp's slope."""
     penalty_k: float = 20.0
     """Change-point penalty in units of noise variance x log(n) (PELT)."""
+    edge: str = "rise"
+    """"rise": the paper's edge, where the current starts to rise; "knee" (beyond the paper):
+    where the steep first rise turns into the loaded ramp, i.e. where the tip starts to move."""
+    knee_slope_ratio: float = 1.5
+    max_knee_deg: float = 15.0
+    settle_fraction: float = 0.1
+    """Band around the constant level, as a fraction of the peak's height above it."""
+    settle_hold_deg: float = 1.0
     max_tracking_error_deg: float = 10.0
     min_follow_ratio: float = 0.5
     """The knob must travel at least this fraction of the commanded travel (else: stalled)."""
@@ -189,7 +197,7 @@ def _pieces(yg: FloatArray, noise: float, opts: IdentifyOptions) -> list[tuple[i
     return list(zip([0, *bkps[:-1]], bkps, strict=True))
 
 
-def _plateau(yg: FloatArray, step: float, noise: float,
+def _plateau(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
              opts: IdentifyOptions) -> tuple[int, int] | None:
     """The constant-current stretch: the longest run of flat pieces (start, stop on the grid).
 
@@ -201,7 +209,6 @@ def _plateau(yg: FloatArray, step: float, noise: float,
     loaded = _slope(tail, step)
     if loaded <= 0:
         return None
-    pieces = _pieces(yg, noise, opts)
     slopes = [_slope(yg[a:b], step) for a, b in pieces]
     flat = [-loaded < s < opts.flat_slope_fraction * loaded for s in slopes]
     best: tuple[int, int] | None = None
@@ -218,6 +225,26 @@ def _plateau(yg: FloatArray, step: float, noise: float,
             best = run
         k = j + 1
     return best
+
+
+def _knee(yg: FloatArray, step: float, pieces: list[tuple[int, int]], rise_k: int,
+          opts: IdentifyOptions) -> int:
+    """Beyond the paper: where the steep first rise (the tendon stretching while the tip is
+    still held) turns into the loaded ramp (the tip moving). No steep part: the rise itself."""
+    loaded = _slope(yg[int(0.75 * yg.size):], step)
+    limit = rise_k + int(opts.max_knee_deg / step)
+    steep = False
+    for a, b in pieces:
+        if b <= rise_k:
+            continue
+        if a >= limit:
+            break
+        slope = _slope(yg[max(a, rise_k):b], step)
+        if slope > opts.knee_slope_ratio * loaded:
+            steep = True
+        elif steep:
+            return max(a, rise_k)
+    return rise_k
 
 
 def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
@@ -239,7 +266,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
                          problems=(f"{where}: only {span:.1f} deg of travel",))
     # The last degrees before the next reversal belong to the motor's deceleration: left out.
     end = max(3 * min_size, yg.size - round(opts.edge_margin_deg / step))
-    plateau_run = _plateau(yg[:end], step, noise, opts)
+    pieces = _pieces(yg[:end], noise, opts)
+    plateau_run = _plateau(yg[:end], step, pieces, opts)
     if plateau_run is None:
         plateau_run = (0, end)
         problems.append(f"{where}: no stretch of constant current")
@@ -248,14 +276,28 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     settle = 0
     backlash_deg = math.nan
     if after_reversal:
-        settle = plateau_run[0]
-        backlash_deg = float(grid[settle] - grid[0])
-        # The small peak after the reversal (reported; the backlash counts from the reversal).
-        peaks, _ = find_peaks(yg[:max(settle, 1) + 1], prominence=opts.peak_noise_k * noise)
+        # The small peak after the reversal (find_peaks), then the first point from which the
+        # current stays on the constant level (noise band around the plateau's median) for
+        # ``settle_hold_deg``; the backlash counts from the reversal (the model's X_ref).
+        level = float(np.median(yg[plateau_run[0]:plateau_run[1]]))
+        search = yg[:plateau_run[1]]
+        peaks, _ = find_peaks(search, prominence=opts.peak_noise_k * noise)
         peak = int(peaks[0]) if peaks.size else None
+        start_k = peak if peak is not None else 0
+        height = float(np.max(np.abs(search[:start_k + 1] - level)))
+        band = max(opts.peak_noise_k * noise, opts.settle_fraction * height)
+        hold = max(2, round(opts.settle_hold_deg / step))
+        inside = np.abs(search[start_k:] - level) <= band
+        run = np.convolve(inside.astype(float), np.ones(hold), mode="valid") >= hold
+        hits = np.flatnonzero(run)
+        settle = start_k + int(hits[0]) if hits.size else plateau_run[0]
+        settle = min(settle, plateau_run[0]) if plateau_run[0] > start_k else settle
+        backlash_deg = float(grid[settle] - grid[0])
 
     # The dead-zone edge: where the constant-current stretch ends and the current rises.
     edge_k: int | None = plateau_run[1] if plateau_run[1] < end else None
+    if edge_k is not None and opts.edge == "knee":
+        edge_k = _knee(yg[:end], step, pieces, edge_k, opts)
     plateau = float(np.median(yg[plateau_run[0]:plateau_run[1]]))
     rise = float(np.median(yg[max(end - min_size, plateau_run[0]):end]) - plateau)
     snr = rise / noise

@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from tsmd.calibration.identify import IdentifyOptions
 from tsmd.errors import TsmdError
 
 
@@ -51,6 +52,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-save", action="store_true",
                         help="identify and check, print the result, do not save a profile")
     parser.add_argument("--seed", type=int, default=0, help="--sim: noise seed")
+    parser.add_argument("--edge", choices=("rise", "knee"), default="rise",
+                        help="dead-zone edge: 'rise' = the paper's (where the current starts to "
+                             "rise), 'knee' = where the steep first rise turns into the loaded "
+                             "ramp (beyond the paper; --sim and recordings)")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -156,7 +161,8 @@ def _sim(args: argparse.Namespace) -> int:
     try:
         with LockstepRunner(config, seed=args.seed) as runner:
             cal = run_calibration(runner, args.catheter, device, protocol=protocol,
-                                  period_s=config.loop.period_s, progress=bar, cancel=cancel)
+                                  period_s=config.loop.period_s, progress=bar, cancel=cancel,
+                                  options=IdentifyOptions(edge=args.edge))
     finally:
         signal.signal(signal.SIGINT, previous)
         bar.done()
@@ -177,7 +183,9 @@ def _from_recordings(args: argparse.Namespace) -> int:
 
     config = _config(args, sim=False) if args.config else None
     device = _device(args, config)
-    points = [identify_recording(read_sweep_file(f, args.steps_per_knob_deg), source=str(f))
+    options = IdentifyOptions(edge=args.edge)
+    points = [identify_recording(read_sweep_file(f, args.steps_per_knob_deg), options,
+                                 source=str(f))
               for f in args.from_recording]
     print(identification_table(points))
     cal = calibration_from_points(points, args.catheter, device)

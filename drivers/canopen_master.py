@@ -174,7 +174,13 @@ class CanOpenDrives(KnobDrives):
         self._wait_until(lambda d: d.nmt_state is not None, self.boot_timeout_s,
                          "boot-up message after NMT reset node")
         for d in self._drives:
-            self._configure(d)
+            try:
+                self._configure(d)
+            except DriveError as exc:
+                reason = str(exc).removeprefix(f"{d.name}: ")
+                if reason.startswith("boot failed"):
+                    raise
+                self._boot_failed(d, reason)
         for d in self._drives:
             d.nmt_state = None
             self._send(0x000, bytes((0x01, d.node_id)))

@@ -328,3 +328,34 @@ def test_drive_leaving_operational_is_a_drive_fault(enabled):
     _, event = run_until(drives, rig, FaultKind.DRIVE_FAULT, 20)  # next heartbeat, <= 50 ms
     assert event.drive == 1
     assert "left OPERATIONAL, NMT state is now STOPPED" in event.message
+
+
+def test_rated_current_mismatch_fails_boot_naming_both_values():
+    channel = "rated-current-mismatch"
+    rig = SimRig(LockstepBus(channel), SpringPlant(),
+                 [DriveConfig(node_id=1), DriveConfig(node_id=2)], PERIOD_S)
+    drives = CanOpenDrives(LockstepBus(channel),
+                           [DriveConfig(node_id=1), DriveConfig(node_id=2, current_scale_A=0.001)],
+                           PERIOD_S, clock=rig.clock, idle=rig.exchange, own_bus=True)
+    try:
+        with pytest.raises(DriveError, match=r"drive 1 \(node 2\): boot failed: motor rated "
+                                             r"current 0x6075 is 2000 mA but "
+                                             r"current_scale_A=0.001 implies 1000 mA"):
+            drives.boot()
+    finally:
+        drives.close()
+        rig.close()
+
+
+def test_sdo_abort_during_boot_is_a_boot_failure_naming_the_object():
+    drives, rig = open_sim_rig(SpringPlant(), None, PERIOD_S)
+    rig.nodes[1].od[0x6065].max = 10  # this drive refuses any realistic following error window
+    try:
+        with pytest.raises(DriveError, match=r"drive 1 \(node 2\): boot failed: SDO download "
+                                             r"0x6065:00 aborted with 0x06090031: value of "
+                                             r"parameter written too high"):
+            drives.boot()
+        assert FaultKind.BOOT_FAILED in {e.kind for e in drives.poll_events()}
+    finally:
+        drives.close()
+        rig.close()

@@ -40,6 +40,8 @@ from drivers.units import DriveConfig, interpolation_period
 _RPDO = struct.Struct(o.RPDO1_FORMAT)
 _TPDO = struct.Struct(o.TPDO1_FORMAT)
 _EMCY = struct.Struct("<HB5s")
+MOTOR_SPEED_HEADROOM = 1.25
+"""0x6080 = knob velocity limit x gear x this: room for the position loop's transients."""
 _NMT_NAMES = {0x00: "boot-up", 0x04: "STOPPED", 0x05: "OPERATIONAL", 0x7F: "PRE-OPERATIONAL"}
 
 
@@ -428,6 +430,8 @@ class CanOpenDrives(KnobDrives):
             (o.SOFTWARE_POSITION_LIMIT, 1, d.min_counts),
             (o.SOFTWARE_POSITION_LIMIT, 2, d.max_counts),
             (o.MAX_PROFILE_VELOCITY, 0, round(c.max_velocity_deg_s * cpd)),
+            (o.MAX_MOTOR_SPEED, 0, round(c.max_velocity_deg_s * c.gear_ratio / 6.0
+                                         * MOTOR_SPEED_HEADROOM)),
             (o.QUICK_STOP_DECELERATION, 0, round(c.max_accel_deg_s2 * cpd)),
             (o.FOLLOWING_ERROR_WINDOW, 0, round(c.following_error_deg * cpd)),
             (o.FOLLOWING_ERROR_TIMEOUT, 0, c.following_error_timeout_ms),

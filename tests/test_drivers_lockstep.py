@@ -171,3 +171,30 @@ def test_default_plant_is_the_tendon_sheath_physics():
     finally:
         drives.close()
         rig.close()
+
+
+def test_boot_writes_mode_period_limits_and_heartbeats_to_the_drive(rig_pair):
+    drives, _ = rig_pair
+    drives.boot()
+    cfg = DriveConfig(node_id=1)
+    cpd = cfg.counts_per_deg
+    expected = {
+        (0x6060, 0): 8,
+        (0x60C2, 1): 4, (0x60C2, 2): -3,
+        (0x1006, 0): 4000,
+        (0x607D, 1): round(cfg.min_deg * cpd), (0x607D, 2): round(cfg.max_deg * cpd),
+        (0x607F, 0): round(cfg.max_velocity_deg_s * cpd),
+        (0x6080, 0): round(cfg.max_velocity_deg_s * cfg.gear_ratio / 6.0 * 1.25),
+        (0x6085, 0): round(cfg.max_accel_deg_s2 * cpd),
+        (0x6065, 0): round(cfg.following_error_deg * cpd),
+        (0x605A, 0): cfg.quick_stop_option,
+        (0x6007, 0): cfg.abort_connection_option,
+        (0x1017, 0): cfg.heartbeat_producer_ms,
+        (0x1016, 1): (127 << 16) | cfg.master_heartbeat_timeout_ms,
+        (0x1600, 0): 2, (0x1600, 1): 0x60400010, (0x1600, 2): 0x607A0020,
+        (0x1A00, 0): 3, (0x1A00, 1): 0x60410010, (0x1A00, 2): 0x60640020,
+        (0x1A00, 3): 0x60780010,
+        (0x1800, 1): 0x181, (0x1800, 2): 1, (0x1400, 1): 0x201, (0x1400, 2): 1,
+    }
+    got = {key: drives.sdo_read(0, *key) for key in expected}
+    assert got == expected

@@ -401,6 +401,7 @@ class SimDriveNode:
         self._fe_window = self._value(o.FOLLOWING_ERROR_WINDOW, 0)
         self._fe_timeout_s = self._value(o.FOLLOWING_ERROR_TIMEOUT, 0) * 1e-3
         self._hb_period_ms = self._value(o.PRODUCER_HEARTBEAT, 0)
+        self.motor.limit_speed(self._value(o.MAX_MOTOR_SPEED, 0))
         hb = self._value(o.CONSUMER_HEARTBEAT, 1)
         self._master_hb_cob = 0x700 + ((hb >> 16) & 0x7F) if hb else -1
         cob = self._value(o.RPDO1_COMM, 1)

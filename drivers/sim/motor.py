@@ -62,6 +62,12 @@ class Motor:
         # exact transition of e'' = -w^2 e - 2 w e' (critically damped) over dt
         self._phi = ((1.0 + w * dt_s) * e, dt_s * e, -w * w * dt_s * e, (1.0 - w * dt_s) * e)
 
+    def limit_speed(self, max_speed_rpm: float) -> None:
+        """Apply the drive's max motor speed (0x6080), never above the motor's own rating."""
+        rpm = min(max_speed_rpm, self.params.max_speed_rpm) if max_speed_rpm > 0 else (
+            self.params.max_speed_rpm)
+        self._max_velocity_deg_s = rpm * 6.0 / self.gear_ratio
+
     def hold(self) -> None:
         """Make the current position the reference (entering OPERATION ENABLED)."""
         self._reference_deg = self.position_deg

@@ -369,3 +369,27 @@ def test_client_error_carries_the_code(stack: Stack) -> None:
     with stack.client() as c, pytest.raises(ApiClientError) as exc:
         c.call("set", q=[0, 0])
     assert exc.value.code == "not_enabled"
+
+
+def test_profile_loads_a_catheter_and_compensation_follows_it(tmp_path: Path) -> None:
+    example = Path(__file__).resolve().parent.parent / "profiles" / "example-sim.yaml"
+    if not example.exists():
+        pytest.skip("profiles/example-sim.yaml is not there")
+    store = tmp_path / "store"
+    store.mkdir()
+    shutil.copy(example, store / "example-sim.yaml")
+    s = start_stack(tmp_path, profiles_dir=store)
+    try:
+        with s.client() as c:
+            r = c.call("profile", catheter="example-sim")
+            assert r["profile"] == "example-sim" and r["active"] == "ours"
+            assert c.call("profile")["available"] == ["example-sim"]
+            assert c.call("compensation", method="paper")["active"] == "paper"
+            assert c.call("compensation", enabled=False)["active"] == "none"
+            status = c.call("status")
+            assert status["profile"] == "example-sim"
+            assert status["compensation"] == {"enabled": False, "method": "paper",
+                                              "active": "none"}
+    finally:
+        s.stop.set()
+        s.server.stop()

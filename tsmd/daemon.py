@@ -560,6 +560,11 @@ class Daemon:
         self.notifier.close()
         return summary
 
+    @property
+    def loop_error(self) -> BaseException | None:
+        """What killed the loop thread, if it died (the process then exits non-zero)."""
+        return self._loop_error
+
     def summary(self) -> RunSummary | None:
         loop = self.loop
         if loop is None:

@@ -162,4 +162,7 @@ def main(args: argparse.Namespace) -> int:
             print(f"  demo, compensation {phase.method}: {len(phase.samples)} samples, {text}")
         if demo.error:
             print(f"  demo stopped: {demo.error}", file=sys.stderr)
-    return 0 if summary.faults == 0 and (demo is None or demo.error is None) else 1
+    if daemon.loop_error is not None:
+        print(f"tsmd run: the control loop stopped: {daemon.loop_error!r}", file=sys.stderr)
+        return 1
+    return 0 if demo is None or demo.error is None else 1

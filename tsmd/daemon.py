@@ -157,6 +157,7 @@ class Controller:
             "compensation": {"enabled": self.choice.enabled, "method": self.choice.method,
                              "active": loop.compensation_label},
             "profile": getattr(self.profile, "catheter_id", None),
+            "calibrating": loop.playing,
             "sample": sample.as_dict() if sample is not None else None,
             "last_events": [f"drive {e.drive}: {e.kind.value}: {e.message}"
                             for e in list(loop.last_events)[-4:]],

@@ -256,6 +256,11 @@ class ControlLoop:
     def compensation_label(self) -> str:
         return self._compensation_label
 
+    @property
+    def playing(self) -> bool:
+        """True while a trajectory (a calibration sweep) owns the setpoint."""
+        return self._playback is not None
+
     def ranges(self) -> list[KnobRange]:
         return [KnobRange(float(lo), float(hi)) for lo, hi in zip(self._min, self._max,
                                                                    strict=True)]

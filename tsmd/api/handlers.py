@@ -93,6 +93,8 @@ class ApiHandlers:
         state = self.loop.state
         if state is not LoopState.ENABLED:
             raise ApiError("not_enabled", f"set: the loop is {state.value}; send enable first")
+        if self.loop.playing:
+            raise ApiError("busy", "set: a calibration trajectory owns the knobs; cancel it first")
         self.loop.setpoint.set((q[0], q[1]))
         return {"q": q}
 

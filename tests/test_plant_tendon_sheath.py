@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pytest
 
+from drivers.plant import tendon_sheath
 from drivers.plant.analysis import loaded_slope, measure_dead_zone_backlash
 from drivers.plant.base import Plant, load_plant
 from drivers.plant.tendon_sheath import TendonSheathPlant, make_tendon_sheath_plant
@@ -177,3 +179,15 @@ def test_bad_step_input_is_refused() -> None:
         plant.step(DT_S, np.array([np.nan, 0.0]))
     with pytest.raises(ValueError, match="dt_s"):
         plant.step(-1.0, np.zeros(2))
+
+
+@pytest.mark.parametrize("params", [{}, {"coupling": 1.0}], ids=["default", "coupling"])
+def test_fast_path_matches_the_full_solve(
+    params: dict[str, Any], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Extending the last solution in closed form changes nothing but the speed."""
+    fast = run_sweep(make_tendon_sheath_plant(**params), cycles=0.6, other_deg=50.0)
+    monkeypatch.setattr(tendon_sheath._Knob, "_extend_fast", lambda *args: False)
+    full = run_sweep(make_tendon_sheath_plant(**params), cycles=0.6, other_deg=50.0)
+    assert np.allclose(fast.tip_deg, full.tip_deg, atol=1e-9)
+    assert np.allclose(fast.torque_Nm, full.torque_Nm, atol=1e-12)

@@ -211,6 +211,7 @@ class _Knob:
         )
         self.kinetic_Nm = p.bend_friction_Nm * spread
         self.static_Nm = self.kinetic_Nm * p.bend_stiction_ratio
+        self.has_stiction = p.bend_stiction_ratio > 1.0
         wrap_rad = math.radians(p.sheath_wrap_deg + eff.sheath_curvature_deg)
         # Friction exponent mu * wrap per element; the handle routing sits at the sheath entry.
         self.sheath_exponent = np.full(n_elements, p.sheath_friction * wrap_rad / n_elements)
@@ -218,9 +219,8 @@ class _Knob:
         self.routing_exponent[0] = p.routing_friction * math.radians(p.routing_wrap_deg)
         self.radius_m = p.pulley_radius_mm * 1e-3
         curvature_slack_m = eff.lumen_clearance_mm * 1e-3 * math.radians(eff.sheath_curvature_deg)
-        self.slack_m = np.array(
-            [p.slack_pos_mm * 1e-3 + curvature_slack_m, p.slack_neg_mm * 1e-3 + curvature_slack_m]
-        )
+        self.slack_pos_m = p.slack_pos_mm * 1e-3 + curvature_slack_m
+        self.slack_neg_m = p.slack_neg_mm * 1e-3 + curvature_slack_m
         self.n_elements = n_elements
         self.n_joints = n_joints
         self.drag_per_element_N = np.full(n_elements, p.sheath_drag_N / n_elements)
@@ -236,15 +236,19 @@ class _Knob:
 
     def reset(self) -> None:
         self.tension_N = np.zeros((2, self.n_elements))
-        self.proximal_N = np.zeros(2)
         self.joints_rad = np.zeros(self.n_joints)
         self.joint_dir = np.zeros(self.n_joints)
         """Direction each joint slid in during the last step (0: stuck, static friction)."""
         self.tip_rad = 0.0
-        self.creep_m = np.zeros(2)
         self.knob_rad: float | None = None
         self.handle_dir = 0.0
         self.handle_slip_deg = 0.0
+        # Per tendon (0: "+", 1: "-"), plain floats for speed: proximal tension, distal tension,
+        # stretch (free segment + sheath), creep.
+        self.proximal = [0.0, 0.0]
+        self.distal = [0.0, 0.0]
+        self.stretch = [0.0, 0.0]
+        self.creep_m = [0.0, 0.0]
         self._last: list[tuple[float, float, FloatArray] | None] = [None, None]
         self._fast: list[_FastPath | None] = [None, None]
 
@@ -260,8 +264,8 @@ class _Knob:
             rel = eff.rate_dependence * abs(math.degrees(speed)) / eff.rate_reference_deg_s
             friction = self._friction(1.0 + rel)
 
-        slack_pos = float(self.slack_m[0] + self.creep_m[0])
-        slack_neg = float(self.slack_m[1] + self.creep_m[1])
+        slack_pos = self.slack_pos_m + self.creep_m[0]
+        slack_neg = self.slack_neg_m + self.creep_m[1]
         if eff.coupling > 0.0:
             rb = self.geom.offset_m
             twist = rb * math.sin(math.radians(eff.coupling_tendon_twist_deg)) * other_tip_rad
@@ -273,15 +277,19 @@ class _Knob:
         draw_in = self.radius_m * knob_rad
         self._solve_tendon(0, 1.0, draw_in - slack_pos, friction)
         self._solve_tendon(1, -1.0, -draw_in - slack_neg, friction)
-        if self.joints_rad is not before:
-            self.joint_dir = np.sign(self.joints_rad - before)
-            self.tip_rad = float(self.joints_rad.sum())
-        elif self.joint_dir.any():
-            self.joint_dir = np.zeros(self.n_joints)
+        if self.has_stiction:
+            if self.joints_rad is not before:
+                self.joint_dir = np.sign(self.joints_rad - before)
+            elif self.joint_dir.any():
+                self.joint_dir = np.zeros(self.n_joints)
 
         if eff.creep_mm_per_N_s > 0.0 and dt_s > 0.0:
-            self.creep_m += eff.creep_mm_per_N_s * 1e-3 * self.proximal_N * dt_s
-        torque = self.radius_m * float(self.proximal_N[0] - self.proximal_N[1])
+            rate = eff.creep_mm_per_N_s * 1e-3 * dt_s
+            self.creep_m = [
+                self.creep_m[0] + rate * self.proximal[0],
+                self.creep_m[1] + rate * self.proximal[1],
+            ]
+        torque = self.radius_m * (self.proximal[0] - self.proximal[1])
         torque += self._handle_friction_Nm(math.degrees(knob_rad - prev), math.degrees(speed))
         return self.tip_rad, torque
 
@@ -302,7 +310,7 @@ class _Knob:
 
     def _solve_tendon(self, side: int, sign: float, target_m: float, friction: Friction) -> None:
         """Bring one tendon (``sign`` +1: pulled by positive rotation) into equilibrium."""
-        other = float(self.tension_N[1 - side, -1])
+        other = self.distal[1 - side]
         last = self._last[side]
         if (
             last is not None
@@ -312,7 +320,11 @@ class _Knob:
             and friction is self.friction_static
         ):
             return  # nothing acting on this tendon changed
-        if not self._extend_fast(side, sign, target_m, other, friction):
+        if self.proximal[side] == 0.0 and (
+            self.stretch[side] + sign * self.geom.offset_m * self.tip_rad >= target_m
+        ):
+            pass  # slack, and staying slack
+        elif not self._extend_fast(side, sign, target_m, other, friction):
             self._fast[side] = None
             self._full_solve(side, sign, target_m, other, friction)
         self._last[side] = (target_m, other, self.joints_rad)
@@ -320,20 +332,35 @@ class _Knob:
         if fast is not None:
             fast.joints = self.joints_rad
 
+    def _store(
+        self, side: int, rho: float, sign: float, t_p: float, prof: FloatArray, jnt: FloatArray
+    ) -> None:
+        """Write a pull-frame solution back into the knob's state."""
+        self.proximal[side] = rho * t_p
+        row = rho * prof
+        self.tension_N[side] = row
+        self.distal[side] = float(row[-1])
+        self.joints_rad = (sign * rho) * jnt
+        self.tip_rad = (sign * rho) * float(jnt.sum())
+
     def _full_solve(
         self, side: int, sign: float, target_m: float, other: float, friction: Friction
     ) -> None:
         tension = self.tension_N[side]
         joints = sign * self.joints_rad
-        t_p = float(self.proximal_N[side])
+        t_p = self.proximal[side]
         f0 = residual_m(self.geom, tension, t_p, joints, target_m)
         if f0 == 0.0 or (t_p == 0.0 and f0 > 0.0):
             return  # in equilibrium, or slack and staying slack
         rho = 1.0 if f0 < 0.0 else -1.0
         g, h = (friction[0], friction[1]) if rho > 0.0 else (friction[2], friction[3])
         # A joint already sliding this way needs only kinetic friction, a stuck one static.
-        sliding = self.joint_dir == sign * rho
-        mf = np.where(sliding, self.kinetic_Nm, self.static_Nm)
+        sliding = self.joint_dir == sign * rho if self.has_stiction else None
+        mf = (
+            self.kinetic_Nm
+            if sliding is None
+            else np.where(sliding, self.kinetic_Nm, self.static_Nm)
+        )
         other_r = rho * other
         sol = solve_pull(self.geom, g, h, rho * tension, rho * joints, mf, other_r, rho * target_m)
         t_new, prof, jnt = sol.proximal_N, sol.tension_N, sol.joints_rad
@@ -341,8 +368,8 @@ class _Knob:
             t_new = 0.0
             prof, jnt = apply_pull(self.geom, g, h, rho * tension, rho * joints, mf, other_r, 0.0)
         elif sol.all_slip:
-            freed = (jnt != rho * joints) & ~sliding
-            if freed.any():
+            freed = None if sliding is None else (jnt != rho * joints) & ~sliding
+            if freed is not None and freed.any():
                 t_new, prof, jnt = settle_breakaway(
                     self.geom, g, h, jnt, freed, self.kinetic_Nm, other_r, rho * target_m
                 )
@@ -351,9 +378,10 @@ class _Knob:
                 self._fast[side] = _FastPath(
                     rho, t_new, target_m, sol.slope_m_per_N, sol.limit_N, other, (g, h), fast_mf
                 )
-        self.proximal_N[side] = rho * t_new
-        self.tension_N[side] = rho * prof
-        self.joints_rad = (sign * rho) * jnt
+        self._store(side, rho, sign, t_new, prof, jnt)
+        self.stretch[side] = self.proximal[side] * self.geom.free_compliance_m_per_N + float(
+            self.tension_N[side] @ self.geom.element_compliance_m_per_N
+        )
 
     def _extend_fast(
         self, side: int, sign: float, target_m: float, other: float, friction: Friction
@@ -375,9 +403,9 @@ class _Knob:
         k = self.geom.joint_stiffness_Nm_per_rad
         turned = (self.geom.offset_m * (float(prof[-1]) - rho * other) - fast.joint_friction_Nm) / k
         jnt = np.maximum((sign * rho) * self.joints_rad, turned)
-        self.proximal_N[side] = rho * t_new
-        self.tension_N[side] = rho * prof
-        self.joints_rad = (sign * rho) * jnt
+        self._store(side, rho, sign, t_new, prof, jnt)
+        # The residual is zero at the solution: stretch = draw-in - distal travel.
+        self.stretch[side] = target_m - sign * self.geom.offset_m * self.tip_rad
         fast.t_p = t_new
         fast.target_m = target_m
         return True
@@ -415,12 +443,16 @@ class TendonSheathPlant:
         """Move the knobs to ``knob_deg`` (degrees, shape (2,)) and settle."""
         if not dt_s >= 0.0:
             raise ValueError(f"dt_s must be >= 0, got {dt_s!r}")
-        q = np.asarray(knob_deg, dtype=np.float64)
-        if q.shape != (2,) or not np.all(np.isfinite(q)):
+        try:
+            q0, q1 = (float(x) for x in knob_deg)
+        except (TypeError, ValueError):
+            raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}") from None
+        if not (math.isfinite(q0) and math.isfinite(q1)):
             raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}")
-        tips = (self._knobs[0].tip_rad, self._knobs[1].tip_rad)
-        tip0, tau0 = self._knobs[0].step(dt_s, math.radians(q[0]), tips[1], self.effects)
-        tip1, tau1 = self._knobs[1].step(dt_s, math.radians(q[1]), tips[0], self.effects)
+        k0, k1 = self._knobs
+        tips = (k0.tip_rad, k1.tip_rad)
+        tip0, tau0 = k0.step(dt_s, math.radians(q0), tips[1], self.effects)
+        tip1, tau1 = k1.step(dt_s, math.radians(q1), tips[0], self.effects)
         return PlantStep(
             tip_deg=np.array([math.degrees(tip0), math.degrees(tip1)]),
             knob_torque_Nm=np.array([tau0, tau1]),
@@ -428,7 +460,7 @@ class TendonSheathPlant:
 
     def tendon_tension_N(self) -> NDArray[np.float64]:
         """Proximal tension of the four tendons, shape (2 knobs, 2 sides: pos, neg)."""
-        return np.array([k.proximal_N.copy() for k in self._knobs])
+        return np.array([k.proximal for k in self._knobs])
 
 
 _EFFECT_NAMES = {f.name for f in fields(Effects)}

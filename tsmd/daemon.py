@@ -228,7 +228,8 @@ class Controller:
         runner = self._runner_factory()
 
         def on_progress(fraction: float, line: str = "") -> None:
-            progress({"progress": round(float(fraction), 4), "status": str(line)})
+            progress({"progress": round(float(fraction), 4), "status": str(line),
+                      "info": [str(line)]})
 
         try:
             profile = calibration.calibrate(runner, catheter, device,

@@ -3,7 +3,8 @@
 Per tick it sends one RPDO per drive (controlword + target position) and a SYNC; each drive
 answers with one TPDO (statusword + position actual + current actual): 5 frames for two drives.
 
-The cyclic path and the SDO client are our own and never block on another thread: frames are
+The cyclic path and the SDO client (:mod:`drivers.sdo`) are our own and never block on another
+thread: frames are
 read by :meth:`CanOpenDrives.pump`, either straight from the bus (``receive="poll"``, lockstep
 and deterministic) or from a python-can ``Notifier`` queue (``receive="notifier"``, real time).
 While boot and the state machine wait for an answer they call the ``idle`` hook (the simulated
@@ -35,6 +36,7 @@ from drivers.drive import (
     FaultKind,
     KnobDrives,
 )
+from drivers.sdo import SdoClient
 from drivers.units import DriveConfig, interpolation_period
 
 _RPDO = struct.Struct(o.RPDO1_FORMAT)
@@ -71,7 +73,7 @@ class _Drive:
         self.heartbeat_lost = False
         self.supervised = False
         self.last_emcy: int | None = None
-        self.sdo_response: bytes | None = None
+        self.sdo: SdoClient
         self.rpdo = can.Message(arbitration_id=0x200 + self.node_id, is_extended_id=False,
                                 data=bytearray(_RPDO.size))
 
@@ -118,6 +120,9 @@ class CanOpenDrives(KnobDrives):
         self._own_bus = own_bus
         self._od = o.load_od()
         self._drives = [_Drive(i, c) for i, c in enumerate(configs)]
+        for d in self._drives:
+            d.sdo = SdoClient(d.node_id, d.name, self._send, self._wait, self.clock,
+                              sdo_timeout_s)
         self._events: list[FaultEvent] = []
         self._unknown_ids: set[int] = set()
         self._send_failing = False
@@ -134,7 +139,7 @@ class CanOpenDrives(KnobDrives):
             self._handlers[0x180 + d.node_id] = self._tpdo_handler(d)
             self._handlers[0x700 + d.node_id] = self._heartbeat_handler(d)
             self._handlers[0x080 + d.node_id] = self._emcy_handler(d)
-            self._handlers[0x580 + d.node_id] = self._sdo_handler(d)
+            self._handlers[0x580 + d.node_id] = d.sdo.on_response
         self._queue: collections.deque[can.Message] | None = None
         self._notifier: can.Notifier | None = None
         if receive == "notifier":
@@ -316,67 +321,12 @@ class CanOpenDrives(KnobDrives):
         self.sdo_download(drive, index, subindex, data)
 
     def sdo_upload(self, drive: int, index: int, subindex: int = 0) -> bytes:
-        d = self._drives[drive]
-        what = f"upload 0x{index:04X}:{subindex:02X}"
-        resp = self._sdo_transfer(d, struct.pack("<BHB4x", 0x40, index, subindex), what)
-        cs = resp[0]
-        if cs & 0xE0 != 0x40:
-            raise DriveError(f"{d.name}: SDO {what}: unexpected response 0x{cs:02X}")
-        self._check_mux(d, resp, index, subindex, what)
-        if cs & 0x02:
-            size = 4 - ((cs >> 2) & 0x3) if cs & 0x01 else 4
-            return bytes(resp[4:4 + size])
-        total = struct.unpack_from("<I", resp, 4)[0] if cs & 0x01 else None
-        data = bytearray()
-        toggle = 0
-        while True:
-            seg = self._sdo_transfer(d, bytes((0x60 | toggle,)) + bytes(7), what)
-            if seg[0] & 0xE0 != 0x00 or seg[0] & 0x10 != toggle:
-                raise DriveError(f"{d.name}: SDO {what}: bad segment 0x{seg[0]:02X}")
-            unused = (seg[0] >> 1) & 0x7
-            data += seg[1:8 - unused]
-            if seg[0] & 0x01:
-                break
-            toggle ^= 0x10
-        if total is not None and len(data) != total:
-            raise DriveError(f"{d.name}: SDO {what}: got {len(data)} bytes, announced {total}")
-        return bytes(data)
+        """Raw SDO upload (expedited or segmented); raises DriveError on abort or timeout."""
+        return self._drives[drive].sdo.upload(index, subindex)
 
     def sdo_download(self, drive: int, index: int, subindex: int, data: bytes) -> None:
-        d = self._drives[drive]
-        what = f"download 0x{index:04X}:{subindex:02X}"
-        if not 1 <= len(data) <= 4:
-            raise DriveError(f"{d.name}: SDO {what}: only 1..4 byte values are supported")
-        cs = 0x23 | ((4 - len(data)) << 2)
-        request = struct.pack("<BHB", cs, index, subindex) + bytes(data).ljust(4, b"\x00")
-        resp = self._sdo_transfer(d, request, what)
-        if resp[0] != 0x60:
-            raise DriveError(f"{d.name}: SDO {what}: unexpected response 0x{resp[0]:02X}")
-        self._check_mux(d, resp, index, subindex, what)
-
-    def _sdo_transfer(self, d: _Drive, request: bytes, what: str) -> bytes:
-        d.sdo_response = None
-        self._send(0x600 + d.node_id, request)
-        deadline = self.clock.now_s() + self.sdo_timeout_s
-        while d.sdo_response is None:
-            if self.clock.now_s() > deadline:
-                raise DriveError(f"{d.name}: SDO {what} timed out after {self.sdo_timeout_s} s "
-                                 f"(no answer from node {d.node_id})")
-            self._wait()
-        resp = d.sdo_response
-        if len(resp) != 8:
-            raise DriveError(f"{d.name}: SDO {what}: malformed response of {len(resp)} bytes")
-        if resp[0] == 0x80:
-            code = struct.unpack_from("<I", resp, 4)[0]
-            raise DriveError(f"{d.name}: SDO {what} aborted with 0x{code:08X}: "
-                             f"{o.abort_meaning(code)}")
-        return resp
-
-    @staticmethod
-    def _check_mux(d: _Drive, resp: bytes, index: int, subindex: int, what: str) -> None:
-        got = struct.unpack_from("<HB", resp, 1)
-        if got != (index, subindex):
-            raise DriveError(f"{d.name}: SDO {what}: answer is for 0x{got[0]:04X}:{got[1]:02X}")
+        """Raw expedited SDO download of 1..4 bytes; raises DriveError on abort or timeout."""
+        self._drives[drive].sdo.download(index, subindex, data)
 
     def _variable(self, d: _Drive, index: int, subindex: int) -> ODVariable:
         try:
@@ -601,12 +551,6 @@ class CanOpenDrives(KnobDrives):
                         f"(error register 0x{register:02X})", code)
 
         return on_emcy
-
-    def _sdo_handler(self, d: _Drive) -> Callable[[bytearray], None]:
-        def on_sdo(data: bytearray) -> None:
-            d.sdo_response = bytes(data)
-
-        return on_sdo
 
     def _unknown(self, msg: can.Message) -> None:
         cob = msg.arbitration_id

@@ -198,3 +198,9 @@ def test_boot_writes_mode_period_limits_and_heartbeats_to_the_drive(rig_pair):
     }
     got = {key: drives.sdo_read(0, *key) for key in expected}
     assert got == expected
+
+
+def test_segmented_sdo_upload_reads_the_device_name(rig_pair):
+    drives, _ = rig_pair
+    drives.boot()
+    assert drives.sdo_read(1, 0x1008) == "tsmd simulated knob drive"

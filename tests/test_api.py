@@ -21,6 +21,7 @@ from test_loop_fakes import FakeDrives
 from drivers.clock import MonotonicClock
 from tsmd.api.client import ApiClient, ApiClientError
 from tsmd.api.handlers import ApiHandlers
+from tsmd.api.protocol import Request, ok
 from tsmd.api.server import ApiServer
 from tsmd.config import TsmdConfig
 from tsmd.daemon import CompensationChoice, Controller, knob_limits, make_compensator
@@ -393,3 +394,33 @@ def test_profile_loads_a_catheter_and_compensation_follows_it(tmp_path: Path) ->
     finally:
         s.stop.set()
         s.server.stop()
+
+
+def test_a_second_daemon_does_not_steal_a_live_socket(stack: Stack) -> None:
+    from tsmd.api.server import ApiServerError
+
+    async def handler(*_: object) -> dict[str, object]:
+        return {}
+
+    with pytest.raises(ApiServerError, match="another daemon"):
+        ApiServer(stack.path, handler).start()
+    with stack.client() as c:
+        assert c.call("status")["ok"]
+
+
+def test_a_stale_socket_file_is_replaced(tmp_path: Path) -> None:
+    path = tmp_path / "old.sock"
+    old = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    old.bind(str(path))
+    old.close()  # a daemon that died left its socket file behind
+
+    async def handler(request: Request, conn: object) -> dict[str, object]:
+        return ok(request.id, pong=True)
+
+    server = ApiServer(path, handler)
+    server.start()
+    try:
+        with ApiClient(path) as c:
+            assert c.call("status")["pong"] is True
+    finally:
+        server.stop()

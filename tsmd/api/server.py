@@ -12,6 +12,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import os
+import socket
 import stat
 import threading
 import time
@@ -89,6 +90,18 @@ class Connection:
 
 
 Handler = Callable[[Request, Connection], Awaitable[dict[str, Any]]]
+
+
+def _someone_listens(path: Path) -> bool:
+    probe = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    probe.settimeout(1.0)
+    try:
+        probe.connect(str(path))
+    except OSError:
+        return False
+    finally:
+        probe.close()
+    return True
 
 
 class TokenBucket:
@@ -171,7 +184,10 @@ class ApiServer:
         if path.exists() or path.is_symlink():
             if not stat.S_ISSOCK(path.lstat().st_mode):
                 raise ApiServerError(f"{path} exists and is not a socket; refusing to replace it")
-            path.unlink()
+            if _someone_listens(path):
+                raise ApiServerError(f"another daemon is listening on {path}; stop it first "
+                                     "or choose another socket (--socket)")
+            path.unlink()  # left over by a daemon that died
         old_umask = os.umask(0o777 & ~self.mode)
         try:
             self._server = await asyncio.start_unix_server(self._client, path=str(path))

@@ -51,6 +51,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "default 16, see docs/calibration.md)")
     parser.add_argument("--no-save", action="store_true",
                         help="identify and check, print the result, do not save a profile")
+    parser.add_argument("--socket", metavar="PATH",
+                        help="daemon socket (default: api.socket_path of the config)")
     parser.add_argument("--seed", type=int, default=0, help="--sim: noise seed")
     parser.add_argument("--edge", choices=("rise", "knee"), default="rise",
                         help="dead-zone edge: 'rise' = the paper's (where the current starts to "
@@ -122,11 +124,12 @@ def _print_result(cal: Any) -> None:
 
 
 class _Bar:
-    """A one-line progress bar on a terminal (plain lines otherwise)."""
+    """A one-line progress bar on a terminal; a line per sweep and per 10 % otherwise."""
 
     def __init__(self) -> None:
         self.tty = sys.stderr.isatty()
         self.last = ""
+        self.last_key: tuple[str, int] = ("", -1)
 
     def __call__(self, fraction: float, text: str) -> None:
         width = 30
@@ -135,8 +138,12 @@ class _Bar:
         if self.tty:
             sys.stderr.write("\r" + line[:150].ljust(len(self.last)))
             sys.stderr.flush()
-        elif text.split(";")[0] != self.last.split(";")[0].split("% ", 1)[-1]:
-            sys.stderr.write(line + "\n")
+        else:
+            key = (text.split(":")[0], int(fraction * 10))
+            if key != self.last_key:
+                sys.stderr.write(line + "\n")
+                sys.stderr.flush()
+            self.last_key = key
         self.last = line
 
     def done(self) -> None:
@@ -194,8 +201,7 @@ def _from_recordings(args: argparse.Namespace) -> int:
 
 
 def _via_daemon(args: argparse.Namespace) -> int:
-    config = _config(args, sim=False)
-    path = config.api.socket_path
+    path = args.socket or _config(args, sim=False).api.socket_path
     bar = _Bar()
     try:
         sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
@@ -203,7 +209,7 @@ def _via_daemon(args: argparse.Namespace) -> int:
     except OSError as exc:
         raise TsmdError(f"cannot reach the daemon at {path}: {exc.strerror or exc} "
                         "(is 'tsmd run' running? use --sim for the simulator)") from None
-    request = {"id": "calibrate", "cmd": "calibrate", "params": {"catheter": args.catheter}}
+    request = {"id": "calibrate", "cmd": "calibrate", "catheter": args.catheter}
     sock.sendall((json.dumps(request) + "\n").encode())
     stream = sock.makefile("rb")
     cancelled = False
@@ -221,8 +227,8 @@ def _via_daemon(args: argparse.Namespace) -> int:
                 raise TsmdError("the daemon closed the connection during calibration")
             message = json.loads(line)
             if message.get("event") == "progress":
-                info = message.get("info") or []
-                bar(float(message.get("progress", 0.0)), str(info[0]) if info else "")
+                info = message.get("info") or [""]
+                bar(float(message.get("progress", 0.0)), str(message.get("status", info[0])))
                 continue
             if message.get("id") != "calibrate":
                 continue

@@ -206,7 +206,7 @@ class CanOpenDrives(KnobDrives):
         def command(d: _Drive) -> int | None:
             if d.state is DriveState.FAULT:
                 raise DriveError(f"{d.name}: cannot enable, drive is in FAULT "
-                                 f"({self._emcy_text(d)}); call fault_reset first")
+                                 f"({self._error_code_text(d)}); call fault_reset first")
             return cia402.next_command_to_enable(d.state, d.config.quick_stop_option,
                                                 d.controlword)
 
@@ -608,6 +608,14 @@ class CanOpenDrives(KnobDrives):
                            code=code)
         with self._lock:
             self._events.append(event)
+
+    def _error_code_text(self, d: _Drive) -> str:
+        """0x603F read from the drive (falls back to the last EMCY if the read fails)."""
+        try:
+            code = int(self.sdo_read(d.index, o.ERROR_CODE))
+        except DriveError:
+            return self._emcy_text(d)
+        return f"0x603F error code 0x{code:04X} {o.emcy_meaning(code)}"
 
     @staticmethod
     def _emcy_text(d: _Drive) -> str:

@@ -118,7 +118,8 @@ def test_fault_then_reset_then_enable_resumes_streaming(enabled):
     drives, rig = enabled
     rig.inject_fault("emcy", drive=1, code=0x4310)
     tick(drives, rig, n=3)
-    with pytest.raises(DriveError, match=r"drive 1 \(node 2\).*FAULT.*0x4310"):
+    with pytest.raises(DriveError, match=r"drive 1 \(node 2\): cannot enable, drive is in FAULT "
+                                         r"\(0x603F error code 0x4310 drive over-temperature\)"):
         drives.enable()
     drives.fault_reset()
     assert drives.feedback()[1].state is DriveState.SWITCH_ON_DISABLED

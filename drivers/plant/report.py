@@ -108,6 +108,65 @@ def signature(rec: SweepRecord) -> Signature:
     )
 
 
+def coupling_grid(
+    params: dict[str, Any], knob: int = 0, others_deg: Sequence[float] = tuple(range(-90, 91, 30))
+) -> list[DeadZoneBacklash]:
+    """D/B of one knob with the other held at each angle (the calibration protocol's grid)."""
+    return [
+        measure_dead_zone_backlash(
+            *_knob_tip(run_sweep(make_tendon_sheath_plant(**params), knob, other_deg=o))
+        )
+        for o in others_deg
+    ]
+
+
+def _knob_tip(rec: SweepRecord) -> tuple[FloatArray, FloatArray]:
+    return rec.knob_deg, rec.tip_deg
+
+
+def plot_grid(others_deg: Sequence[float], grid: Sequence[DeadZoneBacklash], path: str) -> None:
+    """D and B of knob 1 over the other knob's angle."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    arr = np.array(grid)
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(9.0, 3.4))
+    ax1.plot(others_deg, arr[:, 0], "o-", label="D_pos")
+    ax1.plot(others_deg, -arr[:, 1], "s-", label="-D_neg")
+    ax1.set_ylabel("dead zone (deg)")
+    ax2.plot(others_deg, arr[:, 2], "o-", label="B_pos")
+    ax2.plot(others_deg, arr[:, 3], "s-", label="B_neg")
+    ax2.set_ylabel("backlash (deg)")
+    for ax in (ax1, ax2):
+        ax.set_xlabel("other knob angle (deg)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle("Knob 1 with coupling=1.0, +-90 deg at 0.04 Hz (tip-based D/B)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def protocol_cpu_s(params: dict[str, Any], dt_s: float = 0.004) -> tuple[int, float]:
+    """CPU time of the plant over the 700 s calibration protocol (14 sweeps of 50 s)."""
+    plant = make_tendon_sheath_plant(**params)
+    t = np.arange(0.0, 50.0, dt_s)
+    sweep = 90.0 * np.sin(2.0 * np.pi * 0.04 * t)
+    steps = 0
+    c0 = time.process_time()
+    for knob in (0, 1):
+        for other in range(-90, 91, 30):
+            cmd = np.zeros(2)
+            cmd[1 - knob] = other
+            for qi in sweep:
+                cmd[knob] = qi
+                plant.step(dt_s, cmd)
+                steps += 1
+    return steps, time.process_time() - c0
+
+
 def _parse_set(items: Sequence[str]) -> dict[str, Any]:
     params: dict[str, Any] = {}
     for item in items:
@@ -168,6 +227,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--freq", type=float, default=0.04, help="sweep frequency (Hz)")
     parser.add_argument("--other", type=float, default=0.0, help="other knob's angle (deg)")
     parser.add_argument("--plot", metavar="PNG", help="write the sweep figure here")
+    parser.add_argument(
+        "--grid",
+        metavar="PNG",
+        help="also sweep knob 1 with the other at -90..90 step 30 and plot D/B",
+    )
+    parser.add_argument(
+        "--protocol",
+        action="store_true",
+        help="also time the plant over the 700 s calibration protocol",
+    )
     args = parser.parse_args(argv)
     try:
         params = _parse_set(args.set)
@@ -204,6 +273,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.plot:
         plot(records, sigs, args.plot)
         print(f"wrote {args.plot}")
+    if args.grid:
+        others = [float(o) for o in range(-90, 91, 30)]
+        grid = coupling_grid(params, 0, others)
+        print("knob 1 over the other knob's angle: other  D_pos  D_neg  B_pos  B_neg (deg)")
+        for o, m in zip(others, grid, strict=True):
+            print(f"  {o:6.0f} {m[0]:6.1f} {m[1]:6.1f} {m[2]:6.1f} {m[3]:6.1f}")
+        plot_grid(others, grid, args.grid)
+        print(f"wrote {args.grid}")
+    if args.protocol:
+        steps, cpu = protocol_cpu_s(params)
+        print(
+            f"700 s protocol: {steps} steps, plant CPU {cpu:.2f} s, {cpu / steps * 1e6:.1f} us/step"
+        )
     return 0
 
 

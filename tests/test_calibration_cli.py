@@ -1,0 +1,50 @@
+"""`tsmd calibrate`: user errors are one line and exit code 2; offline identification prints."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from tsmd.cli import main
+from tsmd.tee import default_tee_dir
+
+DEVICE = str(Path(__file__).resolve().parent.parent / "profiles" / "devices"
+             / "sim-catheter.yaml")
+
+
+def test_a_malformed_recording_is_one_line_and_exit_2(tmp_path: Path,
+                                                      capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.csv"
+    bad.write_text("x,y\n1,2\n")
+    code = main(["calibrate", "--catheter", "c1", "--device", DEVICE,
+                 "--profiles", str(tmp_path), "--from-recording", str(bad)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "missing column" in err and len(err.strip().splitlines()) == 1
+    assert not list(tmp_path.glob("*.yaml"))
+
+
+def test_an_unreachable_daemon_is_named(tmp_path: Path,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["calibrate", "--catheter", "c1", "--socket", str(tmp_path / "none.sock")])
+    assert code == 2
+    assert "cannot reach the daemon" in capsys.readouterr().err
+
+
+def test_fast_needs_the_simulator_or_recordings(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["calibrate", "--catheter", "c1", "--fast", "--socket", "/x"]) == 2
+    assert "--fast needs --sim" in capsys.readouterr().err
+
+
+@pytest.mark.realdata
+@pytest.mark.skipif(not default_tee_dir().is_dir(), reason="no TEE data")
+def test_tee_files_are_identified_and_the_profile_refused(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    files = sorted(default_tee_dir().glob("motor*_current60__First_acquisition.csv"))
+    code = main(["calibrate", "--catheter", "tee", "--device", DEVICE, "--profiles",
+                 str(tmp_path), "--from-recording", *map(str, files)])
+    captured = capsys.readouterr()
+    assert "| phi1 sweep, phi2 at +0 deg | phi1 |" in captured.out
+    assert code == 2 and "calibration refused" in captured.err
+    assert not list(tmp_path.glob("*.yaml"))

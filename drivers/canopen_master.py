@@ -258,11 +258,7 @@ class CanOpenDrives(KnobDrives):
             self._send_msg(d.pack_rpdo())
 
     def sync(self) -> None:
-        now = self.clock.now_s()
-        nxt = self._next_heartbeat_s
-        if nxt is None or now >= nxt - 1e-9:
-            self._next_heartbeat_s = now + self.master_heartbeat_s
-            self._send_msg(self._hb_msg)
+        self._heartbeat_if_due()
         self._send_msg(self._sync_msg)
         self.syncs_sent += 1
         for d in self._drives:
@@ -460,12 +456,18 @@ class CanOpenDrives(KnobDrives):
             self.idle()
         else:
             time.sleep(min(self.period_s, 0.001))
+        self._heartbeat_if_due()
+        self.pump()
+
+    def _heartbeat_if_due(self) -> None:
+        """Master heartbeat (what the drives' 0x1016 consumers watch), at its period on average."""
         now = self.clock.now_s()
         nxt = self._next_heartbeat_s
         if nxt is None or now >= nxt - 1e-9:
-            self._next_heartbeat_s = now + self.master_heartbeat_s
+            period = self.master_heartbeat_s
+            nxt = now + period if nxt is None else nxt + period
+            self._next_heartbeat_s = nxt if nxt > now else now + period
             self._send_msg(self._hb_msg)
-        self.pump()
 
     def _wait_until(self, done: Callable[[_Drive], bool], timeout_s: float, what: str) -> None:
         deadline = self.clock.now_s() + timeout_s

@@ -378,7 +378,10 @@ class SimDriveNode:
                 self._emit(self._tpdo_cob, data)
         period_ms = self._hb_period_ms
         if period_ms and now_s >= self._next_heartbeat_s - 1e-9:
-            self._next_heartbeat_s = now_s + period_ms * 1e-3
+            # keep the period on average even when ticks do not divide it
+            period_s = period_ms * 1e-3
+            nxt = self._next_heartbeat_s + period_s
+            self._next_heartbeat_s = nxt if nxt > now_s else now_s + period_s
             if not self.heartbeat_stopped:
                 self._emit(0x700 + self.node_id, bytes((self.nmt_state,)))
         elif not period_ms:

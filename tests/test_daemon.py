@@ -209,3 +209,51 @@ def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: 
     (log,) = tmp_path.glob(f"tsmd-can-*.{fmt}")
     ids = [m.arbitration_id for m in can.LogReader(str(log))]
     assert ids == [0x080, 0x181]
+
+
+def test_live_runner_plays_a_trajectory_on_the_running_daemon(tmp_path: Path) -> None:
+    import dataclasses
+
+    import numpy as np
+
+    from tsmd.config import default_sim_config
+    from tsmd.daemon import Daemon
+    from tsmd.replay import LiveTrajectoryRunner
+
+    base = default_sim_config()
+    config = dataclasses.replace(base, profiles=dataclasses.replace(base.profiles, active=None))
+    daemon = Daemon(config, sim=True, api=False)
+    daemon.start()
+    try:
+        assert daemon.loop is not None
+        daemon.loop.post("enable").result(timeout=10)
+        t = np.linspace(0.0, 1.0, 11)
+        q = np.column_stack([20.0 * t, -10.0 * t])
+        fractions: list[float] = []
+        rec = LiveTrajectoryRunner(daemon.loop, poll_s=0.05).run(t, q, compensate=False,
+                                                                progress=fractions.append)
+    finally:
+        daemon.stop()
+    assert len(rec) == 251
+    assert rec["q1"][-1] == pytest.approx(20.0)
+    assert rec["pos1"][-1] == pytest.approx(20.0, abs=1.5)
+    assert fractions and fractions == sorted(fractions)
+
+
+def test_sigint_stops_cleanly_too(tmp_path: Path) -> None:
+    notify = notify_socket(tmp_path)
+    env = dict(os.environ, NOTIFY_SOCKET=str(tmp_path / "notify.sock"))
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "tsmd", "run", "--sim", "--no-demo", "--socket",
+         str(tmp_path / "s.sock")], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env=env, cwd=tmp_path)
+    try:
+        read_notifications(notify, "READY=1")
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert "final state DISABLED" in out

@@ -204,3 +204,22 @@ def test_segmented_sdo_upload_reads_the_device_name(rig_pair):
     drives, _ = rig_pair
     drives.boot()
     assert drives.sdo_read(1, 0x1008) == "tsmd simulated knob drive"
+
+
+def test_feedback_is_in_knob_degrees_and_amperes_within_one_raw_unit():
+    from drivers.sim.rig import IdealCurrentSensor
+
+    drives, rig = open_sim_rig(SpringPlant(), None, PERIOD_S, seed=0,
+                               rig_kwargs={"sensors": [IdealCurrentSensor(),
+                                                       IdealCurrentSensor()]})
+    try:
+        drives.boot()
+        drives.enable()
+        run(drives, rig, np.linspace([0.0, 0.0], [45.0, -20.0], 300))
+        cfg = DriveConfig(node_id=1)
+        for fb, motor in zip(drives.feedback(), rig.motors, strict=True):
+            assert abs(fb.position_deg - motor.position_deg) <= 0.5 / cfg.counts_per_deg
+            assert abs(fb.current_A - motor.current_A) <= 0.5 * cfg.current_scale_A + 1e-12
+    finally:
+        drives.close()
+        rig.close()

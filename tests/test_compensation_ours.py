@@ -185,3 +185,21 @@ def test_fit_refuses_sweeps_without_identified_parameters() -> None:
 def test_lag_estimate_recovers_a_known_delay() -> None:
     s = _sweep(20, -20, 18, 18, 0.0, delay_s=0.02)
     assert estimate_lag_s(s.t_s, s.cmd_deg, s.pos_deg) == pytest.approx(0.02, abs=0.002)
+
+
+def test_dead_zone_jump_starts_before_the_desired_angle_reaches_the_plateau() -> None:
+    profile = make_profile(d0=20.0)
+    paper = build_compensator(profile, "paper", 0.004)
+    ours = build_compensator(profile, "ours", 0.004)
+    t = np.arange(0.0, 4.0, 0.004)
+    q = np.column_stack([-30.0 + 15.0 * t, np.zeros_like(t)])  # up through the dead zone
+    first_jump = {}
+    for name, comp in (("paper", paper), ("ours", ours)):
+        comp.reset(q[0])
+        cmd = np.array([comp.command(r)[0] for r in q])
+        first_jump[name] = int(np.flatnonzero(np.diff(cmd) > 5.0)[-1])  # the dead-zone jump
+        assert np.all(np.diff(cmd) >= -1e-9), name  # never steps back: no false reversal
+    assert first_jump["ours"] < first_jump["paper"]
+    # by about half the crossing time of the jump at 120 deg/s (~40 deg -> ~0.2 s)
+    lead_s = (first_jump["paper"] - first_jump["ours"]) * 0.004
+    assert 0.1 < lead_s < 0.35

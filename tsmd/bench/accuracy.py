@@ -439,6 +439,10 @@ def main(args: argparse.Namespace) -> int:
                 if source == "calibrate":
                     raise TsmdError("tsmd.calibration.calibrate is not available") from None
                 print("tsmd.calibration.calibrate not available: using the ground truth")
+            except TsmdError as exc:
+                if source == "calibrate":
+                    raise
+                print(f"tsmd calibrate refused this plant ({exc}): using the ground truth")
         if profile is None:
             print("measuring D/B on the simulated tracker's tip (ground truth) ...", flush=True)
             profile = ground_truth_profile(device, plant_factory)

@@ -103,7 +103,9 @@ def paper_compensator(profile: CatheterProfile) -> PaperCompensator:
     return PaperCompensator((knobs[0], knobs[1]))
 
 
-def ours_compensator(profile: CatheterProfile, period_s: float) -> OursCompensator:
+def ours_compensator(profile: CatheterProfile, period_s: float,
+                     max_velocity_deg_s: float = 120.0,
+                     max_accel_deg_s2: float = 2000.0) -> OursCompensator:
     knobs = []
     for name, k in zip(("phi1", "phi2"), profile.knobs, strict=True):
         if k.ours is None:
@@ -116,7 +118,7 @@ def ours_compensator(profile: CatheterProfile, period_s: float) -> OursCompensat
             o.release_pivot_pos_deg, o.release_pivot_neg_deg, o.backlash_blend_deg]).astype(float)
         knobs.append(OursKnob(ParameterField(k.other_knob_deg, values, profile.interpolation),
                               k.height_pos_deg, k.height_neg_deg, k.omega, k.ours.lag_s))
-    return OursCompensator((knobs[0], knobs[1]), period_s)
+    return OursCompensator((knobs[0], knobs[1]), period_s, max_velocity_deg_s, max_accel_deg_s2)
 
 
 def build_compensator(profile: CatheterProfile | None, method: str, period_s: float,
@@ -134,7 +136,10 @@ def build_compensator(profile: CatheterProfile | None, method: str, period_s: fl
     elif method == "paper":
         inner = paper_compensator(profile)
     else:
-        inner = ours_compensator(profile, period_s)
+        # the motor's limits set when a jump must start; the simulated rig's when not given
+        v_max = min(lim.max_velocity_deg_s for lim in limits) if limits else 120.0
+        a_max = min(lim.max_accel_deg_s2 for lim in limits) if limits else 2000.0
+        inner = ours_compensator(profile, period_s, v_max, a_max)
     if limits is None:
         return inner
     return LimitedCompensator(inner, limits, period_s)

@@ -297,18 +297,43 @@ class OursKnob:
 class OursCompensator:
     """Two knobs. Each knob's parameters follow where the other knob would sit on its loaded
     branch for the other tip's desired angle (the coupling acts through the bent section, and
-    calibration held the other knob on its loaded branch); each leads by its drive's lag."""
+    calibration held the other knob on its loaded branch); each leads by its drive's lag.
 
-    def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float) -> None:
+    Jumps across the dead zone are centred: the motor needs about
+    ``W / max_velocity + max_velocity / max_accel`` to cross a dead zone of width W, during which the tip stays on the plateau whatever is commanded. The
+    paper starts the crossing when the desired angle reaches the plateau, so the whole crossing
+    time is lag. Ours looks ahead half the crossing time along the desired velocity and, if a
+    jump lies there, starts it; the command then holds (never steps back, which would be a
+    reversal) until the desired angle catches up.
+    """
+
+    def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,
+                 max_velocity_deg_s: float = 120.0, max_accel_deg_s2: float = 2000.0) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be positive, got {period_s}")
+        if not (max_velocity_deg_s > 0 and max_accel_deg_s2 > 0):
+            raise ValueError("max_velocity_deg_s and max_accel_deg_s2 must be positive")
         self.knobs = knobs
         self.period_s = period_s
+        self.max_velocity_deg_s = max_velocity_deg_s
+        self.max_accel_deg_s2 = max_accel_deg_s2
         self._states: list[OursState] = []
         self._q_prev = np.zeros(2)
         self._v_deg_s = np.zeros(2)
         self._axis = np.zeros(2)  # grid coordinate of each knob as seen by the other
+        self._out = np.zeros(2)
+        self._hold = [0, 0]  # direction of a jump started early, 0 = none
+        self._cache: list[tuple[float, Envelopes] | None] = [None, None]
         self.reset(np.zeros(2))
+
+    def _envelopes(self, i: int) -> Envelopes:
+        """Envelopes of knob i at the other knob's grid coordinate (cached while it is still)."""
+        key = round(float(self._axis[1 - i]), 3)
+        cached = self._cache[i]
+        if cached is None or cached[0] != key:
+            cached = (key, self.knobs[i].envelopes(key))
+            self._cache[i] = cached
+        return cached[1]
 
     def _update_axis(self, q: NDArray[np.float64]) -> None:
         axis = self._axis.copy()
@@ -323,11 +348,12 @@ class OursCompensator:
         self._q_prev = q.copy()
         self._v_deg_s = np.zeros(2)
         self._axis = np.zeros(2)
+        self._hold = [0, 0]
         for _ in range(3):  # settle the mutual dependence
             self._update_axis(q)
         states = []
-        for i, knob in enumerate(self.knobs):
-            env = knob.envelopes(float(self._axis[1 - i]))
+        for i in range(2):
+            env = self._envelopes(i)
             lo, hi = env.falling_inverse(q[i]), env.rising_inverse(q[i])
             if lo <= 0.0 <= hi:
                 x, d = 0.0, 1
@@ -335,6 +361,7 @@ class OursCompensator:
                 x, d = (lo, -1) if hi < 0.0 else (hi, 1)
             states.append(OursState(x, float(q[i]), d, float(q[i]), 0.0))
         self._states = states
+        self._out = np.array([st.x_deg for st in states])
 
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         q = np.asarray(q_deg, dtype=float)
@@ -343,18 +370,43 @@ class OursCompensator:
         # velocity of the desired trajectory, lightly filtered, for the lag lead
         self._v_deg_s = 0.7 * self._v_deg_s + 0.3 * (q_ok - self._q_prev) / self.period_s
         self._update_axis(q_ok)
-        out = np.empty(2)
         for i, knob in enumerate(self.knobs):
-            state = self._states[i]
-            if ok[i]:
-                lead = float(np.clip(knob.lag_s * self._v_deg_s[i], -_MAX_LEAD_DEG,
-                                     _MAX_LEAD_DEG))
-                env = knob.envelopes(float(self._axis[1 - i]))
-                state = ours_inverse_step(state, float(q[i]) + lead, env)
-                self._states[i] = state
-            out[i] = state.x_deg
+            if not ok[i]:
+                continue  # hold the last command
+            v = float(self._v_deg_s[i])
+            lead = float(np.clip(knob.lag_s * v, -_MAX_LEAD_DEG, _MAX_LEAD_DEG))
+            env = self._envelopes(i)
+            state = ours_inverse_step(self._states[i], float(q[i]) + lead, env)
+            self._states[i] = state
+            self._out[i] = self._centred(i, state, float(q[i]) + lead, v, env)
         self._q_prev = q_ok
-        return out
+        return self._out.copy()
+
+    def _centred(self, i: int, state: OursState, target: float, v: float,
+                 env: Envelopes) -> float:
+        x = state.x_deg
+        d = state.direction
+        prev = float(self._out[i])
+        if self._hold[i] != 0:
+            if self._hold[i] == d and (x - prev) * d < 0:
+                return prev  # the desired angle has not caught up with the early jump yet
+            self._hold[i] = 0
+        speed = abs(v)
+        if speed < 1e-3 or np.sign(v) != d:
+            return x
+        # Look as far ahead as half the crossing time of a wide (60 deg) jump; if a jump is
+        # there, look again at half the crossing time of that jump and start it when inside.
+        horizon_s = 0.5 * 60.0 / self.max_velocity_deg_s
+        for _ in range(2):
+            ahead = ours_inverse_step(state, target + v * horizon_s, env).x_deg
+            expected = speed * horizon_s / env.omega
+            jump = (ahead - x) * d - expected
+            if jump <= expected + 3.0:
+                return x  # no jump within the horizon
+            horizon_s = 0.5 * (jump / self.max_velocity_deg_s
+                               + self.max_velocity_deg_s / self.max_accel_deg_s2)
+        self._hold[i] = d
+        return ahead
 
 
 # ----------------------------------------------------------------------------------------------

@@ -130,8 +130,21 @@ def test_torque_changes_sign_after_a_reversal_and_stays_near_zero_while_released
     q, tau = s.knob_deg[after], s.torque_Nm[after]
     released = (q < 90.0 - m.backlash_pos_deg - 2.0) & (q > m.dead_zone_pos_deg + 5.0)
     assert tau[0] > 0.8 * peak
-    assert np.any(tau < 0.0)  # the sign changes
+    assert np.all(tau[q < 87.0] < 0.0)  # sharp: the sign has changed within 3 deg
     assert np.max(np.abs(tau[released])) < 0.1 * peak
+
+
+def test_torque_makes_a_small_peak_after_reversal_then_settles(default_sweep: Sweep) -> None:
+    s = default_sweep
+    i_rev = int(np.argmax(s.knob_deg[: int(25.0 / DT_S)]))
+    window = slice(i_rev, i_rev + int(8.0 / DT_S))
+    released = s.knob_deg[window] > 30.0  # before the other tendon engages
+    q, tau = s.knob_deg[window][released], s.torque_Nm[window][released]
+    i_peak = int(np.argmin(tau))
+    settled = float(np.median(tau[(q < q[i_peak] - 5.0) & (q > q[i_peak] - 15.0)]))
+    assert 90.0 - q[i_peak] < 6.0  # right after the reversal
+    assert tau[i_peak] < settled - 0.1 * abs(settled)  # a peak ...
+    assert tau[i_peak] - settled > -0.05 * np.max(s.torque_Nm)  # ... and a small one
 
 
 def test_reset_returns_to_the_straight_unloaded_state() -> None:

@@ -300,11 +300,12 @@ class OursCompensator:
     calibration held the other knob on its loaded branch); each leads by its drive's lag.
 
     Jumps across the dead zone are centred: the motor needs about
-    ``W / max_velocity + max_velocity / max_accel`` to cross a dead zone of width W, during which the tip stays on the plateau whatever is commanded. The
-    paper starts the crossing when the desired angle reaches the plateau, so the whole crossing
-    time is lag. Ours looks ahead half the crossing time along the desired velocity and, if a
-    jump lies there, starts it; the command then holds (never steps back, which would be a
-    reversal) until the desired angle catches up.
+    ``W / max_velocity + max_velocity / max_accel`` to cross a dead zone of width W, during
+    which the tip stays on the plateau whatever is commanded. The paper starts the crossing when
+    the desired angle reaches the plateau, so the whole crossing time is lag. Ours looks ahead
+    half the crossing time along the desired velocity and, if a jump lies there, starts it; the
+    command then holds (never steps back, which would be a reversal) until the desired angle
+    catches up.
     """
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,

@@ -189,8 +189,10 @@ def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: 
     from tsmd.daemon import Daemon
 
     base = TsmdConfig()
+    rt = dataclasses.replace(base.loop.realtime, priority=0)  # leave pytest's thread alone
     config = dataclasses.replace(
-        base, bus=dataclasses.replace(base.bus, log_format=fmt),  # type: ignore[arg-type]
+        base, loop=dataclasses.replace(base.loop, realtime=rt),
+        bus=dataclasses.replace(base.bus, log_format=fmt),  # type: ignore[arg-type]
         recording=dataclasses.replace(base.recording, dir=str(tmp_path)))
     daemon = Daemon(config)
     channel = f"tsmd-canlog-{os.getpid()}-{fmt}"

@@ -34,7 +34,7 @@ from tsmd.errors import TsmdError
 from tsmd.log import EventLog, get_logger
 from tsmd.loop import BackgroundRecorder, ControlLoop, KnobLimiter, KnobRange, LoopError
 from tsmd.notify import Notifier, watchdog_interval_s
-from tsmd.rt import FixedRateScheduler, RealtimeReport, apply_realtime
+from tsmd.rt import FixedRateScheduler, RealtimeReport, apply_realtime, set_fifo
 
 PACKAGE_ROOT = Path(__file__).resolve().parent.parent
 
@@ -265,6 +265,12 @@ class Daemon:
         self.sim = sim
         self.api = api
         self.log = get_logger("tsmd")
+        self._helper_rt_warning: str | None = None
+        if config.loop.realtime.priority > 1:
+            # Every thread created from here on (log, API, recorder, simulated rig) inherits
+            # SCHED_FIFO 1: a thread holding the GIL is then never descheduled by ordinary
+            # processes while the loop thread (priority above) waits for the GIL.
+            self._helper_rt_warning = set_fifo(1)
         self.events = EventLog(self.log)
         self._socket_override = socket_path
         self._profile_path = profile_path
@@ -491,6 +497,9 @@ class Daemon:
             time.sleep(loop.period_s)  # READY means the loop is ticking
         if loop.latest_sample is None:
             raise DaemonError("the control loop did not start ticking", "loop")
+        if self._helper_rt_warning is not None:
+            self.log.warning("real-time setting not applied",
+                             reason=f"helper threads: {self._helper_rt_warning}")
         for warning in self.rt_report.warnings if self.rt_report else []:
             self.log.warning("real-time setting not applied", reason=warning)
 

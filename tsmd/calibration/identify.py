@@ -191,7 +191,7 @@ def _slope(y: FloatArray, step: float) -> float:
 def _pieces(yg: FloatArray, noise: float, opts: IdentifyOptions) -> list[tuple[int, int]]:
     """Linear pieces of the current against angle (ruptures PELT, continuous linear cost)."""
     penalty = max(opts.penalty_k * noise ** 2 * math.log(max(yg.size, 2)), 1e-15)
-    jump = max(1, yg.size // 400)
+    jump = max(2, yg.size // 400)
     algo = rpt.Pelt(model="clinear", min_size=2, jump=jump).fit(yg)
     bkps = [int(b) for b in algo.predict(pen=penalty)]
     return list(zip([0, *bkps[:-1]], bkps, strict=True))

@@ -93,13 +93,13 @@ def paper_protocol(grid_deg: tuple[float, ...] = GRID_DEG,
 
 
 def fast_protocol(grid_deg: tuple[float, ...] = GRID_DEG, amplitude_deg: float = 90.0,
-                  frequency_hz: float = 0.1, cycles: float = 1.5) -> Protocol:
-    """Beyond the paper: constant-speed triangle sweeps, 1.5 cycles at 0.1 Hz (210 s in all).
+                  frequency_hz: float = 0.125, cycles: float = 2.0) -> Protocol:
+    """Beyond the paper: constant-speed triangle sweeps, 2 cycles at 0.125 Hz (224 s in all).
 
     Identification works on current against knob angle, so the time per degree only has to be
     long against the current sensor's lag; a triangle spends equal time on every degree (a sine
-    rushes through the middle, where the dead-zone edges are). 1.5 cycles still give each
-    dead-zone edge twice (agreement check) and each backlash once per direction.
+    rushes through the middle, where the dead-zone edges are). Two cycles keep the agreement
+    check on every parameter.
     """
     sweeps = tuple(Sweep(knob, other, amplitude_deg, frequency_hz, cycles, "triangle")
                    for knob in (0, 1) for other in grid_deg)

@@ -204,3 +204,14 @@ def test_fast_path_matches_the_full_solve(
     full = run_sweep(make_tendon_sheath_plant(**params), cycles=0.6, other_deg=50.0)
     assert np.allclose(fast.tip_deg, full.tip_deg, atol=1e-9)
     assert np.allclose(fast.torque_Nm, full.torque_Nm, atol=1e-12)
+
+
+def test_quasi_static_results_do_not_depend_on_the_tick() -> None:
+    def measure(dt_s: float) -> np.ndarray:
+        plant = make_tendon_sheath_plant()
+        t = np.arange(0.0, 37.5, dt_s)
+        q = 90.0 * np.sin(2.0 * np.pi * 0.04 * t)
+        tip = np.array([plant.step(dt_s, np.array([qi, 0.0])).tip_deg[0] for qi in q])
+        return np.array(measure_dead_zone_backlash(q, tip))
+
+    assert np.allclose(measure(0.002), measure(0.01), atol=0.5)

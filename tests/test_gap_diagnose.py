@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import functools
 import json
 from pathlib import Path
@@ -60,6 +61,14 @@ def test_tip_drift_is_identified_and_shrinks_the_held_out_tip_error() -> None:
     assert result.verdict == "identified: drift"
     assert result.after_top is not None
     assert result.after_top["tip1_rmse_deg"] < 0.5 * result.before["tip1_rmse_deg"]
+
+
+def test_joint_refit_rescores_the_best_screened_candidates() -> None:
+    cfg = dataclasses.replace(CONFIG, joint_top=2, refine_evals=6)
+    result = diagnose([series_from_recording(_rec(tip_drift_deg_s=0.01), "r")],
+                      lambda p: StandInPlant(**p), START, cfg)
+    assert [c.stage for c in result.candidates[:2]] == ["joint", "joint"]
+    assert result.top == ["drift"]
 
 
 def test_a_disturbance_outside_the_catalogue_is_unexplained() -> None:

@@ -32,8 +32,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="plant parameters: a JSON/YAML file or an inline JSON object")
     parser.add_argument("--fit", action="append", default=None, metavar="NAME=LO:HI[@KNOB]",
                         help="a plant parameter to fit (dotted path, bounds, knob 1 or 2 whose "
-                             "channels judge it); repeat. Default for the built-in plant: "
-                             "slack per side and sheath friction of each knob")
+                             "channels judge it; 'a+b' moves a and b together); repeat. Default "
+                             "for the built-in plant: slack per side and sheath friction of "
+                             "each knob")
     parser.add_argument("--holdout", default="0.3",
                         help="held-out fraction of interleaved time blocks, or comma-separated "
                              "recording file names held out whole (default 0.3)")
@@ -41,8 +42,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="time block length in s (default: total duration / 48, >= 1 s)")
     parser.add_argument("--out", default="gap-report", help="output directory")
     parser.add_argument("--seed", type=int, default=0, help="bootstrap seed")
-    parser.add_argument("--fit-rows", type=int, default=3000,
-                        help="rows simulated per fit evaluation (thinning; default 3000)")
+    parser.add_argument("--fit-rows", type=int, default=2000,
+                        help="rows simulated per fit evaluation (thinning; default 2000)")
+    parser.add_argument("--joint-top", type=int, default=0, metavar="K",
+                        help="refit the K best screened candidates jointly with the base "
+                             "parameters (slower; default 0 = off)")
     parser.add_argument("--tee", action="store_true",
                         help="inputs are raw TEE acquisitions (converted by tsmd.tee)")
     parser.add_argument("--sizes", default="120,300",
@@ -127,7 +131,7 @@ def main(args: argparse.Namespace) -> int:
     config = GapConfig(fit_specs=specs,
                        holdout=holdout if isinstance(holdout, float) else tuple(holdout),
                        block_s=args.block_s, fit_max_rows=max(args.fit_rows, 200),
-                       seed=args.seed)
+                       joint_top=max(args.joint_top, 0), seed=args.seed)
     result = diagnose(series, _factory(args.plant, params), params, config)
     out = Path(args.out)
     md, js = write_report(result, out, ", ".join(names),

@@ -14,9 +14,12 @@ from tsmd.gap.model import Candidate, View
 from tsmd.gap.simulate import lowpass
 
 
-def play(x: NDArray[np.float64], half_width: float) -> NDArray[np.float64]:
-    """Backlash (play) operator: the output moves only once the input is ``half_width`` away."""
-    if half_width <= 0:
+def play(x: NDArray[np.float64], half_width: float | NDArray[np.float64]) -> NDArray[np.float64]:
+    """Backlash (play) operator: the output moves only once the input is ``half_width`` away.
+
+    ``half_width`` may vary per row (a friction band that widens and narrows).
+    """
+    if np.all(np.asarray(half_width) <= 0):
         return x.copy()
     y = np.empty_like(x)
     y[0] = x[0]
@@ -48,21 +51,32 @@ class KnobCoupling(Candidate):
 
 
 class RateDependence(Candidate):
-    """Viscous drag along the sheath: the tendon lags the knob more the faster it turns."""
+    """Sheath friction that grows with speed: wider backlash and more pull force when fast."""
 
     name = "rate"
     title = "rate dependence"
-    physics = ("velocity-proportional sheath drag: the tendon end follows the knob through a "
-               "first-order lag tau, so hysteresis width grows with speed (tau*velocity)")
-    param_names = ("tau_s",)
+    physics = ("velocity-strengthened sheath friction: an extra play of half-width "
+               "b*|v|/v90 between knob and tendon (v90 = 90th percentile of knob speed) and a "
+               "pull torque growing with |v|")
+    param_names = ("play_at_v90_deg",)
     lower = (0.0,)
-    upper = (1.5,)
+    upper = (15.0,)
     neutral = (0.0,)
     changes_input = True
 
     def knob(self, theta: NDArray[np.float64], view: View,
              knob_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-        return lowpass(view.t_s, knob_deg, float(theta[0]))
+        speed = np.abs(view.vel_deg_s)
+        v90 = np.maximum(np.percentile(speed, 90, axis=0), 1e-6)
+        width = theta[0] * speed / v90
+        return np.column_stack([play(knob_deg[:, j], width[:, j]) for j in range(2)])
+
+    def current_extra(self, theta: NDArray[np.float64], view: View,
+                      knob: int) -> list[NDArray[np.float64]]:
+        assert view.base_torque is not None
+        speed = np.abs(view.vel_deg_s[:, knob])
+        v90 = max(float(np.percentile(speed, 90)), 1e-6)
+        return [view.base_torque[:, knob] * speed / v90]
 
 
 class TendonCompliance(Candidate):

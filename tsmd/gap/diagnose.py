@@ -32,6 +32,7 @@ from tsmd.gap.model import (
     fit_base,
     fit_candidate,
     get_param,
+    joint_refine,
 )
 from tsmd.gap.simulate import PlantFactory
 from tsmd.gap.stats import bootstrap_ratio_ci, noise_variance, pooled_ljung_box, ptpe, rmse
@@ -45,9 +46,11 @@ class GapConfig:
     fit_specs: tuple[ParamSpec, ...] = ()
     holdout: float | tuple[str, ...] = 0.3
     block_s: float | None = None
-    fit_max_rows: int = 3000
+    fit_max_rows: int = 2000
     rank_max_rows: int = 6000
-    base_evals: int = 31
+    base_evals: int = 54
+    refine_evals: int = 10
+    joint_top: int = 0
     candidate_evals: int = 8
     seed: int = 0
     n_boot: int = 2000
@@ -71,6 +74,7 @@ class CandidateScore:
     train_cost_drop: float
     ljung_box_q: dict[str, float]
     metrics: dict[str, float]
+    stage: str = "screen"
 
 
 @dataclass
@@ -113,6 +117,7 @@ class GapResult:
                 "name": c.name, "title": c.title, "physics": c.physics, "params": c.params,
                 "share": c.share, "ci": list(c.ci), "significant": c.significant,
                 "train_cost_drop": c.train_cost_drop, "ljung_box_q": c.ljung_box_q,
+                "stage": c.stage,
                 "metrics": c.metrics} for c in self.candidates],
             "where": {
                 group: {"shares": self.where_shares[group],
@@ -203,6 +208,32 @@ def _where(views: Sequence[View], pred: Prediction) -> tuple[dict[str, dict[str,
     return shares, bins
 
 
+def _use(ev: Evaluator, params: dict[str, Any]) -> None:
+    """Switch the evaluator to other plant parameters (drops the cached base simulation)."""
+    ev.plant_params = copy.deepcopy(params)
+    ev._base_cache.clear()
+
+
+def _score(ev: Evaluator, cand: Candidate, theta: NDArray[np.float64], cost: float,
+           base_cost: float, fit_views: Sequence[View], rank_views: Sequence[View], split: Split,
+           noise_var: NDArray[np.float64], base_blocks: NDArray[np.float64],
+           excess: NDArray[np.float64], gap_present: bool, cfg: GapConfig,
+           stage: str) -> CandidateScore:
+    """Held-out score of one fitted candidate (with the evaluator's current plant parameters)."""
+    active: Active = [(cand, theta)]
+    coefs = ev.predict(fit_views, active).coefs
+    pred = ev.predict(rank_views, active, coefs=coefs)
+    blocks, _ = _block_costs(rank_views, pred, split, noise_var)
+    share, lo, hi = bootstrap_ratio_ci(base_blocks - blocks, excess, cfg.seed, cfg.n_boot,
+                                       cfg.ci_level)
+    return CandidateScore(
+        cand.name, cand.title, cand.physics,
+        {n: float(x) for n, x in zip(cand.param_names, theta, strict=True)},
+        share, (lo, hi), bool(gap_present and lo > 0 and share >= cfg.min_share),
+        (base_cost - cost) / base_cost if base_cost > 0 else 0.0,
+        _whiteness(rank_views, pred), _metrics(rank_views, pred), stage)
+
+
 def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
              plant_params: dict[str, Any], config: GapConfig | None = None) -> GapResult:
     """Run the five stages on recordings already checked by ``series_from_recording``."""
@@ -224,7 +255,10 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     ev = Evaluator(factory, copy.deepcopy(plant_params), noise_var, v0)
 
     # (2) base fit on training rows of the thinned grid
-    base_params, base_cost = fit_base(ev, fit_views, cfg.fit_specs, cfg.base_evals)
+    coarse_params, _ = fit_base(ev, fit_views, cfg.fit_specs, cfg.base_evals)
+    base_params, _, base_cost = joint_refine(ev, fit_views, cfg.fit_specs, None, np.zeros(0),
+                                             coarse_params, cfg.refine_evals, 0)
+    _use(ev, base_params)
     base_fit = ev.predict(fit_views, [])
     timing["base_fit"] = clock() - t0
 
@@ -250,26 +284,33 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
              if cfg.candidates is None or c.name in cfg.candidates]
     gap_present = float(excess.sum()) > cfg.gap_floor * float(base_blocks.sum())
     scores: list[CandidateScore] = []
-    fitted: dict[str, tuple[Candidate, NDArray[np.float64]]] = {}
+    fitted: dict[str, tuple[Candidate, NDArray[np.float64], dict[str, Any]]] = {}
     for cand in cands:
         theta, cost = fit_candidate(ev, fit_views, cand,
                                     max_evals=cfg.candidate_evals * max(len(cand.param_names), 1))
-        active: Active = [(cand, theta)]
-        coefs = ev.predict(fit_views, active).coefs
-        pred = ev.predict(rank_views, active, coefs=coefs)
-        blocks, _ = _block_costs(rank_views, pred, split, noise_var)
-        share, lo, hi = bootstrap_ratio_ci(base_blocks - blocks, excess, cfg.seed, cfg.n_boot,
-                                           cfg.ci_level)
-        significant = bool(gap_present and lo > 0 and share >= cfg.min_share)
-        scores.append(CandidateScore(
-            cand.name, cand.title, cand.physics,
-            {n: float(x) for n, x in zip(cand.param_names, theta, strict=True)},
-            share, (lo, hi), significant,
-            (base_cost - cost) / base_cost if base_cost > 0 else 0.0,
-            _whiteness(rank_views, pred), _metrics(rank_views, pred)))
-        fitted[cand.name] = (cand, theta)
+        scores.append(_score(ev, cand, theta, cost, base_cost, fit_views, rank_views, split,
+                             noise_var, base_blocks, excess, gap_present, cfg, "screen"))
+        fitted[cand.name] = (cand, theta, base_params)
     scores.sort(key=lambda c: -c.share)
     timing["candidates"] = clock() - t3
+
+    # (4b) the best screened candidates again, fitted jointly with the base parameters
+    t3b = clock()
+    if gap_present and cfg.fit_specs and cfg.joint_top > 0:
+        joint = []
+        for sc in scores[: cfg.joint_top]:
+            cand = fitted[sc.name][0]
+            params, theta, cost = joint_refine(
+                ev, fit_views, cfg.fit_specs, cand, fitted[sc.name][1], coarse_params,
+                cfg.refine_evals, cfg.candidate_evals)
+            joint.append(_score(ev, cand, theta, cost, base_cost, fit_views, rank_views, split,
+                                noise_var, base_blocks, excess, gap_present, cfg, "joint"))
+            fitted[sc.name] = (cand, theta, params)
+        _use(ev, base_params)
+        joint.sort(key=lambda c: -c.share)
+        names = {c.name for c in joint}
+        scores = joint + [c for c in scores if c.name not in names]
+    timing["joint"] = clock() - t3b
 
     # (5) how far, on every held-out row: top effect and the significant top effects together
     t4 = clock()
@@ -280,12 +321,15 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     combined_share = None
     top_pred = comb_pred = None
     if top:
-        active = [fitted[top[0]]]
+        cand, theta, params = fitted[top[0]]
+        _use(ev, params)
+        active = [(cand, theta)]
         top_pred = ev.predict(final_views, active, coefs=ev.predict(fit_views, active).coefs)
         after_top = after_combined = _metrics(final_views, top_pred)
         combined_share = (sig[0].share, *sig[0].ci)
     if len(combined) > 1:
-        active = [fitted[n] for n in combined]
+        _use(ev, fitted[combined[0]][2])
+        active = [fitted[n][:2] for n in combined]
         coefs = ev.predict(fit_views, active).coefs
         comb_rank = ev.predict(rank_views, active, coefs=coefs)
         blocks, _ = _block_costs(rank_views, comb_rank, split, noise_var)
@@ -300,7 +344,7 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     result = GapResult(
         verdict=verdict, summary=summary, split=split.description, base_params=base_params,
         fitted_params={sp.name: float(get_param(base_params, sp.name) or 0.0)
-                       for sp in cfg.fit_specs},
+                       for sp in cfg.fit_specs if "+" not in sp.name},
         noise_std={n: float(np.sqrt(v)) for n, v in zip(CHANNELS, noise_var, strict=True)},
         gap_ratio=gap_ratio, before=_metrics(final_views, base_final), after_top=after_top,
         after_combined=after_combined, top=top, combined=combined,

@@ -245,8 +245,11 @@ class ParamSpec:
     """A plant base parameter to fit: factory keyword path, bounds, and the knob it belongs to.
 
     ``name`` may be a dotted path into nested parameters (``knobs.0.slack_pos_mm``: key
-    ``knobs``, list item 0, key ``slack_pos_mm``). ``knob`` (0 or 1) says whose channels (tip
-    and current of that knob) judge it; ``None`` = all channels.
+    ``knobs``, list item 0, key ``slack_pos_mm``). Paths joined by ``+`` make a *move*: all of
+    them shift together by the value (bounds are shift bounds); each path must also be a spec
+    of its own. Moves let the coordinate search go along a valley (both slacks at once).
+    ``knob`` (0 or 1) says whose channels (tip and current of that knob) judge it; ``None`` =
+    all channels.
     """
 
     name: str
@@ -322,22 +325,55 @@ def _vertex(x: NDArray[np.float64], y: NDArray[np.float64], k: int) -> float:
 
 
 def fit_base(evaluator: Evaluator, views: Sequence[View], specs: Sequence[ParamSpec],
-             max_evals: int) -> tuple[dict[str, Any], float]:
+             max_evals: int, active: Active = (), width: float | None = None,
+             coarse_first: bool = True) -> tuple[dict[str, Any], float]:
     """Fit the plant's base parameters on training rows; sets ``evaluator.plant_params``.
 
     Coordinate search: each group (a parameter, for both knobs at once) is tried at 5 points
-    across its current interval; each knob keeps the value that is best for its own channels,
-    then the interval shrinks around it. Rounds repeat while the evaluation budget lasts. Knob
-    parameters mostly act on their own knob, so one plant run tunes both knobs.
+    across its bounds (or +-``width`` around the starting value), later at two
+    points either side of the current value; each knob takes the vertex of the parabola through
+    its best point and neighbours (judged on its own channels) and the interval halves (or, when
+    the best point is at its edge, moves on with the same width). Knob
+    parameters mostly act on their own knob, so one plant run tunes both knobs. ``active``
+    candidates are part of the model while fitting (joint refinement); ``width`` and
+    ``coarse_first`` set the first interval and whether it starts with the 5-point sweep.
     """
     params = copy.deepcopy(evaluator.plant_params)
     if not specs:
         evaluator._base_cache.clear()
-        return params, evaluator.predict(views, []).cost
-    value = {s.name: float(np.clip(get_param(params, s.name) or 0.5 * (s.lower + s.upper),
-                                   s.lower, s.upper)) for s in specs}
-    lo = {s.name: s.lower for s in specs}
-    hi = {s.name: s.upper for s in specs}
+        return params, evaluator.predict(views, active).cost
+    plain = {s.name: s for s in specs if "+" not in s.name}
+    for s in specs:
+        missing = [p for p in s.name.split("+") if "+" in s.name and p not in plain]
+        if missing:
+            raise ValueError(f"move {s.name!r}: {missing} must also be fitted on their own")
+    value = {n: float(np.clip(get_param(params, n) or 0.5 * (s.lower + s.upper),
+                              s.lower, s.upper)) for n, s in plain.items()}
+
+    def centre(s: ParamSpec) -> float:
+        return value[s.name] if s.name in plain else 0.0
+
+    # first interval: the bounds, or +-width (relative) around the starting value
+    lo: dict[str, float] = {}
+    hi: dict[str, float] = {}
+    for s in specs:
+        c = centre(s)
+        if width is None or s.name not in plain:
+            lo[s.name], hi[s.name] = s.lower, s.upper
+        else:
+            lo[s.name] = max(s.lower, c - width * abs(c))
+            hi[s.name] = min(s.upper, c + width * abs(c))
+        if hi[s.name] - lo[s.name] < 1e-9:
+            lo[s.name], hi[s.name] = s.lower, s.upper
+
+    def place(vals: dict[str, float], s: ParamSpec, x: float) -> None:
+        """Put spec ``s`` at ``x`` (a value, or for a move the shift of all its paths)."""
+        if s.name in plain:
+            vals[s.name] = x
+            return
+        for path in s.name.split("+"):
+            ps = plain[path]
+            vals[path] = float(np.clip(value[path] + x, ps.lower, ps.upper))
 
     def build(vals: dict[str, float]) -> dict[str, Any]:
         out = params
@@ -348,7 +384,7 @@ def fit_base(evaluator: Evaluator, views: Sequence[View], specs: Sequence[ParamS
     def run(vals: dict[str, float]) -> Prediction:
         evaluator.plant_params = build(vals)
         evaluator._base_cache.clear()
-        return evaluator.predict(views, [])
+        return evaluator.predict(views, active)
 
     def judge(pred: Prediction, spec: ParamSpec) -> float:
         c = pred.channel_cost
@@ -357,45 +393,69 @@ def fit_base(evaluator: Evaluator, views: Sequence[View], specs: Sequence[ParamS
     best = run(value)
     evals = 1
     groups = _groups(specs)
-    fractions = np.linspace(0.0, 1.0, 5)
-    while evals + len(fractions) <= max_evals:
+    first = coarse_first
+    while True:
         for group in groups:
-            if evals + len(fractions) > max_evals:
+            fractions = np.linspace(0.0, 1.0, 5) if first else np.array([0.25, 0.75])
+            if evals + len(fractions) + 1 > max_evals:
                 break
             trials = []
+            xs: dict[str, list[float]] = {sp.name: [] for sp in group}
             for f in fractions:
                 vals = dict(value)
-                for s in group:
-                    vals[s.name] = lo[s.name] + f * (hi[s.name] - lo[s.name])
-                trials.append((vals, run(vals)))
+                for sp in group:
+                    x = lo[sp.name] + f * (hi[sp.name] - lo[sp.name])
+                    xs[sp.name].append(x)
+                    place(vals, sp, x)
+                trials.append(run(vals))
                 evals += 1
-            grid_best: dict[str, tuple[float, float]] = {}
-            for s in group:
-                scores = np.array([judge(p, s) for _, p in trials])
-                k = int(np.argmin(scores))
-                x = np.array([t[0][s.name] for t in trials])
-                grid_best[s.name] = (float(x[k]), float(scores[k]))
-                value[s.name] = _vertex(x, scores, k)
-                quarter = 0.25 * (hi[s.name] - lo[s.name])
-                lo[s.name] = max(s.lower, value[s.name] - quarter)
-                hi[s.name] = min(s.upper, value[s.name] + quarter)
+            before = dict(value)
+            chosen: dict[str, tuple[float, float]] = {}
+            for sp in group:
+                x = list(xs[sp.name])
+                scores = [judge(p, sp) for p in trials]
+                if not first:  # the centre is the current value, already judged
+                    x.insert(1, centre(sp))
+                    scores.insert(1, judge(best, sp))
+                xa, ya = np.array(x), np.array(scores)
+                k = int(np.argmin(ya))
+                new_x = _vertex(xa, ya, k)
+                chosen[sp.name] = (float(xa[k]), float(ya[k]))
+                # halve the interval around the new value; at an edge keep its width (walk on)
+                half = 0.5 * (hi[sp.name] - lo[sp.name])
+                at_edge = (k == 0 and xa[k] > sp.lower) or (k == len(xa) - 1 and xa[k] < sp.upper)
+                half = half if at_edge and not first else 0.5 * half
+                place(value, sp, new_x)
+                c = centre(sp)
+                lo[sp.name] = max(sp.lower, c - half)
+                hi[sp.name] = min(sp.upper, c + half)
             best = run(value)
             evals += 1
             reverted = False
-            for s in group:
-                if judge(best, s) > grid_best[s.name][1]:
-                    value[s.name] = grid_best[s.name][0]
+            for sp in group:
+                if judge(best, sp) > chosen[sp.name][1]:
+                    saved = dict(value)
+                    value.update(before)
+                    place(value, sp, chosen[sp.name][0])
+                    moved = {k2: value[k2] for k2 in value if value[k2] != before[k2]}
+                    value.update(saved)
+                    value.update(moved)
                     reverted = True
-            if reverted:
+            if reverted and evals < max_evals:
                 best = run(value)
                 evals += 1
+        else:
+            first = False
+            continue
+        break
     evaluator.plant_params = build(value)
     evaluator._base_cache.clear()
     return evaluator.plant_params, best.cost
 
 
 def fit_candidate(evaluator: Evaluator, views: Sequence[View], cand: Candidate,
-                  fixed: Active = (), max_evals: int = 12) -> tuple[NDArray[np.float64], float]:
+                  fixed: Active = (), max_evals: int = 12,
+                  start: NDArray[np.float64] | None = None) -> tuple[NDArray[np.float64], float]:
     """Fit one candidate's nonlinear parameters on training rows (plant parameters fixed)."""
     if not cand.param_names:
         theta = np.zeros(0)
@@ -406,4 +466,24 @@ def fit_candidate(evaluator: Evaluator, views: Sequence[View], cand: Candidate,
     def cost(x: NDArray[np.float64]) -> float:
         return evaluator.predict(views, [*fixed, (cand, x)]).cost
 
-    return _search(cost, lower, upper, np.array(cand.neutral, dtype=float), max_evals)
+    x0 = np.array(cand.neutral if start is None else start, dtype=float)
+    return _search(cost, lower, upper, x0, max_evals)
+
+
+def joint_refine(evaluator: Evaluator, views: Sequence[View], specs: Sequence[ParamSpec],
+                 cand: Candidate | None, theta: NDArray[np.float64], base_params: dict[str, Any],
+                 base_evals: int, cand_evals: int) -> tuple[dict[str, Any], NDArray[np.float64],
+                                                            float]:
+    """Refit the base parameters (narrow interval) with ``cand`` in the model, then ``cand``.
+
+    With ``cand=None`` this is the control: the same extra base fitting without any candidate,
+    so a candidate is credited only with what more base fitting alone would not give.
+    """
+    evaluator.plant_params = copy.deepcopy(base_params)
+    evaluator._base_cache.clear()
+    active: Active = [] if cand is None else [(cand, theta)]
+    params, cost = fit_base(evaluator, views, specs, base_evals, active, width=0.1,
+                            coarse_first=False)
+    if cand is not None and cand.param_names:
+        theta, cost = fit_candidate(evaluator, views, cand, max_evals=cand_evals, start=theta)
+    return params, theta, cost

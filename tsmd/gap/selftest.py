@@ -31,12 +31,15 @@ from tsmd.recording import Recording
 
 BUILTIN_PLANT = "drivers.plant.tendon_sheath:make_tendon_sheath_plant"
 
-BUILTIN_FIT_SPECS: tuple[ParamSpec, ...] = tuple(
-    ParamSpec(f"knobs.{k}.{name}", lo, hi, knob=k)
-    for name, lo, hi in (("slack_pos_mm", 0.5, 4.0), ("slack_neg_mm", 0.5, 4.0),
-                         ("sheath_friction", 0.05, 0.35))
-    for k in (0, 1))
-"""Base parameters fitted for the built-in plant: dead zone (slack per side) and friction."""
+BUILTIN_FIT_SPECS: tuple[ParamSpec, ...] = (
+    *(ParamSpec(f"knobs.{k}.slack_pos_mm+knobs.{k}.slack_neg_mm", -1.5, 1.5, knob=k)
+      for k in (0, 1)),
+    *(ParamSpec(f"knobs.{k}.{name}", lo, hi, knob=k)
+      for name, lo, hi in (("sheath_friction", 0.03, 0.4), ("slack_pos_mm", 0.2, 4.0),
+                           ("slack_neg_mm", 0.2, 4.0))
+      for k in (0, 1)))
+"""Base parameters fitted for the built-in plant: dead zone (both slacks together, then each
+side) and sheath friction, per knob."""
 
 EFFECTS: dict[str, tuple[dict[str, float], float, str | None]] = {
     "none": ({}, 0.0, None),
@@ -79,11 +82,12 @@ def unit_knobs(seed: int, variation: float) -> list[dict[str, float]]:
     Only the base parameters the diagnosis fits are varied, so that what remains after the base
     fit is the effect put in (plus noise).
     """
+    from drivers.plant.tendon_sheath import DEFAULT_KNOBS
+
     rng = np.random.default_rng(1000 + seed)
-    defaults = ({"slack_pos_mm": 1.9, "slack_neg_mm": 2.1, "sheath_friction": 0.15},
-                {"slack_pos_mm": 2.2, "slack_neg_mm": 1.8, "sheath_friction": 0.15})
-    return [{k: v * (1.0 + variation * rng.uniform(-1, 1)) for k, v in d.items()}
-            for d in defaults]
+    names = ("slack_pos_mm", "slack_neg_mm", "sheath_friction")
+    return [{k: float(getattr(knob, k)) * (1.0 + variation * rng.uniform(-1, 1)) for k in names}
+            for knob in DEFAULT_KNOBS]
 
 
 def make_real_recording(case: str, duration_s: float, rate_hz: float, seed: int,

@@ -186,15 +186,15 @@ def _start_rig_process(config: Any) -> subprocess.Popen[str]:
         yaml.safe_dump(data, handle)
     argv = ["--interface", config.bus.interface, "--channel", config.bus.channel,
             "--config", handle.name, "--status-every", "0"]
-    priority = config.loop.realtime.priority
-
-    def realtime_child() -> None:  # the drives are hardware on the robot: never starved
-        if priority > 1:
-            with contextlib.suppress(OSError):
-                os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority - 1))
+    def ordinary_child() -> None:
+        # On the robot the drives are hardware and take no CPU from the host; here the rig
+        # process runs under the ordinary scheduler so it never preempts the daemon's threads
+        # (it is not starved either: its answers only need to arrive, the loop never waits).
+        with contextlib.suppress(OSError):
+            os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
 
     proc = subprocess.Popen(
-        [sys.executable, "-c", _RIG_MAIN, *argv], preexec_fn=realtime_child,
+        [sys.executable, "-c", _RIG_MAIN, *argv], preexec_fn=ordinary_child,
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert proc.stdout is not None
     line = proc.stdout.readline()  # the rig prints one line when it starts serving

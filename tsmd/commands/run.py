@@ -93,6 +93,8 @@ class Demo:
         status = client.call("status")
         wanted = status["compensation"]["method"]
         methods = ["none", wanted] if status["profile"] and wanted != "none" else ["none"]
+        if self.duration_s is None:  # until stopped: only the configured compensation
+            methods = methods[-1:]
         client.call("enable")
         total = self.duration_s if self.duration_s is not None else math.inf
         phase_s = max((total - 0.5) / len(methods), 1.0)

@@ -259,3 +259,37 @@ def test_sigint_stops_cleanly_too(tmp_path: Path) -> None:
             proc.communicate()
     assert proc.returncode == 0, err
     assert "final state DISABLED" in out
+
+
+def test_injected_drive_fault_shows_on_the_api_and_reset_waits_for_the_cause(
+        tmp_path: Path) -> None:
+    import dataclasses
+
+    from tsmd.config import default_sim_config
+    from tsmd.daemon import Daemon
+
+    base = default_sim_config()
+    config = dataclasses.replace(base, profiles=dataclasses.replace(base.profiles, active=None))
+    daemon = Daemon(config, sim=True, socket_path=str(tmp_path / "f.sock"))
+    daemon.start()
+    try:
+        with ApiClient(tmp_path / "f.sock") as c:
+            c.call("enable")
+            c.call("set", q=[20.0, 0.0])
+            daemon.rig.inject_fault("heartbeat_stop", drive=1)
+            deadline = time.monotonic() + 5
+            status = c.call("status")
+            while status["state"] != "FAULT" and time.monotonic() < deadline:
+                time.sleep(0.05)
+                status = c.call("status")
+            assert status["state"] == "FAULT"
+            assert "heartbeat" in status["fault"]
+            assert c.request("set", q=[0.0, 0.0])["error"]["code"] == "not_enabled"
+            refused = c.request("reset")
+            assert refused["ok"] is False and refused["error"]["code"] == "fault", refused
+            daemon.rig.clear_fault(1)
+            time.sleep(0.3)
+            assert c.call("reset")["state"] == "DISABLED"
+            assert c.call("enable")["state"] == "ENABLED"
+    finally:
+        daemon.stop()

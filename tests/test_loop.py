@@ -192,3 +192,17 @@ def test_failed_enable_reports_the_drive_error() -> None:
     with pytest.raises(LoopError, match="enable failed"):
         loop.execute("enable")
     assert loop.state is LoopState.DISABLED
+
+
+def test_heartbeat_loss_faults_and_reset_waits_until_the_heartbeat_is_back() -> None:
+    loop, drives = make_loop()
+    loop.tick()
+    loop.execute("enable")
+    drives.lose_heartbeat(1)
+    loop.tick()
+    assert loop.state is LoopState.FAULT
+    assert "heartbeat" in (loop.fault_reason or "")
+    with pytest.raises(LoopError, match="no heartbeat"):
+        loop.execute("reset")
+    drives.heartbeat_missing[1] = False
+    assert loop.execute("reset") == "DISABLED"

@@ -24,6 +24,7 @@ class FakeDrives(KnobDrives):
         self.age = 0
         self.calls: list[str] = []
         self.enable_fails = False
+        self.heartbeat_missing = [False, False]
 
     @property
     def count(self) -> int:
@@ -80,6 +81,15 @@ class FakeDrives(KnobDrives):
 
     def close(self) -> None:
         self.calls.append("close")
+
+    def heartbeat_lost(self) -> list[bool]:
+        return list(self.heartbeat_missing)
+
+    def lose_heartbeat(self, drive: int = 0) -> None:
+        """What the master reports once when a drive's heartbeat stops."""
+        self.heartbeat_missing[drive] = True
+        self.events.append(FaultEvent(FaultKind.HEARTBEAT_LOST, drive, 0.0,
+                                      "no heartbeat for 0.150 s"))
 
     def emcy(self, drive: int = 0) -> None:
         """What the real master reports for an EMCY: an event and the drive in FAULT."""

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -95,10 +96,10 @@ def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any
 
     config = load_config(config_path) if config_path else default_sim_config()
     proto = paper_protocol() if name == "paper" else fast_protocol()
-    t0 = time.monotonic()
+    t0, cpu0 = time.monotonic(), time.process_time()
     with LockstepRunner(config, seed=seed) as runner:
         runs = run_sweeps(runner, proto, period_s=config.loop.period_s)
-    wall = time.monotonic() - t0
+    wall, cpu = time.monotonic() - t0, time.process_time() - cpu0
     verdict = "profile accepted by the quality checks"
     device_path = config.profiles.device_model or "profiles/devices/sim-catheter.yaml"
     try:
@@ -131,7 +132,8 @@ def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any
     table = "\n".join(["| " + " | ".join(head) + " |", "|" + "---|" * len(head),
                        *("| " + " | ".join(r) + " |" for r in rows)])
     summary = (f"- sweeping {proto.sweep_time_s:.0f} s, motion {runs.motion_time_s:.0f} s "
-               f"(simulated), wall {wall:.1f} s\n"
+               f"(simulated), wall {wall:.1f} s, CPU {cpu:.1f} s of this process "
+               f"(load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs)\n"
                f"- {verdict}\n" + _error_summary(errors["paper"], "paper identification")
                + _error_summary(errors["knee"], "knee edges (beyond the paper)"))
     return {"points": runs.points, "table": table, "summary": summary, "wall_s": wall,

@@ -5,10 +5,12 @@ jumps, makes a small peak and settles to a constant level while the tendon slack
 (backlash, ``B``); it stays constant through the dead zone and starts to rise (or fall) where the
 tendon loads the tip again (dead-zone edge, ``D``). Here, per monotonic half-cycle:
 
+* the current against knob angle is cut into linear pieces by :mod:`ruptures` (PELT,
+  continuous piecewise-linear cost); the longest run of flat pieces is the constant phase;
+* the dead-zone edge: where that run ends and the current starts to rise (the paper's), or,
+  with ``edge="knee"``, where the steep first rise turns into the loaded ramp;
 * the peak after the reversal: :func:`scipy.signal.find_peaks` on the direction-signed current;
-* the backlash end: where the current has settled on the constant level after that peak;
-* the dead-zone edge: the change point from constant to rising current, found by
-  :mod:`ruptures` (continuous piecewise-linear cost on the current against knob angle).
+  the backlash ends where the current then stays within a noise band of the constant level.
 
 Increasing half-cycles (after the reversal at the negative end) give ``B_neg`` and ``D_pos``;
 decreasing ones (after the positive end) give ``B_pos`` and ``D_neg``, as in the paper's model
@@ -143,8 +145,8 @@ def find_reversals(cmd_deg: FloatArray, min_reversal_deg: float) -> list[int]:
 
 def _moving_start(cmd_deg: FloatArray) -> int:
     """First index where the command has left its starting value (skips a still lead-in)."""
-    moved = np.flatnonzero(np.abs(cmd_deg - cmd_deg[0]) > 1e-6)
-    return int(moved[0]) - 1 if moved.size else 0
+    moved = np.flatnonzero(np.abs(np.diff(cmd_deg)) > 1e-9)
+    return int(moved[0]) if moved.size else 0
 
 
 def split_half_cycles(cmd_deg: FloatArray,
@@ -281,7 +283,11 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         # ``settle_hold_deg``; the backlash counts from the reversal (the model's X_ref).
         level = float(np.median(yg[plateau_run[0]:plateau_run[1]]))
         search = yg[:plateau_run[1]]
-        peaks, _ = find_peaks(search, prominence=opts.peak_noise_k * noise)
+        # The peak belongs to the transient before the constant phase (noise on the plateau
+        # has peaks too).
+        transient = yg[:min(plateau_run[0] + round(opts.settle_hold_deg / step) + 1,
+                            plateau_run[1])]
+        peaks, _ = find_peaks(transient, prominence=opts.peak_noise_k * noise)
         peak = int(peaks[0]) if peaks.size else None
         start_k = peak if peak is not None else 0
         height = float(np.max(np.abs(search[:start_k + 1] - level)))
@@ -365,8 +371,11 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
         raise CalibrationError("the current is constant: no current feedback from the drive")
     stretches = split_half_cycles(data.cmd_deg, opts.min_reversal_deg)
     if sweep_start_s is not None:
+        # The protocol brings the knob to -A going down: the sweep's first stretch follows a
+        # reversal even when the way down is not in this recording.
         first = int(np.searchsorted(data.t_s, sweep_start_s)) - 2
-        stretches = [s for s in stretches if s[1] >= first]
+        first = max(first, 0)
+        stretches = [(d, max(a, first), b, True) for d, a, b, _ in stretches if b > first + 1]
     if not stretches:
         raise CalibrationError(
             f"the command never moves more than {opts.min_reversal_deg:g} deg: nothing to identify")

@@ -20,6 +20,7 @@ from tsmd.compensation.ours import (
     ours_inverse_step,
     ours_model_step,
     release_line,
+    release_line_from_reference,
     smooth_max_excess,
     smooth_max_excess_inverse,
 )
@@ -50,9 +51,11 @@ def test_release_line_reproduces_the_backlash_at_the_calibration_amplitude() -> 
     assert backlash_after_reversal_at(90.0, env(18.0)) == pytest.approx(18.0, abs=0.05)
 
 
-def test_data_sheet_release_constants_place_the_line_from_d_alone() -> None:
-    assert release_line(90.0, D_POS, 18.0, H_POS, H_NEG, OMEGA, 1.6, 7.0) == (1.6, D_POS + 7.0)
-    assert release_line(-90.0, D_NEG, 3.0, H_NEG, H_POS, OMEGA, 1.6, 7.0) == (1.6, D_NEG - 7.0)
+def test_data_sheet_release_line_passes_the_reference_backlash_end_and_moves_with_d() -> None:
+    slope, pivot = release_line_from_reference(72.0, 88.0, H_NEG, 1.6)
+    assert H_NEG + slope * (72.0 - pivot) == pytest.approx(88.0)
+    assert release_line_from_reference(72.0, 88.0, H_NEG, 1.6, 2.5)[1] == pytest.approx(
+        pivot + 2.5)
 
 
 def test_backlash_shrinks_with_the_load_at_the_reversal() -> None:
@@ -166,10 +169,14 @@ def test_fit_gives_release_slopes_from_each_sweeps_amplitude_d_and_b() -> None:
 def test_fit_uses_the_data_sheet_release_slope() -> None:
     import dataclasses
 
-    knob = dataclasses.replace(DEVICE_KNOB, release_omega=1.7, release_offset_deg=6.0)
-    fit = fit_ours_knob([_sweep(20.0, -21.0, 18.0, 17.0, 0.0)], knob)
-    assert fit.release_slope_pos == (1.7,) and fit.release_slope_neg == (1.7,)
-    assert fit.release_pivot_pos_deg == (26.0,) and fit.release_pivot_neg_deg == (-27.0,)
+    knob = dataclasses.replace(DEVICE_KNOB, release_omega=1.7, reference_backlash_pos_deg=18.0,
+                               reference_backlash_neg_deg=17.0)
+    sweeps = [_sweep(20.0, -21.0, 3.0, 3.0, 0.0), _sweep(23.0, -21.0, 3.0, 3.0, 60.0)]
+    fit = fit_ours_knob(sweeps, knob)
+    assert fit.release_slope_pos == (1.7, 1.7) and fit.release_slope_neg == (1.7, 1.7)
+    h_neg = -90.0 + OMEGA * (90.0 - 21.0)
+    assert fit.release_pivot_pos_deg[0] == pytest.approx(72.0 - (90.0 - h_neg) / 1.7)
+    assert fit.release_pivot_pos_deg[1] - fit.release_pivot_pos_deg[0] == pytest.approx(3.0)
 
 
 def test_fit_needs_a_sweep_for_every_grid_point() -> None:

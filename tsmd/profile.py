@@ -64,8 +64,12 @@ class DeviceKnob:
     limits: KnobLimits
     release_omega: float | None = None
     """Optional: tip/knob slope of the release branches (used by our compensator only)."""
-    release_offset_deg: float | None = None
-    """Optional: how far beyond the dead-zone edge the release branch meets the plateau."""
+    reference_backlash_pos_deg: float | None = None
+    """Optional: backlash on the tip after the reversal at reference_pos (with release_omega)."""
+    reference_backlash_neg_deg: float | None = None
+    """Optional: backlash on the tip after the reversal at reference_neg."""
+    dead_zone_offset_deg: float | None = None
+    """Optional: how far beyond the edge the current shows the tip leaves the plateau."""
 
 
 @dataclass(frozen=True)
@@ -233,14 +237,21 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
         neg = r.reference(r.get(k, "reference_neg", key + "."), key + ".reference_neg")
         _check_references(r, key, pos, neg)
         release = k.get("release_omega")
-        offset = k.get("release_offset_deg")
-        if (release is None) != (offset is None):
-            raise r.fail(key, "release_omega and release_offset_deg go together (both or none)")
+        b_pos, b_neg = k.get("reference_backlash_pos_deg"), k.get("reference_backlash_neg_deg")
+        if len({release is None, b_pos is None, b_neg is None}) > 1:
+            raise r.fail(key, "release_omega, reference_backlash_pos_deg and "
+                         "reference_backlash_neg_deg go together (all or none)")
+
+        def optional(value: Any, name: str, lo: float, hi: float, unit: str,
+                     where: str = key) -> float | None:
+            return None if value is None else r.number(value, f"{where}.{name}", lo, hi, unit)
+
         knobs.append(DeviceKnob(
             r.omega(r.get(k, "omega", key + "."), key + ".omega"), pos, neg, limits,
             None if release is None else r.omega(release, key + ".release_omega"),
-            None if offset is None else r.number(offset, key + ".release_offset_deg", -45.0,
-                                                 45.0, "deg")))
+            optional(b_pos, "reference_backlash_pos_deg", 0.0, 90.0, "deg"),
+            optional(b_neg, "reference_backlash_neg_deg", 0.0, 90.0, "deg"),
+            optional(k.get("dead_zone_offset_deg"), "dead_zone_offset_deg", -20.0, 20.0, "deg")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -258,7 +269,10 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         }
         if k.release_omega is not None:
             knobs[name]["release_omega"] = k.release_omega
-            knobs[name]["release_offset_deg"] = k.release_offset_deg
+            knobs[name]["reference_backlash_pos_deg"] = k.reference_backlash_pos_deg
+            knobs[name]["reference_backlash_neg_deg"] = k.reference_backlash_neg_deg
+        if k.dead_zone_offset_deg is not None:
+            knobs[name]["dead_zone_offset_deg"] = k.dead_zone_offset_deg
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

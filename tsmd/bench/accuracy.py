@@ -174,7 +174,8 @@ def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
     """What a manufacturer measures once per product with a tracker on the tip (design
     assumptions 1-3): per knob, the loaded slope omega, the reference points (tip at the knob's
     +-90 deg turning points of a sweep with the other knob at 0 deg), and for our compensator
-    the release slope and how far beyond the dead-zone edge the release line meets the plateau."""
+    the release slope, the backlash (on the tip) after the reversals at the reference points, and
+    how far beyond the edge the calibration finds in the current the tip leaves the plateau."""
     from drivers.plant.analysis import measure_dead_zone_backlash, split_passes
 
     t = np.arange(0.0, 2.25 / 0.04, PERIOD_S)
@@ -188,7 +189,17 @@ def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
         pos = rec[f"pos{knob + 1}"][skip:]
         tip = rec[f"tip{knob + 1}"][skip:]
         dz = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
-        loaded, released, offsets = [], [], []
+        dz_offset = math.nan
+        try:  # where the calibration's current analysis puts the edges on the same sweep
+            from tsmd.calibration.identify import identify_sweep
+
+            cur = identify_sweep(rec["t"][skip:], rec[f"cmd{knob + 1}"][skip:], pos,
+                                 rec[f"cur{knob + 1}"][skip:])
+            dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
+                               + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
+        except ImportError:
+            pass
+        loaded, released = [], []
         for a, b, direction in split_passes(pos):
             x, y = direction * pos[a:b], direction * tip[a:b]  # mirror falling passes
             # loaded: moving out of the dead zone; released: moving back towards it
@@ -197,16 +208,13 @@ def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
                 loaded.append(float(np.polyfit(x[sel_l], y[sel_l], 1)[0]))
             xr, yr = -x, -y  # the same pass seen as releasing the other side's tendon
             sel_r = (xr >= 35.0) & (xr <= 65.0)
-            plateau = yr[np.abs(xr) < 5.0]
-            if np.count_nonzero(sel_r) > 10 and plateau.size:
-                slope, icpt = np.polyfit(xr[sel_r], yr[sel_r], 1)
-                released.append(float(slope))
-                pivot = (float(np.median(plateau)) - icpt) / slope
-                edge = dz.dead_zone_pos_deg if direction < 0 else -dz.dead_zone_neg_deg
-                offsets.append(float(pivot - edge))
+            if np.count_nonzero(sel_r) > 10:
+                released.append(float(np.polyfit(xr[sel_r], yr[sel_r], 1)[0]))
         out.append({"omega": float(np.median(loaded)),
                     "release_omega": float(np.median(released)),
-                    "release_offset_deg": float(np.median(offsets)),
+                    "reference_backlash_pos_deg": float(dz.backlash_pos_deg),
+                    "reference_backlash_neg_deg": float(dz.backlash_neg_deg),
+                    "dead_zone_offset_deg": float(dz_offset),
                     "ref_pos_knob": 90.0, "ref_pos_tip": float(np.median(tip[pos > 89.5])),
                     "ref_neg_knob": -90.0, "ref_neg_tip": float(np.median(tip[pos < -89.5]))})
     return out

@@ -113,11 +113,20 @@ def ours_compensator(profile: CatheterProfile, period_s: float,
                 f"profile {profile.catheter_id!r} has no 'ours' parameters for {name}; "
                 "recalibrate with this tsmd version or use method 'paper'")
         o = k.ours
+        # Our dead-zone edges: the current's, moved outward by the data sheet's offset; H from
+        # the reference points through them (design assumptions 1-3, as for the paper).
+        d_pos = np.asarray(k.dead_zone_pos_deg, float) + o.dead_zone_offset_deg
+        d_neg = np.asarray(k.dead_zone_neg_deg, float) - o.dead_zone_offset_deg
+        grid = np.asarray(k.other_knob_deg, float)
+        h_pos = k.reference_pos.tip_deg - k.omega * (k.reference_pos.knob_deg
+                                                     - float(np.interp(0.0, grid, d_pos)))
+        h_neg = k.reference_neg.tip_deg - k.omega * (k.reference_neg.knob_deg
+                                                     - float(np.interp(0.0, grid, d_neg)))
         values = np.column_stack([
-            k.dead_zone_pos_deg, k.dead_zone_neg_deg, o.release_slope_pos, o.release_slope_neg,
-            o.release_pivot_pos_deg, o.release_pivot_neg_deg, o.backlash_blend_deg]).astype(float)
+            d_pos, d_neg, o.release_slope_pos, o.release_slope_neg, o.release_pivot_pos_deg,
+            o.release_pivot_neg_deg, o.backlash_blend_deg]).astype(float)
         knobs.append(OursKnob(ParameterField(k.other_knob_deg, values, profile.interpolation),
-                              k.height_pos_deg, k.height_neg_deg, k.omega, k.ours.lag_s))
+                              float(h_pos), float(h_neg), k.omega, o.lag_s))
     return OursCompensator((knobs[0], knobs[1]), period_s, max_velocity_deg_s, max_accel_deg_s2)
 
 

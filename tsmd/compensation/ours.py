@@ -5,11 +5,12 @@
    90 deg): the released tendon's branch is steeper than the loaded one. The paper draws the
    release branch parallel to the loaded one, shifted by the backlash measured at the calibration
    amplitude, so every smaller reversal is over-compensated. Here each release branch is a line
-   of its own slope meeting the released plateau a fixed distance beyond the dead-zone edge
-   (``release_omega``, ``release_offset_deg``: data-sheet constants measured once per product,
-   like omega and H), placed by the catheter's own D from its current. Without those constants
-   it goes through the end of the backlash the current showed at the calibration amplitude and
-   the tendon's slack point (:func:`release_line`, :func:`fit_ours_knob`).
+   of its own slope through the end of the backlash after the reversal at the reference point
+   (``release_omega``, ``reference_backlash_*_deg``: data-sheet constants measured once per
+   product, like omega and the reference points), moving with the catheter's dead-zone edge D
+   (from its current) over the other knob's angle. Without those constants it goes through the
+   end of the backlash the current showed at the calibration amplitude and the tendon's slack
+   point (:func:`release_line`, :func:`fit_ours_knob`).
 2. Jerk at transitions. Smaller backlash jumps for smaller reversals; the backlash end can be a
    C1 blend (``backlash_blend_deg``) instead of a corner. Jumps left go through the rate limiter.
 3. Knob coupling. Each knob's parameters follow the grid coordinate at which calibration saw
@@ -46,6 +47,7 @@ class OursParams:
     H_neg at knob angle ``release_pivot_pos_deg``; likewise ``*_neg`` below the dead zone.
     ``backlash_blend_deg``: half-width of the C1 blend at the end of the backlash (0 = corner).
     ``lag_s``: delay of the drive's actual position behind its target.
+    ``dead_zone_offset_deg``: added outward to the current's dead-zone edges (data sheet).
     """
 
     lag_s: float
@@ -54,6 +56,8 @@ class OursParams:
     release_pivot_pos_deg: tuple[float, ...]
     release_pivot_neg_deg: tuple[float, ...]
     backlash_blend_deg: tuple[float, ...]
+    dead_zone_offset_deg: float = 0.0
+    """Where the tip leaves the plateau beyond the edge the current shows (data sheet)."""
 
     @staticmethod
     def pivot_at_dead_zone(omega: float, dead_zone_pos_deg: Sequence[float],
@@ -90,7 +94,7 @@ _OURS_KEYS = ("lag_s", "release_slope_pos", "release_slope_neg", "release_pivot_
 def ours_params_from_mapping(m: Mapping[str, Any], n_grid: int) -> OursParams:
     """Validate the ``ours`` block of a profile knob (ValueError naming the key)."""
     for key in m:
-        if key not in _OURS_KEYS:
+        if key not in (*_OURS_KEYS, "dead_zone_offset_deg"):
             raise ValueError(f"{key}: unknown key")
     for key in _OURS_KEYS:
         if key not in m:
@@ -102,7 +106,9 @@ def ours_params_from_mapping(m: Mapping[str, Any], n_grid: int) -> OursParams:
                       _row(m["release_slope_neg"], "release_slope_neg", n_grid, lo, hi),
                       _row(m["release_pivot_pos_deg"], "release_pivot_pos_deg", n_grid, -90, 180),
                       _row(m["release_pivot_neg_deg"], "release_pivot_neg_deg", n_grid, -180, 90),
-                      _row(m["backlash_blend_deg"], "backlash_blend_deg", n_grid, 0.0, 45.0))
+                      _row(m["backlash_blend_deg"], "backlash_blend_deg", n_grid, 0.0, 45.0),
+                      _row([m.get("dead_zone_offset_deg", 0.0)], "dead_zone_offset_deg", 1,
+                           -20.0, 20.0)[0])
 
 
 def ours_params_to_mapping(p: OursParams) -> dict[str, Any]:
@@ -110,7 +116,8 @@ def ours_params_to_mapping(p: OursParams) -> dict[str, Any]:
             "release_slope_neg": list(p.release_slope_neg),
             "release_pivot_pos_deg": list(p.release_pivot_pos_deg),
             "release_pivot_neg_deg": list(p.release_pivot_neg_deg),
-            "backlash_blend_deg": list(p.backlash_blend_deg)}
+            "backlash_blend_deg": list(p.backlash_blend_deg),
+            "dead_zone_offset_deg": p.dead_zone_offset_deg}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -186,24 +193,18 @@ def envelopes(dead_zone_pos_deg: float, dead_zone_neg_deg: float, height_pos_deg
 
 
 def release_line(amplitude_deg: float, dead_zone_deg: float, backlash_deg: float,
-                 height_loaded_deg: float, height_released_deg: float, omega: float,
-                 slope: float | None = None, offset_deg: float | None = None
+                 height_loaded_deg: float, height_released_deg: float, omega: float
                  ) -> tuple[float, float]:
-    """(slope, pivot) of one side's release line.
+    """(slope, pivot) of one side's release line from a calibration sweep alone.
 
-    With the data sheet's release slope and pivot offset (device constants measured once, like
-    omega and H), the line has that slope and meets the released plateau at D +/- offset: the
-    catheter's own D (from its current) places it, the backlash B is not needed. Otherwise it is
-    built from the calibration sweep: a sweep to ``amplitude_deg`` ends on the loaded line at
-    H + omega*(A - D); after the reversal the tip holds for B, so the release line passes through
-    (A -/+ B, that height); the tendon is taken to go slack where it engaged (pivot = D) and the
-    point fixes the slope. For the negative side pass the negative amplitude, D_neg, B_neg, H_neg
-    as loaded and H_pos as released height.
+    A sweep to ``amplitude_deg`` ends on the loaded line at H + omega*(A - D); after the reversal
+    the tip holds for the backlash B, so the release line passes through (A -/+ B, that height).
+    The tendon is taken to go slack where it engaged (pivot = D), which fixes the slope. For the
+    negative side pass the negative amplitude, D_neg, B_neg, H_neg as loaded and H_pos as
+    released height.
     """
     sign = 1.0 if amplitude_deg > 0 else -1.0
     lo, hi = RELEASE_SLOPE_RANGE
-    if slope is not None and offset_deg is not None:
-        return float(min(max(slope, lo), hi)), float(dead_zone_deg + sign * offset_deg)
     y_end = height_loaded_deg + omega * (amplitude_deg - dead_zone_deg)
     x_end = amplitude_deg - sign * backlash_deg
     run = x_end - dead_zone_deg
@@ -211,6 +212,17 @@ def release_line(amplitude_deg: float, dead_zone_deg: float, backlash_deg: float
         return omega, float(dead_zone_deg)
     s = float(min(max((y_end - height_released_deg) / run, lo), hi))
     return s, float(x_end - (y_end - height_released_deg) / s)
+
+
+def release_line_from_reference(knob_deg: float, tip_deg: float, height_released_deg: float,
+                                slope: float, shift_deg: float = 0.0) -> tuple[float, float]:
+    """(slope, pivot) of a release line from the data sheet: it passes through the end of the
+    backlash after the reversal at the reference point, ``(X_ref -/+ B_ref, Y_ref)``, with the
+    data sheet's release slope, and moves with the dead-zone edge by ``shift_deg`` (the change of
+    D with the other knob's angle, from the current), like the loaded line does."""
+    lo, hi = RELEASE_SLOPE_RANGE
+    s = float(min(max(slope, lo), hi))
+    return s, float(knob_deg - (tip_deg - height_released_deg) / s + shift_deg)
 
 
 @dataclass(frozen=True)
@@ -451,13 +463,17 @@ def estimate_lag_s(t_s: NDArray[np.float64], cmd_deg: NDArray[np.float64],
     return float(lags[int(np.argmin(errors))])
 
 
-def heights_from_sweeps(sweeps: Sequence[SweepData], device_knob: Any) -> tuple[float, float]:
+def heights_from_sweeps(sweeps: Sequence[SweepData], device_knob: Any,
+                        dead_zone_offset_deg: float = 0.0) -> tuple[float, float]:
     """H_pos, H_neg by design assumptions 1-3: the data sheet's reference points and slope with
-    the dead-zone edges identified with the other knob at 0 deg (interpolated over the sweeps)."""
+    the dead-zone edges identified with the other knob at 0 deg (interpolated over the sweeps),
+    moved outward by ``dead_zone_offset_deg``."""
     order = sorted(sweeps, key=lambda s: s.other_knob_deg)
     grid = [s.other_knob_deg for s in order]
     d_pos0 = float(np.interp(0.0, grid, [s.dead_zone_pos_deg for s in order]))
     d_neg0 = float(np.interp(0.0, grid, [s.dead_zone_neg_deg for s in order]))
+    d_pos0 += dead_zone_offset_deg
+    d_neg0 -= dead_zone_offset_deg
     k = device_knob
     h_pos = k.reference_pos.tip_deg - k.omega * (k.reference_pos.knob_deg - d_pos0)
     h_neg = k.reference_neg.tip_deg - k.omega * (k.reference_neg.knob_deg - d_neg0)
@@ -474,10 +490,11 @@ def fit_ours_knob(sweeps: Sequence[SweepData], device_knob: Any,
     ``other_knob_deg``: the profile's grid (default: the sweeps' other-knob angles, sorted); each
     grid point needs a sweep within 1 deg (several are combined by the median).
 
-    Release lines: the data sheet's release slope and offset placed by each sweep's D, or,
-    without them, from the sweep's amplitude (actual knob position), D and B
-    (:func:`release_line`). Lag: commanded vs actual position, median over the sweeps. The
-    backlash blend is 0 (corners): its identification is not built yet.
+    Release lines: the data sheet's release slope and reference backlash, moved with each
+    sweep's D (:func:`release_line_from_reference`), or, without them, from the sweep's
+    amplitude (actual knob position), D and B (:func:`release_line`). Lag: commanded vs actual
+    position, median over the sweeps. The backlash blend is 0 (corners): its identification is
+    not built yet.
     """
     if not sweeps:
         raise ValueError("fit_ours_knob needs at least one sweep")
@@ -488,10 +505,16 @@ def fit_ours_knob(sweeps: Sequence[SweepData], device_knob: Any,
             raise ValueError(f"sweep at {s.other_knob_deg} deg has no finite D/B: {values}")
     omega = float(device_knob.omega)
     release_omega = getattr(device_knob, "release_omega", None)
-    release_offset = getattr(device_knob, "release_offset_deg", None)
-    h_pos, h_neg = heights_from_sweeps(sweeps, device_knob)
+    ref_b_pos = getattr(device_knob, "reference_backlash_pos_deg", None)
+    ref_b_neg = getattr(device_knob, "reference_backlash_neg_deg", None)
+    dz_offset = float(getattr(device_knob, "dead_zone_offset_deg", None) or 0.0)
+    h_pos, h_neg = heights_from_sweeps(sweeps, device_knob, dz_offset)
     grid = sorted({float(s.other_knob_deg) for s in sweeps}) if other_knob_deg is None else list(
         other_knob_deg)
+    order = sorted(sweeps, key=lambda s: s.other_knob_deg)
+    at_zero = [float(np.interp(0.0, [s.other_knob_deg for s in order],
+                               [getattr(s, name) for s in order]))
+               for name in ("dead_zone_pos_deg", "dead_zone_neg_deg")]
     columns: list[list[float]] = [[], [], [], []]
     for g in grid:
         near = [s for s in sweeps if abs(s.other_knob_deg - g) <= 1.0]
@@ -503,14 +526,23 @@ def fit_ours_knob(sweeps: Sequence[SweepData], device_knob: Any,
             pos = pos[np.isfinite(pos)]
             if pos.size == 0:
                 raise ValueError(f"sweep at {g} deg has no finite position")
-            sp, pp = release_line(float(pos.max()), s.dead_zone_pos_deg, s.backlash_pos_deg,
-                                  h_pos, h_neg, omega, release_omega, release_offset)
-            sn, pn = release_line(float(pos.min()), s.dead_zone_neg_deg, s.backlash_neg_deg,
-                                  h_neg, h_pos, omega, release_omega, release_offset)
+            if release_omega is not None and ref_b_pos is not None and ref_b_neg is not None:
+                k = device_knob
+                sp, pp = release_line_from_reference(
+                    k.reference_pos.knob_deg - ref_b_pos, k.reference_pos.tip_deg, h_neg,
+                    release_omega, s.dead_zone_pos_deg - at_zero[0])
+                sn, pn = release_line_from_reference(
+                    k.reference_neg.knob_deg + ref_b_neg, k.reference_neg.tip_deg, h_pos,
+                    release_omega, s.dead_zone_neg_deg - at_zero[1])
+            else:
+                sp, pp = release_line(float(pos.max()), s.dead_zone_pos_deg + dz_offset,
+                                      s.backlash_pos_deg, h_pos, h_neg, omega)
+                sn, pn = release_line(float(pos.min()), s.dead_zone_neg_deg - dz_offset,
+                                      s.backlash_neg_deg, h_neg, h_pos, omega)
             lines.append((sp, sn, pp, pn))
         for j in range(4):
             columns[j].append(float(np.median([line[j] for line in lines])))
     lag = float(np.median([estimate_lag_s(s.t_s, s.cmd_deg, s.pos_deg) for s in sweeps]))
     n = len(grid)
     return OursParams(min(lag, 1.0), tuple(columns[0]), tuple(columns[1]), tuple(columns[2]),
-                      tuple(columns[3]), (0.0,) * n)
+                      tuple(columns[3]), (0.0,) * n, dz_offset)

@@ -83,6 +83,8 @@ class Signature:
     dead_zone_torque_Nm: float
     reversal_dip_Nm: float
     released_torque_Nm: float
+    loop_area_deg2: float
+    """Area of the tip-vs-knob loop over the second cycle."""
 
 
 def signature(rec: SweepRecord) -> Signature:
@@ -105,6 +107,7 @@ def signature(rec: SweepRecord) -> Signature:
         dead_zone_torque_Nm=float(np.median(tau[in_dz])),
         reversal_dip_Nm=float(tau[after].min()),
         released_torque_Nm=float(np.median(tau[released])),
+        loop_area_deg2=float(abs(np.trapezoid(y[t >= period], q[t >= period]))),
     )
 
 
@@ -264,6 +267,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"  releasing slope +/-       {rel[0]:7.3f} {rel[1]:7.3f}")
         lo, hi = sig.tip_range_deg
         print(f"  tip range                 {lo:7.1f} {hi:7.1f} deg")
+        print(f"  loop area (2nd cycle)     {sig.loop_area_deg2:7.0f} deg^2")
         print(f"  torque peak               {sig.torque_peak_Nm:7.3f} Nm")
         print(f"  torque in dead zone       {sig.dead_zone_torque_Nm:7.4f} Nm")
         print(f"  torque dip after reversal {sig.reversal_dip_Nm:7.4f} Nm")

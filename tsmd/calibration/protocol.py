@@ -17,7 +17,13 @@ from numpy.typing import NDArray
 from tsmd.calibration.errors import CalibrationError
 
 GRID_DEG: tuple[float, ...] = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
-WAVEFORMS: tuple[str, ...] = ("sine", "triangle")
+WAVEFORMS: tuple[str, ...] = ("sine", "triangle", "two-speed")
+TWO_SPEED_SLOW_BAND_DEG = 35.0
+"""two-speed: slow within +-35 deg (the dead-zone edges)..."""
+TWO_SPEED_REVERSAL_BAND_DEG = 10.0
+"""... and within 10 deg of each reversal (the backlash transient) ..."""
+TWO_SPEED_RATIO = 3.0
+"""... and this many times faster in between (where the current only follows the load)."""
 
 
 @dataclass(frozen=True)
@@ -45,8 +51,24 @@ class Sweep:
         phase = (self.frequency_hz * t_s) % 1.0
         if self.waveform == "sine":
             return np.asarray(-self.amplitude_deg * np.cos(2 * np.pi * phase), dtype=float)
+        if self.waveform == "two-speed":
+            x, cum = _two_speed_stroke(self.amplitude_deg)
+            up = np.interp(2.0 * phase, cum, x)
+            down = -np.interp(2.0 * phase - 1.0, cum, x)
+            return np.asarray(np.where(phase < 0.5, up, down), dtype=float)
         tri = np.where(phase < 0.5, 4.0 * phase - 1.0, 3.0 - 4.0 * phase)
         return np.asarray(self.amplitude_deg * tri, dtype=float)
+
+
+def _two_speed_stroke(amplitude_deg: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """One stroke -A..A as (angle, fraction of the stroke's time): slow near the dead-zone
+    edges and the reversals, ``TWO_SPEED_RATIO`` times faster in between."""
+    x = np.linspace(-amplitude_deg, amplitude_deg, 4001)
+    slow = (np.abs(x) < TWO_SPEED_SLOW_BAND_DEG) | (
+        np.abs(x) > amplitude_deg - TWO_SPEED_REVERSAL_BAND_DEG)
+    dt = np.where(slow, 1.0, 1.0 / TWO_SPEED_RATIO)
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (dt[1:] + dt[:-1]) * np.diff(x))])
+    return x, cum / cum[-1]
 
 
 @dataclass(frozen=True)
@@ -94,14 +116,15 @@ def paper_protocol(grid_deg: tuple[float, ...] = GRID_DEG,
 
 def fast_protocol(grid_deg: tuple[float, ...] = GRID_DEG, amplitude_deg: float = 90.0,
                   frequency_hz: float = 0.125, cycles: float = 2.0) -> Protocol:
-    """Beyond the paper: constant-speed triangle sweeps, 2 cycles at 0.125 Hz (224 s in all).
+    """Beyond the paper: two-speed sweeps, 2 cycles at 0.125 Hz (224 s in all).
 
-    Identification works on current against knob angle, so the time per degree only has to be
-    long against the current sensor's lag; a triangle spends equal time on every degree (a sine
-    rushes through the middle, where the dead-zone edges are). Two cycles keep the agreement
-    check on every parameter.
+    Identification works on current against knob angle, so only the stretches that hold the
+    features need to be slow: the dead-zone edges (+-35 deg) and the transient after each
+    reversal (the last 10 deg) run at 30 deg/s, about the paper's sine speed there (22 deg/s);
+    the loaded ramps in between, where the current only follows the load, at 90 deg/s. Two
+    cycles keep the agreement check on every parameter.
     """
-    sweeps = tuple(Sweep(knob, other, amplitude_deg, frequency_hz, cycles, "triangle")
+    sweeps = tuple(Sweep(knob, other, amplitude_deg, frequency_hz, cycles, "two-speed")
                    for knob in (0, 1) for other in grid_deg)
     return Protocol("fast", sweeps)
 

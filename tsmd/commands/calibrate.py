@@ -34,7 +34,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="tsmd config (default: /etc/tsmd/tsmd.yaml, or the sim default "
                              "with --sim)")
     parser.add_argument("--fast", action="store_true",
-                        help="the fast protocol (224 s of triangle sweeps) instead of the "
+                        help="the fast protocol (224 s of two-speed sweeps) instead of the "
                              "paper's (700 s of sine sweeps); --sim and recordings only")
     parser.add_argument("--report", metavar="DIR",
                         help="write a calibration report (Markdown + PNG plots) into DIR")

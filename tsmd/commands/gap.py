@@ -18,7 +18,7 @@ from tsmd.gap.diagnose import GapConfig, diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
 from tsmd.gap.report import write_report
-from tsmd.gap.selftest import BUILTIN_FIT_SPECS, BUILTIN_PLANT, EFFECTS
+from tsmd.gap.selftest import BUILTIN_FIT_SPECS, BUILTIN_PLANT, EFFECTS, complete_knobs
 from tsmd.recording import Recording, read_recording
 
 
@@ -108,7 +108,7 @@ def _factory(spec: str, fixed: dict[str, Any]) -> Any:
     load_plant(spec, fixed)  # fail early, with the loader's message
 
     def factory(params: dict[str, Any]) -> Any:
-        return load_plant(spec, params)
+        return load_plant(spec, complete_knobs(params) if spec == BUILTIN_PLANT else params)
 
     return factory
 

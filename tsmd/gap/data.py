@@ -175,7 +175,7 @@ def make_split(series: Sequence[GapSeries], holdout: float | Sequence[str] = 0.3
             chosen = [(counter + b) % period == period - 1 for b in range(nb)]
             counter += nb
             held.append(np.asarray(chosen, dtype=bool)[blk])
-        desc = f"every {period}th time block of {block_s:.1f} s held out (interleaved)"
+        desc = f"1 time block in {period} held out (blocks of {block_s:.1f} s, interleaved)"
     else:
         names = {s.name for s in series}
         unknown = [n for n in holdout if n not in names]

@@ -66,13 +66,14 @@ def markdown(result: GapResult, title: str, plots: dict[str, str]) -> str:
     if "candidates" in plots:
         lines += [f"![candidate ranking]({plots['candidates']})", ""]
     lines += ["## Where the gap is (base simulator, held-out residuals)", "",
-              "Share of the residual sum of squares that is a systematic offset per bin of "
-              "each factor:", "", "| factor | tip | current |", "| --- | ---: | ---: |"]
-    for factor in r.where_shares["tip"]:
+              "Share of the residual sum of squares that one constant offset removes, and that "
+              "each factor's bin means remove beyond it:", "",
+              "| factor | tip | current |", "| --- | ---: | ---: |"]
+    for factor in r.where_shares["tip"]:  # "constant offset" first, then the factors
         lines.append(f"| {factor.replace('_', ' ')} | {_pct(r.where_shares['tip'][factor])} | "
                      f"{_pct(r.where_shares['current'][factor])} |")
     for group in ("tip", "current"):
-        shares = r.where_shares[group]
+        shares = {k: v for k, v in r.where_shares[group].items() if k != "constant offset"}
         factor = max(shares, key=lambda k: shares[k])
         lines += ["", f"{group.capitalize()} residual by {factor.replace('_', ' ')} "
                   f"(largest factor):", "",
@@ -99,15 +100,6 @@ def markdown(result: GapResult, title: str, plots: dict[str, str]) -> str:
     return "\n".join(lines)
 
 
-def _held_out_segment(view: View) -> np.ndarray:
-    """Row indices (within the view) of the longest held-out stretch."""
-    test = view.test.astype(int)
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], test, [0]])))
-    starts, stops = edges[::2], edges[1::2]
-    k = int(np.argmax(stops - starts))
-    return np.arange(starts[k], stops[k])
-
-
 def plots(result: GapResult, out_dir: Path, prefix: str = "gap") -> dict[str, str]:
     """Write the PNGs; return name -> file name (relative to ``out_dir``)."""
     import matplotlib
@@ -124,28 +116,30 @@ def plots(result: GapResult, out_dir: Path, prefix: str = "gap") -> dict[str, st
     if cands and base is not None:
         i = max(range(len(views)), key=lambda j: float(np.ptp(views[j].knob_deg[views[j].test])))
         v = views[i]
-        seg = _held_out_segment(v)
-        t = v.t_s[seg] - v.series.t_s[0]
-        knob = int(np.argmax(np.ptp(v.knob_deg[seg], axis=0)))
-        fig, axes = plt.subplots(3, 1, figsize=(7, 6), sharex=True)
-        meas = v.measured[seg]
-        axes[0].plot(t, meas[:, knob], "k.", ms=1.5, label="measured")
-        axes[0].plot(t, base.values[i][seg, knob], label="base sim")
+        knob = int(np.argmax(np.ptp(v.knob_deg, axis=0)))
+        t = v.t_s - v.series.t_s[0]
+        meas = v.measured
+        fig, axes = plt.subplots(3, 1, figsize=(7, 7.5))
+        for ax, c, unit in ((axes[0], knob, "tip (deg)"), (axes[1], 2 + knob, "current (A)")):
+            ax.plot(t[~v.test], meas[~v.test, c], ".", color="0.75", ms=1.5, label="train")
+            ax.plot(t[v.test], meas[v.test, c], "k.", ms=1.5, label="held out")
+            ax.plot(t, base.values[i][:, c], lw=1, label="base sim")
+            if top is not None:
+                ax.plot(t, top.values[i][:, c], lw=1, label=f"+ {result.top[0]}")
+            ax.set_ylabel(f"knob {knob + 1} {unit}")
+        axes[0].legend(fontsize=7, ncol=4)
+        axes[1].set_xlabel(f"time in {v.series.name} (s)")
+        axes[2].plot(v.knob_deg[:, knob], meas[:, knob], "k.", ms=1.5, label="measured")
+        axes[2].plot(v.knob_deg[:, knob], base.values[i][:, knob], lw=1, label="base sim")
         if top is not None:
-            axes[0].plot(t, top.values[i][seg, knob], label=f"+ {result.top[0]}")
-        axes[0].set_ylabel(f"tip {knob + 1} (deg)")
-        axes[0].legend(fontsize=7)
-        axes[1].plot(t, meas[:, 2 + knob], "k.", ms=1.5)
-        axes[1].plot(t, base.values[i][seg, 2 + knob])
-        if top is not None:
-            axes[1].plot(t, top.values[i][seg, 2 + knob])
-        axes[1].set_ylabel(f"current {knob + 1} (A)")
-        axes[2].plot(t, v.knob_deg[seg, knob], color="gray")
-        axes[2].set_ylabel(f"knob {knob + 1} (deg)")
-        axes[2].set_xlabel(f"time in {v.series.name} (s), held-out stretch")
+            axes[2].plot(v.knob_deg[:, knob], top.values[i][:, knob], lw=1,
+                         label=f"+ {result.top[0]}")
+        axes[2].set_xlabel(f"knob {knob + 1} (deg)")
+        axes[2].set_ylabel(f"tip {knob + 1} (deg)")
+        axes[2].legend(fontsize=7)
         fig.tight_layout()
         name = f"{prefix}_timeseries.png"
-        fig.savefig(out_dir / name, dpi=80)
+        fig.savefig(out_dir / name, dpi=72)
         plt.close(fig)
         files["timeseries"] = name
     if result.candidates:
@@ -166,7 +160,7 @@ def plots(result: GapResult, out_dir: Path, prefix: str = "gap") -> dict[str, st
         files["candidates"] = name
     if result.where_shares:
         fig, ax = plt.subplots(figsize=(6, 2.8))
-        factors = list(result.where_shares["tip"])
+        factors = [f for f in result.where_shares["tip"] if f != "constant offset"]
         x = np.arange(len(factors))
         ax.bar(x - 0.2, [result.where_shares["tip"][f] for f in factors], 0.4, label="tip")
         ax.bar(x + 0.2, [result.where_shares["current"][f] for f in factors], 0.4,

@@ -126,9 +126,17 @@ def builtin_factory(base_params: dict[str, Any] | None = None) -> Callable[[dict
     fixed = dict(base_params or {})
 
     def factory(params: dict[str, Any]) -> Any:
-        return load_plant(BUILTIN_PLANT, {**fixed, **params})
+        return load_plant(BUILTIN_PLANT, complete_knobs({**fixed, **params}))
 
     return factory
+
+
+def complete_knobs(params: dict[str, Any]) -> dict[str, Any]:
+    """The built-in plant wants both knobs listed: pad ``knobs`` set for knob 1 only."""
+    knobs = params.get("knobs")
+    if isinstance(knobs, list) and len(knobs) < 2:
+        params = {**params, "knobs": [*knobs, *({} for _ in range(2 - len(knobs)))]}
+    return params
 
 
 @dataclass

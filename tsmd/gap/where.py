@@ -139,7 +139,8 @@ def breakdown(resid: Sequence[NDArray[np.float64]], labels: Sequence[KnobLabels]
     """
     r = np.concatenate([np.asarray(x, dtype=float) for x in resid]) * weight
     total = float(np.sum(r * r))
-    shares: dict[str, float] = {}
+    offset = float(r.size * r.mean() ** 2) if r.size else 0.0
+    shares: dict[str, float] = {"constant offset": offset / total if total > 0 else 0.0}
     rows: list[BinRow] = []
     for factor in FACTORS:
         lab = np.concatenate([lb.labels[factor] for lb in labels])
@@ -152,5 +153,5 @@ def breakdown(resid: Sequence[NDArray[np.float64]], labels: Sequence[KnobLabels]
             rows.append(BinRow(factor, b, float(m.mean()),
                                float(np.sum(rb * rb) / total) if total > 0 else 0.0,
                                float(np.sqrt(np.mean(rb * rb))) / weight, mean / weight))
-        shares[factor] = removed / total if total > 0 else 0.0
+        shares[factor] = (removed - offset) / total if total > 0 else 0.0
     return shares, rows

@@ -240,3 +240,15 @@ def test_breakdown_attributes_a_bias_to_the_bin_that_holds_it() -> None:
         v for k, v in shares.items() if k not in ("direction", "constant offset"))
     plus = next(r for r in rows if r.factor == "direction" and r.bin == "+")
     assert plus.share_gap > 0.95
+
+
+def test_a_move_shifts_several_parameters_together_within_their_bounds() -> None:
+    s = series_from_recording(_rec(slack_deg=18.0, play_deg=12.0), "r")
+    split = make_split([s], 0.3)
+    views = build_views([s], split, [2], "fit")
+    ev = _evaluator(views, np.array([0.09, 0.09, 2.5e-5, 2.5e-5]))
+    specs = [ParamSpec("slack_deg+play_deg", -6.0, 6.0), ParamSpec("slack_deg", 5.0, 30.0),
+             ParamSpec("play_deg", 0.0, 20.0)]
+    params, _ = fit_base(ev, views, specs, max_evals=30)
+    assert params["slack_deg"] == pytest.approx(18.0, abs=1.0)
+    assert params["play_deg"] == pytest.approx(12.0, abs=1.0)

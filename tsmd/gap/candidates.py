@@ -149,16 +149,19 @@ class DriftCreep(Candidate):
 
     name = "drift"
     title = "drift / creep"
-    physics = ("a linear drift in time of tip and current, and creep: the tip relaxes towards "
-               "its slow (30 s) average, tip += k*(lowpass(tip) - tip)")
+    physics = ("a linear drift in time of tip and current; creep of the section: the tip "
+               "relaxes towards its slow (30 s) average, tip += k*(lowpass(tip) - tip); creep of "
+               "the tendons: the bent tip loses angle in proportion to time in the run")
     creep_tau_s = 30.0
+    bent_deg = 5.0
 
     def tip_extra(self, theta: NDArray[np.float64], view: View,
                   knob: int) -> list[NDArray[np.float64]]:
         assert view.base_tip is not None
         t_run = view.t_s - view.series.t_s[0]
         tip = view.base_tip[:, knob]
-        return [t_run, lowpass(view.t_s, tip, self.creep_tau_s) - tip]
+        return [t_run, lowpass(view.t_s, tip, self.creep_tau_s) - tip,
+                t_run * np.tanh(tip / self.bent_deg)]
 
     def current_extra(self, theta: NDArray[np.float64], view: View,
                       knob: int) -> list[NDArray[np.float64]]:

@@ -214,13 +214,20 @@ SMALL = Protocol("small", tuple(Sweep(k, o, 90.0, 0.1, 1.5, "triangle")
                                 for k in (0, 1) for o in (-30.0, 0.0, 30.0)))
 
 
-def test_a_small_calibration_builds_a_profile_that_saves_and_loads(tmp_path: Path) -> None:
+@pytest.fixture(scope="module")
+def small_cal():
     device = load_device_model(DEVICE)
     runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
     seen: list[tuple[float, str]] = []
     cal = run_calibration(runner, "cat-1", device, protocol=SMALL, period_s=PERIOD_S,
                           progress=lambda f, text: seen.append((f, text)),
                           limits=QualityLimits(max_cycle_spread_deg=10.0))
+    return cal, runner, seen
+
+
+def test_a_small_calibration_builds_a_profile_that_saves_and_loads(small_cal,
+                                                                   tmp_path: Path) -> None:
+    cal, runner, seen = small_cal
     assert cal.profile.knobs[0].other_knob_deg == (-30.0, 0.0, 30.0)
     assert all(k.ours is not None for k in cal.profile.knobs)  # our compensator's fit
     assert seen[-1][0] == pytest.approx(1.0)
@@ -230,6 +237,21 @@ def test_a_small_calibration_builds_a_profile_that_saves_and_loads(tmp_path: Pat
     store.save(cal.profile)
     loaded = store.load("cat-1")
     assert loaded.knobs[1].dead_zone_pos_deg == cal.profile.knobs[1].dead_zone_pos_deg
+
+
+def test_logged_sweeps_give_the_same_profile_offline(small_cal, tmp_path: Path) -> None:
+    from tsmd.calibration import calibrate_from_recordings
+
+    cal, _, _ = small_cal
+    files = []
+    for i, point in enumerate(cal.points):
+        files.append(tmp_path / f"sweep{i}.csv")
+        write_recording(files[-1], point.recording)
+    offline = calibrate_from_recordings([(str(f), read_recording(f)) for f in files], "cat-1",
+                                        load_device_model(DEVICE),
+                                        limits=QualityLimits(max_cycle_spread_deg=10.0))
+    for live, off in zip(cal.profile.knobs, offline.profile.knobs, strict=True):
+        np.testing.assert_allclose(off.grid_array(), live.grid_array(), atol=1e-9)
 
 
 class _CancelAfter(LockstepPlantRunner):

@@ -87,3 +87,18 @@ def test_nested_values_are_read(tmp_path: Path) -> None:
     assert config.loop.realtime.cpu == 1
     assert config.sim.params == {"coupling": False}
     assert config.sim.seed == 7
+
+
+def test_the_example_in_docs_configuration_is_valid() -> None:
+    import re
+
+    from tsmd.config import parse_config
+
+    doc = Path(__file__).resolve().parent.parent / "docs" / "configuration.md"
+    if not doc.exists():
+        pytest.skip("docs/configuration.md is not there")
+    match = re.search(r"## Example \(robot\)\n\n```yaml\n(.*?)```", doc.read_text(), re.S)
+    assert match is not None
+    config = parse_config(yaml.safe_load(match.group(1)), "docs example")
+    assert [d["node_id"] for d in config.drives] == [1, 2]
+    assert config.loop.realtime.cpu == 1

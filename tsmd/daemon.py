@@ -37,6 +37,7 @@ from tsmd.notify import Notifier, watchdog_interval_s
 from tsmd.rt import FixedRateScheduler, RealtimeReport, apply_realtime, set_fifo
 
 PACKAGE_ROOT = Path(__file__).resolve().parent.parent
+SIM_EXAMPLE_PROFILE = "profiles/example-sim.yaml"
 
 
 class DaemonError(TsmdError):
@@ -401,6 +402,11 @@ class Daemon:
             if self._profile_path is not None:
                 return load_profile(self._profile_path)
             if config.profiles.active is None:
+                example = resolve_data_path(SIM_EXAMPLE_PROFILE)
+                if self.sim and example.exists():  # the simulated catheter's own profile
+                    self.log.info("no profile configured: using the simulated catheter's",
+                                  path=str(example))
+                    return load_profile(example)
                 return None
             return ProfileStore(resolve_data_path(config.profiles.dir)).load(
                 config.profiles.active)

@@ -313,3 +313,14 @@ def test_the_knee_edge_lies_beyond_the_rise_and_nearer_the_tip(sweep_rec: Record
         assert abs(knee.estimate(name)) >= abs(rise.estimate(name))
         assert abs(knee.estimate(name) - getattr(truth, name)) <= abs(
             rise.estimate(name) - getattr(truth, name)) + 0.5, name
+
+
+def test_identification_in_a_worker_process_gives_the_same_values() -> None:
+    from tsmd.calibration.run import run_sweeps
+
+    proto = Protocol("one", (SHORT_SWEEP,))
+    here = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto,
+                      period_s=PERIOD_S)
+    isolated = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto,
+                          period_s=PERIOD_S, isolate=True)
+    assert isolated.points[0].result.values == here.points[0].result.values

@@ -174,9 +174,19 @@ def test_calibrate_over_the_socket_streams_progress_and_cancel_saves_nothing(
             assert response["id"] == "cal"
             assert response["error"]["code"] == "cancelled"
             assert other.call("status")["state"] == "ENABLED"
+            # a client that disconnects mid-calibration cancels it too
+            gone = ApiClient(tmp_path / "d.sock")
+            gone.send_raw(b'{"id": 1, "cmd": "calibrate", "catheter": "cath-8"}\n')
+            assert gone.read_message()["event"] == "progress"
+            gone.close()
+            deadline = time.monotonic() + 20
+            while other.call("status")["calibrating"] and time.monotonic() < deadline:
+                time.sleep(0.1)
+            assert other.call("status")["calibrating"] is False
     finally:
         daemon.stop()
     assert not (tmp_path / "profiles" / "cath-7.yaml").exists()
+    assert not (tmp_path / "profiles" / "cath-8.yaml").exists()
 
 
 @pytest.mark.parametrize("fmt", ["blf", "asc"])

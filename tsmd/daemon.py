@@ -135,6 +135,7 @@ class Controller:
         self._runner_factory = runner_factory
         self._extra_status = extra_status
         self._lock = threading.Lock()
+        self.calibrating = False
 
     def _wait(self, name: str, **args: Any) -> Any:
         future = self.loop.post(name, **args)
@@ -158,7 +159,7 @@ class Controller:
             "compensation": {"enabled": self.choice.enabled, "method": self.choice.method,
                              "active": loop.compensation_label},
             "profile": getattr(self.profile, "catheter_id", None),
-            "calibrating": loop.playing,
+            "calibrating": self.calibrating,
             "sample": sample.as_dict() if sample is not None else None,
             "last_events": [f"drive {e.drive}: {e.kind.value}: {e.message}"
                             for e in list(loop.last_events)[-4:]],
@@ -232,6 +233,7 @@ class Controller:
             progress({"progress": round(float(fraction), 4), "status": str(line),
                       "info": [str(line)]})
 
+        self.calibrating = True
         try:
             profile = calibration.calibrate(runner, catheter, device,
                                             period_s=self.loop.period_s,
@@ -240,6 +242,8 @@ class Controller:
             raise DaemonError(f"calibration cancelled: {exc}", "cancelled") from None
         except calibration.CalibrationError as exc:
             raise DaemonError(f"calibration refused: {exc}", "calibration") from None
+        finally:
+            self.calibrating = False
         path = self._store().save(profile)
         with self._lock:
             self._activate(profile, self.choice)

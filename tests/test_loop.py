@@ -206,3 +206,21 @@ def test_heartbeat_loss_faults_and_reset_waits_until_the_heartbeat_is_back() -> 
         loop.execute("reset")
     drives.heartbeat_missing[1] = False
     assert loop.execute("reset") == "DISABLED"
+
+
+def test_a_fault_during_a_trajectory_ends_it_with_the_reason_and_clears_the_setpoint() -> None:
+    from tsmd.loop import Playback
+
+    loop, drives = make_loop()
+    loop.tick()
+    loop.execute("enable")
+    playback = Playback(np.zeros((100, 2)), compensate=True)
+    loop.execute("play", playback=playback)
+    for _ in range(10):
+        loop.tick()
+    drives.emcy(0)
+    loop.tick()
+    assert playback.done.is_set()
+    assert "emcy" in (playback.error or "")
+    assert len(playback.rows) == 10
+    assert loop.setpoint.get() is None

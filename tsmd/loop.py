@@ -397,13 +397,13 @@ class ControlLoop:
         self.state = LoopState.FAULT
         self.fault_reason = reason
         self.stats.faults += 1
-        self.setpoint.clear()
         try:
             self.drives.quick_stop()
         except DriveError as exc:
             reason = f"{reason}; quick stop failed: {exc}"
             self.fault_reason = reason
         self._end_playback(f"fault: {reason}")
+        self.setpoint.clear()
         self._emit("error", "fault", reason=reason)
 
     def _emit(self, level: str, event: str, **fields: Any) -> None:

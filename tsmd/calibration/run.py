@@ -8,8 +8,10 @@ calibration never leaves a half-written profile).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import multiprocessing
+import os
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -285,6 +287,12 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *, period_s: floa
     return SweepRuns(points, motion_s, time.monotonic() - wall0)
 
 
+def _lower_priority() -> None:
+    """Worker initializer: run identification at a lower CPU priority than the daemon."""
+    with contextlib.suppress(OSError):
+        os.nice(10)
+
+
 class _AfterReturnError(CalibrationError):
     """Marker: raised after the knobs are already back at 0."""
 
@@ -296,8 +304,12 @@ class _Identifier:
         self.options = options
         self.pool: ProcessPoolExecutor | None = None
         if isolate:
+            # Started now, while the knobs are still at rest (spawning imports numpy, scipy and
+            # ruptures: a burst of CPU), and niced so that it yields to the control loop.
             self.pool = ProcessPoolExecutor(max_workers=1,
-                                            mp_context=multiprocessing.get_context("spawn"))
+                                            mp_context=multiprocessing.get_context("spawn"),
+                                            initializer=_lower_priority)
+            self.pool.submit(os.getpid).result()
         self.pending: list[Future[GridPoint]] = []
         self.points: list[GridPoint] = []
 

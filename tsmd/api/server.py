@@ -140,6 +140,7 @@ class ApiServer:
         self._connections: set[Connection] = set()
         self._started = threading.Event()
         self._start_error: BaseException | None = None
+        self._inode: int | None = None
         self.requests = 0
         self.refused = 0
         self.background_commands: frozenset[str] = frozenset({"calibrate"})
@@ -196,6 +197,7 @@ class ApiServer:
         finally:
             os.umask(old_umask)
         os.chmod(path, self.mode)
+        self._inode = path.stat().st_ino
 
     async def _shutdown(self) -> None:
         if self._server is not None:
@@ -207,7 +209,8 @@ class ApiServer:
             task.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)
         with contextlib.suppress(OSError):
-            self.socket_path.unlink()
+            if self.socket_path.stat().st_ino == self._inode:  # never another daemon's socket
+                self.socket_path.unlink()
 
     def stop(self) -> None:
         loop = self.loop

@@ -70,3 +70,13 @@ def test_realtime_settings_that_are_refused_become_warnings() -> None:
     assert report.cpu is None  # type: ignore[attr-defined]
     assert any("CPU 10000" in w for w in report.warnings)  # type: ignore[attr-defined]
     assert report.fifo_priority is None  # type: ignore[attr-defined]
+
+
+def test_normal_scheduling_can_always_be_restored() -> None:
+    from tsmd.rt import set_normal_scheduling
+
+    results: list[object] = []
+    thread = threading.Thread(target=lambda: results.append(set_normal_scheduling()))
+    thread.start()
+    thread.join()
+    assert results == [None]

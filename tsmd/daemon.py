@@ -34,7 +34,13 @@ from tsmd.errors import TsmdError
 from tsmd.log import EventLog, get_logger
 from tsmd.loop import BackgroundRecorder, ControlLoop, KnobLimiter, KnobRange, LoopError
 from tsmd.notify import Notifier, watchdog_interval_s
-from tsmd.rt import FixedRateScheduler, RealtimeReport, apply_realtime, set_fifo
+from tsmd.rt import (
+    FixedRateScheduler,
+    RealtimeReport,
+    apply_realtime,
+    set_fifo,
+    set_normal_scheduling,
+)
 
 PACKAGE_ROOT = Path(__file__).resolve().parent.parent
 SIM_EXAMPLE_PROFILE = "profiles/example-sim.yaml"
@@ -227,6 +233,9 @@ class Controller:
             raise DaemonError(str(exc), "profile") from None
         if self.loop.state.value == "DISABLED":
             self._wait("enable")
+        # This worker thread inherited SCHED_FIFO 1 (see Daemon): heavy identification work and
+        # any process it starts must not starve the machine's ordinary processes.
+        set_normal_scheduling()
         runner = self._runner_factory()
 
         def on_progress(fraction: float, line: str = "") -> None:

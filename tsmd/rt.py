@@ -42,6 +42,15 @@ def set_fifo(priority: int) -> str | None:
     return None
 
 
+def set_normal_scheduling() -> str | None:
+    """SCHED_OTHER for the calling thread (and whatever it starts from now on)."""
+    try:
+        os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
+    except (OSError, AttributeError) as exc:
+        return f"SCHED_OTHER refused ({_reason(exc)})"
+    return None
+
+
 def set_affinity(cpu: int) -> str | None:
     try:
         os.sched_setaffinity(0, {cpu})

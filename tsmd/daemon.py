@@ -314,6 +314,7 @@ class Daemon:
         try:
             profile = self._load_profile()
             compensator = self._build_compensator(profile)
+            gc.collect()  # the one full collection, before any thread that must be punctual
             self._open_drives()  # from boot on, the drives expect SYNC + heartbeat: no delay
             self._build_loop(profile, compensator)
             self._start_loop_thread()
@@ -324,7 +325,7 @@ class Daemon:
             raise
         # Everything built so far lives as long as the daemon: keep it out of the cyclic
         # garbage collector, whose full passes over it would stall a tick for milliseconds.
-        gc.collect()
+        # (No collect() here: it holds the GIL for ~100 ms while the loop already ticks.)
         gc.freeze()
         self.notifier.ready(status=f"tsmd ready: {config.loop.rate_hz:g} Hz, socket "
                                    f"{self.socket_path}")

@@ -203,11 +203,14 @@ class ApiServer:
         if self._server is not None:
             self._server.close()
         for conn in list(self._connections):
-            conn.close()
+            conn.close()  # cancels its streams; its reader then sees the end and returns
+        await asyncio.sleep(0)
         tasks = [t for t in asyncio.all_tasks() if t is not asyncio.current_task()]
-        for task in tasks:
-            task.cancel()
-        await asyncio.gather(*tasks, return_exceptions=True)
+        if tasks:
+            _, pending = await asyncio.wait(tasks, timeout=1.0)
+            for task in pending:
+                task.cancel()
+            await asyncio.gather(*pending, return_exceptions=True)
         with contextlib.suppress(OSError):
             if self.socket_path.stat().st_ino == self._inode:  # never another daemon's socket
                 self.socket_path.unlink()

@@ -33,6 +33,7 @@ from tsmd.gap.model import (
     fit_candidate,
     get_param,
     joint_refine,
+    polish_base,
 )
 from tsmd.gap.simulate import PlantFactory
 from tsmd.gap.stats import bootstrap_ratio_ci, noise_variance, pooled_ljung_box, ptpe, rmse
@@ -49,6 +50,7 @@ class GapConfig:
     fit_max_rows: int = 2000
     rank_max_rows: int = 6000
     base_evals: int = 54
+    polish_evals: int = 20
     refine_evals: int = 10
     joint_top: int = 0
     candidate_evals: int = 8
@@ -250,12 +252,13 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     rank_views = build_views(series, split, strides, "eval", rank_stride)
     final_views = build_views(series, split, strides, "eval")
     noise_var = _noise_var(series, split)
-    v0 = np.maximum(0.05 * np.percentile(
+    v0 = np.maximum(0.02 * np.percentile(
         np.abs(np.vstack([v.vel_deg_s for v in fit_views])), 95, axis=0), 0.1)
     ev = Evaluator(factory, copy.deepcopy(plant_params), noise_var, v0)
 
     # (2) base fit on training rows of the thinned grid
-    coarse_params, _ = fit_base(ev, fit_views, cfg.fit_specs, cfg.base_evals)
+    fit_base(ev, fit_views, cfg.fit_specs, cfg.base_evals)
+    coarse_params, _ = polish_base(ev, fit_views, cfg.fit_specs, cfg.polish_evals)
     base_params, _, base_cost = joint_refine(ev, fit_views, cfg.fit_specs, None, np.zeros(0),
                                              coarse_params, cfg.refine_evals, 0)
     _use(ev, base_params)

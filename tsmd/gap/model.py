@@ -10,7 +10,7 @@ parameters) by a bounded derivative-free search with a small evaluation budget.
 from __future__ import annotations
 
 import copy
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -433,13 +433,15 @@ def fit_base(evaluator: Evaluator, views: Sequence[View], specs: Sequence[ParamS
             evals += 1
             reverted = False
             for sp in group:
-                if judge(best, sp) > chosen[sp.name][1]:
-                    saved = dict(value)
-                    value.update(before)
-                    place(value, sp, chosen[sp.name][0])
-                    moved = {k2: value[k2] for k2 in value if value[k2] != before[k2]}
-                    value.update(saved)
-                    value.update(moved)
+                if judge(best, sp) > chosen[sp.name][1]:  # the vertex lost: take the best point
+                    x_best = chosen[sp.name][0]
+                    if sp.name in plain:
+                        value[sp.name] = x_best
+                    else:
+                        for path in sp.name.split("+"):
+                            ps = plain[path]
+                            value[path] = float(np.clip(before[path] + x_best, ps.lower,
+                                                        ps.upper))
                     reverted = True
             if reverted and evals < max_evals:
                 best = run(value)
@@ -451,6 +453,97 @@ def fit_base(evaluator: Evaluator, views: Sequence[View], specs: Sequence[ParamS
     evaluator.plant_params = build(value)
     evaluator._base_cache.clear()
     return evaluator.plant_params, best.cost
+
+
+def _nelder_mead(x0: NDArray[np.float64], step: float,
+                 ) -> Generator[NDArray[np.float64], float, None]:
+    """Nelder-Mead on the unit cube as an ask/tell generator (send the cost of each point).
+
+    A generator, so the two knobs' searches can share one plant run per evaluation.
+    """
+    d = len(x0)
+    pts = [np.clip(x0, 0, 1)]
+    for i in range(d):
+        e = np.zeros(d)
+        e[i] = step if x0[i] + step <= 1 else -step
+        pts.append(np.clip(x0 + e, 0, 1))
+    vals = []
+    for p in pts:
+        vals.append((yield p))
+    while True:
+        order = np.argsort(vals)
+        pts = [pts[i] for i in order]
+        vals = [vals[i] for i in order]
+        c = np.mean(pts[:-1], axis=0)
+        xr = np.clip(2 * c - pts[-1], 0, 1)
+        fr = yield xr
+        if fr < vals[0]:
+            xe = np.clip(3 * c - 2 * pts[-1], 0, 1)
+            fe = yield xe
+            pts[-1], vals[-1] = (xe, fe) if fe < fr else (xr, fr)
+        elif fr < vals[-2]:
+            pts[-1], vals[-1] = xr, fr
+        else:
+            xc = np.clip(0.5 * (c + pts[-1]), 0, 1)
+            fc = yield xc
+            if fc < vals[-1]:
+                pts[-1], vals[-1] = xc, fc
+            else:
+                for i in range(1, d + 1):
+                    pts[i] = 0.5 * (pts[0] + pts[i])
+                    vals[i] = yield pts[i]
+
+
+def polish_base(evaluator: Evaluator, views: Sequence[View], specs: Sequence[ParamSpec],
+                max_evals: int, active: Active = (), step: float = 0.04) -> tuple[dict[str, Any],
+                                                                                  float]:
+    """Nelder-Mead polish of the plain base parameters, one search per knob in lockstep.
+
+    Coordinate search stalls in valleys (slack against friction against the tip gain); the
+    simplex follows them. Each plant run evaluates both knobs' next points; each search gets
+    its knob's cost. Keeps the best point seen per knob.
+    """
+    params = copy.deepcopy(evaluator.plant_params)
+    plain = [s for s in specs if "+" not in s.name]
+    groups = {k: [s for s in plain if s.knob == k] for k in (0, 1, None)}
+    groups = {k: g for k, g in groups.items() if g}
+    if not groups or max_evals < 2:
+        return params, evaluator.predict(views, active).cost
+
+    def unit(s: ParamSpec) -> float:
+        v = get_param(params, s.name)
+        return float(np.clip(((v if v is not None else s.lower) - s.lower)
+                             / (s.upper - s.lower), 0, 1))
+
+    def judge(pred: Prediction, k: int | None) -> float:
+        c = pred.channel_cost
+        return float(c.sum() if k is None else c[k] + c[2 + k])
+
+    gens = {k: _nelder_mead(np.array([unit(s) for s in g]), step) for k, g in groups.items()}
+    asks = {k: next(gen) for k, gen in gens.items()}
+    best = {k: (np.inf, asks[k]) for k in groups}
+    total = np.inf
+    for _ in range(max_evals):
+        trial = params
+        for k, g in groups.items():
+            for s, u in zip(g, asks[k], strict=True):
+                trial = set_param(trial, s.name, s.lower + float(u) * (s.upper - s.lower))
+        evaluator.plant_params = trial
+        evaluator._base_cache.clear()
+        pred = evaluator.predict(views, active)
+        for k in groups:
+            f = judge(pred, k)
+            if f < best[k][0]:
+                best[k] = (f, asks[k].copy())
+            asks[k] = gens[k].send(f)
+    out = params
+    for k, g in groups.items():
+        for s, u in zip(g, best[k][1], strict=True):
+            out = set_param(out, s.name, s.lower + float(u) * (s.upper - s.lower))
+    evaluator.plant_params = out
+    evaluator._base_cache.clear()
+    total = evaluator.predict(views, active).cost
+    return out, total
 
 
 def fit_candidate(evaluator: Evaluator, views: Sequence[View], cand: Candidate,

@@ -61,7 +61,7 @@ def eval_grid(held_out: NDArray[np.bool_], stride: int,
 
 
 def smooth_velocity(t_s: NDArray[np.float64], x: NDArray[np.float64],
-                    window_s: float = 0.2) -> NDArray[np.float64]:
+                    window_s: float = 0.06) -> NDArray[np.float64]:
     """Knob velocity (deg/s) by central differences, then a moving average over ``window_s``."""
     if len(t_s) < 3:
         return np.zeros_like(x)

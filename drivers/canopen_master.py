@@ -286,6 +286,10 @@ class CanOpenDrives(KnobDrives):
                               current_A=d.current_raw * d.scale_A, statusword=d.statusword,
                               state=d.state, age_syncs=d.age_syncs) for d in self._drives]
 
+    def heartbeat_lost(self) -> list[bool]:
+        with self._lock:
+            return [d.heartbeat_lost for d in self._drives]
+
     def poll_events(self) -> list[FaultEvent]:
         with self._lock:
             events, self._events = self._events, []

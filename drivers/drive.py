@@ -118,6 +118,14 @@ class KnobDrives(abc.ABC):
     def poll_events(self) -> list[FaultEvent]:
         """Fault events found since the last call, oldest first."""
 
+    def heartbeat_lost(self) -> list[bool]:
+        """Per drive: is its heartbeat missing right now?
+
+        The loss is reported once as a :class:`FaultEvent`; ``reset`` and ``enable`` need to know
+        whether it persists. Backends without heartbeat supervision never report one.
+        """
+        return [False] * self.count
+
     @abc.abstractmethod
     def close(self) -> None:
         """Stop background work and release the bus."""

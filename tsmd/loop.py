@@ -450,7 +450,7 @@ class ControlLoop:
             raise LoopError("fault", f"in FAULT ({self.fault_reason}); send reset first")
         if self.state is LoopState.ENABLED:
             return self.state.value
-        for i, lost in enumerate(heartbeat_lost(self.drives)):
+        for i, lost in enumerate(self.drives.heartbeat_lost()):
             if lost:
                 raise LoopError("drive", f"drive {i} sends no heartbeat; not enabling")
         self.schedule_reset = True
@@ -516,7 +516,7 @@ class ControlLoop:
                                          f"({fb.age_syncs} SYNCs)")
             if fb.state in (DriveState.FAULT, DriveState.FAULT_REACTION_ACTIVE):
                 raise LoopError("fault", f"cause still present: drive {i} is in {fb.state.value}")
-        for i, lost in enumerate(heartbeat_lost(self.drives)):
+        for i, lost in enumerate(self.drives.heartbeat_lost()):
             if lost:
                 raise LoopError("fault", f"cause still present: drive {i} sends no heartbeat")
         self.state = LoopState.DISABLED
@@ -558,20 +558,6 @@ class ControlLoop:
             self.state = LoopState.DISABLED
         self._emit("info", "shutdown: drives quick-stopped and disabled")
         return self.state.value
-
-
-def heartbeat_lost(drives: KnobDrives) -> list[bool]:
-    """Per drive: is its heartbeat missing right now?
-
-    The KnobDrives interface reports a lost heartbeat once, as an event; whether it is still
-    missing is what ``reset`` and ``enable`` must know. A master that offers
-    ``heartbeat_lost()`` answers it; for :class:`drivers.canopen_master.CanOpenDrives` the
-    per-drive supervision flag is read (TODO: a public accessor in the drivers layer).
-    """
-    method = getattr(drives, "heartbeat_lost", None)
-    if callable(method):
-        return [bool(v) for v in method()]
-    return [bool(getattr(d, "heartbeat_lost", False)) for d in getattr(drives, "_drives", ())]
 
 
 class _Identity:

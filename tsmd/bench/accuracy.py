@@ -317,8 +317,9 @@ def summarise(results: Sequence[RunResult], key: Callable[[RunResult], str]
     """{row: {method: {"ptpe"|"rmse": (mean, std over seeds)}}}; within a seed, the scenarios of
     a row are averaged first (as the paper pools conditions)."""
     table: dict[str, dict[str, dict[str, tuple[float, float]]]] = {}
-    rows = sorted({key(r) for r in results}, key=lambda k: list(PAPER_IMPROVEMENT_PCT).index(
-        k) if k in PAPER_IMPROVEMENT_PCT else 99)
+    order = list(PAPER_IMPROVEMENT_PCT)
+    rows = sorted({key(r) for r in results},
+                  key=lambda k: (order.index(k) if k in order else len(order), k))
     for row in rows:
         table[row] = {}
         for method in METHODS:

@@ -1,4 +1,4 @@
-"""Our compensator: the paper's play structure with the weaknesses the paper names removed.
+"""Our compensator: the paper's play structure, addressing the weaknesses the paper names.
 
 1. Straight lines where the catheter is not. Friction along the sheath makes the backlash grow
    with the load at the reversal (a reversal at 60 deg tip loses less knob travel than one at
@@ -11,8 +11,11 @@
    (from its current) over the other knob's angle. Without those constants it goes through the
    end of the backlash the current showed at the calibration amplitude and the tendon's slack
    point (:func:`release_line`, :func:`fit_ours_knob`).
-2. Jerk at transitions. Smaller backlash jumps for smaller reversals; the backlash end can be a
-   C1 blend (``backlash_blend_deg``) instead of a corner. Jumps left go through the rate limiter.
+2. Transitions. The dead-zone edge the current shows is moved to where the tip leaves its
+   plateau (``dead_zone_offset_deg``, data sheet). Dead-zone jumps are started early so that the
+   motor's crossing time is centred on the desired crossing (:class:`OursCompensator`); smaller
+   reversals make smaller backlash jumps; the backlash end can be a C1 blend
+   (``backlash_blend_deg``). The jumps still go through the rate limiter: jerk is not reduced.
 3. Knob coupling. Each knob's parameters follow the grid coordinate at which calibration saw
    the other tip where it is now wanted: the other knob's loaded-branch angle for the other
    tip's desired angle (the paper uses the other knob's desired angle, up to D + B off).

@@ -184,3 +184,20 @@ def test_bad_device_model_is_refused(tmp_path: Path) -> None:
     path.write_text(yaml.safe_dump(data))
     with pytest.raises(ProfileError, match=r"knobs.phi2.limits.max_deg"):
         load_device_model(path)
+
+
+def test_device_model_round_trip_keeps_our_optional_constants(tmp_path: Path) -> None:
+    from tsmd.profile import device_model_from_mapping, device_model_to_mapping
+
+    device = load_device_model(DEVICE)
+    assert device.knobs[0].release_omega is not None
+    assert device_model_from_mapping(device_model_to_mapping(device)) == device
+
+
+def test_device_release_constants_go_together(tmp_path: Path) -> None:
+    data = yaml.safe_load(DEVICE.read_text())
+    del data["knobs"]["phi1"]["reference_backlash_neg_deg"]
+    path = tmp_path / "dev.yaml"
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(ProfileError, match="knobs.phi1: release_omega, reference_backlash"):
+        load_device_model(path)

@@ -17,7 +17,7 @@ from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
 from tsmd.gap.diagnose import GapConfig, diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
-from tsmd.gap.report import write_report
+from tsmd.gap.report import finite_json, write_report
 from tsmd.gap.selftest import BUILTIN_FIT_SPECS, BUILTIN_PLANT, EFFECTS, complete_knobs
 from tsmd.recording import Recording, read_recording
 
@@ -165,7 +165,7 @@ def _selftest(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "gap_selftest.md").write_text(text + "\n", encoding="utf-8")
-    (out / "gap_selftest.json").write_text(json.dumps(
+    (out / "gap_selftest.json").write_text(json.dumps(finite_json(
         {"summary": result.summary(), "confusion": result.confusion(),
-         "cases": [vars(c) for c in result.cases]}, indent=2), encoding="utf-8")
+         "cases": [vars(c) for c in result.cases]}), indent=2), encoding="utf-8")
     return 0

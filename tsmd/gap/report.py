@@ -189,8 +189,20 @@ def write_report(result: GapResult, out_dir: Path, title: str,
     if extra:
         data.update(extra)
     js = out_dir / "gap_report.json"
-    js.write_text(json.dumps(data, indent=2, default=_jsonable), encoding="utf-8")
+    js.write_text(json.dumps(finite_json(data), indent=2, default=_jsonable, allow_nan=False),
+                  encoding="utf-8")
     return md, js
+
+
+def finite_json(x: Any) -> Any:
+    """NaN/inf (a channel that was not measured) become null: strict JSON."""
+    if isinstance(x, dict):
+        return {k: finite_json(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [finite_json(v) for v in x]
+    if isinstance(x, float | np.floating) and not math.isfinite(float(x)):
+        return None
+    return x
 
 
 def _jsonable(x: Any) -> Any:

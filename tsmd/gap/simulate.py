@@ -8,7 +8,6 @@ Python call per row, so rows the fit does not score are thinned (see :func:`eval
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -94,23 +93,13 @@ def lowpass(t_s: NDArray[np.float64], x: NDArray[np.float64], tau_s: float) -> N
     return y
 
 
-@dataclass(frozen=True)
-class CurrentMap:
-    """Motor current from knob torque: ``i = gain*torque + offset + coulomb*s(v) + viscous*v``.
-
-    ``s(v) = tanh(v / v0)`` smooths the Coulomb sign; per knob, fitted by linear least squares.
-    This is the simple motor model of the gap diagnosis, not the drive's.
-    """
-
-    gain_A_per_Nm: tuple[float, float]
-    offset_A: tuple[float, float]
-    coulomb_A: tuple[float, float]
-    viscous_A_s_per_deg: tuple[float, float]
-    v0_deg_s: float
-
-
 def current_regressors(torque_Nm: NDArray[np.float64], vel_deg_s: NDArray[np.float64],
                        v0_deg_s: float) -> NDArray[np.float64]:
-    """Columns (torque, 1, tanh(v/v0), v) for one knob: the base current map's regressors."""
+    """Columns (torque, 1, tanh(v/v0), v) for one knob: the base current map's regressors.
+
+    The motor-current map of the gap diagnosis (not the drive's) is
+    ``i = gain*torque + offset + coulomb*tanh(v/v0) + viscous*v``, fitted per knob by linear
+    least squares; ``tanh`` smooths the Coulomb sign.
+    """
     return np.column_stack([torque_Nm, np.ones_like(torque_Nm),
                             np.tanh(vel_deg_s / v0_deg_s), vel_deg_s])

@@ -2,7 +2,7 @@
 
 A model evaluation = (1) knob motion through the candidates' input transforms, (2) the plant,
 (3) per channel a linear least-squares map onto the measurement (tip: gain + offset; current: the
-:class:`~tsmd.gap.simulate.CurrentMap` regressors) plus the candidates' extra regressors. Linear
+:func:`~tsmd.gap.simulate.current_regressors`) plus the candidates' extra regressors. Linear
 terms are solved exactly on training rows; nonlinear ones (plant base parameters, candidate
 parameters) by a bounded derivative-free search with a small evaluation budget.
 """

@@ -157,3 +157,14 @@ def test_example_profile_builds_every_method() -> None:
     profile = load_profile(ROOT / "profiles" / "example-sim.yaml")
     for method in ("none", "paper", "ours"):
         build_compensator(profile, method, DT, [LIMITS, LIMITS])
+
+
+def test_limiter_follows_a_feasible_moving_target_without_lag() -> None:
+    t = np.arange(0.0, 5.0, DT)
+    target = 50.0 * np.sin(2 * np.pi * 0.2 * t)  # peak 63 deg/s, 79 deg/s^2: feasible
+    state = LimiterState(float(target[0]), 0.0, float(target[0]))
+    out = []
+    for x in target:
+        state = limit_step(state, float(x), LIMITS, DT)
+        out.append(state.q_deg)
+    assert np.max(np.abs(np.array(out) - target)) < 1e-9

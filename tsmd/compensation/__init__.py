@@ -85,8 +85,9 @@ class LimitedCompensator:
         q = np.asarray(q_deg, dtype=float)
         start = self.inner.command(q)
         self.inner.reset(q_deg)
-        self._states = [LimiterState(lim.clip(float(x)) if np.isfinite(x) else 0.0)
-                        for x, lim in zip(start, self.limits, strict=True)]
+        first = [lim.clip(float(x)) if np.isfinite(x) else 0.0
+                 for x, lim in zip(start, self.limits, strict=True)]
+        self._states = [LimiterState(x, 0.0, x) for x in first]
 
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         raw = self.inner.command(q_deg)

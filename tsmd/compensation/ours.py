@@ -34,6 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
+from tsmd.compensation.safety import KnobLimits, LimiterState, limit_step
 
 _TABLE_X_DEG = np.linspace(-200.0, 200.0, 1601)
 _FLAT_SLOPE = 1e-6  # makes the envelopes strictly increasing so that they can be inverted
@@ -324,7 +325,8 @@ class OursCompensator:
     """
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,
-                 max_velocity_deg_s: float = 120.0, max_accel_deg_s2: float = 2000.0) -> None:
+                 max_velocity_deg_s: float = 120.0, max_accel_deg_s2: float = 2000.0,
+                 smoothing_s: float = 0.1) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be positive, got {period_s}")
         if not (max_velocity_deg_s > 0 and max_accel_deg_s2 > 0):
@@ -333,11 +335,19 @@ class OursCompensator:
         self.period_s = period_s
         self.max_velocity_deg_s = max_velocity_deg_s
         self.max_accel_deg_s2 = max_accel_deg_s2
+        # Jerk: the command goes through the velocity/acceleration limits and then a moving
+        # average over ``smoothing_s``; the average of a feasible motion stays feasible and its
+        # acceleration can change by at most 2 a_max per window (jerk <= 2 a_max / smoothing_s).
+        # Its delay (half the window) is taken out by inverting that much further ahead.
+        self._n_avg = max(1, round(smoothing_s / period_s))
+        self._free = KnobLimits(-1e9, 1e9, max_velocity_deg_s, max_accel_deg_s2)
+        self._lim = [LimiterState(0.0), LimiterState(0.0)]
+        self._window = np.zeros((2, self._n_avg))
         self._states: list[OursState] = []
         self._q_prev = np.zeros(2)
         self._v_deg_s = np.zeros(2)
         self._axis = np.zeros(2)  # grid coordinate of each knob as seen by the other
-        self._out = np.zeros(2)
+        self._out = np.zeros(2)  # the inverse's command (before limiting and smoothing)
         self._hold = [0, 0]  # direction of a jump started early, 0 = none
         self._cache: list[tuple[float, Envelopes] | None] = [None, None]
         self.reset(np.zeros(2))
@@ -378,6 +388,8 @@ class OursCompensator:
             states.append(OursState(x, float(q[i]), d, float(q[i]), 0.0))
         self._states = states
         self._out = np.array([st.x_deg for st in states])
+        self._lim = [LimiterState(float(x)) for x in self._out]
+        self._window = np.repeat(self._out[:, None], self._n_avg, axis=1)
 
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         q = np.asarray(q_deg, dtype=float)
@@ -390,13 +402,19 @@ class OursCompensator:
             if not ok[i]:
                 continue  # hold the last command
             v = float(self._v_deg_s[i])
-            lead = float(np.clip(knob.lag_s * v, -_MAX_LEAD_DEG, _MAX_LEAD_DEG))
+            ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
+            lead = float(np.clip(ahead_s * v, -_MAX_LEAD_DEG, _MAX_LEAD_DEG))
             env = self._envelopes(i)
             state = ours_inverse_step(self._states[i], float(q[i]) + lead, env)
             self._states[i] = state
             self._out[i] = self._centred(i, state, float(q[i]) + lead, v, env)
+            self._lim[i] = limit_step(self._lim[i], float(self._out[i]), self._free,
+                                      self.period_s)
+            self._window[i] = np.roll(self._window[i], 1)
+            self._window[i, 0] = self._lim[i].q_deg
         self._q_prev = q_ok
-        return self._out.copy()
+        smoothed: NDArray[np.float64] = self._window.mean(axis=1)
+        return smoothed
 
     def _centred(self, i: int, state: OursState, target: float, v: float,
                  env: Envelopes) -> float:

@@ -36,30 +36,42 @@ class KnobLimits:
 
 @dataclass(frozen=True)
 class LimiterState:
-    """Where the limited command is and how fast it moves."""
+    """Where the limited command is, how fast it moves, and the last target it was given."""
 
     q_deg: float
     v_deg_s: float = 0.0
+    target_deg: float | None = None
 
 
 def limit_step(state: LimiterState, target_deg: float, limits: KnobLimits,
                dt_s: float) -> LimiterState:
     """One tick of the limiter: move toward ``target_deg`` as fast as the limits allow.
 
-    A non-finite target holds the current position (it never reaches the motor).
+    A target that moves feasibly (within the velocity limit) is followed without lag: the
+    limiter brakes relative to the target's own motion, not as if it were about to stop. A
+    non-finite target holds the current position (it never reaches the motor).
     """
     if dt_s <= 0:
         raise ValueError(f"dt_s must be positive, got {dt_s}")
     a = limits.max_accel_deg_s2
+    v_max = limits.max_velocity_deg_s
     target = limits.clip(target_deg) if math.isfinite(target_deg) else state.q_deg
+    v_target = 0.0
+    if state.target_deg is not None and math.isfinite(target_deg):
+        v_target = (target - state.target_deg) / dt_s
+        if abs(v_target) > 1.05 * v_max:  # a jump, not a motion: chase it as standing still
+            v_target = 0.0
     d = target - state.q_deg
-    # The fastest speed from which the discrete decelerating sequence still stops on the target.
+    # The fastest approach speed from which the discrete decelerating sequence still stops on
+    # the target (relative to its own motion).
     v_stop = math.sqrt(0.25 * a * a * dt_s * dt_s + 2.0 * a * abs(d)) - 0.5 * a * dt_s
-    v_want = math.copysign(min(abs(d) / dt_s, v_stop, limits.max_velocity_deg_s), d)
+    v_want = d / dt_s  # reach the target in this tick if the limits allow
+    if (v_want - v_target) * math.copysign(1.0, d) > v_stop:  # closing in too fast to stop
+        v_want = v_target + math.copysign(v_stop, d)
     v = min(max(v_want, state.v_deg_s - a * dt_s), state.v_deg_s + a * dt_s)
-    v = min(max(v, -limits.max_velocity_deg_s), limits.max_velocity_deg_s)
+    v = min(max(v, -v_max), v_max)
     q = state.q_deg + v * dt_s
     if q < limits.min_deg or q > limits.max_deg:  # position first, whatever the speed
         q = limits.clip(q)
         v = (q - state.q_deg) / dt_s
-    return LimiterState(q, v)
+    return LimiterState(q, v, target)

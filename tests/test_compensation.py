@@ -161,7 +161,7 @@ def test_example_profile_builds_every_method() -> None:
 
 def test_limiter_follows_a_feasible_moving_target_without_lag() -> None:
     t = np.arange(0.0, 5.0, DT)
-    target = 50.0 * np.sin(2 * np.pi * 0.2 * t)  # peak 63 deg/s, 79 deg/s^2: feasible
+    target = 50.0 * (1.0 - np.cos(2 * np.pi * 0.2 * t))  # from rest; 63 deg/s, 79 deg/s^2
     state = LimiterState(float(target[0]), 0.0, float(target[0]))
     out = []
     for x in target:

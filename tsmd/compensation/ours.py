@@ -13,9 +13,10 @@
    point (:func:`release_line`, :func:`fit_ours_knob`).
 2. Transitions. The dead-zone edge the current shows is moved to where the tip leaves its
    plateau (``dead_zone_offset_deg``, data sheet). Dead-zone jumps are started early so that the
-   motor's crossing time is centred on the desired crossing (:class:`OursCompensator`); smaller
-   reversals make smaller backlash jumps; the backlash end can be a C1 blend
-   (``backlash_blend_deg``). The jumps still go through the rate limiter: jerk is not reduced.
+   motor's crossing time is centred on the desired crossing; the command is limited and
+   averaged over 0.1 s, which bounds its jerk to 2 a_max / 0.1 s (:class:`OursCompensator`);
+   smaller reversals make smaller backlash jumps; the backlash end can be a C1 blend
+   (``backlash_blend_deg``).
 3. Knob coupling. Each knob's parameters follow the grid coordinate at which calibration saw
    the other tip where it is now wanted: the other knob's loaded-branch angle for the other
    tip's desired angle (the paper uses the other knob's desired angle, up to D + B off).

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from test_gap_support import StandInPlant, make_recording
 
-from tsmd.gap.candidates import catalogue, play
+from tsmd.gap.candidates import RateDependence, catalogue, play
 from tsmd.gap.data import make_split, parse_holdout, series_from_recording
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import Evaluator, ParamSpec, View, build_views, fit_base
-from tsmd.gap.simulate import eval_grid, fit_grid, lowpass, simulate
+from tsmd.gap.simulate import eval_grid, fit_grid, lowpass, simulate, turning_points
 from tsmd.gap.stats import bootstrap_ratio_ci, ljung_box, noise_variance, ptpe
 from tsmd.gap.where import breakdown, label_knob, reversals
 from tsmd.recording import Recording
@@ -116,6 +116,37 @@ def test_eval_grid_keeps_every_held_out_row() -> None:
     assert set(np.flatnonzero(ho)) <= set(rows.tolist())
     assert len(rows) < 250
     assert fit_grid(1000, 10)[-1] == 999
+
+
+def test_turning_points_are_the_peaks_and_valleys_not_the_jitter() -> None:
+    t = np.linspace(0, 20, 2001)
+    x = 10 * np.sin(t) + np.random.default_rng(0).normal(0, 0.05, len(t))
+    turns = turning_points(x, 0.5)
+    np.testing.assert_allclose(t[turns], np.pi / 2 + np.pi * np.arange(6), atol=0.15)
+    assert len(turning_points(np.random.default_rng(1).normal(0, 0.05, 500), 0.5)) == 0
+
+
+def test_thinned_fit_grid_keeps_the_tops_of_fast_sweeps() -> None:
+    x = np.abs((np.arange(1000) % 40) - 20.0)  # triangle, period 40 rows, peaks off the stride
+    rows = fit_grid(1000, 15, np.column_stack([x, np.zeros(1000)]))
+    assert x[rows].max() == 20.0 and x[rows].min() == 0.0
+    peaks = np.flatnonzero(x == 20.0)[1:-1]
+    assert set(peaks.tolist()) <= set(rows.tolist())
+
+
+def test_rate_candidate_keeps_a_fast_sweeps_loop_wide_through_its_reversal() -> None:
+    t = np.arange(0, 40, 0.01)
+    fast = np.where(t < 20, 60 * (2 / np.pi) * np.arcsin(np.sin(2 * np.pi * t / 2.0)),
+                    60 * (2 / np.pi) * np.arcsin(np.sin(2 * np.pi * t / 20.0)))
+    s = series_from_recording(Recording({
+        "t": t, "q1": fast, "q2": 0 * t, "cmd1": fast, "cmd2": 0 * t, "pos1": fast,
+        "pos2": 0 * t, "cur1": 0 * t, "cur2": 0 * t, "tip1": fast, "tip2": 0 * t}, {}), "r")
+    view = build_views([s], make_split([s], 0.3), [1], "fit")[0]
+    out = RateDependence().knob(np.array([5.0]), view, view.knob_deg)[:, 0]
+    fast_part, slow_part = (t > 2) & (t < 19), t > 22
+    # the output turns short of the knob's peak by the play: wide loops when fast only
+    assert fast[fast_part].max() - out[fast_part].max() == pytest.approx(5.0, abs=0.5)
+    assert fast[slow_part].max() - out[slow_part].max() < 1.0
 
 
 def test_lowpass_matches_first_order_step_response() -> None:

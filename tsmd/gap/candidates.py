@@ -56,27 +56,31 @@ class RateDependence(Candidate):
     name = "rate"
     title = "rate dependence"
     physics = ("velocity-strengthened sheath friction: an extra play of half-width "
-               "b*|v|/v90 between knob and tendon (v90 = 90th percentile of knob speed) and a "
-               "pull torque growing with |v|")
+               "b*s/v90 between knob and tendon, s = the knob's sweep speed (|v| low-passed over "
+               "1 s, so the loop of a fast sweep stays wide through its reversal; v90 = 90th "
+               "percentile of |v|), and a pull torque growing with s")
     param_names = ("play_at_v90_deg",)
     lower = (0.0,)
     upper = (15.0,)
     neutral = (0.0,)
     changes_input = True
+    sweep_tau_s = 1.0
+
+    def sweep_speed(self, view: View) -> NDArray[np.float64]:
+        """Per knob the sweep speed relative to its 90th percentile (about 1 when fast)."""
+        speed = np.abs(view.vel_deg_s)
+        v90 = np.maximum(np.percentile(speed, 90, axis=0), 1e-6)
+        return lowpass(view.t_s, speed, self.sweep_tau_s) / v90
 
     def knob(self, theta: NDArray[np.float64], view: View,
              knob_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-        speed = np.abs(view.vel_deg_s)
-        v90 = np.maximum(np.percentile(speed, 90, axis=0), 1e-6)
-        width = theta[0] * speed / v90
+        width = theta[0] * self.sweep_speed(view)
         return np.column_stack([play(knob_deg[:, j], width[:, j]) for j in range(2)])
 
     def current_extra(self, theta: NDArray[np.float64], view: View,
                       knob: int) -> list[NDArray[np.float64]]:
         assert view.base_torque is not None
-        speed = np.abs(view.vel_deg_s[:, knob])
-        v90 = max(float(np.percentile(speed, 90)), 1e-6)
-        return [view.base_torque[:, knob] * speed / v90]
+        return [view.base_torque[:, knob] * self.sweep_speed(view)[:, knob]]
 
 
 class TendonCompliance(Candidate):
@@ -151,7 +155,8 @@ class DriftCreep(Candidate):
     title = "drift / creep"
     physics = ("a linear drift in time of tip and current; creep of the section: the tip "
                "relaxes towards its slow (30 s) average, tip += k*(lowpass(tip) - tip); creep of "
-               "the tendons: the bent tip loses angle in proportion to time in the run")
+               "the tendons: the bent tip loses angle in proportion to time in the run, at its "
+               "own rate on each side (each side's tendon creeps under its own tension)")
     creep_tau_s = 30.0
     bent_deg = 5.0
 
@@ -160,8 +165,9 @@ class DriftCreep(Candidate):
         assert view.base_tip is not None
         t_run = view.t_s - view.series.t_s[0]
         tip = view.base_tip[:, knob]
+        bent = np.tanh(tip / self.bent_deg)
         return [t_run, lowpass(view.t_s, tip, self.creep_tau_s) - tip,
-                t_run * np.tanh(tip / self.bent_deg)]
+                t_run * np.maximum(bent, 0.0), t_run * np.minimum(bent, 0.0)]
 
     def current_extra(self, theta: NDArray[np.float64], view: View,
                       knob: int) -> list[NDArray[np.float64]]:

@@ -57,6 +57,7 @@ class GapConfig:
     seed: int = 0
     n_boot: int = 2000
     ci_level: float = 0.9
+    family_alpha: float = 0.05
     min_share: float = 0.05
     explained_share: float = 0.5
     gap_floor: float = 0.1
@@ -220,7 +221,7 @@ def _score(ev: Evaluator, cand: Candidate, theta: NDArray[np.float64], cost: flo
            base_cost: float, fit_views: Sequence[View], rank_views: Sequence[View], split: Split,
            noise_var: NDArray[np.float64], base_blocks: NDArray[np.float64],
            excess: NDArray[np.float64], gap_present: bool, cfg: GapConfig,
-           stage: str) -> CandidateScore:
+           stage: str, n_tried: int) -> CandidateScore:
     """Held-out score of one fitted candidate (with the evaluator's current plant parameters)."""
     active: Active = [(cand, theta)]
     coefs = ev.predict(fit_views, active).coefs
@@ -228,10 +229,15 @@ def _score(ev: Evaluator, cand: Candidate, theta: NDArray[np.float64], cost: flo
     blocks, _ = _block_costs(rank_views, pred, split, noise_var)
     share, lo, hi = bootstrap_ratio_ci(base_blocks - blocks, excess, cfg.seed, cfg.n_boot,
                                        cfg.ci_level)
+    # several candidates are tried: each must clear its one-sided bound at alpha / n (Bonferroni)
+    # so that data without an effect raise a false alarm with probability <= family_alpha
+    strict_level = 1.0 - 2.0 * cfg.family_alpha / max(n_tried, 1)
+    strict_lo = bootstrap_ratio_ci(base_blocks - blocks, excess, cfg.seed, cfg.n_boot,
+                                   strict_level)[1]
     return CandidateScore(
         cand.name, cand.title, cand.physics,
         {n: float(x) for n, x in zip(cand.param_names, theta, strict=True)},
-        share, (lo, hi), bool(gap_present and lo > 0 and share >= cfg.min_share),
+        share, (lo, hi), bool(gap_present and strict_lo > 0 and share >= cfg.min_share),
         (base_cost - cost) / base_cost if base_cost > 0 else 0.0,
         _whiteness(rank_views, pred), _metrics(rank_views, pred), stage)
 
@@ -292,7 +298,8 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
         theta, cost = fit_candidate(ev, fit_views, cand,
                                     max_evals=cfg.candidate_evals * max(len(cand.param_names), 1))
         scores.append(_score(ev, cand, theta, cost, base_cost, fit_views, rank_views, split,
-                             noise_var, base_blocks, excess, gap_present, cfg, "screen"))
+                             noise_var, base_blocks, excess, gap_present, cfg, "screen",
+                             len(cands)))
         fitted[cand.name] = (cand, theta, base_params)
     scores.sort(key=lambda c: -c.share)
     timing["candidates"] = clock() - t3
@@ -307,7 +314,8 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
                 ev, fit_views, cfg.fit_specs, cand, fitted[sc.name][1], coarse_params,
                 cfg.refine_evals, cfg.candidate_evals)
             joint.append(_score(ev, cand, theta, cost, base_cost, fit_views, rank_views, split,
-                                noise_var, base_blocks, excess, gap_present, cfg, "joint"))
+                                noise_var, base_blocks, excess, gap_present, cfg, "joint",
+                                len(cands)))
             fitted[sc.name] = (cand, theta, params)
         _use(ev, base_params)
         joint.sort(key=lambda c: -c.share)

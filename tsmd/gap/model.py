@@ -73,7 +73,8 @@ def build_views(series: Sequence[GapSeries], split: Split, strides: Sequence[int
     ho_strides = held_out_strides or [1] * len(series)
     for s, blk, ho, stride, ho_stride in zip(series, split.block, split.held_out, strides,
                                              ho_strides, strict=True):
-        rows = fit_grid(len(s), stride) if kind == "fit" else eval_grid(ho, stride, ho_stride)
+        rows = (fit_grid(len(s), stride, s.knob_deg) if kind == "fit"
+                else eval_grid(ho, stride, ho_stride, s.knob_deg))
         vel = smooth_velocity(s.t_s, s.knob_deg)
         views.append(View(s, rows, ~ho[rows], ho[rows], blk[rows], vel[rows]))
     return views

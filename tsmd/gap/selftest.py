@@ -61,19 +61,29 @@ KT_NM_PER_A = 0.03
 MOTOR_COULOMB_A = 0.01
 
 
+def _sweep(t: NDArray[np.float64], rate_hz: float, speed_deg_s: NDArray[np.float64],
+           amp_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Triangle sweeps of a varying amplitude, each traversed at the given knob speed."""
+    phase = 2 * np.pi * np.cumsum(speed_deg_s / (4.0 * amp_deg)) / rate_hz
+    return amp_deg * (2 / np.pi) * np.arcsin(np.sin(phase))
+
+
 def trajectory(duration_s: float, rate_hz: float) -> tuple[NDArray[np.float64],
                                                             NDArray[np.float64]]:
-    """Knob 1 sweeps +-60..85 deg at periods from 12 to 40 s; knob 2 a slower +-60 deg sine.
+    """An identification experiment: both knobs sweep at several speeds and amplitudes.
 
-    Varying speed and the other knob's angle make rate dependence and coupling observable.
+    Knob 1 sweeps at 6 to 80 deg/s (log-spaced, a full cycle of speeds every 60 s) with
+    amplitudes 35 to 85 deg; knob 2 sweeps more slowly (4 to 40 deg/s, amplitudes 30 to 70 deg)
+    on incommensurate periods, so every speed and load of one knob is seen with the other knob
+    at many angles. One speed, one amplitude or a fixed other knob would leave rate dependence,
+    compliance and coupling without a signature the base fit cannot absorb.
     """
     t = np.arange(0.0, duration_s, 1.0 / rate_hz)
-    period = 26.0 + 14.0 * np.sin(2 * np.pi * t / 110.0)
-    phase = 2 * np.pi * np.cumsum(1.0 / period) / rate_hz
-    amp = 72.0 + 13.0 * np.sin(2 * np.pi * t / 83.0)
-    q1 = amp * (2 / np.pi) * np.arcsin(np.sin(phase))
-    q2 = 60.0 * np.sin(2 * np.pi * t / 47.0 + 0.4)
-    return t, np.column_stack([q1, q2])
+    v1 = 6.0 * (80.0 / 6.0) ** (0.5 - 0.5 * np.cos(2 * np.pi * t / 60.0))
+    a1 = 60.0 + 25.0 * np.sin(2 * np.pi * t / 37.0)
+    v2 = 4.0 * 10.0 ** (0.5 - 0.5 * np.cos(2 * np.pi * t / 83.0 + 1.0))
+    a2 = 50.0 + 20.0 * np.sin(2 * np.pi * t / 53.0 + 0.7)
+    return t, np.column_stack([_sweep(t, rate_hz, v1, a1), _sweep(t, rate_hz, v2, a2)])
 
 
 def unit_knobs(seed: int, variation: float) -> list[dict[str, float]]:

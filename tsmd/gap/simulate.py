@@ -36,26 +36,58 @@ def simulate(plant: Plant, t_s: NDArray[np.float64],
     return tip, torque
 
 
-def fit_grid(n: int, stride: int) -> NDArray[np.int64]:
-    """Every ``stride``-th row (and the last): what the fits simulate and score."""
+def turning_points(x: NDArray[np.float64], min_travel: float) -> NDArray[np.int64]:
+    """Rows where a signal reverses after moving at least ``min_travel`` (peaks and valleys).
+
+    A rate-independent hysteresis's state is set by the sequence of its input's extremes, so a
+    thinned simulation stays exact only if it keeps them; jitter under ``min_travel`` (encoder
+    noise, a knob at rest) is not a reversal.
+    """
+    out: list[int] = []
+    if len(x) < 3:
+        return np.zeros(0, dtype=np.int64)
+    ext_i, ext_v, rising = 0, float(x[0]), 0  # running extreme since the last turn; 0 = unknown
+    for i, v in enumerate(np.asarray(x, dtype=float).tolist()):
+        if (rising >= 0 and v > ext_v) or (rising <= 0 and v < ext_v):
+            if rising == 0 and abs(v - x[0]) >= min_travel:
+                rising = 1 if v > x[0] else -1
+            ext_i, ext_v = i, v
+        elif rising != 0 and abs(v - ext_v) >= min_travel:
+            out.append(ext_i)
+            rising, ext_i, ext_v = -rising, i, v
+    return np.asarray(out, dtype=np.int64)
+
+
+def fit_grid(n: int, stride: int, knob_deg: NDArray[np.float64] | None = None,
+             min_travel_deg: float = 0.5) -> NDArray[np.int64]:
+    """Every ``stride``-th row, the last, and every knob reversal: what the fits simulate.
+
+    Without the reversals a thinned grid cuts the tops off fast sweeps and the simulated
+    hysteresis loop is narrower than the one driven.
+    """
     idx = np.arange(0, n, max(stride, 1))
     if idx[-1] != n - 1:
         idx = np.append(idx, n - 1)
+    if knob_deg is not None and stride > 1:
+        turns = [turning_points(knob_deg[:, j], min_travel_deg) for j in range(knob_deg.shape[1])]
+        idx = np.union1d(idx, np.concatenate([idx, *turns]))
     return idx
 
 
 def eval_grid(held_out: NDArray[np.bool_], stride: int,
-              held_out_stride: int = 1) -> NDArray[np.int64]:
+              held_out_stride: int = 1,
+              knob_deg: NDArray[np.float64] | None = None) -> NDArray[np.int64]:
     """Every ``held_out_stride``-th held-out row plus the fit grid (to carry the plant's state).
 
     A quasi-static plant gives the same state at a row whether the rows before it were stepped
-    one by one or thinned, so training rows need not all be simulated to score held-out ones.
+    one by one or thinned (as long as the knob reversals are kept), so training rows need not
+    all be simulated to score held-out ones.
     """
     n = len(held_out)
     keep = np.zeros(n, dtype=bool)
     ho = np.flatnonzero(held_out)
     keep[ho[:: max(held_out_stride, 1)]] = True
-    keep[fit_grid(n, stride)] = True
+    keep[fit_grid(n, stride, knob_deg)] = True
     return np.flatnonzero(keep)
 
 

@@ -155,8 +155,9 @@ class DriftCreep(Candidate):
     title = "drift / creep"
     physics = ("a linear drift in time of tip and current; creep of the section: the tip "
                "relaxes towards its slow (30 s) average, tip += k*(lowpass(tip) - tip); creep of "
-               "the tendons: the bent tip loses angle in proportion to time in the run, at its "
-               "own rate on each side (each side's tendon creeps under its own tension)")
+               "the tendons: the bent tip loses angle in proportion to the load its tendon has "
+               "carried so far (time integral of the bend on that side; creep strain grows with "
+               "stress x time), at its own rate on each side")
     creep_tau_s = 30.0
     bent_deg = 5.0
 
@@ -166,8 +167,14 @@ class DriftCreep(Candidate):
         t_run = view.t_s - view.series.t_s[0]
         tip = view.base_tip[:, knob]
         bent = np.tanh(tip / self.bent_deg)
-        return [t_run, lowpass(view.t_s, tip, self.creep_tau_s) - tip,
-                t_run * np.maximum(bent, 0.0), t_run * np.minimum(bent, 0.0)]
+        out = [t_run, lowpass(view.t_s, tip, self.creep_tau_s) - tip]
+        for side in (np.maximum, np.minimum):
+            load = side(tip, 0.0)
+            carried = np.concatenate([[0.0], np.cumsum(0.5 * (load[1:] + load[:-1])
+                                                       * np.diff(view.t_s))])
+            scale = max(float(np.max(np.abs(carried))), 1e-9)
+            out.append(carried / scale * side(bent, 0.0))
+        return out
 
     def current_extra(self, theta: NDArray[np.float64], view: View,
                       knob: int) -> list[NDArray[np.float64]]:

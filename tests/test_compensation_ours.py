@@ -232,3 +232,14 @@ def test_command_jerk_is_bounded_by_the_smoothing_window() -> None:
     assert np.abs(v).max() <= 120.0 + 1e-6 and np.abs(a).max() <= 2000.0 + 1e-6
     assert jerk["ours"] <= 2 * 2000.0 / 0.1 * 1.05  # 2 a_max per 0.1 s window
     assert jerk["ours"] < jerk["paper"] / 10.0
+
+
+def test_stopping_after_a_move_never_turns_the_command_back() -> None:
+    profile = make_profile(d0=20.0)
+    comp = build_compensator(profile, "ours", 0.004)
+    s = 0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, 500))  # smooth move 0 -> -60, then rest
+    q = np.concatenate([s * -60.0, np.full(500, -60.0)])
+    rows = np.column_stack([np.zeros_like(q), q])
+    comp.reset(rows[0])
+    cmd = np.array([comp.command(r)[1] for r in rows])
+    assert np.all(np.diff(cmd) <= 1e-9)  # monotone: no false reversal across the backlash

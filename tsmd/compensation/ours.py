@@ -349,6 +349,7 @@ class OursCompensator:
         self._v_deg_s = np.zeros(2)
         self._axis = np.zeros(2)  # grid coordinate of each knob as seen by the other
         self._out = np.zeros(2)  # the inverse's command (before limiting and smoothing)
+        self._target = np.zeros(2)  # desired angle plus lead, as inverted last
         self._hold = [0, 0]  # direction of a jump started early, 0 = none
         self._cache: list[tuple[float, Envelopes] | None] = [None, None]
         self.reset(np.zeros(2))
@@ -388,6 +389,7 @@ class OursCompensator:
                 x, d = (lo, -1) if hi < 0.0 else (hi, 1)
             states.append(OursState(x, float(q[i]), d, float(q[i]), 0.0))
         self._states = states
+        self._target = q.copy()
         self._out = np.array([st.x_deg for st in states])
         self._lim = [LimiterState(float(x)) for x in self._out]
         self._window = np.repeat(self._out[:, None], self._n_avg, axis=1)
@@ -405,10 +407,20 @@ class OursCompensator:
             v = float(self._v_deg_s[i])
             ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
             lead = float(np.clip(ahead_s * v, -_MAX_LEAD_DEG, _MAX_LEAD_DEG))
+            target = float(q[i]) + lead
+            # The lead shrinks when the desired angle slows down; it must never turn the
+            # target back while the desired angle does not turn back itself: a false reversal
+            # would make the inverse jump across the backlash.
+            dq = float(q[i] - self._q_prev[i])
+            back = (target - float(self._target[i])) * (dq if dq != 0.0 else 0.0)
+            if back < 0.0 or (dq == 0.0 and (target - float(self._target[i]))
+                              * self._states[i].direction < 0.0):
+                target = float(self._target[i])
+            self._target[i] = target
             env = self._envelopes(i)
-            state = ours_inverse_step(self._states[i], float(q[i]) + lead, env)
+            state = ours_inverse_step(self._states[i], target, env)
             self._states[i] = state
-            self._out[i] = self._centred(i, state, float(q[i]) + lead, v, env)
+            self._out[i] = self._centred(i, state, target, v, env)
             self._lim[i] = limit_step(self._lim[i], float(self._out[i]), self._free,
                                       self.period_s)
             self._window[i] = np.roll(self._window[i], 1)

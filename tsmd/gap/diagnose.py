@@ -52,7 +52,7 @@ class GapConfig:
     base_evals: int = 54
     polish_evals: int = 20
     refine_evals: int = 10
-    joint_top: int = 0
+    joint_top: int = 2
     candidate_evals: int = 8
     seed: int = 0
     n_boot: int = 2000

@@ -95,8 +95,9 @@ def markdown(result: GapResult, title: str, plots: dict[str, str]) -> str:
               f"{r.rows['model_evaluations']} model evaluations.", "",
               "How to read: see docs/gap.md. Shares are of the *excess* gap (held-out residual "
               "above the noise floor, in noise units, summed over tip and current). An effect is "
-              "significant when its 90 % bootstrap interval over held-out time blocks excludes "
-              "zero and it removes at least 5 %.", ""]
+              "significant when it removes at least 5 % and its one-sided bootstrap lower bound "
+              "(over held-out time blocks) at 5 % / number of candidates tried is above zero "
+              "(Bonferroni); the table shows the 90 % interval.", ""]
     return "\n".join(lines)
 
 

@@ -8,6 +8,7 @@ from test_gap_support import StandInPlant, make_recording
 
 from tsmd.gap.candidates import RateDependence, catalogue, play
 from tsmd.gap.data import make_split, parse_holdout, series_from_recording
+from tsmd.gap.diagnose import GapConfig, is_significant
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import Evaluator, ParamSpec, View, build_views, fit_base
 from tsmd.gap.simulate import eval_grid, fit_grid, lowpass, simulate, turning_points
@@ -230,6 +231,15 @@ def test_bootstrap_interval_contains_the_point_and_excludes_zero_for_a_clear_gai
     num = 0.5 * den + rng.normal(0, 3, 20)
     point, lo, hi = bootstrap_ratio_ci(num, den, seed=0)
     assert lo < point < hi and lo > 0.4 and hi < 0.6
+
+
+def test_significance_bound_tightens_with_the_number_of_candidates_tried() -> None:
+    excess = np.full(16, 100.0)
+    gain = 9.0 + 18.0 * np.linspace(-1.6, 1.6, 16)  # weak: clear for one candidate, not for six
+    cfg = GapConfig()
+    assert is_significant(gain, excess, 1, cfg)
+    assert not is_significant(gain, excess, 6, cfg)
+    assert not is_significant(np.full(16, 2.0), excess, 1, cfg)  # under min_share
 
 
 def test_ptpe_is_highest_minus_lowest_error() -> None:

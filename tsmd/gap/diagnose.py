@@ -217,6 +217,20 @@ def _use(ev: Evaluator, params: dict[str, Any]) -> None:
     ev._base_cache.clear()
 
 
+def is_significant(gain_blocks: NDArray[np.float64], excess_blocks: NDArray[np.float64],
+                   n_tried: int, cfg: GapConfig) -> bool:
+    """Whether a candidate's held-out gain (per block) is more than chance.
+
+    Several candidates are tried, so each must clear its one-sided bootstrap lower bound at
+    ``family_alpha / n_tried`` (Bonferroni): data without an effect then raise a false alarm
+    with probability of about ``family_alpha`` at most, not that much per candidate. It must
+    also remove at least ``min_share`` of the excess gap.
+    """
+    share, strict_lo, _ = bootstrap_ratio_ci(gain_blocks, excess_blocks, cfg.seed, cfg.n_boot,
+                                             1.0 - 2.0 * cfg.family_alpha / max(n_tried, 1))
+    return bool(strict_lo > 0 and share >= cfg.min_share)
+
+
 def _score(ev: Evaluator, cand: Candidate, theta: NDArray[np.float64], cost: float,
            base_cost: float, fit_views: Sequence[View], rank_views: Sequence[View], split: Split,
            noise_var: NDArray[np.float64], base_blocks: NDArray[np.float64],
@@ -229,15 +243,11 @@ def _score(ev: Evaluator, cand: Candidate, theta: NDArray[np.float64], cost: flo
     blocks, _ = _block_costs(rank_views, pred, split, noise_var)
     share, lo, hi = bootstrap_ratio_ci(base_blocks - blocks, excess, cfg.seed, cfg.n_boot,
                                        cfg.ci_level)
-    # several candidates are tried: each must clear its one-sided bound at alpha / n (Bonferroni)
-    # so that data without an effect raise a false alarm with probability <= family_alpha
-    strict_level = 1.0 - 2.0 * cfg.family_alpha / max(n_tried, 1)
-    strict_lo = bootstrap_ratio_ci(base_blocks - blocks, excess, cfg.seed, cfg.n_boot,
-                                   strict_level)[1]
     return CandidateScore(
         cand.name, cand.title, cand.physics,
         {n: float(x) for n, x in zip(cand.param_names, theta, strict=True)},
-        share, (lo, hi), bool(gap_present and strict_lo > 0 and share >= cfg.min_share),
+        share, (lo, hi),
+        gap_present and is_significant(base_blocks - blocks, excess, n_tried, cfg),
         (base_cost - cost) / base_cost if base_cost > 0 else 0.0,
         _whiteness(rank_views, pred), _metrics(rank_views, pred), stage)
 

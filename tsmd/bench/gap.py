@@ -18,6 +18,7 @@ from tsmd.gap.diagnose import GapConfig, diagnose
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,
     EFFECTS,
+    TRAJECTORIES,
     builtin_factory,
     make_real_recording,
     run_selftest,
@@ -35,6 +36,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seeds", default="0,1")
     parser.add_argument("--cases", default=",".join(EFFECTS))
     parser.add_argument("--selftest-rate-hz", type=float, default=50.0)
+    parser.add_argument("--trajectory", default="experiment", choices=sorted(TRAJECTORIES),
+                        help="self-test motion: the identification experiment (default) or the "
+                             "earlier single-speed sweeps, for comparison")
     parser.add_argument("--out", default=None, help="also write the figures as JSON here")
 
 
@@ -66,7 +70,7 @@ def main(args: argparse.Namespace) -> int:
                           progress=lambda c: print(
                               f"  {c.case:<11} {c.duration_s:5.0f} s seed {c.seed}: "
                               f"{c.verdict:<26} top={c.top or 'none':<11} ({c.wall_s:.1f} s)",
-                              flush=True))
+                              flush=True), motion=args.trajectory)
         print(selftest_markdown(st))
         figures["selftest"] = {"summary": st.summary(), "confusion": st.confusion(),
                                "cases": [vars(c) for c in st.cases]}

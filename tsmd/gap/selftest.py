@@ -86,6 +86,26 @@ def trajectory(duration_s: float, rate_hz: float) -> tuple[NDArray[np.float64],
     return t, np.column_stack([_sweep(t, rate_hz, v1, a1), _sweep(t, rate_hz, v2, a2)])
 
 
+def single_speed_trajectory(duration_s: float, rate_hz: float) -> tuple[NDArray[np.float64],
+                                                                         NDArray[np.float64]]:
+    """The earlier self-test motion, kept for comparison: knob 1 triangle sweeps +-59..85 deg at
+    periods 12-40 s (7 to 24 deg/s), knob 2 one +-60 deg sine of period 47 s.
+
+    It shows what a poorly exciting recording does to the diagnosis (benchmarks-gap.md).
+    """
+    t = np.arange(0.0, duration_s, 1.0 / rate_hz)
+    period = 26.0 + 14.0 * np.sin(2 * np.pi * t / 110.0)
+    phase = 2 * np.pi * np.cumsum(1.0 / period) / rate_hz
+    amp = 72.0 + 13.0 * np.sin(2 * np.pi * t / 83.0)
+    q1 = amp * (2 / np.pi) * np.arcsin(np.sin(phase))
+    q2 = 60.0 * np.sin(2 * np.pi * t / 47.0 + 0.4)
+    return t, np.column_stack([q1, q2])
+
+
+TRAJECTORIES = {"experiment": trajectory, "single-speed": single_speed_trajectory}
+"""Self-test motions by name (``--trajectory``)."""
+
+
 def unit_knobs(seed: int, variation: float) -> list[dict[str, float]]:
     """One catheter unit: slack per side and sheath friction off the defaults by +-variation.
 
@@ -102,11 +122,12 @@ def unit_knobs(seed: int, variation: float) -> list[dict[str, float]]:
 
 def make_real_recording(case: str, duration_s: float, rate_hz: float, seed: int,
                         unit_variation: float = 0.15, tip_noise_deg: float = 0.1,
-                        current_noise_A: float = 0.004) -> Recording:
+                        current_noise_A: float = 0.004,
+                        motion: str = "experiment") -> Recording:
     """A 'real' recording of one case (see the module docstring for how it is made)."""
     effects, lag_s, _ = EFFECTS[case]
     plant = load_plant(BUILTIN_PLANT, {"knobs": unit_knobs(seed, unit_variation), **effects})
-    t, q = trajectory(duration_s, rate_hz)
+    t, q = TRAJECTORIES[motion](duration_s, rate_hz)
     tracker = EmTracker(noise_deg=tip_noise_deg, seed=seed)
     sensors = [CurrentSensor(lag_s=lag_s, offset_A=0.003 * (1 - 2 * k), noise_A=current_noise_A,
                              seed=seed * 7 + k) for k in range(2)]
@@ -216,9 +237,10 @@ def _cur_rmse(m: dict[str, float] | None) -> float | None:
 
 
 def run_case(case: str, duration_s: float, seed: int, rate_hz: float = 50.0,
-             config: GapConfig | None = None) -> tuple[SelftestCase, GapResult]:
+             config: GapConfig | None = None,
+             motion: str = "experiment") -> tuple[SelftestCase, GapResult]:
     """Make one 'real' recording and diagnose it blind (the case is not passed on)."""
-    rec = make_real_recording(case, duration_s, rate_hz, seed)
+    rec = make_real_recording(case, duration_s, rate_hz, seed, motion=motion)
     series = series_from_recording(rec, f"{case}-{seed}")
     cfg = config or GapConfig(fit_specs=BUILTIN_FIT_SPECS, seed=seed)
     start = time.perf_counter()
@@ -236,12 +258,13 @@ def run_case(case: str, duration_s: float, seed: int, rate_hz: float = 50.0,
 
 def run_selftest(cases: Sequence[str], sizes_s: Sequence[float], seeds: Sequence[int],
                  rate_hz: float = 50.0, config: GapConfig | None = None,
-                 progress: Callable[[SelftestCase], None] | None = None) -> SelftestResult:
+                 progress: Callable[[SelftestCase], None] | None = None,
+                 motion: str = "experiment") -> SelftestResult:
     result = SelftestResult()
     for size in sizes_s:
         for seed in seeds:
             for case in cases:
-                c, _ = run_case(case, size, seed, rate_hz, config)
+                c, _ = run_case(case, size, seed, rate_hz, config, motion)
                 result.cases.append(c)
                 if progress is not None:
                     progress(c)

@@ -159,6 +159,21 @@ def test_example_profile_builds_every_method() -> None:
         build_compensator(profile, method, DT, [LIMITS, LIMITS])
 
 
+def test_limits_given_without_apply_limits_are_not_applied_by_the_compensator() -> None:
+    """The loop applies the limiter itself; the compensator must not limit a second time."""
+    profile = load_profile(ROOT / "profiles" / "example-sim.yaml")
+    jump = np.array([80.0, 0.0])
+    for method in ("none", "paper"):
+        free = build_compensator(profile, method, DT, [LIMITS, LIMITS], apply_limits=False)
+        limited = build_compensator(profile, method, DT, [LIMITS, LIMITS])
+        free.reset(np.zeros(2))
+        limited.reset(np.zeros(2))
+        step_free = abs(free.command(jump)[0])
+        step_limited = abs(limited.command(jump)[0])
+        assert step_limited <= LIMITS.max_velocity_deg_s * DT + 1e-9
+        assert step_free > step_limited
+
+
 def test_limiter_follows_a_feasible_moving_target_without_lag() -> None:
     t = np.arange(0.0, 5.0, DT)
     target = 50.0 * (1.0 - np.cos(2 * np.pi * 0.2 * t))  # from rest; 63 deg/s, 79 deg/s^2

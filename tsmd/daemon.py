@@ -100,14 +100,16 @@ def knob_limits(config: TsmdConfig) -> tuple[Any, Any]:
 def make_compensator(profile: Any, method: str, config: TsmdConfig) -> Any:
     """The compensator for ``profile`` (None: no compensation), pure and cheap to build.
 
-    Built without limits: the loop applies the rate/position limiter itself, last.
+    It knows the configured motor limits (when a jump across a dead zone must start) but does
+    not apply them: the loop applies the rate/position limiter itself, last.
     """
     from tsmd.compensation import build_compensator
 
     if profile is None:
         method = "none"
     try:
-        return build_compensator(profile, method, config.loop.period_s, None)
+        return build_compensator(profile, method, config.loop.period_s,
+                                 knob_limits(config), apply_limits=False)
     except (ValueError, TsmdError) as exc:
         raise DaemonError(f"cannot build the {method!r} compensator for "
                           f"{getattr(profile, 'catheter_id', '?')}: {exc}",

@@ -132,8 +132,13 @@ def ours_compensator(profile: CatheterProfile, period_s: float,
 
 
 def build_compensator(profile: CatheterProfile | None, method: str, period_s: float,
-                      limits: Sequence[KnobLimits] | None = None) -> Compensator:
-    """The compensator for ``method`` ("none" | "paper" | "ours"), limited when ``limits``."""
+                      limits: Sequence[KnobLimits] | None = None, *,
+                      apply_limits: bool = True) -> Compensator:
+    """The compensator for ``method`` ("none" | "paper" | "ours"), limited when ``limits``.
+
+    ``apply_limits=False`` only informs the compensator of the motor's limits (when ours must
+    start a jump): for a caller such as the control loop that applies the limiter itself, last.
+    """
     if method not in METHODS:
         raise CompensationError(f"compensation method {method!r} is not one of {list(METHODS)}")
     if not period_s > 0:
@@ -150,6 +155,6 @@ def build_compensator(profile: CatheterProfile | None, method: str, period_s: fl
         v_max = min(lim.max_velocity_deg_s for lim in limits) if limits else 120.0
         a_max = min(lim.max_accel_deg_s2 for lim in limits) if limits else 2000.0
         inner = ours_compensator(profile, period_s, v_max, a_max)
-    if limits is None:
+    if limits is None or not apply_limits:
         return inner
     return LimitedCompensator(inner, limits, period_s)

@@ -118,11 +118,20 @@ def _run(t: NDArray[np.float64], q: NDArray[np.float64], profile: Any, method: s
     return run_trajectory(t, q, profile=profile, method=method, seed=seed, plant=plant)
 
 
-def make_plant(coupling: float) -> Any:
+def make_plant(coupling: float, unit_variation: float = 0.0, unit_seed: int = 0) -> Any:
+    """The simulated catheter; ``unit_variation`` > 0 draws another unit of the same product.
+
+    The data sheet was measured on the nominal unit; other units test whether the device
+    constants carry over, as they must for a real product.
+    """
     from drivers.plant.tendon_sheath import make_tendon_sheath_plant
 
-    return make_tendon_sheath_plant(coupling=coupling) if coupling > 0 else (
-        make_tendon_sheath_plant())
+    params: dict[str, Any] = {}
+    if coupling > 0:
+        params["coupling"] = coupling
+    if unit_variation > 0:
+        params.update(unit_variation=unit_variation, seed=unit_seed)
+    return make_tendon_sheath_plant(**params)
 
 
 def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: int = 1000,
@@ -413,6 +422,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--device", type=Path, default=Path("profiles/devices/sim-catheter.yaml"))
     parser.add_argument("--coupling", type=float, default=0.0,
                         help="plant knob-coupling strength (0 = the default simulated catheter)")
+    parser.add_argument("--unit-variation", type=float, default=0.0,
+                        help="catheter-to-catheter variation of the plant (e.g. 0.1 = +-10 %%); "
+                        "0 = the nominal unit the data sheet was measured on")
+    parser.add_argument("--unit-seed", type=int, default=1,
+                        help="which unit to draw with --unit-variation")
     parser.add_argument("--plots", type=Path, default=None,
                         help="directory for the PNG figures (none by default)")
     parser.add_argument("--report", type=Path, default=None,
@@ -428,9 +442,16 @@ def main(args: argparse.Namespace) -> int:
         raise TsmdError("--seeds must be at least 1")
     device = load_device_model(args.device)
     coupling = float(args.coupling)
+    unit_variation = float(args.unit_variation)
+    if not 0.0 <= unit_variation < 0.5:
+        raise TsmdError(f"--unit-variation must be in [0, 0.5), got {unit_variation}")
+    unit_seed = int(args.unit_seed)
+    if unit_variation > 0:
+        print(f"catheter unit: variation +-{unit_variation:.0%}, unit seed {unit_seed} "
+              "(data sheet from the nominal unit)")
 
     def plant_factory() -> Any:
-        return make_plant(coupling)
+        return make_plant(coupling, unit_variation, unit_seed)
 
     t_start = time.perf_counter()
     source = args.profile_source

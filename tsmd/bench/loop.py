@@ -11,7 +11,7 @@ deadline), SYNC period jitter (time between SYNC frames minus the period), overr
 time per tick.
 ``cyclictest`` (rt-tests), when installed, runs at the same time, priority and period: its
 wake-up latency is what this machine allows any thread under the same load. Figures in
-docs/benchmarks-loop.md.
+docs/benchmarks.md#loop.
 """
 
 from __future__ import annotations

@@ -91,7 +91,7 @@ def single_speed_trajectory(duration_s: float, rate_hz: float) -> tuple[NDArray[
     """The earlier self-test motion, kept for comparison: knob 1 triangle sweeps +-59..85 deg at
     periods 12-40 s (7 to 24 deg/s), knob 2 one +-60 deg sine of period 47 s.
 
-    It shows what a poorly exciting recording does to the diagnosis (benchmarks-gap.md).
+    It shows what a poorly exciting recording does to the diagnosis (docs/benchmarks.md#gap).
     """
     t = np.arange(0.0, duration_s, 1.0 / rate_hz)
     period = 26.0 + 14.0 * np.sin(2 * np.pi * t / 110.0)

@@ -9,25 +9,16 @@ from __future__ import annotations
 import itertools
 
 import canopen
-import numpy as np
 import pytest
 from canopen.profiles.p402 import BaseNode402
+from drive_support import SpringPlant
 
 from drivers.od import EDS_PATH
-from drivers.plant.base import PlantStep
 from drivers.sim.rig import SimRig
 from drivers.units import DriveConfig
 
 PERIOD_S = 0.01
 _CHANNEL = itertools.count()
-
-
-class SpringPlant:
-    def reset(self) -> None:
-        pass
-
-    def step(self, dt_s: float, knob_deg: np.ndarray) -> PlantStep:
-        return PlantStep(tip_deg=1.3 * knob_deg, knob_torque_Nm=0.002 * knob_deg)
 
 
 @pytest.fixture()

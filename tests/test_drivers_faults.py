@@ -7,25 +7,15 @@ import time
 import can
 import numpy as np
 import pytest
+from drive_support import SpringPlant
 
 from drivers.canopen_master import CanOpenDrives
 from drivers.drive import DriveError, DriveState, FaultKind
-from drivers.plant.base import PlantStep
 from drivers.sim.lockstep_bus import LockstepBus
 from drivers.sim.rig import SimRig, open_sim_rig
 from drivers.units import DriveConfig
 
 PERIOD_S = 0.004
-
-
-class SpringPlant:
-    """Stand-in catheter: a linear torsion spring per knob."""
-
-    def reset(self) -> None:
-        pass
-
-    def step(self, dt_s: float, knob_deg: np.ndarray) -> PlantStep:
-        return PlantStep(tip_deg=1.3 * knob_deg, knob_torque_Nm=0.002 * knob_deg)
 
 
 @pytest.fixture()

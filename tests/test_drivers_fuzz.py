@@ -4,25 +4,16 @@ events (master) or are ignored / answered with an SDO abort (drive)."""
 from __future__ import annotations
 
 import can
-import numpy as np
+from drive_support import SpringPlant
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from drivers.drive import DriveError, FaultKind
-from drivers.plant.base import PlantStep
 from drivers.sim.rig import open_sim_rig
 
 PERIOD_S = 0.004
 frames = st.lists(st.tuples(st.integers(0, 0x7FF), st.binary(max_size=8)), min_size=1,
                   max_size=6)
-
-
-class SpringPlant:
-    def reset(self) -> None:
-        pass
-
-    def step(self, dt_s: float, knob_deg: np.ndarray) -> PlantStep:
-        return PlantStep(tip_deg=1.3 * knob_deg, knob_torque_Nm=0.002 * knob_deg)
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])

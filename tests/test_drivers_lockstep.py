@@ -4,26 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from drive_support import SpringPlant
 
 from drivers.drive import DriveState
-from drivers.plant.base import PlantStep
 from drivers.sim.rig import open_sim_rig
 from drivers.units import DriveConfig
 
 PERIOD_S = 0.004
-
-
-class SpringPlant:
-    """Stand-in catheter: a linear torsion spring per knob, tip = 1.3 x knob."""
-
-    def __init__(self, stiffness_Nm_deg: float = 0.002) -> None:
-        self.stiffness = stiffness_Nm_deg
-
-    def reset(self) -> None:
-        pass
-
-    def step(self, dt_s: float, knob_deg: np.ndarray) -> PlantStep:
-        return PlantStep(tip_deg=1.3 * knob_deg, knob_torque_Nm=self.stiffness * knob_deg)
 
 
 @pytest.fixture()

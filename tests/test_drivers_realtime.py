@@ -6,20 +6,12 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from drive_support import SpringPlant
 
 from drivers.drive import DriveState
-from drivers.plant.base import PlantStep
 from drivers.sim.rig import open_sim_rig
 
 PERIOD_S = 0.004
-
-
-class SpringPlant:
-    def reset(self) -> None:
-        pass
-
-    def step(self, dt_s: float, knob_deg: np.ndarray) -> PlantStep:
-        return PlantStep(tip_deg=1.3 * knob_deg, knob_torque_Nm=0.002 * knob_deg)
 
 
 def test_real_time_rig_boots_enables_and_follows_targets():

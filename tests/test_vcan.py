@@ -11,6 +11,7 @@ import socket
 
 import numpy as np
 import pytest
+from drive_support import SpringPlant
 
 VCAN = os.environ.get("TSMD_VCAN", "vcan0")
 
@@ -38,16 +39,6 @@ def _vcan_missing() -> str | None:
 
 pytestmark = [pytest.mark.vcan,
               pytest.mark.skipif(_vcan_missing() is not None, reason=str(_vcan_missing()))]
-
-
-class SpringPlant:
-    def reset(self) -> None:
-        pass
-
-    def step(self, dt_s: float, knob_deg: np.ndarray):
-        from drivers.plant.base import PlantStep
-
-        return PlantStep(tip_deg=1.3 * knob_deg, knob_torque_Nm=0.002 * knob_deg)
 
 
 def test_master_boots_and_streams_to_the_rig_over_vcan():

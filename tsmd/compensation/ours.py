@@ -242,16 +242,20 @@ class OursState:
     blend_tip_deg: float
 
 
+def _held_and_blend(state: OursState, direction: int, env: Envelopes) -> tuple[float, float]:
+    """The held output and transition blend; a reversal holds the output where it is."""
+    if direction == state.direction:
+        return state.held_deg, state.blend_tip_deg
+    held = state.y_deg
+    gap = (held - env.rising(state.x_deg)) if direction > 0 else (env.falling(state.x_deg) - held)
+    return held, min(env.blend_tip_deg, max(gap, 0.0))
+
+
 def ours_model_step(state: OursState, x_deg: float, env: Envelopes) -> OursState:
     """Forward model: the smooth play. Used by tests and for the inverse's bookkeeping."""
     dx = x_deg - state.x_deg
     direction = state.direction if dx == 0 else (1 if dx > 0 else -1)
-    held, blend = state.held_deg, state.blend_tip_deg
-    if direction != state.direction:
-        held = state.y_deg
-        gap = (held - env.rising(state.x_deg)) if direction > 0 else (env.falling(state.x_deg)
-                                                                      - held)
-        blend = min(env.blend_tip_deg, max(gap, 0.0))
+    held, blend = _held_and_blend(state, direction, env)
     if direction > 0:
         y = held + smooth_max_excess(env.rising(x_deg) - held, blend)
     else:
@@ -265,12 +269,7 @@ def ours_inverse_step(state: OursState, y_desired_deg: float, env: Envelopes) ->
     if y == state.y_deg:
         return state
     direction = 1 if y > state.y_deg else -1
-    held, blend = state.held_deg, state.blend_tip_deg
-    if direction != state.direction:
-        held = state.y_deg
-        gap = (held - env.rising(state.x_deg)) if direction > 0 else (env.falling(state.x_deg)
-                                                                      - held)
-        blend = min(env.blend_tip_deg, max(gap, 0.0))
+    held, blend = _held_and_blend(state, direction, env)
     if direction > 0:
         b = held + smooth_max_excess_inverse(y - held, blend)
         x = env.rising_inverse(b)

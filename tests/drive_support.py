@@ -1,0 +1,20 @@
+"""Shared test stand-ins for the drivers tests."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drivers.plant.base import PlantStep
+
+
+class SpringPlant:
+    """Stand-in catheter: a linear torsion spring per knob, tip = 1.3 x knob."""
+
+    def __init__(self, stiffness_Nm_deg: float = 0.002) -> None:
+        self.stiffness = stiffness_Nm_deg
+
+    def reset(self) -> None:
+        pass
+
+    def step(self, dt_s: float, knob_deg: np.ndarray) -> PlantStep:
+        return PlantStep(tip_deg=1.3 * knob_deg, knob_torque_Nm=self.stiffness * knob_deg)

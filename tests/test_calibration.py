@@ -324,3 +324,37 @@ def test_identification_in_a_worker_process_gives_the_same_values() -> None:
     isolated = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto,
                           period_s=PERIOD_S, isolate=True)
     assert isolated.points[0].result.values == here.points[0].result.values
+
+
+def _with_backlash(base: SweepResult, backlash_deg: float) -> SweepResult:
+    values = dict(base.values)
+    values["backlash_pos_deg"] = (backlash_deg, backlash_deg)
+    values["backlash_neg_deg"] = (backlash_deg, backlash_deg)
+    return SweepResult(base.data, base.half_cycles, values)
+
+
+def test_backlash_far_below_the_data_sheets_is_a_warning_kept_in_the_figures() -> None:
+    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
+
+    device = load_device_model(DEVICE)
+    sheet_b = device.knobs[0].reference_backlash_pos_deg
+    assert sheet_b is not None
+    small = _with_backlash(_identify(_sweep(SHORT_SWEEP)), 0.2 * sheet_b)
+    report = QualityReport()
+    cross_check_device([GridPoint(k, 0.0, small) for k in (0, 1)], device, report)
+    assert len(report.warnings) == 4
+    assert "phi1: backlash_pos_deg from the current" in report.warnings[0]
+    assert report.figures["phi1_backlash_pos_vs_datasheet"] == pytest.approx(0.2)
+
+
+def test_backlash_near_the_data_sheets_gives_no_warning() -> None:
+    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
+
+    device = load_device_model(DEVICE)
+    sheet_b = device.knobs[1].reference_backlash_neg_deg
+    assert sheet_b is not None
+    near = _with_backlash(_identify(_sweep(SHORT_SWEEP)), 0.9 * sheet_b)
+    report = QualityReport()
+    cross_check_device([GridPoint(k, 0.0, near) for k in (0, 1)], device, report)
+    assert report.warnings == []
+    assert report.figures["phi2_backlash_neg_vs_datasheet"] == pytest.approx(0.9)

@@ -57,6 +57,8 @@ class QualityReport:
 
     figures: dict[str, float] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    """Findings that do not stop the calibration but that its user must read."""
 
     def raise_if_bad(self) -> None:
         if self.problems:
@@ -125,6 +127,42 @@ def _check_point(p: GridPoint, lim: QualityLimits, amplitude_deg: float, problem
     snr = r.snr
     if math.isfinite(snr) and snr < lim.min_snr:
         problems.append(f"{p.name}: current signal too weak (SNR {snr:.1f} < {lim.min_snr:g})")
+
+
+BACKLASH_DATASHEET_MIN_RATIO = 0.5
+"""Backlash from the current below this share of the data sheet's reference backlash is flagged."""
+
+
+def cross_check_device(points: Sequence[GridPoint], device: DeviceModel,
+                       report: QualityReport) -> None:
+    """Compare the backlash the current shows with the data sheet's, where it gives one.
+
+    The paper reads the end of the backlash where the current settles after a reversal; on a
+    catheter whose current settles long before the tip moves, B comes out far too small and no
+    check on the current alone can see it. The data sheet's reference backlash (measured once per
+    product at the reference points, other knob at 0) can: the ratio is kept in the profile's
+    quality figures and a low one becomes a warning.
+    """
+    for knob in (0, 1):
+        sheet = device.knobs[knob]
+        zero = [p for p in points if p.knob == knob and abs(p.other_deg) < 1e-6]
+        if not zero:
+            continue
+        label = KNOB_LABELS[knob]
+        for side, reference in (("pos", sheet.reference_backlash_pos_deg),
+                                ("neg", sheet.reference_backlash_neg_deg)):
+            found = zero[0].result.estimate(f"backlash_{side}_deg")
+            if reference is None or not reference > 0 or not math.isfinite(found):
+                continue
+            ratio = found / reference
+            report.figures[f"{label}_backlash_{side}_vs_datasheet"] = ratio
+            if ratio < BACKLASH_DATASHEET_MIN_RATIO:
+                report.warnings.append(
+                    f"{label}: backlash_{side}_deg from the current is {found:.1f} deg, "
+                    f"{ratio:.0%} of the data sheet's reference backlash {reference:.1f} deg: "
+                    "the current settles before the tip moves on this catheter, so the paper's "
+                    "compensator will under-compensate reversals (ours takes the release branch "
+                    "from the data sheet)")
 
 
 def knob_grid(points: Sequence[GridPoint], knob: int) -> tuple[tuple[float, ...],

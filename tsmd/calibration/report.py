@@ -82,6 +82,7 @@ def write_report(cal: Calibration, directory: Path) -> Path:
            "## Every half-cycle", "", identification_table(cal.points), "",
            "## Quality", ""]
     md += [f"- {k}: {v:.2f}" for k, v in sorted(cal.quality.figures.items())]
+    md += [f"- **warning**: {w}" for w in cal.quality.warnings]
     notes = sorted({n for p in cal.points for n in p.result.data.notes})
     if notes:
         md += ["", "Signal conditioning notes: " + "; ".join(notes)]

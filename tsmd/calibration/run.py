@@ -30,6 +30,7 @@ from tsmd.calibration.assemble import (
     QualityReport,
     build_profile,
     check_quality,
+    cross_check_device,
 )
 from tsmd.calibration.errors import CalibrationCancelledError, CalibrationError
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
@@ -144,6 +145,7 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
     """Quality checks, our compensator's fit and the profile (CalibrationError if refused)."""
     report = check_quality(points, limits, amplitude_deg)
     report.raise_if_bad()
+    cross_check_device(points, device, report)
     ours = []
     for knob in (0, 1):
         try:

@@ -118,6 +118,8 @@ def _print_result(cal: Any) -> None:
     from tsmd.calibration.report import grid_table
 
     print(grid_table(cal))
+    for warning in cal.quality.warnings:
+        print(f"warning: {warning}")
     if cal.sweep_time_s:
         print(f"protocol {cal.protocol_name}: {cal.sweep_time_s:.0f} s sweeping, "
               f"{cal.motion_time_s:.0f} s of motion, {cal.wall_time_s:.1f} s wall")

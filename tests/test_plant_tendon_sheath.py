@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -11,43 +10,20 @@ import pytest
 from drivers.plant import tendon_sheath
 from drivers.plant.analysis import loaded_slope, measure_dead_zone_backlash
 from drivers.plant.base import Plant, load_plant
+from drivers.plant.report import SweepRecord
+from drivers.plant.report import run_sweep as report_sweep
 from drivers.plant.tendon_sheath import TendonSheathPlant, make_tendon_sheath_plant
 
 DT_S = 0.004  # 250 Hz ticks
 
 
-@dataclass
-class Sweep:
-    t_s: np.ndarray
-    knob_deg: np.ndarray
-    tip_deg: np.ndarray
-    torque_Nm: np.ndarray
-
-
-def run_sweep(
-    plant: Plant,
-    knob: int = 0,
-    freq_hz: float = 0.04,
-    amp_deg: float = 90.0,
-    cycles: float = 2.0,
-    other_deg: float = 0.0,
-) -> Sweep:
-    t = np.arange(0.0, cycles / freq_hz, DT_S)
-    q = amp_deg * np.sin(2.0 * np.pi * freq_hz * t)
-    tip = np.empty_like(t)
-    tau = np.empty_like(t)
-    cmd = np.zeros(2)
-    cmd[1 - knob] = other_deg
-    for i, qi in enumerate(q):
-        cmd[knob] = qi
-        step = plant.step(DT_S, cmd)
-        tip[i] = step.tip_deg[knob]
-        tau[i] = step.knob_torque_Nm[knob]
-    return Sweep(t, q, tip, tau)
+def run_sweep(plant: Plant, knob: int = 0, **kwargs: Any) -> SweepRecord:
+    """The report's sweep at 250 Hz ticks (it resets the plant first)."""
+    return report_sweep(plant, knob, dt_s=DT_S, **kwargs)
 
 
 @pytest.fixture(scope="module", params=[0, 1], ids=["phi1", "phi2"])
-def default_sweep(request: pytest.FixtureRequest) -> Sweep:
+def default_sweep(request: pytest.FixtureRequest) -> SweepRecord:
     return run_sweep(make_tendon_sheath_plant(), knob=request.param)
 
 
@@ -63,25 +39,25 @@ def test_straight_and_unloaded_at_rest() -> None:
     assert np.allclose(step.knob_torque_Nm, 0.0)
 
 
-def test_sweep_shows_a_dead_zone_on_both_sides(default_sweep: Sweep) -> None:
+def test_sweep_shows_a_dead_zone_on_both_sides(default_sweep: SweepRecord) -> None:
     m = measure_dead_zone_backlash(default_sweep.knob_deg, default_sweep.tip_deg)
     assert 15.0 <= m.dead_zone_pos_deg <= 25.0
     assert -25.0 <= m.dead_zone_neg_deg <= -15.0
 
 
-def test_sweep_shows_backlash_after_both_reversals(default_sweep: Sweep) -> None:
+def test_sweep_shows_backlash_after_both_reversals(default_sweep: SweepRecord) -> None:
     m = measure_dead_zone_backlash(default_sweep.knob_deg, default_sweep.tip_deg)
     assert 15.0 <= m.backlash_pos_deg <= 25.0
     assert 15.0 <= m.backlash_neg_deg <= 25.0
 
 
-def test_tip_slope_in_the_loaded_region_is_about_1_3(default_sweep: Sweep) -> None:
+def test_tip_slope_in_the_loaded_region_is_about_1_3(default_sweep: SweepRecord) -> None:
     pos, neg = loaded_slope(default_sweep.knob_deg, default_sweep.tip_deg, 40.0, 85.0)
     assert 1.2 <= pos <= 1.45
     assert 1.2 <= neg <= 1.45
 
 
-def test_backlash_transitions_are_curved_not_straight(default_sweep: Sweep) -> None:
+def test_backlash_transitions_are_curved_not_straight(default_sweep: SweepRecord) -> None:
     """After the backlash the tip speeds up over several degrees instead of snapping to a line."""
     s = default_sweep
     falling = (s.t_s > 31.25) & (s.t_s < 37.5) & (s.knob_deg > 30.0)
@@ -94,7 +70,7 @@ def test_backlash_transitions_are_curved_not_straight(default_sweep: Sweep) -> N
     assert early < 0.7 * later
 
 
-def test_torque_is_flat_and_small_in_the_dead_zone(default_sweep: Sweep) -> None:
+def test_torque_is_flat_and_small_in_the_dead_zone(default_sweep: SweepRecord) -> None:
     s = default_sweep
     rising_dz = (np.gradient(s.knob_deg) > 0) & (np.abs(s.knob_deg) < 10.0) & (s.t_s > 12.5)
     tau = s.torque_Nm[rising_dz]
@@ -103,7 +79,7 @@ def test_torque_is_flat_and_small_in_the_dead_zone(default_sweep: Sweep) -> None
     assert np.max(np.abs(tau)) < 0.06 * peak
 
 
-def test_torque_rises_once_the_tendon_engages(default_sweep: Sweep) -> None:
+def test_torque_rises_once_the_tendon_engages(default_sweep: SweepRecord) -> None:
     s = default_sweep
     second_cycle = s.t_s > 25.0
     loading = (
@@ -115,12 +91,12 @@ def test_torque_rises_once_the_tendon_engages(default_sweep: Sweep) -> None:
     assert np.corrcoef(q, tau)[0, 1] > 0.99
 
 
-def test_knob_torque_is_of_order_0_05_to_0_3_Nm(default_sweep: Sweep) -> None:
+def test_knob_torque_is_of_order_0_05_to_0_3_Nm(default_sweep: SweepRecord) -> None:
     assert 0.05 <= np.max(np.abs(default_sweep.torque_Nm)) <= 0.3
 
 
 def test_torque_changes_sign_after_a_reversal_and_stays_near_zero_while_released(
-    default_sweep: Sweep,
+    default_sweep: SweepRecord,
 ) -> None:
     s = default_sweep
     peak = np.max(s.torque_Nm)
@@ -134,7 +110,7 @@ def test_torque_changes_sign_after_a_reversal_and_stays_near_zero_while_released
     assert np.max(np.abs(tau[released])) < 0.1 * peak
 
 
-def test_torque_makes_a_small_peak_after_reversal_then_settles(default_sweep: Sweep) -> None:
+def test_torque_makes_a_small_peak_after_reversal_then_settles(default_sweep: SweepRecord) -> None:
     s = default_sweep
     i_rev = int(np.argmax(s.knob_deg[: int(25.0 / DT_S)]))
     window = slice(i_rev, i_rev + int(8.0 / DT_S))

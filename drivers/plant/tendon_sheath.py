@@ -44,17 +44,20 @@ class KnobParams:
     slack_neg_mm: float = 2.15
     tendon_offset_mm: float = 2.47
     """Moment arm of the tendons in the bending section."""
-    tendon_stiffness_N: float = 1830.0
+    tendon_stiffness_N: float = 6000.0
     """Axial stiffness EA of the tendon."""
     sheath_length_m: float = 1.0
     free_length_m: float = 0.01
     """Tendon length between pulley and sheath entry (no friction)."""
-    sheath_friction: float = 0.15
+    sheath_friction: float = 0.25
     """Coulomb friction coefficient tendon/sheath."""
-    sheath_wrap_deg: float = 240.0
+    sheath_wrap_deg: float = 480.0
     """Total wrap angle of the tendon in the (straight) sheath: coil helix and lumen contact."""
-    routing_wrap_deg: float = 360.0
-    """Wrap of the tendon over guide pins in the handle, right after the pulley."""
+    routing_wrap_deg: float = 0.0
+    """Wrap of the tendon over guide pins in the handle, right after the pulley. The default
+    handle runs the tendon straight from the pulley into the sheath; a routed handle (e.g. 360)
+    isolates the knob from the sheath, so the motor current no longer shows the backlash
+    (docs/plant.md, "Handle routing")."""
     routing_friction: float = 0.25
     """Friction coefficient on the handle guide pins."""
     sheath_drag_N: float = 0.15
@@ -107,7 +110,7 @@ class KnobParams:
 # The anterior-posterior and right-left knobs of one catheter differ slightly.
 DEFAULT_KNOBS = (
     KnobParams(),
-    KnobParams(slack_pos_mm=2.15, slack_neg_mm=1.95, sheath_wrap_deg=225.0, tendon_offset_mm=2.43),
+    KnobParams(slack_pos_mm=2.15, slack_neg_mm=1.95, sheath_wrap_deg=450.0, tendon_offset_mm=2.43),
 )
 
 

@@ -10,7 +10,8 @@ tendon loads the tip again (dead-zone edge, ``D``). Here, per monotonic half-cyc
 * the dead-zone edge: where that run ends and the current starts to rise (the paper's), or,
   with ``edge="knee"``, where the steep first rise turns into the loaded ramp;
 * the peak after the reversal: :func:`scipy.signal.find_peaks` on the direction-signed current;
-  the backlash ends where the current then stays within a noise band of the constant level.
+  the backlash ends where the current then joins the constant level that follows (the first run
+  of flat pieces after the peak), see :func:`_backlash_end`.
 
 Increasing half-cycles (after the reversal at the negative end) give ``B_neg`` and ``D_pos``;
 decreasing ones (after the positive end) give ``B_pos`` and ``D_neg``, as in the paper's model
@@ -60,9 +61,10 @@ class IdentifyOptions:
     where the steep first rise turns into the loaded ramp, i.e. where the tip starts to move."""
     knee_slope_ratio: float = 1.5
     max_knee_deg: float = 15.0
-    settle_fraction: float = 0.1
-    """Band around the constant level, as a fraction of the peak's height above it."""
     settle_hold_deg: float = 1.0
+    """The current must stay on the constant level this long to count as settled."""
+    backlash_tangent_deg: float = 3.0
+    """Stretch of current before it settles that is extended to meet the constant level."""
     max_tracking_error_deg: float = 10.0
     min_follow_ratio: float = 0.5
     """The knob must travel at least this fraction of the commanded travel (else: stalled)."""
@@ -199,20 +201,24 @@ def _pieces(yg: FloatArray, noise: float, opts: IdentifyOptions) -> list[tuple[i
     return list(zip([0, *bkps[:-1]], bkps, strict=True))
 
 
-def _plateau(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
-             opts: IdentifyOptions) -> tuple[int, int] | None:
-    """The constant-current stretch: the longest run of flat pieces (start, stop on the grid).
-
-    The reference is the loaded ramp: the slope over the last quarter of the travel. A piece is
-    flat when the current rises slower than ``flat_slope_fraction`` of that, or falls gently
-    (a fall as steep as the ramp is the peak after a reversal coming down, not a plateau).
-    """
-    tail = yg[int(0.75 * yg.size):]
-    loaded = _slope(tail, step)
+def _flat_pieces(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
+                 opts: IdentifyOptions) -> list[bool] | None:
+    """Which pieces are flat: rising slower than ``flat_slope_fraction`` of the loaded ramp
+    (the slope over the last quarter of the travel), or falling gently (a fall as steep as the
+    ramp is the peak after a reversal coming down, not a plateau). None without a ramp."""
+    loaded = _slope(yg[int(0.75 * yg.size):], step)
     if loaded <= 0:
         return None
     slopes = [_slope(yg[a:b], step) for a, b in pieces]
-    flat = [-loaded < s < opts.flat_slope_fraction * loaded for s in slopes]
+    return [-loaded < s < opts.flat_slope_fraction * loaded for s in slopes]
+
+
+def _plateau(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
+             opts: IdentifyOptions) -> tuple[int, int] | None:
+    """The constant-current stretch: the longest run of flat pieces (start, stop on the grid)."""
+    flat = _flat_pieces(yg, step, pieces, opts)
+    if flat is None:
+        return None
     best: tuple[int, int] | None = None
     k = 0
     while k < len(pieces):
@@ -249,6 +255,49 @@ def _knee(yg: FloatArray, step: float, pieces: list[tuple[int, int]], rise_k: in
     return rise_k
 
 
+def _backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
+                  pieces: list[tuple[int, int]], noise: float,
+                  opts: IdentifyOptions) -> int | None:
+    """Where the current becomes constant after the reversal (the paper's point a2).
+
+    While the sheath unloads, the current falls steeply, then less and less steeply as the slip
+    front runs distally; when the front reaches the tip the current joins the release level
+    (a line, nearly flat). That level is fitted on the first run of flat pieces after the peak;
+    the backlash ends where the current reaches it and stays within ``peak_noise_k`` noise sigmas,
+    refined to where the current's last ``backlash_tangent_deg`` before that, extended as a line,
+    meets the level (the current approaches the level at a slant, so a band alone ends early).
+    """
+    step = float(grid[1] - grid[0])
+    flat = _flat_pieces(yg, step, pieces, opts)
+    if flat is None:
+        return None
+    first = next((k for k, (a, _) in enumerate(pieces) if flat[k] and a >= start_k), None)
+    if first is None:
+        return None
+    last = first
+    while last + 1 < len(pieces) and flat[last + 1]:
+        last += 1
+    a0, b0 = pieces[first][0], pieces[last][1]
+    if b0 - a0 < 3:
+        return None
+    level = np.polyfit(grid[a0:b0], yg[a0:b0], 1)
+    near = np.abs(yg[start_k:b0] - np.polyval(level, grid[start_k:b0])) <= opts.peak_noise_k * noise
+    hold = max(2, round(opts.settle_hold_deg / step))
+    stays = np.convolve(near.astype(float), np.ones(hold), mode="valid") >= hold
+    hits = np.flatnonzero(stays)
+    settle = start_k + int(hits[0]) if hits.size else a0
+    width = round(opts.backlash_tangent_deg / step)
+    lo = max(start_k, settle - width)
+    if settle - lo >= 3:
+        tangent = np.polyfit(grid[lo:settle], yg[lo:settle], 1)
+        if abs(tangent[0] - level[0]) > 1e-12:
+            x = (level[1] - tangent[1]) / (tangent[0] - level[0])
+            k = int(np.searchsorted(grid, x))
+            if settle <= k <= settle + width:
+                settle = k
+    return settle
+
+
 def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
                        after_reversal: bool, opts: IdentifyOptions) -> HalfCycle:
     """Peak, backlash end and dead-zone edge in one monotonic stretch."""
@@ -278,26 +327,18 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     settle = 0
     backlash_deg = math.nan
     if after_reversal:
-        # The small peak after the reversal (find_peaks), then the first point from which the
-        # current stays on the constant level (noise band around the plateau's median) for
-        # ``settle_hold_deg``; the backlash counts from the reversal (the model's X_ref).
-        level = float(np.median(yg[plateau_run[0]:plateau_run[1]]))
-        search = yg[:plateau_run[1]]
-        # The peak belongs to the transient before the constant phase (noise on the plateau
-        # has peaks too).
-        transient = yg[:min(plateau_run[0] + round(opts.settle_hold_deg / step) + 1,
-                            plateau_run[1])]
+        # The small peak after the reversal (find_peaks); it belongs to the transient before the
+        # constant phase (noise on the plateau has peaks too).
+        hold = max(2, round(opts.settle_hold_deg / step))
+        transient = yg[:min(plateau_run[0] + hold + 1, plateau_run[1])]
         peaks, _ = find_peaks(transient, prominence=opts.peak_noise_k * noise)
         peak = int(peaks[0]) if peaks.size else None
         start_k = peak if peak is not None else 0
-        height = float(np.max(np.abs(search[:start_k + 1] - level)))
-        band = max(opts.peak_noise_k * noise, opts.settle_fraction * height)
-        hold = max(2, round(opts.settle_hold_deg / step))
-        inside = np.abs(search[start_k:] - level) <= band
-        run = np.convolve(inside.astype(float), np.ones(hold), mode="valid") >= hold
-        hits = np.flatnonzero(run)
-        settle = start_k + int(hits[0]) if hits.size else plateau_run[0]
-        settle = min(settle, plateau_run[0]) if plateau_run[0] > start_k else settle
+        found = _backlash_end(grid[:end], yg[:end], start_k, pieces, noise, opts)
+        settle = plateau_run[0] if found is None else found
+        if found is None:
+            problems.append(f"{where}: the current never becomes constant after the reversal")
+        # The backlash counts from the reversal (the model's X_ref).
         backlash_deg = float(grid[settle] - grid[0])
 
     # The dead-zone edge: where the constant-current stretch ends and the current rises.

@@ -79,8 +79,11 @@ def test_without_rate_dependence_the_loop_does_not_depend_on_speed() -> None:
 
 
 def test_rate_dependence_widens_the_loop_at_higher_speed() -> None:
-    slow_q, slow_tip, _ = sweep(make_tendon_sheath_plant(rate_dependence=1.0), freq_hz=0.04)
-    fast_q, fast_tip, _ = sweep(make_tendon_sheath_plant(rate_dependence=1.0), freq_hz=0.2)
+    """0.3: sheath friction 34 % higher at the 0.2 Hz sweep's peak speed (113 deg/s), 7 % at
+    0.04 Hz. With the nominal mu*wrap ~2.1 rad much more nearly locks the tip at 0.2 Hz (k=1:
+    B > 120 deg, the loop collapses), which is no longer a wider loop."""
+    slow_q, slow_tip, _ = sweep(make_tendon_sheath_plant(rate_dependence=0.3), freq_hz=0.04)
+    fast_q, fast_tip, _ = sweep(make_tendon_sheath_plant(rate_dependence=0.3), freq_hz=0.2)
     assert loop_area(fast_q, fast_tip) > 1.05 * loop_area(slow_q, slow_tip)
     slow = measure_dead_zone_backlash(slow_q, slow_tip)
     fast = measure_dead_zone_backlash(fast_q, fast_tip)
@@ -122,14 +125,17 @@ def test_reset_forgets_creep() -> None:
     assert measure_dead_zone_backlash(*sweep(plant)[:2]) == first
 
 
-def test_knob_stiction_adds_a_peak_after_reversal() -> None:
-    """The knob's friction breaks loose after a reversal: a short extra opposing torque."""
+def test_knob_stiction_opposes_the_knob_right_after_a_reversal() -> None:
+    """The knob's friction breaks loose after a reversal: extra opposing torque over the first
+    few degrees of slip, gone once the knob has slid well past handle_slip_deg (3 deg)."""
     q, _, tau = sweep(make_tendon_sheath_plant(), cycles=0.5)
     _, _, tau1 = sweep(
         make_tendon_sheath_plant(knobs=[{"handle_stiction_Nm": 0.012}, {}]), cycles=0.5
     )
-    after = (np.gradient(q) < 0) & (q > 70.0) & (q < 87.5)
-    assert tau[after].min() < tau1[after].min() - 0.005
+    falling = np.gradient(q) < 0
+    extra = tau - tau1
+    assert extra[falling & (q > 88.5) & (q < 89.7)].max() < -0.01
+    assert np.abs(extra[falling & (q > 40.0) & (q < 70.0)]).max() < 0.002
 
 
 def test_unit_variation_draws_a_different_catheter_per_seed() -> None:

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from drivers.plant.report import main
+from drivers.plant.report import main, run_sweep, signature
+from drivers.plant.tendon_sheath import make_tendon_sheath_plant
 
 
 def test_report_prints_both_knobs_and_writes_the_figure(
@@ -16,6 +17,7 @@ def test_report_prints_both_knobs_and_writes_the_figure(
     assert main(["--plot", str(png)]) == 0
     out = capsys.readouterr().out
     assert out.count("dead zone D_pos/D_neg") == 2
+    assert out.count("torque settled after") == 2
     assert "us/step" in out
     assert png.stat().st_size > 10_000
 
@@ -25,3 +27,13 @@ def test_report_refuses_an_unknown_parameter(capsys: pytest.CaptureFixture[str])
     err = capsys.readouterr().err
     assert "bogus" in err
     assert "Traceback" not in err
+
+
+def test_report_says_where_the_torque_settles_after_a_reversal() -> None:
+    """About the backlash on the straight handle, a few degrees on a routed one."""
+    straight = signature(run_sweep(make_tendon_sheath_plant(), 0))
+    routed = signature(
+        run_sweep(make_tendon_sheath_plant(knobs=[{"routing_wrap_deg": 360.0}, {}]), 0)
+    )
+    assert straight.torque_settled_deg > 0.7 * straight.dz_bl.backlash_pos_deg
+    assert routed.torque_settled_deg < 6.0 < 20.0 < routed.dz_bl.backlash_pos_deg

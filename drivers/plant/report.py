@@ -83,6 +83,9 @@ class Signature:
     dead_zone_torque_Nm: float
     reversal_dip_Nm: float
     released_torque_Nm: float
+    torque_settled_deg: float
+    """Knob travel after the reversal until the torque is within 2 % of its peak of the released
+    level: about the backlash with a straight handle, a few degrees with a routed one."""
     loop_area_deg2: float
     """Area of the tip-vs-knob loop over the second cycle."""
 
@@ -98,6 +101,9 @@ def signature(rec: SweepRecord) -> Signature:
     i_rev = int(np.argmax(np.where(t > period, q, -np.inf)))
     after = (t > t[i_rev]) & (t < t[i_rev] + period / 4) & (q > m.dead_zone_pos_deg + 5.0)
     released = after & (q < 90.0 - m.backlash_pos_deg - 2.0)
+    level = float(np.median(tau[released])) if released.any() else float("nan")  # tip locked
+    peak = float(np.max(np.abs(tau)))
+    settled = np.flatnonzero(after & (np.abs(tau - level) < 0.02 * peak))
     return Signature(
         dz_bl=m,
         loading_slope=loaded_slope(q, y, 40.0, 85.0),
@@ -106,7 +112,8 @@ def signature(rec: SweepRecord) -> Signature:
         torque_peak_Nm=float(np.max(np.abs(tau))),
         dead_zone_torque_Nm=float(np.median(tau[in_dz])),
         reversal_dip_Nm=float(tau[after].min()),
-        released_torque_Nm=float(np.median(tau[released])),
+        released_torque_Nm=level,
+        torque_settled_deg=float(q[i_rev] - q[settled[0]]) if settled.size else float("nan"),
         loop_area_deg2=float(abs(np.trapezoid(y[t >= period], q[t >= period]))),
     )
 
@@ -192,7 +199,7 @@ def plot(records: Sequence[SweepRecord], sigs: Sequence[Signature], path: str) -
         m = sig.dz_bl
         ax = axes[0, col]
         ax.plot(rec.knob_deg, rec.tip_deg, lw=1.0)
-        ax.plot([-90, 90], [-90 * 1.3, 90 * 1.3], ":", color="grey", lw=0.8, label="slope 1.3")
+        ax.plot([-90, 90], [-90 * 1.32, 90 * 1.32], ":", color="grey", lw=0.8, label="paper: 1.32")
         for x in (m.dead_zone_pos_deg, m.dead_zone_neg_deg):
             ax.axvline(x, color="tab:orange", lw=0.8, ls="--")
         for x in (90.0 - m.backlash_pos_deg, -90.0 + m.backlash_neg_deg):
@@ -272,6 +279,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"  torque in dead zone       {sig.dead_zone_torque_Nm:7.4f} Nm")
         print(f"  torque dip after reversal {sig.reversal_dip_Nm:7.4f} Nm")
         print(f"  torque while released     {sig.released_torque_Nm:7.4f} Nm")
+        print(f"  torque settled after      {sig.torque_settled_deg:7.1f} deg (of the reversal)")
         us = rec.cpu_s / rec.t_s.size * 1e6
         print(f"  plant CPU time            {us:7.1f} us/step ({rec.t_s.size} steps)")
     if args.plot:

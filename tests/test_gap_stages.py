@@ -293,3 +293,33 @@ def test_a_move_shifts_several_parameters_together_within_their_bounds() -> None
     params, _ = fit_base(ev, views, specs, max_evals=30)
     assert params["slack_deg"] == pytest.approx(18.0, abs=1.0)
     assert params["play_deg"] == pytest.approx(12.0, abs=1.0)
+
+
+def test_effect_size_measures_the_tip_gap_of_the_effect_alone() -> None:
+    from tsmd.gap.selftest import effect_size
+
+    coupling = effect_size("coupling", 20.0, 0, effects={"coupling": 0.5})
+    stronger = effect_size("coupling", 20.0, 0, effects={"coupling": 1.0})
+    nothing = effect_size("coupling", 20.0, 0, effects={})
+    sensor = effect_size("sensor", 20.0, 0)
+    assert nothing.tip_rmse_deg == 0.0 and nothing.cur_rmse_A == 0.0
+    assert 0.0 < coupling.tip_rmse_deg < stronger.tip_rmse_deg
+    # the current filter leaves the tip alone and moves only the current
+    assert sensor.tip_rmse_deg == 0.0 and sensor.cur_rmse_A > 1e-3
+
+
+def test_selftest_recording_is_the_noise_free_plant_output_plus_tracker_noise() -> None:
+    from drivers.plant.base import load_plant
+    from tsmd.gap.selftest import (
+        BUILTIN_PLANT,
+        drive_plant,
+        make_real_recording,
+        trajectory,
+        unit_knobs,
+    )
+
+    rec = make_real_recording("none", 10.0, 50.0, seed=3)
+    _t, q = trajectory(10.0, 50.0)
+    tip, _cur = drive_plant(load_plant(BUILTIN_PLANT, {"knobs": unit_knobs(3, 0.15)}), q, 50.0)
+    noise = rec.columns["tip1"] - tip[:, 0]
+    assert 0.07 < float(np.std(noise)) < 0.13  # the tracker's 0.1 deg noise, nothing else

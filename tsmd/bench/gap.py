@@ -4,6 +4,8 @@ Speed: a recording of ``--duration-s`` at ``--rate-hz`` (default 10 min at 250 H
 is made by the built-in plant with the coupling effect on (see :mod:`tsmd.gap.selftest`; making
 it is not timed), then diagnosed with the default settings; the figure is the diagnosis wall time.
 ``--selftest`` then runs the self-test grid (cases x sizes x seeds) and prints its scores.
+``--effect-sizes`` prints how much each self-test effect moves the tip and current before any
+diagnosis (the criterion its strength is chosen by), optionally for another plant version.
 """
 
 from __future__ import annotations
@@ -13,13 +15,17 @@ import json
 import time
 from pathlib import Path
 
+import numpy as np
+
 from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import GapConfig, diagnose
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,
+    BUILTIN_PLANT,
     EFFECTS,
     TRAJECTORIES,
     builtin_factory,
+    effect_size,
     make_real_recording,
     run_selftest,
     selftest_markdown,
@@ -39,30 +45,67 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--trajectory", default="experiment", choices=sorted(TRAJECTORIES),
                         help="self-test motion: the identification experiment (default) or the "
                              "earlier single-speed sweeps, for comparison")
+    parser.add_argument("--effect-sizes", action="store_true",
+                        help="print each self-test effect's size on the tip and current (effect "
+                             "on vs off, noise-free) over the self-test grid, then stop")
+    parser.add_argument("--effect-plant", default=BUILTIN_PLANT,
+                        help="plant factory measured by --effect-sizes (module:factory; its "
+                             "module must define DEFAULT_KNOBS)")
     parser.add_argument("--out", default=None, help="also write the figures as JSON here")
+
+
+def effect_sizes(args: argparse.Namespace) -> dict[str, object]:
+    """Each effect's tip/current RMSE (effect on minus off) per grid run and over the grid."""
+    cases = [c for c in args.cases.split(",") if c and c != "none"]
+    sizes = [float(x) for x in args.sizes.split(",")]
+    seeds = [int(x) for x in args.seeds.split(",")]
+    out: dict[str, object] = {}
+    print("| case | strength | tip RMSE per run (deg) | tip RMSE over the grid (deg) | "
+          "current RMSE over the grid (mA) |")
+    print("| --- | --- | --- | ---: | ---: |")
+    for case in cases:
+        runs = [effect_size(case, d, s, args.selftest_rate_hz, plant_spec=args.effect_plant,
+                            motion=args.trajectory) for d in sizes for s in seeds]
+        tip = float(np.sqrt(np.mean([r.tip_rmse_deg**2 for r in runs])))
+        cur = float(np.sqrt(np.mean([r.cur_rmse_A**2 for r in runs])))
+        effects, lag_s, _ = EFFECTS[case]
+        strength = ", ".join(f"{k} {v:g}" for k, v in effects.items()) or f"lag {lag_s:g} s"
+        per_run = " / ".join(f"{r.tip_rmse_deg:.2f}" for r in runs)
+        print(f"| {case} | {strength} | {per_run} | {tip:.2f} | {1e3 * cur:.1f} |", flush=True)
+        out[case] = {"strength": strength, "tip_rmse_deg": tip, "cur_rmse_A": cur,
+                     "runs": [vars(r) for r in runs]}
+    return out
 
 
 def main(args: argparse.Namespace) -> int:
     figures: dict[str, object] = {}
+    if args.effect_sizes:
+        figures["effect_sizes"] = effect_sizes(args)
+        args.skip_speed = True
+        args.selftest = False
     if not args.skip_speed:
         t0 = time.perf_counter()
         rec = make_real_recording(args.case, args.duration_s, args.rate_hz, seed=0)
         made_s = time.perf_counter() - t0
         series = series_from_recording(rec, f"bench-{args.case}")
         t1 = time.perf_counter()
+        c1 = time.process_time()
         result = diagnose([series], builtin_factory(), {}, GapConfig(fit_specs=BUILTIN_FIT_SPECS))
         wall = time.perf_counter() - t1
+        cpu = time.process_time() - c1
         print(f"recording: {len(series)} rows ({args.duration_s:.0f} s at {args.rate_hz:.0f} Hz, "
               f"case {args.case}), made in {made_s:.1f} s (not timed)")
-        print(f"diagnosis wall time: {wall:.1f} s (target <= 60 s)")
+        print(f"diagnosis wall time: {wall:.1f} s (target <= 60 s); CPU time of this process "
+              f"{cpu:.1f} s (what a loaded machine does not inflate)")
         print("  stages: " + ", ".join(f"{k} {v:.1f} s" for k, v in result.timing_s.items()))
         print(f"  plant steps simulated: {result.rows['simulated']}, model evaluations: "
               f"{result.rows['model_evaluations']}, fit stride {result.rows['fit_stride']}, "
               f"held-out rows scored at full rate: {result.rows['held_out']}")
         print(f"  verdict: {result.verdict}; top: {result.top}")
-        figures["speed"] = {"rows": len(series), "wall_s": wall, "timing_s": result.timing_s,
-                            "rows_detail": result.rows, "verdict": result.verdict}
-    if args.selftest or args.skip_speed:
+        figures["speed"] = {"rows": len(series), "wall_s": wall, "cpu_s": cpu,
+                            "timing_s": result.timing_s, "rows_detail": result.rows,
+                            "verdict": result.verdict}
+    if args.selftest or (args.skip_speed and not args.effect_sizes):
         cases = [c for c in args.cases.split(",") if c]
         sizes = [float(x) for x in args.sizes.split(",")]
         seeds = [int(x) for x in args.seeds.split(",")]

@@ -13,6 +13,7 @@ diagnosis has to recognise them by their signature.
 
 from __future__ import annotations
 
+import importlib
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -43,18 +44,24 @@ side) and sheath friction, per knob."""
 
 EFFECTS: dict[str, tuple[dict[str, float], float, str | None]] = {
     "none": ({}, 0.0, None),
-    "coupling": ({"coupling": 1.0}, 0.0, "coupling"),
-    "rate": ({"rate_dependence": 1.0}, 0.0, "rate"),
+    "coupling": ({"coupling": 0.5}, 0.0, "coupling"),
+    "rate": ({"rate_dependence": 0.25}, 0.0, "rate"),
     "compliance": ({"tendon_compliance": 1.0}, 0.0, "compliance"),
-    "curvature": ({"sheath_curvature_deg": 180.0}, 0.0, "curvature"),
+    "curvature": ({"sheath_curvature_deg": 120.0}, 0.0, "curvature"),
     "sensor": ({}, 0.1, "sensor"),
-    "creep": ({"creep_mm_per_N_s": 2e-4}, 0.0, "drift"),
+    "creep": ({"creep_mm_per_N_s": 1.5e-4}, 0.0, "drift"),
 }
 """Case -> (plant effect keywords, current-sensor lag s, the candidate that should win).
 
-Strengths are the plant's nominal values (coupling 1.0 = its documented constants, friction
-doubling at 50 deg/s, twice the tendon compliance, a U-shaped sheath, a 0.1 s current filter,
-slack creep of 0.2 um per newton-second)."""
+Strengths are chosen by the size of the effect on the tip (:func:`effect_size`: RMS of the tip
+with the effect minus without, same unit and motion, over the 120 s and 300 s self-test runs of
+seeds 0 and 1), so that each effect makes a tip gap of the size it made on the earlier nominal
+plant (sheath friction 0.15 over 240 deg, routed handle, tendon EA 1830 N) at that plant's
+nominal strengths: half the plant's nominal coupling constants, sheath friction +25 % at
+100 deg/s (the nominal +100 % nearly locks the tip of the high-friction sheath), twice the
+tendon compliance, a 120 deg sheath bend, a 0.1 s current filter, slack creep of 0.15 um per
+newton-second. An effect whose size changed by under 20 % kept its strength (compliance; the
+sensor lag, sized on the current). docs/gap.md, "Self-test strengths", has the figures."""
 
 GEAR_RATIO = 50.0
 KT_NM_PER_A = 0.03
@@ -106,18 +113,79 @@ TRAJECTORIES = {"experiment": trajectory, "single-speed": single_speed_trajector
 """Self-test motions by name (``--trajectory``)."""
 
 
-def unit_knobs(seed: int, variation: float) -> list[dict[str, float]]:
+def unit_knobs(seed: int, variation: float,
+               defaults: Sequence[Any] | None = None) -> list[dict[str, float]]:
     """One catheter unit: slack per side and sheath friction off the defaults by +-variation.
 
     Only the base parameters the diagnosis fits are varied, so that what remains after the base
-    fit is the effect put in (plus noise).
+    fit is the effect put in (plus noise). ``defaults``: the plant's per-knob constants (default:
+    the built-in plant's ``DEFAULT_KNOBS``).
     """
     from drivers.plant.tendon_sheath import DEFAULT_KNOBS
 
     rng = np.random.default_rng(1000 + seed)
     names = ("slack_pos_mm", "slack_neg_mm", "sheath_friction")
     return [{k: float(getattr(knob, k)) * (1.0 + variation * rng.uniform(-1, 1)) for k in names}
-            for knob in DEFAULT_KNOBS]
+            for knob in (DEFAULT_KNOBS if defaults is None else defaults)]
+
+
+def drive_plant(plant: Any, q: NDArray[np.float64], rate_hz: float) -> tuple[NDArray[np.float64],
+                                                                            NDArray[np.float64]]:
+    """Step a plant along knob angles ``q`` (rows x 2); returns the true tip angle (deg) and the
+    true motor current (A: torque / (gear * kt) plus motor Coulomb friction), both noise-free."""
+    dt = 1.0 / rate_hz
+    tip = np.empty_like(q)
+    cur = np.empty_like(q)
+    prev = q[0].copy()
+    for k in range(len(q)):
+        out = plant.step(dt, q[k])
+        vel = (q[k] - prev) / dt
+        prev = q[k]
+        tip[k] = out.tip_deg
+        cur[k] = (np.asarray(out.knob_torque_Nm) / (GEAR_RATIO * KT_NM_PER_A)
+                  + MOTOR_COULOMB_A * np.tanh(vel / 0.5))
+    return tip, cur
+
+
+@dataclass
+class EffectSize:
+    """How much one injected effect moves the plant's outputs, before any diagnosis."""
+
+    case: str
+    duration_s: float
+    seed: int
+    tip_rmse_deg: float
+    """RMS over both knobs and all rows of (tip with the effect - tip without), noise-free."""
+    tip_max_deg: float
+    cur_rmse_A: float
+    """The same for the true motor current (the sensor lag applied for the ``sensor`` case)."""
+
+
+def effect_size(case: str, duration_s: float, seed: int, rate_hz: float = 50.0,
+                effects: dict[str, float] | None = None, lag_s: float | None = None,
+                plant_spec: str = BUILTIN_PLANT, unit_variation: float = 0.15,
+                motion: str = "experiment") -> EffectSize:
+    """The size of an effect on one self-test unit: same unit and motion, effect on vs off.
+
+    This is the criterion the self-test strengths are chosen by (a gap of a given size on the
+    tip), independent of what the diagnosis makes of it. ``effects``/``lag_s`` default to the
+    case's entry in :data:`EFFECTS`; ``plant_spec`` lets another plant version be measured.
+    """
+    case_effects, case_lag_s, _ = EFFECTS[case]
+    eff = case_effects if effects is None else effects
+    lag = case_lag_s if lag_s is None else lag_s
+    module = importlib.import_module(plant_spec.partition(":")[0])
+    knobs = unit_knobs(seed, unit_variation, module.DEFAULT_KNOBS)
+    _t, q = TRAJECTORIES[motion](duration_s, rate_hz)
+    tip0, cur0 = drive_plant(load_plant(plant_spec, {"knobs": knobs}), q, rate_hz)
+    tip1, cur1 = drive_plant(load_plant(plant_spec, {"knobs": knobs, **eff}), q, rate_hz)
+    if lag > 0.0:
+        sensors = [CurrentSensor(lag_s=lag) for _ in range(2)]
+        cur1 = np.array([[sensors[j].measure(1.0 / rate_hz, float(row[j])) for j in range(2)]
+                         for row in cur1])
+    dtip = tip1 - tip0
+    return EffectSize(case, duration_s, seed, float(np.sqrt(np.mean(dtip**2))),
+                      float(np.max(np.abs(dtip))), float(np.sqrt(np.mean((cur1 - cur0) ** 2))))
 
 
 def make_real_recording(case: str, duration_s: float, rate_hz: float, seed: int,
@@ -132,17 +200,12 @@ def make_real_recording(case: str, duration_s: float, rate_hz: float, seed: int,
     sensors = [CurrentSensor(lag_s=lag_s, offset_A=0.003 * (1 - 2 * k), noise_A=current_noise_A,
                              seed=seed * 7 + k) for k in range(2)]
     dt = 1.0 / rate_hz
+    true_tip, true_A = drive_plant(plant, q, rate_hz)
     tip = np.empty_like(q)
     cur = np.empty_like(q)
-    prev = q[0].copy()
     for k in range(len(t)):
-        out = plant.step(dt, q[k])
-        vel = (q[k] - prev) / dt
-        prev = q[k]
-        true_A = (out.knob_torque_Nm / (GEAR_RATIO * KT_NM_PER_A)
-                  + MOTOR_COULOMB_A * np.tanh(vel / 0.5))
-        tip[k] = tracker.measure(out.tip_deg)
-        cur[k] = [sensors[j].measure(dt, float(true_A[j])) for j in range(2)]
+        tip[k] = tracker.measure(true_tip[k])
+        cur[k] = [sensors[j].measure(dt, float(true_A[k, j])) for j in range(2)]
     cols = {"t": t, "q1": q[:, 0], "q2": q[:, 1], "cmd1": q[:, 0], "cmd2": q[:, 1],
             "pos1": q[:, 0], "pos2": q[:, 1], "cur1": cur[:, 0], "cur2": cur[:, 1],
             "tip1": tip[:, 0], "tip2": tip[:, 1]}

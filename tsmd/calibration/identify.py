@@ -65,6 +65,10 @@ class IdentifyOptions:
     """The current must stay on the constant level this long to count as settled."""
     backlash_tangent_deg: float = 3.0
     """Stretch of current before it settles that is extended to meet the constant level."""
+    min_level_deg: float = 3.0
+    """A run of flat pieces shorter than this after a reversal is a pause in the transient (a
+    turn of the filtered reversal, a speed change), not the release level, which lasts until
+    the dead-zone edge."""
     max_tracking_error_deg: float = 10.0
     min_follow_ratio: float = 0.5
     """The knob must travel at least this fraction of the commanded travel (else: stalled)."""
@@ -219,7 +223,12 @@ def _plateau(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
     flat = _flat_pieces(yg, step, pieces, opts)
     if flat is None:
         return None
-    best: tuple[int, int] | None = None
+    return max(_flat_runs(pieces, flat), key=lambda r: r[1] - r[0], default=None)
+
+
+def _flat_runs(pieces: list[tuple[int, int]], flat: list[bool]) -> list[tuple[int, int]]:
+    """Maximal runs of consecutive flat pieces, as (start, stop) on the grid, in order."""
+    runs: list[tuple[int, int]] = []
     k = 0
     while k < len(pieces):
         if not flat[k]:
@@ -228,11 +237,9 @@ def _plateau(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
         j = k
         while j + 1 < len(pieces) and flat[j + 1]:
             j += 1
-        run = (pieces[k][0], pieces[j][1])
-        if best is None or run[1] - run[0] > best[1] - best[0]:
-            best = run
+        runs.append((pieces[k][0], pieces[j][1]))
         k = j + 1
-    return best
+    return runs
 
 
 def _knee(yg: FloatArray, step: float, pieces: list[tuple[int, int]], rise_k: int,
@@ -262,8 +269,9 @@ def _backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
 
     While the sheath unloads, the current falls steeply, then less and less steeply as the slip
     front runs distally; when the front reaches the tip the current joins the release level
-    (a line, nearly flat). That level is fitted on the first run of flat pieces after the peak;
-    the backlash ends where the current reaches it and stays within ``peak_noise_k`` noise sigmas,
+    (a line, nearly flat). That level is fitted on the first run of flat pieces after the peak
+    at least ``min_level_deg`` long; the backlash ends where the current reaches it and stays
+    within ``peak_noise_k`` noise sigmas for ``settle_hold_deg``,
     refined to where the current's last ``backlash_tangent_deg`` before that, extended as a line,
     meets the level (the current approaches the level at a slant, so a band alone ends early).
     """
@@ -271,15 +279,14 @@ def _backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
     flat = _flat_pieces(yg, step, pieces, opts)
     if flat is None:
         return None
-    first = next((k for k, (a, _) in enumerate(pieces) if flat[k] and a >= start_k), None)
-    if first is None:
+    min_points = max(3, round(opts.min_level_deg / step))
+    # A run that the peak falls inside counts from the peak on (a noise peak at the start of
+    # the level must not hide the level).
+    runs = [(max(a, start_k), b) for a, b in _flat_runs(pieces, flat)]
+    run = next(((a, b) for a, b in runs if b - a >= min_points), None)
+    if run is None:
         return None
-    last = first
-    while last + 1 < len(pieces) and flat[last + 1]:
-        last += 1
-    a0, b0 = pieces[first][0], pieces[last][1]
-    if b0 - a0 < 3:
-        return None
+    a0, b0 = run
     level = np.polyfit(grid[a0:b0], yg[a0:b0], 1)
     near = np.abs(yg[start_k:b0] - np.polyval(level, grid[start_k:b0])) <= opts.peak_noise_k * noise
     hold = max(2, round(opts.settle_hold_deg / step))
@@ -335,11 +342,13 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         peak = int(peaks[0]) if peaks.size else None
         start_k = peak if peak is not None else 0
         found = _backlash_end(grid[:end], yg[:end], start_k, pieces, noise, opts)
-        settle = plateau_run[0] if found is None else found
         if found is None:
+            # No value rather than a guess: the quality checks then name this reason.
             problems.append(f"{where}: the current never becomes constant after the reversal")
-        # The backlash counts from the reversal (the model's X_ref).
-        backlash_deg = float(grid[settle] - grid[0])
+        else:
+            settle = found
+            # The backlash counts from the reversal (the model's X_ref).
+            backlash_deg = float(grid[settle] - grid[0])
 
     # The dead-zone edge: where the constant-current stretch ends and the current rises.
     edge_k: int | None = plateau_run[1] if plateau_run[1] < end else None

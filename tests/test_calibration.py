@@ -358,3 +358,44 @@ def test_backlash_near_the_data_sheets_gives_no_warning() -> None:
     cross_check_device([GridPoint(k, 0.0, near) for k in (0, 1)], device, report)
     assert report.warnings == []
     assert report.figures["phi2_backlash_neg_vs_datasheet"] == pytest.approx(0.9)
+
+
+def _one_point_cross_check(plant_params: dict[str, object]):
+    """Full stack (drives, bus, loop, plant), one grid point, then the data-sheet cross-check
+    against the straight-handle product's data sheet."""
+    from dataclasses import replace
+
+    from tsmd.calibration.assemble import QualityReport, cross_check_device
+    from tsmd.calibration.run import run_sweeps
+    from tsmd.config import default_sim_config
+    from tsmd.replay import LockstepRunner
+
+    config = default_sim_config()
+    config = replace(config, sim=replace(config.sim, params=plant_params))
+    with LockstepRunner(config, seed=0) as runner:
+        runs = run_sweeps(runner, paper_protocol(grid_deg=(0.0,)),
+                          period_s=config.loop.period_s)
+    report = QualityReport()
+    cross_check_device(runs.points, load_device_model(DEVICE), report)
+    ratios = {k: v for k, v in report.figures.items() if k.endswith("_vs_datasheet")}
+    return report, ratios
+
+
+def test_a_routed_handle_makes_the_calibration_warn_that_its_backlash_is_implausibly_small(
+) -> None:
+    # The documented failure case of current-only backlash: with the tendon wrapped 360 deg
+    # around the handle's routing right after the pulley, the knob torque collapses a few
+    # degrees after a reversal while the tip still holds ~20 deg.
+    routed = {"knobs": [{"routing_wrap_deg": 360.0}, {"routing_wrap_deg": 360.0}]}
+    report, ratios = _one_point_cross_check(routed)
+    assert len(ratios) == 4
+    assert all(r < 0.5 for r in ratios.values()), ratios
+    assert len(report.warnings) == 4
+    assert all("the current settles before the tip moves" in w for w in report.warnings)
+
+
+def test_the_nominal_straight_handle_passes_the_data_sheet_cross_check() -> None:
+    report, ratios = _one_point_cross_check({})
+    assert len(ratios) == 4
+    assert all(0.8 < r < 1.2 for r in ratios.values()), ratios
+    assert report.warnings == []

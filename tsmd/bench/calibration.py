@@ -79,11 +79,25 @@ def tip_truth(point: GridPoint) -> dict[str, float]:
         return {}
     rate = 1.0 / float(np.median(np.diff(t)))
     tip_f, _ = lowpass(tip, rate)
+    knob = monotone_knob(rec[f"cmd{k}"][m], pos)
     try:
-        truth = measure_dead_zone_backlash(pos, tip_f, threshold_deg=TIP_THRESHOLD_DEG)
+        truth = measure_dead_zone_backlash(knob, tip_f, threshold_deg=TIP_THRESHOLD_DEG)
     except SweepAnalysisError:
         return {}
     return dict(truth._asdict())
+
+
+def monotone_knob(cmd_deg: np.ndarray, pos_deg: np.ndarray) -> np.ndarray:
+    """The actual knob angle made monotonic between the command's reversals.
+
+    At a speed change the drive's position wobbles back by ~0.02 deg; the plant analysis cuts
+    passes at every direction change, so without this a wobble becomes a "reversal" and the
+    tip's backlash comes out as the 1 deg threshold's knob travel.
+    """
+    out = np.asarray(pos_deg, dtype=float).copy()
+    for direction, a, b, _ in split_half_cycles(np.asarray(cmd_deg, dtype=float), 10.0):
+        out[a:b] = direction * np.maximum.accumulate(direction * out[a:b])
+    return out
 
 
 def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any]:

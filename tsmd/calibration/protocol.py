@@ -116,15 +116,18 @@ def paper_protocol(grid_deg: tuple[float, ...] = GRID_DEG,
 
 def fast_protocol(grid_deg: tuple[float, ...] = GRID_DEG, amplitude_deg: float = 90.0,
                   frequency_hz: float = 0.125, cycles: float = 2.0) -> Protocol:
-    """Beyond the paper: two-speed sweeps, 2 cycles at 0.125 Hz (224 s in all).
+    """Beyond the paper: the paper's sine sweeps 3.125x faster, 2 cycles at 0.125 Hz (224 s).
 
-    Identification works on current against knob angle, so only the stretches that hold the
-    features need to be slow: the dead-zone edges (+-35 deg) and the transient after each
-    reversal (the last 10 deg) run at 30 deg/s, about the paper's sine speed there (22 deg/s);
-    the loaded ramps in between, where the current only follows the load, at 90 deg/s. Two
-    cycles keep the agreement check on every parameter.
+    Identification works on current against knob angle, so the sweep may be faster as long as
+    the features keep their shape against the drive's and the current sensor's lag. The sine
+    stays slow where the backlash is read (the knob turns and speeds up through it: 0-45 deg/s
+    over the first 25 deg after a reversal) and passes the dead-zone edges at 69 deg/s. Two
+    cycles keep the agreement check on every parameter. (The two-speed waveform, slow at the
+    edges and reversals and 3x faster between, was the fast protocol on the earlier plant; on
+    the straight-handle plant the backlash runs into its fast stretch, the speed change steps
+    the current there and B came out up to 6 deg early.)
     """
-    sweeps = tuple(Sweep(knob, other, amplitude_deg, frequency_hz, cycles, "two-speed")
+    sweeps = tuple(Sweep(knob, other, amplitude_deg, frequency_hz, cycles, "sine")
                    for knob in (0, 1) for other in grid_deg)
     return Protocol("fast", sweeps)
 

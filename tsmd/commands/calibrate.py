@@ -34,8 +34,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="tsmd config (default: /etc/tsmd/tsmd.yaml, or the sim default "
                              "with --sim)")
     parser.add_argument("--fast", action="store_true",
-                        help="the fast protocol (224 s of two-speed sweeps) instead of the "
-                             "paper's (700 s of sine sweeps); --sim and recordings only")
+                        help="the fast protocol (224 s: the paper's sine at 0.125 Hz) instead "
+                             "of the paper's (700 s at 0.04 Hz); --sim and recordings only")
     parser.add_argument("--report", metavar="DIR",
                         help="write a calibration report (Markdown + PNG plots) into DIR")
     parser.add_argument("--from-recording", nargs="+", metavar="FILE",

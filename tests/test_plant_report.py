@@ -37,3 +37,17 @@ def test_report_says_where_the_torque_settles_after_a_reversal() -> None:
     )
     assert straight.torque_settled_deg > 0.7 * straight.dz_bl.backlash_pos_deg
     assert routed.torque_settled_deg < 6.0 < 20.0 < routed.dz_bl.backlash_pos_deg
+
+
+def test_report_routing_study_prints_each_wrap_and_writes_the_figure(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    png = tmp_path / "routing.png"
+    assert main(["--routing", str(png)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    i = next(n for n, line in enumerate(lines) if line.startswith("knob 1 per routing_wrap_deg"))
+    rows = [[float(v) for v in line.split()] for line in lines[i + 1 : i + 5]]
+    assert [r[0] for r in rows] == [0.0, 90.0, 180.0, 360.0]
+    settled = [r[4] for r in rows]
+    assert settled == sorted(settled, reverse=True)  # more routing, earlier collapse
+    assert png.stat().st_size > 10_000

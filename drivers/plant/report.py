@@ -159,6 +159,56 @@ def plot_grid(others_deg: Sequence[float], grid: Sequence[DeadZoneBacklash], pat
     plt.close(fig)
 
 
+def routing_study(
+    params: dict[str, Any], wraps_deg: Sequence[float] = (0.0, 90.0, 180.0, 360.0), knob: int = 0
+) -> list[tuple[float, SweepRecord, Signature]]:
+    """One knob's sweep per handle routing wrap (both knobs routed alike, the rest as given)."""
+    out = []
+    for wrap in wraps_deg:
+        knobs = [dict(k) for k in params.get("knobs", [{}, {}])]
+        for k in knobs:
+            k["routing_wrap_deg"] = wrap
+        rec = run_sweep(make_tendon_sheath_plant(**{**params, "knobs": knobs}), knob)
+        out.append((wrap, rec, signature(rec)))
+    return out
+
+
+def plot_routing(study: Sequence[tuple[float, SweepRecord, Signature]], path: str) -> None:
+    """Torque and tip after the second positive reversal, against knob travel since it."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(9.0, 3.6), sharex=True)
+    for wrap, rec, sig in study:
+        t, q = rec.t_s, rec.knob_deg
+        period = float(t[-1] + t[1] - t[0]) / 2.0
+        i_rev = int(np.argmax(np.where(t > period, q, -np.inf)))
+        w = slice(i_rev, i_rev + round(period / 4 / (t[1] - t[0])))
+        travel = q[i_rev] - q[w]
+        tau = rec.torque_Nm[w]
+        level, peak = sig.released_torque_Nm, tau[0]
+        (line,) = ax1.plot(travel, (tau - level) / (peak - level), lw=1.2, label=f"{wrap:.0f} deg")
+        ax2.plot(travel, rec.tip_deg[i_rev] - rec.tip_deg[w], lw=1.2, color=line.get_color())
+        for ax in (ax1, ax2):
+            ax.axvline(sig.dz_bl.backlash_pos_deg, color=line.get_color(), lw=0.7, ls="--")
+    ax1.set_ylabel("(torque - released) / (peak - released)")
+    ax2.set_ylabel("tip travel back (deg)")
+    ax2.set_ylim(-2.0, 40.0)
+    for ax in (ax1, ax2):
+        ax.set_xlabel("knob travel since the +90 deg reversal (deg)")
+        ax.set_xlim(0.0, 40.0)
+        ax.grid(alpha=0.3)
+    ax1.legend(title="routing_wrap_deg", fontsize=8)
+    fig.suptitle(
+        "Handle routing: knob 1 after a reversal (dashed: tip backlash B_pos)", fontsize=10
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def protocol_cpu_s(params: dict[str, Any], dt_s: float = 0.004) -> tuple[int, float]:
     """CPU time of the plant over the 700 s calibration protocol (14 sweeps of 50 s)."""
     plant = make_tendon_sheath_plant(**params)
@@ -243,6 +293,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="also sweep knob 1 with the other at -90..90 step 30 and plot D/B",
     )
     parser.add_argument(
+        "--routing",
+        metavar="PNG",
+        help="also sweep knob 1 with routing_wrap_deg 0/90/180/360 on both knobs and plot",
+    )
+    parser.add_argument(
         "--protocol",
         action="store_true",
         help="also time the plant over the 700 s calibration protocol",
@@ -277,7 +332,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"  loop area (2nd cycle)     {sig.loop_area_deg2:7.0f} deg^2")
         print(f"  torque peak               {sig.torque_peak_Nm:7.3f} Nm")
         print(f"  torque in dead zone       {sig.dead_zone_torque_Nm:7.4f} Nm")
-        print(f"  torque dip after reversal {sig.reversal_dip_Nm:7.4f} Nm")
+        print(f"  torque min after reversal {sig.reversal_dip_Nm:7.4f} Nm")
         print(f"  torque while released     {sig.released_torque_Nm:7.4f} Nm")
         print(f"  torque settled after      {sig.torque_settled_deg:7.1f} deg (of the reversal)")
         us = rec.cpu_s / rec.t_s.size * 1e6
@@ -293,6 +348,17 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"  {o:6.0f} {m[0]:6.1f} {m[1]:6.1f} {m[2]:6.1f} {m[3]:6.1f}")
         plot_grid(others, grid, args.grid)
         print(f"wrote {args.grid}")
+    if args.routing:
+        study = routing_study(params)
+        print("knob 1 per routing_wrap_deg: wrap  B_pos  B_neg (deg)  peak (Nm)  settled (deg)")
+        for wrap, _, sig in study:
+            m = sig.dz_bl
+            print(
+                f"  {wrap:6.0f} {m.backlash_pos_deg:6.1f} {m.backlash_neg_deg:6.1f}"
+                f" {sig.torque_peak_Nm:8.3f} {sig.torque_settled_deg:8.1f}"
+            )
+        plot_routing(study, args.routing)
+        print(f"wrote {args.routing}")
     if args.protocol:
         steps, cpu = protocol_cpu_s(params)
         print(

@@ -63,6 +63,27 @@ def _settle(t: NDArray[np.float64], q: NDArray[np.float64], move_s: float = 2.0
     return tt.astype(float), full, len(head)
 
 
+CONDITIONING_CYCLES = 1.0
+"""Sweep cycles run before a tip measurement is analysed. The plant starts tension-free
+(virgin): its first release rests higher and its first engagement of the antagonist comes
+later (phi1: plateau 16 instead of 5 deg, D_neg -15 instead of -22 deg on the tip), which a
+product's data sheet must not average in; the calibration protocol conditions likewise."""
+
+
+def _tip_sweep(knob: int, other_deg: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A +-90 deg, 0.04 Hz sweep of ``knob`` (2.25 cycles after the conditioning cycles)."""
+    t = np.arange(0.0, (CONDITIONING_CYCLES + 2.25) / 0.04, PERIOD_S)
+    q = np.zeros((t.size, 2))
+    q[:, knob] = 90.0 * np.sin(2 * math.pi * 0.04 * t)
+    q[:, 1 - knob] = other_deg
+    return t, q
+
+
+def _analysed_from(skip: int) -> int:
+    """First sample of a ``_tip_sweep`` run (after ``_settle``) that is analysed."""
+    return skip + round(CONDITIONING_CYCLES / 0.04 / PERIOD_S)
+
+
 def scenarios(quick: bool = False) -> list[Scenario]:
     """The paper's scenarios (section "Scenarios"): 1-DOF with the other knob fixed, 2-DOF."""
     f1 = 0.04
@@ -138,25 +159,22 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
                          log: Callable[[str], None] = print) -> Any:
     """A profile from sweeps scored on the tracker's tip angle (not from motor current).
 
-    The paper's calibration protocol (each knob +-90 deg at 0.04 Hz, two cycles, the other knob
-    held at each grid angle), uncompensated through the full stack; D and B measured on the tip
-    with ``drivers.plant.analysis`` (ground truth); our extra parameters from the same sweeps.
+    The paper's calibration protocol (each knob +-90 deg at 0.04 Hz, two cycles after a
+    conditioning cycle, the other knob held at each grid angle), uncompensated through the full
+    stack; D and B measured on the tip with ``drivers.plant.analysis`` (ground truth); our extra
+    parameters from the same sweeps.
     """
     from drivers.plant.analysis import measure_dead_zone_backlash
     from tsmd.compensation.ours import SweepData, fit_ours_knob
     from tsmd.profile import CatheterProfile, make_knob_profile
 
-    t = np.arange(0.0, 2.25 / 0.04, PERIOD_S)
-    sweep = 90.0 * np.sin(2 * math.pi * 0.04 * t)
     knobs = []
     for knob in (0, 1):
         sweeps = []
         for other in GRID_DEG:
-            q = np.zeros((t.size, 2))
-            q[:, knob] = sweep
-            q[:, 1 - knob] = other
-            tt, qq, skip = _settle(t, q)
+            tt, qq, skip = _settle(*_tip_sweep(knob, other))
             rec = _run(tt, qq, None, "none", seed, plant_factory())
+            skip = _analysed_from(skip)
             pos = rec[f"pos{knob + 1}"][skip:]
             tip = rec[f"tip{knob + 1}"][skip:]
             m = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
@@ -184,17 +202,16 @@ def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
     assumptions 1-3): per knob, the loaded slope omega, the reference points (tip at the knob's
     +-90 deg turning points of a sweep with the other knob at 0 deg), and for our compensator
     the release slope, the backlash (on the tip) after the reversals at the reference points, and
-    how far beyond the edge the calibration finds in the current the tip leaves the plateau."""
+    how far beyond the edge the calibration finds in the current the tip leaves the plateau.
+    Analysed after ``CONDITIONING_CYCLES`` (the plant's virgin start is not the product's
+    behaviour)."""
     from drivers.plant.analysis import measure_dead_zone_backlash, split_passes
 
-    t = np.arange(0.0, 2.25 / 0.04, PERIOD_S)
-    sweep = 90.0 * np.sin(2 * math.pi * 0.04 * t)
     out = []
     for knob in (0, 1):
-        q = np.zeros((t.size, 2))
-        q[:, knob] = sweep
-        tt, qq, skip = _settle(t, q)
+        tt, qq, skip = _settle(*_tip_sweep(knob, 0.0))
         rec = _run(tt, qq, None, "none", seed, plant_factory())
+        skip = _analysed_from(skip)
         pos = rec[f"pos{knob + 1}"][skip:]
         tip = rec[f"tip{knob + 1}"][skip:]
         dz = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)

@@ -13,6 +13,8 @@ reaches 0 at ``u = B`` with a corner: that knob angle is where the current becom
 backlash the rule must find. ``a`` sets how steep the start is and how slanted the join; as
 ``a`` grows the join becomes tangential and the rule ends early (a documented limit, see
 docs/calibration.md), so these tests cover joins that keep a visible corner (a <= 2).
+
+The last test checks the benchmark's truth on the tip (the other side of every B comparison).
 """
 
 from __future__ import annotations
@@ -143,3 +145,36 @@ def test_a_current_that_never_becomes_constant_gives_no_backlash_and_says_why() 
     with pytest.raises(CalibrationError,
                        match="no backlash_pos_deg .*the current never becomes constant"):
         report.raise_if_bad()
+
+
+def test_the_bench_tip_truth_ignores_drive_wobbles_at_speed_changes() -> None:
+    # The benchmark's truth on a tip that holds for 25 knob deg after each reversal (a play
+    # operator, then 1.5 deg of tip per knob deg). The measured knob angle steps back by
+    # 0.02 deg twice per stroke, as the drive did at the two-speed protocol's speed changes:
+    # cut there, the tip analysis took the pieces after the steps for passes and gave B < 1 deg.
+    from drivers.plant.analysis import measure_dead_zone_backlash
+    from tsmd.bench.calibration import monotone_knob
+
+    t = np.arange(0.0, 2 * PERIOD_S, 1.0 / RATE_HZ)
+    cmd, direction, travel = _half_cycle_phase(t)
+    half_play = 12.5
+    z = np.empty_like(cmd)
+    z_prev = cmd[0] + half_play  # arrived at -A going down
+    for k, x in enumerate(cmd):
+        z_prev = min(max(z_prev, x - half_play), x + half_play)
+        z[k] = z_prev
+    tip = 1.5 * z
+    pos = cmd.copy()
+    for at in (57.0, 170.0):
+        for k in np.flatnonzero(np.diff((travel >= at).astype(int)) == 1) + 1:
+            pos[k] = pos[k - 1] - direction[k] * 0.02  # one sample backwards
+    raw = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
+    fixed = measure_dead_zone_backlash(monotone_knob(cmd, pos), tip, threshold_deg=1.0)
+    expected = 2 * half_play + 1.0 / 1.5  # the tip has moved by the 1 deg threshold
+    assert raw.backlash_neg_deg < 2.0  # what the benchmark printed before the fix
+    assert abs(fixed.backlash_neg_deg - expected) < 0.2
+    assert abs(fixed.backlash_pos_deg - expected) < 0.2
+    # Only the wobble samples move, by no more than the step back plus one sample's travel.
+    changed = np.abs(monotone_knob(cmd, pos) - pos) > 1e-12
+    assert changed.sum() == 8  # 2 per stroke, 4 strokes
+    assert np.max(np.abs(monotone_knob(cmd, pos) - pos)) <= 0.02 + np.abs(np.diff(cmd)).max()

@@ -11,6 +11,7 @@ from tsmd.bench.accuracy import (
     CONDITIONING_CYCLES,
     PERIOD_S,
     _analysed_from,
+    _conditioned,
     _settle,
     _tip_sweep,
     scenarios,
@@ -73,3 +74,17 @@ def test_tip_measurements_skip_the_conditioning_cycle() -> None:
     assert after.size * PERIOD_S == pytest.approx(2.25 / 0.04, abs=2 * PERIOD_S)
     assert abs(after[0]) < 0.1 and after[1] > after[0]  # the same start as without conditioning
     assert np.all(qq[skip:, 0] == 30.0)  # the other knob held (reached during the settle move)
+
+
+def test_conditioned_start_adds_one_unscored_full_cycle_of_both_knobs() -> None:
+    s = next(s for s in scenarios() if s.group == "2-DOF periodic")
+    _, plain, skip = _conditioned(s.t_s, s.q_deg, False)
+    t, cond, skip_c = _conditioned(s.t_s, s.q_deg, True)
+    lead = cond[:skip_c - skip]
+    assert np.allclose(cond[skip_c - skip:], plain)  # the scored part is unchanged
+    assert np.allclose(cond[skip_c:], s.q_deg) and np.allclose(plain[skip:], s.q_deg)
+    for k in (0, 1):
+        assert lead[:, k].max() == pytest.approx(90.0, abs=0.01)
+        assert lead[:, k].min() == pytest.approx(-90.0, abs=0.01)
+    assert np.all(np.abs(np.diff(cond, axis=0)) / PERIOD_S < 120.0)  # within the drive's limit
+    assert np.allclose(np.diff(t), PERIOD_S)

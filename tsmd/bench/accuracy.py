@@ -63,6 +63,27 @@ def _settle(t: NDArray[np.float64], q: NDArray[np.float64], move_s: float = 2.0
     return tt.astype(float), full, len(head)
 
 
+CONDITIONING_HZ = 0.08
+
+
+def _conditioned(t: NDArray[np.float64], q: NDArray[np.float64], condition: bool
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
+    """``_settle``, optionally after one unscored +-90 deg cycle of both knobs at 0.08 Hz.
+
+    A fresh simulated plant is tension-free, a state a catheter that has been calibrated (the
+    paper's experiments follow the calibration on the same catheter) is never in. With
+    ``condition`` every run starts from the state one full cycle leaves.
+    """
+    tt, qq, skip = _settle(t, q)
+    if not condition:
+        return tt, qq, skip
+    tc = np.arange(0.0, 1.0 / CONDITIONING_HZ, PERIOD_S)
+    cond = np.repeat((90.0 * np.sin(2 * math.pi * CONDITIONING_HZ * tc))[:, None], 2, axis=1)
+    full: NDArray[np.float64] = np.vstack([cond, qq]).astype(float)
+    t_full: NDArray[np.float64] = np.arange(len(full), dtype=float) * PERIOD_S
+    return t_full, full, skip + len(cond)
+
+
 CONDITIONING_CYCLES = 1.0
 """Sweep cycles run before a tip measurement is analysed. The plant starts tension-free
 (virgin): its first release rests higher and its first engagement of the antagonist comes
@@ -276,8 +297,8 @@ class RunResult:
 
 
 def run_scenario(s: Scenario, method: str, seed: int, profile: Any,
-                 plant_factory: Callable[[], Any]) -> RunResult:
-    tt, qq, skip = _settle(s.t_s, s.q_deg)
+                 plant_factory: Callable[[], Any], condition: bool = False) -> RunResult:
+    tt, qq, skip = _conditioned(s.t_s, s.q_deg, condition)
     rec = _run(tt, qq, profile if method != "none" else None, method, seed, plant_factory())
     tip = np.column_stack([rec["tip1"], rec["tip2"]])[skip:]
     cmd = np.column_stack([rec["cmd1"], rec["cmd2"]])[skip:]
@@ -444,6 +465,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "0 = the nominal unit the data sheet was measured on")
     parser.add_argument("--unit-seed", type=int, default=1,
                         help="which unit to draw with --unit-variation")
+    parser.add_argument("--condition", action="store_true",
+                        help="start every run after one unscored +-90 deg cycle of both knobs "
+                        "(the state calibration leaves a catheter in) instead of the fresh "
+                        "plant's tension-free state")
     parser.add_argument("--plots", type=Path, default=None,
                         help="directory for the PNG figures (none by default)")
     parser.add_argument("--report", type=Path, default=None,
@@ -505,7 +530,8 @@ def main(args: argparse.Namespace) -> int:
     for seed in range(n_seeds):
         for s in scen:
             for method in METHODS:
-                results.append(run_scenario(s, method, seed, profile, plant_factory))
+                results.append(run_scenario(s, method, seed, profile, plant_factory,
+                                            bool(args.condition)))
         print(f"seed {seed + 1}/{n_seeds} done ({time.perf_counter() - t_start:.0f} s)",
               flush=True)
 
@@ -513,7 +539,8 @@ def main(args: argparse.Namespace) -> int:
     fixed = summarise([r for r in results if r.scenario.group == "1-DOF periodic"],
                       lambda r: "other knob at " + ("0" if r.scenario.name.endswith("+0") else
                                                      "±" + r.scenario.name.split()[-1][1:]))
-    lines = [f"Profile: {label}", f"Seeds: {n_seeds}; quick: {quick}; plant coupling: {coupling}",
+    lines = [f"Profile: {label}", f"Seeds: {n_seeds}; quick: {quick}; plant coupling: {coupling}"
+             f"; start: {'conditioned (one +-90 deg cycle)' if args.condition else 'fresh plant'}",
              "", "Tip against desired, degrees (mean ± std over seeds):", ""]
     lines += format_table(groups, with_paper=True)
     lines += ["", "1-DOF periodic by the other knob's fixed angle (paper's Table 1d_fixed):", ""]

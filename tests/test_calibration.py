@@ -347,6 +347,20 @@ def test_backlash_far_below_the_data_sheets_is_a_warning_kept_in_the_figures() -
     assert report.figures["phi1_backlash_pos_vs_datasheet"] == pytest.approx(0.2)
 
 
+def test_a_refusal_carries_the_data_sheet_warning_that_may_explain_it() -> None:
+    from tsmd.calibration.assemble import GridPoint
+    from tsmd.calibration.run import finish
+
+    device = load_device_model(DEVICE)
+    sheet_b = device.knobs[0].reference_backlash_pos_deg
+    assert sheet_b is not None
+    small = _with_backlash(_identify(_sweep(SHORT_SWEEP)), 0.2 * sheet_b)
+    # One grid point per knob: refused (needs >= 2), and the cross-check still reports.
+    with pytest.raises(CalibrationError, match=r"needs sweeps at >= 2 other-knob angles.*"
+                       r"; warning: phi1: backlash_pos_deg from the current is"):
+        finish("c", device, [GridPoint(k, 0.0, small) for k in (0, 1)])
+
+
 def test_backlash_near_the_data_sheets_gives_no_warning() -> None:
     from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
 
@@ -389,7 +403,7 @@ def test_a_routed_handle_makes_the_calibration_warn_that_its_backlash_is_implaus
     routed = {"knobs": [{"routing_wrap_deg": 360.0}, {"routing_wrap_deg": 360.0}]}
     report, ratios, _ = _one_point_cross_check(routed)
     assert len(ratios) == 4
-    assert all(r < 0.5 for r in ratios.values()), ratios
+    assert all(r < 0.6 for r in ratios.values()), ratios  # measured 0.41-0.46
     assert len(report.warnings) == 4
     assert all("the current settles before the tip moves" in w for w in report.warnings)
 

@@ -61,10 +61,12 @@ class QualityReport:
     """Findings that do not stop the calibration but that its user must read."""
 
     def raise_if_bad(self) -> None:
+        """Refuse with every problem; warnings found so far follow them (they often say why)."""
         if self.problems:
             head = f"calibration refused ({len(self.problems)} problem"
             head += "s): " if len(self.problems) > 1 else "): "
-            raise CalibrationError(head + "; ".join(self.problems))
+            tail = "".join(f"; warning: {w}" for w in self.warnings)
+            raise CalibrationError(head + "; ".join(self.problems) + tail)
 
 
 def check_quality(points: Sequence[GridPoint], limits: QualityLimits | None = None,
@@ -129,8 +131,13 @@ def _check_point(p: GridPoint, lim: QualityLimits, amplitude_deg: float, problem
         problems.append(f"{p.name}: current signal too weak (SNR {snr:.1f} < {lim.min_snr:g})")
 
 
-BACKLASH_DATASHEET_MIN_RATIO = 0.5
-"""Backlash from the current below this share of the data sheet's reference backlash is flagged."""
+BACKLASH_DATASHEET_MIN_RATIO = 0.8
+"""Backlash from the current below this share of the data sheet's reference backlash is flagged.
+
+On the straight-handle simulated catheter the ratio is 0.87-1.09 (seeds 0 and 1, units 1 and 2
+of +-10 % variation, both protocols); with the handle routed 180 or 360 deg it is 0.41-0.70 while
+B from the current is on average 8-13 deg (at most 17 deg) short of the tip's (docs/plant.md,
+docs/calibration.md). 0.5 let most of those through."""
 
 
 def cross_check_device(points: Sequence[GridPoint], device: DeviceModel,

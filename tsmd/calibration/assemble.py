@@ -134,7 +134,7 @@ def _check_point(p: GridPoint, lim: QualityLimits, amplitude_deg: float, problem
 BACKLASH_DATASHEET_MIN_RATIO = 0.8
 """Backlash from the current below this share of the data sheet's reference backlash is flagged.
 
-On the straight-handle simulated catheter the ratio is 0.87-1.09 (seeds 0 and 1, units 1 and 2
+On the straight-handle simulated catheter the ratio is 0.85-1.06 (seeds 0 and 1, units 1 and 2
 of +-10 % variation, both protocols); with the handle routed 180 or 360 deg it is 0.41-0.70 while
 B from the current is on average 8-13 deg (at most 17 deg) short of the tip's (docs/plant.md,
 docs/calibration.md). 0.5 let most of those through."""

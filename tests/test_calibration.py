@@ -28,7 +28,7 @@ from tsmd.calibration import (
     paper_protocol,
     run_calibration,
 )
-from tsmd.calibration.identify import SweepResult
+from tsmd.calibration.identify import IdentifyOptions, SweepResult
 from tsmd.calibration.protocol import sweep_run
 from tsmd.calibration.run import sweep_metadata
 from tsmd.calibration.signal import lowpass
@@ -292,6 +292,37 @@ def test_cycles_that_disagree_are_refused_with_the_spread() -> None:
         report.raise_if_bad()
 
 
+def _with_cycles(name: str, first: float, second: float) -> list:
+    from tsmd.calibration.assemble import GridPoint
+    base = _identify(_sweep(SHORT_SWEEP))
+    values = dict(base.values)
+    values[name] = (first, second)
+    odd = SweepResult(base.data, base.half_cycles, values)
+    return [GridPoint(0, 0.0, odd), GridPoint(0, 30.0, base),
+            GridPoint(1, 0.0, base), GridPoint(1, 30.0, base)]
+
+
+def test_backlash_cycles_may_differ_by_their_measured_scatter() -> None:
+    from tsmd.calibration.assemble import check_quality
+    report = check_quality(_with_cycles("backlash_pos_deg", 24.0, 28.0))
+    assert not [p for p in report.problems if "backlash_pos_deg" in p]
+
+
+def test_backlash_cycles_further_apart_than_that_are_refused() -> None:
+    from tsmd.calibration.assemble import check_quality
+    report = check_quality(_with_cycles("backlash_pos_deg", 20.0, 26.5))
+    with pytest.raises(CalibrationError,
+                       match=r"cycles disagree on backlash_pos_deg by 6\.5 deg .*allowed 5\)"):
+        report.raise_if_bad()
+
+
+def test_dead_zone_cycles_keep_the_tighter_limit() -> None:
+    from tsmd.calibration.assemble import check_quality
+    report = check_quality(_with_cycles("dead_zone_pos_deg", 18.0, 22.0))
+    with pytest.raises(CalibrationError, match=r"dead_zone_pos_deg by 4\.0 deg .*allowed 3\)"):
+        report.raise_if_bad()
+
+
 def test_a_grid_without_the_zero_sweep_is_refused() -> None:
     from tsmd.calibration.assemble import GridPoint, check_quality
 
@@ -302,9 +333,9 @@ def test_a_grid_without_the_zero_sweep_is_refused() -> None:
 
 
 def test_the_knee_edge_lies_beyond_the_rise_and_nearer_the_tip(sweep_rec: Recording) -> None:
-    from tsmd.calibration import IdentifyOptions
-
-    rise = _identify(sweep_rec)
+    rise = identify_sweep(sweep_rec["t"], sweep_rec["cmd1"], sweep_rec["pos1"],
+                          sweep_rec["cur1"], IdentifyOptions(edge="rise"),
+                          sweep_start_s=float(sweep_rec.metadata["calibration_sweep_start_s"]))
     knee = identify_sweep(sweep_rec["t"], sweep_rec["cmd1"], sweep_rec["pos1"],
                           sweep_rec["cur1"], IdentifyOptions(edge="knee"),
                           sweep_start_s=float(sweep_rec.metadata["calibration_sweep_start_s"]))
@@ -421,3 +452,19 @@ def test_the_nominal_straight_handle_shows_its_backlash_in_the_current() -> None
         truth = tip_truth(p)
         for name in ("backlash_pos_deg", "backlash_neg_deg"):
             assert abs(p.result.estimate(name) - truth[name]) <= 2.0, (p.knob, name)
+
+
+def test_the_default_dead_zone_edge_is_where_the_tip_starts_to_move() -> None:
+    # tsmd's default (knee) edge against the tracked tip, and the paper's rise edge beside it:
+    # the current rises when the tendon engages, a few degrees before the tip moves.
+    from tsmd.bench.calibration import tip_truth
+    from tsmd.calibration.run import identify_recording
+
+    _, _, points = _one_point_cross_check({})
+    for p in points:
+        truth = tip_truth(p)
+        assert p.recording is not None
+        rise = identify_recording(p.recording, IdentifyOptions(edge="rise")).result
+        for name in ("dead_zone_pos_deg", "dead_zone_neg_deg"):
+            assert abs(p.result.estimate(name) - truth[name]) <= 2.0, (p.knob, name)
+            assert abs(rise.estimate(name)) < abs(truth[name]), (p.knob, name)

@@ -121,24 +121,39 @@ def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any
         finish("bench", device, runs.points, amplitude_deg=90.0)
     except CalibrationError as exc:
         verdict = f"profile REFUSED by the quality checks: {exc}"
-    knee = {(p.knob, p.other_deg): identify_recording(p.recording, IdentifyOptions(edge="knee"))
+    # The calibration itself used the default (knee) edge; the paper's own edge for comparison.
+    rise = {(p.knob, p.other_deg): identify_recording(p.recording, IdentifyOptions(edge="rise"))
             for p in runs.points if p.recording is not None}
     rows = []
     errors: dict[str, list[float]] = {"paper": [], "knee": []}
+    single: dict[str, list[float]] = {"B": [], "D knee": [], "D paper": []}
+    cycle_gaps: dict[str, list[float]] = {"B": [], "D knee": [], "D paper": []}
     for p in sorted(runs.points, key=lambda q: (q.knob, q.other_deg)):
         truth = tip_truth(p)
+        r_result = rise[(p.knob, p.other_deg)].result
+        for kind, result, names in (("B", p.result, PARAMETERS[2:]),
+                                    ("D paper", r_result, PARAMETERS[:2]),
+                                    ("D knee", p.result, PARAMETERS[:2])):
+            for name in names:
+                values = result.values.get(name, ())
+                # Signed outward: a dead-zone edge inside the tip's counts negative on both sides.
+                sign = -1.0 if name == "dead_zone_neg_deg" else 1.0
+                single[kind] += [sign * (v - truth.get(name, math.nan)) for v in values]
+                if len(values) > 1:
+                    cycle_gaps[kind].append(float(np.ptp(values)))
         cells = [KNOB_LABELS[p.knob], f"{p.other_deg:+.0f}"]
         for param in PARAMETERS:
             true = truth.get(param, math.nan)
             ident = p.result.estimate(param)
-            errors["paper"].append(ident - true)
-            text = f"{ident:.1f}"
             if param.startswith("dead_zone"):
-                k_ident = knee[(p.knob, p.other_deg)].result.estimate(param)
-                errors["knee"].append(k_ident - true)
-                text += f" / {k_ident:.1f}"
-            else:
+                r_ident = r_result.estimate(param)
+                errors["paper"].append(r_ident - true)
                 errors["knee"].append(ident - true)
+                text = f"{r_ident:.1f} / {ident:.1f}"
+            else:
+                errors["paper"].append(ident - true)
+                errors["knee"].append(ident - true)
+                text = f"{ident:.1f}"
             cells.append(f"{text} / {true:.1f}")
         rows.append(cells)
     head = ["knob", "other (deg)", "D_pos paper / knee / tip", "D_neg paper / knee / tip",
@@ -148,8 +163,9 @@ def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any
     summary = (f"- sweeping {proto.sweep_time_s:.0f} s, motion {runs.motion_time_s:.0f} s "
                f"(simulated), wall {wall:.1f} s, CPU {cpu:.1f} s of this process "
                f"(load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs)\n"
-               f"- {verdict}\n" + _error_summary(errors["paper"], "paper identification")
-               + _error_summary(errors["knee"], "knee edges (beyond the paper)"))
+               f"- {verdict}\n" + _error_summary(errors["paper"], "with the paper's edge (rise)")
+               + _error_summary(errors["knee"], "tsmd calibrate (knee edge, the default)")
+               + _scatter_summary(single, cycle_gaps))
     return {"points": runs.points, "table": table, "summary": summary, "wall_s": wall,
             "errors": errors}
 
@@ -165,6 +181,22 @@ def _error_summary(signed: list[float], label: str) -> str:
     within = int((finite <= TARGET_DEG).sum())
     return (f"- {label}: |error| {', '.join(parts)} deg; within {TARGET_DEG:g} deg: {within} "
             f"of {errs.size} values ({errs.size - finite.size} without a tip value)\n")
+
+
+def _scatter_summary(single: dict[str, list[float]], gaps: dict[str, list[float]]) -> str:
+    """How one half-cycle's value scatters around the tip's, and how far two cycles differ:
+    what the quality checks' cycle-agreement limits must leave room for."""
+    parts = []
+    for kind, errs in single.items():
+        e = np.asarray(errs, dtype=float)
+        e = e[np.isfinite(e)]
+        g = np.asarray(gaps[kind], dtype=float)
+        if e.size < 2 or g.size == 0:
+            continue
+        parts.append(f"{kind} {e.mean():+.2f} +- {e.std(ddof=1):.2f} deg, cycles apart "
+                     f"max {g.max():.2f} (>3 deg: {(g > 3).sum()}, >5 deg: {(g > 5).sum()} "
+                     f"of {g.size})")
+    return "- one half-cycle against the tip: " + "; ".join(parts) + "\n"
 
 
 def compare_protocols(paper: Sequence[GridPoint], fast: Sequence[GridPoint]) -> str:
@@ -225,12 +257,12 @@ def tee_table(directory: str | None) -> str:
             lines.append(f"| {f.stem} | - | {exc} |")
             continue
         tip = tee_tip_measures(point)
-        knee = identify_recording(rec, IdentifyOptions(edge="knee"), source=f.name)
+        rise = identify_recording(rec, IdentifyOptions(edge="rise"), source=f.name)
         cells = [f.stem.replace("_current60__", " "), f"phi{point.knob + 1}"]
         for p in PARAMETERS:
             cur = _fmt(point.result.values.get(p, ()))
             if p.startswith("dead_zone"):
-                cur += f" (knee {_fmt(knee.result.values.get(p, ()))})"
+                cur += f" (paper's rise {_fmt(rise.result.values.get(p, ()))})"
             cells.append(f"{cur} / {_fmt(tuple(tip[p]))}")
         snr = point.result.snr
         cells.append(f"{snr:.1f}" if math.isfinite(snr) else "-")

@@ -56,9 +56,11 @@ class IdentifyOptions:
     """"Constant" current: rising slower than this fraction of the loaded ramp's slope."""
     penalty_k: float = 20.0
     """Change-point penalty in units of noise variance x log(n) (PELT)."""
-    edge: str = "rise"
-    """"rise": the paper's edge, where the current starts to rise; "knee" (beyond the paper):
-    where the steep first rise turns into the loaded ramp, i.e. where the tip starts to move."""
+    edge: str = "knee"
+    """"knee" (beyond the paper, the default): where the steep first rise turns into the loaded
+    ramp, i.e. where the tip starts to move; "rise": the paper's edge, where the current starts
+    to rise (the tendon engages; the tip follows a few degrees later, and the exact start of a
+    gentle rise scatters by 3 deg from cycle to cycle; docs/calibration.md)."""
     knee_slope_ratio: float = 1.5
     max_knee_deg: float = 15.0
     settle_hold_deg: float = 1.0

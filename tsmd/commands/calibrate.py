@@ -54,10 +54,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--socket", metavar="PATH",
                         help="daemon socket (default: api.socket_path of the config)")
     parser.add_argument("--seed", type=int, default=0, help="--sim: noise seed")
-    parser.add_argument("--edge", choices=("rise", "knee"), default="rise",
-                        help="dead-zone edge: 'rise' = the paper's (where the current starts to "
-                             "rise), 'knee' = where the steep first rise turns into the loaded "
-                             "ramp (beyond the paper; --sim and recordings)")
+    parser.add_argument("--edge", choices=("knee", "rise"), default="knee",
+                        help="dead-zone edge: 'knee' (default, beyond the paper) = where the "
+                             "steep first rise turns into the loaded ramp, where the tip starts "
+                             "to move; 'rise' = the paper's, where the current starts to rise "
+                             "(--sim and recordings; the daemon uses the default)")
 
 
 def main(args: argparse.Namespace) -> int:

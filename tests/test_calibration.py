@@ -468,3 +468,15 @@ def test_the_default_dead_zone_edge_is_where_the_tip_starts_to_move() -> None:
         for name in ("dead_zone_pos_deg", "dead_zone_neg_deg"):
             assert abs(p.result.estimate(name) - truth[name]) <= 2.0, (p.knob, name)
             assert abs(rise.estimate(name)) < abs(truth[name]), (p.knob, name)
+
+
+def test_a_refused_calibration_keeps_its_sweeps_for_examination() -> None:
+    from tsmd.calibration.assemble import GridPoint
+    from tsmd.calibration.errors import CalibrationRefusedError
+    from tsmd.calibration.run import finish
+
+    base = _identify(_sweep(SHORT_SWEEP))
+    points = [GridPoint(k, 30.0, base) for k in (0, 1)]  # no sweep at 0 deg: refused
+    with pytest.raises(CalibrationRefusedError, match="design assumption 1") as refused:
+        finish("cat-3", load_device_model(DEVICE), points)
+    assert refused.value.points == tuple(points)

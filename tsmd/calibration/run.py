@@ -32,7 +32,11 @@ from tsmd.calibration.assemble import (
     check_quality,
     cross_check_device,
 )
-from tsmd.calibration.errors import CalibrationCancelledError, CalibrationError
+from tsmd.calibration.errors import (
+    CalibrationCancelledError,
+    CalibrationError,
+    CalibrationRefusedError,
+)
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
 from tsmd.calibration.ours_fit import fit_ours_for_knob
 from tsmd.calibration.protocol import Protocol as SweepProtocol
@@ -146,7 +150,10 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
     report = check_quality(points, limits, amplitude_deg)
     # Before refusing: a backlash far below the data sheet's often explains cycles that disagree.
     cross_check_device(points, device, report)
-    report.raise_if_bad()
+    try:
+        report.raise_if_bad()
+    except CalibrationError as exc:
+        raise CalibrationRefusedError(str(exc), points) from None
     ours = []
     for knob in (0, 1):
         try:

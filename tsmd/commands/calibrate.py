@@ -18,9 +18,12 @@ import socket
 import sys
 import threading
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from tsmd.calibration.assemble import GridPoint
+from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.calibration.identify import IdentifyOptions
 from tsmd.errors import TsmdError
 
@@ -159,7 +162,6 @@ class _Bar:
 
 def _sim(args: argparse.Namespace) -> int:
     from tsmd.calibration import fast_protocol, paper_protocol, run_calibration
-    from tsmd.recording import write_recording
     from tsmd.replay import LockstepRunner
 
     config = _config(args, sim=True)
@@ -173,18 +175,28 @@ def _sim(args: argparse.Namespace) -> int:
             cal = run_calibration(runner, args.catheter, device, protocol=protocol,
                                   period_s=config.loop.period_s, progress=bar, cancel=cancel,
                                   options=IdentifyOptions(edge=args.edge))
+    except CalibrationRefusedError as exc:
+        # A refused calibration's sweeps are what its user needs to see why.
+        if args.save_sweeps:
+            _write_sweeps(Path(args.save_sweeps), exc.points)
+        raise
     finally:
         signal.signal(signal.SIGINT, previous)
         bar.done()
     if args.save_sweeps:
-        out = Path(args.save_sweeps)
-        out.mkdir(parents=True, exist_ok=True)
-        for i, point in enumerate(cal.points):
-            if point.recording is not None:
-                write_recording(out / f"sweep{i + 1:02d}.csv", point.recording)
-        print(f"sweeps written to {out}")
+        _write_sweeps(Path(args.save_sweeps), cal.points)
     _save(args, config, cal)
     return 0
+
+
+def _write_sweeps(out: Path, points: Sequence[GridPoint]) -> None:
+    from tsmd.recording import write_recording
+
+    out.mkdir(parents=True, exist_ok=True)
+    for i, point in enumerate(points):
+        if point.recording is not None:
+            write_recording(out / f"sweep{i + 1:02d}.csv", point.recording)
+    print(f"sweeps written to {out}")
 
 
 def _from_recordings(args: argparse.Namespace) -> int:

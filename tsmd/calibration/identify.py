@@ -6,7 +6,7 @@ jumps, makes a small peak and settles to a constant level while the tendon slack
 tendon loads the tip again (dead-zone edge, ``D``). Here, per monotonic half-cycle:
 
 * the current against knob angle is cut into linear pieces by :mod:`ruptures` (PELT,
-  continuous piecewise-linear cost); the longest run of flat pieces is the constant phase;
+  continuous piecewise-linear cost); the last long run of flat pieces is the constant phase;
 * the dead-zone edge: where that run ends and the current starts to rise (the paper's), or,
   with ``edge="knee"``, where the steep first rise turns into the loaded ramp;
 * the peak after the reversal: :func:`scipy.signal.find_peaks` on the direction-signed current;
@@ -221,11 +221,21 @@ def _flat_pieces(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
 
 def _plateau(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
              opts: IdentifyOptions) -> tuple[int, int] | None:
-    """The constant-current stretch: the longest run of flat pieces (start, stop on the grid)."""
+    """The constant-current stretch before the dead-zone edge (start, stop on the grid): the last
+    run of flat pieces at least ``min_level_deg`` long (else the longest run).
+
+    Not simply the longest: the release level after a reversal is flat too, and where the tip
+    re-enters the dead zone the released tendon drops its last tension, a short step that cuts
+    the two apart; the release run can then be the longer one (fast sweeps, phi2 at +90 deg).
+    """
     flat = _flat_pieces(yg, step, pieces, opts)
     if flat is None:
         return None
-    return max(_flat_runs(pieces, flat), key=lambda r: r[1] - r[0], default=None)
+    runs = _flat_runs(pieces, flat)
+    long_enough = [r for r in runs if (r[1] - r[0]) * step >= opts.min_level_deg]
+    if long_enough:
+        return long_enough[-1]
+    return max(runs, key=lambda r: r[1] - r[0], default=None)
 
 
 def _flat_runs(pieces: list[tuple[int, int]], flat: list[bool]) -> list[tuple[int, int]]:

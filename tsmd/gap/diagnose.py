@@ -49,7 +49,7 @@ class GapConfig:
     block_s: float | None = None
     fit_max_rows: int = 2000
     rank_max_rows: int = 6000
-    base_evals: int = 54
+    base_evals: int = 120
     polish_evals: int = 20
     refine_evals: int = 10
     joint_top: int = 2

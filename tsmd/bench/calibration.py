@@ -118,7 +118,8 @@ def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any
     device_path = config.profiles.device_model or "profiles/devices/sim-catheter.yaml"
     try:
         device = load_device_model(resolve_data_path(device_path))
-        finish("bench", device, runs.points, amplitude_deg=90.0)
+        _, quality = finish("bench", device, runs.points, amplitude_deg=90.0)
+        verdict += "".join(f"; warning: {w}" for w in quality.warnings)
     except CalibrationError as exc:
         verdict = f"profile REFUSED by the quality checks: {exc}"
     # The calibration itself used the default (knee) edge; the paper's own edge for comparison.

@@ -465,10 +465,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "0 = the nominal unit the data sheet was measured on")
     parser.add_argument("--unit-seed", type=int, default=1,
                         help="which unit to draw with --unit-variation")
-    parser.add_argument("--condition", action="store_true",
-                        help="start every run after one unscored +-90 deg cycle of both knobs "
-                        "(the state calibration leaves a catheter in) instead of the fresh "
-                        "plant's tension-free state")
+    parser.add_argument("--fresh", action="store_true",
+                        help="start every run on the fresh plant's tension-free tendons instead "
+                        "of after one unscored +-90 deg cycle of both knobs (the default: the "
+                        "state calibration leaves a catheter in)")
     parser.add_argument("--plots", type=Path, default=None,
                         help="directory for the PNG figures (none by default)")
     parser.add_argument("--report", type=Path, default=None,
@@ -531,7 +531,7 @@ def main(args: argparse.Namespace) -> int:
         for s in scen:
             for method in METHODS:
                 results.append(run_scenario(s, method, seed, profile, plant_factory,
-                                            bool(args.condition)))
+                                            not args.fresh))
         print(f"seed {seed + 1}/{n_seeds} done ({time.perf_counter() - t_start:.0f} s)",
               flush=True)
 
@@ -540,7 +540,7 @@ def main(args: argparse.Namespace) -> int:
                       lambda r: "other knob at " + ("0" if r.scenario.name.endswith("+0") else
                                                      "±" + r.scenario.name.split()[-1][1:]))
     lines = [f"Profile: {label}", f"Seeds: {n_seeds}; quick: {quick}; plant coupling: {coupling}"
-             f"; start: {'conditioned (one +-90 deg cycle)' if args.condition else 'fresh plant'}",
+             f"; start: {'fresh plant' if args.fresh else 'conditioned (one +-90 deg cycle)'}",
              "", "Tip against desired, degrees (mean ± std over seeds):", ""]
     lines += format_table(groups, with_paper=True)
     lines += ["", "1-DOF periodic by the other knob's fixed angle (paper's Table 1d_fixed):", ""]

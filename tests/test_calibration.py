@@ -280,14 +280,9 @@ def test_a_cancelled_calibration_returns_the_knobs_to_zero_and_saves_nothing(
 
 
 def test_cycles_that_disagree_are_refused_with_the_spread() -> None:
-    from tsmd.calibration.assemble import GridPoint, check_quality
-    base = _identify(_sweep(SHORT_SWEEP))
-    values = dict(base.values)
-    d = values["dead_zone_pos_deg"]
-    values["dead_zone_pos_deg"] = (d[0], d[0] + 9.0)
-    bad = SweepResult(base.data, base.half_cycles, values)
-    report = check_quality([GridPoint(0, 0.0, bad), GridPoint(0, 30.0, base),
-                            GridPoint(1, 0.0, base), GridPoint(1, 30.0, base)])
+    from tsmd.calibration.assemble import check_quality
+    d = _identify(_sweep(SHORT_SWEEP)).values["dead_zone_pos_deg"][0]
+    report = check_quality(_with_cycles("dead_zone_pos_deg", d, d + 9.0))
     with pytest.raises(CalibrationError, match=r"cycles disagree on dead_zone_pos_deg by 9\.0"):
         report.raise_if_bad()
 

@@ -213,12 +213,11 @@ def compare_protocols(paper: Sequence[GridPoint], fast: Sequence[GridPoint]) -> 
         diffs: list[float] = []
         tip_errors: list[float] = []
         for knob in (0, 1):
-            mine = sorted((f for f in fast if f.knob == knob), key=lambda f: f.other_deg)
-            xs = [f.other_deg for f in mine if math.isfinite(f.result.estimate(param))]
-            ys = [f.result.estimate(param) for f in mine if math.isfinite(f.result.estimate(param))]
-            if len(xs) < 2:
+            found = sorted((f.other_deg, f.result.estimate(param)) for f in fast if f.knob == knob)
+            finite = [(x, y) for x, y in found if math.isfinite(y)]
+            if len(finite) < 2:
                 continue
-            curve = PchipInterpolator(xs, ys, extrapolate=True)
+            curve = PchipInterpolator(*zip(*finite, strict=True), extrapolate=True)
             for p in paper:
                 if p.knob != knob:
                     continue

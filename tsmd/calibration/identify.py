@@ -219,7 +219,7 @@ def _flat_pieces(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
     return [-loaded < s < opts.flat_slope_fraction * loaded for s in slopes]
 
 
-def _plateau(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
+def _plateau(pieces: list[tuple[int, int]], flat: list[bool], step: float,
              opts: IdentifyOptions) -> tuple[int, int] | None:
     """The constant-current stretch before the dead-zone edge (start, stop on the grid): the last
     run of flat pieces at least ``min_level_deg`` long (else the longest run).
@@ -228,9 +228,6 @@ def _plateau(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
     re-enters the dead zone the released tendon drops its last tension, a short step that cuts
     the two apart; the release run can then be the longer one (fast sweeps, phi2 at +90 deg).
     """
-    flat = _flat_pieces(yg, step, pieces, opts)
-    if flat is None:
-        return None
     runs = _flat_runs(pieces, flat)
     long_enough = [r for r in runs if (r[1] - r[0]) * step >= opts.min_level_deg]
     if long_enough:
@@ -275,7 +272,7 @@ def _knee(yg: FloatArray, step: float, pieces: list[tuple[int, int]], rise_k: in
 
 
 def _backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
-                  pieces: list[tuple[int, int]], noise: float,
+                  pieces: list[tuple[int, int]], flat: list[bool], noise: float,
                   opts: IdentifyOptions) -> int | None:
     """Where the current becomes constant after the reversal (the paper's point a2).
 
@@ -288,9 +285,6 @@ def _backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
     meets the level (the current approaches the level at a slant, so a band alone ends early).
     """
     step = float(grid[1] - grid[0])
-    flat = _flat_pieces(yg, step, pieces, opts)
-    if flat is None:
-        return None
     min_points = max(3, round(opts.min_level_deg / step))
     # A run that the peak falls inside counts from the peak on (a noise peak at the start of
     # the level must not hide the level).
@@ -337,7 +331,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     # The last degrees before the next reversal belong to the motor's deceleration: left out.
     end = max(3 * min_size, yg.size - round(opts.edge_margin_deg / step))
     pieces = _pieces(yg[:end], noise, opts)
-    plateau_run = _plateau(yg[:end], step, pieces, opts)
+    flat = _flat_pieces(yg[:end], step, pieces, opts)
+    plateau_run = None if flat is None else _plateau(pieces, flat, step, opts)
     if plateau_run is None:
         plateau_run = (0, end)
         problems.append(f"{where}: no stretch of constant current")
@@ -353,7 +348,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         peaks, _ = find_peaks(transient, prominence=opts.peak_noise_k * noise)
         peak = int(peaks[0]) if peaks.size else None
         start_k = peak if peak is not None else 0
-        found = _backlash_end(grid[:end], yg[:end], start_k, pieces, noise, opts)
+        found = (None if flat is None
+                 else _backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts))
         if found is None:
             # No value rather than a guess: the quality checks then name this reason.
             problems.append(f"{where}: the current never becomes constant after the reversal")

@@ -28,6 +28,7 @@ from drivers.sim.tracker import EmTracker
 from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import GapConfig, GapResult, diagnose
 from tsmd.gap.model import ParamSpec
+from tsmd.gap.simulate import simulate
 from tsmd.recording import Recording
 
 BUILTIN_PLANT = "drivers.plant.tendon_sheath:make_tendon_sheath_plant"
@@ -133,18 +134,9 @@ def drive_plant(plant: Any, q: NDArray[np.float64], rate_hz: float) -> tuple[NDA
                                                                             NDArray[np.float64]]:
     """Step a plant along knob angles ``q`` (rows x 2); returns the true tip angle (deg) and the
     true motor current (A: torque / (gear * kt) plus motor Coulomb friction), both noise-free."""
-    dt = 1.0 / rate_hz
-    tip = np.empty_like(q)
-    cur = np.empty_like(q)
-    prev = q[0].copy()
-    for k in range(len(q)):
-        out = plant.step(dt, q[k])
-        vel = (q[k] - prev) / dt
-        prev = q[k]
-        tip[k] = out.tip_deg
-        cur[k] = (np.asarray(out.knob_torque_Nm) / (GEAR_RATIO * KT_NM_PER_A)
-                  + MOTOR_COULOMB_A * np.tanh(vel / 0.5))
-    return tip, cur
+    tip, torque = simulate(plant, np.arange(len(q)) / rate_hz, q)
+    vel = np.diff(q, axis=0, prepend=q[:1]) * rate_hz
+    return tip, torque / (GEAR_RATIO * KT_NM_PER_A) + MOTOR_COULOMB_A * np.tanh(vel / 0.5)
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""Motor-driver layer of tsmd: CANopen CiA 402 master, simulated drives and catheter physics.
+"""Hardware layer of tsmd: the CANopen CiA 402 master, drive interface, units and clocks.
 
-This package knows nothing of :mod:`tsmd`; the daemon composes it.
+This package knows nothing of :mod:`tsmd` or of simulation (:mod:`simrig`); the daemon composes it.
 """

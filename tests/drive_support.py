@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drivers.plant.base import PlantStep
+from simrig.plant import PlantStep
 
 
 class SpringPlant:

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from test_calibration_helpers import LockstepPlantRunner
 
-from drivers.plant.analysis import measure_dead_zone_backlash
-from drivers.plant.tendon_sheath import make_tendon_sheath_plant
+from simrig.analysis import measure_dead_zone_backlash
+from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd.calibration import (
     CalibrationCancelledError,
     CalibrationError,

@@ -152,7 +152,7 @@ def test_the_bench_tip_truth_ignores_drive_wobbles_at_speed_changes() -> None:
     # operator, then 1.5 deg of tip per knob deg). The measured knob angle steps back by
     # 0.02 deg twice per stroke, as the drive did at the two-speed protocol's speed changes:
     # cut there, the tip analysis took the pieces after the steps for passes and gave B < 1 deg.
-    from drivers.plant.analysis import measure_dead_zone_backlash
+    from simrig.analysis import measure_dead_zone_backlash
     from tsmd.bench.calibration import monotone_knob
 
     t = np.arange(0.0, 2 * PERIOD_S, 1.0 / RATE_HZ)

@@ -19,7 +19,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.plant.base import PlantStep
+from simrig.plant import PlantStep
 from tsmd.recording import Recording
 
 

@@ -14,8 +14,8 @@ from canopen.profiles.p402 import BaseNode402
 from drive_support import SpringPlant
 
 from drivers.od import EDS_PATH
-from drivers.sim.rig import SimRig
 from drivers.units import DriveConfig
+from simrig.rig import SimRig
 
 PERIOD_S = 0.01
 _CHANNEL = itertools.count()

@@ -11,9 +11,9 @@ from drive_support import SpringPlant
 
 from drivers.canopen_master import CanOpenDrives
 from drivers.drive import DriveError, DriveState, FaultKind
-from drivers.sim.lockstep_bus import LockstepBus
-from drivers.sim.rig import SimRig, open_sim_rig
 from drivers.units import DriveConfig
+from simrig.lockstep_bus import LockstepBus
+from simrig.rig import SimRig, open_sim_rig
 
 PERIOD_S = 0.004
 

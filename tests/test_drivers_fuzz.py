@@ -9,7 +9,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from drivers.drive import DriveError, FaultKind
-from drivers.sim.rig import open_sim_rig
+from simrig.rig import open_sim_rig
 
 PERIOD_S = 0.004
 frames = st.lists(st.tuples(st.integers(0, 0x7FF), st.binary(max_size=8)), min_size=1,

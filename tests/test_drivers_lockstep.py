@@ -7,8 +7,8 @@ import pytest
 from drive_support import SpringPlant
 
 from drivers.drive import DriveState
-from drivers.sim.rig import open_sim_rig
 from drivers.units import DriveConfig
+from simrig.rig import open_sim_rig
 
 PERIOD_S = 0.004
 
@@ -143,7 +143,7 @@ def test_replay_depends_on_the_seed_only_through_the_sensor_noise():
 
 
 def test_default_plant_is_the_tendon_sheath_physics():
-    from drivers.plant.tendon_sheath import TendonSheathPlant
+    from simrig.plants.capstan.tendon_sheath import TendonSheathPlant
 
     drives, rig = open_sim_rig(None, None, PERIOD_S, seed=0)
     try:
@@ -194,7 +194,7 @@ def test_segmented_sdo_upload_reads_the_device_name(rig_pair):
 
 
 def test_feedback_is_in_knob_degrees_and_amperes_within_one_raw_unit():
-    from drivers.sim.rig import IdealCurrentSensor
+    from simrig.rig import IdealCurrentSensor
 
     drives, rig = open_sim_rig(SpringPlant(), None, PERIOD_S, seed=0,
                                rig_kwargs={"sensors": [IdealCurrentSensor(),

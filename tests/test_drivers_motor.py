@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from drivers.sim.motor import Motor, MotorParams
+from simrig.motor import Motor, MotorParams
 
 DT_S = 0.004
 GEAR = 50.0

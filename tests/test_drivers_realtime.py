@@ -9,7 +9,7 @@ import numpy as np
 from drive_support import SpringPlant
 
 from drivers.drive import DriveState
-from drivers.sim.rig import open_sim_rig
+from simrig.rig import open_sim_rig
 
 PERIOD_S = 0.004
 

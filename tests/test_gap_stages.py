@@ -309,7 +309,7 @@ def test_effect_size_measures_the_tip_gap_of_the_effect_alone() -> None:
 
 
 def test_selftest_recording_is_the_noise_free_plant_output_plus_tracker_noise() -> None:
-    from drivers.plant.base import load_plant
+    from simrig.plant import load_plant
     from tsmd.gap.selftest import (
         BUILTIN_PLANT,
         drive_plant,

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.plant.base import PlantStep
+from simrig.plant import PlantStep
 from tsmd.recording import Recording
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from drivers.plant.analysis import (
+from simrig.analysis import (
     SweepAnalysisError,
     loaded_slope,
     measure_dead_zone_backlash,

@@ -7,9 +7,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from drivers.plant.analysis import DeadZoneBacklash, loaded_slope, measure_dead_zone_backlash
-from drivers.plant.base import PlantLoadError
-from drivers.plant.tendon_sheath import TendonSheathPlant, make_tendon_sheath_plant
+from simrig.analysis import DeadZoneBacklash, loaded_slope, measure_dead_zone_backlash
+from simrig.plant import PlantLoadError
+from simrig.plants.capstan.tendon_sheath import TendonSheathPlant, make_tendon_sheath_plant
 
 DT_S = 0.008  # quasi-static plant: a coarser tick keeps these tests fast
 

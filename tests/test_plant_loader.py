@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from drivers.plant.base import PlantLoadError, load_plant
+from simrig.plant import PlantLoadError, load_plant
 
 
 @pytest.mark.parametrize(

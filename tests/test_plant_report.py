@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from drivers.plant.report import main, run_sweep, signature
-from drivers.plant.tendon_sheath import make_tendon_sheath_plant
+from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
+from simrig.report import main, run_sweep, signature
 
 
 def test_report_prints_both_knobs_and_writes_the_figure(

@@ -7,8 +7,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from drivers.plant.current_sensor import CurrentSensor
-from drivers.sim.tracker import EmTracker
+from simrig.current_sensor import CurrentSensor
+from simrig.tracker import EmTracker
 
 DT_S = 0.004
 

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
-from drivers.plant import tendon_sheath
-from drivers.plant.analysis import loaded_slope, measure_dead_zone_backlash
-from drivers.plant.base import Plant, load_plant
-from drivers.plant.report import SweepRecord
-from drivers.plant.report import run_sweep as report_sweep
-from drivers.plant.tendon_sheath import TendonSheathPlant, make_tendon_sheath_plant
+from simrig.analysis import loaded_slope, measure_dead_zone_backlash
+from simrig.plant import Plant, load_plant
+from simrig.plants.capstan import tendon_sheath
+from simrig.plants.capstan.tendon_sheath import TendonSheathPlant, make_tendon_sheath_plant
+from simrig.report import SweepRecord
+from simrig.report import run_sweep as report_sweep
 
 DT_S = 0.004  # 250 Hz ticks
 FloatArray = NDArray[np.float64]
@@ -30,7 +30,7 @@ def default_sweep(request: pytest.FixtureRequest) -> SweepRecord:
 
 
 def test_factory_builds_a_plant_through_the_config_loader() -> None:
-    plant = load_plant("drivers.plant.tendon_sheath:make_tendon_sheath_plant", {"coupling": 1.0})
+    plant = load_plant("simrig.plants.capstan:make_tendon_sheath_plant", {"coupling": 1.0})
     assert isinstance(plant, TendonSheathPlant)
     assert isinstance(plant, Plant)
 

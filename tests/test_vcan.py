@@ -48,7 +48,7 @@ def test_master_boots_and_streams_to_the_rig_over_vcan():
 
     from drivers.canopen_master import CanOpenDrives
     from drivers.drive import DriveState
-    from drivers.sim.rig import SimRig, default_drive_configs
+    from simrig.rig import SimRig, default_drive_configs
 
     period_s = 0.004
     configs = default_drive_configs()

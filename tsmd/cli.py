@@ -12,7 +12,7 @@ import sys
 from collections.abc import Sequence
 
 from drivers.drive import DriveError
-from drivers.plant.base import PlantLoadError
+from simrig.plant import PlantLoadError
 from tsmd.errors import TsmdError
 
 COMMANDS: dict[str, tuple[str, str]] = {

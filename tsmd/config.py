@@ -112,8 +112,8 @@ class RecordingConfig:
 
 @dataclass(frozen=True)
 class SimConfig:
-    plant: str = "drivers.plant.tendon_sheath:make_tendon_sheath_plant"
-    """``module:factory`` of the simulated catheter (drivers.plant.base.load_plant)."""
+    plant: str = "simrig.plants.capstan:make_tendon_sheath_plant"
+    """``module:factory`` of the simulated catheter (simrig.plant.load_plant)."""
     params: dict[str, Any] = field(default_factory=dict)
     seed: int = field(default=0, metadata=_range(0, 2**32 - 1))
     tracker_noise_deg: float = field(default=0.2, metadata=_range(0.0, 10.0))

@@ -339,8 +339,8 @@ class Daemon:
         config = self.config
         drive_cfgs = drive_configs(config)
         if self.sim:
-            from drivers.plant.base import load_plant
-            from drivers.sim.rig import open_sim_rig
+            from simrig.plant import load_plant
+            from simrig.rig import open_sim_rig
 
             plant = load_plant(config.sim.plant, config.sim.params)
             self.drives, self.rig = open_sim_rig(plant, drive_cfgs, config.loop.period_s,

@@ -82,7 +82,7 @@ def _limits_and_ranges(config: TsmdConfig) -> tuple[Any, list[KnobRange]]:
 def configure_tracker(rig: Any, noise_deg: float, seed: int) -> None:
     """Give the rig an EM tracker with the configured noise (when the tracker model exists)."""
     try:
-        from drivers.sim.tracker import EmTracker
+        from simrig.tracker import EmTracker
     except ImportError:
         return
     rig.tracker = EmTracker(noise_deg=noise_deg, seed=seed + 7)
@@ -97,8 +97,8 @@ class LockstepRunner:
 
     def __init__(self, config: TsmdConfig | None = None, profile: Any = None,
                  method: str = "none", seed: int = 0, plant: Any = None) -> None:
-        from drivers.plant.base import load_plant
-        from drivers.sim.rig import open_sim_rig
+        from simrig.plant import load_plant
+        from simrig.rig import open_sim_rig
         from tsmd.daemon import make_compensator
 
         self.config = config if config is not None else default_sim_config()

@@ -166,7 +166,7 @@ def make_plant(coupling: float, unit_variation: float = 0.0, unit_seed: int = 0)
     The data sheet was measured on the nominal unit; other units test whether the device
     constants carry over, as they must for a real product.
     """
-    from drivers.plant.tendon_sheath import make_tendon_sheath_plant
+    from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 
     params: dict[str, Any] = {}
     if coupling > 0:
@@ -182,10 +182,10 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
 
     The paper's calibration protocol (each knob +-90 deg at 0.04 Hz, two cycles after a
     conditioning cycle, the other knob held at each grid angle), uncompensated through the full
-    stack; D and B measured on the tip with ``drivers.plant.analysis`` (ground truth); our extra
+    stack; D and B measured on the tip with ``simrig.analysis`` (ground truth); our extra
     parameters from the same sweeps.
     """
-    from drivers.plant.analysis import measure_dead_zone_backlash
+    from simrig.analysis import measure_dead_zone_backlash
     from tsmd.compensation.ours import SweepData, fit_ours_knob
     from tsmd.profile import CatheterProfile, make_knob_profile
 
@@ -226,7 +226,7 @@ def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
     how far beyond the edge the calibration finds in the current the tip leaves the plateau.
     Analysed after ``CONDITIONING_CYCLES`` (the plant's virgin start is not the product's
     behaviour)."""
-    from drivers.plant.analysis import measure_dead_zone_backlash, split_passes
+    from simrig.analysis import measure_dead_zone_backlash, split_passes
 
     out = []
     for knob in (0, 1):

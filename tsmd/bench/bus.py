@@ -114,7 +114,7 @@ class _Tap:
 
 
 def _spring() -> object:
-    from drivers.plant.base import PlantStep
+    from simrig.plant import PlantStep
 
     class Spring:
         def reset(self) -> None:
@@ -133,7 +133,7 @@ def _trajectory(n: int, period_s: float) -> np.ndarray:
 
 
 def measure_traffic(ticks: int, period_s: float, bitrate: int, seed: int) -> list[str]:
-    from drivers.sim.rig import open_sim_rig
+    from simrig.rig import open_sim_rig
 
     drives, rig = open_sim_rig(None, None, period_s, seed=seed)
     try:
@@ -190,7 +190,7 @@ def measure_latency(ticks: int, period_s: float, seed: int) -> list[str]:
     frame when it is sent, so the figure is the rig's answer time, not the master's polling.
     The master runs as the daemon does: one tick per period, sleeping in between.
     """
-    from drivers.sim.rig import open_sim_rig
+    from simrig.rig import open_sim_rig
 
     channel = f"tsmd-bench-latency-{os.getpid()}"
     drives, rig = open_sim_rig(_spring(), None, period_s, seed=seed,  # type: ignore[arg-type]
@@ -242,8 +242,8 @@ def measure_latency(ticks: int, period_s: float, seed: int) -> list[str]:
 
 
 def measure_speed(seconds: float, period_s: float, seed: int) -> list[str]:
-    from drivers.plant.base import load_plant
-    from drivers.sim.rig import DEFAULT_PLANT, open_sim_rig
+    from simrig.plant import load_plant
+    from simrig.rig import DEFAULT_PLANT, open_sim_rig
 
     ticks = round(seconds / period_s)
     q = _trajectory(ticks, period_s)

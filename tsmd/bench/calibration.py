@@ -3,7 +3,7 @@
 On the simulator: both protocols (the paper's and the fast one) run through the full stack in
 lockstep (drivers + loop, E's ``LockstepRunner``); the calibration sees only commanded/actual
 position and current. The truth per grid point is measured on the simulated EM tracker's tip
-angle by the plant package's own analysis (``drivers.plant.analysis``), never read from the
+angle by the plant package's own analysis (``simrig.analysis``), never read from the
 plant's parameters. The tracker signal is low-passed with the same 20 Hz zero-phase Butterworth
 first (its 0.2 deg noise would otherwise cross the 1 deg threshold by itself).
 
@@ -66,7 +66,7 @@ def main(args: argparse.Namespace) -> int:
 
 def tip_truth(point: GridPoint) -> dict[str, float]:
     """D and B measured on the tracked tip of the sweep (the plant package's analysis)."""
-    from drivers.plant.analysis import SweepAnalysisError, measure_dead_zone_backlash
+    from simrig.analysis import SweepAnalysisError, measure_dead_zone_backlash
 
     rec = point.recording
     if rec is None:
@@ -239,7 +239,7 @@ def compare_protocols(paper: Sequence[GridPoint], fast: Sequence[GridPoint]) -> 
 
 def tee_tip_measures(point: GridPoint) -> dict[str, list[float]]:
     """Per pass on the tracked tip, with the plant analysis' threshold definitions."""
-    from drivers.plant.analysis import _rising_pass_measures
+    from simrig.analysis import _rising_pass_measures
 
     rec = point.recording
     assert rec is not None

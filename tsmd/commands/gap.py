@@ -104,7 +104,7 @@ def _load_recording(path: str, tee: bool) -> GapSeries:
 
 
 def _factory(spec: str, fixed: dict[str, Any]) -> Any:
-    from drivers.plant.base import load_plant
+    from simrig.plant import load_plant
 
     load_plant(spec, fixed)  # fail early, with the loader's message
 

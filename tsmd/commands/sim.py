@@ -35,8 +35,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     import can
 
-    from drivers.plant.base import load_plant
-    from drivers.sim.rig import SimRig
+    from simrig.plant import load_plant
+    from simrig.rig import SimRig
     from tsmd.config import default_sim_config, drive_configs, load_config
 
     config = load_config(args.config) if args.config else default_sim_config()

@@ -1,6 +1,6 @@
 """Self-test: diagnose 'real' data made by the built-in plant with one effect the simulator lacks.
 
-The data are made by driving the plant (``drivers.plant.tendon_sheath``) directly with a knob
+The data are made by driving the capstan plant (``simrig.plants.capstan``) directly with a knob
 trajectory, bypassing CAN and the drive: the knob follows the command exactly, the tip is read
 by the simulated EM tracker and the motor current is ``torque / (gear * kt)`` plus motor Coulomb
 friction, read through the plant package's :class:`CurrentSensor` (noise, offset and, for the
@@ -22,16 +22,16 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.plant.base import load_plant
-from drivers.plant.current_sensor import CurrentSensor
-from drivers.sim.tracker import EmTracker
+from simrig.current_sensor import CurrentSensor
+from simrig.plant import load_plant
+from simrig.tracker import EmTracker
 from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import GapConfig, GapResult, diagnose
 from tsmd.gap.model import ParamSpec
 from tsmd.gap.simulate import simulate
 from tsmd.recording import Recording
 
-BUILTIN_PLANT = "drivers.plant.tendon_sheath:make_tendon_sheath_plant"
+BUILTIN_PLANT = "simrig.plants.capstan:make_tendon_sheath_plant"
 
 BUILTIN_FIT_SPECS: tuple[ParamSpec, ...] = (
     *(ParamSpec(f"knobs.{k}.slack_pos_mm+knobs.{k}.slack_neg_mm", -1.5, 1.5, knob=k)
@@ -122,7 +122,7 @@ def unit_knobs(seed: int, variation: float,
     fit is the effect put in (plus noise). ``defaults``: the plant's per-knob constants (default:
     the built-in plant's ``DEFAULT_KNOBS``).
     """
-    from drivers.plant.tendon_sheath import DEFAULT_KNOBS
+    from simrig.plants.capstan.tendon_sheath import DEFAULT_KNOBS
 
     rng = np.random.default_rng(1000 + seed)
     names = ("slack_pos_mm", "slack_neg_mm", "sheath_friction")

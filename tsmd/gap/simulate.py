@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import signal
 
-from drivers.plant.base import Plant
+from simrig.plant import Plant
 
 PlantFactory = Callable[[dict[str, Any]], Plant]
 """Builds a fresh plant from the base parameters being fitted (the others are fixed)."""

@@ -23,7 +23,7 @@ from canopen.sdo import SdoAbortedError, SdoServer
 from drivers import cia402
 from drivers import od as o
 from drivers.drive import DriveState
-from drivers.sim.motor import Motor
+from simrig.motor import Motor
 
 SendFn = Callable[[int, bytes], None]
 

@@ -21,13 +21,13 @@ from numpy.typing import NDArray
 
 from drivers.canopen_master import CanOpenDrives
 from drivers.clock import Clock, MonotonicClock, SimClock
-from drivers.plant.base import Plant, load_plant
-from drivers.sim.drive_node import SimDriveNode
-from drivers.sim.lockstep_bus import LockstepBus, make_message
-from drivers.sim.motor import Motor, MotorParams
 from drivers.units import DriveConfig
+from simrig.drive_node import SimDriveNode
+from simrig.lockstep_bus import LockstepBus, make_message
+from simrig.motor import Motor, MotorParams
+from simrig.plant import Plant, load_plant
 
-DEFAULT_PLANT = "drivers.plant.tendon_sheath:make_tendon_sheath_plant"
+DEFAULT_PLANT = "simrig.plants.capstan:make_tendon_sheath_plant"
 _CHANNELS = itertools.count()
 
 
@@ -244,7 +244,7 @@ DEFAULT_CURRENT_SENSOR: dict[str, float] = {
 def _default_sensors(seed: int, params: Mapping[str, float] | None) -> list[CurrentMeasurement]:
     """The plant package's current-sensor model, one per drive with its own seed."""
     try:
-        module = importlib.import_module("drivers.plant.current_sensor")
+        module = importlib.import_module("simrig.current_sensor")
     except ImportError:
         return [IdealCurrentSensor(), IdealCurrentSensor()]
     factory: Callable[..., CurrentMeasurement] = module.CurrentSensor
@@ -254,7 +254,7 @@ def _default_sensors(seed: int, params: Mapping[str, float] | None) -> list[Curr
 
 def _default_tracker(seed: int, noise_deg: float) -> Any:
     try:
-        tracker = importlib.import_module("drivers.sim.tracker")
+        tracker = importlib.import_module("simrig.tracker")
     except ImportError:
         return _NoiseFreeTracker()
     return tracker.EmTracker(noise_deg=noise_deg, seed=seed + 7)

@@ -5,7 +5,7 @@ has slack between pulley and sheath (the dead zone), is elastic, and runs throug
 discretised into elements with capstan friction (stick/slip per element, so the backlash has
 curved transitions). At the distal end both tendons act on a bending section made of joints
 with stiffness and Coulomb friction; its stiffness straightens the tip when the tendons release.
-Equilibrium is solved exactly every step (see :mod:`drivers.plant.tendon`), so the plant is
+Equilibrium is solved exactly every step (see :mod:`simrig.plants.capstan.tendon`), so the plant is
 quasi-static, stable at any step size and cheap.
 
 The knob torque is the tendon torque plus the handle's own friction (knob bearings, friction
@@ -22,8 +22,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.plant.base import PlantLoadError, PlantStep
-from drivers.plant.tendon import (
+from simrig.plant import PlantLoadError, PlantStep
+from simrig.plants.capstan.tendon import (
     TendonGeometry,
     apply_pull,
     residual_m,
@@ -417,7 +417,7 @@ class _Knob:
 class TendonSheathPlant:
     """Two knobs (phi1 anterior-posterior, phi2 right-left), each an antagonistic tendon pair.
 
-    Implements :class:`drivers.plant.base.Plant`. Build it with :func:`make_tendon_sheath_plant`.
+    Implements :class:`simrig.plant.Plant`. Build it with :func:`make_tendon_sheath_plant`.
     """
 
     def __init__(

@@ -1,9 +1,9 @@
 """Print (and plot) the signature of a plant on the paper's sweep: +-90 deg at 0.04 Hz.
 
-``python -m drivers.plant.report [--plot docs/img/plant_sweep.png] [--set coupling=1.0]``
+``python -m simrig.report [--plot docs/img/plant_sweep.png] [--set coupling=1.0]``
 
 For each knob in turn (the other held at 0 deg) it runs two cycles at 250 Hz and reports the
-tip-based dead zone and backlash (:mod:`drivers.plant.analysis`), the tip slopes, the knob-torque
+tip-based dead zone and backlash (:mod:`simrig.analysis`), the tip slopes, the knob-torque
 signature and the plant's CPU time per step. Figures in ``docs/plant.md`` come from here.
 """
 
@@ -20,14 +20,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from drivers.plant.analysis import (
+from simrig.analysis import (
     DeadZoneBacklash,
     loaded_slope,
     measure_dead_zone_backlash,
     releasing_slope,
 )
-from drivers.plant.base import Plant, PlantLoadError
-from drivers.plant.tendon_sheath import make_tendon_sheath_plant
+from simrig.plant import Plant, PlantLoadError
+from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 
 FloatArray = NDArray[np.float64]
 
@@ -276,7 +276,7 @@ def plot(records: Sequence[SweepRecord], sigs: Sequence[Signature], path: str) -
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m drivers.plant.report", description=__doc__)
+    parser = argparse.ArgumentParser(prog="python -m simrig.report", description=__doc__)
     parser.add_argument(
         "--set",
         action="append",

@@ -1,0 +1,1 @@
+"""Built-in catheter plants: independent physics models behind :class:`simrig.plant.Plant`."""

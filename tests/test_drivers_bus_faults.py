@@ -42,7 +42,7 @@ def test_error_passive_frame_is_decoded_with_its_counters():
     assert report.state is BusState.ERROR_PASSIVE
     assert report.details == ("TX error passive",)
     assert (report.tx_errors, report.rx_errors) == (130, 5)
-    assert "controller problem (TX error passive), error counters TX 130 RX 5" == report.text()
+    assert report.text() == "controller problem (TX error passive), error counters TX 130 RX 5"
 
 
 @pytest.mark.parametrize(("classes", "data", "words"), [

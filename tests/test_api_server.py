@@ -81,7 +81,8 @@ def test_an_idle_connection_is_told_and_closed_after_the_idle_timeout(
     t0 = time.monotonic()
     message = read_line(sock)
     waited = time.monotonic() - t0
-    assert message["error"]["code"] == "timeout" and "no request" in message["error"]["message"]
+    assert message["error"]["code"] == "idle_timeout"
+    assert "no request for 0.4 s" in message["error"]["message"]
     assert 0.3 <= waited < 2.0
     assert closed_by_server(sock)
 
@@ -92,7 +93,8 @@ def test_a_half_line_is_closed_after_the_partial_line_timeout(
     sock.sendall(b'{"cmd": "sta')
     t0 = time.monotonic()
     message = read_line(sock)
-    assert message["error"]["code"] == "timeout" and "end of line" in message["error"]["message"]
+    assert message["error"]["code"] == "line_timeout"
+    assert "no end of line within 0.3 s" in message["error"]["message"]
     assert time.monotonic() - t0 < 0.4  # the partial-line limit, not the idle one
 
 

@@ -412,7 +412,7 @@ class ApiServer:
                        "closing")
         else:
             message = f"no request for {self.idle_timeout_s:g} s; closing"
-        await conn.reply(error(None, "timeout", message))
+        await conn.reply(error(None, "line_timeout" if partial else "idle_timeout", message))
         conn.close()
 
     def _event(self, level: str, message: str, **fields: Any) -> None:

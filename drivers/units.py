@@ -49,6 +49,8 @@ class HomingConfig:
     """0x6098, see :data:`HOMING_METHODS` (names or numbers in a config)."""
     required: bool = False
     """Set points are refused until this drive is homed (the daemon enforces it)."""
+    at_start: bool = False
+    """Home when the daemon starts (else only on request): a search moves the knob."""
     home_offset_deg: float = 0.0
     switch_speed_deg_s: float = 10.0
     """0x6099:01, speed while searching the hard stop or index."""
@@ -66,6 +68,8 @@ class HomingConfig:
                f"must be one of {', '.join(HOMING_METHODS)} (or 0x6098 numbers "
                f"{sorted(_HOMING_NUMBERS)})")
         _check(not (self.required and self.method == 0), "homing.required", self.required,
+               "needs a homing method other than none")
+        _check(not (self.at_start and self.method == 0), "homing.at_start", self.at_start,
                "needs a homing method other than none")
         _check(math.isfinite(self.home_offset_deg), "homing.home_offset_deg",
                self.home_offset_deg, "must be finite")
@@ -99,9 +103,9 @@ class HomingConfig:
                 elif isinstance(value, bool) or not isinstance(value, int):
                     raise DriveConfigError(f"drive key 'homing.method': {value!r} is not one "
                                            f"of {', '.join(HOMING_METHODS)}")
-            elif key == "required":
+            elif key in ("required", "at_start"):
                 if not isinstance(value, bool):
-                    raise DriveConfigError(f"drive key 'homing.required': {value!r} must be "
+                    raise DriveConfigError(f"drive key 'homing.{key}': {value!r} must be "
                                            "true or false")
             elif isinstance(value, bool) or not isinstance(value, int | float):
                 raise DriveConfigError(f"drive key 'homing.{key}': {value!r} is not a number")

@@ -299,6 +299,9 @@ class CanOpenDrives(KnobDrives):
             if d.rebooted or not d.supervised:
                 raise DriveUnreachableError(f"{d.name} is not running (rebooted or not booted);"
                                             f" reset it before homing")
+            if d.state in (DriveState.FAULT, DriveState.FAULT_REACTION_ACTIVE):
+                raise DriveError(f"{d.name}: cannot home, drive is in {d.state.value} "
+                                 f"({self._emcy_text(d)}); call fault_reset first")
         if not todo:
             return self.homing_status()
         self._walk({DriveState.SWITCH_ON_DISABLED}, lambda d: cia402.CW_DISABLE_VOLTAGE,

@@ -58,9 +58,13 @@ class SimHoming:
         if start and not previous & cia402.CW_HOMING_START:
             self._start()
         elif not start and self.active:
-            self.active = False
-            self.bits = NOT_STARTED
+            self.interrupt()
             self.node.hold_position()
+
+    def interrupt(self) -> None:
+        """Stop searching without a reference (bit 4 cleared, drive left OPERATION ENABLED)."""
+        self.active = False
+        self.bits = NOT_STARTED
 
     def _start(self) -> None:
         node = self.node

@@ -269,6 +269,8 @@ class SimDriveNode:
             self.mode_display = self.mode
         elif not self.powered and powered_before:
             self.velocity_counts_s = 0
+        if state is not DriveState.OPERATION_ENABLED and self.homing.active:
+            self.homing.interrupt()  # a search never resumes by itself on the next enable
         self._update_statusword()
 
     def _start_quick_stop(self) -> None:

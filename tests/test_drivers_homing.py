@@ -169,3 +169,30 @@ def test_homing_config_reads_method_names():
     config = DriveConfig.from_dict({"node_id": 1, "homing": {"method": "current_position",
                                                              "required": True}})
     assert config.homing.method == 37 and config.homing.required
+
+
+def test_a_following_error_at_the_stop_fails_homing_naming_the_fault():
+    drives, rig = rig_with(HomingConfig(method=-4, switch_speed_deg_s=20.0,
+                                        current_threshold_A=2.9, timeout_s=5.0))
+    try:
+        rig.motors[0].travel_deg = (-10.0, 10.0)
+        with pytest.raises(DriveError, match=r"drive 0 \(node 1\): homing \(hard_stop_negative, "
+                                             r"method -4\) stopped: the drive is in FAULT"):
+            drives.home()
+        assert not rig.nodes[0].homing.active  # never resumes on its own
+        assert rig.nodes[0].mode_display == 8
+    finally:
+        drives.close()
+        rig.close()
+
+
+def test_a_drive_in_fault_is_not_homed():
+    drives, rig = rig_with(HomingConfig(method=37))
+    try:
+        rig.inject_fault("emcy", 0)
+        tick(drives, rig, (0.0, 0.0), 40)
+        with pytest.raises(DriveError, match=r"cannot home, drive is in FAULT"):
+            drives.home()
+    finally:
+        drives.close()
+        rig.close()

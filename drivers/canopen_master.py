@@ -258,8 +258,12 @@ class CanOpenDrives(KnobDrives):
                 "docs/drivers.md, or restart it by hand)")
         for d in self._drives:
             if d.heartbeat_lost and not d.rebooted:
-                raise DriveUnreachableError(f"{d.name} silent: no heartbeat for "
-                                            f"{self._silence_s(d):.3f} s")
+                if d.age_syncs >= d.config.stale_after_syncs:
+                    raise DriveUnreachableError(f"{d.name} silent: no heartbeat for "
+                                                f"{self._silence_s(d):.3f} s and no TPDO for "
+                                                f"{d.age_syncs} SYNCs")
+                raise DriveUnreachableError(f"{d.name} sends no heartbeat for "
+                                            f"{self._silence_s(d):.3f} s (its TPDOs arrive)")
         rebooted = [d for d in self._drives if d.rebooted]
         for d in rebooted:
             self._configure(d)

@@ -439,3 +439,28 @@ def test_a_huge_integer_gets_an_answer_and_the_connection_stays_usable(stack: St
         assert response["id"] == 9 and error_code(response) == "out_of_range"
         assert c.call("status")["ok"]
     assert all_targets_inside_limits(stack.drives)
+
+
+def test_reset_with_a_silent_drive_answers_fault_naming_it(tmp_path: Path) -> None:
+    import dataclasses
+
+    from tsmd.config import default_sim_config
+    from tsmd.daemon import Daemon
+
+    base = default_sim_config()
+    config = dataclasses.replace(base, profiles=dataclasses.replace(base.profiles, active=None))
+    daemon = Daemon(config, sim=True, socket_path=str(tmp_path / "s.sock"))
+    daemon.start()
+    try:
+        with ApiClient(tmp_path / "s.sock") as c:
+            c.call("enable")
+            daemon.rig.inject_fault("silent", drive=1)
+            deadline = time.monotonic() + 5
+            while c.call("status")["state"] != "FAULT" and time.monotonic() < deadline:
+                time.sleep(0.05)
+            time.sleep(0.6)  # past the drive's heartbeat timeout
+            response = c.request("reset")
+            assert error_code(response) == "fault"
+            assert "drive 1 (node 2) silent" in response["error"]["message"]
+    finally:
+        daemon.stop()

@@ -190,7 +190,8 @@ def test_reset_of_a_silent_drive_is_a_fault_class_error(enabled):
     drives, rig = enabled
     rig.inject_fault("silent", drive=0)
     tick(drives, rig, n=60)  # heartbeat timeout 150 ms
-    with pytest.raises(DriveUnreachableError, match=r"drive 0 \(node 1\) silent: no heartbeat"):
+    with pytest.raises(DriveUnreachableError,
+                       match=r"drive 0 \(node 1\) silent: no heartbeat for .* and no TPDO"):
         drives.fault_reset()
 
 
@@ -211,3 +212,12 @@ def test_sdo_and_boot_timeouts_are_configurable():
     finally:
         drives.close()
         rig.close()
+
+
+def test_reset_of_a_drive_without_heartbeat_says_its_tpdos_still_arrive(enabled):
+    drives, rig = enabled
+    rig.inject_fault("heartbeat_stop", drive=1)
+    tick(drives, rig, n=60)
+    with pytest.raises(DriveUnreachableError, match=r"drive 1 \(node 2\) sends no heartbeat "
+                                                    r"for .* \(its TPDOs arrive\)"):
+        drives.fault_reset()

@@ -63,7 +63,6 @@ def _someone_listens(path: Path) -> bool:
     return True
 
 
-
 class ApiServer:
     """Serves :data:`Handler` on a Unix stream socket from a background thread."""
 

@@ -24,9 +24,11 @@ from tsmd.api.handlers import ApiHandlers
 from tsmd.api.protocol import Request, ok
 from tsmd.api.server import ApiServer
 from tsmd.config import TsmdConfig
-from tsmd.daemon import CompensationChoice, Controller, knob_limits, make_compensator
-from tsmd.loop import ControlLoop, KnobLimiter, KnobRange, LoopState
+from tsmd.compensation.safety import KnobLimiter
+from tsmd.loop import ControlLoop, LoopState
 from tsmd.rt import FixedRateScheduler
+from tsmd.service import CompensationChoice, Service
+from tsmd.stack import knob_limits, make_compensator
 
 PERIOD_S = 0.004
 
@@ -55,12 +57,11 @@ def start_stack(tmp_path: Path, *, max_line_bytes: int = 4096, max_clients: int 
     config = TsmdConfig()
     drives = FakeDrives()
     loop = ControlLoop(drives, make_compensator(None, "none", config),
-                       KnobLimiter(knob_limits(config), PERIOD_S),
-                       [KnobRange(-90.0, 90.0)] * 2, PERIOD_S, MonotonicClock())
-    controller = Controller(config, loop, None, CompensationChoice(True, "ours"),
-                            profiles_dir=profiles_dir or tmp_path / "profiles")
+                       KnobLimiter(knob_limits(config), PERIOD_S), PERIOD_S, MonotonicClock())
+    service = Service(config, loop, None, CompensationChoice(True, "ours"),
+                      profiles_dir=profiles_dir or tmp_path / "profiles")
     path = tmp_path / "run" / "tsmd.sock"
-    server = ApiServer(path, ApiHandlers(controller), max_line_bytes=max_line_bytes,
+    server = ApiServer(path, ApiHandlers(service), max_line_bytes=max_line_bytes,
                        max_clients=max_clients)
     server.start()
     stop = threading.Event()

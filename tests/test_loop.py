@@ -8,8 +8,8 @@ from test_loop_fakes import FakeDrives
 
 from drivers.clock import SimClock
 from drivers.drive import DriveState
-from tsmd.compensation.safety import KnobLimits
-from tsmd.loop import ControlLoop, KnobLimiter, KnobRange, LoopError, LoopState, MemoryRecorder
+from tsmd.compensation.safety import KnobLimiter, KnobLimits
+from tsmd.loop import ControlLoop, LoopError, LoopState, MemoryRecorder
 
 PERIOD_S = 0.004
 LIMITS = [KnobLimits(-90.0, 90.0, 120.0, 2000.0)] * 2
@@ -34,8 +34,7 @@ class Offset:
 def make_loop(comp: Offset | None = None, **kwargs: object) -> tuple[ControlLoop, FakeDrives]:
     drives = FakeDrives()
     clock = SimClock()
-    loop = ControlLoop(drives, comp or Offset(0.0), KnobLimiter(LIMITS, PERIOD_S),
-                       [KnobRange(-90.0, 90.0)] * 2, PERIOD_S, clock,
+    loop = ControlLoop(drives, comp or Offset(0.0), KnobLimiter(LIMITS, PERIOD_S), PERIOD_S, clock,
                        after_sync=lambda: clock.advance(PERIOD_S), recorder=MemoryRecorder(),
                        **kwargs)  # type: ignore[arg-type]
     return loop, drives

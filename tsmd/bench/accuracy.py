@@ -21,8 +21,22 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from simrig.analysis import measure_dead_zone_backlash, split_passes
+from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd import __version__
+from tsmd.calibration import calibrate
+from tsmd.calibration.identify import identify_sweep
+from tsmd.compensation import LimitedCompensator, build_compensator
+from tsmd.compensation.ours import SweepData, fit_ours_knob
 from tsmd.errors import TsmdError
+from tsmd.profile import (
+    CatheterProfile,
+    load_device_model,
+    load_profile,
+    make_knob_profile,
+    save_profile,
+)
+from tsmd.replay import LockstepRunner, run_trajectory
 
 PERIOD_S = 0.004
 GRID_DEG = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
@@ -155,8 +169,6 @@ def tracking_errors(tip_deg: NDArray[np.float64], q_deg: NDArray[np.float64]
 
 def _run(t: NDArray[np.float64], q: NDArray[np.float64], profile: Any, method: str, seed: int,
          plant: Any) -> Any:
-    from tsmd.replay import run_trajectory
-
     return run_trajectory(t, q, profile=profile, method=method, seed=seed, plant=plant)
 
 
@@ -166,8 +178,6 @@ def make_plant(coupling: float, unit_variation: float = 0.0, unit_seed: int = 0)
     The data sheet was measured on the nominal unit; other units test whether the device
     constants carry over, as they must for a real product.
     """
-    from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
-
     params: dict[str, Any] = {}
     if coupling > 0:
         params["coupling"] = coupling
@@ -185,10 +195,6 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
     stack; D and B measured on the tip with ``simrig.analysis`` (ground truth); our extra
     parameters from the same sweeps.
     """
-    from simrig.analysis import measure_dead_zone_backlash
-    from tsmd.compensation.ours import SweepData, fit_ours_knob
-    from tsmd.profile import CatheterProfile, make_knob_profile
-
     knobs = []
     for knob in (0, 1):
         sweeps = []
@@ -226,8 +232,6 @@ def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
     how far beyond the edge the calibration finds in the current the tip leaves the plateau.
     Analysed after ``CONDITIONING_CYCLES`` (the plant's virgin start is not the product's
     behaviour)."""
-    from simrig.analysis import measure_dead_zone_backlash, split_passes
-
     out = []
     for knob in (0, 1):
         tt, qq, skip = _settle(*_tip_sweep(knob, 0.0))
@@ -236,16 +240,11 @@ def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
         pos = rec[f"pos{knob + 1}"][skip:]
         tip = rec[f"tip{knob + 1}"][skip:]
         dz = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
-        dz_offset = math.nan
-        try:  # where the calibration's current analysis puts the edges on the same sweep
-            from tsmd.calibration.identify import identify_sweep
-
-            cur = identify_sweep(rec["t"][skip:], rec[f"cmd{knob + 1}"][skip:], pos,
-                                 rec[f"cur{knob + 1}"][skip:])
-            dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
-                               + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
-        except ImportError:
-            pass
+        # where the calibration's current analysis puts the edges on the same sweep
+        cur = identify_sweep(rec["t"][skip:], rec[f"cmd{knob + 1}"][skip:], pos,
+                             rec[f"cur{knob + 1}"][skip:])
+        dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
+                           + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
         loaded, released = [], []
         for a, b, direction in split_passes(pos):
             x, y = direction * pos[a:b], direction * tip[a:b]  # mirror falling passes
@@ -268,13 +267,7 @@ def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
 
 
 def calibrated_profile(device: Any, plant_factory: Callable[[], Any], seed: int = 3000) -> Any:
-    """A profile from ``tsmd.calibration.calibrate`` (motor current only) on the lockstep sim.
-
-    Raises ImportError when the calibration package does not provide ``calibrate`` yet.
-    """
-    from tsmd.calibration import calibrate
-    from tsmd.replay import LockstepRunner
-
+    """A profile from ``tsmd.calibration.calibrate`` (motor current only) on the lockstep sim."""
     with LockstepRunner(None, None, "none", seed, plant_factory()) as runner:
         return calibrate(runner, "sim-bench", device)
 
@@ -310,8 +303,6 @@ def run_scenario(s: Scenario, method: str, seed: int, profile: Any,
 
 def compute_time_us(profile: Any, method: str, n_ticks: int = 5000) -> tuple[float, float]:
     """Median and p99 wall time of one ``command`` call for two knobs (microseconds)."""
-    from tsmd.compensation import build_compensator
-
     comp = build_compensator(profile if method != "none" else None, method, PERIOD_S)
     t = np.arange(n_ticks) * PERIOD_S
     q = np.column_stack([60 * np.sin(2 * math.pi * 0.04 * t), 60 * np.sin(2 * math.pi * 0.08 * t)])
@@ -328,8 +319,6 @@ def limiter_cost(profile: Any, method: str, device: Any, scen: Sequence[Scenario
                  ) -> dict[str, float]:
     """How far the rate/position limiter moves the compensator's command (same trajectories,
     offline): RMS and max deviation and the share of ticks where it acted."""
-    from tsmd.compensation import LimitedCompensator, build_compensator
-
     dev: list[NDArray[np.float64]] = []
     for s in scen:
         comp = build_compensator(profile, method, PERIOD_S)
@@ -476,8 +465,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from tsmd.profile import load_device_model, load_profile, save_profile
-
     quick = bool(args.quick)
     n_seeds = args.seeds if args.seeds is not None else (1 if quick else 5)
     if n_seeds < 1:
@@ -507,10 +494,6 @@ def main(args: argparse.Namespace) -> int:
                 print("calibrating from motor current (tsmd.calibration) ...", flush=True)
                 profile = calibrated_profile(device, plant_factory)
                 label = "tsmd calibrate: motor current only"
-            except ImportError:
-                if source == "calibrate":
-                    raise TsmdError("tsmd.calibration.calibrate is not available") from None
-                print("tsmd.calibration.calibrate not available: using the ground truth")
             except TsmdError as exc:
                 if source == "calibrate":
                     raise

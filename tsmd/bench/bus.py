@@ -16,6 +16,9 @@ import time
 import can
 import numpy as np
 
+from simrig.plant import PlantStep, load_plant
+from simrig.rig import DEFAULT_PLANT, open_sim_rig
+
 PERIOD_S = 0.004
 
 
@@ -114,8 +117,6 @@ class _Tap:
 
 
 def _spring() -> object:
-    from simrig.plant import PlantStep
-
     class Spring:
         def reset(self) -> None:
             pass
@@ -133,8 +134,6 @@ def _trajectory(n: int, period_s: float) -> np.ndarray:
 
 
 def measure_traffic(ticks: int, period_s: float, bitrate: int, seed: int) -> list[str]:
-    from simrig.rig import open_sim_rig
-
     drives, rig = open_sim_rig(None, None, period_s, seed=seed)
     try:
         drives.boot()
@@ -190,8 +189,6 @@ def measure_latency(ticks: int, period_s: float, seed: int) -> list[str]:
     frame when it is sent, so the figure is the rig's answer time, not the master's polling.
     The master runs as the daemon does: one tick per period, sleeping in between.
     """
-    from simrig.rig import open_sim_rig
-
     channel = f"tsmd-bench-latency-{os.getpid()}"
     drives, rig = open_sim_rig(_spring(), None, period_s, seed=seed,  # type: ignore[arg-type]
                                lockstep=False, channel=channel)
@@ -242,9 +239,6 @@ def measure_latency(ticks: int, period_s: float, seed: int) -> list[str]:
 
 
 def measure_speed(seconds: float, period_s: float, seed: int) -> list[str]:
-    from simrig.plant import load_plant
-    from simrig.rig import DEFAULT_PLANT, open_sim_rig
-
     ticks = round(seconds / period_s)
     q = _trajectory(ticks, period_s)
     lines = []

@@ -28,6 +28,7 @@ from tsmd.calibration import calibrate
 from tsmd.calibration.identify import identify_sweep
 from tsmd.compensation import LimitedCompensator, build_compensator
 from tsmd.compensation.ours import SweepData, fit_ours_knob
+from tsmd.config import default_sim_config
 from tsmd.errors import TsmdError
 from tsmd.profile import (
     CatheterProfile,
@@ -38,7 +39,8 @@ from tsmd.profile import (
 )
 from tsmd.replay import LockstepRunner, run_trajectory
 
-PERIOD_S = 0.004
+PERIOD_S = default_sim_config().loop.period_s
+"""The bench runs on the packaged simulated rig: trajectories at that loop's own tick."""
 GRID_DEG = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
 METHODS = ("none", "paper", "ours")
 

@@ -1,7 +1,7 @@
 """Calibration from motor current: identification, bad data, protocol, cancel, profile.
 
 Sweeps come from the built-in tendon-sheath plant (physics, not the compensator's model) driven
-by a small lockstep runner (tests/test_calibration_helpers.py); the truth is measured on the
+by a small lockstep runner (tests/support/calibration.py); the truth is measured on the
 plant's noise-free tip with the plant package's own analysis, never read from its parameters.
 """
 
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_calibration_helpers import LockstepPlantRunner
+from support.calibration import LockstepPlantRunner
 
 from simrig.analysis import measure_dead_zone_backlash
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
@@ -219,7 +219,8 @@ def small_cal():
     device = load_device_model(DEVICE)
     runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
     seen: list[tuple[float, str]] = []
-    cal = run_calibration(runner, "cat-1", device, protocol=SMALL, progress=lambda f, text: seen.append((f, text)),
+    cal = run_calibration(runner, "cat-1", device, protocol=SMALL,
+                          progress=lambda f, text: seen.append((f, text)),
                           limits=QualityLimits(max_cycle_spread_deg=10.0))
     return cal, runner, seen
 

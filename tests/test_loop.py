@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_loop_fakes import FakeDrives
+from support.drives import FakeDrives
 
 from drivers.clock import SimClock
 from drivers.drive import DriveState
 from tsmd.compensation.safety import KnobLimiter, KnobLimits
-from tsmd.loop import ControlLoop, LoopError, LoopState, MemoryRecorder
+from tsmd.loop import ControlLoop, LoopError, LoopState, MemoryRecorder, Playback
 
 PERIOD_S = 0.004
 LIMITS = [KnobLimits(-90.0, 90.0, 120.0, 2000.0)] * 2
@@ -208,8 +208,6 @@ def test_heartbeat_loss_faults_and_reset_waits_until_the_heartbeat_is_back() -> 
 
 
 def test_a_fault_during_a_trajectory_ends_it_with_the_reason_and_clears_the_setpoint() -> None:
-    from tsmd.loop import Playback
-
     loop, drives = make_loop()
     loop.tick()
     loop.execute("enable")

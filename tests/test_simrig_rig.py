@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from drive_support import SpringPlant
+from support.plants import SpringPlant
 
 from drivers.drive import DriveState
 from drivers.units import DriveConfig
-from simrig.rig import open_sim_rig
+from simrig.plants.capstan.tendon_sheath import TendonSheathPlant
+from simrig.rig import IdealCurrentSensor, open_sim_rig
 
 PERIOD_S = 0.004
 
@@ -143,8 +144,6 @@ def test_replay_depends_on_the_seed_only_through_the_sensor_noise():
 
 
 def test_default_plant_is_the_tendon_sheath_physics():
-    from simrig.plants.capstan.tendon_sheath import TendonSheathPlant
-
     drives, rig = open_sim_rig(None, None, PERIOD_S, seed=0)
     try:
         assert isinstance(rig.plant, TendonSheathPlant)
@@ -194,8 +193,6 @@ def test_segmented_sdo_upload_reads_the_device_name(rig_pair):
 
 
 def test_feedback_is_in_knob_degrees_and_amperes_within_one_raw_unit():
-    from simrig.rig import IdealCurrentSensor
-
     drives, rig = open_sim_rig(SpringPlant(), None, PERIOD_S, seed=0,
                                rig_kwargs={"sensors": [IdealCurrentSensor(),
                                                        IdealCurrentSensor()]})

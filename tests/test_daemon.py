@@ -201,14 +201,13 @@ def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: 
     channel = f"tsmd-canlog-{os.getpid()}-{fmt}"
     bus = can.Bus(interface="virtual", channel=channel)
     peer = can.Bus(interface="virtual", channel=channel)
+    logged = daemon._can_log(bus)
     try:
-        daemon._can_log(bus)
-        bus.send(can.Message(arbitration_id=0x080, data=b"", is_extended_id=False))
+        logged.send(can.Message(arbitration_id=0x080, data=b"", is_extended_id=False))
         peer.send(can.Message(arbitration_id=0x181, data=b"\x27\x00", is_extended_id=False))
-        assert bus.recv(1.0) is not None
-        daemon._can_writer.stop()
+        assert logged.recv(1.0) is not None
     finally:
-        bus.shutdown()
+        logged.shutdown()  # stops the writer, then the bus it wraps
         peer.shutdown()
         daemon.events.close()
     (log,) = tmp_path.glob(f"tsmd-can-*.{fmt}")

@@ -14,13 +14,14 @@ from types import ModuleType
 from drivers.drive import DriveError
 from simrig.plant import PlantLoadError
 from tsmd import __version__
-from tsmd.commands import bench, calibrate, gap, replay, run, sim
+from tsmd.commands import bench, calibrate, datasheet, gap, replay, run, sim
 from tsmd.errors import TsmdError
 
 COMMANDS: dict[str, tuple[ModuleType, str]] = {
     "run": (run, "run the daemon (loop, drives, socket API)"),
     "sim": (sim, "run the simulated rig as its own process on a CAN interface"),
     "calibrate": (calibrate, "calibrate a catheter from motor current"),
+    "datasheet": (datasheet, "measure a device's data sheet (simulator or tracked recordings)"),
     "replay": (replay, "run a trajectory through the full stack and record it"),
     "gap": (gap, "diagnose the sim-to-real gap from real recordings"),
     "bench": (bench, "benchmarks that print figures (bus, loop, accuracy, ...)"),

@@ -12,7 +12,7 @@ from support.profiles import DEVICE
 
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd.cli import main
-from tsmd.datasheet import analysed_from, settle, tip_sweep
+from tsmd.datasheet import CONDITIONING_CYCLES, analysed_from, settle, tip_sweep
 from tsmd.profile import load_device_model
 from tsmd.recording import Recording, write_recording
 
@@ -86,3 +86,18 @@ def test_plant_parameters_must_be_a_json_object(tmp_path: Path,
                  "--params", "[1, 2]", "--device-model", "x", "--out", str(tmp_path / "d.yaml")])
     assert code == 2
     assert "--params" in capsys.readouterr().err
+
+
+def test_tip_measurements_skip_the_conditioning_cycle() -> None:
+    """Data-sheet sweeps analyse 2.25 cycles of +-90 deg after the plant has been through
+    every state once (its tension-free start is not the product's behaviour)."""
+    assert CONDITIONING_CYCLES >= 1.0
+    t, q = tip_sweep(1, 30.0, PERIOD_S)
+    _, qq, skip = settle(t, q, PERIOD_S)
+    first = analysed_from(skip, PERIOD_S)
+    before, after = qq[skip:first, 1], qq[first:, 1]
+    assert before.min() == pytest.approx(-90.0, abs=0.01)
+    assert before.max() == pytest.approx(90.0, abs=0.01)
+    assert after.size * PERIOD_S == pytest.approx(2.25 / 0.04, abs=2 * PERIOD_S)
+    assert abs(after[0]) < 0.1 and after[1] > after[0]  # the same start as without conditioning
+    assert np.all(qq[skip:, 0] == 30.0)  # the other knob held (reached during the settle move)

@@ -18,7 +18,7 @@ from tsmd.errors import TsmdError
 from tsmd.loop import ControlLoop
 from tsmd.profile import ProfileError, ProfileStore, load_device_model
 from tsmd.rt import set_normal_scheduling
-from tsmd.stack import StackError, make_compensator
+from tsmd.stack import StackError, knob_limits, make_compensator
 from tsmd.trajectory import TrajectoryRunner
 
 
@@ -141,8 +141,11 @@ class Service:
             raise ServiceError("profiles.device_model is not configured", "unavailable")
         try:
             device = load_device_model(resolve_data_path(device_path))
+            knob_limits(self.config, device)  # the configured motion must fit the data sheet
         except ProfileError as exc:
             raise ServiceError(str(exc), "profile") from None
+        except StackError as exc:
+            raise ServiceError(str(exc), exc.code) from None
         if self.loop.state.value == "DISABLED":
             self._wait("enable")
         # This worker thread inherited SCHED_FIFO 1 (see Daemon): heavy identification work and

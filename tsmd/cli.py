@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from types import ModuleType
 
 from drivers.drive import DriveError
-from simrig.plant import PlantLoadError
+from simrig.plant import PlantLoadError, PlantOutputError
 from tsmd import __version__
 from tsmd.commands import bench, calibrate, datasheet, gap, replay, run, sim
 from tsmd.errors import TsmdError
@@ -27,7 +27,8 @@ COMMANDS: dict[str, tuple[ModuleType, str]] = {
     "bench": (bench, "benchmarks that print figures (bus, loop, accuracy, ...)"),
 }
 
-USER_ERRORS: tuple[type[BaseException], ...] = (TsmdError, DriveError, PlantLoadError)
+USER_ERRORS: tuple[type[BaseException], ...] = (TsmdError, DriveError, PlantLoadError,
+                                                PlantOutputError)
 
 
 def build_parser() -> argparse.ArgumentParser:

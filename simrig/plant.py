@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 
 @dataclass(frozen=True)
@@ -32,12 +32,34 @@ class Plant(Protocol):
     def reset(self) -> None:
         """Return to the straight, unloaded state."""
 
-    def step(self, dt_s: float, knob_deg: NDArray[np.float64]) -> PlantStep:
-        """Advance by ``dt_s``; ``knob_deg`` (shape (2,)) is where the knobs are at its end."""
+    def step(self, dt_s: float, knob_deg: NDArray[np.float64]
+             ) -> PlantStep | tuple[ArrayLike, ArrayLike]:
+        """Advance by ``dt_s``; ``knob_deg`` (shape (2,)) is where the knobs are at its end.
+
+        The answer is a :class:`PlantStep` or a plain ``(tip_deg, knob_torque_Nm)`` pair.
+        """
+
+
+def as_plant_step(answer: PlantStep | tuple[ArrayLike, ArrayLike]) -> PlantStep:
+    """The answer of ``Plant.step`` as a :class:`PlantStep` (a plain pair is checked first)."""
+    if isinstance(answer, PlantStep):
+        return answer
+    try:
+        tip, torque = answer
+        tip_deg = np.asarray(tip, dtype=float).reshape(2)
+        torque_Nm = np.asarray(torque, dtype=float).reshape(2)
+    except (TypeError, ValueError):
+        raise PlantOutputError(f"a plant's step() must return a PlantStep or a pair "
+                               f"(tip_deg[2], knob_torque_Nm[2]), got {answer!r}") from None
+    return PlantStep(tip_deg, torque_Nm)
 
 
 class PlantLoadError(ValueError):
     """The configured plant factory could not be loaded or built."""
+
+
+class PlantOutputError(ValueError):
+    """A plant's ``step()`` answered something that is neither a PlantStep nor a pair."""
 
 
 def load_plant(spec: str, params: dict[str, Any] | None = None) -> Plant:

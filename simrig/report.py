@@ -26,7 +26,7 @@ from simrig.analysis import (
     measure_dead_zone_backlash,
     releasing_slope,
 )
-from simrig.plant import Plant, PlantLoadError
+from simrig.plant import Plant, PlantLoadError, as_plant_step
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 
 FloatArray = NDArray[np.float64]
@@ -64,7 +64,7 @@ def run_sweep(
     for i, qi in enumerate(q):
         cmd[knob] = qi
         c0 = time.process_time()
-        step = plant.step(dt_s, cmd)
+        step = as_plant_step(plant.step(dt_s, cmd))
         cpu += time.process_time() - c0
         tip[i] = step.tip_deg[knob]
         tau[i] = step.knob_torque_Nm[knob]

@@ -8,11 +8,10 @@ Real time (``lockstep=False``): a thread serves the bus and steps the physics at
 
 from __future__ import annotations
 
-import importlib
 import itertools
 import os
 import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, Protocol
 
 import can
@@ -23,10 +22,12 @@ from drivers.can_errors import error_frame
 from drivers.canopen_master import CanOpenDrives
 from drivers.clock import Clock, MonotonicClock, SimClock
 from drivers.units import DriveConfig
+from simrig.current_sensor import CurrentSensor
 from simrig.drive_node import SimDriveNode
 from simrig.lockstep_bus import LockstepBus, make_message
 from simrig.motor import Motor, MotorParams
-from simrig.plant import Plant, load_plant
+from simrig.plant import Plant, as_plant_step, load_plant
+from simrig.tracker import EmTracker
 
 DEFAULT_PLANT = "simrig.plants.capstan:make_tendon_sheath_plant"
 _CHANNELS = itertools.count()
@@ -43,11 +44,6 @@ class IdealCurrentSensor:
 
     def measure(self, dt_s: float, current_A: float) -> float:
         return current_A
-
-
-class _NoiseFreeTracker:
-    def measure(self, tip_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-        return tip_deg
 
 
 def default_drive_configs() -> list[DriveConfig]:
@@ -121,7 +117,7 @@ class SimRig:
         knob = self._knob
         for i, n in enumerate(nodes):
             knob[i] = n.motor.step(n.motion_target_deg(), n.powered)
-        step = self.plant.step(dt, knob)
+        step = as_plant_step(self.plant.step(dt, knob))
         self._tip = step.tip_deg
         torque = step.knob_torque_Nm.tolist()
         if self._sim_clock is not None:
@@ -258,22 +254,13 @@ DEFAULT_CURRENT_SENSOR: dict[str, float] = {
 
 
 def _default_sensors(seed: int, params: Mapping[str, float] | None) -> list[CurrentMeasurement]:
-    """The plant package's current-sensor model, one per drive with its own seed."""
-    try:
-        module = importlib.import_module("simrig.current_sensor")
-    except ImportError:
-        return [IdealCurrentSensor(), IdealCurrentSensor()]
-    factory: Callable[..., CurrentMeasurement] = module.CurrentSensor
+    """The drive's current-sensor model, one per drive with its own seed."""
     kwargs = dict(DEFAULT_CURRENT_SENSOR if params is None else params)
-    return [factory(seed=seed + 1000 * (i + 1), **kwargs) for i in range(2)]
+    return [CurrentSensor(seed=seed + 1000 * (i + 1), **kwargs) for i in range(2)]
 
 
-def _default_tracker(seed: int, noise_deg: float) -> Any:
-    try:
-        tracker = importlib.import_module("simrig.tracker")
-    except ImportError:
-        return _NoiseFreeTracker()
-    return tracker.EmTracker(noise_deg=noise_deg, seed=seed + 7)
+def _default_tracker(seed: int, noise_deg: float) -> EmTracker:
+    return EmTracker(noise_deg=noise_deg, seed=seed + 7)
 
 
 def open_sim_rig(plant: Plant | None, drive_configs: Sequence[DriveConfig] | None,

@@ -8,77 +8,16 @@ import shutil
 import socket
 import stat
 import subprocess
-import threading
 import time
-from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import pytest
-from test_loop_fakes import FakeDrives
+from support.api import Stack, all_targets_inside_limits, start_stack
 
-from drivers.clock import MonotonicClock
 from tsmd.api.client import ApiClient, ApiClientError
-from tsmd.api.handlers import ApiHandlers
 from tsmd.api.protocol import Request, ok
-from tsmd.api.server import ApiServer
-from tsmd.config import TsmdConfig
-from tsmd.daemon import CompensationChoice, Controller, knob_limits, make_compensator
-from tsmd.loop import ControlLoop, KnobLimiter, KnobRange, LoopState
-from tsmd.rt import FixedRateScheduler
-
-PERIOD_S = 0.004
-
-
-@dataclass
-class Stack:
-    drives: FakeDrives
-    loop: ControlLoop
-    server: ApiServer
-    path: Path
-    stop: threading.Event
-    thread: threading.Thread
-
-    def client(self) -> ApiClient:
-        return ApiClient(self.path, timeout_s=10.0)
-
-    def wait_ticks(self, n: int) -> None:
-        target = self.loop.stats.ticks + n
-        deadline = time.monotonic() + 10.0
-        while self.loop.stats.ticks < target and time.monotonic() < deadline:
-            time.sleep(0.005)
-
-
-def start_stack(tmp_path: Path, *, max_line_bytes: int = 4096, max_clients: int = 16,
-                profiles_dir: Path | None = None) -> Stack:
-    config = TsmdConfig()
-    drives = FakeDrives()
-    loop = ControlLoop(drives, make_compensator(None, "none", config),
-                       KnobLimiter(knob_limits(config), PERIOD_S),
-                       [KnobRange(-90.0, 90.0)] * 2, PERIOD_S, MonotonicClock())
-    controller = Controller(config, loop, None, CompensationChoice(True, "ours"),
-                            profiles_dir=profiles_dir or tmp_path / "profiles")
-    path = tmp_path / "run" / "tsmd.sock"
-    server = ApiServer(path, ApiHandlers(controller), max_line_bytes=max_line_bytes,
-                       max_clients=max_clients)
-    server.start()
-    stop = threading.Event()
-    scheduler = FixedRateScheduler(PERIOD_S, loop.tick, on_tick_end=loop.note_overrun)
-    thread = threading.Thread(target=scheduler.run, args=(stop,), daemon=True)
-    thread.start()
-    stack = Stack(drives, loop, server, path, stop, thread)
-    stack.wait_ticks(2)
-    return stack
-
-
-@pytest.fixture
-def stack(tmp_path: Path) -> Iterator[Stack]:
-    s = start_stack(tmp_path)
-    yield s
-    s.stop.set()
-    s.thread.join(5)
-    s.server.stop()
+from tsmd.api.server import ApiServer, ApiServerError
+from tsmd.loop import LoopState
 
 
 def error_code(response: dict[str, object]) -> str:
@@ -93,11 +32,6 @@ def raw(client: ApiClient, line: bytes) -> dict[str, object]:
     return client.read_message()
 
 
-def all_targets_inside_limits(drives: FakeDrives) -> bool:
-    t = drives.targets_array()
-    return bool(np.all(np.isfinite(t)) and t.min() >= -90.0 and t.max() <= 90.0)
-
-
 # --- the socket ------------------------------------------------------------------------------
 
 def test_socket_has_mode_0660(stack: Stack) -> None:
@@ -105,8 +39,6 @@ def test_socket_has_mode_0660(stack: Stack) -> None:
 
 
 def test_a_regular_file_at_the_socket_path_is_not_replaced(tmp_path: Path) -> None:
-    from tsmd.api.server import ApiServerError
-
     path = tmp_path / "tsmd.sock"
     path.write_text("precious")
 
@@ -403,8 +335,6 @@ def test_profile_loads_a_catheter_and_compensation_follows_it(tmp_path: Path) ->
 
 
 def test_a_second_daemon_does_not_steal_a_live_socket(stack: Stack) -> None:
-    from tsmd.api.server import ApiServerError
-
     async def handler(*_: object) -> dict[str, object]:
         return {}
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_api import PERIOD_S, all_targets_inside_limits, start_stack
+from support.api import PERIOD_S, all_targets_inside_limits, start_stack
 
 json_scalars = st.one_of(
     st.none(), st.booleans(), st.integers(min_value=-(10**30), max_value=10**30),

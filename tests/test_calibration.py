@@ -1,7 +1,7 @@
 """Calibration from motor current: identification, bad data, protocol, cancel, profile.
 
 Sweeps come from the built-in tendon-sheath plant (physics, not the compensator's model) driven
-by a small lockstep runner (tests/test_calibration_helpers.py); the truth is measured on the
+by a small lockstep runner (tests/support/calibration.py); the truth is measured on the
 plant's noise-free tip with the plant package's own analysis, never read from its parameters.
 """
 
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_calibration_helpers import LockstepPlantRunner
+from support.calibration import LockstepPlantRunner
 
 from simrig.analysis import measure_dead_zone_backlash
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
@@ -219,7 +219,7 @@ def small_cal():
     device = load_device_model(DEVICE)
     runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
     seen: list[tuple[float, str]] = []
-    cal = run_calibration(runner, "cat-1", device, protocol=SMALL, period_s=PERIOD_S,
+    cal = run_calibration(runner, "cat-1", device, protocol=SMALL,
                           progress=lambda f, text: seen.append((f, text)),
                           limits=QualityLimits(max_cycle_spread_deg=10.0))
     return cal, runner, seen
@@ -272,8 +272,7 @@ def test_a_cancelled_calibration_returns_the_knobs_to_zero_and_saves_nothing(
     cancel = threading.Event()
     runner = _CancelAfter(1, cancel)
     with pytest.raises(CalibrationCancelledError, match="knobs returned to 0, nothing saved"):
-        run_calibration(runner, "cat-2", device, protocol=SMALL, period_s=PERIOD_S,
-                        cancel=cancel)
+        run_calibration(runner, "cat-2", device, protocol=SMALL, cancel=cancel)
     assert np.allclose(runner.pos, 0.0, atol=0.5)
     assert np.allclose(runner.trajectories[-1][-1], 0.0)
     assert ProfileStore(tmp_path).list() == []
@@ -345,10 +344,9 @@ def test_identification_in_a_worker_process_gives_the_same_values() -> None:
     from tsmd.calibration.run import run_sweeps
 
     proto = Protocol("one", (SHORT_SWEEP,))
-    here = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto,
-                      period_s=PERIOD_S)
+    here = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto)
     isolated = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto,
-                          period_s=PERIOD_S, isolate=True)
+                          isolate=True)
     assert isolated.points[0].result.values == here.points[0].result.values
 
 
@@ -413,8 +411,7 @@ def _one_point_cross_check(plant_params: dict[str, object]):
     config = default_sim_config()
     config = replace(config, sim=replace(config.sim, params=plant_params))
     with LockstepRunner(config, seed=0) as runner:
-        runs = run_sweeps(runner, paper_protocol(grid_deg=(0.0,)),
-                          period_s=config.loop.period_s)
+        runs = run_sweeps(runner, paper_protocol(grid_deg=(0.0,)))
     report = QualityReport()
     cross_check_device(runs.points, load_device_model(DEVICE), report)
     ratios = {k: v for k, v in report.figures.items() if k.endswith("_vs_datasheet")}

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_profile import ROOT, make_profile
+from support.profiles import ROOT, make_profile
 
 from tsmd.compensation import (
     CompensationError,

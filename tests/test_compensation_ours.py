@@ -2,15 +2,16 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_profile import make_profile
+from support.profiles import make_profile
 
-from tsmd.compensation import build_compensator
+from tsmd.compensation import build_compensator, ours_compensator
 from tsmd.compensation.ours import (
     OursState,
     SweepData,
@@ -168,8 +169,6 @@ def test_fit_gives_release_slopes_from_each_sweeps_amplitude_d_and_b() -> None:
 
 
 def test_fit_uses_the_data_sheet_release_slope() -> None:
-    import dataclasses
-
     knob = dataclasses.replace(DEVICE_KNOB, release_omega=1.7, reference_backlash_pos_deg=18.0,
                                reference_backlash_neg_deg=17.0)
     sweeps = [_sweep(20.0, -21.0, 3.0, 3.0, 0.0), _sweep(23.0, -21.0, 3.0, 3.0, 60.0)]
@@ -196,8 +195,6 @@ def test_lag_estimate_recovers_a_known_delay() -> None:
 
 
 def test_dead_zone_crossing_is_centred_on_the_desired_crossing() -> None:
-    from tsmd.compensation import ours_compensator
-
     profile = make_profile(d0=20.0)
     instant = ours_compensator(profile, 0.004, 1e6, 1e9)  # jumps in one tick, no look-ahead
     motor = ours_compensator(profile, 0.004, 120.0, 2000.0)
@@ -216,8 +213,6 @@ def test_dead_zone_crossing_is_centred_on_the_desired_crossing() -> None:
 
 
 def test_command_jerk_is_bounded_by_the_smoothing_window() -> None:
-    from tsmd.compensation import KnobLimits
-
     profile = make_profile(d0=20.0)
     t = np.arange(0.0, 50.0, 0.004)
     q = np.column_stack([60 * np.sin(2 * np.pi * 0.04 * t), 60 * np.sin(2 * np.pi * 0.08 * t)])

@@ -2,12 +2,20 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
 import yaml
 
-from tsmd.config import ConfigError, TsmdConfig, default_sim_config, drive_configs, load_config
+from tsmd.config import (
+    ConfigError,
+    TsmdConfig,
+    default_sim_config,
+    drive_configs,
+    load_config,
+    parse_config,
+)
 
 
 def write(tmp_path: Path, text: str) -> Path:
@@ -90,10 +98,6 @@ def test_nested_values_are_read(tmp_path: Path) -> None:
 
 
 def test_the_example_in_docs_configuration_is_valid() -> None:
-    import re
-
-    from tsmd.config import parse_config
-
     doc = Path(__file__).resolve().parent.parent / "docs" / "configuration.md"
     if not doc.exists():
         pytest.skip("docs/configuration.md is not there")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import socket
@@ -10,13 +11,17 @@ import sys
 import time
 from pathlib import Path
 
+import can
+import numpy as np
 import pytest
 import yaml
 
 from tsmd.api.client import ApiClient
-from tsmd.daemon import resolve_socket_path
+from tsmd.config import TsmdConfig, default_sim_config
+from tsmd.daemon import Daemon, resolve_socket_path
 from tsmd.notify import Notifier, watchdog_interval_s
 from tsmd.recording import read_recording
+from tsmd.replay import LiveTrajectoryRunner
 
 SIM_YAML = Path(__file__).resolve().parent.parent / "tsmd" / "data" / "sim.yaml"
 
@@ -152,11 +157,6 @@ def test_watchdog_interval_is_half_of_watchdog_usec(monkeypatch: pytest.MonkeyPa
 
 def test_calibrate_over_the_socket_streams_progress_and_cancel_saves_nothing(
         tmp_path: Path) -> None:
-    import dataclasses
-
-    from tsmd.config import default_sim_config
-    from tsmd.daemon import Daemon
-
     base = default_sim_config()
     config = dataclasses.replace(base, profiles=dataclasses.replace(
         base.profiles, dir=str(tmp_path / "profiles"), active=None))
@@ -191,13 +191,6 @@ def test_calibrate_over_the_socket_streams_progress_and_cancel_saves_nothing(
 
 @pytest.mark.parametrize("fmt", ["blf", "asc"])
 def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: str) -> None:
-    import dataclasses
-
-    import can
-
-    from tsmd.config import TsmdConfig
-    from tsmd.daemon import Daemon
-
     base = TsmdConfig()
     rt = dataclasses.replace(base.loop.realtime, priority=0)  # leave pytest's thread alone
     config = dataclasses.replace(
@@ -208,14 +201,13 @@ def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: 
     channel = f"tsmd-canlog-{os.getpid()}-{fmt}"
     bus = can.Bus(interface="virtual", channel=channel)
     peer = can.Bus(interface="virtual", channel=channel)
+    logged = daemon._can_log(bus)
     try:
-        daemon._can_log(bus)
-        bus.send(can.Message(arbitration_id=0x080, data=b"", is_extended_id=False))
+        logged.send(can.Message(arbitration_id=0x080, data=b"", is_extended_id=False))
         peer.send(can.Message(arbitration_id=0x181, data=b"\x27\x00", is_extended_id=False))
-        assert bus.recv(1.0) is not None
-        daemon._can_writer.stop()
+        assert logged.recv(1.0) is not None
     finally:
-        bus.shutdown()
+        logged.shutdown()  # stops the writer, then the bus it wraps
         peer.shutdown()
         daemon.events.close()
     (log,) = tmp_path.glob(f"tsmd-can-*.{fmt}")
@@ -224,14 +216,6 @@ def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: 
 
 
 def test_live_runner_plays_a_trajectory_on_the_running_daemon(tmp_path: Path) -> None:
-    import dataclasses
-
-    import numpy as np
-
-    from tsmd.config import default_sim_config
-    from tsmd.daemon import Daemon
-    from tsmd.replay import LiveTrajectoryRunner
-
     base = default_sim_config()
     config = dataclasses.replace(base, profiles=dataclasses.replace(base.profiles, active=None))
     daemon = Daemon(config, sim=True, api=False)
@@ -273,11 +257,6 @@ def test_sigint_stops_cleanly_too(tmp_path: Path) -> None:
 
 def test_injected_drive_fault_shows_on_the_api_and_reset_waits_for_the_cause(
         tmp_path: Path) -> None:
-    import dataclasses
-
-    from tsmd.config import default_sim_config
-    from tsmd.daemon import Daemon
-
     base = default_sim_config()
     config = dataclasses.replace(base, profiles=dataclasses.replace(base.profiles, active=None))
     daemon = Daemon(config, sim=True, socket_path=str(tmp_path / "f.sock"))

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from drive_support import SpringPlant
+from support.plants import SpringPlant
 
 from drivers import can_errors as ce
 from drivers.can_errors import BusState, decode_error_frame, error_frame

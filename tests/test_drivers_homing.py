@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import pytest
-from drive_support import SpringPlant
+from support.plants import SpringPlant
 
 from drivers.drive import DriveError, DriveState
 from drivers.units import DriveConfig, DriveConfigError, HomingConfig

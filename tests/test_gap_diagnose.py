@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_gap_support import StandInPlant, make_recording
+from support.gap import StandInPlant, make_recording
 
 from tsmd.commands import gap as gap_command
 from tsmd.gap.data import series_from_recording
@@ -142,11 +142,11 @@ def test_cli_diagnoses_with_a_plugged_plant(tmp_path: Path,
                                             capsys: pytest.CaptureFixture[str]) -> None:
     path = _write(tmp_path, _rec(lag_s=0.2))
     out = tmp_path / "report"
-    code = _run([str(path), "--plant", "test_gap_support:make_stand_in",
+    code = _run([str(path), "--plant", "support.gap:make_stand_in",
                  "--params", json.dumps(START), "--fit", "slack_deg=5:30",
                  "--fit", "play_deg=0:20", "--fit-rows", "1000", "--out", str(out)])
     assert code == 0
     assert "verdict:" in capsys.readouterr().out
     data = json.loads((out / "gap_report.json").read_text())
-    assert data["plant"] == "test_gap_support:make_stand_in"
+    assert data["plant"] == "support.gap:make_stand_in"
     assert data["candidates"][0]["name"] == "sensor"

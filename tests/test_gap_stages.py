@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_gap_support import StandInPlant, make_recording
+from support.gap import StandInPlant, make_recording
 
 from tsmd.gap.candidates import RateDependence, catalogue, play
 from tsmd.gap.data import make_split, parse_holdout, series_from_recording

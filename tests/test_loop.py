@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_loop_fakes import FakeDrives
+from support.drives import FakeDrives
 
 from drivers.clock import SimClock
 from drivers.drive import DriveState
-from tsmd.compensation.safety import KnobLimits
-from tsmd.loop import ControlLoop, KnobLimiter, KnobRange, LoopError, LoopState, MemoryRecorder
+from tsmd.compensation.safety import KnobLimiter, KnobLimits
+from tsmd.loop import ControlLoop, LoopError, LoopState, MemoryRecorder, Playback
 
 PERIOD_S = 0.004
 LIMITS = [KnobLimits(-90.0, 90.0, 120.0, 2000.0)] * 2
@@ -34,8 +34,7 @@ class Offset:
 def make_loop(comp: Offset | None = None, **kwargs: object) -> tuple[ControlLoop, FakeDrives]:
     drives = FakeDrives()
     clock = SimClock()
-    loop = ControlLoop(drives, comp or Offset(0.0), KnobLimiter(LIMITS, PERIOD_S),
-                       [KnobRange(-90.0, 90.0)] * 2, PERIOD_S, clock,
+    loop = ControlLoop(drives, comp or Offset(0.0), KnobLimiter(LIMITS, PERIOD_S), PERIOD_S, clock,
                        after_sync=lambda: clock.advance(PERIOD_S), recorder=MemoryRecorder(),
                        **kwargs)  # type: ignore[arg-type]
     return loop, drives
@@ -209,8 +208,6 @@ def test_heartbeat_loss_faults_and_reset_waits_until_the_heartbeat_is_back() -> 
 
 
 def test_a_fault_during_a_trajectory_ends_it_with_the_reason_and_clears_the_setpoint() -> None:
-    from tsmd.loop import Playback
-
     loop, drives = make_loop()
     loop.tick()
     loop.execute("enable")

@@ -10,35 +10,19 @@ from typing import Any
 
 import pytest
 import yaml
+from support.profiles import DEVICE, ROOT, make_profile
 
-from tsmd.compensation.ours import OursParams
 from tsmd.profile import (
-    CatheterProfile,
     ProfileError,
     ProfileStore,
+    device_model_from_mapping,
+    device_model_to_mapping,
     load_device_model,
     load_profile,
-    make_knob_profile,
     profile_from_mapping,
     profile_to_mapping,
     save_profile,
 )
-
-ROOT = Path(__file__).resolve().parents[1]
-DEVICE = ROOT / "profiles" / "devices" / "sim-catheter.yaml"
-GRID = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
-
-
-def make_profile(catheter_id: str = "sim-001", d0: float = 20.0) -> CatheterProfile:
-    device = load_device_model(DEVICE)
-    knobs = tuple(
-        make_knob_profile(k, GRID, [d0 - abs(g) / 30 for g in GRID],
-                          [-d0 + abs(g) / 30 for g in GRID], [15.0] * 7, [16.0] * 7,
-                          OursParams.pivot_at_dead_zone(k.omega, [20.0] * 7, [-20.0] * 7))
-        for k in device.knobs)
-    return CatheterProfile(catheter_id, device.device_model, "2026-11-22T03:00:00Z",
-                           "tsmd 0.1.0", "pchip", (knobs[0], knobs[1]),
-                           quality={"cycle_agreement_deg": 0.4})
 
 
 def mapping() -> dict[str, Any]:
@@ -187,8 +171,6 @@ def test_bad_device_model_is_refused(tmp_path: Path) -> None:
 
 
 def test_device_model_round_trip_keeps_our_optional_constants(tmp_path: Path) -> None:
-    from tsmd.profile import device_model_from_mapping, device_model_to_mapping
-
     device = load_device_model(DEVICE)
     assert device.knobs[0].release_omega is not None
     assert device_model_from_mapping(device_model_to_mapping(device)) == device

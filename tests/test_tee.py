@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tsmd.calibration import identify_recording
 from tsmd.recording import RecordingError, read_recording, write_recording
 from tsmd.tee import (
     CURRENT_A_PER_RAW,
@@ -134,8 +135,6 @@ def test_real_acquisition_converts_and_round_trips(path: Path, tmp_path: Path) -
 @needs_data
 @pytest.mark.realdata
 def test_real_acquisition_goes_through_the_identification() -> None:
-    from tsmd.calibration import identify_recording
-
     path = _real_files()[0]
     point = identify_recording(load_tee_acquisition(path), source=path.name)
     assert point.knob == int(path.name[5]) - 1

@@ -8,10 +8,16 @@ from __future__ import annotations
 
 import os
 import socket
+import time
 
+import can
 import numpy as np
 import pytest
-from drive_support import SpringPlant
+from support.plants import SpringPlant
+
+from drivers.canopen_master import CanOpenDrives
+from drivers.drive import DriveState
+from simrig.rig import SimRig, default_drive_configs
 
 VCAN = os.environ.get("TSMD_VCAN", "vcan0")
 
@@ -43,14 +49,6 @@ pytestmark = [pytest.mark.vcan]
 
 @needs_vcan
 def test_master_boots_and_streams_to_the_rig_over_vcan():
-    import time
-
-    import can
-
-    from drivers.canopen_master import CanOpenDrives
-    from drivers.drive import DriveState
-    from simrig.rig import SimRig, default_drive_configs
-
     period_s = 0.004
     configs = default_drive_configs()
     rig = SimRig(can.Bus(interface="socketcan", channel=VCAN), SpringPlant(), configs, period_s,

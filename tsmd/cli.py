@@ -7,24 +7,28 @@ Each command module under :mod:`tsmd.commands` provides ``add_arguments(parser)`
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 from collections.abc import Sequence
+from types import ModuleType
 
 from drivers.drive import DriveError
-from simrig.plant import PlantLoadError
+from simrig.plant import PlantLoadError, PlantOutputError
+from tsmd import __version__
+from tsmd.commands import bench, calibrate, datasheet, gap, replay, run, sim
 from tsmd.errors import TsmdError
 
-COMMANDS: dict[str, tuple[str, str]] = {
-    "run": ("tsmd.commands.run", "run the daemon (loop, drives, socket API)"),
-    "sim": ("tsmd.commands.sim", "run the simulated rig as its own process on a CAN interface"),
-    "calibrate": ("tsmd.commands.calibrate", "calibrate a catheter from motor current"),
-    "replay": ("tsmd.commands.replay", "run a trajectory through the full stack and record it"),
-    "gap": ("tsmd.commands.gap", "diagnose the sim-to-real gap from real recordings"),
-    "bench": ("tsmd.commands.bench", "benchmarks that print figures (bus, loop, accuracy, ...)"),
+COMMANDS: dict[str, tuple[ModuleType, str]] = {
+    "run": (run, "run the daemon (loop, drives, socket API)"),
+    "sim": (sim, "run the simulated rig as its own process on a CAN interface"),
+    "calibrate": (calibrate, "calibrate a catheter from motor current"),
+    "datasheet": (datasheet, "measure a device's data sheet (simulator or tracked recordings)"),
+    "replay": (replay, "run a trajectory through the full stack and record it"),
+    "gap": (gap, "diagnose the sim-to-real gap from real recordings"),
+    "bench": (bench, "benchmarks that print figures (bus, loop, accuracy, ...)"),
 }
 
-USER_ERRORS: tuple[type[BaseException], ...] = (TsmdError, DriveError, PlantLoadError)
+USER_ERRORS: tuple[type[BaseException], ...] = (TsmdError, DriveError, PlantLoadError,
+                                                PlantOutputError)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -32,8 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="tsmd", description="Driver daemon for tendon-sheath-driven robotic catheters.")
     parser.add_argument("--version", action="version", version=_version())
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name, (module_name, help_text) in COMMANDS.items():
-        module = importlib.import_module(module_name)
+    for name, (module, help_text) in COMMANDS.items():
         p = sub.add_parser(name, help=help_text, description=help_text)
         module.add_arguments(p)
         p.set_defaults(_module=module)
@@ -41,8 +44,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _version() -> str:
-    from tsmd import __version__
-
     return f"tsmd {__version__}"
 
 

@@ -19,6 +19,9 @@ from typing import Any, Literal
 
 import yaml
 
+from drivers.drive import DriveError
+from drivers.units import DriveConfig
+from tsmd.compensation.safety import DEFAULT_MAX_ACCEL_DEG_S2, DEFAULT_MAX_VELOCITY_DEG_S
 from tsmd.errors import TsmdError
 
 DEFAULT_CONFIG_PATH = Path("/etc/tsmd/tsmd.yaml")
@@ -75,8 +78,9 @@ class BusConfig:
 class KnobLimitsConfig:
     min_deg: float = field(default=-90.0, metadata=_range(-360.0, 360.0))
     max_deg: float = field(default=90.0, metadata=_range(-360.0, 360.0))
-    max_velocity_deg_s: float = field(default=120.0, metadata=_range(1e-3, 10_000.0))
-    max_accel_deg_s2: float = field(default=2000.0, metadata=_range(1e-3, 1e6))
+    max_velocity_deg_s: float = field(default=DEFAULT_MAX_VELOCITY_DEG_S,
+                                      metadata=_range(1e-3, 10_000.0))
+    max_accel_deg_s2: float = field(default=DEFAULT_MAX_ACCEL_DEG_S2, metadata=_range(1e-3, 1e6))
 
 
 @dataclass(frozen=True)
@@ -324,11 +328,8 @@ def default_sim_config() -> TsmdConfig:
     return parse_config(yaml.safe_load(text), source="tsmd/data/sim.yaml")
 
 
-def drive_configs(config: TsmdConfig) -> list[Any]:
+def drive_configs(config: TsmdConfig) -> list[DriveConfig]:
     """The ``drives`` entries as ``drivers.units.DriveConfig`` objects, validated."""
-    from drivers.drive import DriveError
-    from drivers.units import DriveConfig
-
     out = []
     for i, entry in enumerate(config.drives):
         try:
@@ -336,3 +337,16 @@ def drive_configs(config: TsmdConfig) -> list[Any]:
         except (DriveError, TypeError, ValueError) as exc:
             raise ConfigError(f"drives[{i}]: {exc}") from None
     return out
+
+
+PACKAGE_ROOT = Path(__file__).resolve().parent.parent
+"""The source tree (profiles/, devices/ ship next to the package)."""
+
+
+def resolve_data_path(path: str) -> Path:
+    """Relative paths: the working directory first, then the source tree (profiles/...)."""
+    p = Path(path)
+    if p.is_absolute() or p.exists():
+        return p
+    candidate = PACKAGE_ROOT / p
+    return candidate if candidate.exists() else p

@@ -17,7 +17,7 @@ import collections
 import enum
 import math
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from concurrent.futures import Future
 from dataclasses import dataclass, field
 from typing import Any, Protocol
@@ -27,7 +27,10 @@ from numpy.typing import NDArray
 
 from drivers.clock import Clock
 from drivers.drive import DriveError, DriveFeedback, DriveState, FaultEvent, KnobDrives
+from tsmd.compensation import Compensator, NoCompensation
+from tsmd.compensation.safety import KnobLimiter, KnobLimits
 from tsmd.errors import TsmdError
+from tsmd.recording import RecordingWriter
 
 Array = NDArray[np.float64]
 
@@ -54,30 +57,8 @@ class LoopError(TsmdError):
         self.code = code
 
 
-class Compensator(Protocol):
-    """tsmd.compensation.Compensator: desired knob angles -> motor command, once per tick."""
-
-    def reset(self, q_deg: Array) -> None: ...
-
-    def command(self, q_deg: Array) -> Array: ...
-
-
-class CommandLimiter(Protocol):
-    """Position/velocity/acceleration limiter applied to the command last (stateful)."""
-
-    def reset(self, cmd_deg: Array) -> None: ...
-
-    def limit(self, cmd_deg: Array) -> Array: ...
-
-
 class TickRecorder(Protocol):
     def append(self, row: tuple[float, ...]) -> None: ...
-
-
-@dataclass(frozen=True)
-class KnobRange:
-    min_deg: float
-    max_deg: float
 
 
 @dataclass(frozen=True)
@@ -173,8 +154,6 @@ class BackgroundRecorder:
     """
 
     def __init__(self, path: str, metadata: dict[str, object], flush_interval_s: float) -> None:
-        from tsmd.recording import RecordingWriter
-
         self.path = path
         self._writer = RecordingWriter(path, metadata)
         self._rows: collections.deque[tuple[float, ...]] = collections.deque()
@@ -208,8 +187,8 @@ class BackgroundRecorder:
 class ControlLoop:
     """Fixed-period feed-forward control of the knob drives; see the module docstring."""
 
-    def __init__(self, drives: KnobDrives, compensator: Compensator, limiter: CommandLimiter,
-                 ranges: Sequence[KnobRange], period_s: float, clock: Clock, *,
+    def __init__(self, drives: KnobDrives, compensator: Compensator, limiter: KnobLimiter,
+                 period_s: float, clock: Clock, *,
                  stale_feedback_syncs: int = 3, overrun_fault_streak: int = 5,
                  compensation_label: str = "none",
                  tip_source: Callable[[], Any] | None = None,
@@ -227,8 +206,10 @@ class ControlLoop:
         self._compensation_label = compensation_label
         self._no_compensation: Compensator | None = None
         self._limiter = limiter
-        self._min = np.array([r.min_deg for r in ranges], dtype=float)
-        self._max = np.array([r.max_deg for r in ranges], dtype=float)
+        if limiter.dt_s != period_s:
+            raise ValueError(f"the limiter steps {limiter.dt_s} s, the loop {period_s} s")
+        self._min = np.array([r.min_deg for r in limiter.limits], dtype=float)
+        self._max = np.array([r.max_deg for r in limiter.limits], dtype=float)
         self._min_f = tuple(float(v) for v in self._min)
         self._max_f = tuple(float(v) for v in self._max)
         self._tip_source = tip_source
@@ -261,9 +242,9 @@ class ControlLoop:
         """True while a trajectory (a calibration sweep) owns the setpoint."""
         return self._playback is not None
 
-    def ranges(self) -> list[KnobRange]:
-        return [KnobRange(float(lo), float(hi)) for lo, hi in zip(self._min, self._max,
-                                                                   strict=True)]
+    def ranges(self) -> tuple[KnobLimits, ...]:
+        """The knobs' limits: setpoints are clamped into them, commands limited by them."""
+        return self._limiter.limits
 
     # --- the tick --------------------------------------------------------------------------
 
@@ -367,7 +348,7 @@ class ControlLoop:
 
     def _uncompensated(self) -> Compensator:
         if self._no_compensation is None:
-            self._no_compensation = _Identity()
+            self._no_compensation = NoCompensation()
         return self._no_compensation
 
     def _end_playback(self, error: str | None) -> None:
@@ -558,34 +539,3 @@ class ControlLoop:
             self.state = LoopState.DISABLED
         self._emit("info", "shutdown: drives quick-stopped and disabled")
         return self.state.value
-
-
-class _Identity:
-    """The uncompensated path used while a trajectory asks for ``compensate=False``."""
-
-    def reset(self, q_deg: Array) -> None:
-        pass
-
-    def command(self, q_deg: Array) -> Array:
-        return np.asarray(q_deg, dtype=float)
-
-
-class KnobLimiter:
-    """:class:`CommandLimiter` over ``tsmd.compensation.safety.limit_step``, one per knob."""
-
-    def __init__(self, limits: Sequence[Any], dt_s: float) -> None:
-        from tsmd.compensation.safety import LimiterState, limit_step
-
-        self._step = limit_step
-        self._state_cls = LimiterState
-        self.limits = list(limits)
-        self.dt_s = dt_s
-        self._states = [LimiterState(0.0) for _ in self.limits]
-
-    def reset(self, cmd_deg: Array) -> None:
-        self._states = [self._state_cls(float(q)) for q in cmd_deg]
-
-    def limit(self, cmd_deg: Array) -> Array:
-        self._states = [self._step(s, float(c), lim, self.dt_s)
-                        for s, c, lim in zip(self._states, cmd_deg, self.limits, strict=True)]
-        return np.array([s.q_deg for s in self._states])

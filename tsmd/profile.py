@@ -419,6 +419,21 @@ def save_profile(profile: CatheterProfile, path: str | os.PathLike[str]) -> None
     target = Path(path)
     text = dump_profile(profile)
     profile_from_mapping(yaml.safe_load(text), str(target))  # never write what we cannot read
+    _write_atomically(target, text)
+
+
+def save_device_model(device: DeviceModel, path: str | os.PathLike[str],
+                      comment: str = "") -> None:
+    """Write a data sheet atomically (as :func:`save_profile`), ``comment`` as its YAML header."""
+    target = Path(path)
+    header = "".join(f"# {line}\n".replace("# \n", "#\n") for line in comment.splitlines())
+    text = header + yaml.safe_dump(_plain(device_model_to_mapping(device)), sort_keys=False,
+                                   allow_unicode=True)
+    device_model_from_mapping(yaml.safe_load(text), str(target))  # never write what we cannot read
+    _write_atomically(target, text)
+
+
+def _write_atomically(target: Path, text: str) -> None:
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     try:
@@ -428,7 +443,7 @@ def save_profile(profile: CatheterProfile, path: str | os.PathLike[str]) -> None
             os.fsync(f.fileno())
         if target.exists():
             backup = target.with_name(target.name + ".bak")
-            # A hard link keeps the old profile under the backup name while the target name
+            # A hard link keeps the old file under the backup name while the target name
             # still points at it; replace() then swaps the target in one step.
             with contextlib.suppress(FileNotFoundError):
                 backup.unlink()

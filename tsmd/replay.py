@@ -1,45 +1,35 @@
 """Running a trajectory through the full stack (drives + loop) and recording every tick.
 
-Two :class:`TrajectoryRunner` implementations, used by replay, the accuracy benchmark and the
-calibration: :class:`LockstepRunner` builds the in-process simulated rig and ticks the loop in
-lockstep with the rig's SimClock (deterministic, much faster than real time);
-:class:`LiveTrajectoryRunner` hands the trajectory to the running daemon's loop, which plays it
-one sample per tick in real time. Both return a :class:`tsmd.recording.Recording`.
+Two :class:`tsmd.trajectory.TrajectoryRunner` implementations, used by replay, the accuracy
+benchmark and the calibration: :class:`LockstepRunner` builds the in-process simulated rig and
+ticks the loop in lockstep with the rig's SimClock (deterministic, much faster than real time);
+:class:`LiveTrajectoryRunner` hands the trajectory to the running daemon's loop, which plays
+it one sample per tick in real time. Both return a :class:`tsmd.recording.Recording`.
 """
 
 from __future__ import annotations
 
 import math
 import threading
-from collections.abc import Callable, Sequence
-from typing import Any, Protocol
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from simrig.plant import Plant
 from tsmd import __version__
-from tsmd.config import TsmdConfig, default_sim_config, drive_configs
+from tsmd.compensation import METHODS
+from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.errors import TsmdError
-from tsmd.loop import ROW_COLUMNS, ControlLoop, KnobLimiter, KnobRange, LoopError, Playback
+from tsmd.loop import ROW_COLUMNS, ControlLoop, LoopError, Playback
+from tsmd.profile import CatheterProfile
 from tsmd.recording import Recording
-
-ProgressFn = Callable[[float], None]
+from tsmd.stack import build_loop, make_compensator, open_sim
+from tsmd.trajectory import ProgressFn
 
 
 class ReplayError(TsmdError):
     """A trajectory could not be run (bad input, a fault on the way, cancelled)."""
-
-
-class TrajectoryRunner(Protocol):
-    """Plays desired knob angles ``q_deg`` (N, 2) at times ``t_s`` and records each tick.
-
-    When ``cancel`` is set the run stops at the next tick and returns what it recorded so far
-    (metadata ``cancelled: true``); a fault on the way raises :class:`ReplayError`.
-    """
-
-    def run(self, t_s: ArrayLike, q_deg: ArrayLike, compensate: bool,
-            cancel: threading.Event | None = None,
-            progress: ProgressFn | None = None) -> Recording: ...
 
 
 def resample(t_s: ArrayLike, q_deg: ArrayLike, period_s: float
@@ -72,22 +62,6 @@ def rows_to_recording(rows: Sequence[tuple[float, ...]], t_ticks: NDArray[np.flo
     return Recording(columns, metadata)
 
 
-def _limits_and_ranges(config: TsmdConfig) -> tuple[Any, list[KnobRange]]:
-    from tsmd.daemon import knob_limits
-
-    limits = knob_limits(config)
-    return limits, [KnobRange(k.min_deg, k.max_deg) for k in config.limits.knobs()]
-
-
-def configure_tracker(rig: Any, noise_deg: float, seed: int) -> None:
-    """Give the rig an EM tracker with the configured noise (when the tracker model exists)."""
-    try:
-        from simrig.tracker import EmTracker
-    except ImportError:
-        return
-    rig.tracker = EmTracker(noise_deg=noise_deg, seed=seed + 7)
-
-
 class LockstepRunner:
     """The full stack on the in-process simulated rig, ticked in lockstep (deterministic).
 
@@ -95,34 +69,21 @@ class LockstepRunner:
     knobs are, as on the device (calibration runs many sweeps back to back).
     """
 
-    def __init__(self, config: TsmdConfig | None = None, profile: Any = None,
-                 method: str = "none", seed: int = 0, plant: Any = None) -> None:
-        from simrig.plant import load_plant
-        from simrig.rig import open_sim_rig
-        from tsmd.daemon import make_compensator
-
+    def __init__(self, config: TsmdConfig | None = None, profile: CatheterProfile | None = None,
+                 method: str = "none", seed: int = 0, plant: Plant | None = None) -> None:
         self.config = config if config is not None else default_sim_config()
         cfg = self.config
-        if method not in ("none", "paper", "ours"):
-            raise ReplayError(f"method must be none, paper or ours, got {method!r}")
+        if method not in METHODS:
+            raise ReplayError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
         if method != "none" and profile is None:
             raise ReplayError(f"method {method!r} needs a catheter profile")
         self.method = method
         self.profile = profile
         self.seed = seed
-        if plant is None:
-            plant = load_plant(cfg.sim.plant, cfg.sim.params)
-        period_s = cfg.loop.period_s
-        self.drives, self.rig = open_sim_rig(plant, drive_configs(cfg), period_s, seed,
-                                             lockstep=True)
-        configure_tracker(self.rig, cfg.sim.tracker_noise_deg, seed)
-        limits, ranges = _limits_and_ranges(cfg)
-        self.loop = ControlLoop(
-            self.drives, make_compensator(profile, method, cfg), KnobLimiter(limits, period_s),
-            ranges, period_s, self.rig.clock,
-            stale_feedback_syncs=cfg.loop.stale_feedback_syncs,
-            overrun_fault_streak=cfg.loop.overrun_fault_streak, compensation_label=method,
-            tip_source=self.rig.tip_deg, after_sync=self.rig.exchange)
+        self.drives, self.rig = open_sim(cfg, seed, lockstep=True, plant=plant)
+        self.loop = build_loop(cfg, self.drives, make_compensator(profile, method, cfg),
+                               self.rig.clock, compensation_label=method,
+                               tip_source=self.rig.tip_deg, after_sync=self.rig.exchange)
         try:
             self.drives.boot()
             self.loop.tick()
@@ -130,6 +91,10 @@ class LockstepRunner:
         except (LoopError, TsmdError) as exc:
             self.close()
             raise ReplayError(f"the simulated rig did not start: {exc}") from None
+
+    @property
+    def period_s(self) -> float:
+        return self.loop.period_s
 
     def run(self, t_s: ArrayLike, q_deg: ArrayLike, compensate: bool,
             cancel: threading.Event | None = None,
@@ -174,8 +139,8 @@ class LockstepRunner:
 
 
 def run_trajectory(t_s: ArrayLike, q_deg: ArrayLike, *, config: TsmdConfig | None = None,
-                   profile: Any = None, method: str = "none", seed: int = 0,
-                   plant: Any = None) -> Recording:
+                   profile: CatheterProfile | None = None, method: str = "none", seed: int = 0,
+                   plant: Plant | None = None) -> Recording:
     """Run one trajectory in lockstep on a fresh simulated rig and return its recording."""
     with LockstepRunner(config, profile, method, seed, plant) as runner:
         return runner.run(t_s, q_deg, compensate=method != "none")
@@ -187,6 +152,10 @@ class LiveTrajectoryRunner:
     def __init__(self, loop: ControlLoop, poll_s: float = 0.05) -> None:
         self.loop = loop
         self.poll_s = poll_s
+
+    @property
+    def period_s(self) -> float:
+        return self.loop.period_s
 
     def run(self, t_s: ArrayLike, q_deg: ArrayLike, compensate: bool,
             cancel: threading.Event | None = None,

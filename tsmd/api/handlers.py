@@ -21,7 +21,7 @@ from tsmd.loop import ControlLoop, LoopError, LoopState
 
 
 class Services(Protocol):
-    """What the daemon offers the API besides the loop (see tsmd.daemon.Controller)."""
+    """What the daemon offers the API besides the loop (see tsmd.service.Service)."""
 
     loop: ControlLoop
 

@@ -21,10 +21,26 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from simrig.analysis import measure_dead_zone_backlash
+from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd import __version__
+from tsmd.calibration import calibrate
+from tsmd.compensation import LimitedCompensator, build_compensator
+from tsmd.compensation.ours import SweepData, fit_ours_knob
+from tsmd.config import default_sim_config
+from tsmd.datasheet import analysed_from, settle, tip_sweep
 from tsmd.errors import TsmdError
+from tsmd.profile import (
+    CatheterProfile,
+    load_device_model,
+    load_profile,
+    make_knob_profile,
+    save_profile,
+)
+from tsmd.replay import LockstepRunner, run_trajectory
 
-PERIOD_S = 0.004
+PERIOD_S = default_sim_config().loop.period_s
+"""The bench runs on the packaged simulated rig: trajectories at that loop's own tick."""
 GRID_DEG = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
 METHODS = ("none", "paper", "ours")
 
@@ -50,31 +66,18 @@ class Scenario:
     knobs: tuple[int, ...]
 
 
-def _settle(t: NDArray[np.float64], q: NDArray[np.float64], move_s: float = 2.0
-            ) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
-    """Prepend a smooth move from 0 to the first sample and a rest, like an operator would."""
-    n_move = round(move_s / PERIOD_S)
-    s = 0.5 - 0.5 * np.cos(np.linspace(0.0, math.pi, n_move))
-    pre = s[:, None] * q[0][None, :]
-    rest = np.repeat(q[:1], round(0.5 / PERIOD_S), axis=0)
-    head = np.vstack([pre, rest])
-    tt = np.arange(len(head) + len(t)) * PERIOD_S
-    full: NDArray[np.float64] = np.vstack([head, q]).astype(float)
-    return tt.astype(float), full, len(head)
-
-
 CONDITIONING_HZ = 0.08
 
 
 def _conditioned(t: NDArray[np.float64], q: NDArray[np.float64], condition: bool
                  ) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
-    """``_settle``, optionally after one unscored +-90 deg cycle of both knobs at 0.08 Hz.
+    """``settle``, optionally after one unscored +-90 deg cycle of both knobs at 0.08 Hz.
 
     A fresh simulated plant is tension-free, a state a catheter that has been calibrated (the
     paper's experiments follow the calibration on the same catheter) is never in. With
     ``condition`` every run starts from the state one full cycle leaves.
     """
-    tt, qq, skip = _settle(t, q)
+    tt, qq, skip = settle(t, q, PERIOD_S)
     if not condition:
         return tt, qq, skip
     tc = np.arange(0.0, 1.0 / CONDITIONING_HZ, PERIOD_S)
@@ -82,27 +85,6 @@ def _conditioned(t: NDArray[np.float64], q: NDArray[np.float64], condition: bool
     full: NDArray[np.float64] = np.vstack([cond, qq]).astype(float)
     t_full: NDArray[np.float64] = np.arange(len(full), dtype=float) * PERIOD_S
     return t_full, full, skip + len(cond)
-
-
-CONDITIONING_CYCLES = 1.0
-"""Sweep cycles run before a tip measurement is analysed. The plant starts tension-free
-(virgin): its first release rests higher and its first engagement of the antagonist comes
-later (phi1: plateau 16 instead of 5 deg, D_neg -15 instead of -22 deg on the tip), which a
-product's data sheet must not average in; the calibration protocol conditions likewise."""
-
-
-def _tip_sweep(knob: int, other_deg: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """A +-90 deg, 0.04 Hz sweep of ``knob`` (2.25 cycles after the conditioning cycles)."""
-    t = np.arange(0.0, (CONDITIONING_CYCLES + 2.25) / 0.04, PERIOD_S)
-    q = np.zeros((t.size, 2))
-    q[:, knob] = 90.0 * np.sin(2 * math.pi * 0.04 * t)
-    q[:, 1 - knob] = other_deg
-    return t, q
-
-
-def _analysed_from(skip: int) -> int:
-    """First sample of a ``_tip_sweep`` run (after ``_settle``) that is analysed."""
-    return skip + round(CONDITIONING_CYCLES / 0.04 / PERIOD_S)
 
 
 def scenarios(quick: bool = False) -> list[Scenario]:
@@ -155,8 +137,6 @@ def tracking_errors(tip_deg: NDArray[np.float64], q_deg: NDArray[np.float64]
 
 def _run(t: NDArray[np.float64], q: NDArray[np.float64], profile: Any, method: str, seed: int,
          plant: Any) -> Any:
-    from tsmd.replay import run_trajectory
-
     return run_trajectory(t, q, profile=profile, method=method, seed=seed, plant=plant)
 
 
@@ -166,8 +146,6 @@ def make_plant(coupling: float, unit_variation: float = 0.0, unit_seed: int = 0)
     The data sheet was measured on the nominal unit; other units test whether the device
     constants carry over, as they must for a real product.
     """
-    from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
-
     params: dict[str, Any] = {}
     if coupling > 0:
         params["coupling"] = coupling
@@ -185,17 +163,13 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
     stack; D and B measured on the tip with ``simrig.analysis`` (ground truth); our extra
     parameters from the same sweeps.
     """
-    from simrig.analysis import measure_dead_zone_backlash
-    from tsmd.compensation.ours import SweepData, fit_ours_knob
-    from tsmd.profile import CatheterProfile, make_knob_profile
-
     knobs = []
     for knob in (0, 1):
         sweeps = []
         for other in GRID_DEG:
-            tt, qq, skip = _settle(*_tip_sweep(knob, other))
+            tt, qq, skip = settle(*tip_sweep(knob, other, PERIOD_S), PERIOD_S)
             rec = _run(tt, qq, None, "none", seed, plant_factory())
-            skip = _analysed_from(skip)
+            skip = analysed_from(skip, PERIOD_S)
             pos = rec[f"pos{knob + 1}"][skip:]
             tip = rec[f"tip{knob + 1}"][skip:]
             m = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
@@ -217,64 +191,8 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
         (knobs[0], knobs[1]), source="ground truth: D/B measured on the simulated tracker's tip")
 
 
-def measure_device_constants(plant_factory: Callable[[], Any], seed: int = 2000
-                             ) -> list[dict[str, float]]:
-    """What a manufacturer measures once per product with a tracker on the tip (design
-    assumptions 1-3): per knob, the loaded slope omega, the reference points (tip at the knob's
-    +-90 deg turning points of a sweep with the other knob at 0 deg), and for our compensator
-    the release slope, the backlash (on the tip) after the reversals at the reference points, and
-    how far beyond the edge the calibration finds in the current the tip leaves the plateau.
-    Analysed after ``CONDITIONING_CYCLES`` (the plant's virgin start is not the product's
-    behaviour)."""
-    from simrig.analysis import measure_dead_zone_backlash, split_passes
-
-    out = []
-    for knob in (0, 1):
-        tt, qq, skip = _settle(*_tip_sweep(knob, 0.0))
-        rec = _run(tt, qq, None, "none", seed, plant_factory())
-        skip = _analysed_from(skip)
-        pos = rec[f"pos{knob + 1}"][skip:]
-        tip = rec[f"tip{knob + 1}"][skip:]
-        dz = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
-        dz_offset = math.nan
-        try:  # where the calibration's current analysis puts the edges on the same sweep
-            from tsmd.calibration.identify import identify_sweep
-
-            cur = identify_sweep(rec["t"][skip:], rec[f"cmd{knob + 1}"][skip:], pos,
-                                 rec[f"cur{knob + 1}"][skip:])
-            dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
-                               + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
-        except ImportError:
-            pass
-        loaded, released = [], []
-        for a, b, direction in split_passes(pos):
-            x, y = direction * pos[a:b], direction * tip[a:b]  # mirror falling passes
-            # loaded: moving out of the dead zone; released: moving back towards it
-            sel_l = (x >= 40.0) & (x <= 85.0)
-            if np.count_nonzero(sel_l) > 10:
-                loaded.append(float(np.polyfit(x[sel_l], y[sel_l], 1)[0]))
-            xr, yr = -x, -y  # the same pass seen as releasing the other side's tendon
-            sel_r = (xr >= 35.0) & (xr <= 65.0)
-            if np.count_nonzero(sel_r) > 10:
-                released.append(float(np.polyfit(xr[sel_r], yr[sel_r], 1)[0]))
-        out.append({"omega": float(np.median(loaded)),
-                    "release_omega": float(np.median(released)),
-                    "reference_backlash_pos_deg": float(dz.backlash_pos_deg),
-                    "reference_backlash_neg_deg": float(dz.backlash_neg_deg),
-                    "dead_zone_offset_deg": float(dz_offset),
-                    "ref_pos_knob": 90.0, "ref_pos_tip": float(np.median(tip[pos > 89.5])),
-                    "ref_neg_knob": -90.0, "ref_neg_tip": float(np.median(tip[pos < -89.5]))})
-    return out
-
-
 def calibrated_profile(device: Any, plant_factory: Callable[[], Any], seed: int = 3000) -> Any:
-    """A profile from ``tsmd.calibration.calibrate`` (motor current only) on the lockstep sim.
-
-    Raises ImportError when the calibration package does not provide ``calibrate`` yet.
-    """
-    from tsmd.calibration import calibrate
-    from tsmd.replay import LockstepRunner
-
+    """A profile from ``tsmd.calibration.calibrate`` (motor current only) on the lockstep sim."""
     with LockstepRunner(None, None, "none", seed, plant_factory()) as runner:
         return calibrate(runner, "sim-bench", device)
 
@@ -310,8 +228,6 @@ def run_scenario(s: Scenario, method: str, seed: int, profile: Any,
 
 def compute_time_us(profile: Any, method: str, n_ticks: int = 5000) -> tuple[float, float]:
     """Median and p99 wall time of one ``command`` call for two knobs (microseconds)."""
-    from tsmd.compensation import build_compensator
-
     comp = build_compensator(profile if method != "none" else None, method, PERIOD_S)
     t = np.arange(n_ticks) * PERIOD_S
     q = np.column_stack([60 * np.sin(2 * math.pi * 0.04 * t), 60 * np.sin(2 * math.pi * 0.08 * t)])
@@ -328,13 +244,11 @@ def limiter_cost(profile: Any, method: str, device: Any, scen: Sequence[Scenario
                  ) -> dict[str, float]:
     """How far the rate/position limiter moves the compensator's command (same trajectories,
     offline): RMS and max deviation and the share of ticks where it acted."""
-    from tsmd.compensation import LimitedCompensator, build_compensator
-
     dev: list[NDArray[np.float64]] = []
     for s in scen:
         comp = build_compensator(profile, method, PERIOD_S)
         lim = LimitedCompensator(comp, device.limits, PERIOD_S)
-        _, qq, _ = _settle(s.t_s, s.q_deg)
+        _, qq, _ = settle(s.t_s, s.q_deg, PERIOD_S)
         lim.reset(qq[0])
         for row in qq:
             out = lim.command(row)
@@ -476,8 +390,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from tsmd.profile import load_device_model, load_profile, save_profile
-
     quick = bool(args.quick)
     n_seeds = args.seeds if args.seeds is not None else (1 if quick else 5)
     if n_seeds < 1:
@@ -507,10 +419,6 @@ def main(args: argparse.Namespace) -> int:
                 print("calibrating from motor current (tsmd.calibration) ...", flush=True)
                 profile = calibrated_profile(device, plant_factory)
                 label = "tsmd calibrate: motor current only"
-            except ImportError:
-                if source == "calibrate":
-                    raise TsmdError("tsmd.calibration.calibrate is not available") from None
-                print("tsmd.calibration.calibrate not available: using the ground truth")
             except TsmdError as exc:
                 if source == "calibrate":
                     raise

@@ -16,7 +16,9 @@ import time
 import can
 import numpy as np
 
-PERIOD_S = 0.004
+from simrig.lockstep_bus import LockstepBus
+from simrig.plant import PlantStep, load_plant
+from simrig.rig import DEFAULT_PLANT, open_sim_rig
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -88,34 +90,22 @@ def worst_case_frame_bits(dlc: int) -> int:
 
 
 # -- measurements ------------------------------------------------------------------------------
-class _Tap:
-    """Counts every frame the master sends and receives during a window."""
+class _Tap(can.Listener):
+    """Counts every frame on the bus during a window (the master's and the drives')."""
 
     def __init__(self) -> None:
         self.frames: list[tuple[int, bytes]] = []
 
-    def wrap(self, bus: can.BusABC) -> None:
-        send = bus.send
-        recv = bus.recv
-        frames = self.frames
+    def on_message_received(self, msg: can.Message) -> None:
+        self.frames.append((msg.arbitration_id, bytes(msg.data)))
 
-        def tapped_send(msg: can.Message, timeout: float | None = None) -> None:
-            frames.append((msg.arbitration_id, bytes(msg.data)))
-            send(msg, timeout)
-
-        def tapped_recv(timeout: float | None = None) -> can.Message | None:
-            msg = recv(timeout)
-            if msg is not None:
-                frames.append((msg.arbitration_id, bytes(msg.data)))
-            return msg
-
-        bus.send = tapped_send  # type: ignore[method-assign]
-        bus.recv = tapped_recv  # type: ignore[method-assign]
+    def drain(self, bus: can.BusABC) -> None:
+        """Everything ``bus`` (an observer on the channel) has seen so far."""
+        while (msg := bus.recv(0)) is not None:
+            self.on_message_received(msg)
 
 
 def _spring() -> object:
-    from simrig.plant import PlantStep
-
     class Spring:
         def reset(self) -> None:
             pass
@@ -133,14 +123,17 @@ def _trajectory(n: int, period_s: float) -> np.ndarray:
 
 
 def measure_traffic(ticks: int, period_s: float, bitrate: int, seed: int) -> list[str]:
-    from simrig.rig import open_sim_rig
-
-    drives, rig = open_sim_rig(None, None, period_s, seed=seed)
+    channel = f"tsmd-bench-traffic-{os.getpid()}"
+    drives, rig = open_sim_rig(None, None, period_s, seed=seed, channel=channel)
+    # A third node on the lockstep channel sees every frame of the master and the drives,
+    # as a bus analyser would; it is read between ticks, outside the timed sections.
+    observer = LockstepBus(channel)
     try:
         drives.boot()
         drives.enable()
         tap = _Tap()
-        tap.wrap(drives.bus)
+        while observer.recv(0) is not None:  # boot traffic
+            pass
         q = _trajectory(ticks, period_s)
         per_tick: list[int] = []
         cpu_ns: list[int] = []
@@ -157,6 +150,7 @@ def measure_traffic(ticks: int, period_s: float, bitrate: int, seed: int) -> lis
             drives.feedback()
             c3 = clock()
             cpu_ns.append((c1 - c0) + (c3 - c2))
+            tap.drain(observer)
             per_tick.append(len(tap.frames) - before)
         frames = tap.frames
         heartbeat = [f for f in frames if 0x701 <= f[0] <= 0x77F]
@@ -169,6 +163,7 @@ def measure_traffic(ticks: int, period_s: float, bitrate: int, seed: int) -> lis
         cpu_us = np.array(cpu_ns) / 1e3
         events = drives.poll_events()
     finally:
+        observer.shutdown()
         drives.close()
         rig.close()
     return [
@@ -190,8 +185,6 @@ def measure_latency(ticks: int, period_s: float, seed: int) -> list[str]:
     frame when it is sent, so the figure is the rig's answer time, not the master's polling.
     The master runs as the daemon does: one tick per period, sleeping in between.
     """
-    from simrig.rig import open_sim_rig
-
     channel = f"tsmd-bench-latency-{os.getpid()}"
     drives, rig = open_sim_rig(_spring(), None, period_s, seed=seed,  # type: ignore[arg-type]
                                lockstep=False, channel=channel)
@@ -242,9 +235,6 @@ def measure_latency(ticks: int, period_s: float, seed: int) -> list[str]:
 
 
 def measure_speed(seconds: float, period_s: float, seed: int) -> list[str]:
-    from simrig.plant import load_plant
-    from simrig.rig import DEFAULT_PLANT, open_sim_rig
-
     ticks = round(seconds / period_s)
     q = _trajectory(ticks, period_s)
     lines = []

@@ -22,12 +22,20 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 
+from simrig.analysis import SweepAnalysisError, _rising_pass_measures, measure_dead_zone_backlash
+from tsmd.calibration import fast_protocol, paper_protocol
 from tsmd.calibration.assemble import KNOB_LABELS, GridPoint
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.identify import PARAMETERS, IdentifyOptions, split_half_cycles
 from tsmd.calibration.offline import SHORT
+from tsmd.calibration.run import finish, identify_recording, run_sweeps
 from tsmd.calibration.signal import lowpass
+from tsmd.config import default_sim_config, load_config, resolve_data_path
+from tsmd.profile import load_device_model
+from tsmd.replay import LockstepRunner
+from tsmd.tee import DEFAULT_STEPS_PER_KNOB_DEG, default_tee_dir, load_tee_acquisition
 
 TARGET_DEG = 2.0
 TIP_THRESHOLD_DEG = 1.0
@@ -66,8 +74,6 @@ def main(args: argparse.Namespace) -> int:
 
 def tip_truth(point: GridPoint) -> dict[str, float]:
     """D and B measured on the tracked tip of the sweep (the plant package's analysis)."""
-    from simrig.analysis import SweepAnalysisError, measure_dead_zone_backlash
-
     rec = point.recording
     if rec is None:
         return {}
@@ -101,18 +107,11 @@ def monotone_knob(cmd_deg: np.ndarray, pos_deg: np.ndarray) -> np.ndarray:
 
 
 def sim_protocol(name: str, seed: int, config_path: str | None) -> dict[str, Any]:
-    from tsmd.calibration import fast_protocol, paper_protocol
-    from tsmd.calibration.run import finish, identify_recording, run_sweeps
-    from tsmd.config import default_sim_config, load_config
-    from tsmd.daemon import resolve_data_path
-    from tsmd.profile import load_device_model
-    from tsmd.replay import LockstepRunner
-
     config = load_config(config_path) if config_path else default_sim_config()
     proto = paper_protocol() if name == "paper" else fast_protocol()
     t0, cpu0 = time.monotonic(), time.process_time()
     with LockstepRunner(config, seed=seed) as runner:
-        runs = run_sweeps(runner, proto, period_s=config.loop.period_s)
+        runs = run_sweeps(runner, proto)
     wall, cpu = time.monotonic() - t0, time.process_time() - cpu0
     verdict = "profile accepted by the quality checks"
     device_path = config.profiles.device_model or "profiles/devices/sim-catheter.yaml"
@@ -204,8 +203,6 @@ def compare_protocols(paper: Sequence[GridPoint], fast: Sequence[GridPoint]) -> 
     """The fast protocol's values, interpolated over the other knob's angle as a profile is
     (pchip), at every grid point of the paper protocol: against the paper protocol's values and
     against the tip measured in the paper protocol's sweeps."""
-    from scipy.interpolate import PchipInterpolator
-
     lines = ["| parameter | max abs(fast - paper) (deg) | mean (deg) | max abs(fast - tip) (deg) "
              "| fast within 2 deg of the tip |", "|---|---|---|---|---|"]
     truths = {(p.knob, p.other_deg): tip_truth(p) for p in paper}
@@ -239,8 +236,6 @@ def compare_protocols(paper: Sequence[GridPoint], fast: Sequence[GridPoint]) -> 
 
 def tee_tip_measures(point: GridPoint) -> dict[str, list[float]]:
     """Per pass on the tracked tip, with the plant analysis' threshold definitions."""
-    from simrig.analysis import _rising_pass_measures
-
     rec = point.recording
     assert rec is not None
     k = point.knob + 1
@@ -260,9 +255,6 @@ def tee_tip_measures(point: GridPoint) -> dict[str, list[float]]:
 
 
 def tee_table(directory: str | None) -> str:
-    from tsmd.calibration.run import identify_recording
-    from tsmd.tee import DEFAULT_STEPS_PER_KNOB_DEG, default_tee_dir, load_tee_acquisition
-
     root = Path(directory) if directory else default_tee_dir()
     files = sorted(root.glob("motor*_current60__*.csv")) if root.is_dir() else []
     if not files:

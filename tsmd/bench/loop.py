@@ -25,6 +25,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -33,9 +34,10 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import yaml
 from numpy.typing import NDArray
 
-from tsmd.config import default_sim_config
+from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.daemon import Daemon
 from tsmd.errors import TsmdError
 from tsmd.log import configure_logging
@@ -195,13 +197,6 @@ sys.exit(sim.main(parser.parse_args(sys.argv[1:])))
 
 def _start_rig_process(config: Any) -> subprocess.Popen[str]:
     """``tsmd sim`` on the bus of ``config``; returns once it serves the bus."""
-    import sys
-    import tempfile
-
-    import yaml
-
-    from tsmd.config import TsmdConfig
-
     assert isinstance(config, TsmdConfig)
     data = dataclasses.asdict(config)
     handle = tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False)  # noqa: SIM115

@@ -11,7 +11,6 @@ from tsmd.calibration.identify import IdentifyOptions, SweepResult, identify_swe
 from tsmd.calibration.protocol import Protocol, Sweep, fast_protocol, paper_protocol
 from tsmd.calibration.run import (
     Calibration,
-    TrajectoryRunner,
     calibrate,
     calibrate_from_recordings,
     identify_recording,
@@ -20,7 +19,7 @@ from tsmd.calibration.run import (
 
 __all__ = [
     "Calibration", "CalibrationCancelledError", "CalibrationError", "GridPoint", "IdentifyOptions",
-    "Protocol", "QualityLimits", "Sweep", "SweepResult", "TrajectoryRunner", "calibrate",
+    "Protocol", "QualityLimits", "Sweep", "SweepResult", "calibrate",
     "calibrate_from_recordings", "check_quality", "fast_protocol", "identify_recording",
     "identify_sweep", "paper_protocol", "run_calibration",
 ]

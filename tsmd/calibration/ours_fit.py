@@ -6,30 +6,24 @@ calibration hands it the current-only sweep arrays and what the paper's identifi
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
 
-if TYPE_CHECKING:
-    from tsmd.calibration.assemble import GridPoint
-    from tsmd.profile import DeviceModel
+from tsmd.calibration.assemble import GridPoint
+from tsmd.compensation.ours import OursParams, SweepData, fit_ours_knob
+from tsmd.profile import DeviceModel
 
 
-def fit_ours_for_knob(points: Sequence[GridPoint], device: DeviceModel, knob: int) -> Any:
-    """Call ``tsmd.compensation.ours.fit_ours_knob`` (None when this build has no such fit)."""
-    ours = importlib.import_module("tsmd.compensation.ours")
-    fit = getattr(ours, "fit_ours_knob", None)
-    sweep_data = getattr(ours, "SweepData", None)
-    if fit is None or sweep_data is None:
-        return None
+def fit_ours_for_knob(points: Sequence[GridPoint], device: DeviceModel, knob: int
+                      ) -> OursParams:
+    """``tsmd.compensation.ours.fit_ours_knob`` on the current-only data of the sweeps."""
     sweeps = []
     for p in sorted(points, key=lambda q: q.other_deg):
         d = p.result.data
-        sweeps.append(sweep_data(
+        sweeps.append(SweepData(
             t_s=d.t_s, cmd_deg=d.cmd_deg, pos_deg=d.pos_deg, current_A=d.current_A,
             other_knob_deg=float(p.other_deg),
             dead_zone_pos_deg=p.result.estimate("dead_zone_pos_deg"),
             dead_zone_neg_deg=p.result.estimate("dead_zone_neg_deg"),
             backlash_pos_deg=p.result.estimate("backlash_pos_deg"),
             backlash_neg_deg=p.result.estimate("backlash_neg_deg")))
-    return fit(sweeps, device.knobs[knob])
+    return fit_ours_knob(sweeps, device.knobs[knob])

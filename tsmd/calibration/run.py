@@ -17,7 +17,6 @@ import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
-from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,21 +43,11 @@ from tsmd.calibration.protocol import Sweep, paper_protocol, return_to_zero, swe
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
+from tsmd.trajectory import TrajectoryRunner
 
 ProgressCallback = Callable[[float, str], None]
 """Called with the overall fraction done (0..1) and a line such as
 ``"sweep 3/14: phi1 sweep, phi2 at -30 deg; 412 s left"``."""
-
-
-class TrajectoryRunner(Protocol):
-    """Contract 4 (the daemon's side): play a trajectory, one sample per loop tick, record it.
-
-    On cancel the runner stops early and returns what it recorded so far.
-    """
-
-    def run(self, t_s: NDArray[np.float64], q_deg: NDArray[np.float64], compensate: bool,
-            cancel: threading.Event | None,
-            progress: Callable[[float], None] | None) -> Recording: ...
 
 
 @dataclass
@@ -211,7 +200,7 @@ class SweepRuns:
 
 
 def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *,
-                    protocol: SweepProtocol | None = None, period_s: float = 0.004,
+                    protocol: SweepProtocol | None = None,
                     progress: ProgressCallback | None = None,
                     cancel: threading.Event | None = None,
                     options: IdentifyOptions | None = None,
@@ -224,15 +213,15 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
     proto = protocol or paper_protocol()
     proto.validate(tuple((k.limits.min_deg, k.limits.max_deg)  # type: ignore[arg-type]
                          for k in device.knobs))
-    runs = run_sweeps(runner, proto, period_s=period_s, progress=progress, cancel=cancel,
-                      options=options, isolate=isolate)
+    runs = run_sweeps(runner, proto, progress=progress, cancel=cancel, options=options,
+                      isolate=isolate)
     profile, report = finish(catheter_id, device, runs.points, limits=limits,
                              amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
     return Calibration(profile, runs.points, report, proto.name, proto.sweep_time_s,
                        runs.motion_time_s, runs.wall_time_s)
 
 
-def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *, period_s: float = 0.004,
+def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
                progress: ProgressCallback | None = None, cancel: threading.Event | None = None,
                options: IdentifyOptions | None = None, isolate: bool = False) -> SweepRuns:
     """Run and identify each sweep in turn; the knobs end at 0 whatever happens.
@@ -241,6 +230,7 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *, period_s: floa
     change-point search is pure Python and holds the GIL; in the daemon's process it delays a
     4 ms control loop by up to 11 ms (measured), so the live daemon must isolate it.
     """
+    period_s = runner.period_s  # sweeps are planned at the loop's own tick
     wall0 = time.monotonic()
     identifier = _Identifier(options, isolate)
     q_now = np.zeros(2)
@@ -347,7 +337,7 @@ class _Identifier:
 
 
 def calibrate(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *,
-              protocol: SweepProtocol | None = None, period_s: float = 0.004,
+              protocol: SweepProtocol | None = None,
               progress: ProgressCallback | None = None,
               cancel: threading.Event | None = None) -> CatheterProfile:
     """Contract 5: calibrate one catheter over a trajectory runner; the caller saves it.
@@ -355,7 +345,7 @@ def calibrate(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *
     Identification runs in a worker process (``isolate``), so that a live control loop in this
     process is never held up by it.
     """
-    return run_calibration(runner, catheter_id, device, protocol=protocol, period_s=period_s,
+    return run_calibration(runner, catheter_id, device, protocol=protocol,
                            progress=progress, cancel=cancel, isolate=True).profile
 
 

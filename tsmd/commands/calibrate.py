@@ -22,10 +22,18 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from tsmd.calibration import fast_protocol, paper_protocol, run_calibration
 from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.calibration.identify import IdentifyOptions
+from tsmd.calibration.offline import identification_table, read_sweep_file
+from tsmd.calibration.report import grid_table, write_report
+from tsmd.calibration.run import calibration_from_points, identify_recording
+from tsmd.config import default_sim_config, load_config, resolve_data_path
 from tsmd.errors import TsmdError
+from tsmd.profile import ProfileStore, load_device_model
+from tsmd.recording import write_recording
+from tsmd.replay import LockstepRunner
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -80,8 +88,6 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _config(args: argparse.Namespace, sim: bool) -> Any:
-    from tsmd.config import default_sim_config, load_config
-
     if args.config:
         return load_config(args.config)
     if sim:
@@ -90,23 +96,16 @@ def _config(args: argparse.Namespace, sim: bool) -> Any:
 
 
 def _device(args: argparse.Namespace, config: Any) -> Any:
-    from tsmd.profile import load_device_model
-
     path = args.device or getattr(config.profiles, "device_model", None)
     if path is None:
         raise TsmdError("no device model: pass --device FILE or set profiles.device_model")
-    from tsmd.daemon import resolve_data_path
 
     return load_device_model(resolve_data_path(str(path)))
 
 
 def _save(args: argparse.Namespace, config: Any, cal: Any) -> None:
-    from tsmd.profile import ProfileStore
-
     _print_result(cal)
     if args.report:
-        from tsmd.calibration.report import write_report
-
         index = write_report(cal, Path(args.report))
         print(f"report: {index}")
     if args.no_save:
@@ -120,8 +119,6 @@ def _save(args: argparse.Namespace, config: Any, cal: Any) -> None:
 
 
 def _print_result(cal: Any) -> None:
-    from tsmd.calibration.report import grid_table
-
     print(grid_table(cal))
     for warning in cal.quality.warnings:
         print(f"warning: {warning}")
@@ -162,9 +159,6 @@ class _Bar:
 
 
 def _sim(args: argparse.Namespace) -> int:
-    from tsmd.calibration import fast_protocol, paper_protocol, run_calibration
-    from tsmd.replay import LockstepRunner
-
     config = _config(args, sim=True)
     device = _device(args, config)
     protocol = fast_protocol() if args.fast else paper_protocol()
@@ -174,7 +168,7 @@ def _sim(args: argparse.Namespace) -> int:
     try:
         with LockstepRunner(config, seed=args.seed) as runner:
             cal = run_calibration(runner, args.catheter, device, protocol=protocol,
-                                  period_s=config.loop.period_s, progress=bar, cancel=cancel,
+                                  progress=bar, cancel=cancel,
                                   options=IdentifyOptions(edge=args.edge))
     except CalibrationRefusedError as exc:
         # A refused calibration's sweeps are what its user needs to see why.
@@ -191,8 +185,6 @@ def _sim(args: argparse.Namespace) -> int:
 
 
 def _write_sweeps(out: Path, points: Sequence[GridPoint]) -> None:
-    from tsmd.recording import write_recording
-
     out.mkdir(parents=True, exist_ok=True)
     for i, point in enumerate(points):
         if point.recording is not None:
@@ -201,9 +193,6 @@ def _write_sweeps(out: Path, points: Sequence[GridPoint]) -> None:
 
 
 def _from_recordings(args: argparse.Namespace) -> int:
-    from tsmd.calibration.offline import identification_table, read_sweep_file
-    from tsmd.calibration.run import calibration_from_points, identify_recording
-
     config = _config(args, sim=False) if args.config else None
     device = _device(args, config)
     options = IdentifyOptions(edge=args.edge)

@@ -13,13 +13,22 @@ from typing import Any
 
 import yaml
 
+from simrig.plant import load_plant
 from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
 from tsmd.gap.diagnose import GapConfig, diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
 from tsmd.gap.report import finite_json, write_report
-from tsmd.gap.selftest import BUILTIN_FIT_SPECS, BUILTIN_PLANT, EFFECTS, complete_knobs
+from tsmd.gap.selftest import (
+    BUILTIN_FIT_SPECS,
+    BUILTIN_PLANT,
+    EFFECTS,
+    complete_knobs,
+    run_selftest,
+    selftest_markdown,
+)
 from tsmd.recording import Recording, read_recording
+from tsmd.tee import load_tee_acquisition
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -95,8 +104,6 @@ def parse_fit_spec(text: str) -> ParamSpec:
 
 def _load_recording(path: str, tee: bool) -> GapSeries:
     if tee:
-        from tsmd.tee import load_tee_acquisition
-
         rec: Recording = load_tee_acquisition(path)
     else:
         rec = read_recording(path, required=("t",))
@@ -104,8 +111,6 @@ def _load_recording(path: str, tee: bool) -> GapSeries:
 
 
 def _factory(spec: str, fixed: dict[str, Any]) -> Any:
-    from simrig.plant import load_plant
-
     load_plant(spec, fixed)  # fail early, with the loader's message
 
     def factory(params: dict[str, Any]) -> Any:
@@ -144,8 +149,6 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _selftest(args: argparse.Namespace) -> int:
-    from tsmd.gap.selftest import run_selftest, selftest_markdown
-
     cases = [c.strip() for c in args.cases.split(",") if c.strip()]
     unknown = [c for c in cases if c not in EFFECTS]
     if unknown:

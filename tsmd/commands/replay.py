@@ -8,14 +8,24 @@ it the trajectory is played in real time on the drives of the configuration file
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
 
-from tsmd.config import DEFAULT_CONFIG_PATH, TsmdConfig, default_sim_config, load_config
+from tsmd.config import (
+    DEFAULT_CONFIG_PATH,
+    TsmdConfig,
+    default_sim_config,
+    load_config,
+    resolve_data_path,
+)
+from tsmd.daemon import Daemon
 from tsmd.errors import TsmdError
+from tsmd.profile import ProfileStore, load_profile
 from tsmd.recording import Recording, read_trajectory, write_recording
+from tsmd.replay import LiveTrajectoryRunner, run_trajectory
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -40,9 +50,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _profile(args: argparse.Namespace, config: TsmdConfig) -> Any:
-    from tsmd.daemon import resolve_data_path
-    from tsmd.profile import ProfileStore, load_profile
-
     if args.no_compensation:
         return None
     ident = args.profile or config.profiles.active
@@ -71,8 +78,6 @@ def main(args: argparse.Namespace) -> int:
     q = trajectory.columns
     q_deg = np.column_stack([q["q1"], q["q2"]])
     if args.sim:
-        from tsmd.replay import run_trajectory
-
         seed = config.sim.seed if args.seed is None else args.seed
         recording = run_trajectory(t_s, q_deg, config=config, profile=profile, method=method,
                                    seed=seed)
@@ -86,11 +91,6 @@ def main(args: argparse.Namespace) -> int:
 
 def _run_live(config: TsmdConfig, profile: Any, method: str, t_s: Any, q_deg: Any) -> Recording:
     """Real time on the configured drives, without opening the socket API."""
-    import dataclasses
-
-    from tsmd.daemon import Daemon
-    from tsmd.replay import LiveTrajectoryRunner
-
     config = dataclasses.replace(config, compensation=dataclasses.replace(
         config.compensation, method=cast(Any, method if method != "none" else "ours"),
         enabled=method != "none"))

@@ -14,6 +14,11 @@ import threading
 import time
 from types import FrameType
 
+import can
+
+from simrig.plant import load_plant
+from simrig.rig import SimRig
+from tsmd.config import default_sim_config, drive_configs, load_config
 from tsmd.errors import TsmdError
 
 
@@ -33,12 +38,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    import can
-
-    from simrig.plant import load_plant
-    from simrig.rig import SimRig
-    from tsmd.config import default_sim_config, drive_configs, load_config
-
     config = load_config(args.config) if args.config else default_sim_config()
     seed = config.sim.seed if args.seed is None else args.seed
     plant = load_plant(config.sim.plant, config.sim.params)

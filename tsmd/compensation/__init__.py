@@ -18,7 +18,12 @@ from numpy.typing import NDArray
 from tsmd.compensation.grid import ParameterField
 from tsmd.compensation.ours import OursCompensator, OursKnob
 from tsmd.compensation.paper import PaperCompensator, PaperKnob
-from tsmd.compensation.safety import KnobLimits, LimiterState, limit_step
+from tsmd.compensation.safety import (
+    DEFAULT_MAX_ACCEL_DEG_S2,
+    DEFAULT_MAX_VELOCITY_DEG_S,
+    KnobLimiter,
+    KnobLimits,
+)
 from tsmd.errors import TsmdError
 
 if TYPE_CHECKING:
@@ -30,6 +35,7 @@ __all__ = [
     "METHODS",
     "CompensationError",
     "Compensator",
+    "KnobLimiter",
     "KnobLimits",
     "LimitedCompensator",
     "NoCompensation",
@@ -69,16 +75,18 @@ class NoCompensation:
 
 
 class LimitedCompensator:
-    """Any compensator followed by the position/velocity/acceleration limiter per knob."""
+    """Any compensator followed by the knob limiter (offline use: the loop limits by itself)."""
 
     def __init__(self, inner: Compensator, limits: Sequence[KnobLimits], period_s: float) -> None:
         if len(limits) != 2:
             raise CompensationError(f"need limits for 2 knobs, got {len(limits)}")
         self.inner = inner
-        self.limits = tuple(limits)
-        self.period_s = period_s
-        self._states = [LimiterState(0.0) for _ in self.limits]
+        self.limiter = KnobLimiter(limits, period_s)
         self.last_unlimited = np.zeros(2)
+
+    @property
+    def limits(self) -> tuple[KnobLimits, ...]:
+        return self.limiter.limits
 
     def reset(self, q_deg: NDArray[np.float64]) -> None:
         self.inner.reset(q_deg)
@@ -87,14 +95,12 @@ class LimitedCompensator:
         self.inner.reset(q_deg)
         first = [lim.clip(float(x)) if np.isfinite(x) else 0.0
                  for x, lim in zip(start, self.limits, strict=True)]
-        self._states = [LimiterState(x, 0.0, x) for x in first]
+        self.limiter.reset(np.array(first), hold=True)
 
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         raw = self.inner.command(q_deg)
         self.last_unlimited = np.asarray(raw, dtype=float).copy()
-        self._states = [limit_step(s, float(x), lim, self.period_s)
-                        for s, x, lim in zip(self._states, raw, self.limits, strict=True)]
-        return np.array([s.q_deg for s in self._states])
+        return self.limiter.limit(raw)
 
 
 def paper_compensator(profile: CatheterProfile) -> PaperCompensator:
@@ -105,8 +111,8 @@ def paper_compensator(profile: CatheterProfile) -> PaperCompensator:
 
 
 def ours_compensator(profile: CatheterProfile, period_s: float,
-                     max_velocity_deg_s: float = 120.0,
-                     max_accel_deg_s2: float = 2000.0) -> OursCompensator:
+                     max_velocity_deg_s: float = DEFAULT_MAX_VELOCITY_DEG_S,
+                     max_accel_deg_s2: float = DEFAULT_MAX_ACCEL_DEG_S2) -> OursCompensator:
     knobs = []
     for name, k in zip(("phi1", "phi2"), profile.knobs, strict=True):
         if k.ours is None:
@@ -152,8 +158,9 @@ def build_compensator(profile: CatheterProfile | None, method: str, period_s: fl
         inner = paper_compensator(profile)
     else:
         # the motor's limits set when a jump must start; the simulated rig's when not given
-        v_max = min(lim.max_velocity_deg_s for lim in limits) if limits else 120.0
-        a_max = min(lim.max_accel_deg_s2 for lim in limits) if limits else 2000.0
+        v_max = (min(lim.max_velocity_deg_s for lim in limits) if limits
+                 else DEFAULT_MAX_VELOCITY_DEG_S)
+        a_max = min(lim.max_accel_deg_s2 for lim in limits) if limits else DEFAULT_MAX_ACCEL_DEG_S2
         inner = ours_compensator(profile, period_s, v_max, a_max)
     if limits is None or not apply_limits:
         return inner

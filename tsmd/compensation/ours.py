@@ -35,7 +35,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
-from tsmd.compensation.safety import KnobLimits, LimiterState, limit_step
+from tsmd.compensation.safety import (
+    DEFAULT_MAX_ACCEL_DEG_S2,
+    DEFAULT_MAX_VELOCITY_DEG_S,
+    KnobLimits,
+    LimiterState,
+    limit_step,
+)
 
 _TABLE_X_DEG = np.linspace(-200.0, 200.0, 1601)
 _FLAT_SLOPE = 1e-6  # makes the envelopes strictly increasing so that they can be inverted
@@ -325,7 +331,8 @@ class OursCompensator:
     """
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,
-                 max_velocity_deg_s: float = 120.0, max_accel_deg_s2: float = 2000.0,
+                 max_velocity_deg_s: float = DEFAULT_MAX_VELOCITY_DEG_S,
+                 max_accel_deg_s2: float = DEFAULT_MAX_ACCEL_DEG_S2,
                  smoothing_s: float = 0.1) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be positive, got {period_s}")

@@ -9,7 +9,16 @@ its speed never exceeds ``max_velocity_deg_s`` and its speed changes by at most
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+DEFAULT_MAX_VELOCITY_DEG_S = 120.0
+"""Knob speed limit when the configuration does not say (the simulated rig's data sheet)."""
+DEFAULT_MAX_ACCEL_DEG_S2 = 2000.0
+"""Knob acceleration limit when the configuration does not say."""
 
 
 @dataclass(frozen=True)
@@ -75,3 +84,30 @@ def limit_step(state: LimiterState, target_deg: float, limits: KnobLimits,
         q = limits.clip(q)
         v = (q - state.q_deg) / dt_s
     return LimiterState(q, v, target)
+
+
+class KnobLimiter:
+    """The limiter of both knobs, stateful: :func:`limit_step` once per knob and tick.
+
+    The one limiter of tsmd: the control loop applies it last, and
+    :class:`tsmd.compensation.LimitedCompensator` puts it behind a compensator offline.
+    """
+
+    def __init__(self, limits: Sequence[KnobLimits], dt_s: float) -> None:
+        if len(limits) != 2:
+            raise ValueError(f"need limits for 2 knobs, got {len(limits)}")
+        if not dt_s > 0:
+            raise ValueError(f"dt_s must be positive, got {dt_s}")
+        self.limits = tuple(limits)
+        self.dt_s = dt_s
+        self._states = [LimiterState(0.0) for _ in self.limits]
+
+    def reset(self, cmd_deg: NDArray[np.float64], *, hold: bool = False) -> None:
+        """Stand still at ``cmd_deg``; ``hold``: also take it as the last target (no jump)."""
+        self._states = [LimiterState(float(q), 0.0, float(q) if hold else None)
+                        for q in cmd_deg]
+
+    def limit(self, cmd_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+        self._states = [limit_step(s, float(c), lim, self.dt_s)
+                        for s, c, lim in zip(self._states, cmd_deg, self.limits, strict=True)]
+        return np.array([s.q_deg for s in self._states])

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import signal
 
-from simrig.plant import Plant
+from simrig.plant import Plant, as_plant_step
 
 PlantFactory = Callable[[dict[str, Any]], Plant]
 """Builds a fresh plant from the base parameters being fitted (the others are fixed)."""
@@ -30,7 +30,7 @@ def simulate(plant: Plant, t_s: NDArray[np.float64],
     dt = np.diff(t_s, prepend=t_s[0] - (t_s[1] - t_s[0] if n > 1 else 0.01))
     step = plant.step
     for k in range(n):
-        out = step(float(dt[k]), knob_deg[k])
+        out = as_plant_step(step(float(dt[k]), knob_deg[k]))
         tip[k] = out.tip_deg
         torque[k] = out.knob_torque_Nm
     return tip, torque

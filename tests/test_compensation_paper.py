@@ -13,11 +13,13 @@ from tsmd.compensation.paper import (
     Line,
     ModelState,
     PaperParams,
+    falling_branch,
     height_from_reference,
     initial_state,
     inverse_step,
     model_step,
     rest_state,
+    rising_branch,
 )
 
 # Hand-worked: D = +-20, B = 15, H = 0, omega = 1.3 -> D_hat_pos = -5, D_hat_neg = 5.
@@ -183,8 +185,6 @@ def test_model_output_is_continuous_in_the_input(p: PaperParams, x0: float, x1: 
 @settings(max_examples=100, deadline=None)
 @given(params, steps)
 def test_rising_branch_never_above_falling_branch(p: PaperParams, deltas: list[float]) -> None:
-    from tsmd.compensation.paper import falling_branch, rising_branch
-
     for x in np.clip(np.cumsum(deltas), -100, 100):
         assert rising_branch(float(x), p)[0] <= falling_branch(float(x), p)[0]
 

@@ -7,7 +7,7 @@ import time
 import can
 import numpy as np
 import pytest
-from drive_support import SpringPlant
+from support.plants import SpringPlant
 
 from drivers.canopen_master import CanOpenDrives
 from drivers.drive import DriveError, DriveState, FaultKind

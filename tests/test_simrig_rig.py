@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from drive_support import SpringPlant
+from support.plants import PairPlant, SpringPlant
 
 from drivers.drive import DriveState
 from drivers.units import DriveConfig
-from simrig.rig import open_sim_rig
+from simrig.plant import PlantOutputError, as_plant_step
+from simrig.plants.capstan.tendon_sheath import TendonSheathPlant
+from simrig.rig import IdealCurrentSensor, open_sim_rig
 
 PERIOD_S = 0.004
 
@@ -143,8 +145,6 @@ def test_replay_depends_on_the_seed_only_through_the_sensor_noise():
 
 
 def test_default_plant_is_the_tendon_sheath_physics():
-    from simrig.plants.capstan.tendon_sheath import TendonSheathPlant
-
     drives, rig = open_sim_rig(None, None, PERIOD_S, seed=0)
     try:
         assert isinstance(rig.plant, TendonSheathPlant)
@@ -194,8 +194,6 @@ def test_segmented_sdo_upload_reads_the_device_name(rig_pair):
 
 
 def test_feedback_is_in_knob_degrees_and_amperes_within_one_raw_unit():
-    from simrig.rig import IdealCurrentSensor
-
     drives, rig = open_sim_rig(SpringPlant(), None, PERIOD_S, seed=0,
                                rig_kwargs={"sensors": [IdealCurrentSensor(),
                                                        IdealCurrentSensor()]})
@@ -210,3 +208,27 @@ def test_feedback_is_in_knob_degrees_and_amperes_within_one_raw_unit():
     finally:
         drives.close()
         rig.close()
+
+
+def test_a_plant_answering_a_plain_pair_drives_the_rig_like_its_plantstep_twin() -> None:
+    q = sine(300)
+    results = []
+    for plant in (SpringPlant(), PairPlant()):
+        drives, rig = open_sim_rig(plant, None, PERIOD_S, seed=3)
+        try:
+            drives.boot()
+            drives.enable()
+            pos = run(drives, rig, q)
+            results.append((pos, rig.tip_deg(), [f.current_A for f in drives.feedback()]))
+        finally:
+            drives.close()
+            rig.close()
+    (pos_a, tip_a, cur_a), (pos_b, tip_b, cur_b) = results
+    assert np.array_equal(pos_a, pos_b)
+    assert np.array_equal(tip_a, tip_b) and cur_a == cur_b
+
+
+@pytest.mark.parametrize("answer", [None, (1.0, 2.0), ([1.0, 2.0, 3.0], [0.0, 0.0]), "ab"])
+def test_a_plant_answer_that_is_neither_plantstep_nor_pair_is_named(answer: object) -> None:
+    with pytest.raises(PlantOutputError, match="PlantStep or a pair"):
+        as_plant_step(answer)  # type: ignore[arg-type]

@@ -6,7 +6,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from drive_support import SpringPlant
+from support.plants import SpringPlant
 
 from drivers.drive import DriveState
 from simrig.rig import open_sim_rig

@@ -4,9 +4,9 @@ events (master) or are ignored / answered with an SDO abort (drive)."""
 from __future__ import annotations
 
 import can
-from drive_support import SpringPlant
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from support.plants import SpringPlant
 
 from drivers.drive import DriveError, FaultKind
 from simrig.rig import open_sim_rig

@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import itertools
 
+import can
 import canopen
 import pytest
 from canopen.profiles.p402 import BaseNode402
-from drive_support import SpringPlant
+from support.plants import SpringPlant
 
 from drivers.od import EDS_PATH
 from drivers.units import DriveConfig
@@ -24,7 +25,6 @@ _CHANNEL = itertools.count()
 @pytest.fixture()
 def canopen_node():
     channel = f"tsmd-402-{next(_CHANNEL)}"
-    import can
 
     rig = SimRig(can.Bus(interface="virtual", channel=channel), SpringPlant(),
                  [DriveConfig(node_id=1), DriveConfig(node_id=2)], PERIOD_S, lockstep=False)

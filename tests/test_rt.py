@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from tsmd.rt import FixedRateScheduler, apply_realtime
+from tsmd.rt import FixedRateScheduler, apply_realtime, set_normal_scheduling
 
 
 def test_ticks_follow_absolute_deadlines_without_drift() -> None:
@@ -77,8 +77,6 @@ def test_realtime_settings_that_are_refused_become_warnings() -> None:
 
 
 def test_normal_scheduling_can_always_be_restored() -> None:
-    from tsmd.rt import set_normal_scheduling
-
     results: list[object] = []
     thread = threading.Thread(target=lambda: results.append(set_normal_scheduling()))
     thread.start()

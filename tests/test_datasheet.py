@@ -1,0 +1,103 @@
+"""`tsmd datasheet` (tsmd.datasheet): a tracked unit's sweeps give its data sheet; bad input is
+one line. The simulator path is the same analysis on a recording of the full stack."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from support.calibration import LockstepPlantRunner
+from support.profiles import DEVICE
+
+from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
+from tsmd.cli import main
+from tsmd.datasheet import CONDITIONING_CYCLES, analysed_from, settle, tip_sweep
+from tsmd.profile import load_device_model
+from tsmd.recording import Recording, write_recording
+
+PERIOD_S = 0.01
+
+
+def tracked_sweep(knob: int) -> Recording:
+    """A conditioned +-90 deg sweep of ``knob`` on the built-in plant, tip tracked."""
+    runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S, seed=knob)
+    t, q, skip = settle(*tip_sweep(knob, 0.0, PERIOD_S), PERIOD_S)
+    rec = runner.run(t, q)
+    first = analysed_from(skip, PERIOD_S)
+    return Recording({k: v[first:] for k, v in rec.columns.items()}, rec.metadata)
+
+
+@pytest.fixture(scope="module")
+def sweep_files(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+    out = []
+    for knob in (0, 1):
+        path = tmp_path_factory.mktemp("sweeps") / f"sweep-phi{knob + 1}.csv"
+        write_recording(path, tracked_sweep(knob))
+        out.append(path)
+    return out
+
+
+def test_tracked_sweeps_give_the_plants_data_sheet(sweep_files: list[Path], tmp_path: Path,
+                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "device.yaml"
+    code = main(["datasheet", "--from-recording", *map(str, reversed(sweep_files)),
+                 "--device-model", "unit-7", "--out", str(out),
+                 "--config", str(Path(__file__).parents[1] / "tsmd" / "data" / "sim.yaml")])
+    assert code == 0, capsys.readouterr().err
+    measured = load_device_model(out)
+    shipped = load_device_model(DEVICE)  # measured on the full simulated stack
+    assert measured.device_model == "unit-7"
+    for got, ref in zip(measured.knobs, shipped.knobs, strict=True):
+        assert got.omega == pytest.approx(ref.omega, abs=0.1)
+        assert got.reference_pos.tip_deg == pytest.approx(ref.reference_pos.tip_deg, abs=3.0)
+        assert got.reference_neg.tip_deg == pytest.approx(ref.reference_neg.tip_deg, abs=3.0)
+        assert got.reference_backlash_pos_deg == pytest.approx(ref.reference_backlash_pos_deg,
+                                                               abs=3.0)
+        assert got.limits == ref.limits
+
+
+def test_a_recording_without_tip_angles_is_refused_in_one_line(
+        sweep_files: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rec = tracked_sweep(0)
+    rec.columns["tip1"] = np.full(len(rec), np.nan)
+    rec.columns["tip2"] = np.full(len(rec), np.nan)
+    bare = tmp_path / "no-tip.csv"
+    write_recording(bare, rec)
+    code = main(["datasheet", "--from-recording", str(bare), str(sweep_files[1]),
+                 "--device-model", "x", "--out", str(tmp_path / "d.yaml")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert "no-tip.csv" in err and "tip" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "d.yaml").exists()
+
+
+def test_two_sweeps_of_the_same_knob_are_refused(
+        sweep_files: list[Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["datasheet", "--from-recording", str(sweep_files[0]), str(sweep_files[0]),
+                 "--device-model", "x", "--out", str(tmp_path / "d.yaml")])
+    assert code == 2
+    assert "second sweep of knob 1" in capsys.readouterr().err
+
+
+def test_plant_parameters_must_be_a_json_object(tmp_path: Path,
+                                                capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["datasheet", "--plant", "simrig.plants.capstan:make_tendon_sheath_plant",
+                 "--params", "[1, 2]", "--device-model", "x", "--out", str(tmp_path / "d.yaml")])
+    assert code == 2
+    assert "--params" in capsys.readouterr().err
+
+
+def test_tip_measurements_skip_the_conditioning_cycle() -> None:
+    """Data-sheet sweeps analyse 2.25 cycles of +-90 deg after the plant has been through
+    every state once (its tension-free start is not the product's behaviour)."""
+    assert CONDITIONING_CYCLES >= 1.0
+    t, q = tip_sweep(1, 30.0, PERIOD_S)
+    _, qq, skip = settle(t, q, PERIOD_S)
+    first = analysed_from(skip, PERIOD_S)
+    before, after = qq[skip:first, 1], qq[first:, 1]
+    assert before.min() == pytest.approx(-90.0, abs=0.01)
+    assert before.max() == pytest.approx(90.0, abs=0.01)
+    assert after.size * PERIOD_S == pytest.approx(2.25 / 0.04, abs=2 * PERIOD_S)
+    assert abs(after[0]) < 0.1 and after[1] > after[0]  # the same start as without conditioning
+    assert np.all(qq[skip:, 0] == 30.0)  # the other knob held (reached during the settle move)

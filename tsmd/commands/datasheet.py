@@ -1,0 +1,110 @@
+"""`tsmd datasheet`: measure a device's data sheet and write the device YAML.
+
+``--plant module:factory [--params JSON]``: on the simulated rig, tip tracked by the simulated
+EM tracker. ``--from-recording FILE...``: from a tracked real unit, one +-90 deg sweep recording
+per knob (the recording format of docs/recording-format.md, with tip columns).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from simrig.plant import Plant, load_plant
+from tsmd import __version__
+from tsmd.config import DEFAULT_CONFIG_PATH, default_sim_config, load_config
+from tsmd.datasheet import (
+    CONDITIONING_CYCLES,
+    SWEEP_AMPLITUDE_DEG,
+    SWEEP_HZ,
+    DatasheetError,
+    KnobConstants,
+    device_model,
+    knob_constants,
+    measure_device_constants,
+    swept_knob,
+)
+from tsmd.profile import save_device_model
+from tsmd.recording import read_recording
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--plant", metavar="MODULE:FACTORY",
+                        help="measure on the simulated rig with this plant")
+    source.add_argument("--from-recording", nargs="+", metavar="FILE",
+                        help="a tracked real unit's sweep recordings, one per knob")
+    parser.add_argument("--params", metavar="JSON", help="the plant factory's keyword parameters")
+    parser.add_argument("--device-model", required=True, metavar="NAME",
+                        help="the catheter type's name in the data sheet")
+    parser.add_argument("--description", default="", help="one line describing the device")
+    parser.add_argument("--out", required=True, metavar="FILE", help="device YAML to write")
+    parser.add_argument("--config", metavar="FILE",
+                        help=f"configuration whose limits go into the data sheet (default: "
+                             f"packaged sim config with --plant, else {DEFAULT_CONFIG_PATH})")
+    parser.add_argument("--seed", type=int, default=2000, help="simulated rig's noise seed")
+
+
+def _params(text: str | None) -> dict[str, Any]:
+    if text is None:
+        return {}
+    try:
+        params = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise DatasheetError(f"--params: not JSON: {exc.msg}") from None
+    if not isinstance(params, dict):
+        raise DatasheetError("--params: must be a JSON object of plant parameters")
+    return params
+
+
+def _from_recordings(paths: list[str]) -> list[KnobConstants]:
+    by_knob: dict[int, KnobConstants] = {}
+    for path in paths:
+        rec = read_recording(path)
+        knob = swept_knob(rec)
+        if knob in by_knob:
+            raise DatasheetError(f"{path}: a second sweep of knob {knob + 1}; give one per knob")
+        try:
+            by_knob[knob] = knob_constants(rec, knob)
+        except DatasheetError as exc:
+            raise DatasheetError(f"{path}: {exc}") from None
+    missing = [k + 1 for k in (0, 1) if k not in by_knob]
+    if missing:
+        raise DatasheetError(f"no sweep of knob {missing[0]} among the recordings")
+    return [by_knob[0], by_knob[1]]
+
+
+def main(args: argparse.Namespace) -> int:
+    if args.params is not None and args.plant is None:
+        raise DatasheetError("--params goes with --plant")
+    if args.plant is not None:
+        config = load_config(args.config) if args.config is not None else default_sim_config()
+        params = _params(args.params)
+        load_plant(args.plant, params)  # fail early, with the loader's message
+
+        def factory() -> Plant:
+            return load_plant(args.plant, params)
+
+        constants = measure_device_constants(factory, args.seed, config)
+        source = (f"the simulated rig, plant {args.plant} with {json.dumps(params)}, seed "
+                  f"{args.seed}")
+    else:
+        constants = _from_recordings(args.from_recording)
+        config = load_config(args.config if args.config is not None else DEFAULT_CONFIG_PATH)
+        source = "recordings " + ", ".join(Path(p).name for p in args.from_recording)
+    device = device_model(args.device_model, constants, config, args.description)
+    comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "
+               f"(tsmd datasheet) on {source}:\n"
+               f"each knob swept +-{SWEEP_AMPLITUDE_DEG:g} deg at {SWEEP_HZ:g} Hz, other knob "
+               f"at 0 deg, analysed after {CONDITIONING_CYCLES:g} conditioning cycle(s); tip "
+               f"from the tracker.\nLimits: limits.* of the configuration.")
+    save_device_model(device, args.out, comment)
+    for name, c in zip(("phi1", "phi2"), constants, strict=True):
+        print(f"{name}: omega {c.omega:.2f}, release_omega {c.release_omega:.2f}, reference "
+              f"tip {c.reference_pos.tip_deg:.2f}/{c.reference_neg.tip_deg:.2f} deg, backlash "
+              f"{c.reference_backlash_pos_deg:.2f}/{c.reference_backlash_neg_deg:.2f} deg, "
+              f"dead-zone offset {c.dead_zone_offset_deg:.2f} deg")
+    print(f"tsmd datasheet: wrote {args.out}")
+    return 0

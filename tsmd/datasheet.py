@@ -1,0 +1,181 @@
+"""A device's data sheet, measured as a manufacturer would: once per product, tracker on the tip.
+
+The paper's design assumptions 1-3 give each catheter type constants that calibration does not
+identify from current: the loaded tip/knob slope omega and two reference points. Our compensator
+adds the release slope, the backlash on the tip after the reversals at the reference points and
+how far beyond the current's dead-zone edge the tip leaves the plateau. All come from a +-90 deg,
+0.04 Hz sweep of each knob (other knob at 0 deg) with the tip tracked: on the simulator
+(:func:`measure_device_constants`) or on a tracked real unit's recordings (:func:`knob_constants`
+on each). The tip is used here only: this is the manufacturer's bench, not the robot.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from simrig.analysis import measure_dead_zone_backlash, split_passes
+from simrig.plant import Plant
+from tsmd.calibration.identify import identify_sweep
+from tsmd.compensation.safety import KnobLimits
+from tsmd.config import TsmdConfig, default_sim_config
+from tsmd.errors import TsmdError
+from tsmd.profile import DeviceKnob, DeviceModel, ReferencePoint
+from tsmd.recording import Recording
+from tsmd.replay import run_trajectory
+from tsmd.stack import knob_limits
+
+SWEEP_HZ = 0.04
+SWEEP_AMPLITUDE_DEG = 90.0
+ANALYSED_CYCLES = 2.25
+CONDITIONING_CYCLES = 1.0
+"""Sweep cycles run before a tip measurement is analysed. The plant starts tension-free
+(virgin): its first release rests higher and its first engagement of the antagonist comes
+later (phi1: plateau 16 instead of 5 deg, D_neg -15 instead of -22 deg on the tip), which a
+product's data sheet must not average in; the calibration protocol conditions likewise."""
+LOADED_FIT_DEG = (40.0, 85.0)
+"""Knob range where the loaded branch is fitted for omega (mirrored for falling passes)."""
+RELEASED_FIT_DEG = (35.0, 65.0)
+"""Knob range where the releasing branch is fitted for release_omega."""
+TIP_THRESHOLD_DEG = 1.0
+REFERENCE_BAND_DEG = 0.5
+"""Samples within this of the knob's turning point give the reference tip angle."""
+
+
+class DatasheetError(TsmdError):
+    """The data sheet cannot be measured from this input (no tip, no sweep, too short)."""
+
+
+@dataclass(frozen=True)
+class KnobConstants:
+    """One knob's data-sheet constants as measured (before limits are attached)."""
+
+    omega: float
+    release_omega: float
+    reference_pos: ReferencePoint
+    reference_neg: ReferencePoint
+    reference_backlash_pos_deg: float
+    reference_backlash_neg_deg: float
+    dead_zone_offset_deg: float
+
+    def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
+        """The data sheet's knob entry, rounded as a data sheet is printed."""
+        def r(x: float) -> float:
+            return round(float(x), decimals)
+
+        return DeviceKnob(
+            r(self.omega), ReferencePoint(r(self.reference_pos.knob_deg),
+                                          r(self.reference_pos.tip_deg)),
+            ReferencePoint(r(self.reference_neg.knob_deg), r(self.reference_neg.tip_deg)),
+            limits, release_omega=r(self.release_omega),
+            reference_backlash_pos_deg=r(self.reference_backlash_pos_deg),
+            reference_backlash_neg_deg=r(self.reference_backlash_neg_deg),
+            dead_zone_offset_deg=r(self.dead_zone_offset_deg))
+
+
+def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,
+           move_s: float = 2.0) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
+    """Prepend a smooth move from 0 to the first sample and a rest, like an operator would.
+
+    Returns the times, the angles and the index of the trajectory's first own sample.
+    """
+    n_move = round(move_s / period_s)
+    s = 0.5 - 0.5 * np.cos(np.linspace(0.0, math.pi, n_move))
+    pre = s[:, None] * q_deg[0][None, :]
+    rest = np.repeat(q_deg[:1], round(0.5 / period_s), axis=0)
+    head = np.vstack([pre, rest])
+    tt = np.arange(len(head) + len(t_s)) * period_s
+    full: NDArray[np.float64] = np.vstack([head, q_deg]).astype(float)
+    return tt.astype(float), full, len(head)
+
+
+def tip_sweep(knob: int, other_deg: float, period_s: float
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A +-90 deg, 0.04 Hz sweep of ``knob`` (2.25 cycles after the conditioning cycles)."""
+    t = np.arange(0.0, (CONDITIONING_CYCLES + ANALYSED_CYCLES) / SWEEP_HZ, period_s)
+    q = np.zeros((t.size, 2))
+    q[:, knob] = SWEEP_AMPLITUDE_DEG * np.sin(2 * math.pi * SWEEP_HZ * t)
+    q[:, 1 - knob] = other_deg
+    return t, q
+
+
+def analysed_from(skip: int, period_s: float) -> int:
+    """First sample of a :func:`tip_sweep` run (after :func:`settle`) that is analysed."""
+    return skip + round(CONDITIONING_CYCLES / SWEEP_HZ / period_s)
+
+
+def swept_knob(rec: Recording) -> int:
+    """Which knob a sweep recording moves (0: phi1, 1: phi2): the one with the wider travel."""
+    spans = [float(np.ptp(rec[f"pos{k + 1}"])) if len(rec) else 0.0 for k in (0, 1)]
+    return int(np.argmax(spans))
+
+
+def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
+    """The data-sheet constants of ``knob`` from a tracked sweep, analysed from row ``start``."""
+    if not rec.has_tip:
+        raise DatasheetError("the recording has no tip angles (tip1, tip2): a data sheet "
+                             "needs a tracker on the tip")
+    t = rec["t"][start:]
+    pos = rec[f"pos{knob + 1}"][start:]
+    tip = rec[f"tip{knob + 1}"][start:]
+    if not np.all(np.isfinite(tip)):
+        raise DatasheetError(f"tip{knob + 1} has missing values in the analysed rows")
+    if pos.size < 100 or pos.max() < SWEEP_AMPLITUDE_DEG - REFERENCE_BAND_DEG \
+            or pos.min() > -SWEEP_AMPLITUDE_DEG + REFERENCE_BAND_DEG:
+        raise DatasheetError(f"knob {knob + 1} does not sweep +-{SWEEP_AMPLITUDE_DEG:g} deg in "
+                             f"the analysed rows (range {pos.min():.1f}..{pos.max():.1f} deg)")
+    dz = measure_dead_zone_backlash(pos, tip, threshold_deg=TIP_THRESHOLD_DEG)
+    # where the calibration's current analysis puts the edges on the same sweep
+    cur = identify_sweep(t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:])
+    dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
+                       + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
+    loaded, released = [], []
+    for a, b, direction in split_passes(pos):
+        x, y = direction * pos[a:b], direction * tip[a:b]  # mirror falling passes
+        # loaded: moving out of the dead zone; released: moving back towards it
+        sel_l = (x >= LOADED_FIT_DEG[0]) & (x <= LOADED_FIT_DEG[1])
+        if np.count_nonzero(sel_l) > 10:
+            loaded.append(float(np.polyfit(x[sel_l], y[sel_l], 1)[0]))
+        xr, yr = -x, -y  # the same pass seen as releasing the other side's tendon
+        sel_r = (xr >= RELEASED_FIT_DEG[0]) & (xr <= RELEASED_FIT_DEG[1])
+        if np.count_nonzero(sel_r) > 10:
+            released.append(float(np.polyfit(xr[sel_r], yr[sel_r], 1)[0]))
+    if not loaded or not released:
+        raise DatasheetError(f"knob {knob + 1}: no complete pass to fit the tip/knob slopes")
+    top = SWEEP_AMPLITUDE_DEG - REFERENCE_BAND_DEG
+    return KnobConstants(
+        omega=float(np.median(loaded)), release_omega=float(np.median(released)),
+        reference_pos=ReferencePoint(SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos > top]))),
+        reference_neg=ReferencePoint(-SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos < -top]))),
+        reference_backlash_pos_deg=float(dz.backlash_pos_deg),
+        reference_backlash_neg_deg=float(dz.backlash_neg_deg),
+        dead_zone_offset_deg=float(dz_offset))
+
+
+def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 2000,
+                             config: TsmdConfig | None = None) -> list[KnobConstants]:
+    """Both knobs' constants on the simulated rig: each knob swept through the full stack
+    (uncompensated, other knob at 0), analysed after ``CONDITIONING_CYCLES``."""
+    cfg = config if config is not None else default_sim_config()
+    period_s = cfg.loop.period_s
+    out = []
+    for knob in (0, 1):
+        t, q, skip = settle(*tip_sweep(knob, 0.0, period_s), period_s)
+        rec = run_trajectory(t, q, config=cfg, profile=None, method="none", seed=seed,
+                             plant=plant_factory())
+        out.append(knob_constants(rec, knob, analysed_from(skip, period_s)))
+    return out
+
+
+def device_model(name: str, constants: Sequence[KnobConstants], config: TsmdConfig,
+                 description: str = "") -> DeviceModel:
+    """The data sheet: measured constants with the knobs' limits of ``config``."""
+    if len(constants) != 2:
+        raise DatasheetError(f"need the constants of 2 knobs, got {len(constants)}")
+    limits = knob_limits(config)
+    knobs = tuple(c.device_knob(lim) for c, lim in zip(constants, limits, strict=True))
+    return DeviceModel(name, (knobs[0], knobs[1]), description)

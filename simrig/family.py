@@ -81,7 +81,7 @@ SCATTER: dict[str, dict[str, float]] = {
 }
 """Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""
 
-_NOMINAL = {"capstan": CAPSTAN_KNOBS, "lumped": LUMPED_KNOBS}
+_NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMPED_KNOBS}
 
 
 @dataclass(frozen=True)

@@ -107,7 +107,8 @@ def torque_signature(knob_deg: FloatArray, tip_deg: FloatArray, torque_Nm: Float
     second = t_s >= period
     peak = float(np.max(np.abs(torque_Nm[second])))
     up = np.gradient(knob_deg) > 0
-    dz = second & up & (knob_deg > m.dead_zone_neg_deg + 3.0) & (knob_deg < m.dead_zone_pos_deg - 3.0)
+    inside = (knob_deg > m.dead_zone_neg_deg + 3.0) & (knob_deg < m.dead_zone_pos_deg - 3.0)
+    dz = second & up & inside
     dz_tau = torque_Nm[dz]
     flat = float(np.ptp(np.percentile(dz_tau, [10, 90]))) / peak if dz_tau.size else math.nan
     dz_level = float(np.median(dz_tau)) if dz_tau.size else math.nan

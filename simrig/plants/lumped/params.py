@@ -100,9 +100,9 @@ class LumpedEffects:
     coupling_lumen_angle_deg: float = 10.0
     """Angular misplacement of the tendon lumens: bending the other plane lengthens one tendon's
     path and shortens the other's (shifts the dead zone)."""
-    coupling_bend_length_mm: float = 40.0
-    """Length of the bending section: bent in the other plane, its chord shortens and both
-    tendons gain slack ``L (1 - sin(x)/x)``-like (widens the dead zone)."""
+    coupling_compression_mm_per_N: float = 0.03
+    """Axial compliance of the coil sheath: the other pair's tension compresses it, which
+    shortens this pair's path, i.e. adds slack to both tendons (widens the dead zone)."""
     coupling_friction_per_rad: float = 0.6
     """Relative rise of this plane's bending friction per radian bent in the other plane (the
     links press on each other)."""
@@ -121,5 +121,5 @@ class LumpedEffects:
     creep_time_s: float = 60.0
 
     def validated(self) -> LumpedEffects:
-        _check_numbers(self, "", ("creep_time_s", "coupling_bend_length_mm"))
+        _check_numbers(self, "", ("creep_time_s",))
         return self

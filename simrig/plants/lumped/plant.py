@@ -33,6 +33,8 @@ _EPS_N_PER_M = 1.0
 """Tiny stiffness to ground on every node so a fully slack, friction-free node stays put."""
 _SETTLED_M = 1e-12
 """Below this Newton move (m) with unchanged inputs the knob is at rest and is not re-solved."""
+_SUBSTEP_OF_PRESLIDING = 0.25
+_MAX_SUBSTEPS = 40
 _TOE_FLOOR = 1e-3
 """Fraction of the segment stiffness kept as tangent of a slack segment (conditioning only)."""
 
@@ -88,6 +90,7 @@ class _Knob:
         self.creep_m = [0.0, 0.0]
         self.proximal_N = [0.0, 0.0]
         self._settled: tuple[float, float, float] | None = None
+        self._pulley: list[float] | None = None
 
     # -- constitutive laws -----------------------------------------------------------------
     def _free(self, stretch_m: float) -> tuple[float, float]:
@@ -100,7 +103,8 @@ class _Knob:
         return k * (stretch_m - 0.5 * toe), k
 
     # -- one step --------------------------------------------------------------------------
-    def step(self, dt_s: float, knob_deg: float, other_tip_rad: float) -> tuple[float, float]:
+    def step(self, dt_s: float, knob_deg: float, other_tip_rad: float,
+             other_tension_N: float) -> tuple[float, float]:
         """Advance to ``knob_deg``; returns (tip angle rad, knob torque Nm)."""
         p, eff = self.p, self.eff
         prev = knob_deg if self.knob_deg is None else self.knob_deg
@@ -109,21 +113,31 @@ class _Knob:
         slack = [p.slack_pos_mm * 1e-3, p.slack_neg_mm * 1e-3]
         bend_friction = p.bend_friction_Nm
         if eff.coupling > 0.0:
-            x = abs(other_tip_rad)
-            chord = eff.coupling_bend_length_mm * 1e-3 * (1.0 - (math.sin(x) / x if x > 1e-9
-                                                                else 1.0))
+            squeeze = eff.coupling_compression_mm_per_N * 1e-3 * other_tension_N
             shift = self.arm_m * math.sin(math.radians(eff.coupling_lumen_angle_deg)) * (
                 other_tip_rad)
-            slack = [slack[0] + eff.coupling * (chord - shift),
-                     slack[1] + eff.coupling * (chord + shift)]
-            bend_friction *= 1.0 + eff.coupling * eff.coupling_friction_per_rad * x
+            slack = [slack[0] + eff.coupling * (squeeze - shift),
+                     slack[1] + eff.coupling * (squeeze + shift)]
+            bend_friction *= 1.0 + eff.coupling * eff.coupling_friction_per_rad * abs(
+                other_tip_rad)
         pulley = [draw - slack[0] - self.curve_slack_m - self.creep_m[0],
                   -draw - slack[1] - self.curve_slack_m - self.creep_m[1]]
         key = (pulley[0], pulley[1], bend_friction)
         if key != self._settled:  # at rest and converged, nothing would move: skip the solve
-            visc = [v / dt_s for v in self.viscous] if dt_s > 0.0 else [0.0] * self.n
-            moved = self._solve(pulley, visc, bend_friction)
+            # Sub-steps keep each Newton step's travel within a fraction of the presliding
+            # length (the Dahl law's scale), so the result does not depend on the knob speed.
+            start = self._pulley or pulley
+            travel = max(abs(pulley[0] - start[0]), abs(pulley[1] - start[1]))
+            n_sub = min(max(math.ceil(travel / (_SUBSTEP_OF_PRESLIDING * self.delta_m)), 1),
+                        _MAX_SUBSTEPS)
+            sub_dt = dt_s / n_sub
+            visc = [v / sub_dt for v in self.viscous] if dt_s > 0.0 else [0.0] * self.n
+            for i in range(1, n_sub + 1):
+                w = i / n_sub
+                at = [a + w * (b - a) for a, b in zip(start, pulley, strict=True)]
+                moved = self._solve(at, visc, bend_friction)
             self._settled = key if moved < _SETTLED_M else None
+        self._pulley = pulley
         if eff.creep_compliance_mm_per_N > 0.0 and dt_s > 0.0:
             a = -math.expm1(-dt_s / eff.creep_time_s)
             for s in (0, 1):
@@ -165,7 +179,8 @@ class _Knob:
         tension[0], tangent[0] = self._free(pulley_m - u[0])
         k = t.k_seg
         for j in range(1, self.n + 1):
-            stretch = (u[j - 1] - u[j]) if j < self.n else (u[-1] - sign * self.arm_m * self.tip_rad)
+            distal = u[j] if j < self.n else sign * self.arm_m * self.tip_rad
+            stretch = u[j - 1] - distal
             if stretch > 0.0:
                 tension[j], tangent[j] = k * stretch, k
             else:
@@ -217,7 +232,7 @@ class _Knob:
         """Move the nodes and the tip, integrate every Dahl state exactly over the move."""
         self.tip_rad += dtheta
         self.bend_force_Nm = _dahl(self.bend_force_Nm, dtheta, bend_friction, self.bend_delta_rad)
-        for s, (t, sign) in enumerate(zip(self.tendons, (1.0, -1.0), strict=True)):
+        for s, t in enumerate(self.tendons):
             u = t.u_m = [u + d for u, d in zip(t.u_m, du[s], strict=True)]
             t_in = self._free(pulley[s] - u[0])[0]
             self.proximal_N[s] = t_in
@@ -298,8 +313,9 @@ class LumpedPlant:
             raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}")
         k0, k1 = self._knobs
         tips = (k0.tip_rad, k1.tip_rad)
-        tip0, tau0 = k0.step(dt_s, q0, tips[1])
-        tip1, tau1 = k1.step(dt_s, q1, tips[0])
+        loads = (sum(k0.proximal_N), sum(k1.proximal_N))
+        tip0, tau0 = k0.step(dt_s, q0, tips[1], loads[1])
+        tip1, tau1 = k1.step(dt_s, q1, tips[0], loads[0])
         return PlantStep(tip_deg=np.array([math.degrees(tip0), math.degrees(tip1)]),
                          knob_torque_Nm=np.array([tau0, tau1]))
 

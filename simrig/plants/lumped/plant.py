@@ -170,61 +170,73 @@ class _Knob:
             self.bend_dir = bend_dir
         return max(abs(dtheta) * self.arm_m, *(abs(d) for row in du for d in row))
 
-    def _segments(self, t: _Tendon, sign: float, pulley_m: float
-                  ) -> tuple[list[float], list[float]]:
-        """Tensions and tangents of the n+1 segments: free, between contacts, to the tip."""
-        u = t.u_m
-        tension = [0.0] * (self.n + 1)
-        tangent = [0.0] * (self.n + 1)
-        tension[0], tangent[0] = self._free(pulley_m - u[0])
-        k = t.k_seg
-        for j in range(1, self.n + 1):
-            distal = u[j] if j < self.n else sign * self.arm_m * self.tip_rad
-            stretch = u[j - 1] - distal
-            if stretch > 0.0:
-                tension[j], tangent[j] = k * stretch, k
-            else:
-                tangent[j] = k * _TOE_FLOOR
-        return tension, tangent
-
     def _newton(self, pulley: list[float], visc: list[float], bend_friction: float,
                 dirs: list[list[float]], bend_dir: float
                 ) -> tuple[list[list[float]], float]:
+        """Assemble and solve the tangent system in one pass per tendon (Thomas forward sweep),
+        eliminate the tip angle (Schur complement), then back-substitute once per tendon."""
         n = self.n
-        xs: list[list[float]] = []
-        ys: list[list[float]] = []
-        last_k: list[float] = []
+        arm = self.arm_m
+        tip_arc = arm * self.tip_rad
+        take, drag, inv_delta = self.take, self.drag_N, 1.0 / self.delta_m
+        k_free, toe = self.k_free, self.toe_m
+        sweeps = []
+        last_k = [0.0, 0.0]
         tip_load = 0.0
-        for s, (t, sign) in enumerate(zip(self.tendons, (1.0, -1.0), strict=True)):
-            tension, tangent = self._segments(t, sign, pulley[s])
-            diag = [0.0] * n
-            rhs = [0.0] * n
+        for s in (0, 1):
+            t = self.tendons[s]
+            sign = 1.0 if s == 0 else -1.0
+            u, force, d_s, k = t.u_m, t.force_N, dirs[s], t.k_seg
+            e = pulley[s] - u[0]
+            if e <= 0.0:
+                t_in, k_in = 0.0, k_free * _TOE_FLOOR
+            elif e < toe:
+                t_in, k_in = 0.5 * k_free * e * e / toe, max(k_free * e / toe, k_free * _TOE_FLOOR)
+            else:
+                t_in, k_in = k_free * (e - 0.5 * toe), k_free
+            c = [0.0] * n
+            xp = [0.0] * n
+            yp = [0.0] * n
+            c_prev = x_prev = y_prev = 0.0
+            t_out = k_out = 0.0
             for j in range(n):
-                cap = tension[j] * self.take[j] + self.drag_N[j]
-                f = t.force_N[j]
-                d = dirs[s][j]
+                stretch = u[j] - (u[j + 1] if j + 1 < n else sign * tip_arc)
+                if stretch > 0.0:
+                    t_out, k_out = k * stretch, k
+                else:
+                    t_out, k_out = 0.0, k * _TOE_FLOOR
+                f = force[j]
                 # Dahl tangent (F_c - d F)/delta: stiff right after a reversal, ~0 when sliding.
-                dahl = (cap - d * f) / self.delta_m if d != 0.0 else cap / self.delta_m
-                diag[j] = tangent[j] + tangent[j + 1] + dahl + visc[j] + _EPS_N_PER_M
-                rhs[j] = tension[j] - tension[j + 1] - f
-            x, y = _thomas(diag, tangent, rhs, -sign * self.arm_m * tangent[n])
-            xs.append(x)
-            ys.append(y)
-            last_k.append(tangent[n])
-            tip_load += sign * tension[n]
-        a = self.arm_m
+                dahl = (t_in * take[j] + drag[j] - d_s[j] * f) * inv_delta
+                diag = k_in + k_out + dahl + visc[j] + _EPS_N_PER_M
+                load = -sign * arm * k_out if j == n - 1 else 0.0
+                if j:
+                    diag += k_in * c_prev
+                    x_prev = (t_in - t_out - f + k_in * x_prev) / diag
+                    y_prev = (load + k_in * y_prev) / diag
+                else:
+                    x_prev = (t_in - t_out - f) / diag
+                    y_prev = load / diag
+                c_prev = -k_out / diag
+                c[j], xp[j], yp[j] = c_prev, x_prev, y_prev
+                t_in, k_in = t_out, k_out
+            sweeps.append((c, xp, yp))
+            last_k[s] = k_out
+            tip_load += sign * t_out
         k_b = self.p.bend_stiffness_Nm_per_rad
         f_b = self.bend_force_Nm
-        dahl_b = (bend_friction - bend_dir * f_b) / self.bend_delta_rad if bend_dir != 0.0 else (
-            bend_friction / self.bend_delta_rad)
-        a_tt = a * a * (last_k[0] + last_k[1]) + k_b + dahl_b
-        r_t = a * tip_load - k_b * self.tip_rad - f_b
-        b = (-a * last_k[0], a * last_k[1])
-        num = r_t - b[0] * xs[0][-1] - b[1] * xs[1][-1]
-        den = a_tt - b[0] * ys[0][-1] - b[1] * ys[1][-1]
+        dahl_b = (bend_friction - bend_dir * f_b) / self.bend_delta_rad
+        b0, b1 = -arm * last_k[0], arm * last_k[1]
+        (_, x0, y0), (_, x1, y1) = sweeps
+        num = arm * tip_load - k_b * self.tip_rad - f_b - b0 * x0[-1] - b1 * x1[-1]
+        den = arm * arm * (last_k[0] + last_k[1]) + k_b + dahl_b - b0 * y0[-1] - b1 * y1[-1]
         dtheta = num / den
-        du = [[xi - yi * dtheta for xi, yi in zip(x, y, strict=True)]
-              for x, y in zip(xs, ys, strict=True)]
+        du = []
+        for c, xp, yp in sweeps:
+            z = [xi - yi * dtheta for xi, yi in zip(xp, yp, strict=True)]
+            for j in range(n - 2, -1, -1):
+                z[j] -= c[j] * z[j + 1]
+            du.append(z)
         return du, dtheta
 
     def _apply(self, du: list[list[float]], dtheta: float, pulley: list[float],
@@ -255,29 +267,6 @@ def _dahl(force: float, travel: float, level: float, delta: float) -> float:
         return force
     target = level if travel > 0.0 else -level
     return target + (force - target) * math.exp(-abs(travel) / delta)
-
-
-def _thomas(diag: list[float], k: list[float], rhs: list[float], last: float
-            ) -> tuple[list[float], list[float]]:
-    """Solve the chain's SPD tridiagonal system for ``rhs`` and for a unit load ``last`` on
-    its last node (the tip coupling); off-diagonals are ``-k[j]`` between nodes j-1 and j."""
-    n = len(diag)
-    c = [0.0] * n
-    x = [0.0] * n
-    y = [0.0] * n
-    denom = diag[0]
-    x[0] = rhs[0] / denom
-    y[0] = (last if n == 1 else 0.0) / denom
-    for j in range(1, n):
-        c[j - 1] = -k[j] / denom
-        denom = diag[j] + k[j] * c[j - 1]
-        load = last if j == n - 1 else 0.0
-        x[j] = (rhs[j] + k[j] * x[j - 1]) / denom
-        y[j] = (load + k[j] * y[j - 1]) / denom
-    for j in range(n - 2, -1, -1):
-        x[j] -= c[j] * x[j + 1]
-        y[j] -= c[j] * y[j + 1]
-    return x, y
 
 
 class LumpedPlant:

@@ -223,6 +223,94 @@ def conditioned_prefix(start_deg: FloatArray) -> FloatArray:
     return np.vstack([cond, s[:, None] * start_deg[None, :]])
 
 
+def reversal_shape(knob_deg: FloatArray, tip_deg: FloatArray, current: FloatArray
+                   ) -> tuple[float, float]:
+    """After the top reversal of a triangle: knob travel (% of the knob range) until the
+    current (median-filtered, spikes out) has fallen halfway to its released level, and until
+    the tip has come back by 3 % of its range. Same rule on real and simulated data."""
+    from scipy.signal import medfilt  # scipy is heavy; only this comparison needs it
+
+    c = medfilt(np.asarray(current, dtype=float), 9)
+    span = float(np.ptp(knob_deg))
+    i_rev = int(np.argmax(knob_deg))
+    i_low = i_rev + int(np.argmin(knob_deg[i_rev:]))
+    q = knob_deg[i_rev:i_low]
+    travel = (knob_deg[i_rev] - q) / span
+    mid = (travel > 0.3) & (travel < 0.45)
+    released = float(np.median(c[i_rev:i_low][mid]))
+    top = float(np.median(c[max(i_rev - 3, 0):i_rev + 1]))
+    fell = np.flatnonzero(c[i_rev:i_low] < top - 0.5 * (top - released))
+    moved = np.flatnonzero(tip_deg[i_rev:i_low] < tip_deg[i_rev] - 0.03 * np.ptp(tip_deg))
+    return (100.0 * float(travel[fell[0]]) if fell.size else math.nan,
+            100.0 * float(travel[moved[0]]) if moved.size else math.nan)
+
+
+def tee_comparison(tee_dir: Path, spec: str, plot_path: Path | None) -> list[str]:
+    """Each TEE acquisition against the plant driven through the same triangle, scaled to
+    +-90 deg (the probe's knob range is unknown: 16 steps per degree gives about +-37)."""
+    from simrig.plant import load_plant
+    from tsmd.tee import DEFAULT_SAMPLE_PERIOD_S, knob_from_filename, load_tee_acquisition
+
+    files = sorted(tee_dir.glob("motor*_*.csv"))
+    if not files:
+        raise TsmdError(f"no TEE acquisitions (motor*_*.csv) in {tee_dir}")
+    lines = ["| acquisition | current halfway down (% of range) real / plant | tip moves back "
+             "(% of range) real / plant |", "|---|---|---|"]
+    panels = []
+    for f in files:
+        knob = knob_from_filename(f)
+        rec = load_tee_acquisition(f)
+        q, tip, cur = rec[f"pos{knob}"], rec[f"tip{knob}"], rec[f"cur{knob}"]
+        scale = 90.0 / float(np.max(np.abs(q)))
+        n_sub = round(DEFAULT_SAMPLE_PERIOD_S / PERIOD_S)
+        fine = np.interp(np.arange((q.size - 1) * n_sub + 1) / n_sub, np.arange(q.size), q)
+        plant = load_plant(spec)
+        cmd = np.zeros(2)
+        sim = np.empty((fine.size, 2))
+        for i, x in enumerate(fine * scale):
+            cmd[knob - 1] = x
+            step = plant.step(PERIOD_S, cmd)
+            sim[i] = step.tip_deg[knob - 1], step.knob_torque_Nm[knob - 1]
+        real_shape = reversal_shape(q, tip, cur)
+        sim_shape = reversal_shape(fine, sim[:, 0], sim[:, 1])
+        lines.append(f"| {f.stem} | {real_shape[0]:.1f} / {sim_shape[0]:.1f} | "
+                     f"{real_shape[1]:.1f} / {sim_shape[1]:.1f} |")
+        panels.append((f.stem, q, tip, cur, fine, sim))
+    if plot_path is not None:
+        _plot_tee(panels, plot_path, spec)
+    return lines
+
+
+def _plot_tee(panels: Sequence[tuple[str, FloatArray, FloatArray, FloatArray, FloatArray,
+                                     FloatArray]], path: Path, spec: str) -> None:
+    import matplotlib  # plotting only on request
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    chosen = [p for p in panels if p[0].endswith("First_acquisition")] or list(panels[:2])
+    fig, axes = plt.subplots(2, len(chosen), figsize=(5.0 * len(chosen), 6.4), squeeze=False)
+    for col, (name, q, tip, cur, fine, sim) in enumerate(chosen):
+        for row, (real_y, sim_y, label) in enumerate(
+                ((tip, sim[:, 0], "tip"), (cur, sim[:, 1], "current / knob torque"))):
+            ax = axes[row, col]
+            ax.plot(q / np.max(np.abs(q)), real_y / np.max(np.abs(real_y)), lw=0.7,
+                    color="tab:grey", label="TEE probe (real)")
+            ax.plot(fine / np.max(np.abs(fine)), sim_y / np.max(np.abs(sim_y)), lw=1.1,
+                    color="tab:red", label="plant")
+            ax.set_xlabel("knob / its largest excursion")
+            ax.set_ylabel(f"{label} / its peak")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7, loc="upper left")
+        axes[0, col].set_title(name, fontsize=9)
+    fig.suptitle(f"TEE acquisitions against {spec} on the same triangle (normalised)",
+                 fontsize=10)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=72)
+    plt.close(fig)
+
+
 def format_member(res: MemberResult) -> list[str]:
     m = res.member
     values = " | ".join(f"{c.value:.3g}{'' if c.ok else ' ✗'}" for c in res.checks)
@@ -246,6 +334,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--calibrate", action="store_true",
                         help="also calibrate from current through the full stack (slow: about "
                         "10 min per member on 2 shared cores)")
+    parser.add_argument("--tee", type=Path, default=None, metavar="DIR",
+                        help="also compare each plant with the real TEE acquisitions in DIR")
+    parser.add_argument("--tee-plot", type=Path, default=None, metavar="PNG_PREFIX",
+                        help="with --tee: write PNG_PREFIX-<plant>.png")
+    parser.add_argument("--skip-checks", action="store_true",
+                        help="only the TEE comparison (with --tee)")
     parser.add_argument("--device", type=Path, default=Path("profiles/devices/sim-catheter.yaml"),
                         help="data sheet whose limits are used (slope and references are "
                         "re-measured on the plant's nominal unit)")
@@ -259,6 +353,12 @@ def main(args: argparse.Namespace) -> int:
     for plant in args.plant or list(PLANT_SPECS):
         members = family(plant, args.units, held_out=args.held_out, variants=args.variants)
         print(f"\n## {plant} ({PLANT_ROLE[plant]} plant, {PLANT_SPECS[plant]})\n")
+        if args.tee is not None:
+            png = (None if args.tee_plot is None
+                   else args.tee_plot.with_name(f"{args.tee_plot.name}-{plant}.png"))
+            print("\n".join(tee_comparison(args.tee, PLANT_SPECS[plant], png)) + "\n")
+        if args.skip_checks:
+            continue
         results = [check_member(m, scen) for m in members]
         names = [c.name for c in results[0].checks]
         print("| member | " + " | ".join(names) + " |")

@@ -26,7 +26,7 @@ def test_nominal_lumped_plant_shows_every_torque_signature(
 
 def test_a_torque_that_never_rises_fails_the_engagement_check(
         lumped_sweep: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]) -> None:
-    q, tip, tau, t = lumped_sweep
+    q, tip, _, t = lumped_sweep
     flat = 0.01 * np.sign(np.gradient(q)) + 1e-4 * q  # knob friction only, no tendon load
     failed = {c.name for c in realism.torque_signature(q, tip, flat, t) if not c.ok}
     assert any(name.startswith("rise on engagement") for name in failed)

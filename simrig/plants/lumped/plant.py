@@ -154,21 +154,24 @@ class _Knob:
     def _solve(self, pulley: list[float], visc: list[float], bend_friction: float) -> float:
         """One Newton step of the equilibrium, re-taken once if a contact turned the other way;
         returns the largest node or tip-arc move (m)."""
-        dirs = [list(t.direction) for t in self.tendons]
+        dirs = [self.tendons[0].direction, self.tendons[1].direction]
         bend_dir = self.bend_dir
-        for _ in range(2):
+        du, dtheta = self._newton(pulley, visc, bend_friction, dirs, bend_dir)
+        turned = _turned(du, dirs) or (dtheta * bend_dir < 0.0 or (dtheta and not bend_dir))
+        if turned:
+            dirs = [[_sign(d, old) for d, old in zip(row, old_row, strict=True)]
+                    for row, old_row in zip(du, dirs, strict=True)]
+            bend_dir = _sign(dtheta, bend_dir)
             du, dtheta = self._newton(pulley, visc, bend_friction, dirs, bend_dir)
-            new_dirs = [[math.copysign(1.0, d) if d != 0.0 else 0.0 for d in row] for row in du]
-            new_bend = math.copysign(1.0, dtheta) if dtheta != 0.0 else 0.0
-            if new_dirs == dirs and new_bend == bend_dir:
-                break
-            dirs, bend_dir = new_dirs, new_bend
         self._apply(du, dtheta, pulley, bend_friction)
-        for t, row in zip(self.tendons, dirs, strict=True):
-            t.direction = [d if d != 0.0 else old for d, old in zip(row, t.direction, strict=True)]
-        if bend_dir != 0.0:
-            self.bend_dir = bend_dir
-        return max(abs(dtheta) * self.arm_m, *(abs(d) for row in du for d in row))
+        largest = abs(dtheta) * self.arm_m
+        for t, row in zip(self.tendons, du, strict=True):
+            t.direction = [_sign(d, old) for d, old in zip(row, t.direction, strict=True)]
+            for d in row:
+                if d > largest or -d > largest:
+                    largest = abs(d)
+        self.bend_dir = _sign(dtheta, self.bend_dir)
+        return largest
 
     def _newton(self, pulley: list[float], visc: list[float], bend_friction: float,
                 dirs: list[list[float]], bend_dir: float
@@ -259,6 +262,20 @@ class _Knob:
                 forces[j] = cap if f > cap else -cap if f < -cap else f
                 if j + 1 < self.n:
                     t_in = max(k * (u[j] - u[j + 1]), 0.0)
+
+
+def _sign(move: float, previous: float) -> float:
+    """Direction of a move; a node that did not move keeps its last direction."""
+    return 1.0 if move > 0.0 else -1.0 if move < 0.0 else previous
+
+
+def _turned(du: list[list[float]], dirs: list[list[float]]) -> bool:
+    """Did any node move against the direction its Dahl tangent assumed?"""
+    for row, drow in zip(du, dirs, strict=True):
+        for d, old in zip(row, drow, strict=True):
+            if d * old < 0.0 or (d != 0.0 and old == 0.0):
+                return True
+    return False
 
 
 def _dahl(force: float, travel: float, level: float, delta: float) -> float:

@@ -29,10 +29,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 from numpy.typing import NDArray
 
 from simrig.analysis import SweepAnalysisError, loaded_slope, measure_dead_zone_backlash
+from simrig.current_sensor import CurrentSensor
 from simrig.family import PLANT_ROLE, PLANT_SPECS, FamilyMember, family
+from simrig.plant import load_plant
 from simrig.report import run_sweep
 from tsmd.bench.accuracy import (
     PERIOD_S,
@@ -42,6 +45,8 @@ from tsmd.bench.accuracy import (
     tracking_errors,
 )
 from tsmd.errors import TsmdError
+from tsmd.profile import device_model_from_mapping
+from tsmd.tee import DEFAULT_SAMPLE_PERIOD_S, knob_from_filename, load_tee_acquisition
 
 FloatArray = NDArray[np.float64]
 
@@ -164,9 +169,10 @@ def check_member(member: FamilyMember, scen: Sequence[Scenario]) -> MemberResult
 
 
 def _apply_drive(rig: Any, member: FamilyMember) -> None:
-    """Give the simulated rig this member's motor and current sensor (lives outside the plant)."""
-    from simrig.current_sensor import CurrentSensor
+    """Give the simulated rig this member's motor and current sensor (lives outside the plant).
 
+    Only friction constants differ between members' motors; the drive's bandwidth and speed
+    limit, fixed when the motor is built, stay the same."""
     for i, motor in enumerate(rig.motors):
         motor.params = member.motor
         rig.sensors[i] = CurrentSensor(seed=rig.seed + 1000 * (i + 1), **member.current_sensor)
@@ -174,10 +180,6 @@ def _apply_drive(rig: Any, member: FamilyMember) -> None:
 
 def data_sheet(nominal: FamilyMember, base: Path) -> Any:
     """The device model with the slope and reference points measured on the nominal unit."""
-    import yaml
-
-    from tsmd.profile import device_model_from_mapping
-
     raw = yaml.safe_load(base.read_text(encoding="utf-8"))
     for key, c in zip(("phi1", "phi2"), measure_device_constants(nominal.build), strict=True):
         k = raw["knobs"][key]
@@ -193,6 +195,7 @@ def data_sheet(nominal: FamilyMember, base: Path) -> Any:
 def calibrated_reduction(member: FamilyMember, device: Any, scen: Sequence[Scenario],
                          seed: int = 3000) -> float:
     """RMSE reduction (%) of the paper's compensator calibrated from current, full stack."""
+    # The full stack (drives, loop, calibration) loads only when --calibrate asks for it.
     from tsmd.calibration import calibrate
     from tsmd.replay import LockstepRunner
 
@@ -248,9 +251,6 @@ def reversal_shape(knob_deg: FloatArray, tip_deg: FloatArray, current: FloatArra
 def tee_comparison(tee_dir: Path, spec: str, plot_path: Path | None) -> list[str]:
     """Each TEE acquisition against the plant driven through the same triangle, scaled to
     +-90 deg (the probe's knob range is unknown: 16 steps per degree gives about +-37)."""
-    from simrig.plant import load_plant
-    from tsmd.tee import DEFAULT_SAMPLE_PERIOD_S, knob_from_filename, load_tee_acquisition
-
     files = sorted(tee_dir.glob("motor*_*.csv"))
     if not files:
         raise TsmdError(f"no TEE acquisitions (motor*_*.csv) in {tee_dir}")

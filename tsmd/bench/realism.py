@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 import yaml
 from numpy.typing import NDArray
+from scipy.signal import medfilt
 
 from simrig.analysis import SweepAnalysisError, loaded_slope, measure_dead_zone_backlash
 from simrig.current_sensor import CurrentSensor
@@ -231,8 +232,6 @@ def reversal_shape(knob_deg: FloatArray, tip_deg: FloatArray, current: FloatArra
     """After the top reversal of a triangle: knob travel (% of the knob range) until the
     current (median-filtered, spikes out) has fallen halfway to its released level, and until
     the tip has come back by 3 % of its range. Same rule on real and simulated data."""
-    from scipy.signal import medfilt  # scipy is heavy; only this comparison needs it
-
     c = medfilt(np.asarray(current, dtype=float), 9)
     span = float(np.ptp(knob_deg))
     i_rev = int(np.argmax(knob_deg))

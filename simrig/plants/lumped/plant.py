@@ -75,6 +75,8 @@ class _Knob:
         self.drag_N = [0.0] + [p.sheath_drag_N / n_lumps] * n_lumps
         self.delta_m = p.presliding_mm * 1e-3
         self.viscous = [0.0] + [eff.viscous_N_s_per_m] * n_lumps
+        self.has_viscosity = eff.viscous_N_s_per_m > 0.0
+        self._no_viscosity = [0.0] * n
         self.curve_slack_m = eff.lumen_clearance_mm * 1e-3 * curve
         self.bend_delta_rad = math.radians(p.bend_presliding_deg)
         self.handle_delta_deg = p.handle_presliding_deg
@@ -130,12 +132,16 @@ class _Knob:
             travel = max(abs(pulley[0] - start[0]), abs(pulley[1] - start[1]))
             n_sub = min(max(math.ceil(travel / (_SUBSTEP_OF_PRESLIDING * self.delta_m)), 1),
                         _MAX_SUBSTEPS)
-            sub_dt = dt_s / n_sub
-            visc = [v / sub_dt for v in self.viscous] if dt_s > 0.0 else [0.0] * self.n
-            for i in range(1, n_sub + 1):
-                w = i / n_sub
-                at = [a + w * (b - a) for a, b in zip(start, pulley, strict=True)]
-                moved = self._solve(at, visc, bend_friction)
+            visc = self._no_viscosity
+            if self.has_viscosity and dt_s > 0.0:
+                visc = [v * n_sub / dt_s for v in self.viscous]
+            if n_sub == 1:
+                moved = self._solve(pulley, visc, bend_friction)
+            else:
+                for i in range(1, n_sub + 1):
+                    w = i / n_sub
+                    at = [a + w * (b - a) for a, b in zip(start, pulley, strict=True)]
+                    moved = self._solve(at, visc, bend_friction)
             self._settled = key if moved < _SETTLED_M else None
         self._pulley = pulley
         if eff.creep_compliance_mm_per_N > 0.0 and dt_s > 0.0:
@@ -163,15 +169,7 @@ class _Knob:
                     for row, old_row in zip(du, dirs, strict=True)]
             bend_dir = _sign(dtheta, bend_dir)
             du, dtheta = self._newton(pulley, visc, bend_friction, dirs, bend_dir)
-        self._apply(du, dtheta, pulley, bend_friction)
-        largest = abs(dtheta) * self.arm_m
-        for t, row in zip(self.tendons, du, strict=True):
-            t.direction = [_sign(d, old) for d, old in zip(row, t.direction, strict=True)]
-            for d in row:
-                if d > largest or -d > largest:
-                    largest = abs(d)
-        self.bend_dir = _sign(dtheta, self.bend_dir)
-        return largest
+        return self._apply(du, dtheta, pulley, bend_friction)
 
     def _newton(self, pulley: list[float], visc: list[float], bend_friction: float,
                 dirs: list[list[float]], bend_dir: float
@@ -243,25 +241,37 @@ class _Knob:
         return du, dtheta
 
     def _apply(self, du: list[list[float]], dtheta: float, pulley: list[float],
-               bend_friction: float) -> None:
-        """Move the nodes and the tip, integrate every Dahl state exactly over the move."""
+               bend_friction: float) -> float:
+        """Move the nodes and the tip, integrate every Dahl state exactly over the move and
+        remember each contact's direction; returns the largest node or tip-arc move (m)."""
         self.tip_rad += dtheta
         self.bend_force_Nm = _dahl(self.bend_force_Nm, dtheta, bend_friction, self.bend_delta_rad)
+        self.bend_dir = _sign(dtheta, self.bend_dir)
+        largest = abs(dtheta) * self.arm_m
+        n, take, drag, delta = self.n, self.take, self.drag_N, self.delta_m
         for s, t in enumerate(self.tendons):
-            u = t.u_m = [u + d for u, d in zip(t.u_m, du[s], strict=True)]
+            moves = du[s]
+            u = t.u_m = [u + d for u, d in zip(t.u_m, moves, strict=True)]
             t_in = self._free(pulley[s] - u[0])[0]
             self.proximal_N[s] = t_in
-            forces = t.force_N
-            k, take, drag, delta = t.k_seg, self.take, self.drag_N, self.delta_m
-            for j, d in enumerate(du[s]):
+            forces, direction, k = t.force_N, list(t.direction), t.k_seg
+            for j in range(n):
+                d = moves[j]
                 cap = t_in * take[j] + drag[j]
                 f = forces[j]
-                if d != 0.0:
-                    target = cap if d > 0.0 else -cap
-                    f = target + (f - target) * math.exp(-abs(d) / delta)
+                if d > 0.0:
+                    f = cap + (f - cap) * math.exp(-d / delta)
+                    direction[j] = 1.0
+                    largest = max(largest, d)
+                elif d < 0.0:
+                    f = -cap + (f + cap) * math.exp(d / delta)
+                    direction[j] = -1.0
+                    largest = max(largest, -d)
                 forces[j] = cap if f > cap else -cap if f < -cap else f
-                if j + 1 < self.n:
+                if j + 1 < n:
                     t_in = max(k * (u[j] - u[j + 1]), 0.0)
+            t.direction = direction
+        return largest
 
 
 def _sign(move: float, previous: float) -> float:

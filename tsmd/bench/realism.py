@@ -358,12 +358,14 @@ def main(args: argparse.Namespace) -> int:
             print("\n".join(tee_comparison(args.tee, PLANT_SPECS[plant], png)) + "\n")
         if args.skip_checks:
             continue
-        results = [check_member(m, scen) for m in members]
-        names = [c.name for c in results[0].checks]
-        print("| member | " + " | ".join(names) + " |")
-        print("|" + "---|" * (len(names) + 1))
-        for r in results:
-            print("\n".join(format_member(r)))
+        results = []
+        for m in members:  # rows as they come: a member takes seconds to a minute
+            results.append(check_member(m, scen))
+            if len(results) == 1:
+                names = [c.name for c in results[0].checks]
+                print("| member | " + " | ".join(names) + " |")
+                print("|" + "---|" * (len(names) + 1))
+            print("\n".join(format_member(results[-1])), flush=True)
         rmse = [r.checks[0].value for r in results]
         worst = results[int(np.argmin(rmse))]
         n_ok = sum(not r.failed for r in results)

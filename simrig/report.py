@@ -1,6 +1,6 @@
 """Print (and plot) the signature of a plant on the paper's sweep: +-90 deg at 0.04 Hz.
 
-``python -m simrig.report [--plot docs/img/plant_sweep.png] [--set coupling=1.0]``
+``python -m simrig.report [--plant lumped] [--plot docs/img/plant_sweep.png] [--set coupling=1.0]``
 
 For each knob in turn (the other held at 0 deg) it runs two cycles at 250 Hz and reports the
 tip-based dead zone and backlash (:mod:`simrig.analysis`), the tip slopes, the knob-torque
@@ -26,8 +26,8 @@ from simrig.analysis import (
     measure_dead_zone_backlash,
     releasing_slope,
 )
-from simrig.plant import Plant, PlantLoadError, as_plant_step
-from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
+from simrig.family import PLANT_SPECS
+from simrig.plant import Plant, PlantLoadError, as_plant_step, load_plant
 
 FloatArray = NDArray[np.float64]
 
@@ -118,13 +118,21 @@ def signature(rec: SweepRecord) -> Signature:
     )
 
 
+def plant_spec(name: str) -> str:
+    """A family plant name (``capstan``, ``lumped``) or a ``module:factory`` spec."""
+    return PLANT_SPECS.get(name, name)
+
+
 def coupling_grid(
-    params: dict[str, Any], knob: int = 0, others_deg: Sequence[float] = tuple(range(-90, 91, 30))
+    params: dict[str, Any],
+    knob: int = 0,
+    others_deg: Sequence[float] = tuple(range(-90, 91, 30)),
+    spec: str = PLANT_SPECS["capstan"],
 ) -> list[DeadZoneBacklash]:
     """D/B of one knob with the other held at each angle (the calibration protocol's grid)."""
     return [
         measure_dead_zone_backlash(
-            *_knob_tip(run_sweep(make_tendon_sheath_plant(**params), knob, other_deg=o))
+            *_knob_tip(run_sweep(load_plant(spec, params), knob, other_deg=o))
         )
         for o in others_deg
     ]
@@ -168,7 +176,7 @@ def routing_study(
         knobs = [dict(k) for k in params.get("knobs", [{}, {}])]
         for k in knobs:
             k["routing_wrap_deg"] = wrap
-        rec = run_sweep(make_tendon_sheath_plant(**{**params, "knobs": knobs}), knob)
+        rec = run_sweep(load_plant(PLANT_SPECS["capstan"], {**params, "knobs": knobs}), knob)
         out.append((wrap, rec, signature(rec)))
     return out
 
@@ -209,9 +217,11 @@ def plot_routing(study: Sequence[tuple[float, SweepRecord, Signature]], path: st
     plt.close(fig)
 
 
-def protocol_cpu_s(params: dict[str, Any], dt_s: float = 0.004) -> tuple[int, float]:
+def protocol_cpu_s(
+    params: dict[str, Any], dt_s: float = 0.004, spec: str = PLANT_SPECS["capstan"]
+) -> tuple[int, float]:
     """CPU time of the plant over the 700 s calibration protocol (14 sweeps of 50 s)."""
-    plant = make_tendon_sheath_plant(**params)
+    plant = load_plant(spec, params)
     t = np.arange(0.0, 50.0, dt_s)
     sweep = 90.0 * np.sin(2.0 * np.pi * 0.04 * t)
     steps = 0
@@ -237,7 +247,12 @@ def _parse_set(items: Sequence[str]) -> dict[str, Any]:
     return params
 
 
-def plot(records: Sequence[SweepRecord], sigs: Sequence[Signature], path: str) -> None:
+def plot(
+    records: Sequence[SweepRecord],
+    sigs: Sequence[Signature],
+    path: str,
+    title: str = "Default tendon-sheath plant",
+) -> None:
     """Tip vs knob and knob torque vs knob, one column per knob."""
     import matplotlib
 
@@ -269,7 +284,7 @@ def plot(records: Sequence[SweepRecord], sigs: Sequence[Signature], path: str) -
         ax.set_xlabel("knob angle (deg)")
         ax.set_ylabel("knob torque (Nm)")
         ax.grid(alpha=0.3)
-    fig.suptitle("Default tendon-sheath plant, +-90 deg sine at 0.04 Hz, 2 cycles", fontsize=10)
+    fig.suptitle(f"{title}, +-90 deg sine at 0.04 Hz, 2 cycles", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
@@ -283,6 +298,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         default=[],
         metavar="KEY=JSON",
         help="plant parameter, e.g. coupling=1.0 or knobs='[{...},{}]'",
+    )
+    parser.add_argument(
+        "--plant",
+        default="capstan",
+        help="capstan (default), lumped, or a module:factory spec",
     )
     parser.add_argument("--freq", type=float, default=0.04, help="sweep frequency (Hz)")
     parser.add_argument("--other", type=float, default=0.0, help="other knob's angle (deg)")
@@ -303,10 +323,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="also time the plant over the 700 s calibration protocol",
     )
     args = parser.parse_args(argv)
+    spec = plant_spec(args.plant)
+    if args.routing and spec != PLANT_SPECS["capstan"]:
+        print("error: --routing studies the capstan plant's routing_wrap_deg", file=sys.stderr)
+        return 2
     try:
         params = _parse_set(args.set)
         records = [
-            run_sweep(make_tendon_sheath_plant(**params), k, args.freq, other_deg=args.other)
+            run_sweep(load_plant(spec, params), k, args.freq, other_deg=args.other)
             for k in (0, 1)
         ]
     except (PlantLoadError, json.JSONDecodeError) as exc:
@@ -338,11 +362,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         us = rec.cpu_s / rec.t_s.size * 1e6
         print(f"  plant CPU time            {us:7.1f} us/step ({rec.t_s.size} steps)")
     if args.plot:
-        plot(records, sigs, args.plot)
+        plot(records, sigs, args.plot, f"{args.plant} plant")
         print(f"wrote {args.plot}")
     if args.grid:
         others = [float(o) for o in range(-90, 91, 30)]
-        grid = coupling_grid(params, 0, others)
+        grid = coupling_grid(params, 0, others, spec)
         print("knob 1 over the other knob's angle: other  D_pos  D_neg  B_pos  B_neg (deg)")
         for o, m in zip(others, grid, strict=True):
             print(f"  {o:6.0f} {m[0]:6.1f} {m[1]:6.1f} {m[2]:6.1f} {m[3]:6.1f}")
@@ -360,7 +384,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         plot_routing(study, args.routing)
         print(f"wrote {args.routing}")
     if args.protocol:
-        steps, cpu = protocol_cpu_s(params)
+        steps, cpu = protocol_cpu_s(params, spec=spec)
         print(
             f"700 s protocol: {steps} steps, plant CPU {cpu:.2f} s, {cpu / steps * 1e6:.1f} us/step"
         )

@@ -1,0 +1,230 @@
+"""Units of the product: catheters drawn around each built-in plant's nominal unit, by seed.
+
+A real product's catheters differ: every physical constant scatters from unit to unit (table
+``SCATTER``, relative half-range of a uniform draw, per plant), and a lab meets named variants
+(``VARIANTS``: a routed handle, a longer or curved sheath, asymmetric slack, a worn catheter, a
+noisier current sensor, a stiffer motor). ``family_member(plant, unit, variant)`` returns one
+catheter as a :class:`FamilyMember`: the ``module:factory`` spec and parameters
+``simrig.plant.load_plant`` takes, plus the drive-side settings of the simulated rig (motor
+friction, current sensor) that live outside the plant.
+
+Unit 0 is the nominal unit (no scatter). Units 1-8 are the development set, units 101-108 the
+held-out set: tune on the first, report the second. The capstan plant is the development plant,
+the lumped plant is held out (``PLANT_ROLE``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from simrig.motor import MotorParams
+from simrig.plant import Plant, PlantLoadError, load_plant
+from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
+from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
+from simrig.rig import DEFAULT_CURRENT_SENSOR
+
+PLANT_SPECS: dict[str, str] = {
+    "capstan": "simrig.plants.capstan:make_tendon_sheath_plant",
+    "lumped": "simrig.plants.lumped:make_lumped_plant",
+}
+PLANT_ROLE = {"capstan": "development", "lumped": "held-out"}
+
+DEVELOPMENT_UNITS = tuple(range(1, 9))
+HELD_OUT_UNITS = tuple(range(101, 109))
+
+SCATTER: dict[str, dict[str, float]] = {
+    "capstan": {
+        "pulley_radius_mm": 0.02,  # machined part
+        "slack_pos_mm": 0.15,  # assembly: tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "tendon_stiffness_N": 0.15,  # tendon lot (EA)
+        "sheath_length_m": 0.02,
+        "free_length_m": 0.20,
+        "sheath_friction": 0.15,  # coating, lubricant
+        "sheath_wrap_deg": 0.10,  # coil pitch
+        "routing_wrap_deg": 0.10,
+        "routing_friction": 0.15,
+        "sheath_drag_N": 0.20,
+        "bend_stiffness_Nm_per_rad": 0.15,  # polymer cover, links
+        "bend_friction_Nm": 0.20,
+        "handle_friction_Nm": 0.20,  # knob bearing / brake setting
+        "handle_stiction_Nm": 0.20,
+        "handle_slip_deg": 0.20,
+    },
+    "lumped": {
+        "pulley_radius_mm": 0.02,
+        "slack_pos_mm": 0.15,
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,
+        "tendon_stiffness_N": 0.15,
+        "sheath_length_m": 0.02,
+        "free_length_m": 0.20,
+        "guide_wrap_deg": 0.10,
+        "guide_friction": 0.15,
+        "sheath_wrap_deg": 0.10,
+        "sheath_friction": 0.15,
+        "sheath_drag_N": 0.20,
+        "presliding_mm": 0.20,
+        "tendon_offset_mm": 0.05,
+        "bend_stiffness_Nm_per_rad": 0.15,
+        "bend_friction_Nm": 0.20,
+        "bend_presliding_deg": 0.20,
+        "handle_friction_Nm": 0.20,
+        "handle_presliding_deg": 0.20,
+    },
+}
+"""Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""
+
+_NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMPED_KNOBS}
+
+
+@dataclass(frozen=True)
+class Variant:
+    """A named deviation a lab meets: per-knob factors, plant effects, rig settings."""
+
+    description: str
+    factors: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    """Per plant, constant -> factor on both knobs (after the scatter)."""
+    absolute: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    """Per plant, constant -> value on both knobs."""
+    effects: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    motor: Mapping[str, float] = field(default_factory=dict)
+    """Factors on :class:`simrig.motor.MotorParams` fields."""
+    current_sensor: Mapping[str, float] = field(default_factory=dict)
+    """Values for :class:`simrig.current_sensor.CurrentSensor` keywords."""
+
+
+VARIANTS: dict[str, Variant] = {
+    "routed-handle": Variant(
+        "tendons wrap over guide pins in the handle before the sheath",
+        absolute={"capstan": {"routing_wrap_deg": 90.0}},
+        factors={"lumped": {"guide_wrap_deg": 3.0}},
+    ),
+    "long-sheath": Variant(
+        "30 % longer sheath (more wrap, more tendon to stretch)",
+        factors={p: {"sheath_length_m": 1.3, "sheath_wrap_deg": 1.3} for p in _NOMINAL},
+    ),
+    "curved-sheath": Variant(
+        "sheath laid in a 120 deg curve",
+        effects={p: {"sheath_curvature_deg": 120.0} for p in _NOMINAL},
+    ),
+    "asymmetric-slack": Variant(
+        "one tendon of each pair tensioned tighter at assembly",
+        factors={p: {"slack_pos_mm": 1.3, "slack_neg_mm": 0.75} for p in _NOMINAL},
+    ),
+    "worn": Variant(
+        "worn catheter: lumen coating and links rubbed, more friction everywhere",
+        factors={
+            "capstan": {"sheath_friction": 1.3, "sheath_drag_N": 1.5, "bend_friction_Nm": 1.5,
+                        "handle_friction_Nm": 1.5},
+            "lumped": {"sheath_friction": 1.3, "sheath_drag_N": 1.5, "bend_friction_Nm": 1.5,
+                       "handle_friction_Nm": 1.5},
+        },
+    ),
+    "noisy-sensor": Variant(
+        "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",
+        current_sensor={"noise_A": 0.010, "spike_rate_hz": 2.0, "lag_s": 0.005},
+    ),
+    "motor-friction": Variant(
+        "another motor/gearbox: three times the Coulomb friction, twice the viscous",
+        motor={"friction_Nm": 3.0, "viscous_Nm_s_rad": 2.0},
+    ),
+}
+
+
+@dataclass(frozen=True)
+class FamilyMember:
+    """One catheter of the family: how to build its plant and how its drives differ."""
+
+    plant: str
+    unit: int
+    variant: str | None
+    spec: str
+    params: dict[str, Any]
+    motor: MotorParams
+    current_sensor: dict[str, float]
+
+    @property
+    def label(self) -> str:
+        return f"{self.plant} unit {self.unit}" + (f" {self.variant}" if self.variant else "")
+
+    @property
+    def unit_set(self) -> str:
+        """``nominal``, ``development`` or ``held-out``."""
+        return unit_set(self.unit)
+
+    def build(self) -> Plant:
+        """A fresh plant of this unit."""
+        return load_plant(self.spec, self.params)
+
+    def rig_kwargs(self) -> dict[str, Any]:
+        """Keywords for :class:`simrig.rig.SimRig` (``motor``, ``current_sensor``)."""
+        return {"motor": self.motor, "current_sensor": dict(self.current_sensor)}
+
+
+def unit_set(unit: int) -> str:
+    if unit == 0:
+        return "nominal"
+    if unit in DEVELOPMENT_UNITS:
+        return "development"
+    if unit in HELD_OUT_UNITS:
+        return "held-out"
+    return "other"
+
+
+def family_member(plant: str = "capstan", unit: int = 0, variant: str | None = None,
+                  seed: int = 0) -> FamilyMember:
+    """Catheter ``unit`` of ``plant`` (0: nominal), optionally a named ``variant``.
+
+    The draw depends only on (plant, unit, seed): the same arguments give the same catheter.
+    """
+    if plant not in PLANT_SPECS:
+        raise PlantLoadError(f"unknown plant {plant!r}; known: {', '.join(PLANT_SPECS)}")
+    if isinstance(unit, bool) or not isinstance(unit, int) or unit < 0:
+        raise PlantLoadError(f"unit must be an integer >= 0, got {unit!r}")
+    if variant is not None and variant not in VARIANTS:
+        raise PlantLoadError(f"unknown variant {variant!r}; known: {', '.join(VARIANTS)}")
+    rng = np.random.default_rng([list(PLANT_SPECS).index(plant), unit, seed])
+    knobs: list[dict[str, float]] = []
+    for nominal in _NOMINAL[plant]:
+        values = dataclasses.asdict(nominal)
+        for name, half_range in SCATTER[plant].items():
+            draw = rng.uniform(-1.0, 1.0)  # drawn for unit 0 too: the sequence stays aligned
+            if unit != 0:
+                values[name] *= 1.0 + half_range * draw
+        knobs.append(values)
+    effects: dict[str, float] = {}
+    motor = MotorParams()
+    sensor = dict(DEFAULT_CURRENT_SENSOR)
+    if variant is not None:
+        v = VARIANTS[variant]
+        for values in knobs:
+            for name, factor in v.factors.get(plant, {}).items():
+                values[name] *= factor
+            values.update(v.absolute.get(plant, {}))
+        effects.update(v.effects.get(plant, {}))
+        motor = dataclasses.replace(motor, **{k: getattr(motor, k) * f
+                                              for k, f in v.motor.items()})
+        sensor.update(v.current_sensor)
+    params: dict[str, Any] = {"knobs": knobs, **effects}
+    return FamilyMember(plant, unit, variant, PLANT_SPECS[plant], params, motor, sensor)
+
+
+def family(plant: str, units: int, held_out: bool = False, variants: bool = False,
+           seed: int = 0) -> list[FamilyMember]:
+    """The nominal unit, then ``units`` units of the chosen set, then (optionally) every named
+    variant of the nominal unit."""
+    pool = HELD_OUT_UNITS if held_out else DEVELOPMENT_UNITS
+    if not 0 <= units <= len(pool):
+        raise PlantLoadError(f"units must be in 0..{len(pool)}, got {units}")
+    members = [family_member(plant, 0, seed=seed)]
+    members += [family_member(plant, u, seed=seed) for u in pool[:units]]
+    if variants:
+        members += [family_member(plant, 0, v, seed=seed) for v in VARIANTS]
+    return members

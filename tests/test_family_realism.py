@@ -1,0 +1,62 @@
+"""`tsmd bench realism`: the paper's signatures checked automatically on family members."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+import pytest
+
+from simrig.family import family_member
+from simrig.report import run_sweep
+from tsmd.bench import realism
+
+
+@pytest.fixture(scope="module")
+def lumped_sweep() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    rec = run_sweep(family_member("lumped", 0).build(), 0, dt_s=0.008)
+    return rec.knob_deg, rec.tip_deg, rec.torque_Nm, rec.t_s
+
+
+def test_nominal_lumped_plant_shows_every_torque_signature(
+        lumped_sweep: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]) -> None:
+    checks = realism.torque_signature(*lumped_sweep)
+    assert [c.name for c in checks if not c.ok] == []
+
+
+def test_a_torque_that_never_rises_fails_the_engagement_check(
+        lumped_sweep: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]) -> None:
+    q, tip, _, t = lumped_sweep
+    flat = 0.01 * np.sign(np.gradient(q)) + 1e-4 * q  # knob friction only, no tendon load
+    failed = {c.name for c in realism.torque_signature(q, tip, flat, t) if not c.ok}
+    assert any(name.startswith("rise on engagement") for name in failed)
+
+
+def test_reversal_shape_reads_a_current_drop_and_a_tip_hold_on_a_textbook_loop() -> None:
+    up = np.linspace(-50.0, 50.0, 1001)
+    q = np.concatenate([up, up[::-1][1:]])
+    # Tip: play of 10 deg (10 % of the range) after the top reversal, slope 1 elsewhere.
+    tip = np.concatenate([up, np.minimum(up[::-1][1:] + 10.0, 50.0)])
+    current = np.concatenate([np.where(up > 0, up / 50.0, 0.0), np.zeros(1000)])
+    fall_pct, hold_pct = realism.reversal_shape(q, tip, current)
+    assert fall_pct < 1.0
+    assert hold_pct == pytest.approx(10.0 + 3.0, abs=0.5)  # the play + the 3 % tip threshold
+
+
+def test_bench_prints_one_row_per_member_and_names_what_is_outside(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    few = realism.scenarios(True)[:1]
+    monkeypatch.setattr(realism, "scenarios", lambda quick: few)
+    args = argparse.Namespace(plant=["lumped"], units=1, held_out=True, variants=False,
+                              quick=True, calibrate=False, tee=None, tee_plot=None,
+                              skip_checks=False, device=None)
+    assert realism.main(args) == 0
+    out = capsys.readouterr().out
+    assert "lumped unit 0 (nominal)" in out and "lumped unit 101 (held-out)" in out
+    assert "held-out plant" in out
+
+
+def test_bench_refuses_more_units_than_the_family_has() -> None:
+    args = argparse.Namespace(units=9)
+    with pytest.raises(realism.TsmdError, match="--units must be in 0..8"):
+        realism.main(args)

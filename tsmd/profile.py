@@ -29,6 +29,11 @@ import yaml
 from tsmd.compensation.grid import CALIBRATION_GRID_DEG, INTERPOLATION_METHODS
 from tsmd.compensation.ours import OursParams, ours_params_from_mapping, ours_params_to_mapping
 from tsmd.compensation.safety import KnobLimits
+from tsmd.compensation.tension_play import (
+    TensionPlayParams,
+    tension_play_from_mapping,
+    tension_play_to_mapping,
+)
 from tsmd.errors import TsmdError
 
 PROFILE_SCHEMA_VERSION = 1
@@ -101,6 +106,7 @@ class KnobProfile:
     backlash_pos_deg: tuple[float, ...]
     backlash_neg_deg: tuple[float, ...]
     ours: OursParams | None = None
+    tension_play: TensionPlayParams | None = None
 
     def grid_array(self) -> np.ndarray:
         """(n, 4) array: D_pos, D_neg, B_pos, B_neg per grid point."""
@@ -313,7 +319,14 @@ def _knob_from_mapping(r: _Reader, raw: Any, key: str) -> KnobProfile:
     ours = None
     if k.get("ours") is not None:
         ours = _ours_from_mapping(r, k["ours"], p + "ours", n)
-    return KnobProfile(omega, pos, neg, h_pos, h_neg, grid, d_pos, d_neg, b_pos, b_neg, ours)
+    tension = None
+    if k.get("tension_play") is not None:
+        try:
+            tension = tension_play_from_mapping(r.mapping(k["tension_play"], p + "tension_play"))
+        except ValueError as exc:
+            raise r.fail(p + "tension_play", str(exc)) from None
+    return KnobProfile(omega, pos, neg, h_pos, h_neg, grid, d_pos, d_neg, b_pos, b_neg, ours,
+                       tension)
 
 
 def _ours_from_mapping(r: _Reader, raw: Any, key: str, n: int) -> OursParams:
@@ -363,6 +376,8 @@ def profile_to_mapping(profile: CatheterProfile) -> dict[str, Any]:
         }
         if k.ours is not None:
             entry["ours"] = ours_params_to_mapping(k.ours)
+        if k.tension_play is not None:
+            entry["tension_play"] = tension_play_to_mapping(k.tension_play)
         knobs[name] = entry
     return {
         "schema_version": profile.schema_version,

@@ -103,8 +103,8 @@ class LockstepRunner:
 
         self.config = config if config is not None else default_sim_config()
         cfg = self.config
-        if method not in ("none", "paper", "ours"):
-            raise ReplayError(f"method must be none, paper or ours, got {method!r}")
+        if method not in ("none", "paper", "ours", "tension"):
+            raise ReplayError(f"method must be none, paper, ours or tension, got {method!r}")
         if method != "none" and profile is None:
             raise ReplayError(f"method {method!r} needs a catheter profile")
         self.method = method

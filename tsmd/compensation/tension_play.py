@@ -41,6 +41,9 @@ _FAR_DEG = 1000.0
 _TABLE_STEP_DEG = 0.25  # resolution of the other knob's angle in the precomputed envelopes
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
+REVERSAL_DEADBAND_DEG = 0.1
+"""A desired angle that turns back by less than this is held: an exact inverse would make the
+motor cross the whole backlash for every jitter of the operator's input (error <= this)."""
 
 
 @dataclass(frozen=True)
@@ -233,10 +236,19 @@ def model_step(state: PlayState, x_deg: float, b: Branches) -> PlayState:
 
 
 def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
-    """The input that makes the model output ``y_deg`` next (exact on sloped parts)."""
-    if y_deg == state.y_deg or not math.isfinite(y_deg):
+    """The input that makes the model output ``y_deg`` next (exact on sloped parts).
+
+    An unchanged output keeps a held input; one on a branch follows the branch forward if the
+    branches moved (the other knob's angle changed the dead zone).
+    """
+    if not math.isfinite(y_deg):
         return state
-    direction = 1 if y_deg > state.y_deg else -1
+    if y_deg == state.y_deg:
+        if state.y_deg == state.held_deg:
+            return state
+        direction = state.direction
+    else:
+        direction = 1 if y_deg > state.y_deg else -1
     held = state.held_deg if direction == state.direction else state.y_deg
     if direction > 0:
         x = max(b.rising_inverse(y_deg), state.x_deg)
@@ -250,9 +262,9 @@ def rest_state(y_deg: float, b: Branches, home_deg: float = 0.0) -> PlayState:
     lo, hi = b.falling_inverse(y_deg), b.rising_inverse(y_deg)
     if lo <= home_deg <= hi:
         return PlayState(home_deg, y_deg, 1, y_deg)
-    if hi < home_deg:
-        return PlayState(lo, y_deg, -1, y_deg)
-    return PlayState(hi, y_deg, 1, y_deg)
+    if hi < home_deg:  # arrived moving down along the falling branch
+        return PlayState(lo, y_deg, -1, max(y_deg, b.falling(home_deg)))
+    return PlayState(hi, y_deg, 1, min(y_deg, b.rising(home_deg)))
 
 
 class BranchTable:
@@ -285,23 +297,30 @@ class TensionPlayCompensator:
     half the smoothing window; the inverse gives the command; a jump across a flat part seen
     within half the motor's crossing time ahead is started now and then held until the desired
     angle catches up (the crossing error is centred instead of all lag); the command then goes
-    through the velocity/acceleration limits and a moving average over ``smoothing_s``.
+    through the knob's position/velocity/acceleration limits and a moving average over
+    ``smoothing_s``: the average of a feasible motion stays feasible, and its acceleration
+    changes by at most 2 a_max per window, so the jerk is at most 2 a_max / ``smoothing_s``.
     """
 
     def __init__(self, knobs: tuple[TensionPlayParams, TensionPlayParams], period_s: float,
-                 max_velocity_deg_s: float = 120.0, max_accel_deg_s2: float = 2000.0,
-                 smoothing_s: float = 0.1, interpolation: str = "pchip") -> None:
+                 limits: Sequence[KnobLimits] | None = None, smoothing_s: float = 0.1,
+                 interpolation: str = "pchip") -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be positive, got {period_s}")
-        if not (max_velocity_deg_s > 0 and max_accel_deg_s2 > 0):
-            raise ValueError("max_velocity_deg_s and max_accel_deg_s2 must be positive")
+        if limits is None:  # the simulated rig's drives, no position limit
+            limits = (KnobLimits(-1e9, 1e9, 120.0, 2000.0),) * 2
+        if len(limits) != 2:
+            raise ValueError(f"need limits for 2 knobs, got {len(limits)}")
         self.params = knobs
         self.period_s = period_s
-        self.v_max = max_velocity_deg_s
-        self.a_max = max_accel_deg_s2
+        self.limits = (limits[0], limits[1])
+        # jumps are planned with the slower knob's limits
+        self.v_max = min(lim.max_velocity_deg_s for lim in limits)
+        self.a_max = min(lim.max_accel_deg_s2 for lim in limits)
         self._tables = (BranchTable(knobs[0], interpolation), BranchTable(knobs[1], interpolation))
         self._n_avg = max(1, round(smoothing_s / period_s))
-        self._free = KnobLimits(-1e9, 1e9, max_velocity_deg_s, max_accel_deg_s2)
+        # faster than any knob can make the tip move (release slope <= 5 omega)
+        self._jump_deg = 5.0 * max(k.omega for k in knobs) * self.v_max * period_s
         self._ahead_s = [k.lag_s + 0.5 * (self._n_avg - 1) * period_s for k in knobs]
         self._states = [PlayState(0.0, 0.0, 1, 0.0), PlayState(0.0, 0.0, 1, 0.0)]
         self._lim = [LimiterState(0.0), LimiterState(0.0)]
@@ -313,6 +332,7 @@ class TensionPlayCompensator:
         self._target = [0.0, 0.0]
         self._out = [0.0, 0.0]
         self._hold = [0, 0]
+        self._q_dir = [1, 1]
         self.reset(np.zeros(2))
 
     def reset(self, q_deg: NDArray[np.float64]) -> None:
@@ -326,6 +346,8 @@ class TensionPlayCompensator:
         self._target = list(q)
         self._out = list(x)
         self._hold = [0, 0]
+        self._q_dir = [s.direction for s in self._states]
+        x = [self.limits[i].clip(x[i]) for i in (0, 1)]
         self._lim = [LimiterState(x[0]), LimiterState(x[1])]
         self._window = [[x[0]] * self._n_avg, [x[1]] * self._n_avg]
         self._sum = [x[0] * self._n_avg, x[1] * self._n_avg]
@@ -340,7 +362,7 @@ class TensionPlayCompensator:
             if math.isfinite(qi):
                 self._track(i, qi, self._tables[i].at(others[i]))
             # non-finite desired angle: the command stays where it is (limited, smoothed)
-            lim = limit_step(self._lim[i], self._out[i], self._free, self.period_s)
+            lim = limit_step(self._lim[i], self._out[i], self.limits[i], self.period_s)
             self._lim[i] = lim
             self._sum[i] += lim.q_deg - self._window[i][slot]
             self._window[i][slot] = lim.q_deg
@@ -348,10 +370,18 @@ class TensionPlayCompensator:
         n = self._n_avg
         return np.array([self._sum[0] / n, self._sum[1] / n])
 
-    def _track(self, i: int, qi: float, b: Branches) -> None:
+    def _track(self, i: int, q_raw: float, b: Branches) -> None:
+        qi = self._q_prev[i]
+        if (q_raw - qi) * self._q_dir[i] >= 0.0:
+            qi = q_raw
+        elif abs(q_raw - qi) >= REVERSAL_DEADBAND_DEG:  # a reversal, not jitter
+            qi = q_raw
+            self._q_dir[i] = -self._q_dir[i]
         dq = qi - self._q_prev[i]
         self._q_prev[i] = qi
         v = 0.7 * self._v[i] + 0.3 * dq / self.period_s
+        if abs(dq) > self._jump_deg:  # a step, not a motion: nothing to predict from it
+            v = 0.0
         self._v[i] = v
         lead = min(max(self._ahead_s[i] * v, -_MAX_LEAD_DEG), _MAX_LEAD_DEG)
         target = qi + lead
@@ -361,6 +391,7 @@ class TensionPlayCompensator:
         state = self._states[i]
         if step * dq < 0.0 or (dq == 0.0 and step * state.direction < 0.0):
             target = self._target[i]
+
         self._target[i] = target
         state = inverse_step(state, target, b)
         self._states[i] = state
@@ -393,8 +424,6 @@ class TensionPlayCompensator:
 def tension_play_compensator(knobs: Sequence[TensionPlayParams], period_s: float,
                              limits: Sequence[KnobLimits] | None = None,
                              interpolation: str = "pchip") -> TensionPlayCompensator:
-    """The compensator for two knobs; jumps are planned with the slowest knob's limits."""
-    v_max = min(lim.max_velocity_deg_s for lim in limits) if limits else 120.0
-    a_max = min(lim.max_accel_deg_s2 for lim in limits) if limits else 2000.0
-    return TensionPlayCompensator((knobs[0], knobs[1]), period_s, v_max, a_max,
+    """The compensator for two knobs, within the knobs' limits (the sim rig's when None)."""
+    return TensionPlayCompensator((knobs[0], knobs[1]), period_s, limits,
                                   interpolation=interpolation)

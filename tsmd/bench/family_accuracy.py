@@ -64,9 +64,9 @@ def extra_scenarios() -> list[Scenario]:
     freqs = (0.02, 0.05, 0.11, 0.17)
     amps = (30.0, 15.0, 8.0, 4.0)
     phases = (0.0, 1.3, 2.9, 4.1)
-    multi = sum(a * np.sin(2 * math.pi * f * t_m + p) for a, f, p in
-                zip(amps, freqs, phases, strict=True)) - sum(
-        a * math.sin(p) for a, p in zip(amps, phases, strict=True))
+    multi = np.zeros_like(t_m)
+    for a, f, p in zip(amps, freqs, phases, strict=True):  # starts at 0
+        multi += a * (np.sin(2 * math.pi * f * t_m + p) - math.sin(p))
     q_m = np.column_stack([multi, 0.8 * multi[::-1] - 0.8 * multi[-1]])
     out.append(Scenario("2-DOF multisine", "4 tones 0.02-0.17 Hz", t_m, q_m, (0, 1)))
     return out

@@ -88,6 +88,14 @@ def test_data_sheet_dead_zone_offset_moves_the_edges_outward() -> None:
     assert p.dead_zone_neg_deg == (D_NEG - 0.5,) * 2
 
 
+def test_plateau_heights_are_product_constants_with_the_data_sheet_units_edges() -> None:
+    knob = dataclasses.replace(DEVICE_KNOB, reference_dead_zone_pos_deg=25.0,
+                               reference_dead_zone_neg_deg=-25.0)
+    p = fit_tension_play([synthetic_sweep(g) for g in (-90.0, 90.0)], knob)
+    assert p.height_pos_deg == pytest.approx(100.0 - 1.5 * (90.0 - 25.0))
+    assert p.height_neg_deg == pytest.approx(-100.0 + 1.5 * (90.0 - 25.0))
+
+
 def test_sweep_too_small_for_the_dead_zone_is_refused_naming_it() -> None:
     with pytest.raises(ValueError, match=r"other knob at \+30 deg: too few samples"):
         fit_tension_play([synthetic_sweep(0.0), synthetic_sweep(30.0, amplitude_deg=26.0)],

@@ -75,6 +75,11 @@ class DeviceKnob:
     """Optional: backlash on the tip after the reversal at reference_neg."""
     dead_zone_offset_deg: float | None = None
     """Optional: how far beyond the edge the current shows the tip leaves the plateau."""
+    reference_dead_zone_pos_deg: float | None = None
+    """Optional (with ``_neg``): the dead-zone edges tsmd's calibration found in the current of
+    the unit the reference points were measured on (other knob at 0): the plateau heights are
+    then product constants and each unit's loaded line moves with its own edges (tension play)."""
+    reference_dead_zone_neg_deg: float | None = None
 
 
 @dataclass(frozen=True)
@@ -257,7 +262,11 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             None if release is None else r.omega(release, key + ".release_omega"),
             optional(b_pos, "reference_backlash_pos_deg", 0.0, 90.0, "deg"),
             optional(b_neg, "reference_backlash_neg_deg", 0.0, 90.0, "deg"),
-            optional(k.get("dead_zone_offset_deg"), "dead_zone_offset_deg", -20.0, 20.0, "deg")))
+            optional(k.get("dead_zone_offset_deg"), "dead_zone_offset_deg", -20.0, 20.0, "deg"),
+            optional(k.get("reference_dead_zone_pos_deg"), "reference_dead_zone_pos_deg", 0.0,
+                     90.0, "deg"),
+            optional(k.get("reference_dead_zone_neg_deg"), "reference_dead_zone_neg_deg", -90.0,
+                     0.0, "deg")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -279,6 +288,10 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             knobs[name]["reference_backlash_neg_deg"] = k.reference_backlash_neg_deg
         if k.dead_zone_offset_deg is not None:
             knobs[name]["dead_zone_offset_deg"] = k.dead_zone_offset_deg
+        for side in ("pos", "neg"):
+            value = getattr(k, f"reference_dead_zone_{side}_deg")
+            if value is not None:
+                knobs[name][f"reference_dead_zone_{side}_deg"] = value
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

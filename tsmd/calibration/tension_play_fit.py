@@ -9,7 +9,12 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
 * the zero-tension point ``x0``: the loaded current ramp (from 10 deg past ``D`` to 5 deg before
   the turn) fitted by a line and extrapolated to the current that moves the knob the same way
   through the dead zone, where no tendon is loaded (friction and any sensor offset cancel);
-* ``beta = B_A / (A - x0)``: the backlash grows with the load, and the load with ``x - x0``.
+* ``beta = B_A / (A - x0)``: the backlash grows with the load, and the load with ``x - x0``;
+* the plateau heights ``H``: product constants, from the data sheet's reference points through
+  the edges the current showed on the data-sheet unit (``reference_dead_zone_*_deg``), so that
+  each unit's loaded line moves with its own edges (more slack: the tip reaches less at +-90).
+  Without those data-sheet keys, the paper's assumption: the line through the reference point
+  and this unit's own edge at 0 deg.
 
 ``beta`` and ``x0`` scatter from sweep to sweep (``B_A`` by about 1 deg); over the grid they are
 smoothed by a least-squares polynomial in the other knob's angle (degree <= 2, at most n - 2),
@@ -163,10 +168,16 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     d_pos = [f.dead_zone_deg for f in pos_fits]
     d_neg = [f.dead_zone_deg for f in neg_fits]
     k = device_knob
-    h_pos = height_from_reference(k.reference_pos.knob_deg, k.reference_pos.tip_deg,
-                                  float(np.interp(0.0, grid, d_pos)), k.omega)
-    h_neg = height_from_reference(k.reference_neg.knob_deg, k.reference_neg.tip_deg,
-                                  float(np.interp(0.0, grid, d_neg)), k.omega)
+    # H: with the data-sheet unit's own edges a product constant (the unit's loaded line moves
+    # with its edges); without them the paper's assumption (the line through the reference point)
+    ref_pos = getattr(k, "reference_dead_zone_pos_deg", None)
+    ref_neg = getattr(k, "reference_dead_zone_neg_deg", None)
+    edge_pos = float(np.interp(0.0, grid, d_pos)) if ref_pos is None else ref_pos + offset
+    edge_neg = float(np.interp(0.0, grid, d_neg)) if ref_neg is None else ref_neg - offset
+    h_pos = height_from_reference(k.reference_pos.knob_deg, k.reference_pos.tip_deg, edge_pos,
+                                  k.omega)
+    h_neg = height_from_reference(k.reference_neg.knob_deg, k.reference_neg.tip_deg, edge_neg,
+                                  k.omega)
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
                                           np.asarray(s.pos_deg, float)) for s in order]))
     lo, hi = BETA_RANGE

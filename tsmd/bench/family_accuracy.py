@@ -13,8 +13,10 @@ tension play's RMSE to the paper's, and the worst unit and scenario.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
+import re
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -28,6 +30,7 @@ from tsmd.bench.accuracy import (
     Scenario,
     calibrated_profile,
     compute_time_us,
+    plot_runs,
     run_scenario,
     scenarios,
 )
@@ -102,6 +105,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fresh", action="store_true", help="fresh plant, no conditioning")
     parser.add_argument("--device", type=Path, default=Path("profiles/devices/sim-catheter.yaml"))
     parser.add_argument("--report", type=Path, default=None)
+    parser.add_argument("--plots", type=Path, default=None,
+                        help="directory for time and input-output figures of the first unit")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -145,6 +150,13 @@ def main(args: argparse.Namespace) -> int:
                     + f" | {red:.1f} | {red_p:.1f} | {ratio:.2f} |")
             lines.append(line)
             print(line, f"({time.perf_counter() - t0:.0f} s)", flush=True)
+            if args.plots is not None and seed == seeds[0]:
+                # the figure's "ours" is the tension play (meant to replace it)
+                runs = [dataclasses.replace(r, method="ours" if m == "tension" else m)
+                        for m, r in res.items()]
+                name = f"family-unit{seed}-{s.group}-{s.name}".replace(" ", "_")
+                plot_runs(runs, args.plots / (re.sub(r"[^A-Za-z0-9_.-]", "", name) + ".png"),
+                          f"unit {seed}: {s.group}, {s.name} (ours = tension play)")
         med, p99 = compute_time_us(profile, "tension")
         lines.append(f"| {seed} | compute per tick, two knobs | median {med:.1f} us, "
                      f"p99 {p99:.1f} us |")

@@ -16,6 +16,7 @@ from tsmd.calibration.tension_play_fit import (
     fit_side,
     fit_tension_play,
     friction_current_A,
+    median_of_three,
 )
 from tsmd.compensation import CompensationError, build_compensator
 from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
@@ -106,6 +107,11 @@ def test_backlash_longer_than_the_loaded_run_is_refused() -> None:
     with pytest.raises(ValueError, match="does not fit a load ramp"):
         fit_tension_play([synthetic_sweep(g, backlash_deg=85.0) for g in (-90.0, 90.0)],
                          DEVICE_KNOB)
+
+
+def test_one_sweeps_outlying_edge_is_removed_and_a_trend_kept() -> None:
+    assert median_of_three([20.0, 20.2, 21.0, 20.1, 20.0]) == [20.0, 20.2, 20.2, 20.1, 20.0]
+    assert median_of_three([43.0, 35.0, 28.0, 21.0]) == [43.0, 35.0, 28.0, 21.0]
 
 
 def test_one_sweep_is_not_a_grid() -> None:

@@ -18,7 +18,8 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
 
 ``beta`` and ``x0`` scatter from sweep to sweep (``B_A`` by about 1 deg); over the grid they are
 smoothed by a least-squares polynomial in the other knob's angle (degree <= 2, at most n - 2),
-which keeps a trend the coupling gives and removes the scatter. ``lag_s`` is the delay that maps
+which keeps a trend the coupling gives and removes the scatter. The edges ``D``, which coupling
+can move steeply, get a running median of three instead. ``lag_s`` is the delay that maps
 commanded onto actual position. The tip is never used.
 """
 
@@ -116,6 +117,16 @@ def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list
     return [float(v) for v in np.polyval(coef, g)]
 
 
+def median_of_three(values: Sequence[float]) -> list[float]:
+    """Each inner grid value replaced by the median of it and its neighbours: removes one
+    sweep's outlier (an edge scatters by ~0.5 deg per sweep) and keeps any monotone trend the
+    coupling of the knobs gives exactly."""
+    v = [float(x) for x in values]
+    if len(v) < 3:
+        return v
+    return [v[0]] + [float(np.median(v[i - 1:i + 2])) for i in range(1, len(v) - 1)] + [v[-1]]
+
+
 def estimate_lag_s(t_s: FloatArray, cmd_deg: FloatArray, pos_deg: FloatArray,
                    max_lag_s: float = 0.5) -> float:
     """The delay that best maps commanded onto actual position (least squares over a grid)."""
@@ -188,8 +199,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                 fits.append(fit_side(pos, cur, sign, d, b, zero))
         except ValueError as exc:
             raise ValueError(f"{where}: {exc}") from None
-    d_pos = [f.dead_zone_deg for f in pos_fits]
-    d_neg = [f.dead_zone_deg for f in neg_fits]
+    d_pos = median_of_three([f.dead_zone_deg for f in pos_fits])
+    d_neg = median_of_three([f.dead_zone_deg for f in neg_fits])
     k = device_knob
     # H: with the data-sheet unit's own edges a product constant (the unit's loaded line moves
     # with its edges); without them the paper's assumption (the line through the reference point)

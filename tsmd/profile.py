@@ -80,13 +80,6 @@ class DeviceKnob:
     the unit the reference points were measured on (other knob at 0): the plateau heights are
     then product constants and each unit's loaded line moves with its own edges (tension play)."""
     reference_dead_zone_neg_deg: float | None = None
-    reference_zero_load_pos_deg: float | None = None
-    """Optional (tension play): where the same unit's loaded current ramps extrapolate to zero
-    tension; ``D - x0`` measures the joint friction the tip must overcome (``_neg`` likewise)."""
-    reference_zero_load_neg_deg: float | None = None
-    plateau_gain: float | None = None
-    """Optional (tension play): tip plateau height per knob degree of ``D - x0`` (tip deg/deg),
-    the plateau (tip at rest, held by joint friction) over the same unit's mean ``D - x0``."""
 
 
 @dataclass(frozen=True)
@@ -273,12 +266,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional(k.get("reference_dead_zone_pos_deg"), "reference_dead_zone_pos_deg", 0.0,
                      90.0, "deg"),
             optional(k.get("reference_dead_zone_neg_deg"), "reference_dead_zone_neg_deg", -90.0,
-                     0.0, "deg"),
-            optional(k.get("reference_zero_load_pos_deg"), "reference_zero_load_pos_deg", -90.0,
-                     90.0, "deg"),
-            optional(k.get("reference_zero_load_neg_deg"), "reference_zero_load_neg_deg", -90.0,
-                     90.0, "deg"),
-            optional(k.get("plateau_gain"), "plateau_gain", 0.0, 5.0, "tip deg per knob deg")))
+                     0.0, "deg")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -300,8 +288,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             knobs[name]["reference_backlash_neg_deg"] = k.reference_backlash_neg_deg
         if k.dead_zone_offset_deg is not None:
             knobs[name]["dead_zone_offset_deg"] = k.dead_zone_offset_deg
-        for key in ("reference_dead_zone_pos_deg", "reference_dead_zone_neg_deg",
-                    "reference_zero_load_pos_deg", "reference_zero_load_neg_deg", "plateau_gain"):
+        for key in ("reference_dead_zone_pos_deg", "reference_dead_zone_neg_deg"):
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
     return {"schema_version": device.schema_version, "device_model": device.device_model,

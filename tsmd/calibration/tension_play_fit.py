@@ -141,29 +141,6 @@ def estimate_lag_s(t_s: FloatArray, cmd_deg: FloatArray, pos_deg: FloatArray,
     return float(lags[int(np.argmin(errors))])
 
 
-def plateau_spread_deg(device_knob: Any, pos_fits: Sequence[SideFit],
-                       neg_fits: Sequence[SideFit], offset_deg: float) -> float:
-    """How much further apart this unit's plateaus are than the data-sheet unit's (each side).
-
-    Joint friction holds the tip bent at rest (the plateaus) and must be overcome by tension
-    before the tip moves: the current shows it as the run ``D - x0`` from the zero-tension point
-    to the edge. The plateau grows with it by the data sheet's ``plateau_gain``; 0 without it.
-    """
-    k = device_knob
-    refs = (getattr(k, "reference_dead_zone_pos_deg", None),
-            getattr(k, "reference_dead_zone_neg_deg", None),
-            getattr(k, "reference_zero_load_pos_deg", None),
-            getattr(k, "reference_zero_load_neg_deg", None), getattr(k, "plateau_gain", None))
-    if any(v is None for v in refs):
-        return 0.0
-    d_pos, d_neg, x0_pos, x0_neg, gain = (float(v) for v in refs)  # type: ignore[arg-type]
-    reference = 0.5 * ((d_pos - x0_pos) + (x0_neg - d_neg))
-    unit = float(np.median([0.5 * ((p.dead_zone_deg - offset_deg - p.zero_load_deg)
-                                   + (n.zero_load_deg - n.dead_zone_deg - offset_deg))
-                            for p, n in zip(pos_fits, neg_fits, strict=True)]))
-    return gain * (unit - reference)
-
-
 def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> TensionPlayParams:
     """One knob's parameters from all its sweeps (ValueError naming the sweep that fails).
 
@@ -212,8 +189,6 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                                   k.omega)
     h_neg = height_from_reference(k.reference_neg.knob_deg, k.reference_neg.tip_deg, edge_neg,
                                   k.omega)
-    spread = plateau_spread_deg(k, pos_fits, neg_fits, offset)
-    h_pos, h_neg = h_pos - spread, h_neg + spread
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
                                           np.asarray(s.pos_deg, float)) for s in order]))
     lo, hi = BETA_RANGE

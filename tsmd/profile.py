@@ -29,6 +29,11 @@ import yaml
 from tsmd.compensation.grid import CALIBRATION_GRID_DEG, INTERPOLATION_METHODS
 from tsmd.compensation.ours import OursParams, ours_params_from_mapping, ours_params_to_mapping
 from tsmd.compensation.safety import KnobLimits
+from tsmd.compensation.tension_play import (
+    TensionPlayParams,
+    tension_play_from_mapping,
+    tension_play_to_mapping,
+)
 from tsmd.errors import TsmdError
 
 PROFILE_SCHEMA_VERSION = 1
@@ -70,6 +75,11 @@ class DeviceKnob:
     """Optional: backlash on the tip after the reversal at reference_neg."""
     dead_zone_offset_deg: float | None = None
     """Optional: how far beyond the edge the current shows the tip leaves the plateau."""
+    reference_dead_zone_pos_deg: float | None = None
+    """Optional (with ``_neg``): the dead-zone edges tsmd's calibration found in the current of
+    the unit the reference points were measured on (other knob at 0): the plateau heights are
+    then product constants and each unit's loaded line moves with its own edges (tension play)."""
+    reference_dead_zone_neg_deg: float | None = None
 
 
 @dataclass(frozen=True)
@@ -101,6 +111,7 @@ class KnobProfile:
     backlash_pos_deg: tuple[float, ...]
     backlash_neg_deg: tuple[float, ...]
     ours: OursParams | None = None
+    tension_play: TensionPlayParams | None = None
 
     def grid_array(self) -> np.ndarray:
         """(n, 4) array: D_pos, D_neg, B_pos, B_neg per grid point."""
@@ -251,7 +262,11 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             None if release is None else r.omega(release, key + ".release_omega"),
             optional(b_pos, "reference_backlash_pos_deg", 0.0, 90.0, "deg"),
             optional(b_neg, "reference_backlash_neg_deg", 0.0, 90.0, "deg"),
-            optional(k.get("dead_zone_offset_deg"), "dead_zone_offset_deg", -20.0, 20.0, "deg")))
+            optional(k.get("dead_zone_offset_deg"), "dead_zone_offset_deg", -20.0, 20.0, "deg"),
+            optional(k.get("reference_dead_zone_pos_deg"), "reference_dead_zone_pos_deg", 0.0,
+                     90.0, "deg"),
+            optional(k.get("reference_dead_zone_neg_deg"), "reference_dead_zone_neg_deg", -90.0,
+                     0.0, "deg")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -273,6 +288,9 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             knobs[name]["reference_backlash_neg_deg"] = k.reference_backlash_neg_deg
         if k.dead_zone_offset_deg is not None:
             knobs[name]["dead_zone_offset_deg"] = k.dead_zone_offset_deg
+        for key in ("reference_dead_zone_pos_deg", "reference_dead_zone_neg_deg"):
+            if getattr(k, key) is not None:
+                knobs[name][key] = getattr(k, key)
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 
@@ -313,7 +331,14 @@ def _knob_from_mapping(r: _Reader, raw: Any, key: str) -> KnobProfile:
     ours = None
     if k.get("ours") is not None:
         ours = _ours_from_mapping(r, k["ours"], p + "ours", n)
-    return KnobProfile(omega, pos, neg, h_pos, h_neg, grid, d_pos, d_neg, b_pos, b_neg, ours)
+    tension = None
+    if k.get("tension_play") is not None:
+        try:
+            tension = tension_play_from_mapping(r.mapping(k["tension_play"], p + "tension_play"))
+        except ValueError as exc:
+            raise r.fail(p + "tension_play", str(exc)) from None
+    return KnobProfile(omega, pos, neg, h_pos, h_neg, grid, d_pos, d_neg, b_pos, b_neg, ours,
+                       tension)
 
 
 def _ours_from_mapping(r: _Reader, raw: Any, key: str, n: int) -> OursParams:
@@ -363,6 +388,8 @@ def profile_to_mapping(profile: CatheterProfile) -> dict[str, Any]:
         }
         if k.ours is not None:
             entry["ours"] = ours_params_to_mapping(k.ours)
+        if k.tension_play is not None:
+            entry["tension_play"] = tension_play_to_mapping(k.tension_play)
         knobs[name] = entry
     return {
         "schema_version": profile.schema_version,

@@ -40,6 +40,7 @@ from tsmd.calibration.identify import IdentifyOptions, identify_sweep
 from tsmd.calibration.ours_fit import fit_ours_for_knob
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import Sweep, paper_protocol, return_to_zero, sweep_run
+from tsmd.calibration.tension_play_fit import with_tension_play
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
@@ -152,6 +153,10 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
                                    f"{exc}") from None
     profile = build_profile(catheter_id, device, points, quality=report,
                             software_version=__version__, ours=ours, source=source)
+    try:
+        profile = with_tension_play(profile, points, device)
+    except (ValueError, ArithmeticError) as exc:
+        raise CalibrationError(f"the tension-play fit failed: {exc}") from None
     return profile, report
 
 

@@ -24,12 +24,13 @@ from tsmd.compensation.safety import (
     KnobLimiter,
     KnobLimits,
 )
+from tsmd.compensation.tension_play import tension_play_compensator
 from tsmd.errors import TsmdError
 
 if TYPE_CHECKING:
     from tsmd.profile import CatheterProfile
 
-METHODS: tuple[str, ...] = ("none", "paper", "ours")
+METHODS: tuple[str, ...] = ("none", "paper", "ours", "tension")
 
 __all__ = [
     "METHODS",
@@ -156,6 +157,13 @@ def build_compensator(profile: CatheterProfile | None, method: str, period_s: fl
         raise CompensationError(f"compensation method {method!r} needs a catheter profile")
     elif method == "paper":
         inner = paper_compensator(profile)
+    elif method == "tension":
+        params = [k.tension_play for k in profile.knobs]
+        if params[0] is None or params[1] is None:
+            raise CompensationError(f"profile {profile.catheter_id!r} has no 'tension_play' "
+                                    "parameters; recalibrate with this tsmd version")
+        inner = tension_play_compensator((params[0], params[1]), period_s, limits,
+                                         profile.interpolation)
     else:
         # the motor's limits set when a jump must start; the simulated rig's when not given
         v_max = (min(lim.max_velocity_deg_s for lim in limits) if limits

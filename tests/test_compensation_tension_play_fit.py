@@ -1,0 +1,165 @@
+"""Identification of the tension play from calibration current, and its profile section."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from test_profile import make_profile
+
+from tsmd.calibration.tension_play_fit import (
+    SweepCurrent,
+    fit_side,
+    fit_tension_play,
+    friction_current_A,
+    median_of_three,
+)
+from tsmd.compensation import CompensationError, build_compensator
+from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
+from tsmd.profile import (
+    DeviceKnob,
+    KnobLimits,
+    ProfileError,
+    ReferencePoint,
+    load_profile,
+    profile_to_mapping,
+    save_profile,
+)
+
+PERIOD_S = 0.004
+D_POS, D_NEG, X0_POS, X0_NEG = 20.0, -22.0, 12.0, -13.0
+DEVICE_KNOB = DeviceKnob(1.5, ReferencePoint(90.0, 100.0), ReferencePoint(-90.0, -100.0),
+                         KnobLimits(-90.0, 90.0, 120.0, 2000.0))
+
+
+def synthetic_sweep(other_deg: float = 0.0, amplitude_deg: float = 90.0, seed: int = 0,
+                    offset_A: float = 0.004, backlash_deg: float = 25.0) -> SweepCurrent:
+    """A +-A sine sweep whose current is friction (sign of the speed, plus a sensor offset) and
+    a tension ramp from the zero-tension points, as a capstan drive shows on its loaded side."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 50.0, PERIOD_S)
+    pos = -amplitude_deg * np.cos(2 * math.pi * 0.04 * t)
+    v = np.gradient(pos)
+    load = np.where((v > 0) & (pos > D_POS), 0.003 * (pos - X0_POS), 0.0)
+    load += np.where((v < 0) & (pos < D_NEG), 0.003 * (pos - X0_NEG), 0.0)
+    current = offset_A + 0.03 * np.sign(v) + load + rng.normal(0.0, 0.002, t.size)
+    return SweepCurrent(other_deg, t, pos, pos, current, D_POS, D_NEG, backlash_deg,
+                        backlash_deg)
+
+
+def test_zero_tension_point_is_where_the_ramp_meets_the_friction_current() -> None:
+    s = synthetic_sweep()
+    zero = friction_current_A(s.pos_deg, s.current_A, D_POS, D_NEG, 1)
+    side = fit_side(s.pos_deg, s.current_A, 1, D_POS, 25.0, zero)
+    assert side.zero_load_deg == pytest.approx(X0_POS, abs=0.3)
+
+
+def test_backlash_gain_is_the_calibration_backlash_over_the_loaded_run() -> None:
+    s = synthetic_sweep()
+    zero = friction_current_A(s.pos_deg, s.current_A, D_POS, D_NEG, -1)
+    side = fit_side(s.pos_deg, s.current_A, -1, D_NEG, 25.0, zero)
+    assert side.backlash_gain == pytest.approx(25.0 / (90.0 + X0_NEG), rel=0.01)
+
+
+def test_sensor_offset_does_not_move_the_zero_tension_point() -> None:
+    a = fit_tension_play([synthetic_sweep(g, offset_A=0.0) for g in (-90.0, 0.0, 90.0)],
+                         DEVICE_KNOB)
+    b = fit_tension_play([synthetic_sweep(g, offset_A=0.05) for g in (-90.0, 0.0, 90.0)],
+                         DEVICE_KNOB)
+    assert np.allclose(a.zero_load_pos_deg, b.zero_load_pos_deg, atol=0.05)
+
+
+def test_fit_gives_every_parameter_on_the_sweeps_grid() -> None:
+    grid = (-90.0, -30.0, 0.0, 30.0, 90.0)
+    p = fit_tension_play([synthetic_sweep(g, seed=i) for i, g in enumerate(grid)], DEVICE_KNOB)
+    assert p.other_knob_deg == grid
+    assert np.allclose(p.zero_load_neg_deg, X0_NEG, atol=0.5)
+    assert p.dead_zone_pos_deg == (D_POS,) * 5
+    assert p.height_pos_deg == pytest.approx(100.0 - 1.5 * (90.0 - D_POS))
+
+
+def test_data_sheet_dead_zone_offset_moves_the_edges_outward() -> None:
+    knob = dataclasses.replace(DEVICE_KNOB, dead_zone_offset_deg=0.5)
+    p = fit_tension_play([synthetic_sweep(g) for g in (-90.0, 90.0)], knob)
+    assert p.dead_zone_pos_deg == (D_POS + 0.5,) * 2
+    assert p.dead_zone_neg_deg == (D_NEG - 0.5,) * 2
+
+
+def test_plateau_heights_are_product_constants_with_the_data_sheet_units_edges() -> None:
+    knob = dataclasses.replace(DEVICE_KNOB, reference_dead_zone_pos_deg=25.0,
+                               reference_dead_zone_neg_deg=-25.0)
+    p = fit_tension_play([synthetic_sweep(g) for g in (-90.0, 90.0)], knob)
+    assert p.height_pos_deg == pytest.approx(100.0 - 1.5 * (90.0 - 25.0))
+    assert p.height_neg_deg == pytest.approx(-100.0 + 1.5 * (90.0 - 25.0))
+
+
+def test_sweep_too_small_for_the_dead_zone_is_refused_naming_it() -> None:
+    with pytest.raises(ValueError, match=r"other knob at \+30 deg: too few samples"):
+        fit_tension_play([synthetic_sweep(0.0), synthetic_sweep(30.0, amplitude_deg=26.0)],
+                         DEVICE_KNOB)
+
+
+def test_backlash_longer_than_the_loaded_run_is_refused() -> None:
+    with pytest.raises(ValueError, match="does not fit a load ramp"):
+        fit_tension_play([synthetic_sweep(g, backlash_deg=85.0) for g in (-90.0, 90.0)],
+                         DEVICE_KNOB)
+
+
+def test_one_sweeps_outlying_edge_is_removed_and_a_trend_kept() -> None:
+    assert median_of_three([20.0, 20.2, 21.0, 20.1, 20.0]) == [20.0, 20.2, 20.2, 20.1, 20.0]
+    assert median_of_three([43.0, 35.0, 28.0, 21.0]) == [43.0, 35.0, 28.0, 21.0]
+
+
+def test_one_sweep_is_not_a_grid() -> None:
+    with pytest.raises(ValueError, match=">= 2 other-knob angles"):
+        fit_tension_play([synthetic_sweep()], DEVICE_KNOB)
+
+
+# ----------------------------------------------------------------------------------------------
+# Profile section
+
+
+def profile_with_tension_play():  # type: ignore[no-untyped-def]
+    p = fit_tension_play([synthetic_sweep(g) for g in (-90.0, 0.0, 90.0)], DEVICE_KNOB)
+    base = make_profile()
+    return dataclasses.replace(base, knobs=tuple(dataclasses.replace(k, tension_play=p)
+                                                 for k in base.knobs))
+
+
+def test_tension_play_section_round_trips_through_a_profile_file(tmp_path: Path) -> None:
+    profile = profile_with_tension_play()
+    save_profile(profile, tmp_path / "p.yaml")
+    assert load_profile(tmp_path / "p.yaml") == profile
+
+
+def test_bad_tension_play_value_is_one_line_error_naming_the_key(tmp_path: Path) -> None:
+    data = profile_to_mapping(profile_with_tension_play())
+    data["knobs"]["phi2"]["tension_play"]["backlash_gain_pos"][1] = 1.5
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(data), encoding="utf-8")
+    with pytest.raises(ProfileError, match=r"knobs\.phi2\.tension_play.*backlash_gain_pos\[1\]"):
+        load_profile(path)
+
+
+def test_mapping_refuses_unknown_and_missing_keys() -> None:
+    m = tension_play_to_mapping(profile_with_tension_play().knobs[0].tension_play)
+    with pytest.raises(ValueError, match="colour: unknown key"):
+        tension_play_from_mapping({**m, "colour": 1.0})
+    m.pop("zero_load_neg_deg")
+    with pytest.raises(ValueError, match="zero_load_neg_deg: missing key"):
+        tension_play_from_mapping(m)
+
+
+def test_method_tension_needs_the_section() -> None:
+    with pytest.raises(CompensationError, match="no 'tension_play' parameters"):
+        build_compensator(make_profile(), "tension", PERIOD_S)
+
+
+def test_method_tension_builds_from_a_profile_with_the_section() -> None:
+    comp = build_compensator(profile_with_tension_play(), "tension", PERIOD_S)
+    comp.reset(np.zeros(2))
+    assert np.all(np.isfinite(comp.command(np.array([10.0, -10.0]))))

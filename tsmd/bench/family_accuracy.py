@@ -1,0 +1,185 @@
+"""`tsmd bench family`: tracking accuracy on a family of catheter units, each calibrated from its
+own motor current, scored against the simulated tip.
+
+Each unit is drawn from a plant factory (``module:factory`` with JSON parameters; by default the
+built-in capstan plant with ``unit_variation`` and a unit ``seed``), calibrated by
+``tsmd.calibration.calibrate`` through the full simulated stack, then every scenario runs through
+the full stack (``tsmd.bench.accuracy.run_scenario``) for each method. The data sheet stays the
+one measured once on the nominal unit, which is therefore not scored. Printed: per unit and
+scenario the RMSE/PTPE of each method, the reductions against no compensation, the ratio of the
+tension play's RMSE to the paper's, and the worst unit and scenario.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import re
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tsmd.bench.accuracy import (
+    PERIOD_S,
+    Scenario,
+    calibrated_profile,
+    compute_time_us,
+    plot_runs,
+    run_scenario,
+    scenarios,
+)
+from tsmd.errors import TsmdError
+
+FloatArray = NDArray[np.float64]
+DEFAULT_PLANT = "simrig.plants.capstan.tendon_sheath:make_tendon_sheath_plant"
+TARGET_RMSE_PCT = {"1-DOF": 90.0, "2-DOF": 85.0}
+TARGET_PTPE_PCT = {"1-DOF": 75.0, "2-DOF": 60.0}
+TARGET_RATIO_TO_PAPER = 0.6
+
+
+def extra_scenarios() -> list[Scenario]:
+    """Beyond the paper: 0.1 Hz triangles, point-to-point moves with dwell, a multisine."""
+    out: list[Scenario] = []
+    t = np.arange(0.0, 20.0, PERIOD_S)
+    phase = (0.1 * t) % 1.0
+    tri = 60.0 * np.where(phase < 0.25, 4 * phase, np.where(phase < 0.75, 2 - 4 * phase,
+                                                            4 * phase - 4))
+    q = np.zeros((t.size, 2))
+    q[:, 0] = tri
+    out.append(Scenario("1-DOF triangle", "phi1 0.1 Hz +-60", t, q, (0,)))
+    targets = (40.0, -20.0, 60.0, 10.0, -50.0, 25.0, -5.0, 0.0)
+    t_p = np.arange(0.0, 4.0 * len(targets), PERIOD_S)
+    q_p = np.zeros((t_p.size, 2))
+    start = 0.0
+    for k, goal in enumerate(targets):  # 1.5 s raised-cosine move, 2.5 s dwell
+        sel = (t_p >= 4.0 * k) & (t_p < 4.0 * (k + 1))
+        s = np.clip((t_p[sel] - 4.0 * k) / 1.5, 0.0, 1.0)
+        q_p[sel, 1] = start + (goal - start) * (0.5 - 0.5 * np.cos(math.pi * s))
+        start = goal
+    out.append(Scenario("1-DOF point-to-point", "phi2 moves with 2.5 s dwell", t_p, q_p, (1,)))
+    t_m = np.arange(0.0, 50.0, PERIOD_S)
+    freqs = (0.02, 0.05, 0.11, 0.17)
+    amps = (30.0, 15.0, 8.0, 4.0)
+    phases = (0.0, 1.3, 2.9, 4.1)
+    multi = np.zeros_like(t_m)
+    for a, f, p in zip(amps, freqs, phases, strict=True):  # starts at 0
+        multi += a * (np.sin(2 * math.pi * f * t_m + p) - math.sin(p))
+    q_m = np.column_stack([multi, 0.8 * multi[::-1] - 0.8 * multi[-1]])
+    out.append(Scenario("2-DOF multisine", "4 tones 0.02-0.17 Hz", t_m, q_m, (0, 1)))
+    return out
+
+
+def plant_factory(spec: str, params: dict[str, Any]) -> Callable[[], Any]:
+    from simrig.plant import PlantLoadError, load_plant
+
+    def make() -> Any:
+        try:
+            return load_plant(spec, params)
+        except PlantLoadError as exc:
+            raise TsmdError(str(exc)) from None
+
+    make()  # fail early with a one-line error
+    return make
+
+
+def _pct(none: float, other: float) -> float:
+    return 100.0 * (none - other) / none if none > 0 else math.nan
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--plant", default=DEFAULT_PLANT, help="plant factory module:factory")
+    parser.add_argument("--params", default="{}", help="JSON keyword parameters of the plant")
+    parser.add_argument("--unit-variation", type=float, default=0.15,
+                        help="unit scatter passed to the plant as unit_variation (0: not passed)")
+    parser.add_argument("--unit-seeds", default="1,2,3",
+                        help="comma-separated unit seeds (passed as seed)")
+    parser.add_argument("--methods", default="none,paper,tension")
+    parser.add_argument("--quick", action="store_true", help="the paper's quick scenario set")
+    parser.add_argument("--no-extra", action="store_true", help="skip the extra scenarios")
+    parser.add_argument("--fresh", action="store_true", help="fresh plant, no conditioning")
+    parser.add_argument("--device", type=Path, default=Path("profiles/devices/sim-catheter.yaml"))
+    parser.add_argument("--report", type=Path, default=None)
+    parser.add_argument("--plots", type=Path, default=None,
+                        help="directory for time and input-output figures of the first unit")
+
+
+def main(args: argparse.Namespace) -> int:
+    from tsmd.profile import load_device_model
+
+    try:
+        base = json.loads(args.params)
+    except json.JSONDecodeError as exc:
+        raise TsmdError(f"--params is not valid JSON: {exc}") from None
+    if not isinstance(base, dict):
+        raise TsmdError("--params must be a JSON object")
+    try:
+        seeds = [int(s) for s in str(args.unit_seeds).split(",") if s.strip()]
+    except ValueError:
+        raise TsmdError(f"--unit-seeds must be integers, got {args.unit_seeds!r}") from None
+    methods = [m.strip() for m in str(args.methods).split(",") if m.strip()]
+    device = load_device_model(args.device)
+    scen = scenarios(bool(args.quick)) + ([] if args.no_extra else extra_scenarios())
+    t0 = time.perf_counter()
+    lines = [f"plant {args.plant} {json.dumps(base)}; unit_variation {args.unit_variation}; "
+             f"units {seeds}; start {'fresh' if args.fresh else 'conditioned'}", "",
+             "| unit | scenario | " + " | ".join(f"{m} RMSE/PTPE" for m in methods)
+             + " | RMSE red. % | PTPE red. % | RMSE / paper |", "|" + "---|" * (len(methods) + 5)]
+    rows: list[tuple[int, str, str, float, float, float]] = []
+    for seed in seeds:
+        params = dict(base)
+        if args.unit_variation > 0:
+            params.update(unit_variation=float(args.unit_variation), seed=seed)
+        make = plant_factory(args.plant, params)
+        print(f"unit {seed}: calibrating from motor current ...", flush=True)
+        profile = calibrated_profile(device, make)
+        for s in scen:
+            res = {m: run_scenario(s, m, 0, profile, make, not args.fresh) for m in methods}
+            red = _pct(res["none"].rmse_deg, res["tension"].rmse_deg)
+            red_p = _pct(res["none"].ptpe_deg, res["tension"].ptpe_deg)
+            ratio = (res["tension"].rmse_deg / res["paper"].rmse_deg
+                     if "paper" in res else math.nan)
+            rows.append((seed, s.group, s.name, red, red_p, ratio))
+            line = (f"| {seed} | {s.group}: {s.name} | "
+                    + " | ".join(f"{res[m].rmse_deg:.2f}/{res[m].ptpe_deg:.1f}" for m in methods)
+                    + f" | {red:.1f} | {red_p:.1f} | {ratio:.2f} |")
+            lines.append(line)
+            print(line, f"({time.perf_counter() - t0:.0f} s)", flush=True)
+            if args.plots is not None and seed == seeds[0]:
+                # the figure's "ours" is the tension play (meant to replace it)
+                runs = [dataclasses.replace(r, method="ours" if m == "tension" else m)
+                        for m, r in res.items()]
+                name = f"family-unit{seed}-{s.group}-{s.name}".replace(" ", "_")
+                plot_runs(runs, args.plots / (re.sub(r"[^A-Za-z0-9_.-]", "", name) + ".png"),
+                          f"unit {seed}: {s.group}, {s.name} (ours = tension play)")
+        med, p99 = compute_time_us(profile, "tension")
+        lines.append(f"| {seed} | compute per tick, two knobs | median {med:.1f} us, "
+                     f"p99 {p99:.1f} us |")
+    lines += ["", "Targets (tension play): RMSE red. >= 90 % 1-DOF / 85 % 2-DOF, PTPE red. >= 75 "
+              "/ 60 %, RMSE <= 0.6 x paper's.", ""]
+    for label, idx in (("RMSE reduction", 3), ("PTPE reduction", 4)):
+        worst = min(rows, key=lambda r: r[idx])
+        lines.append(f"worst {label}: {worst[idx]:.1f} % (unit {worst[0]}, {worst[1]}: "
+                     f"{worst[2]})")
+    worst_ratio = max(rows, key=lambda r: r[5])
+    lines.append(f"worst RMSE ratio to paper: {worst_ratio[5]:.2f} (unit {worst_ratio[0]}, "
+                 f"{worst_ratio[1]}: {worst_ratio[2]})")
+    misses = [r for r in rows if r[3] < TARGET_RMSE_PCT[r[1].split()[0]]
+              or r[4] < TARGET_PTPE_PCT[r[1].split()[0]] or r[5] > TARGET_RATIO_TO_PAPER]
+    lines.append(f"rows missing a target: {len(misses)} of {len(rows)}")
+    lines.append(f"wall time {time.perf_counter() - t0:.0f} s")
+    print("\n".join(lines))
+    if args.report is not None:
+        args.report.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return 0
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__)
+    add_arguments(parser)
+    raise SystemExit(main(parser.parse_args()))

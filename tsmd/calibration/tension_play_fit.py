@@ -1,0 +1,232 @@
+"""Tension-play parameters of one catheter from its calibration sweeps (motor current only).
+
+Per sweep (one knob swept +-A, the other held at a grid angle) and side:
+
+* the dead-zone edge ``D`` and the backlash at the amplitude ``B_A``: what the current analysis
+  (:mod:`tsmd.calibration.identify`) found, ``D`` moved outward by the data sheet's
+  ``dead_zone_offset_deg`` where it gives one (a per-product constant: where the tip leaves its
+  plateau beyond the current's edge);
+* the zero-tension point ``x0``: the loaded current ramp (from 10 deg past ``D`` to 5 deg before
+  the turn) fitted by a line and extrapolated to the current that moves the knob the same way
+  through the dead zone, where no tendon is loaded (friction and any sensor offset cancel);
+* ``beta = B_A / (A - x0)``: the backlash grows with the load, and the load with ``x - x0``;
+* the plateau heights ``H``: product constants, from the data sheet's reference points through
+  the edges the current showed on the data-sheet unit (``reference_dead_zone_*_deg``), so that
+  each unit's loaded line moves with its own edges (more slack: the tip reaches less at +-90).
+  Without those data-sheet keys, the paper's assumption: the line through the reference point
+  and this unit's own edge at 0 deg.
+
+``beta`` and ``x0`` scatter from sweep to sweep (``B_A`` by about 1 deg); over the grid they are
+smoothed by a least-squares polynomial in the other knob's angle (degree <= 2, at most n - 2),
+which keeps a trend the coupling gives and removes the scatter. The edges ``D``, which coupling
+can move steeply, get a running median of three instead. ``lag_s`` is the delay that maps
+commanded onto actual position. The tip is never used.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tsmd.compensation.paper import height_from_reference
+from tsmd.compensation.tension_play import BETA_RANGE, TensionPlayParams
+
+FloatArray = NDArray[np.float64]
+RAMP_START_DEG = 10.0
+"""The loaded ramp is fitted from this far past the dead-zone edge (the knee is curved) ..."""
+RAMP_END_DEG = 5.0
+"""... to this far before the turn (the current lags and the drive slows there)."""
+PLATEAU_MARGIN_DEG = 5.0
+MIN_RAMP_SAMPLES = 50
+
+
+@dataclass(frozen=True)
+class SweepCurrent:
+    """One sweep's arrays (uncompensated) and the current analysis' D and B (deg)."""
+
+    other_knob_deg: float
+    t_s: FloatArray
+    cmd_deg: FloatArray
+    pos_deg: FloatArray
+    current_A: FloatArray
+    dead_zone_pos_deg: float
+    dead_zone_neg_deg: float
+    backlash_pos_deg: float
+    backlash_neg_deg: float
+
+
+@dataclass(frozen=True)
+class SideFit:
+    """What one side of one sweep gave."""
+
+    dead_zone_deg: float
+    backlash_deg: float
+    amplitude_deg: float
+    zero_load_deg: float
+    backlash_gain: float
+
+
+def friction_current_A(pos_deg: FloatArray, current_A: FloatArray, d_pos: float, d_neg: float,
+                       direction: int) -> float:
+    """The current moving through the dead zone in ``direction``: no tendon is loaded, only the
+    knob's and the motor's friction act (and any offset of the sensor). The loaded ramp of the
+    same direction carries the same friction, so tension = current minus this."""
+    v = np.gradient(pos_deg)
+    inside = (pos_deg > d_neg + PLATEAU_MARGIN_DEG) & (pos_deg < d_pos - PLATEAU_MARGIN_DEG)
+    moving = current_A[inside & (direction * v > 0)]
+    if moving.size < 10:
+        raise ValueError("the sweep does not cross the dead zone both ways")
+    return float(np.median(moving))
+
+
+def fit_side(pos_deg: FloatArray, current_A: FloatArray, sign: int, dead_zone_deg: float,
+             backlash_deg: float, zero_A: float) -> SideFit:
+    """x0 and beta of one side (``sign`` +1: positive side, loaded while moving up)."""
+    v = np.gradient(pos_deg)
+    amplitude = float(np.max(sign * pos_deg)) * sign
+    x = sign * pos_deg
+    sel = ((sign * v > 0) & (x > sign * dead_zone_deg + RAMP_START_DEG)
+           & (x < sign * amplitude - RAMP_END_DEG))
+    if np.count_nonzero(sel) < MIN_RAMP_SAMPLES:
+        raise ValueError(f"too few samples on the loaded ramp of the {'+' if sign > 0 else '-'} "
+                         "side (amplitude too small for the dead zone)")
+    slope, intercept = np.polyfit(pos_deg[sel], current_A[sel] - zero_A, 1)
+    if not slope > 0:  # the current grows with the position on both sides (sign of load)
+        raise ValueError("the loaded current does not grow with the load")
+    x0 = float(-intercept / slope)
+    run = sign * (amplitude - x0)
+    if not run > backlash_deg > 0:
+        raise ValueError(f"backlash {backlash_deg:.1f} deg does not fit a load ramp of "
+                         f"{run:.1f} deg")
+    beta = min(max(backlash_deg / run, BETA_RANGE[0]), BETA_RANGE[1])
+    return SideFit(dead_zone_deg, backlash_deg, amplitude, x0, beta)
+
+
+def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list[float]:
+    """Least-squares polynomial over the grid (degree min(2, n - 2), 0 for n <= 2)."""
+    g = np.asarray(grid_deg, float)
+    y = np.asarray(values, float)
+    degree = max(0, min(2, g.size - 2))
+    coef = np.polyfit(g, y, degree)
+    return [float(v) for v in np.polyval(coef, g)]
+
+
+def median_of_three(values: Sequence[float]) -> list[float]:
+    """Each inner grid value replaced by the median of it and its neighbours: removes one
+    sweep's outlier (an edge scatters by ~0.5 deg per sweep) and keeps any monotone trend the
+    coupling of the knobs gives exactly."""
+    v = [float(x) for x in values]
+    if len(v) < 3:
+        return v
+    return [v[0]] + [float(np.median(v[i - 1:i + 2])) for i in range(1, len(v) - 1)] + [v[-1]]
+
+
+def estimate_lag_s(t_s: FloatArray, cmd_deg: FloatArray, pos_deg: FloatArray,
+                   max_lag_s: float = 0.5) -> float:
+    """The delay that best maps commanded onto actual position (least squares over a grid)."""
+    ok = np.isfinite(t_s) & np.isfinite(cmd_deg) & np.isfinite(pos_deg)
+    t, cmd, pos = t_s[ok], cmd_deg[ok], pos_deg[ok]
+    if t.size < 10:
+        return 0.0
+    dt = float(np.median(np.diff(t)))
+    use = t > t[0] + max_lag_s
+    lags = np.arange(0.0, max_lag_s + 0.5 * dt, max(dt / 4.0, 1e-4))
+    errors = [float(np.mean((np.interp(t - lag, t, cmd) - pos)[use] ** 2)) for lag in lags]
+    return float(lags[int(np.argmin(errors))])
+
+
+def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> TensionPlayParams:
+    """One knob's parameters from all its sweeps (ValueError naming the sweep that fails).
+
+    ``device_knob``: the data sheet's knob (``omega``, ``reference_pos``/``_neg`` and optionally
+    ``dead_zone_offset_deg``), measured once per product on another unit.
+    """
+    if len(sweeps) < 2:
+        raise ValueError("needs sweeps at >= 2 other-knob angles")
+    order = sorted(sweeps, key=lambda s: s.other_knob_deg)
+    grid = [float(s.other_knob_deg) for s in order]
+    if any(b <= a for a, b in itertools.pairwise(grid)):
+        raise ValueError(f"two sweeps at the same other-knob angle: {grid}")
+    offset = float(getattr(device_knob, "dead_zone_offset_deg", None) or 0.0)
+    pos_fits: list[SideFit] = []
+    neg_fits: list[SideFit] = []
+    for s in order:
+        where = f"sweep with the other knob at {s.other_knob_deg:+.0f} deg"
+        values = (s.dead_zone_pos_deg, s.dead_zone_neg_deg, s.backlash_pos_deg,
+                  s.backlash_neg_deg)
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"{where}: no finite D/B from the current: {values}")
+        pos = np.asarray(s.pos_deg, float)
+        cur = np.asarray(s.current_A, float)
+        ok = np.isfinite(pos) & np.isfinite(cur)
+        pos, cur = pos[ok], cur[ok]
+        try:
+            for sign, fits, d, b in ((1, pos_fits, s.dead_zone_pos_deg + offset,
+                                      s.backlash_pos_deg),
+                                     (-1, neg_fits, s.dead_zone_neg_deg - offset,
+                                      s.backlash_neg_deg)):
+                zero = friction_current_A(pos, cur, s.dead_zone_pos_deg, s.dead_zone_neg_deg,
+                                          sign)
+                fits.append(fit_side(pos, cur, sign, d, b, zero))
+        except ValueError as exc:
+            raise ValueError(f"{where}: {exc}") from None
+    d_pos = median_of_three([f.dead_zone_deg for f in pos_fits])
+    d_neg = median_of_three([f.dead_zone_deg for f in neg_fits])
+    k = device_knob
+    # H: with the data-sheet unit's own edges a product constant (the unit's loaded line moves
+    # with its edges); without them the paper's assumption (the line through the reference point)
+    ref_pos = getattr(k, "reference_dead_zone_pos_deg", None)
+    ref_neg = getattr(k, "reference_dead_zone_neg_deg", None)
+    edge_pos = float(np.interp(0.0, grid, d_pos)) if ref_pos is None else ref_pos + offset
+    edge_neg = float(np.interp(0.0, grid, d_neg)) if ref_neg is None else ref_neg - offset
+    h_pos = height_from_reference(k.reference_pos.knob_deg, k.reference_pos.tip_deg, edge_pos,
+                                  k.omega)
+    h_neg = height_from_reference(k.reference_neg.knob_deg, k.reference_neg.tip_deg, edge_neg,
+                                  k.omega)
+    lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
+                                          np.asarray(s.pos_deg, float)) for s in order]))
+    lo, hi = BETA_RANGE
+    return TensionPlayParams(
+        omega=float(k.omega), height_pos_deg=float(h_pos), height_neg_deg=float(h_neg),
+        other_knob_deg=tuple(grid), dead_zone_pos_deg=tuple(d_pos),
+        dead_zone_neg_deg=tuple(d_neg),
+        backlash_gain_pos=tuple(min(max(b, lo), hi) for b in
+                                smooth_over_grid(grid, [f.backlash_gain for f in pos_fits])),
+        backlash_gain_neg=tuple(min(max(b, lo), hi) for b in
+                                smooth_over_grid(grid, [f.backlash_gain for f in neg_fits])),
+        zero_load_pos_deg=tuple(smooth_over_grid(grid, [f.zero_load_deg for f in pos_fits])),
+        zero_load_neg_deg=tuple(smooth_over_grid(grid, [f.zero_load_deg for f in neg_fits])),
+        lag_s=min(max(lag, 0.0), 1.0))
+
+
+def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
+    """:class:`SweepCurrent` of one knob from the calibration's grid points."""
+    out = []
+    for p in points:
+        if p.knob != knob:
+            continue
+        d = p.result.data
+        est = p.result.estimate
+        out.append(SweepCurrent(float(p.other_deg), d.t_s, d.cmd_deg, d.pos_deg,
+                                d.current_filtered_A, est("dead_zone_pos_deg"),
+                                est("dead_zone_neg_deg"), est("backlash_pos_deg"),
+                                est("backlash_neg_deg")))
+    return out
+
+
+def fit_from_points(points: Sequence[Any], device: Any) -> tuple[TensionPlayParams, ...]:
+    """Both knobs' parameters from the calibration's grid points and the data sheet."""
+    return tuple(fit_tension_play(sweeps_from_points(points, k), device.knobs[k]) for k in (0, 1))
+
+
+def with_tension_play(profile: Any, points: Sequence[Any], device: Any) -> Any:
+    """``profile`` with each knob's ``tension_play`` parameters fitted from ``points``."""
+    params = fit_from_points(points, device)
+    knobs = tuple(replace(k, tension_play=p) for k, p in zip(profile.knobs, params, strict=True))
+    return replace(profile, knobs=knobs)

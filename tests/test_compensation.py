@@ -18,6 +18,8 @@ from tsmd.compensation import (
     build_compensator,
 )
 from tsmd.compensation.grid import ParameterField
+from tsmd.compensation.ours import OursKnob
+from tsmd.compensation.paper import at_other_knob_zero, offset_edges, plateau_heights
 from tsmd.compensation.safety import LimiterState, limit_step
 from tsmd.profile import load_profile
 
@@ -151,6 +153,51 @@ def test_pchip_does_not_overshoot_between_grid_points() -> None:
     xs = np.linspace(-90, 90, 361)
     ys = np.array([f.at(x)[0] for x in xs])
     assert ys.min() >= 10.0 - 1e-12 and ys.max() <= 20.0 + 1e-12
+
+
+def test_named_parameter_field_finds_its_columns_by_name() -> None:
+    f = ParameterField.from_columns([-90, 0, 90], {"dead_zone_pos_deg": [14, 15, 16],
+                                                   "backlash_pos_deg": [20, 21, 22]}, "linear")
+    assert f.columns == ("dead_zone_pos_deg", "backlash_pos_deg")
+    assert f.at(0)[f.column("backlash_pos_deg")] == 21.0
+    with pytest.raises(KeyError, match="no parameter 'omega'"):
+        f.column("omega")
+
+
+def test_shifting_a_named_parameter_moves_only_that_parameter() -> None:
+    f = ParameterField.from_columns([-90, 0, 90], {"a": [1, 2, 3], "b": [4, 5, 6]}, "linear")
+    g = f.shifted({"b": -1.5})
+    assert np.array_equal(g.values[:, 0], f.values[:, 0])
+    assert np.array_equal(g.values[:, 1], f.values[:, 1] - 1.5)
+    assert g.columns == f.columns
+
+
+def test_a_field_refuses_column_names_that_do_not_match_its_values() -> None:
+    with pytest.raises(ValueError, match="2 column names for 1 columns"):
+        ParameterField([-90, 0, 90], np.array([[1.0], [2.0], [3.0]]), "linear", ("a", "b"))
+
+
+def test_our_knob_refuses_a_field_without_its_named_columns() -> None:
+    unnamed = ParameterField([-90, 0, 90], np.zeros((3, 7)), "linear")
+    with pytest.raises(ValueError, match="must hold"):
+        OursKnob(unnamed, 5.0, -5.0, 1.5, 0.0)
+
+
+def test_plateau_heights_come_from_the_reference_line_through_the_edge_at_zero() -> None:
+    profile = load_profile(ROOT / "profiles" / "example-sim.yaml")
+    k = profile.knobs[0]
+    d_pos0 = at_other_knob_zero(k.other_knob_deg, k.dead_zone_pos_deg)
+    d_neg0 = at_other_knob_zero(k.other_knob_deg, k.dead_zone_neg_deg)
+    h_pos, h_neg = plateau_heights(k, d_pos0, d_neg0)
+    assert h_pos == pytest.approx(k.reference_pos.tip_deg
+                                  - k.omega * (k.reference_pos.knob_deg - d_pos0))
+    assert h_neg == pytest.approx(k.reference_neg.tip_deg
+                                  - k.omega * (k.reference_neg.knob_deg - d_neg0))
+
+
+def test_the_dead_zone_offset_moves_both_edges_outward() -> None:
+    d_pos, d_neg = offset_edges([15.0, 16.0], [-14.0, -15.0], 0.5)
+    assert d_pos.tolist() == [15.5, 16.5] and d_neg.tolist() == [-14.5, -15.5]
 
 
 def test_example_profile_builds_every_method() -> None:

@@ -11,13 +11,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from support.profiles import make_profile
 
+from tsmd.calibration.lag import estimate_lag_s
+from tsmd.calibration.ours_fit import SweepData, fit_ours_knob
 from tsmd.compensation import build_compensator, ours_compensator
 from tsmd.compensation.ours import (
     OursState,
-    SweepData,
     envelopes,
-    estimate_lag_s,
-    fit_ours_knob,
     ours_inverse_step,
     ours_model_step,
     release_line,

@@ -28,6 +28,7 @@ import yaml
 
 from tsmd.compensation.grid import CALIBRATION_GRID_DEG, INTERPOLATION_METHODS
 from tsmd.compensation.ours import OursParams, ours_params_from_mapping, ours_params_to_mapping
+from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
     TensionPlayParams,
@@ -546,12 +547,9 @@ def make_knob_profile(device_knob: DeviceKnob, other_knob_deg: Sequence[float],
     H_pos/H_neg follow design assumptions 1-3: the line of slope omega through the reference point
     (other knob at 0 deg) meets the dead-zone edge D(0) at height H; H is then constant.
     """
-    grid = np.asarray(other_knob_deg, dtype=float)
-    d_pos0 = float(np.interp(0.0, grid, np.asarray(dead_zone_pos_deg, dtype=float)))
-    d_neg0 = float(np.interp(0.0, grid, np.asarray(dead_zone_neg_deg, dtype=float)))
     k = device_knob
-    h_pos = k.reference_pos.tip_deg - k.omega * (k.reference_pos.knob_deg - d_pos0)
-    h_neg = k.reference_neg.tip_deg - k.omega * (k.reference_neg.knob_deg - d_neg0)
+    h_pos, h_neg = plateau_heights(k, at_other_knob_zero(other_knob_deg, dead_zone_pos_deg),
+                                   at_other_knob_zero(other_knob_deg, dead_zone_neg_deg))
 
     def floats(values: Sequence[float]) -> tuple[float, ...]:
         return tuple(float(v) for v in values)

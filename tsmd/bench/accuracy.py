@@ -25,8 +25,8 @@ from simrig.analysis import measure_dead_zone_backlash
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd import __version__
 from tsmd.calibration import calibrate
+from tsmd.calibration.ours_fit import SweepData, fit_ours_knob
 from tsmd.compensation import LimitedCompensator, build_compensator
-from tsmd.compensation.ours import SweepData, fit_ours_knob
 from tsmd.config import default_sim_config
 from tsmd.datasheet import analysed_from, settle, tip_sweep
 from tsmd.errors import TsmdError

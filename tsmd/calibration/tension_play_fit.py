@@ -34,7 +34,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tsmd.compensation.paper import height_from_reference
+from tsmd.calibration.lag import estimate_lag_s
+from tsmd.compensation.paper import at_other_knob_zero, offset_edges, plateau_heights
 from tsmd.compensation.tension_play import BETA_RANGE, TensionPlayParams
 
 FloatArray = NDArray[np.float64]
@@ -127,20 +128,6 @@ def median_of_three(values: Sequence[float]) -> list[float]:
     return [v[0]] + [float(np.median(v[i - 1:i + 2])) for i in range(1, len(v) - 1)] + [v[-1]]
 
 
-def estimate_lag_s(t_s: FloatArray, cmd_deg: FloatArray, pos_deg: FloatArray,
-                   max_lag_s: float = 0.5) -> float:
-    """The delay that best maps commanded onto actual position (least squares over a grid)."""
-    ok = np.isfinite(t_s) & np.isfinite(cmd_deg) & np.isfinite(pos_deg)
-    t, cmd, pos = t_s[ok], cmd_deg[ok], pos_deg[ok]
-    if t.size < 10:
-        return 0.0
-    dt = float(np.median(np.diff(t)))
-    use = t > t[0] + max_lag_s
-    lags = np.arange(0.0, max_lag_s + 0.5 * dt, max(dt / 4.0, 1e-4))
-    errors = [float(np.mean((np.interp(t - lag, t, cmd) - pos)[use] ** 2)) for lag in lags]
-    return float(lags[int(np.argmin(errors))])
-
-
 def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> TensionPlayParams:
     """One knob's parameters from all its sweeps (ValueError naming the sweep that fails).
 
@@ -166,11 +153,11 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         cur = np.asarray(s.current_A, float)
         ok = np.isfinite(pos) & np.isfinite(cur)
         pos, cur = pos[ok], cur[ok]
+        edge_pos, edge_neg = (float(e) for e in offset_edges(s.dead_zone_pos_deg,
+                                                              s.dead_zone_neg_deg, offset))
         try:
-            for sign, fits, d, b in ((1, pos_fits, s.dead_zone_pos_deg + offset,
-                                      s.backlash_pos_deg),
-                                     (-1, neg_fits, s.dead_zone_neg_deg - offset,
-                                      s.backlash_neg_deg)):
+            for sign, fits, d, b in ((1, pos_fits, edge_pos, s.backlash_pos_deg),
+                                     (-1, neg_fits, edge_neg, s.backlash_neg_deg)):
                 zero = friction_current_A(pos, cur, s.dead_zone_pos_deg, s.dead_zone_neg_deg,
                                           sign)
                 fits.append(fit_side(pos, cur, sign, d, b, zero))
@@ -183,12 +170,11 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     # with its edges); without them the paper's assumption (the line through the reference point)
     ref_pos = getattr(k, "reference_dead_zone_pos_deg", None)
     ref_neg = getattr(k, "reference_dead_zone_neg_deg", None)
-    edge_pos = float(np.interp(0.0, grid, d_pos)) if ref_pos is None else ref_pos + offset
-    edge_neg = float(np.interp(0.0, grid, d_neg)) if ref_neg is None else ref_neg - offset
-    h_pos = height_from_reference(k.reference_pos.knob_deg, k.reference_pos.tip_deg, edge_pos,
-                                  k.omega)
-    h_neg = height_from_reference(k.reference_neg.knob_deg, k.reference_neg.tip_deg, edge_neg,
-                                  k.omega)
+    ref_edges = offset_edges(0.0 if ref_pos is None else ref_pos,
+                             0.0 if ref_neg is None else ref_neg, offset)
+    edge_pos = at_other_knob_zero(grid, d_pos) if ref_pos is None else float(ref_edges[0])
+    edge_neg = at_other_knob_zero(grid, d_neg) if ref_neg is None else float(ref_edges[1])
+    h_pos, h_neg = plateau_heights(k, edge_pos, edge_neg)
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
                                           np.asarray(s.pos_deg, float)) for s in order]))
     lo, hi = BETA_RANGE

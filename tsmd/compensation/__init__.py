@@ -16,8 +16,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
-from tsmd.compensation.ours import OursCompensator, OursKnob
-from tsmd.compensation.paper import PaperCompensator, PaperKnob
+from tsmd.compensation.ours import OursCompensator, OursKnob, ours_field
+from tsmd.compensation.paper import (
+    PaperCompensator,
+    PaperKnob,
+    at_other_knob_zero,
+    offset_edges,
+    plateau_heights,
+)
 from tsmd.compensation.safety import (
     DEFAULT_MAX_ACCEL_DEG_S2,
     DEFAULT_MAX_VELOCITY_DEG_S,
@@ -105,7 +111,11 @@ class LimitedCompensator:
 
 
 def paper_compensator(profile: CatheterProfile) -> PaperCompensator:
-    knobs = tuple(PaperKnob(ParameterField(k.other_knob_deg, k.grid_array(), profile.interpolation),
+    knobs = tuple(PaperKnob(ParameterField.from_columns(k.other_knob_deg, {
+                      "dead_zone_pos_deg": k.dead_zone_pos_deg,
+                      "dead_zone_neg_deg": k.dead_zone_neg_deg,
+                      "backlash_pos_deg": k.backlash_pos_deg,
+                      "backlash_neg_deg": k.backlash_neg_deg}, profile.interpolation),
                             k.height_pos_deg, k.height_neg_deg, k.omega)
                   for k in profile.knobs)
     return PaperCompensator((knobs[0], knobs[1]))
@@ -123,18 +133,13 @@ def ours_compensator(profile: CatheterProfile, period_s: float,
         o = k.ours
         # Our dead-zone edges: the current's, moved outward by the data sheet's offset; H from
         # the reference points through them (design assumptions 1-3, as for the paper).
-        d_pos = np.asarray(k.dead_zone_pos_deg, float) + o.dead_zone_offset_deg
-        d_neg = np.asarray(k.dead_zone_neg_deg, float) - o.dead_zone_offset_deg
-        grid = np.asarray(k.other_knob_deg, float)
-        h_pos = k.reference_pos.tip_deg - k.omega * (k.reference_pos.knob_deg
-                                                     - float(np.interp(0.0, grid, d_pos)))
-        h_neg = k.reference_neg.tip_deg - k.omega * (k.reference_neg.knob_deg
-                                                     - float(np.interp(0.0, grid, d_neg)))
-        values = np.column_stack([
-            d_pos, d_neg, o.release_slope_pos, o.release_slope_neg, o.release_pivot_pos_deg,
-            o.release_pivot_neg_deg, o.backlash_blend_deg]).astype(float)
-        knobs.append(OursKnob(ParameterField(k.other_knob_deg, values, profile.interpolation),
-                              float(h_pos), float(h_neg), k.omega, o.lag_s))
+        d_pos, d_neg = offset_edges(k.dead_zone_pos_deg, k.dead_zone_neg_deg,
+                                    o.dead_zone_offset_deg)
+        h_pos, h_neg = plateau_heights(k, at_other_knob_zero(k.other_knob_deg, d_pos),
+                                       at_other_knob_zero(k.other_knob_deg, d_neg))
+        field = ours_field(k.other_knob_deg, d_pos.tolist(), d_neg.tolist(), o,
+                           profile.interpolation)
+        knobs.append(OursKnob(field, h_pos, h_neg, k.omega, o.lag_s))
     return OursCompensator((knobs[0], knobs[1]), period_s, max_velocity_deg_s, max_accel_deg_s2)
 
 

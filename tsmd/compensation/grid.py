@@ -7,7 +7,7 @@ end values are held (no extrapolation): the grid already spans the knob's range.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -24,7 +24,7 @@ class ParameterField:
     """Several named parameters sampled on one grid, evaluated together at any angle."""
 
     def __init__(self, grid_deg: Sequence[float], values: NDArray[np.float64],
-                 method: str = "pchip") -> None:
+                 method: str = "pchip", columns: Sequence[str] = ()) -> None:
         grid = np.asarray(grid_deg, dtype=float)
         vals = np.asarray(values, dtype=float)
         if method not in INTERPOLATION_METHODS:
@@ -33,9 +33,13 @@ class ParameterField:
             raise ValueError("grid must be strictly increasing with at least two points")
         if vals.ndim != 2 or vals.shape[0] != grid.size:
             raise ValueError(f"values must have shape ({grid.size}, n), got {vals.shape}")
+        if columns and len(columns) != vals.shape[1]:
+            raise ValueError(f"{len(columns)} column names for {vals.shape[1]} columns")
         self.grid_deg = grid
         self.values = vals
         self.method = method
+        self.columns = tuple(columns)
+        """The parameters' names, in column order (empty for an unnamed field)."""
         self._lo = float(grid[0])
         self._hi = float(grid[-1])
         if method == "pchip":
@@ -54,3 +58,25 @@ class ParameterField:
             out: NDArray[np.float64] = (1.0 - w) * self.values[i] + w * self.values[i + 1]
             return out
         return np.asarray(self._f(a), dtype=float)
+
+    @classmethod
+    def from_columns(cls, grid_deg: Sequence[float], columns: Mapping[str, Sequence[float]],
+                     method: str = "pchip") -> ParameterField:
+        """A named field: one grid row of values per name, columns in the mapping's order."""
+        names = tuple(columns)
+        values = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
+        return cls(grid_deg, values, method, names)
+
+    def column(self, name: str) -> int:
+        """The column index of the parameter ``name``."""
+        try:
+            return self.columns.index(name)
+        except ValueError:
+            raise KeyError(f"no parameter {name!r} in this field {self.columns}") from None
+
+    def shifted(self, offsets_deg: Mapping[str, float]) -> ParameterField:
+        """A copy with ``offsets_deg[name]`` added to each named parameter at every grid point."""
+        values = self.values.copy()
+        for name, offset in offsets_deg.items():
+            values[:, self.column(name)] += offset
+        return ParameterField(self.grid_deg.tolist(), values, self.method, self.columns)

@@ -287,15 +287,42 @@ def ours_inverse_step(state: OursState, y_desired_deg: float, env: Envelopes) ->
     return OursState(x, y, direction, held, blend)
 
 
+OURS_COLUMNS: tuple[str, ...] = (
+    "dead_zone_pos_deg", "dead_zone_neg_deg", "release_slope_pos", "release_slope_neg",
+    "release_pivot_pos_deg", "release_pivot_neg_deg", "backlash_blend_deg")
+"""The parameters of :attr:`OursKnob.field`, in the column order :meth:`OursKnob.envelopes`
+reads them."""
+
+
+def ours_field(other_knob_deg: Sequence[float], dead_zone_pos_deg: Sequence[float],
+               dead_zone_neg_deg: Sequence[float], params: OursParams,
+               interpolation: str = "pchip") -> ParameterField:
+    """The named field of one knob: the (offset) dead-zone edges and our extra parameters."""
+    return ParameterField.from_columns(other_knob_deg, {
+        "dead_zone_pos_deg": dead_zone_pos_deg,
+        "dead_zone_neg_deg": dead_zone_neg_deg,
+        "release_slope_pos": params.release_slope_pos,
+        "release_slope_neg": params.release_slope_neg,
+        "release_pivot_pos_deg": params.release_pivot_pos_deg,
+        "release_pivot_neg_deg": params.release_pivot_neg_deg,
+        "backlash_blend_deg": params.backlash_blend_deg,
+    }, interpolation)
+
+
 @dataclass(frozen=True)
 class OursKnob:
     """One knob of our compensator: parameters over the other knob's angle + constants."""
 
-    field: ParameterField  # D_pos, D_neg, release slopes (pos, neg), pivots (pos, neg), blend
+    field: ParameterField  # named :data:`OURS_COLUMNS`, built by :func:`ours_field`
     height_pos_deg: float
     height_neg_deg: float
     omega: float
     lag_s: float
+
+    def __post_init__(self) -> None:
+        if self.field.columns != OURS_COLUMNS:
+            raise ValueError(f"our compensator's field must hold {OURS_COLUMNS}, "
+                             f"got {self.field.columns}")
 
     def envelopes(self, other_deg: float) -> Envelopes:
         d_pos, d_neg, s_pos, s_neg, p_pos, p_neg, blend = (float(v) for v in
@@ -464,125 +491,3 @@ class OursCompensator:
 
 # ----------------------------------------------------------------------------------------------
 # Identification (called by the calibration with the arrays it collects)
-
-
-@dataclass(frozen=True)
-class SweepData:
-    """One calibration sweep of one knob with the other knob held at ``other_knob_deg``.
-
-    Arrays of equal length, uncompensated: ``cmd_deg`` commanded and ``pos_deg`` actual knob
-    angle, ``current_A`` the knob motor's current (filtered or raw: it is filtered again here).
-    ``dead_zone_*``/``backlash_*`` are what the paper's identification found for this sweep.
-    """
-
-    t_s: NDArray[np.float64]
-    cmd_deg: NDArray[np.float64]
-    pos_deg: NDArray[np.float64]
-    current_A: NDArray[np.float64]
-    other_knob_deg: float
-    dead_zone_pos_deg: float
-    dead_zone_neg_deg: float
-    backlash_pos_deg: float
-    backlash_neg_deg: float
-
-
-def estimate_lag_s(t_s: NDArray[np.float64], cmd_deg: NDArray[np.float64],
-                   pos_deg: NDArray[np.float64], max_lag_s: float = 0.5) -> float:
-    """The delay that best maps commanded onto actual position (least squares over a grid)."""
-    t = np.asarray(t_s, float)
-    cmd = np.asarray(cmd_deg, float)
-    pos = np.asarray(pos_deg, float)
-    ok = np.isfinite(t) & np.isfinite(cmd) & np.isfinite(pos)
-    t, cmd, pos = t[ok], cmd[ok], pos[ok]
-    if t.size < 10:
-        return 0.0
-    dt = float(np.median(np.diff(t)))
-    lags = np.arange(0.0, max_lag_s + 0.5 * dt, max(dt / 4.0, 1e-4))
-    errors = [float(np.mean((np.interp(t - lag, t, cmd) - pos)[t > t[0] + max_lag_s] ** 2))
-              for lag in lags]
-    return float(lags[int(np.argmin(errors))])
-
-
-def heights_from_sweeps(sweeps: Sequence[SweepData], device_knob: Any,
-                        dead_zone_offset_deg: float = 0.0) -> tuple[float, float]:
-    """H_pos, H_neg by design assumptions 1-3: the data sheet's reference points and slope with
-    the dead-zone edges identified with the other knob at 0 deg (interpolated over the sweeps),
-    moved outward by ``dead_zone_offset_deg``."""
-    order = sorted(sweeps, key=lambda s: s.other_knob_deg)
-    grid = [s.other_knob_deg for s in order]
-    d_pos0 = float(np.interp(0.0, grid, [s.dead_zone_pos_deg for s in order]))
-    d_neg0 = float(np.interp(0.0, grid, [s.dead_zone_neg_deg for s in order]))
-    d_pos0 += dead_zone_offset_deg
-    d_neg0 -= dead_zone_offset_deg
-    k = device_knob
-    h_pos = k.reference_pos.tip_deg - k.omega * (k.reference_pos.knob_deg - d_pos0)
-    h_neg = k.reference_neg.tip_deg - k.omega * (k.reference_neg.knob_deg - d_neg0)
-    return float(h_pos), float(h_neg)
-
-
-def fit_ours_knob(sweeps: Sequence[SweepData], device_knob: Any,
-                  other_knob_deg: Sequence[float] | None = None) -> OursParams:
-    """Our extra parameters for one knob from its calibration sweeps (current-only data).
-
-    ``sweeps``: every sweep of this knob, each tagged with the other knob's angle and the D/B the
-    paper's identification found in its current. ``device_knob``: the data sheet's
-    :class:`tsmd.profile.DeviceKnob` (omega, reference points) that also gives the profile's H.
-    ``other_knob_deg``: the profile's grid (default: the sweeps' other-knob angles, sorted); each
-    grid point needs a sweep within 1 deg (several are combined by the median).
-
-    Release lines: the data sheet's release slope and reference backlash, moved with each
-    sweep's D (:func:`release_line_from_reference`), or, without them, from the sweep's
-    amplitude (actual knob position), D and B (:func:`release_line`). Lag: commanded vs actual
-    position, median over the sweeps. The backlash blend is 0 (corners): its identification is
-    not built yet.
-    """
-    if not sweeps:
-        raise ValueError("fit_ours_knob needs at least one sweep")
-    for s in sweeps:
-        values = (s.dead_zone_pos_deg, s.dead_zone_neg_deg, s.backlash_pos_deg,
-                  s.backlash_neg_deg)
-        if not all(math.isfinite(v) for v in values):
-            raise ValueError(f"sweep at {s.other_knob_deg} deg has no finite D/B: {values}")
-    omega = float(device_knob.omega)
-    release_omega = getattr(device_knob, "release_omega", None)
-    ref_b_pos = getattr(device_knob, "reference_backlash_pos_deg", None)
-    ref_b_neg = getattr(device_knob, "reference_backlash_neg_deg", None)
-    dz_offset = float(getattr(device_knob, "dead_zone_offset_deg", None) or 0.0)
-    h_pos, h_neg = heights_from_sweeps(sweeps, device_knob, dz_offset)
-    grid = sorted({float(s.other_knob_deg) for s in sweeps}) if other_knob_deg is None else list(
-        other_knob_deg)
-    order = sorted(sweeps, key=lambda s: s.other_knob_deg)
-    at_zero = [float(np.interp(0.0, [s.other_knob_deg for s in order],
-                               [getattr(s, name) for s in order]))
-               for name in ("dead_zone_pos_deg", "dead_zone_neg_deg")]
-    columns: list[list[float]] = [[], [], [], []]
-    for g in grid:
-        near = [s for s in sweeps if abs(s.other_knob_deg - g) <= 1.0]
-        if not near:
-            raise ValueError(f"no sweep with the other knob at {g} deg")
-        lines: list[tuple[float, float, float, float]] = []
-        for s in near:
-            pos = np.asarray(s.pos_deg, float)
-            pos = pos[np.isfinite(pos)]
-            if pos.size == 0:
-                raise ValueError(f"sweep at {g} deg has no finite position")
-            if release_omega is not None and ref_b_pos is not None and ref_b_neg is not None:
-                k = device_knob
-                sp, pp = release_line_from_reference(
-                    k.reference_pos.knob_deg - ref_b_pos, k.reference_pos.tip_deg, h_neg,
-                    release_omega, s.dead_zone_pos_deg - at_zero[0])
-                sn, pn = release_line_from_reference(
-                    k.reference_neg.knob_deg + ref_b_neg, k.reference_neg.tip_deg, h_pos,
-                    release_omega, s.dead_zone_neg_deg - at_zero[1])
-            else:
-                sp, pp = release_line(float(pos.max()), s.dead_zone_pos_deg + dz_offset,
-                                      s.backlash_pos_deg, h_pos, h_neg, omega)
-                sn, pn = release_line(float(pos.min()), s.dead_zone_neg_deg - dz_offset,
-                                      s.backlash_neg_deg, h_neg, h_pos, omega)
-            lines.append((sp, sn, pp, pn))
-        for j in range(4):
-            columns[j].append(float(np.median([line[j] for line in lines])))
-    lag = float(np.median([estimate_lag_s(s.t_s, s.cmd_deg, s.pos_deg) for s in sweeps]))
-    n = len(grid)
-    return OursParams(min(lag, 1.0), tuple(columns[0]), tuple(columns[1]), tuple(columns[2]),
-                      tuple(columns[3]), (0.0,) * n, dz_offset)

@@ -17,9 +17,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import Protocol
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from tsmd.compensation.grid import ParameterField
 
@@ -95,6 +96,54 @@ def height_from_reference(reference_knob_deg: float, reference_tip_deg: float,
     """H from design assumptions 1-3: the line of slope omega through the reference point
     (X_ref, Y_ref) measured with the other knob at 0 deg, evaluated at the dead-zone end D."""
     return reference_tip_deg - omega * (reference_knob_deg - dead_zone_deg)
+
+
+class ReferenceConstants(Protocol):
+    """What H needs from a data sheet's knob (``tsmd.profile.DeviceKnob`` and ``KnobProfile``)."""
+
+    @property
+    def omega(self) -> float: ...
+    @property
+    def reference_pos(self) -> ReferenceLike: ...
+    @property
+    def reference_neg(self) -> ReferenceLike: ...
+
+
+class ReferenceLike(Protocol):
+    @property
+    def knob_deg(self) -> float: ...
+    @property
+    def tip_deg(self) -> float: ...
+
+
+def plateau_heights(constants: ReferenceConstants, dead_zone_pos_at_zero_deg: float,
+                    dead_zone_neg_at_zero_deg: float) -> tuple[float, float]:
+    """(H_pos, H_neg): :func:`height_from_reference` at both reference points, with the edges
+    the catheter shows with the other knob at 0 deg (where the reference points were measured).
+
+    The one place H is computed: profiles, compensators and calibration all call this.
+    """
+    h_pos = height_from_reference(constants.reference_pos.knob_deg,
+                                  constants.reference_pos.tip_deg, dead_zone_pos_at_zero_deg,
+                                  constants.omega)
+    h_neg = height_from_reference(constants.reference_neg.knob_deg,
+                                  constants.reference_neg.tip_deg, dead_zone_neg_at_zero_deg,
+                                  constants.omega)
+    return float(h_pos), float(h_neg)
+
+
+def at_other_knob_zero(other_knob_deg: ArrayLike, values: ArrayLike) -> float:
+    """A grid parameter at the other knob's 0 deg (linear between grid points, exact on one)."""
+    return float(np.interp(0.0, np.asarray(other_knob_deg, dtype=float),
+                           np.asarray(values, dtype=float)))
+
+
+def offset_edges(dead_zone_pos_deg: ArrayLike, dead_zone_neg_deg: ArrayLike, offset_deg: float
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The current's dead-zone edges moved outward by ``offset_deg`` (data sheet: how far
+    outside the current's edge the tip leaves its plateau). The one place the offset is applied."""
+    return (np.asarray(dead_zone_pos_deg, dtype=float) + offset_deg,
+            np.asarray(dead_zone_neg_deg, dtype=float) - offset_deg)
 
 
 def _line_rising(x_deg: float, p: PaperParams) -> tuple[float, Line]:

@@ -25,6 +25,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from simrig.family import PLANT_ROLE, PLANT_SPECS, family_member
+from simrig.plant import PlantLoadError, load_plant
 from tsmd.bench.accuracy import (
     PERIOD_S,
     Scenario,
@@ -34,7 +36,9 @@ from tsmd.bench.accuracy import (
     run_scenario,
     scenarios,
 )
+from tsmd.bench.realism import data_sheet
 from tsmd.errors import TsmdError
+from tsmd.profile import load_device_model
 
 FloatArray = NDArray[np.float64]
 DEFAULT_PLANT = "simrig.plants.capstan.tendon_sheath:make_tendon_sheath_plant"
@@ -76,8 +80,6 @@ def extra_scenarios() -> list[Scenario]:
 
 
 def plant_factory(spec: str, params: dict[str, Any]) -> Callable[[], Any]:
-    from simrig.plant import PlantLoadError, load_plant
-
     def make() -> Any:
         try:
             return load_plant(spec, params)
@@ -93,6 +95,12 @@ def _pct(none: float, other: float) -> float:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--family", choices=sorted(PLANT_SPECS), default=None,
+                        help="score units of a family plant (simrig.family) instead of --plant; "
+                             "the data sheet is measured on that plant's nominal unit")
+    parser.add_argument("--units", default="101,102",
+                        help="with --family: comma-separated unit numbers (1-8 development, "
+                             "101-108 held out)")
     parser.add_argument("--plant", default=DEFAULT_PLANT, help="plant factory module:factory")
     parser.add_argument("--params", default="{}", help="JSON keyword parameters of the plant")
     parser.add_argument("--unit-variation", type=float, default=0.15,
@@ -110,8 +118,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from tsmd.profile import load_device_model
-
     try:
         base = json.loads(args.params)
     except json.JSONDecodeError as exc:
@@ -131,11 +137,25 @@ def main(args: argparse.Namespace) -> int:
              "| unit | scenario | " + " | ".join(f"{m} RMSE/PTPE" for m in methods)
              + " | RMSE red. % | PTPE red. % | RMSE / paper |", "|" + "---|" * (len(methods) + 5)]
     rows: list[tuple[int, str, str, float, float, float]] = []
-    for seed in seeds:
+    units: list[tuple[int, Callable[[], Any]]] = []
+    if args.family is not None:
+        try:
+            numbers = [int(u) for u in str(args.units).split(",") if u.strip()]
+            members = [family_member(args.family, u) for u in numbers]
+        except (ValueError, PlantLoadError) as exc:
+            raise TsmdError(f"--units: {exc}") from None
+        if args.family != "capstan":  # the packaged sheet is the capstan product's
+            print(f"measuring the data sheet on {args.family} unit 0 ...", flush=True)
+            device = data_sheet(family_member(args.family, 0), args.device)
+        lines[0] = (f"family plant {args.family} ({PLANT_ROLE[args.family]}); units {numbers}; "
+                    f"data sheet from unit 0; start {'fresh' if args.fresh else 'conditioned'}")
+        units = [(m.unit, m.build) for m in members]
+    for seed in seeds if args.family is None else []:
         params = dict(base)
         if args.unit_variation > 0:
             params.update(unit_variation=float(args.unit_variation), seed=seed)
-        make = plant_factory(args.plant, params)
+        units.append((seed, plant_factory(args.plant, params)))
+    for seed, make in units:
         print(f"unit {seed}: calibrating from motor current ...", flush=True)
         profile = calibrated_profile(device, make)
         for s in scen:
@@ -150,7 +170,7 @@ def main(args: argparse.Namespace) -> int:
                     + f" | {red:.1f} | {red_p:.1f} | {ratio:.2f} |")
             lines.append(line)
             print(line, f"({time.perf_counter() - t0:.0f} s)", flush=True)
-            if args.plots is not None and seed == seeds[0]:
+            if args.plots is not None and seed == units[0][0]:
                 # the figure's "ours" is the tension play (meant to replace it)
                 runs = [dataclasses.replace(r, method="ours" if m == "tension" else m)
                         for m, r in res.items()]

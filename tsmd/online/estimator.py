@@ -34,7 +34,7 @@ class EstimatorOptions:
     window: int = 5
     gate_deg: float = 1.5
     confirm: int = 2
-    confirm_spread_deg: float = 1.5
+    confirm_spread_deg: float = 2.0
     max_offset_deg: float = 12.0
     deadband_deg: float = 0.4
     slope_ratio_max: float = 3.0

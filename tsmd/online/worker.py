@@ -17,7 +17,13 @@ from typing import Any
 
 from tsmd.online.apply import ZERO_OFFSETS, Offsets, apply_knobs, edges_at, shifted_knob
 from tsmd.online.estimator import EdgeTracker, EstimatorOptions
-from tsmd.online.features import LoadedRamp, RampOptions, Rejected, loaded_ramp
+from tsmd.online.features import (
+    LoadedRamp,
+    RampOptions,
+    Rejected,
+    loaded_ramp,
+    relocated_edge_deg,
+)
 from tsmd.online.segment import StrokeSegmenter
 
 RECORDING_COLUMNS: tuple[str, ...] = ("dz_off_pos1", "dz_off_neg1", "dz_off_pos2", "dz_off_neg2")
@@ -140,6 +146,9 @@ class OnlineWorker:
             else 0.0
         d_pos, d_neg = edges_at(self.base_knobs[knob], other)
         expected = d_pos + tracker.applied_deg if side > 0 else d_neg - tracker.applied_deg
+        if tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
+            expected = relocated_edge_deg(stroke, expected, tracker.level_A,
+                                          tracker.slope_ref_A_per_deg, self.ramp_options)
         ramp = loaded_ramp(stroke, expected, self.ramp_options)
         if isinstance(ramp, Rejected):
             if ramp.stall:

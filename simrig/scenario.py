@@ -58,7 +58,7 @@ class ShapeChangePlant:
         self.t_s += dt_s
         while self._next < len(self.changes) and self.t_s >= self.changes[self._next].at_s:
             change = self.changes[self._next]
-            self.plant.reshape(**dict(change.changes))  # type: ignore[attr-defined]
+            self.plant.reshape(**dict(change.changes))
             self.applied.append((self.t_s, change))
             self._next += 1
         return self.plant.step(dt_s, knob_deg)

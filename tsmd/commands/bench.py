@@ -11,6 +11,7 @@ BENCHMARKS: dict[str, tuple[str, str]] = {
     "accuracy": ("tsmd.bench.accuracy", "the paper's tracking protocol: none / paper / ours"),
     "calibration": ("tsmd.bench.calibration", "identified D and B against ground truth"),
     "gap": ("tsmd.bench.gap", "sim-to-real gap diagnosis self-test and speed"),
+    "online": ("tsmd.bench.online", "online dead-zone re-estimation through a shape change"),
 }
 
 

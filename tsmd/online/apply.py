@@ -42,7 +42,7 @@ def _shifted_field(f: ParameterField, columns: Sequence[tuple[int, int, int]],
     values = f.values.copy()
     for col, sign, which in columns:
         values[:, col] += sign * offset[which]
-    return ParameterField(f.grid_deg, values, f.method)
+    return ParameterField(f.grid_deg.tolist(), values, f.method)
 
 
 def shifted_knob(knob: Any, offset: tuple[float, float]) -> Any:

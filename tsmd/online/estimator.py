@@ -113,10 +113,10 @@ class EdgeTracker:
         self.last_measurement_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()
-            self.accepted = (self.accepted + [m])[-o.window:]
+            self.accepted = [*self.accepted, m][-o.window:]
             self.estimate_deg = median(self.accepted)
         else:
-            self.suspects = (self.suspects + [m])[-o.confirm:]
+            self.suspects = [*self.suspects, m][-o.confirm:]
             if len(self.suspects) >= o.confirm and (max(self.suspects) - min(self.suspects)
                                                     <= o.confirm_spread_deg):
                 new = median(self.suspects)

@@ -44,7 +44,7 @@ class OnlineWorker:
                  rate_deg_s: float = 4.0, queue_len: int = 8192, drain_every: int = 0,
                  on_event: EventSink | None = None) -> None:
         self.compensator = compensator
-        self.base_knobs: tuple[Any, Any] = tuple(compensator.knobs)  # type: ignore[assignment]
+        self.base_knobs: tuple[Any, Any] = (compensator.knobs[0], compensator.knobs[1])
         for k in self.base_knobs:
             shifted_knob(k, (0.0, 0.0))  # refuses a compensator it cannot shift, now
         self.period_s = period_s

@@ -240,8 +240,9 @@ class _Knob:
         self.slack_pos_m = (p.slack_pos_mm + slack_delta_mm[0]) * 1e-3 + curvature_slack_m
         self.slack_neg_m = (p.slack_neg_mm + slack_delta_mm[1]) * 1e-3 + curvature_slack_m
         self.friction_static = self._friction(1.0)
-        self._last = [None, None]
-        self._fast = [None, None]
+        for side in (0, 1):  # cached solutions belong to the old shape
+            self._last[side] = None
+            self._fast[side] = None
 
     def _friction(self, sheath_scale: float) -> Friction:
         """(G, H) for pulling and for the mirrored release, sheath friction scaled."""

@@ -83,9 +83,11 @@ class LoadedRamp:
         """The line's current at a knob angle."""
         return self.current_at_u0_A + self.slope_A_per_deg * (self.side * knob_deg - self.u0_deg)
 
-    def crossing_deg(self, level_A: float) -> float:
-        """Knob angle where the line crosses ``level_A`` (the edge for that level)."""
-        return self.side * (self.u0_deg + (level_A - self.current_at_u0_A) / self.slope_A_per_deg)
+    def crossing_deg(self, level_A: float, slope_A_per_deg: float | None = None) -> float:
+        """Knob angle where the line crosses ``level_A`` (the edge for that level); with
+        ``slope_A_per_deg``, the line through the window's centre with that slope instead."""
+        slope = self.slope_A_per_deg if slope_A_per_deg is None else slope_A_per_deg
+        return self.side * (self.u0_deg + (level_A - self.current_at_u0_A) / slope)
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,10 @@ from __future__ import annotations
 import collections
 import threading
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from typing import Any
+
+import numpy as np
 
 from tsmd.online.apply import ZERO_OFFSETS, Offsets, apply_knobs, edges_at, shifted_knob
 from tsmd.online.estimator import EdgeTracker, EstimatorOptions
@@ -21,6 +24,7 @@ from tsmd.online.features import (
     LoadedRamp,
     RampOptions,
     Rejected,
+    Stroke,
     loaded_ramp,
     relocated_edge_deg,
 )
@@ -68,6 +72,7 @@ class OnlineWorker:
         self._t_last = None  # type: float | None
         self._t_publish = 0.0
         self._was_enabled = True
+        self._stalled = [False, False]
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -133,19 +138,28 @@ class OnlineWorker:
             self._was_enabled = enabled
             return t
         self._was_enabled = True
+        max_lag = self.ramp_options.max_lag_deg
         for knob, (cmd, pos, cur, other) in enumerate(((c1, p1, i1, p2), (c2, p2, i2, p1))):
+            if abs(cmd - pos) > max_lag:  # the motor does not follow: stalled or blocked
+                self._segmenters[knob].discard()
+                if not self._stalled[knob]:
+                    self._stalled[knob] = True
+                    reason = f"the motor lags its command by more than {max_lag:g} deg"
+                    for side in (1, -1):
+                        self.trackers[(knob, side)].freeze(reason)
+                    self._emit("warning", "online estimate frozen", knob=knob, reason=reason)
+                continue
+            self._stalled[knob] = False
             stroke = self._segmenters[knob].push(t, cmd, pos, cur, other)
             if stroke is not None:
                 self._stroke(stroke)
         return t
 
-    def _stroke(self, stroke: Any) -> None:
+    def _stroke(self, stroke: Stroke) -> None:
         knob, side = stroke.knob, stroke.direction
         tracker = self.trackers[(knob, side)]
-        other = float(stroke.other_deg[len(stroke.other_deg) // 2]) if len(stroke.other_deg) \
-            else 0.0
-        d_pos, d_neg = edges_at(self.base_knobs[knob], other)
-        expected = d_pos + tracker.applied_deg if side > 0 else d_neg - tracker.applied_deg
+        stroke, edge = self._referred(stroke)
+        expected = edge + side * tracker.applied_deg
         if tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
             expected = relocated_edge_deg(stroke, expected, tracker.level_A,
                                           tracker.slope_ref_A_per_deg, self.ramp_options)
@@ -156,6 +170,23 @@ class OnlineWorker:
                 self._emit("warning", "online estimate frozen", knob=knob, reason=ramp.reason)
             return
         self._ramp(tracker, ramp)
+
+    def _referred(self, stroke: Stroke) -> tuple[Stroke, float]:
+        """The stroke with the profile's own edge motion taken out, and that edge.
+
+        The profile says how the edge moves with the other knob's angle; over one stroke the
+        other knob may move far. Each sample's angle is moved by the profile edge's change
+        from the stroke's middle, so the ramp's foot stays put unless the catheter changed.
+        """
+        f = self.base_knobs[stroke.knob].field
+        column = 0 if stroke.direction > 0 else 1
+        grid = np.asarray(f.grid_deg, dtype=float)
+        values = np.asarray(f.values, dtype=float)[:, column]
+        mid = float(np.median(stroke.other_deg))
+        edge = float(f.at(mid)[column])
+        moved = np.interp(stroke.other_deg, grid, values) - float(np.interp(mid, grid, values))
+        return replace(stroke, cmd_deg=stroke.cmd_deg - moved, pos_deg=stroke.pos_deg - moved,
+                       other_deg=np.full_like(stroke.other_deg, mid)), edge
 
     def _ramp(self, tracker: EdgeTracker, ramp: LoadedRamp) -> None:
         d_pos, d_neg = edges_at(self.base_knobs[ramp.knob], ramp.other_deg)

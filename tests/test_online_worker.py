@@ -11,7 +11,13 @@ import pytest
 from tests.online_support import profile_edges, rows
 from tsmd.compensation import build_compensator
 from tsmd.loop import ROW_COLUMNS
-from tsmd.online import OnlineWorker, profile_with_offsets, save_online_version
+from tsmd.online import (
+    OnlineError,
+    OnlineWorker,
+    profile_with_offsets,
+    save_online_version,
+    shifted_knob,
+)
 from tsmd.online.apply import edges_at
 from tsmd.profile import load_profile
 
@@ -142,9 +148,8 @@ def test_a_saved_version_compensates_like_the_online_offsets(profile: Any) -> No
     offsets = ((3.0, 2.0), (1.0, -1.0))
     live = build_compensator(profile, "ours", 0.004)
     worker = OnlineWorker(live, 0.004, ROW_COLUMNS)
-    worker.published = (1, offsets, tuple(
-        __import__("tsmd.online.apply", fromlist=["shifted_knob"]).shifted_knob(k, o)
-        for k, o in zip(worker.base_knobs, offsets, strict=True)))  # type: ignore[assignment]
+    worker.published = (1, offsets, (shifted_knob(worker.base_knobs[0], offsets[0]),
+                                     shifted_knob(worker.base_knobs[1], offsets[1])))
     worker.observe(worker_row(), True)
     saved = build_compensator(profile_with_offsets(profile, offsets), "ours", 0.004)
     t = np.arange(0.0, 30.0, 0.004)
@@ -153,3 +158,21 @@ def test_a_saved_version_compensates_like_the_online_offsets(profile: Any) -> No
     saved.reset(q[0])
     worst = max(float(np.max(np.abs(live.command(row) - saved.command(row)))) for row in q)
     assert worst < 1e-6
+
+
+def test_a_compensator_without_edges_is_refused_in_one_line(profile: Any) -> None:
+    with pytest.raises(OnlineError, match="needs the 'ours' or 'paper' compensator"):
+        OnlineWorker(build_compensator(None, "none", 0.004), 0.004, ROW_COLUMNS)
+
+
+def test_the_paper_compensator_under_the_limiter_is_shifted_too(profile: Any) -> None:
+    from tsmd.compensation import KnobLimits
+
+    limited = build_compensator(profile, "paper", 0.004,
+                                [KnobLimits(-90.0, 90.0, 120.0, 2000.0)] * 2)
+    worker = OnlineWorker(limited, 0.004, ROW_COLUMNS)
+    worker.published = (1, ((2.0, 0.0), (0.0, 0.0)), (
+        shifted_knob(worker.base_knobs[0], (2.0, 0.0)), worker.base_knobs[1]))
+    worker.observe(worker_row(), True)
+    assert edges_at(limited.inner.knobs[0], 0.0)[0] == pytest.approx(  # type: ignore[attr-defined]
+        edges_at(worker.base_knobs[0], 0.0)[0] + 2.0)

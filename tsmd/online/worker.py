@@ -18,7 +18,14 @@ from typing import Any
 
 import numpy as np
 
-from tsmd.online.apply import ZERO_OFFSETS, Offsets, apply_knobs, edges_at, shifted_knob
+from tsmd.online.apply import (
+    ZERO_OFFSETS,
+    Offsets,
+    OnlineError,
+    apply_knobs,
+    edges_at,
+    shifted_knob,
+)
 from tsmd.online.estimator import EdgeTracker, EstimatorOptions
 from tsmd.online.features import (
     LoadedRamp,
@@ -47,8 +54,13 @@ class OnlineWorker:
                  estimator: EstimatorOptions | None = None, ramp: RampOptions | None = None,
                  rate_deg_s: float = 4.0, queue_len: int = 8192, drain_every: int = 0,
                  on_event: EventSink | None = None) -> None:
+        compensator = getattr(compensator, "inner", compensator)  # under a LimitedCompensator
+        knobs = getattr(compensator, "knobs", None)
+        if knobs is None or len(knobs) != 2:
+            raise OnlineError("online re-estimation needs the 'ours' or 'paper' compensator, "
+                              f"got {type(compensator).__name__}")
         self.compensator = compensator
-        self.base_knobs: tuple[Any, Any] = (compensator.knobs[0], compensator.knobs[1])
+        self.base_knobs: tuple[Any, Any] = (knobs[0], knobs[1])
         for k in self.base_knobs:
             shifted_knob(k, (0.0, 0.0))  # refuses a compensator it cannot shift, now
         self.period_s = period_s

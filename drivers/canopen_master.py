@@ -27,17 +27,20 @@ from canopen.objectdictionary import ODVariable
 
 from drivers import cia402
 from drivers import od as o
+from drivers.can_errors import BusEvent, BusState, decode_error_frame
 from drivers.clock import Clock, MonotonicClock
 from drivers.drive import (
     DriveError,
     DriveFeedback,
     DriveState,
+    DriveUnreachableError,
     FaultEvent,
     FaultKind,
+    HomingStatus,
     KnobDrives,
 )
 from drivers.sdo import SdoClient
-from drivers.units import DriveConfig, interpolation_period
+from drivers.units import DriveConfig, MasterTimeouts, interpolation_period
 
 _RPDO = struct.Struct(o.RPDO1_FORMAT)
 _TPDO = struct.Struct(o.TPDO1_FORMAT)
@@ -45,6 +48,9 @@ _EMCY = struct.Struct("<HB5s")
 MOTOR_SPEED_HEADROOM = 1.25
 """0x6080 = knob velocity limit x gear x this: room for the position loop's transients."""
 _NMT_NAMES = {0x00: "boot-up", 0x04: "STOPPED", 0x05: "OPERATIONAL", 0x7F: "PRE-OPERATIONAL"}
+_HOMING_DONE = cia402.SW_HOMING_ATTAINED | cia402.SW_TARGET_REACHED
+MAX_PENDING_BUS_EVENTS = 256
+"""Error frames can flood (a broken wire): older bus events are dropped and counted."""
 
 
 class _Drive:
@@ -73,6 +79,9 @@ class _Drive:
         self.heartbeat_lost = False
         self.supervised = False
         self.last_emcy: int | None = None
+        self.rebooted = False
+        """Sent a boot-up while running: parameters lost, waits for fault_reset to re-configure."""
+        self.homed = False
         self.sdo: SdoClient
         self.rpdo = can.Message(arbitration_id=0x200 + self.node_id, is_extended_id=False,
                                 data=bytearray(_RPDO.size))
@@ -96,9 +105,7 @@ class CanOpenDrives(KnobDrives):
         receive: Literal["poll", "notifier"] = "poll",
         master_node_id: int = 127,
         master_heartbeat_ms: int = 50,
-        sdo_timeout_s: float = 0.5,
-        state_timeout_s: float = 0.5,
-        boot_timeout_s: float = 2.0,
+        timeouts: MasterTimeouts | None = None,
         own_bus: bool = False,
     ) -> None:
         if not configs:
@@ -114,16 +121,19 @@ class CanOpenDrives(KnobDrives):
         self.idle = idle
         self.master_node_id = master_node_id
         self.master_heartbeat_s = master_heartbeat_ms * 1e-3
-        self.sdo_timeout_s = sdo_timeout_s
-        self.state_timeout_s = state_timeout_s
-        self.boot_timeout_s = boot_timeout_s
+        self.timeouts = timeouts if timeouts is not None else MasterTimeouts()
         self._own_bus = own_bus
         self._od = o.load_od()
         self._drives = [_Drive(i, c) for i, c in enumerate(configs)]
         for d in self._drives:
             d.sdo = SdoClient(d.node_id, d.name, self._send, self._wait, self.clock,
-                              sdo_timeout_s)
+                              self.timeouts.sdo_s)
         self._events: list[FaultEvent] = []
+        self.bus_state = BusState.ERROR_ACTIVE
+        """Our controller's state as its error frames announce it (SocketCAN)."""
+        self._bus_events: collections.deque[BusEvent] = collections.deque(
+            maxlen=MAX_PENDING_BUS_EVENTS)
+        self.bus_events_dropped = 0
         self._unknown_ids: set[int] = set()
         self._send_failing = False
         self._recv_failing = False
@@ -177,8 +187,10 @@ class CanOpenDrives(KnobDrives):
             d.supervised = False
             d.has_feedback = False
             d.nmt_state = None
+            d.rebooted = False
+            d.homed = False
             self._send(0x000, bytes((0x81, d.node_id)))
-        self._wait_until(lambda d: d.nmt_state is not None, self.boot_timeout_s,
+        self._wait_until(lambda d: d.nmt_state is not None, self.timeouts.boot_s,
                          "boot-up message after NMT reset node")
         for d in self._drives:
             try:
@@ -188,29 +200,35 @@ class CanOpenDrives(KnobDrives):
                 if reason.startswith("boot failed"):
                     raise
                 self._boot_failed(d, reason)
-        for d in self._drives:
+        self._start_supervised(self._drives)
+
+    def _start_supervised(self, drives: Sequence[_Drive]) -> None:
+        """NMT start, wait for OPERATIONAL heartbeats, then supervise (heartbeat, TPDO age)."""
+        for d in drives:
             d.nmt_state = None
             self._send(0x000, bytes((0x01, d.node_id)))
-        self._wait_until(lambda d: d.nmt_state == 0x05, self.boot_timeout_s,
-                         "heartbeat in OPERATIONAL after NMT start")
+        self._wait_until(lambda d: d.nmt_state == 0x05, self.timeouts.boot_s,
+                         "heartbeat in OPERATIONAL after NMT start", drives)
         now = self.clock.now_s()
-        for d in self._drives:
+        for d in drives:
             d.supervised = True
             d.heartbeat_lost = False
             d.last_heartbeat_s = now
             d.controlword = 0
             d.age_syncs = 0
             d.stale_reported = False
+            d.rebooted = False
 
     def enable(self) -> None:
-        def command(d: _Drive) -> int | None:
-            if d.state is DriveState.FAULT:
-                raise DriveError(f"{d.name}: cannot enable, drive is in FAULT "
-                                 f"({self._error_code_text(d)}); call fault_reset first")
-            return cia402.next_command_to_enable(d.state, d.config.quick_stop_option,
-                                                d.controlword)
+        self._walk({DriveState.OPERATION_ENABLED}, self._enable_command, "enable",
+                   raise_on_timeout=True)
 
-        self._walk({DriveState.OPERATION_ENABLED}, command, "enable", raise_on_timeout=True)
+    def _enable_command(self, d: _Drive) -> int | None:
+        if d.state is DriveState.FAULT:
+            raise DriveError(f"{d.name}: cannot enable, drive is in FAULT "
+                             f"({self._error_code_text(d)}); call fault_reset first")
+        return cia402.next_command_to_enable(d.state, d.config.quick_stop_option,
+                                             d.controlword & ~cia402.CW_HOMING_START)
 
     def disable(self) -> None:
         self._walk({DriveState.SWITCH_ON_DISABLED, DriveState.FAULT},
@@ -229,6 +247,28 @@ class CanOpenDrives(KnobDrives):
             self._send_msg(d.pack_rpdo())
 
     def fault_reset(self) -> None:
+        """Recover what can be: checks the bus is back, re-configures drives that rebooted
+        (they come back SWITCH ON DISABLED, never moving), then resets drives in FAULT.
+
+        Raises :class:`DriveUnreachableError` while the bus is off or a drive is silent.
+        """
+        if self.bus_state is BusState.BUS_OFF:
+            raise DriveUnreachableError(
+                "CAN bus-off: the interface has not restarted (give it restart-ms, see "
+                "docs/drivers.md, or restart it by hand)")
+        for d in self._drives:
+            if d.heartbeat_lost and not d.rebooted:
+                if d.age_syncs >= d.config.stale_after_syncs:
+                    raise DriveUnreachableError(f"{d.name} silent: no heartbeat for "
+                                                f"{self._silence_s(d):.3f} s and no TPDO for "
+                                                f"{d.age_syncs} SYNCs")
+                raise DriveUnreachableError(f"{d.name} sends no heartbeat for "
+                                            f"{self._silence_s(d):.3f} s (its TPDOs arrive)")
+        rebooted = [d for d in self._drives if d.rebooted]
+        for d in rebooted:
+            self._configure(d)
+        if rebooted:
+            self._start_supervised(rebooted)
         faulty = [d for d in self._drives if d.state is DriveState.FAULT]
         if not faulty:
             return
@@ -242,6 +282,119 @@ class CanOpenDrives(KnobDrives):
         for d in faulty:
             d.controlword = cia402.CW_DISABLE_VOLTAGE
             d.last_emcy = None
+
+    # -- homing (CiA 402 Homing Mode) ------------------------------------------------------
+    def home(self, drives: Sequence[int] | None = None) -> list[HomingStatus]:
+        """Run each chosen drive's configured homing method; ``none`` drives are skipped.
+
+        Per drive: homing parameters and 0x6060 = 6 by SDO, enable, controlword bit 4 until the
+        statusword says homing attained (or error, or ``homing.timeout_s``), then disable and
+        back to CSP (0x6060 = 8). Leaves the drives disabled; raises :class:`DriveError` naming
+        the drive, the method and the statusword when homing fails.
+        """
+        indices = range(self.count) if drives is None else drives
+        chosen: list[_Drive] = []
+        for i in indices:
+            if isinstance(i, bool) or not isinstance(i, int) or not 0 <= i < self.count:
+                raise DriveError(f"home: no drive {i!r} (drives 0..{self.count - 1})")
+            chosen.append(self._drives[i])
+        todo = [d for d in chosen if d.config.homing.enabled]
+        for d in todo:
+            if d.rebooted or not d.supervised:
+                raise DriveUnreachableError(f"{d.name} is not running (rebooted or not booted);"
+                                            f" reset it before homing")
+            if d.state in (DriveState.FAULT, DriveState.FAULT_REACTION_ACTIVE):
+                raise DriveError(f"{d.name}: cannot home, drive is in {d.state.value} "
+                                 f"({self._emcy_text(d)}); call fault_reset first")
+        if not todo:
+            return self.homing_status()
+        self._walk({DriveState.SWITCH_ON_DISABLED}, lambda d: cia402.CW_DISABLE_VOLTAGE,
+                   "disable", raise_on_timeout=True, only=todo)
+        for d in todo:
+            d.homed = False
+            self._write_homing_parameters(d)
+        ok = False
+        try:
+            self._walk({DriveState.OPERATION_ENABLED}, self._enable_command, "enable",
+                       raise_on_timeout=True, only=todo)
+            for d in todo:
+                mode = int(self.sdo_read(d.index, o.MODES_OF_OPERATION_DISPLAY))
+                if mode != o.HOMING_MODE:
+                    raise DriveError(f"{d.name}: homing ({d.config.homing.method_name}): the "
+                                     f"drive reports mode {mode} (0x6061), not Homing Mode 6")
+            self._search_home(todo)
+            ok = True
+        finally:
+            self._leave_homing(todo, ok)
+        return self.homing_status()
+
+    def _write_homing_parameters(self, d: _Drive) -> None:
+        h = d.config.homing
+        cpd = d.cpd
+        writes = [(o.HOMING_METHOD, 0, h.method),
+                  (o.HOME_OFFSET, 0, round(h.home_offset_deg * cpd)),
+                  (o.HOMING_SPEEDS, 1, round(h.switch_speed_deg_s * cpd)),
+                  (o.HOMING_SPEEDS, 2, round(h.zero_speed_deg_s * cpd)),
+                  (o.HOMING_ACCELERATION, 0, round(h.accel_deg_s2 * cpd))]
+        if h.method in (-3, -4):
+            writes.append((o.HOMING_CURRENT_THRESHOLD, 0, round(h.current_threshold_A * 1e3)))
+        writes.append((o.MODES_OF_OPERATION, 0, o.HOMING_MODE))
+        for index, subindex, value in writes:
+            self.sdo_write(d.index, index, subindex, value)
+
+    def _search_home(self, todo: Sequence[_Drive]) -> None:
+        """Controlword bit 4 on; cycle until every drive reports homing attained."""
+        for d in todo:
+            d.controlword = cia402.CW_ENABLE_OPERATION | cia402.CW_HOMING_START
+        start = self.clock.now_s()
+        pending = list(todo)
+        cycles = 0
+        while pending:
+            self._cycle()
+            cycles += 1
+            elapsed = self.clock.now_s() - start
+            for d in list(pending):
+                h = d.config.homing
+                what = f"{d.name}: homing ({h.method_name}, method {h.method})"
+                fresh = d.has_feedback and d.age_syncs == 0
+                sw = d.statusword
+                if fresh and cycles >= 2:  # the first answer may predate the start command
+                    if d.state is not DriveState.OPERATION_ENABLED:
+                        raise DriveError(f"{what} stopped: the drive is in {d.state.value} "
+                                         f"(statusword 0x{sw:04X}, {self._emcy_text(d)})")
+                    if sw & cia402.SW_HOMING_ERROR:
+                        raise DriveError(f"{what} failed: the drive reports a homing error "
+                                         f"(statusword 0x{sw:04X})")
+                    if sw & _HOMING_DONE == _HOMING_DONE:
+                        d.homed = True
+                        pending.remove(d)
+                        continue
+                if elapsed > h.timeout_s:
+                    self._event(FaultKind.STATE_TIMEOUT, d.index,
+                                f"{what} timed out after {h.timeout_s} s")
+                    raise DriveError(f"{what} timed out after {h.timeout_s} s (statusword "
+                                     f"0x{sw:04X}, feedback {d.age_syncs} SYNCs old)")
+
+    def _leave_homing(self, todo: Sequence[_Drive], ok: bool) -> None:
+        """Stop (quick stop on failure), disable, back to CSP. Never masks the first error."""
+        try:
+            if not ok:
+                self._walk({DriveState.QUICK_STOP_ACTIVE, DriveState.SWITCH_ON_DISABLED,
+                            DriveState.FAULT}, lambda d: cia402.CW_QUICK_STOP, "quick stop",
+                           raise_on_timeout=False, only=todo)
+            self._walk({DriveState.SWITCH_ON_DISABLED, DriveState.FAULT},
+                       lambda d: cia402.CW_DISABLE_VOLTAGE, "disable", raise_on_timeout=ok,
+                       only=todo)
+            for d in todo:
+                self.sdo_write(d.index, o.MODES_OF_OPERATION, 0, o.CSP_MODE)
+                d.target_counts = d.position_counts
+        except DriveError:
+            if ok:
+                raise
+
+    def homing_status(self) -> list[HomingStatus]:
+        return [HomingStatus(d.config.homing.method_name, d.config.homing.required, d.homed,
+                             d.config.homing.home_offset_deg) for d in self._drives]
 
     def write_targets(self, knob_deg: Sequence[float]) -> None:
         drives = self._drives
@@ -421,13 +574,22 @@ class CanOpenDrives(KnobDrives):
                 d.controlword = cw | (d.controlword & cia402.CW_HALT)
             if not pending:
                 return
-            if self.clock.now_s() - start > self.state_timeout_s:
+            timeout_s = self.timeouts.transition_s(what)
+            if self.clock.now_s() - start > timeout_s:
+                silent = [d for d in pending if self._silent_since(d, start)]
                 for d in pending:
-                    reason = (f"{d.name}: {what} timed out after {self.state_timeout_s} s in "
+                    reason = (f"{d.name}: {what} timed out after {timeout_s} s in "
                               f"state {d.state.value} (statusword 0x{d.statusword:04X}, "
                               f"feedback {d.age_syncs} SYNCs old)")
+                    if d in silent:
+                        reason = (f"{d.name} silent: no TPDO and no heartbeat for "
+                                  f"{self._silence_s(d):.3f} s ({what} not possible)")
                     self._event(FaultKind.STATE_TIMEOUT, d.index, reason)
                 if raise_on_timeout:
+                    if silent:
+                        raise DriveUnreachableError(
+                            f"{silent[0].name} silent: no TPDO and no heartbeat for "
+                            f"{self._silence_s(silent[0]):.3f} s ({what} not possible)")
                     raise DriveError(reason)
                 return
             self._cycle()
@@ -473,11 +635,22 @@ class CanOpenDrives(KnobDrives):
             self._next_heartbeat_s = nxt if nxt > now else now + period
             self._send_msg(self._hb_msg)
 
-    def _wait_until(self, done: Callable[[_Drive], bool], timeout_s: float, what: str) -> None:
+    def _silent_since(self, d: _Drive, start_s: float) -> bool:
+        """No TPDO answered a SYNC and no heartbeat arrived since ``start_s``."""
+        last_hb = d.last_heartbeat_s
+        return (not d.has_feedback or d.age_syncs > 0) and (last_hb is None or last_hb < start_s)
+
+    def _silence_s(self, d: _Drive) -> float:
+        last = d.last_heartbeat_s
+        return self.clock.now_s() - last if last is not None else math.inf
+
+    def _wait_until(self, done: Callable[[_Drive], bool], timeout_s: float, what: str,
+                    drives: Sequence[_Drive] | None = None) -> None:
+        drives = self._drives if drives is None else drives
         deadline = self.clock.now_s() + timeout_s
-        while not all(done(d) for d in self._drives):
+        while not all(done(d) for d in drives):
             if self.clock.now_s() > deadline:
-                missing = [d for d in self._drives if not done(d)]
+                missing = [d for d in drives if not done(d)]
                 for d in missing:
                     self._event(FaultKind.BOOT_FAILED, d.index,
                                 f"{d.name}: no {what} within {timeout_s} s")
@@ -489,7 +662,7 @@ class CanOpenDrives(KnobDrives):
     def _on_message(self, msg: can.Message) -> None:
         self.frames_received += 1
         if msg.is_error_frame:
-            self._event(FaultKind.BUS_ERROR, -1, "CAN error frame received")
+            self._on_error_frame(msg)
             return
         handler = self._handlers.get(msg.arbitration_id)
         if handler is None or msg.is_extended_id or msg.is_remote_frame:
@@ -531,6 +704,9 @@ class CanOpenDrives(KnobDrives):
                             f"{d.name}: malformed heartbeat with {len(data)} bytes")
                 return
             state = data[0] & 0x7F
+            if state == 0x00 and d.supervised:
+                self._on_reboot(d)
+                return
             if d.supervised and state != 0x05 and d.nmt_state == 0x05:
                 self._event(FaultKind.DRIVE_FAULT, d.index,
                             f"{d.name}: left OPERATIONAL, NMT state is now "
@@ -557,6 +733,49 @@ class CanOpenDrives(KnobDrives):
                         f"(error register 0x{register:02X})", code)
 
         return on_emcy
+
+    def _on_reboot(self, d: _Drive) -> None:
+        """A boot-up from a running drive: it lost power or reset, and with it its PDO mapping,
+        its parameters and (relative encoder) its zero reference."""
+        d.rebooted = True
+        d.supervised = False
+        d.has_feedback = False
+        d.homed = False
+        d.nmt_state = 0x00
+        d.state = DriveState.UNKNOWN
+        d.controlword = 0
+        d.last_heartbeat_s = self.clock.now_s()
+        self._event(FaultKind.DRIVE_REBOOTED, d.index,
+                    f"{d.name}: rebooted while running (boot-up message): parameters, PDO "
+                    f"mapping and zero reference lost; it stays without torque until a reset "
+                    f"re-configures it")
+
+    def _on_error_frame(self, msg: can.Message) -> None:
+        report = decode_error_frame(msg)
+        previous = self.bus_state
+        if report.state is not None:
+            self.bus_state = report.state
+        text = report.text()
+        with self._lock:
+            if len(self._bus_events) == self._bus_events.maxlen:
+                self.bus_events_dropped += 1
+            self._bus_events.append(BusEvent(self.clock.now_s(), report, text))
+        if report.bus_off and previous is not BusState.BUS_OFF:
+            for d in self._drives:  # the first frames after a restart must not move anything
+                d.controlword = cia402.CW_QUICK_STOP
+            self._event(FaultKind.BUS_OFF, -1,
+                        f"CAN controller bus-off ({text}): nothing can be sent until the "
+                        f"interface restarts; the drives quick-stop on the lost master heartbeat")
+
+    def poll_bus_events(self) -> list[BusEvent]:
+        """Error frames decoded since the last call (warnings, restarts...), oldest first.
+
+        Only bus-off is a fault (a ``BUS_OFF`` :class:`FaultEvent`); the rest is for the log.
+        """
+        with self._lock:
+            events = list(self._bus_events)
+            self._bus_events.clear()
+        return events
 
     def _unknown(self, msg: can.Message) -> None:
         cob = msg.arbitration_id

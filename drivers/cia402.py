@@ -15,6 +15,8 @@ CW_ENABLE_OPERATION = 0x000F
 CW_QUICK_STOP = 0x0002
 CW_FAULT_RESET = 0x0080
 CW_HALT = 0x0100
+CW_HOMING_START = 0x0010
+"""Homing Mode: a rising edge starts homing, clearing it interrupts (operation-mode bit 4)."""
 
 # Statusword bits
 SW_READY_TO_SWITCH_ON = 0x0001
@@ -32,6 +34,10 @@ SW_INTERNAL_LIMIT = 0x0800
 SW_FOLLOWS_TARGET = 0x1000
 """CSP: the drive follows the target position."""
 SW_FOLLOWING_ERROR = 0x2000
+SW_HOMING_ATTAINED = 0x1000
+"""Homing Mode meaning of bit 12 (bits 12/13 are operation-mode specific)."""
+SW_HOMING_ERROR = 0x2000
+"""Homing Mode meaning of bit 13."""
 
 STATE_BITS: dict[DriveState, int] = {
     DriveState.NOT_READY_TO_SWITCH_ON: 0x0000,

@@ -37,6 +37,8 @@ class FaultKind(enum.Enum):
     DRIVE_FAULT = "drive_fault"
     BOOT_FAILED = "boot_failed"
     STATE_TIMEOUT = "state_timeout"
+    BUS_OFF = "bus_off"
+    DRIVE_REBOOTED = "drive_rebooted"
 
 
 @dataclass(frozen=True)
@@ -62,8 +64,26 @@ class FaultEvent:
     code: int | None = None
 
 
+@dataclass(frozen=True)
+class HomingStatus:
+    """Zero reference of one knob drive: how it is found and whether it has been."""
+
+    method: str
+    """``none`` (position taken as the drive reports it), ``current_position``, ..."""
+    required: bool
+    """Set points must wait for homing (the config says so)."""
+    homed: bool
+    home_offset_deg: float
+    """0x607C: the position reads ``-home_offset_deg`` at the home position."""
+
+
 class DriveError(RuntimeError):
     """A drive operation failed; the message names the drive, the step and the reason."""
+
+
+class DriveUnreachableError(DriveError):
+    """Nothing answers (a silent drive, a bus-off controller): a fault of the system, not a
+    command the drive refused. The message starts with what is unreachable."""
 
 
 class KnobDrives(abc.ABC):
@@ -125,6 +145,21 @@ class KnobDrives(abc.ABC):
         whether it persists. Backends without heartbeat supervision never report one.
         """
         return [False] * self.count
+
+    def home(self, drives: Sequence[int] | None = None) -> list[HomingStatus]:
+        """Run the configured homing method of each drive (all, or the given indices).
+
+        Drives whose method is ``none`` are skipped. Leaves the drives disabled.
+        """
+        raise DriveError(f"{type(self).__name__} cannot home its drives")
+
+    def homing_status(self) -> list[HomingStatus]:
+        """Per drive: method, required, homed, offset. Backends without homing: ``none``."""
+        return [HomingStatus("none", False, False, 0.0) for _ in range(self.count)]
+
+    def zero_referenced(self) -> bool:
+        """May set points be followed? False while a drive that requires homing is not homed."""
+        return all(h.homed or not h.required for h in self.homing_status())
 
     @abc.abstractmethod
     def close(self) -> None:

@@ -23,6 +23,7 @@ from canopen.sdo import SdoAbortedError, SdoServer
 from drivers import cia402
 from drivers import od as o
 from drivers.drive import DriveState
+from simrig.drive_homing import HOMING_BITS, SimHoming
 from simrig.motor import Motor
 
 SendFn = Callable[[int, bytes], None]
@@ -105,6 +106,12 @@ class SimDriveNode:
         self._defaults[(o.MOTOR_RATED_CURRENT, 0)] = rated_current_mA
         self.sdo = SdoServer(0x600 + node_id, 0x580 + node_id, self)
         self.sdo.network = _ServerLink(send)  # type: ignore[assignment]
+        self.encoder_zero_deg = 0.0
+        """Motor position (knob degrees) the relative encoder reads as 0: where it powered up,
+        until homing moves it."""
+        self.index_phase_deg = 0.0
+        """Where the encoder's index pulses are (one per motor revolution from here)."""
+        self.homing = SimHoming(self)
         # fault injection
         self.silent = False
         self.heartbeat_stopped = False
@@ -138,12 +145,20 @@ class SimDriveNode:
         self._master_lost = False
         self._internal_target_deg = self.motor.position_deg
         self._qs_velocity_deg_s = 0.0
-        self.position_counts = round(self.motor.position_deg * self.counts_per_deg)
+        self.homing.clear()
+        self.position_counts = round((self.motor.position_deg - self.encoder_zero_deg)
+                                     * self.counts_per_deg)
         self._configure_pdos()
         self._update_statusword()
         self.nmt_state = NMT_PRE_OPERATIONAL
         self._next_heartbeat_s = now_s
         self._emit(0x700 + self.node_id, b"\x00")  # boot-up
+
+    def reboot(self, now_s: float) -> None:
+        """Power cycle: the relative encoder restarts at 0 where the motor is, PDO mapping and
+        every parameter are back to their defaults, and the boot-up message goes out."""
+        self.encoder_zero_deg = self.motor.position_deg
+        self.reset(now_s)
 
     def _nmt_command(self, data: bytes | bytearray, now_s: float) -> None:
         if len(data) != 2 or data[1] not in (0, self.node_id):
@@ -240,6 +255,8 @@ class SimDriveNode:
                 s is S.QUICK_STOP_ACTIVE and cw != previous
                 and self._value(o.QUICK_STOP_OPTION, 0) in _QS_HOLD_OPTIONS)):
             self._set_state(S.OPERATION_ENABLED)  # enable operation
+        if self.state is S.OPERATION_ENABLED and self.mode_display == o.HOMING_MODE:
+            self.homing.on_controlword(previous, cw)
 
     def _set_state(self, state: DriveState) -> None:
         powered_before = self.powered
@@ -252,6 +269,8 @@ class SimDriveNode:
             self.mode_display = self.mode
         elif not self.powered and powered_before:
             self.velocity_counts_s = 0
+        if state is not DriveState.OPERATION_ENABLED and self.homing.active:
+            self.homing.interrupt()  # a search never resumes by itself on the next enable
         self._update_statusword()
 
     def _start_quick_stop(self) -> None:
@@ -283,7 +302,24 @@ class SimDriveNode:
         sw = _STATUSWORDS.get(key)
         if sw is None:
             sw = _STATUSWORDS[key] = _statusword(*key)
+        if self.mode_display == o.HOMING_MODE:  # bits 10, 12, 13 mean homing progress here
+            sw = (sw & ~HOMING_BITS) | self.homing.bits
         self.statusword = sw
+
+    # -- used by the homing mode ----------------------------------------------------------
+    @property
+    def internal_target_deg(self) -> float:
+        return self._internal_target_deg
+
+    def hold_position(self) -> None:
+        """Stop where the motor is (end or interruption of a homing search, mode change)."""
+        self._internal_target_deg = self.motor.position_deg
+        self.target_counts = round((self.motor.position_deg - self.encoder_zero_deg)
+                                   * self.counts_per_deg)
+
+    def value(self, index: int, subindex: int) -> Any:
+        """An object's value as the drive uses it (written, else its default)."""
+        return self._value(index, subindex)
 
     # -- one period of motion -------------------------------------------------------------
     def motion_target_deg(self) -> float:
@@ -291,13 +327,16 @@ class SimDriveNode:
         S = DriveState
         dt = self.motor.dt_s
         if self.state is S.OPERATION_ENABLED and not self.halted:
+            if self.mode_display == o.HOMING_MODE:
+                self._internal_target_deg = self.homing.target_deg(dt)
+                return self._internal_target_deg
             target = self.target_counts
             lo = self._limit_lo
             hi = self._limit_hi
             limited = target < lo or target > hi
             if limited:
                 target = lo if target < lo else hi
-            target_deg = target / self.counts_per_deg
+            target_deg = target / self.counts_per_deg + self.encoder_zero_deg
             vmax = self._vmax_deg_s
             step = target_deg - self._internal_target_deg
             if step > vmax * dt or step < -vmax * dt:
@@ -321,7 +360,7 @@ class SimDriveNode:
         """After the physics step: actual values, following error, state timers, heartbeat."""
         motor = self.motor
         cpd = self.counts_per_deg
-        self.position_counts = round(motor.position_deg * cpd)
+        self.position_counts = round((motor.position_deg - self.encoder_zero_deg) * cpd)
         self.velocity_counts_s = round(motor.velocity_deg_s * cpd)
         raw = round(measured_current_A * self._raw_per_A) if self.powered else 0
         self.current_raw = -32768 if raw < -32768 else 32767 if raw > 32767 else raw
@@ -341,6 +380,9 @@ class SimDriveNode:
                 self._fe_since_s = None
         else:
             self._fe_since_s = None
+        if state is S.OPERATION_ENABLED and self.homing.active:
+            self.homing.after_step(measured_current_A)
+            self.position_counts = round((motor.position_deg - self.encoder_zero_deg) * cpd)
         if state is S.FAULT_REACTION_ACTIVE and self._qs_velocity_deg_s == 0.0:
             self._set_state(S.FAULT)
         elif state is S.QUICK_STOP_ACTIVE and self._qs_velocity_deg_s == 0.0 and (
@@ -482,7 +524,7 @@ class SimDriveNode:
             self._check_mappable(value, rpdo=index == o.RPDO1_MAP)
         if index in (o.RPDO1_MAP, o.TPDO1_MAP) and subindex == 0:
             self._check_mapping_length(index, value)
-        if index == o.MODES_OF_OPERATION and value not in (0, o.CSP_MODE):
+        if index == o.MODES_OF_OPERATION and value not in (0, o.CSP_MODE, o.HOMING_MODE):
             raise SdoAbortedError(0x06090030)
         if index == o.CONTROLWORD:
             self.write_controlword(value)
@@ -491,7 +533,11 @@ class SimDriveNode:
             self.target_counts = value
             return
         if index == o.MODES_OF_OPERATION:
+            if value != self.mode_display:
+                self.homing.clear()
+                self.hold_position()  # a mode change never moves the motor
             self.mode = self.mode_display = value
+            self._update_statusword()
             return
         self.values[(index, subindex)] = value
         self._configure_pdos()

@@ -15,6 +15,8 @@ from typing import Any
 
 import can
 
+from drivers.can_errors import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED
+
 _CHANNELS: dict[str, list[LockstepBus]] = {}
 _MESSAGE_SLOTS = {"__weakref__", "arbitration_id", "bitrate_switch", "channel", "data", "dlc",
                   "error_state_indicator", "is_error_frame", "is_extended_id", "is_fd",
@@ -63,13 +65,31 @@ class LockstepBus(can.BusABC):
         self._peers = _CHANNELS.setdefault(channel, [])
         self._peers.append(self)
         self._open = True
+        self._bus_off = False
+
+    def set_bus_off(self, on: bool) -> None:
+        """Simulate this controller going bus-off (nothing in or out) or being restarted.
+
+        Like SocketCAN, the change is announced by an error frame (bus-off, restarted).
+        """
+        self._bus_off = on
+        if on:
+            self._queue.clear()
+        self._queue.append(make_message(CAN_ERR_BUSOFF if on else CAN_ERR_RESTARTED,
+                                        bytes(8), error=True))
+
+    def others(self) -> list[LockstepBus]:
+        """The other buses on this channel (the rig reaches the master's controller here)."""
+        return [peer for peer in self._peers if peer is not self]
 
     def send(self, msg: can.Message, timeout: float | None = None) -> None:
         if not self._open:
             raise can.CanOperationError(f"lockstep bus {self._name!r} is shut down")
+        if self._bus_off:
+            raise can.CanOperationError(f"lockstep bus {self._name!r}: controller is bus-off")
         data = msg.data
         for peer in self._peers:
-            if peer is not self:
+            if peer is not self and not peer._bus_off:
                 peer._queue.append(make_message(msg.arbitration_id, data, msg.is_extended_id,
                                                 msg.is_remote_frame, msg.is_error_frame))
 
@@ -78,7 +98,7 @@ class LockstepBus(can.BusABC):
         if not self._open:
             raise can.CanOperationError(f"lockstep bus {self._name!r} is shut down")
         for peer in self._peers:
-            if peer is not self:
+            if peer is not self and not peer._bus_off:
                 peer._queue.append(msg)
 
     def recv(self, timeout: float | None = None) -> can.Message | None:

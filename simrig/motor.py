@@ -51,6 +51,9 @@ class Motor:
         self.velocity_deg_s = 0.0
         self.current_A = 0.0
         self.jammed = False
+        self.travel_deg = (-math.inf, math.inf)
+        """Hard stops of the knob mechanism (knob degrees); none by default."""
+        self._pressing_Nm = 0.0
         self._reference_deg = position_deg
         self._load_Nm = 0.0
         self._accel_rad_s2 = 0.0
@@ -58,6 +61,8 @@ class Motor:
         self._rad_per_knob_deg = gear_ratio * math.pi / 180.0
         self._max_velocity_deg_s = params.max_speed_rpm * 6.0 / gear_ratio
         w = 2.0 * math.pi * params.bandwidth_hz
+        self._stiffness_Nm_rad = params.rotor_inertia_kgm2 * w * w
+        """Static stiffness of the position loop (what pushes against a hard stop)."""
         e = math.exp(-w * dt_s)
         # exact transition of e'' = -w^2 e - 2 w e' (critically damped) over dt
         self._phi = ((1.0 + w * dt_s) * e, dt_s * e, -w * w * dt_s * e, (1.0 - w * dt_s) * e)
@@ -112,6 +117,14 @@ class Motor:
             v1 = v0 + accel / k * dt
             x1 = x0 + 0.5 * (v0 + v1) * dt
             self._saturated_Nm = limit  # the drive delivers its peak current this period
+        lo, hi = self.travel_deg
+        self._pressing_Nm = 0.0
+        if x1 < lo or x1 > hi:  # against a hard stop: the loop pushes as far as the target is
+            x1 = lo if x1 < lo else hi
+            v1 = 0.0
+            accel = 0.0
+            push = self._stiffness_Nm_rad * (target_deg - x1) * k
+            self._pressing_Nm = max(-torque_max, min(torque_max, push))
         self.position_deg = x1
         self.velocity_deg_s = v1
         self._reference_deg = target_deg
@@ -130,6 +143,8 @@ class Motor:
         if self.jammed:
             torque = par.torque_constant_Nm_A * par.max_current_A * (
                 1.0 if self._reference_deg >= self.position_deg else -1.0)
+        elif self._pressing_Nm:
+            torque = self._pressing_Nm + self._load_torque_motor_Nm(knob_torque_Nm, 0.0)
         elif self._saturated_Nm:
             torque = self._saturated_Nm
         else:

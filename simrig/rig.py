@@ -19,6 +19,7 @@ import can
 import numpy as np
 from numpy.typing import NDArray
 
+from drivers.can_errors import error_frame
 from drivers.canopen_master import CanOpenDrives
 from drivers.clock import Clock, MonotonicClock, SimClock
 from drivers.units import DriveConfig
@@ -161,7 +162,12 @@ class SimRig:
         ``following_error``: the motor jams until ``clear_fault``, the drive detects it;
         ``heartbeat_stop``: heartbeats stop, PDOs go on; ``silent``: the node sends nothing;
         ``corrupt``: the next TPDO is sent truncated; ``frame``: send a raw frame
-        (``can_id``, ``data``) on the rig's side of the bus.
+        (``can_id``, ``data``) on the rig's side of the bus; ``reboot``: the drive power-cycles
+        (boot-up message, parameters and PDO mapping lost, its relative encoder restarts at 0).
+        Bus-wide (``drive`` ignored): ``error_frame`` (``classes``, ``data``: a SocketCAN error
+        frame as linux/can/error.h defines it); ``bus_off`` / ``bus_restart``: the master's
+        controller goes bus-off / is restarted (lockstep bus only: python-can's ``virtual``
+        has no controller to switch off).
         """
         node = self.nodes[drive]
         if kind == "emcy":
@@ -176,9 +182,19 @@ class SimRig:
             node.corrupt_next_tpdo = True
         elif kind == "frame":
             self._send(int(kwargs["can_id"]), bytes(kwargs.get("data", b"")))
+        elif kind == "reboot":
+            node.reboot(self.clock.now_s())
+        elif kind == "error_frame":
+            self.bus.send(error_frame(int(kwargs["classes"]), bytes(kwargs.get("data", b""))))
+        elif kind in ("bus_off", "bus_restart"):
+            if not isinstance(self.bus, LockstepBus):
+                raise ValueError(f"{kind} needs the lockstep bus (interface='lockstep')")
+            for master_bus in self.bus.others():
+                master_bus.set_bus_off(kind == "bus_off")
         else:
             raise ValueError(f"unknown fault kind {kind!r}; one of emcy, following_error, "
-                             f"heartbeat_stop, silent, corrupt, frame")
+                             f"heartbeat_stop, silent, corrupt, frame, reboot, error_frame, "
+                             f"bus_off, bus_restart")
 
     def clear_fault(self, drive: int = 0) -> None:
         """Undo every injected fault on ``drive`` (the drive's own FAULT state stays)."""

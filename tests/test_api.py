@@ -262,6 +262,9 @@ def test_calibrate_without_a_device_model_is_unavailable(stack: Stack) -> None:
     (b'{"id": true, "cmd": "status"}', "bad_request"),
     (b"\xff\xfe{}", "bad_json"),
     (b"[" * 1500 + b"]" * 1500, "bad_json"),
+    (b'{"cmd": "set", "q": [1' + b"0" * 400 + b', 0]}', "out_of_range"),
+    (b'{"cmd": "set", "q": [-1' + b"0" * 4000 + b', 0]}', "out_of_range"),
+    (b'{"cmd": "subscribe", "rate_hz": 1' + b"0" * 400 + b"}", "out_of_range"),
 ], ids=lambda v: repr(v)[:24])
 def test_malformed_request_is_refused_with_its_code(stack: Stack, line: bytes,
                                                     code: str) -> None:
@@ -294,14 +297,17 @@ def test_oversized_line_is_refused_and_the_connection_still_works(tmp_path: Path
         s.server.stop()
 
 
-def test_clients_beyond_the_maximum_are_turned_away(tmp_path: Path) -> None:
+def test_a_newcomer_beyond_the_maximum_evicts_the_least_active_client(tmp_path: Path) -> None:
     s = start_stack(tmp_path, max_clients=2)
     try:
         a, b = s.client(), s.client()
         a.call("status")
+        time.sleep(0.01)
         b.call("status")
         with s.client() as c:
-            assert error_code(c.read_message()) == "too_many_clients"
+            assert c.call("status")["ok"]
+            assert error_code(a.read_message()) == "evicted"
+            assert b.call("status")["ok"]
         a.close()
         b.close()
     finally:
@@ -424,3 +430,37 @@ def test_a_stale_socket_file_is_replaced(tmp_path: Path) -> None:
             assert c.call("status")["pong"] is True
     finally:
         server.stop()
+
+
+def test_a_huge_integer_gets_an_answer_and_the_connection_stays_usable(stack: Stack) -> None:
+    with stack.client() as c:
+        c.call("enable")
+        response = raw(c, b'{"id": 9, "cmd": "set", "q": [1' + b"0" * 1000 + b", 0]}")
+        assert response["id"] == 9 and error_code(response) == "out_of_range"
+        assert c.call("status")["ok"]
+    assert all_targets_inside_limits(stack.drives)
+
+
+def test_reset_with_a_silent_drive_answers_fault_naming_it(tmp_path: Path) -> None:
+    import dataclasses
+
+    from tsmd.config import default_sim_config
+    from tsmd.daemon import Daemon
+
+    base = default_sim_config()
+    config = dataclasses.replace(base, profiles=dataclasses.replace(base.profiles, active=None))
+    daemon = Daemon(config, sim=True, socket_path=str(tmp_path / "s.sock"))
+    daemon.start()
+    try:
+        with ApiClient(tmp_path / "s.sock") as c:
+            c.call("enable")
+            daemon.rig.inject_fault("silent", drive=1)
+            deadline = time.monotonic() + 5
+            while c.call("status")["state"] != "FAULT" and time.monotonic() < deadline:
+                time.sleep(0.05)
+            time.sleep(0.6)  # past the drive's heartbeat timeout
+            response = c.request("reset")
+            assert error_code(response) == "fault"
+            assert "drive 1 (node 2) silent" in response["error"]["message"]
+    finally:
+        daemon.stop()

@@ -37,10 +37,11 @@ def _vcan_missing() -> str | None:
     return None
 
 
-pytestmark = [pytest.mark.vcan,
-              pytest.mark.skipif(_vcan_missing() is not None, reason=str(_vcan_missing()))]
+needs_vcan = pytest.mark.skipif(_vcan_missing() is not None, reason=str(_vcan_missing()))
+pytestmark = [pytest.mark.vcan]
 
 
+@needs_vcan
 def test_master_boots_and_streams_to_the_rig_over_vcan():
     import time
 
@@ -72,5 +73,89 @@ def test_master_boots_and_streams_to_the_rig_over_vcan():
         assert np.allclose([f.position_deg for f in fb], [10.0, -10.0], atol=0.05)
         assert drives.poll_events() == []
     finally:
+        drives.close()
+        rig.close()
+
+
+def _real_time_pair(interface: str, configs):
+    import can
+
+    from drivers.canopen_master import CanOpenDrives
+    from simrig.rig import SimRig
+
+    period_s = 0.004
+    channel = VCAN if interface == "socketcan" else f"tsmd-rt-{os.getpid()}"
+    rig = SimRig(can.Bus(interface=interface, channel=channel), SpringPlant(), configs, period_s,
+                 lockstep=False)
+    rig.start()
+    drives = CanOpenDrives(can.Bus(interface=interface, channel=channel), configs, period_s,
+                           receive="notifier", own_bus=True)
+    return drives, rig
+
+
+def _stream(drives, q, ticks: int, period_s: float = 0.004) -> list:
+    import time
+
+    events = []
+    deadline = time.monotonic()
+    for _ in range(ticks):
+        drives.write_targets(q)
+        drives.sync()
+        deadline += period_s
+        time.sleep(max(0.0, deadline - time.monotonic()))
+        drives.pump()
+        events += drives.poll_events()
+    return events
+
+
+@pytest.mark.parametrize("interface", [
+    "virtual", pytest.param("socketcan", marks=needs_vcan)])
+def test_homing_then_reboot_and_recovery_in_real_time(interface):
+    from drivers.drive import FaultKind
+    from drivers.units import DriveConfig, HomingConfig
+
+    configs = [DriveConfig(node_id=1, homing=HomingConfig(method=37, home_offset_deg=2.0,
+                                                          required=True)),
+               DriveConfig(node_id=2)]
+    drives, rig = _real_time_pair(interface, configs)
+    try:
+        drives.boot()
+        assert not drives.zero_referenced()
+        assert drives.home()[0].homed
+        _stream(drives, [0.0, 0.0], 3)
+        assert drives.feedback()[0].position_deg == pytest.approx(-2.0, abs=0.01)
+        drives.enable()
+        _stream(drives, [3.0, 3.0], 100)
+        rig.inject_fault("reboot", drive=1)
+        events = _stream(drives, [3.0, 3.0], 50)
+        assert FaultKind.DRIVE_REBOOTED in {e.kind for e in events}
+        drives.fault_reset()
+        drives.disable()
+        drives.enable()
+        _stream(drives, [3.0, 6.0], 150)
+        fb = drives.feedback()
+        assert np.allclose([f.position_deg for f in fb], [3.0, 6.0], atol=0.05)
+    finally:
+        drives.close()
+        rig.close()
+
+
+@needs_vcan
+def test_error_frames_sent_on_vcan_become_bus_events():
+    import can
+
+    from drivers.can_errors import CAN_ERR_CRTL, CAN_ERR_CRTL_TX_PASSIVE, BusState, error_frame
+    from simrig.rig import default_drive_configs
+
+    drives, rig = _real_time_pair("socketcan", default_drive_configs())
+    sender = can.Bus(interface="socketcan", channel=VCAN)
+    try:
+        drives.boot()
+        sender.send(error_frame(CAN_ERR_CRTL, bytes((0, CAN_ERR_CRTL_TX_PASSIVE))))
+        _stream(drives, [0.0, 0.0], 10)
+        assert drives.bus_state is BusState.ERROR_PASSIVE
+        assert drives.poll_bus_events()
+    finally:
+        sender.shutdown()
         drives.close()
         rig.close()

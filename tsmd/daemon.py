@@ -534,7 +534,8 @@ class Daemon:
         handlers = ApiHandlers(self.controller, max_subscribe_hz=config.api.max_subscribe_hz)
         self.server = ApiServer(path, handlers, mode=config.api.socket_mode,
                                 max_line_bytes=config.api.max_line_bytes,
-                                max_clients=config.api.max_clients, on_event=self.events.emit)
+                                max_clients=config.api.max_clients, on_event=self.events.emit,
+                                loop_cpu=config.loop.realtime.cpu)
         self.server.start()
         self.socket_path = path
 

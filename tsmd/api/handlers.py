@@ -13,7 +13,7 @@ import threading
 from collections.abc import Callable
 from typing import Any, Protocol
 
-from drivers.drive import DriveError
+from drivers.drive import DriveError, DriveUnreachableError
 from tsmd.api.protocol import ApiError, Request, ok
 from tsmd.api.server import Connection
 from tsmd.errors import TsmdError
@@ -66,8 +66,9 @@ class ApiHandlers:
                                       f"{self.command_timeout_s:g} s") from None
         except LoopError as exc:
             raise ApiError(exc.code, str(exc)) from None
-        except DriveError as exc:
-            raise ApiError("drive", f"{name}: {exc}") from None
+        except DriveError as exc:  # unreachable (silent drive, bus-off) is a fault, not a refusal
+            code = "fault" if isinstance(exc, DriveUnreachableError) else "drive"
+            raise ApiError(code, f"{name}: {exc}") from None
 
     async def _status(self, request: Request, conn: Connection) -> dict[str, Any]:
         return self.services.status()

@@ -119,10 +119,9 @@ def _check_types(cmd: str, params: dict[str, Any]) -> None:
         for i, v in enumerate(q):
             if isinstance(v, bool) or not isinstance(v, int | float):
                 raise ApiError("bad_param", f"set: q[{i}] must be a number, got {_kind(v)}")
-            if not math.isfinite(float(v)):
-                raise ApiError("bad_param", f"set: q[{i}] must be finite")
+        params["q"] = [_number(cmd, f"q[{i}]", v) for i, v in enumerate(q)]
     elif cmd == "subscribe" and "rate_hz" in params:
-        _number(cmd, "rate_hz", params["rate_hz"])
+        params["rate_hz"] = _number(cmd, "rate_hz", params["rate_hz"])
     elif cmd == "compensation":
         if "enabled" in params and not isinstance(params["enabled"], bool):
             raise ApiError("bad_param", "compensation: 'enabled' must be true or false")
@@ -142,9 +141,17 @@ def is_catheter_id(text: str) -> bool:
 
 
 def _number(cmd: str, name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ApiError("bad_param", f"{cmd}: {name!r} must be a finite number")
-    return float(value)
+    """A JSON number as a finite float; an integer too large for a float is out of range."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ApiError("bad_param", f"{cmd}: {name} must be a finite number, got {_kind(value)}")
+    try:
+        number = float(value)
+    except OverflowError:  # integers of 309+ digits: float() cannot hold them
+        raise ApiError("out_of_range", f"{cmd}: {name} has {len(str(abs(value)))} digits, "
+                                       "far outside any valid value") from None
+    if not math.isfinite(number):
+        raise ApiError("bad_param", f"{cmd}: {name} must be finite")
+    return number
 
 
 def _kind(value: Any) -> str:

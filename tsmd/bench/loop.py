@@ -8,7 +8,8 @@ only what it holds on the robot (master, loop, compensator); ``--rig thread`` ke
 the daemon's process on the ``virtual`` bus, as ``tsmd run --sim`` does, where the physics
 competes with the loop for the GIL. Measured: tick lateness (wake-up after the absolute
 deadline), SYNC period jitter (time between SYNC frames minus the period), overruns and CPU
-time per tick.
+time per tick. The "hostile clients" run repeats each rate with the API socket open and
+another process connecting and closing as fast as it can (the churn that once took ticks).
 ``cyclictest`` (rt-tests), when installed, runs at the same time, priority and period: its
 wake-up latency is what this machine allows any thread under the same load. Figures in
 docs/benchmarks.md#loop.
@@ -24,6 +25,7 @@ import os
 import re
 import shutil
 import subprocess
+import tempfile
 import threading
 import time
 from collections.abc import Callable
@@ -50,6 +52,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-cyclictest", action="store_true")
     parser.add_argument("--rig", choices=("process", "thread"), default="process",
                         help="simulated rig in its own process (default) or in the daemon's")
+    parser.add_argument("--no-hostile", action="store_true",
+                        help="skip the run with a connect/close storm on the API socket")
 
 
 @dataclass
@@ -82,11 +86,16 @@ class LoopResult:
     cpu_per_tick_us: Stats
     realtime: str
     faults: int
+    seconds: float = 0.0
+    churn_per_s: float | None = None
+    """Connect attempts per second of the hostile client (None: quiet run)."""
+    accepted_per_s: float | None = None
 
 
 def run_loop(rate_hz: float, seconds: float, priority: int, cpu: int | None,
              rig: str = "process",
-             on_measure_start: Callable[[], None] | None = None) -> LoopResult:
+             on_measure_start: Callable[[], None] | None = None,
+             hostile: bool = False) -> LoopResult:
     """The daemon's loop against the real-time simulated rig; timings of every tick and SYNC."""
     base = default_sim_config()
     rt = dataclasses.replace(base.loop.realtime, priority=priority, cpu=cpu, lock_memory=True)
@@ -104,8 +113,11 @@ def run_loop(rate_hz: float, seconds: float, priority: int, cpu: int | None,
         config = dataclasses.replace(config, bus=dataclasses.replace(
             config.bus, interface="udp_multicast", channel=group))
         rig_proc = _start_rig_process(config)
-    daemon = Daemon(config, sim=rig == "thread", api=False)
+    socket_dir = tempfile.TemporaryDirectory(prefix="tsmd-bench-") if hostile else None
+    daemon = Daemon(config, sim=rig == "thread", api=hostile,
+                    socket_path=f"{socket_dir.name}/tsmd.sock" if socket_dir else None)
     sync_times: list[float] = []
+    storm: subprocess.Popen[str] | None = None
     try:
         daemon.start()
         assert daemon.loop is not None and daemon.drives is not None
@@ -129,10 +141,15 @@ def run_loop(rate_hz: float, seconds: float, priority: int, cpu: int | None,
         stop = threading.Event()
         setter = threading.Thread(target=_sine_setpoints, args=(loop, stop, priority),
                                   daemon=True)
+        accepted0 = daemon.server.accepted if daemon.server is not None else 0
+        if daemon.socket_path is not None:
+            storm = _start_churn(str(daemon.socket_path), seconds)
         setter.start()
         time.sleep(seconds)
         stop.set()
         setter.join()
+        churn = _churn_rate(storm, seconds) if storm is not None else None
+        accepted = (daemon.server.accepted - accepted0 if daemon.server is not None else None)
         assert daemon.scheduler is not None
         times = daemon.scheduler.times
         report = daemon.rt_report
@@ -152,9 +169,15 @@ def run_loop(rate_hz: float, seconds: float, priority: int, cpu: int | None,
             lateness=Stats.of(times.lateness()),
             sync_jitter=Stats.of(np.abs(syncs - 1.0 / rate_hz)),
             cpu_per_tick_us=Stats.of(times.cpu()), realtime=realtime,
-            faults=loop.stats.faults)
+            faults=loop.stats.faults, seconds=seconds, churn_per_s=churn,
+            accepted_per_s=accepted / seconds if accepted is not None and hostile else None)
     finally:
+        if storm is not None and storm.poll() is None:
+            storm.kill()
+            storm.communicate()
         daemon.stop()
+        if socket_dir is not None:
+            socket_dir.cleanup()
         if rig_proc is not None:
             rig_proc.terminate()
             rig_proc.communicate(timeout=10)
@@ -203,6 +226,37 @@ def _start_rig_process(config: Any) -> subprocess.Popen[str]:
         err = proc.stderr.read() if proc.stderr else ""
         raise TsmdError(f"the simulated rig process did not start: {err.strip()[:300]}")
     return proc
+
+
+_CHURN_MAIN = """
+import socket, sys, time
+path, seconds = sys.argv[1], float(sys.argv[2])
+end = time.monotonic() + seconds
+attempts = 0
+while time.monotonic() < end:
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    s.setblocking(False)
+    try:
+        s.connect(path)
+    except OSError:
+        pass
+    s.close()
+    attempts += 1
+print(attempts)
+"""
+
+
+def _start_churn(path: str, seconds: float) -> subprocess.Popen[str]:
+    """A hostile client in its own process: connect and close as fast as it can."""
+    import sys
+
+    return subprocess.Popen([sys.executable, "-c", _CHURN_MAIN, path, str(seconds)],
+                            stdout=subprocess.PIPE, text=True)
+
+
+def _churn_rate(proc: subprocess.Popen[str], seconds: float) -> float:
+    out, _ = proc.communicate(timeout=seconds + 30)
+    return int(out.strip() or 0) / seconds
 
 
 def _sine_setpoints(loop: Any, stop: threading.Event, priority: int) -> None:
@@ -285,6 +339,8 @@ def main(args: argparse.Namespace) -> int:
             tester = Cyclictest(rate, args.seconds, args.priority, args.cpu)
         result = run_loop(rate, args.seconds, args.priority, args.cpu, args.rig,
                           on_measure_start=tester.start if tester is not None else None)
+        hostile = (None if args.no_hostile else
+                   run_loop(rate, args.seconds, args.priority, args.cpu, args.rig, hostile=True))
         ct = tester.result() if tester is not None else None
         pct = 100.0 * result.overruns / max(result.ticks, 1)
         print(f"\n{rate:g} Hz ({result.realtime}): {result.ticks} ticks, {result.overruns} "
@@ -312,7 +368,27 @@ def main(args: argparse.Namespace) -> int:
             ok = pct <= 0.1
             print(f"  goal <= 0.1 % overruns at {rate:g} Hz: {'met' if ok else 'NOT met'}")
         goals_ok &= ok
+        if hostile is not None:
+            goals_ok &= _print_hostile(result, hostile)
     load = os.getloadavg()
     print(f"\nload average after {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}; "
           f"goals {'all met' if goals_ok else 'NOT all met'}")
     return 0
+
+
+def _print_hostile(quiet: LoopResult, hostile: LoopResult) -> bool:
+    """The hostile-clients row: overruns and tick rate during a churn storm vs quiet."""
+    def rate(r: LoopResult) -> float:
+        return r.ticks / r.seconds if r.seconds else math.nan
+
+    pct = 100.0 * hostile.overruns / max(hostile.ticks, 1)
+    quiet_pct = 100.0 * quiet.overruns / max(quiet.ticks, 1)
+    print(f"  hostile clients ({hostile.churn_per_s or 0:.0f} connects/s tried, "
+          f"{hostile.accepted_per_s or 0:.0f}/s accepted): {hostile.ticks} ticks "
+          f"({rate(hostile):.1f}/s vs {rate(quiet):.1f}/s quiet), {hostile.overruns} overruns "
+          f"({pct:.3f} % vs {quiet_pct:.3f} % quiet), {hostile.faults} faults")
+    print(f"{'loop tick lateness, hostile clients':34} {hostile.lateness.row()}")
+    ok = rate(hostile) >= 0.99 * rate(quiet) and pct <= max(2.0 * quiet_pct, 0.1)
+    print(f"  goal hostile clients take no ticks (tick rate >= 99 % of quiet, overruns <= "
+          f"max(2 x quiet, 0.1 %)): {'met' if ok else 'NOT met'}")
+    return ok

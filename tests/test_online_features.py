@@ -120,3 +120,26 @@ def test_slip_restarts_after_the_knob_stood_still() -> None:
     after = stroke.pos_deg > 20.5
     assert stroke.slip_deg[after].min() < 1.0  # counted again from the restart at 20 deg
     assert stroke.slip_deg[~after].max() == pytest.approx(20.0, abs=0.5)
+
+
+def test_the_real_probe_shows_a_loaded_ramp_of_the_same_slope_in_every_acquisition() -> None:
+    from tsmd.calibration import identify_sweep
+    from tsmd.tee import default_tee_dir, load_tee_acquisition
+
+    files = sorted(default_tee_dir().glob("motor1_current60__*_acquisition.csv"))
+    if not files:
+        pytest.skip(f"no TEE data in {default_tee_dir()} (set TSMD_TEE_DATA)")
+    slopes = []
+    for f in files:
+        rec = load_tee_acquisition(f)
+        t, cmd, pos, cur = rec["t"], rec["cmd1"], rec["pos1"], rec["cur1"]
+        edge = identify_sweep(t, cmd, pos, cur).estimate("dead_zone_pos_deg")
+        seg = StrokeSegmenter(0)
+        for sample in zip(t, cmd, pos, cur, np.zeros_like(t), strict=True):
+            stroke = seg.push(*(float(v) for v in sample))
+            if stroke is not None and stroke.direction > 0:
+                ramp = loaded_ramp(stroke, edge)
+                assert isinstance(ramp, LoadedRamp), getattr(ramp, "reason", "")
+                slopes.append(ramp.slope_A_per_deg)
+    assert len(slopes) == len(files)
+    assert min(slopes) > 0 and max(slopes) / min(slopes) < 1.5

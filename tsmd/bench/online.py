@@ -164,12 +164,15 @@ def change_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, A
                                                                   float(b)), 1e-9)
                  for a, b in itertools.pairwise(revs[:REVERSALS + 1])]
         out["knobs"].append({
-            "before": rmse(rec_on, k, 10.0, at), "on": rmse(rec_on, k, t10),
+            "before": rmse(rec_on, k, 10.0, at), "before_off": rmse(rec_off, k, 10.0, at),
+            "on": rmse(rec_on, k, t10),
             "off": rmse(rec_off, k, t10), "fresh": rmse(rec_fresh, k, t10), "t10": t10 - at,
             "trend": trend})
     assert worker is not None
     out["offsets"] = worker.offsets()
     out["events"] = [e for e in worker.events if e["level"] == "warning"]
+    out["max_before_deg"] = max([abs(e["offset_deg"]) for e in worker.events
+                                 if e["event"] == "online offset" and e["t"] < at], default=0.0)
     return out
 
 
@@ -252,7 +255,7 @@ def main(args: argparse.Namespace) -> int:
     if not args.no_change:
         print(f"\nshape change {args.change} at {args.change_at:g} s; RMSE from each knob's "
               f"{REVERSALS}th reversal after it to {args.after_s:g} s after it (tip deg)\n")
-        print("| unit | knob | before | online on | online off | fresh calibration | "
+        print("| unit | knob | before (on / off) | online on | online off | fresh calibration | "
               "on / fresh | 10th reversal after (s) |")
         print("|---|---|---|---|---|---|---|---|")
         ratios = []
@@ -261,10 +264,13 @@ def main(args: argparse.Namespace) -> int:
             for k, kn in enumerate(r["knobs"]):
                 ratio = kn["on"] / kn["fresh"]
                 ratios.append(ratio)
-                print(f"| {u} | phi{k + 1} | {kn['before']:.2f} | {kn['on']:.2f} | "
+                print(f"| {u} | phi{k + 1} | {kn['before']:.2f} / {kn['before_off']:.2f} | "
+                      f"{kn['on']:.2f} | "
                       f"{kn['off']:.2f} | {kn['fresh']:.2f} | {ratio:.2f} | {kn['t10']:.0f} |")
             trend = " / ".join(" ".join(f"{x:.1f}" for x in kn["trend"]) for kn in r["knobs"])
-            print(f"|   | offsets (deg, outward) {r['offsets']}; on/fresh per reversal "
+            offsets = [[round(v, 2) for v in pair] for pair in r["offsets"]]
+            print(f"|   | offsets (deg, outward) {offsets}, largest before the change "
+                  f"{r['max_before_deg']:.2f}; on/fresh per reversal "
                   f"interval phi1 / phi2: {trend}; {len(r['events'])} warnings; "
                   f"3 runs {r['wall_s']:.0f} s wall | | | | | | |", flush=True)
         print(f"\non / fresh: mean {np.mean(ratios):.2f}, worst {max(ratios):.2f} "

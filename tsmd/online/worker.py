@@ -72,7 +72,7 @@ class OnlineWorker:
             maxlen=queue_len)
         self.drain_every = drain_every
         self.on_event = on_event
-        self.events: collections.deque[dict[str, Any]] = collections.deque(maxlen=64)
+        self.events: collections.deque[dict[str, Any]] = collections.deque(maxlen=256)
         idx = {name: i for i, name in enumerate(columns)}
         self._i = [idx[c] for c in ("t", "cmd1", "cmd2", "pos1", "pos2", "cur1", "cur2")]
         self._segmenters = [StrokeSegmenter(0), StrokeSegmenter(1)]

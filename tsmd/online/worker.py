@@ -85,6 +85,7 @@ class OnlineWorker:
         self._t_publish = 0.0
         self._was_enabled = True
         self._stalled = [False, False]
+        self._publish_lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -132,7 +133,8 @@ class OnlineWorker:
             n += 1
             t_now = self._sample(row, enabled)
         if t_now is not None:
-            self._publish(t_now)
+            with self._publish_lock:
+                self._publish(t_now)
         return n
 
     def _sample(self, row: tuple[float, ...], enabled: bool) -> float:
@@ -239,10 +241,11 @@ class OnlineWorker:
 
     def set_enabled(self, enabled: bool) -> None:
         """Switch re-estimation off (the profile's values come back at once) or on again."""
-        self.enabled = enabled
-        if not enabled:
-            version = self.published[0]
-            self.published = (version + 1, ZERO_OFFSETS, self.base_knobs)
+        with self._publish_lock:  # not the loop's lock: the loop only reads ``published``
+            self.enabled = enabled
+            if not enabled:
+                version = self.published[0]
+                self.published = (version + 1, ZERO_OFFSETS, self.base_knobs)
         self._emit("info", "online re-estimation", enabled=enabled)
 
     def offsets(self) -> Offsets:

@@ -86,3 +86,20 @@ def test_confidence_grows_with_agreeing_measurements() -> None:
         confidences.append(tracker.confidence)
     assert confidences == sorted(confidences)
     assert confidences[-1] > 0.8
+
+
+def test_both_edges_of_a_knob_agreeing_confirm_a_change_at_once() -> None:
+    pos, neg = learned(), learned()
+    pos.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    assert not pos.agrees_with(neg)  # one suspect on one side only
+    neg.update(ramp_with_edge(EDGE_DEG + 4.3), EDGE_DEG)
+    assert pos.agrees_with(neg)
+    pos.follow(pos.suspects[-1], "test")
+    assert pos.applied_deg == pytest.approx(4.0)
+
+
+def test_edges_of_a_knob_that_disagree_confirm_nothing() -> None:
+    pos, neg = learned(), learned()
+    pos.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    neg.update(ramp_with_edge(EDGE_DEG - 3.0), EDGE_DEG)
+    assert not pos.agrees_with(neg)

@@ -10,7 +10,9 @@ coupling the profile knows is not mistaken for a change).
 - **Noise**: the estimate is the median of the last ``window`` accepted measurements.
 - **Spikes / outliers**: a measurement further than ``gate_deg`` from the estimate is held as
   suspect; it is followed only when ``confirm`` suspects in a row agree within
-  ``confirm_spread_deg`` (a shape change), and that is reported as a warning.
+  ``confirm_spread_deg``, or when the other edge of the same knob has a suspect that agrees
+  (:meth:`EdgeTracker.agrees_with`, checked by the worker): a shape change, reported as a
+  warning.
 - **Bounds**: an offset beyond ``max_offset_deg`` is never followed (warning, estimate kept).
 - **Hysteresis**: the applied offset moves only when the estimate leaves a band of
   ``deadband_deg`` around it.
@@ -126,22 +128,39 @@ class EdgeTracker:
             self.suspects = [*self.suspects, m][-o.confirm:]
             if len(self.suspects) >= o.confirm and (max(self.suspects) - min(self.suspects)
                                                     <= o.confirm_spread_deg):
-                new = median(self.suspects)
-                if abs(new) > o.max_offset_deg:
-                    events.append(("warning", "online change beyond bounds, not followed",
-                                   {**tag, "offset_deg": round(new, 2),
-                                    "bound_deg": o.max_offset_deg}))
-                    self.suspects.clear()
-                else:
-                    events.append(("warning", "online shape change followed",
-                                   {**tag, "from_deg": round(self.estimate_deg, 2),
-                                    "to_deg": round(new, 2)}))
-                    self.accepted = list(self.suspects)
-                    self.suspects.clear()
-                    self.estimate_deg = new
+                events += self.follow(median(self.suspects), "consecutive ramps agree")
+        self._apply()
+        return events
+
+    def agrees_with(self, other: EdgeTracker) -> bool:
+        """Both edges of a knob have a suspect and they agree: the knob's shape changed (a
+        slack or curvature change moves both tendons' edges outward together; a spike does not
+        hit both tendons' ramps alike)."""
+        return (bool(self.suspects) and bool(other.suspects) and self.frozen_for == 0
+                and other.frozen_for == 0
+                and abs(self.suspects[-1] - other.suspects[-1]) <= self.options.confirm_spread_deg)
+
+    def follow(self, new_deg: float, why: str) -> list[tuple[str, str, dict[str, Any]]]:
+        """Take a confirmed change (within the bound) as the estimate; events to report."""
+        o = self.options
+        tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
+        kept = list(self.suspects)
+        self.suspects.clear()
+        if abs(new_deg) > o.max_offset_deg:
+            return [("warning", "online change beyond bounds, not followed",
+                     {**tag, "offset_deg": round(new_deg, 2), "bound_deg": o.max_offset_deg})]
+        events = [("warning", "online shape change followed",
+                   {**tag, "from_deg": round(self.estimate_deg, 2), "to_deg": round(new_deg, 2),
+                    "why": why})]
+        self.accepted = kept or [new_deg]
+        self.estimate_deg = new_deg
+        self._apply()
+        return events
+
+    def _apply(self) -> None:
+        o = self.options
         if abs(self.estimate_deg - self.applied_deg) > o.deadband_deg:
             self.applied_deg = max(-o.max_offset_deg, min(o.max_offset_deg, self.estimate_deg))
-        return events
 
     def status(self) -> dict[str, Any]:
         state = ("learning" if self.learning else "frozen" if self.frozen_for > 0

@@ -205,7 +205,18 @@ class OnlineWorker:
     def _ramp(self, tracker: EdgeTracker, ramp: LoadedRamp) -> None:
         d_pos, d_neg = edges_at(self.base_knobs[ramp.knob], ramp.other_deg)
         before = tracker.applied_deg
-        for level, event, fields in tracker.update(ramp, d_pos if ramp.side > 0 else d_neg):
+        events = tracker.update(ramp, d_pos if ramp.side > 0 else d_neg)
+        other = self.trackers[(ramp.knob, -ramp.side)]
+        if tracker.agrees_with(other):
+            other_before = other.applied_deg
+            events += tracker.follow(tracker.suspects[-1], "both edges of the knob agree")
+            events += other.follow(other.suspects[-1], "both edges of the knob agree")
+            if other.applied_deg != other_before:
+                self._emit("info", "online offset", knob=ramp.knob,
+                           side="pos" if other.side > 0 else "neg",
+                           offset_deg=round(other.applied_deg, 3),
+                           confidence=round(other.confidence, 2))
+        for level, event, fields in events:
             self._emit(level, event, **fields)
         if tracker.applied_deg != before:
             self._emit("info", "online offset", knob=ramp.knob,

@@ -249,6 +249,7 @@ def main(args: argparse.Namespace) -> int:
         units = [int(u) for u in str(args.units).split(",") if u.strip()]
     except ValueError:
         raise TsmdError(f"--units {args.units!r}: expected integers like 0,1,2") from None
+    shape_change(args.change)  # a bad --change is refused before anything runs
     med, p99, top = hot_path_us()
     print(f"hot path (loop-side observe, two knobs): median {med:.2f} us, p99 {p99:.2f} us, "
           f"max {top:.1f} us")

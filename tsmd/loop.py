@@ -227,6 +227,8 @@ class ControlLoop:
         self.schedule_reset = False
         """Set after a command that blocked (enable): the scheduler re-anchors its deadlines."""
         self._playback: Playback | None = None
+        self.observer: Callable[[tuple[float, ...], bool], None] | None = None
+        """Called with each tick's row and whether the loop is enabled (tsmd.online)."""
         self._q = np.zeros(2)
         self._last_cmd = np.zeros(2)
         self._nan2 = (math.nan, math.nan)
@@ -280,6 +282,8 @@ class ControlLoop:
                feedback[0].position_deg, feedback[1].position_deg,
                feedback[0].current_A, feedback[1].current_A, float(tip[0]), float(tip[1]))
         self._record(row)
+        if self.observer is not None:
+            self.observer(row, self.state is LoopState.ENABLED)
         self.stats.ticks += 1
         sample = Sample(self.stats.ticks, t_s, self.state, (row[1], row[2]), (row[3], row[4]),
                         (row[5], row[6]), (row[7], row[8]), (row[9], row[10]), self.fault_reason)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from types import ModuleType
 
-from tsmd.bench import accuracy, bus, calibration, family_accuracy, gap, loop, realism
+from tsmd.bench import accuracy, bus, calibration, family_accuracy, gap, loop, online, realism
 
 BENCHMARKS: dict[str, tuple[ModuleType, str]] = {
     "bus": (bus, "CAN frames, bus load, CPU and latency per tick"),
@@ -14,6 +14,7 @@ BENCHMARKS: dict[str, tuple[ModuleType, str]] = {
     "calibration": (calibration, "identified D and B against ground truth"),
     "gap": (gap, "sim-to-real gap diagnosis self-test and speed"),
     "family": (family_accuracy, "tracking on catheter units each calibrated from current"),
+    "online": (online, "online dead-zone re-estimation through a shape change"),
     "realism": (realism, "family of simulated catheters against the paper's figures"),
 }
 

@@ -387,6 +387,11 @@ class OursCompensator:
         self._cache: list[tuple[float, Envelopes] | None] = [None, None]
         self.reset(np.zeros(2))
 
+    def replace_knobs(self, knobs: tuple[OursKnob, OursKnob]) -> None:
+        """New parameters from now on, state kept (online re-estimation, tsmd.online)."""
+        self.knobs = knobs
+        self._cache = [None, None]
+
     def _envelopes(self, i: int) -> Envelopes:
         """Envelopes of knob i at the other knob's grid coordinate (cached while it is still)."""
         key = round(float(self._axis[1 - i]), 3)

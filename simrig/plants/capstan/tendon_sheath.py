@@ -230,6 +230,20 @@ class _Knob:
         self.friction_static = self._friction(1.0)
         self.reset()
 
+    def reshape(self, eff: Effects, slack_delta_mm: tuple[float, float]) -> None:
+        """A new sheath shape mid-run: wrap and slack change, the tendons keep their tension."""
+        p = self.p
+        wrap_rad = math.radians(p.sheath_wrap_deg + eff.sheath_curvature_deg)
+        self.sheath_exponent = np.full(self.n_elements, p.sheath_friction * wrap_rad
+                                       / self.n_elements)
+        curvature_slack_m = eff.lumen_clearance_mm * 1e-3 * math.radians(eff.sheath_curvature_deg)
+        self.slack_pos_m = (p.slack_pos_mm + slack_delta_mm[0]) * 1e-3 + curvature_slack_m
+        self.slack_neg_m = (p.slack_neg_mm + slack_delta_mm[1]) * 1e-3 + curvature_slack_m
+        self.friction_static = self._friction(1.0)
+        for side in (0, 1):  # cached solutions belong to the old shape
+            self._last[side] = None
+            self._fast[side] = None
+
     def _friction(self, sheath_scale: float) -> Friction:
         """(G, H) for pulling and for the mirrored release, sheath friction scaled."""
         gain = np.exp(-np.cumsum(sheath_scale * self.sheath_exponent + self.routing_exponent))
@@ -460,6 +474,20 @@ class TendonSheathPlant:
             tip_deg=np.array([math.degrees(tip0), math.degrees(tip1)]),
             knob_torque_Nm=np.array([tau0, tau1]),
         )
+
+    def reshape(self, sheath_curvature_deg: float | None = None,
+                slack_delta_mm: Sequence[tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
+                ) -> None:
+        """Change the sheath's shape now (``simrig.scenario``): its total bend, and per knob the
+        tendons' slack (pos, neg) relative to the built values; the state carries over."""
+        eff = self.effects
+        if sheath_curvature_deg is not None:
+            eff = replace(eff, sheath_curvature_deg=float(sheath_curvature_deg)).validated()
+        if len(slack_delta_mm) != 2:
+            raise ValueError(f"slack_delta_mm must list 2 knobs, got {len(slack_delta_mm)}")
+        self.effects = eff
+        for knob, (d_pos, d_neg) in zip(self._knobs, slack_delta_mm, strict=True):
+            knob.reshape(eff, (float(d_pos), float(d_neg)))
 
     def tendon_tension_N(self) -> NDArray[np.float64]:
         """Proximal tension of the four tendons, shape (2 knobs, 2 sides: pos, neg)."""

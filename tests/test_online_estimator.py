@@ -1,0 +1,105 @@
+"""The edge-offset estimator: baseline, gating, bounds, hysteresis, freezes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tsmd.online.estimator import EdgeTracker, EstimatorOptions
+from tsmd.online.features import LoadedRamp
+
+EDGE_DEG = 20.0
+LEVEL_A = 0.05
+SLOPE = 0.003
+
+
+def ramp_with_edge(edge_deg: float, slope: float = SLOPE) -> LoadedRamp:
+    """A ramp whose crossing of LEVEL_A is at ``edge_deg`` (positive side)."""
+    u0 = edge_deg + 10.0
+    return LoadedRamp(0, 1, u0, LEVEL_A + slope * 10.0, slope, 0.0, 0.0, 200, 0.003)
+
+
+def learned(options: EstimatorOptions | None = None) -> EdgeTracker:
+    tracker = EdgeTracker(0, 1, options or EstimatorOptions())
+    for _ in range(tracker.options.baseline_ramps):
+        tracker.update(ramp_with_edge(EDGE_DEG), EDGE_DEG)
+    assert not tracker.learning
+    return tracker
+
+
+def test_baseline_learns_the_level_at_the_calibrated_edge() -> None:
+    tracker = learned()
+    assert tracker.level_A == pytest.approx(LEVEL_A)
+    assert tracker.applied_deg == 0.0
+
+
+def test_step_change_is_followed_after_confirmation_with_a_warning() -> None:
+    tracker = learned()
+    events = tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    assert tracker.applied_deg == 0.0  # one ramp alone is a suspect
+    events += tracker.update(ramp_with_edge(EDGE_DEG + 4.2), EDGE_DEG)
+    assert tracker.applied_deg == pytest.approx(4.1, abs=0.01)
+    assert any(level == "warning" and "followed" in name for level, name, _ in events)
+
+
+def test_no_change_no_drift_under_noise() -> None:
+    tracker = learned()
+    rng = np.random.default_rng(0)
+    applied = []
+    for _ in range(300):
+        tracker.update(ramp_with_edge(EDGE_DEG + 0.3 * rng.standard_normal()), EDGE_DEG)
+        applied.append(tracker.applied_deg)
+    assert max(abs(a) for a in applied) <= 0.5  # hysteresis: noise does not move it
+
+
+def test_an_isolated_outlier_is_not_followed() -> None:
+    tracker = learned()
+    for m in (0.1, 9.0, -0.1, 0.0, 7.0, 0.2):
+        tracker.update(ramp_with_edge(EDGE_DEG + m), EDGE_DEG)
+    assert tracker.applied_deg == 0.0
+
+
+def test_a_change_beyond_the_bound_is_refused_with_a_warning() -> None:
+    tracker = learned(EstimatorOptions(max_offset_deg=6.0))
+    events = []
+    for _ in range(4):
+        events += tracker.update(ramp_with_edge(EDGE_DEG + 9.0), EDGE_DEG)
+    assert tracker.applied_deg == 0.0
+    assert any("beyond bounds" in name for _, name, _ in events)
+
+
+def test_a_much_steeper_ramp_freezes_the_estimate() -> None:
+    tracker = learned()
+    events = tracker.update(ramp_with_edge(EDGE_DEG + 5.0, slope=5 * SLOPE), EDGE_DEG)
+    assert tracker.frozen_for > 0 and tracker.status()["state"] == "frozen"
+    assert any("frozen" in name for _, name, _ in events)
+    for _ in range(2):  # the frozen ramps after it do not count, even consistent ones
+        tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    assert tracker.applied_deg == 0.0
+
+
+def test_confidence_grows_with_agreeing_measurements() -> None:
+    tracker = learned()
+    confidences = []
+    for _ in range(5):
+        tracker.update(ramp_with_edge(EDGE_DEG + 0.1), EDGE_DEG)
+        confidences.append(tracker.confidence)
+    assert confidences == sorted(confidences)
+    assert confidences[-1] > 0.8
+
+
+def test_both_edges_of_a_knob_agreeing_confirm_a_change_at_once() -> None:
+    pos, neg = learned(), learned()
+    pos.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    assert not pos.agrees_with(neg)  # one suspect on one side only
+    neg.update(ramp_with_edge(EDGE_DEG + 4.3), EDGE_DEG)
+    assert pos.agrees_with(neg)
+    pos.follow(pos.suspects[-1], "test")
+    assert pos.applied_deg == pytest.approx(4.0)
+
+
+def test_edges_of_a_knob_that_disagree_confirm_nothing() -> None:
+    pos, neg = learned(), learned()
+    pos.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    neg.update(ramp_with_edge(EDGE_DEG - 3.0), EDGE_DEG)
+    assert not pos.agrees_with(neg)

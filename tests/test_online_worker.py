@@ -1,0 +1,178 @@
+"""The worker beside the loop: strokes in, offsets published, compensator updated between ticks."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from support.online import profile_edges, rows
+
+from tsmd.compensation import build_compensator
+from tsmd.loop import ROW_COLUMNS
+from tsmd.online import (
+    OnlineError,
+    OnlineWorker,
+    profile_with_offsets,
+    save_online_version,
+    shifted_knob,
+)
+from tsmd.online.apply import edges_at
+from tsmd.profile import load_profile
+
+PROFILE = Path(__file__).resolve().parents[1] / "profiles" / "example-sim.yaml"
+
+
+@pytest.fixture(scope="module")
+def profile() -> Any:
+    return load_profile(PROFILE)
+
+
+def make_worker(profile: Any) -> tuple[OnlineWorker, Any, tuple[Any, Any]]:
+    """A worker on a fresh compensator, and the compensator's original knobs (the truth)."""
+    comp = build_compensator(profile, "ours", 0.004)
+    return OnlineWorker(comp, 0.004, ROW_COLUMNS, drain_every=25), comp, comp.knobs
+
+
+def feed(worker: OnlineWorker, data: list[tuple[float, ...]], enabled: bool = True) -> None:
+    for row in data:
+        worker.observe(row, enabled)
+    worker.drain()
+    worker.observe(data[-1], enabled)  # the loop's next tick picks the last update up
+
+
+def test_step_change_is_recovered_and_reaches_the_compensator(profile: Any) -> None:
+    worker, comp, base = make_worker(profile)
+    feed(worker, rows(200.0, profile_edges(base, 4.0, at_s=100.0)))
+    for knob in (0, 1):
+        for side in (0, 1):
+            assert worker.offsets()[knob][side] == pytest.approx(4.0, abs=0.8)
+    d_pos, d_neg = edges_at(comp.knobs[0], 0.0)
+    b_pos, b_neg = edges_at(base[0], 0.0)
+    assert d_pos == pytest.approx(b_pos + worker.offsets()[0][0], abs=1e-9)
+    assert d_neg == pytest.approx(b_neg - worker.offsets()[0][1], abs=1e-9)
+
+
+def test_no_change_no_drift(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    feed(worker, rows(300.0, profile_edges(base), seed=1))
+    assert max(abs(v) for pair in worker.offsets() for v in pair) <= 0.5
+
+
+def test_spikes_do_not_move_the_offsets(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    feed(worker, rows(200.0, profile_edges(base), spike_rate=0.01,
+                      seed=2))
+    assert max(abs(v) for pair in worker.offsets() for v in pair) <= 0.5
+
+
+def test_twice_the_noise_keeps_the_offsets_within_a_degree(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    feed(worker, rows(200.0, profile_edges(base), noise_A=0.006,
+                      spike_rate=0.01, seed=4))
+    assert max(abs(v) for pair in worker.offsets() for v in pair) <= 1.0
+
+
+def test_a_stalled_motor_freezes_the_estimate(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    # phi1 stalls over a whole stroke out of the dead zone while its edges "move"
+    data = rows(120.0, profile_edges(base), seed=3)
+    stalled = rows(40.0, profile_edges(base, 5.0), stall=(0, 0.0, 40.0),
+                   seed=4)
+    feed(worker, data)
+    t0 = data[-1][0] + 0.004
+    feed(worker, [(r[0] + t0, *r[1:]) for r in stalled])
+    assert worker.offsets()[0] == (0.0, 0.0)
+    assert any(e["event"] == "online estimate frozen" for e in worker.events)
+
+
+def test_a_fault_freezes_the_estimate(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    data = rows(200.0, profile_edges(base, 4.0, at_s=100.0), seed=5)
+    feed(worker, data[:25000])  # until t = 100 s: the change has not happened yet
+    feed(worker, data[25000:], enabled=False)  # loop in FAULT: rows come, nothing is learned
+    assert worker.offsets() == ((0.0, 0.0), (0.0, 0.0))
+    assert worker.status()["edges"]["phi1_pos"]["state"] == "frozen"
+
+
+def test_switching_off_restores_the_profiles_values(profile: Any) -> None:
+    worker, comp, base = make_worker(profile)
+    original = comp.knobs
+    feed(worker, rows(200.0, profile_edges(base, 4.0, at_s=100.0), seed=6))
+    assert comp.knobs[0] is not original[0]
+    worker.set_enabled(False)
+    worker.observe(worker_row(), True)
+    assert all(a is b for a, b in zip(comp.knobs, original, strict=True))
+    assert worker.status()["offsets_deg"] == [[0.0, 0.0], [0.0, 0.0]]
+
+
+def worker_row() -> tuple[float, ...]:
+    return tuple(0.0 if c != "t" else 1e6 for c in ROW_COLUMNS)
+
+
+def test_an_update_reaches_the_compensator_only_at_a_tick(profile: Any) -> None:
+    worker, comp, _ = make_worker(profile)
+    knobs_before = comp.knobs
+    version, offsets, knobs = worker.published
+    worker.published = (version + 1, offsets, (knobs[1], knobs[0]))
+    assert comp.knobs is knobs_before  # published, not yet picked up
+    worker.observe(worker_row(), True)
+    assert comp.knobs[0] is knobs[1]
+
+
+def test_the_queue_is_bounded(profile: Any) -> None:
+    comp = build_compensator(profile, "ours", 0.004)
+    worker = OnlineWorker(comp, 0.004, ROW_COLUMNS, queue_len=100)
+    for _ in range(1000):
+        worker.observe(worker_row(), True)
+    assert len(worker.queue) == 100
+
+
+def test_saving_writes_a_new_version_and_keeps_the_calibrated_file(profile: Any,
+                                                                   tmp_path: Path) -> None:
+    calibrated = tmp_path / f"{profile.catheter_id}.yaml"
+    calibrated.write_bytes(PROFILE.read_bytes())
+    offsets = ((3.0, 2.0), (1.0, -1.0))
+    first = save_online_version(profile, offsets, tmp_path)
+    second = save_online_version(profile, offsets, tmp_path)
+    assert first != second and calibrated.read_bytes() == PROFILE.read_bytes()
+    saved = load_profile(first)
+    k = saved.knobs[0]
+    assert np.allclose(k.dead_zone_pos_deg, np.add(profile.knobs[0].dead_zone_pos_deg, 3.0))
+    assert np.allclose(k.dead_zone_neg_deg, np.subtract(profile.knobs[0].dead_zone_neg_deg, 2.0))
+    assert saved.quality["phi1_online_offset_pos_deg"] == 3.0
+
+
+def test_a_saved_version_compensates_like_the_online_offsets(profile: Any) -> None:
+    offsets = ((3.0, 2.0), (1.0, -1.0))
+    live = build_compensator(profile, "ours", 0.004)
+    worker = OnlineWorker(live, 0.004, ROW_COLUMNS)
+    worker.published = (1, offsets, (shifted_knob(worker.base_knobs[0], offsets[0]),
+                                     shifted_knob(worker.base_knobs[1], offsets[1])))
+    worker.observe(worker_row(), True)
+    saved = build_compensator(profile_with_offsets(profile, offsets), "ours", 0.004)
+    t = np.arange(0.0, 30.0, 0.004)
+    q = np.column_stack([50 * np.sin(2 * np.pi * 0.07 * t), 40 * np.sin(2 * np.pi * 0.05 * t)])
+    live.reset(q[0])
+    saved.reset(q[0])
+    worst = max(float(np.max(np.abs(live.command(row) - saved.command(row)))) for row in q)
+    assert worst < 1e-6
+
+
+def test_a_compensator_without_edges_is_refused_in_one_line(profile: Any) -> None:
+    with pytest.raises(OnlineError, match="needs the 'ours' or 'paper' compensator"):
+        OnlineWorker(build_compensator(None, "none", 0.004), 0.004, ROW_COLUMNS)
+
+
+def test_the_paper_compensator_under_the_limiter_is_shifted_too(profile: Any) -> None:
+    from tsmd.compensation import KnobLimits
+
+    limited = build_compensator(profile, "paper", 0.004,
+                                [KnobLimits(-90.0, 90.0, 120.0, 2000.0)] * 2)
+    worker = OnlineWorker(limited, 0.004, ROW_COLUMNS)
+    worker.published = (1, ((2.0, 0.0), (0.0, 0.0)), (
+        shifted_knob(worker.base_knobs[0], (2.0, 0.0)), worker.base_knobs[1]))
+    worker.observe(worker_row(), True)
+    assert edges_at(limited.inner.knobs[0], 0.0)[0] == pytest.approx(  # type: ignore[attr-defined]
+        edges_at(worker.base_knobs[0], 0.0)[0] + 2.0)

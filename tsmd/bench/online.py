@@ -1,0 +1,290 @@
+"""`tsmd bench online`: online re-estimation of the dead zone through a shape change.
+
+Every run is the full stack in lockstep (simulated CiA 402 drives, the control loop, our
+compensator) on a catheter unit of the capstan family. The worker is the loop's observer and is
+drained synchronously every 25 ticks (deterministic); the estimator sees only commanded and
+actual position and current. Per unit:
+
+- the unit is calibrated from current (fast protocol) before the change, and again, freshly,
+  with the changed shape (the reference a new calibration would give);
+- one mixed-motion trajectory (both knobs, two sines each, so reversals happen on the loaded
+  ramps and inside the dead zone) is played three times: the shape changes at ``--change-at``
+  with online re-estimation on, the same with it off, and on the changed plant with the fresh
+  profile. Tip RMSE (simulated tracker, evaluation only) is compared from each knob's 10th
+  reversal after the change to the end;
+- ``--drift-s`` > 0: the same motion without a change, online on and off, to see that the
+  offsets stay within the calibration's uncertainty and the tracking is not worse.
+
+Calibrated profiles are cached in ``--cache`` (keyed by unit and shape) so reruns are cheap.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tsmd.errors import TsmdError
+
+Array = NDArray[np.float64]
+PERIOD_S = 0.004
+DRAIN_EVERY = 25
+REVERSALS = 10
+CALIBRATION_UNCERTAINTY_DEG = 0.5
+"""One half-cycle's knee edge against the tip's, standard deviation (docs/calibration.md)."""
+
+
+def mixed_motion(duration_s: float, seed: int) -> tuple[Array, Array]:
+    """Both knobs, each a slow large sine plus a faster smaller one (phases from ``seed``)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, duration_s, PERIOD_S)
+    ph = rng.uniform(0.0, 2 * math.pi, 4)
+    q1 = 45.0 * np.sin(2 * math.pi * 0.06 * t + ph[0]) + 12.0 * np.sin(2 * math.pi * 0.17 * t
+                                                                        + ph[1])
+    q2 = 42.0 * np.sin(2 * math.pi * 0.05 * t + ph[2]) + 12.0 * np.sin(2 * math.pi * 0.14 * t
+                                                                        + ph[3])
+    ramp = np.clip(t / 2.0, 0.0, 1.0)  # start from rest
+    return t, np.column_stack([q1 * ramp, q2 * ramp])
+
+
+def shape_change(kind: str) -> dict[str, Any]:
+    """``slack:MM`` (every tendon's slack grows by MM) or ``curvature:DEG`` (sheath bend)."""
+    name, _, value = kind.partition(":")
+    try:
+        x = float(value)
+    except ValueError:
+        raise TsmdError(f"--change {kind!r}: expected slack:MM or curvature:DEG") from None
+    if name == "slack":
+        return {"slack_delta_mm": ((x, x), (x, x))}
+    if name == "curvature":
+        return {"sheath_curvature_deg": x}
+    raise TsmdError(f"--change {kind!r}: expected slack:MM or curvature:DEG")
+
+
+def make_unit(unit: int, variation: float, changes: list[Any]) -> Any:
+    """Capstan unit ``unit`` (0 = nominal), with shape changes ``[ShapeChange, ...]``."""
+    from simrig.plants.capstan import make_tendon_sheath_plant
+    from simrig.scenario import ShapeChangePlant
+
+    params: dict[str, Any] = {}
+    if unit > 0:
+        params.update(unit_variation=variation, seed=unit)
+    return ShapeChangePlant(make_tendon_sheath_plant(**params), changes)
+
+
+def calibrated(unit: int, variation: float, change: dict[str, Any] | None, device: Any,
+               cache: Path, label: str) -> Any:
+    """The unit's profile from ``tsmd.calibration`` (fast protocol), cached."""
+    from simrig.scenario import ShapeChange
+    from tsmd.calibration import calibrate, fast_protocol
+    from tsmd.profile import load_profile, save_profile
+    from tsmd.replay import LockstepRunner
+
+    path = cache / f"unit{unit}-v{variation:g}-{label}.yaml"
+    if path.exists():
+        return load_profile(path)
+    plant = make_unit(unit, variation, [ShapeChange(0.0, change)] if change else [])
+    t0 = time.perf_counter()
+    with LockstepRunner(None, None, "none", 3000 + unit, plant) as runner:
+        profile = calibrate(runner, f"unit{unit}-{label}", device, protocol=fast_protocol())
+    cache.mkdir(parents=True, exist_ok=True)
+    save_profile(profile, path)
+    print(f"  calibrated unit {unit} ({label}) in {time.perf_counter() - t0:.0f} s wall",
+          flush=True)
+    return profile
+
+
+def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int
+        ) -> tuple[Any, Any]:
+    """One lockstep run with our compensator; returns (recording, worker or None)."""
+    from tsmd.daemon import make_compensator
+    from tsmd.loop import ROW_COLUMNS
+    from tsmd.online import OnlineWorker
+    from tsmd.replay import LockstepRunner
+
+    with LockstepRunner(None, profile, "ours", seed, plant) as runner:
+        comp = make_compensator(profile, "ours", runner.config)
+        runner.loop.execute("set_compensator", compensator=comp, label="ours")
+        worker = None
+        if online:
+            worker = OnlineWorker(comp, runner.loop.period_s, ROW_COLUMNS,
+                                  drain_every=DRAIN_EVERY)
+            runner.loop.observer = worker.observe
+        rec = runner.run(t, q, compensate=True)
+    return rec, worker
+
+
+def reversal_times(t: Array, q: Array, after_s: float) -> Array:
+    """Times where the desired angle turns back (any size), after ``after_s``."""
+    dq = np.diff(q)
+    s = np.sign(dq)
+    idx = np.nonzero((s[1:] * s[:-1]) < 0)[0] + 1
+    times = t[idx]
+    return times[times > after_s]
+
+
+def rmse(rec: Any, knob: int, t0: float, t1: float = math.inf) -> float:
+    sel = (rec["t"] >= t0) & (rec["t"] < t1)
+    e = rec[f"tip{knob + 1}"][sel] - rec[f"q{knob + 1}"][sel]
+    return float(np.sqrt(np.mean(e * e)))
+
+
+def change_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, Any]:
+    from simrig.scenario import ShapeChange
+
+    change = shape_change(args.change)
+    cache = Path(args.cache)
+    before = calibrated(unit, args.variation, None, device, cache, "straight")
+    fresh = calibrated(unit, args.variation, change, device, cache,
+                       args.change.replace(":", "-"))
+    t, q = mixed_motion(args.change_at + args.after_s, args.seed)
+    at = args.change_at
+    t0 = time.perf_counter()
+    rec_on, worker = run(before, make_unit(unit, args.variation, [ShapeChange(at, change)]),
+                         t, q, True, args.seed)
+    rec_off, _ = run(before, make_unit(unit, args.variation, [ShapeChange(at, change)]),
+                     t, q, False, args.seed)
+    rec_fresh, _ = run(fresh, make_unit(unit, args.variation, [ShapeChange(0.0, change)]),
+                       t, q, False, args.seed)
+    wall = time.perf_counter() - t0
+    out: dict[str, Any] = {"unit": unit, "wall_s": wall, "knobs": []}
+    for k in (0, 1):
+        revs = reversal_times(t, q[:, k], at)
+        if len(revs) < REVERSALS:
+            raise TsmdError(f"only {len(revs)} reversals of knob {k + 1} after the change; "
+                            "lengthen --after-s")
+        t10 = float(revs[REVERSALS - 1])
+        trend = [rmse(rec_on, k, float(a), float(b)) / max(rmse(rec_fresh, k, float(a),
+                                                                  float(b)), 1e-9)
+                 for a, b in itertools.pairwise(revs[:REVERSALS + 1])]
+        out["knobs"].append({
+            "before": rmse(rec_on, k, 10.0, at), "before_off": rmse(rec_off, k, 10.0, at),
+            "on": rmse(rec_on, k, t10),
+            "off": rmse(rec_off, k, t10), "fresh": rmse(rec_fresh, k, t10), "t10": t10 - at,
+            "trend": trend})
+    assert worker is not None
+    out["offsets"] = worker.offsets()
+    out["events"] = [e for e in worker.events if e["level"] == "warning"]
+    out["max_before_deg"] = max([abs(e["offset_deg"]) for e in worker.events
+                                 if e["event"] == "online offset" and e["t"] < at], default=0.0)
+    return out
+
+
+def drift_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, Any]:
+    cache = Path(args.cache)
+    profile = calibrated(unit, args.variation, None, device, cache, "straight")
+    t, q = mixed_motion(args.drift_s, args.seed + 100)
+    t0 = time.perf_counter()
+    rec_on, worker = run(profile, make_unit(unit, args.variation, []), t, q, True, args.seed)
+    wall_on = time.perf_counter() - t0
+    rec_off, _ = run(profile, make_unit(unit, args.variation, []), t, q, False, args.seed)
+    assert worker is not None
+    off = worker.offsets()
+    return {"unit": unit, "wall_on_s": wall_on, "offsets": off,
+            "max_abs_deg": max(abs(v) for pair in off for v in pair),
+            "on": [rmse(rec_on, k, 10.0) for k in (0, 1)],
+            "off": [rmse(rec_off, k, 10.0) for k in (0, 1)],
+            "edges": worker.status()["edges"]}
+
+
+def hot_path_us(n: int = 20000) -> tuple[float, float, float]:
+    """Median, p99 and max wall time of the loop-side ``observe`` for two knobs, with the
+    worker draining on its own thread every 50 ms (as in the daemon)."""
+    from tsmd.compensation import build_compensator
+    from tsmd.loop import ROW_COLUMNS
+    from tsmd.online import OnlineWorker
+    from tsmd.profile import load_profile
+
+    profile = load_profile(Path(__file__).resolve().parents[2] / "profiles" / "example-sim.yaml")
+    comp = build_compensator(profile, "ours", PERIOD_S)
+    worker = OnlineWorker(comp, PERIOD_S, ROW_COLUMNS)
+    t, q = mixed_motion(n * PERIOD_S, 0)
+    rows = [(float(t[i]), float(q[i, 0]), float(q[i, 1]), float(q[i, 0]), float(q[i, 1]),
+             float(q[i, 0]), float(q[i, 1]), 0.05, 0.05, math.nan, math.nan) for i in range(n)]
+    times = np.empty(n)
+    worker.start()
+    try:
+        for i, row in enumerate(rows):
+            if i % 500 == 0:  # a published update every 2 s: the pick-up is timed too
+                worker.published = (worker.published[0] + 1, worker.published[1],
+                                    worker.published[2])
+            t0 = time.perf_counter_ns()
+            worker.observe(row, True)
+            times[i] = time.perf_counter_ns() - t0
+            time.sleep(0)  # let the worker thread run between ticks
+    finally:
+        worker.stop()
+    return (float(np.median(times) / 1e3), float(np.percentile(times, 99) / 1e3),
+            float(times.max() / 1e3))
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--units", default="0,1,2",
+                        help="capstan units (0 = nominal, N = unit_variation draw with seed N)")
+    parser.add_argument("--variation", type=float, default=0.1, help="unit-to-unit variation")
+    parser.add_argument("--change", default="slack:0.5",
+                        help="slack:MM (all tendons) or curvature:DEG (sheath bend)")
+    parser.add_argument("--change-at", type=float, default=80.0, help="plant time of the change")
+    parser.add_argument("--after-s", type=float, default=110.0, help="run time after the change")
+    parser.add_argument("--drift-s", type=float, default=0.0,
+                        help="also run this long without a change, online on and off")
+    parser.add_argument("--seed", type=int, default=0, help="noise and trajectory seed")
+    parser.add_argument("--cache", default="/tmp/tsmd-bench-online",
+                        help="directory for the calibrated profiles")
+    parser.add_argument("--no-change", action="store_true", help="skip the shape-change runs")
+
+
+def main(args: argparse.Namespace) -> int:
+    from tsmd.profile import load_device_model
+
+    device = load_device_model(Path(__file__).resolve().parents[2] / "profiles" / "devices"
+                               / "sim-catheter.yaml")
+    try:
+        units = [int(u) for u in str(args.units).split(",") if u.strip()]
+    except ValueError:
+        raise TsmdError(f"--units {args.units!r}: expected integers like 0,1,2") from None
+    shape_change(args.change)  # a bad --change is refused before anything runs
+    med, p99, top = hot_path_us()
+    print(f"hot path (loop-side observe, two knobs): median {med:.2f} us, p99 {p99:.2f} us, "
+          f"max {top:.1f} us")
+    if not args.no_change:
+        print(f"\nshape change {args.change} at {args.change_at:g} s; RMSE from each knob's "
+              f"{REVERSALS}th reversal after it to {args.after_s:g} s after it (tip deg)\n")
+        print("| unit | knob | before (on / off) | online on | online off | fresh calibration | "
+              "on / fresh | 10th reversal after (s) |")
+        print("|---|---|---|---|---|---|---|---|")
+        ratios = []
+        for u in units:
+            r = change_unit(u, args, device)
+            for k, kn in enumerate(r["knobs"]):
+                ratio = kn["on"] / kn["fresh"]
+                ratios.append(ratio)
+                print(f"| {u} | phi{k + 1} | {kn['before']:.2f} / {kn['before_off']:.2f} | "
+                      f"{kn['on']:.2f} | "
+                      f"{kn['off']:.2f} | {kn['fresh']:.2f} | {ratio:.2f} | {kn['t10']:.0f} |")
+            trend = " / ".join(" ".join(f"{x:.1f}" for x in kn["trend"]) for kn in r["knobs"])
+            offsets = [[round(v, 2) for v in pair] for pair in r["offsets"]]
+            print(f"|   | offsets (deg, outward) {offsets}, largest before the change "
+                  f"{r['max_before_deg']:.2f}; on/fresh per reversal "
+                  f"interval phi1 / phi2: {trend}; {len(r['events'])} warnings; "
+                  f"3 runs {r['wall_s']:.0f} s wall | | | | | | |", flush=True)
+        print(f"\non / fresh: mean {np.mean(ratios):.2f}, worst {max(ratios):.2f} "
+              f"(target <= 1.2)")
+    if args.drift_s > 0:
+        print(f"\nno change, {args.drift_s:g} s of mixed motion (calibration uncertainty "
+              f"{CALIBRATION_UNCERTAINTY_DEG} deg)\n")
+        print("| unit | max abs offset deg | offsets | RMSE on (phi1, phi2) | RMSE off | "
+              "wall s (on) |")
+        print("|---|---|---|---|---|---|")
+        for u in units:
+            d = drift_unit(u, args, device)
+            print(f"| {u} | {d['max_abs_deg']:.2f} | {d['offsets']} | "
+                  f"{d['on'][0]:.2f}, {d['on'][1]:.2f} | {d['off'][0]:.2f}, {d['off'][1]:.2f} "
+                  f"| {d['wall_on_s']:.0f} |", flush=True)
+    return 0

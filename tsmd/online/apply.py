@@ -1,0 +1,113 @@
+"""Dead-zone edge offsets applied to a compensator's knobs, and saved as a new profile version.
+
+An offset moves one edge outward (positive: a wider dead zone, e.g. more slack after the shaft
+was bent). A slack change moves the tendon's whole characteristic along the knob axis, so the
+loaded line and (for our compensator) the release line of that tendon move with its edge,
+while the plateau heights H stay: the tip's plateaus do not depend on where the tendon engages.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import replace
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tsmd.compensation.ours import OursKnob
+from tsmd.compensation.paper import PaperKnob
+from tsmd.errors import TsmdError
+from tsmd.profile import CatheterProfile, KnobProfile, ReferencePoint, save_profile
+
+Offsets = tuple[tuple[float, float], tuple[float, float]]
+"""Per knob (phi1, phi2): (outward offset of D_pos, outward offset of D_neg), degrees."""
+
+ZERO_OFFSETS: Offsets = ((0.0, 0.0), (0.0, 0.0))
+
+
+class OnlineError(TsmdError):
+    """Online estimates cannot be applied or saved as asked."""
+
+
+def shifted_knob(knob: Any, offset: tuple[float, float]) -> Any:
+    """A copy of a compensator knob (ours or the paper's) with its edges moved outward.
+
+    Our release lines pivot at the edges, so their pivots move with them.
+    """
+    off_pos, off_neg = offset
+    moves = {"dead_zone_pos_deg": off_pos, "dead_zone_neg_deg": -off_neg}
+    if isinstance(knob, OursKnob):
+        moves.update(release_pivot_pos_deg=off_pos, release_pivot_neg_deg=-off_neg)
+    elif not isinstance(knob, PaperKnob):
+        raise OnlineError(f"online re-estimation cannot shift a {type(knob).__name__}")
+    return replace(knob, field=knob.field.shifted(moves))
+
+
+def edges_at(knob: Any, other_deg: float) -> tuple[float, float]:
+    """(D_pos, D_neg) a compensator knob uses at the other knob's angle."""
+    values = knob.field.at(other_deg)
+    return (float(values[knob.field.column("dead_zone_pos_deg")]),
+            float(values[knob.field.column("dead_zone_neg_deg")]))
+
+
+def apply_knobs(compensator: Any, knobs: tuple[Any, Any]) -> None:
+    """Hand new knobs to the compensator (called on the loop thread, between two ticks)."""
+    replace_knobs = getattr(compensator, "replace_knobs", None)
+    if replace_knobs is not None:
+        replace_knobs(knobs)
+    else:
+        compensator.knobs = knobs
+
+
+def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str = ""
+                         ) -> CatheterProfile:
+    """The profile with its edges moved by ``offsets`` (same catheter, a new version).
+
+    The reference points move with the edges, so the plateau heights stay what the
+    calibration gave (H from the reference point through D(0), design assumption 1).
+    """
+    knobs = []
+    for k, (off_pos, off_neg) in zip(profile.knobs, offsets, strict=True):
+        ours = k.ours
+        if ours is not None:
+            ours = replace(ours,
+                           release_pivot_pos_deg=tuple(v + off_pos
+                                                       for v in ours.release_pivot_pos_deg),
+                           release_pivot_neg_deg=tuple(v - off_neg
+                                                       for v in ours.release_pivot_neg_deg))
+        knobs.append(KnobProfile(
+            k.omega, ReferencePoint(k.reference_pos.knob_deg + off_pos, k.reference_pos.tip_deg),
+            ReferencePoint(k.reference_neg.knob_deg - off_neg, k.reference_neg.tip_deg),
+            k.height_pos_deg, k.height_neg_deg, k.other_knob_deg,
+            tuple(float(v) + off_pos for v in k.dead_zone_pos_deg),
+            tuple(float(v) - off_neg for v in k.dead_zone_neg_deg),
+            k.backlash_pos_deg, k.backlash_neg_deg, ours))
+    quality = dict(profile.quality)
+    for i, (off_pos, off_neg) in enumerate(offsets):
+        quality[f"phi{i + 1}_online_offset_pos_deg"] = float(off_pos)
+        quality[f"phi{i + 1}_online_offset_neg_deg"] = float(off_neg)
+    now = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
+    source = (f"online re-estimation from motor current, {now}, on the calibration of "
+              f"{profile.calibrated_at} ({profile.source})" + (f"; {note}" if note else ""))
+    return replace(profile, knobs=(knobs[0], knobs[1]), source=source, quality=quality,
+                   calibrated_at=now)
+
+
+def save_online_version(profile: CatheterProfile, offsets: Offsets,
+                        directory: str | os.PathLike[str], note: str = "") -> Path:
+    """Save the online estimates as ``<dir>/<catheter_id>.online-<UTC time>.yaml``.
+
+    Never overwrites: not the calibrated ``<catheter_id>.yaml``, not an earlier version.
+    """
+    if not all(np.isfinite(v) for pair in offsets for v in pair):
+        raise OnlineError(f"online offsets must be finite, got {offsets}")
+    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
+    path = Path(directory) / f"{profile.catheter_id}.online-{stamp}.yaml"
+    n = 1
+    while path.exists():
+        n += 1
+        path = Path(directory) / f"{profile.catheter_id}.online-{stamp}-{n}.yaml"
+    save_profile(profile_with_offsets(profile, offsets, note), path)
+    return path

@@ -1,0 +1,171 @@
+"""Dead-zone edge offsets from loaded ramps: bounded, with hysteresis, confidence and freezes.
+
+One :class:`EdgeTracker` per knob and side. The first ``baseline_ramps`` ramps after start
+fix the reference (the profile is taken as right at the start of use, right after its
+calibration): the current level the ramp has at the calibrated edge, the ramp's slope and the
+residual between the edge at that level and the profile's edge. Afterwards each ramp measures
+the offset of the edge from the profile's (at the other knob's angle of that ramp, so the
+coupling the profile knows is not mistaken for a change).
+
+- **Noise**: the estimate is the median of the last ``window`` accepted measurements.
+- **Spikes / outliers**: a measurement further than ``gate_deg`` from the estimate is held as
+  suspect; it is followed only when ``confirm`` suspects in a row agree within
+  ``confirm_spread_deg``, or when the other edge of the same knob has a suspect that agrees
+  (:meth:`EdgeTracker.agrees_with`, checked by the worker): a shape change, reported as a
+  warning.
+- **Bounds**: an offset beyond ``max_offset_deg`` is never followed (warning, estimate kept).
+- **Hysteresis**: the applied offset moves only when the estimate leaves a band of
+  ``deadband_deg`` around it.
+- **Freeze**: a stalled motor, a fault, or a ramp much steeper or flatter than the reference
+  (a stuck knob, a blocked tip) freezes the tracker for ``freeze_ramps`` ramps.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from statistics import median
+from typing import Any
+
+from tsmd.online.features import LoadedRamp
+
+
+@dataclass(frozen=True)
+class EstimatorOptions:
+    baseline_ramps: int = 3
+    window: int = 5
+    gate_deg: float = 1.5
+    confirm: int = 2
+    confirm_spread_deg: float = 2.0
+    max_offset_deg: float = 12.0
+    deadband_deg: float = 0.4
+    slope_ratio_max: float = 3.0
+    freeze_ramps: int = 2
+    same_slope_tolerance: float = 0.15
+
+
+@dataclass
+class EdgeTracker:
+    """The offset of one dead-zone edge (knob, side) from the profile's; see the module."""
+
+    knob: int
+    side: int
+    options: EstimatorOptions = field(default_factory=EstimatorOptions)
+    level_A: float | None = None
+    slope_ref_A_per_deg: float | None = None
+    residual_ref_deg: float = 0.0
+    estimate_deg: float = 0.0
+    applied_deg: float = 0.0
+    accepted: list[float] = field(default_factory=list)
+    suspects: list[float] = field(default_factory=list)
+    frozen_for: int = 0
+    frozen_reason: str = ""
+    n_ramps: int = 0
+    last_measurement_deg: float = math.nan
+    _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
+
+    @property
+    def learning(self) -> bool:
+        return self.level_A is None
+
+    @property
+    def confidence(self) -> float:
+        """0..1: how many measurements back the estimate, and how well they agree."""
+        if self.learning or not self.accepted:
+            return 0.0
+        o = self.options
+        spread = max(self.accepted) - min(self.accepted) if len(self.accepted) > 1 else 0.0
+        return min(len(self.accepted) / o.window, 1.0) * max(0.0, 1.0 - spread / (2 * o.gate_deg))
+
+    def freeze(self, reason: str, ramps: int | None = None) -> None:
+        self.frozen_for = max(self.frozen_for, self.options.freeze_ramps if ramps is None
+                              else ramps)
+        self.frozen_reason = reason
+        self.suspects.clear()
+
+    def update(self, ramp: LoadedRamp, profile_edge_deg: float) -> list[tuple[str, str, dict[str,
+                                                                                             Any]]]:
+        """Take one ramp; returns events (level, name, fields) to report."""
+        o = self.options
+        self.n_ramps += 1
+        events: list[tuple[str, str, dict[str, Any]]] = []
+        tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
+        if self.learning:
+            self._baseline.append((ramp, profile_edge_deg))
+            if len(self._baseline) >= o.baseline_ramps:
+                self.level_A = median(r.current_at(d) for r, d in self._baseline)
+                self.slope_ref_A_per_deg = median(r.slope_A_per_deg for r, _ in self._baseline)
+                self.residual_ref_deg = median(
+                    r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
+                    for r, d in self._baseline)
+                events.append(("info", "online reference learned",
+                               {**tag, "level_A": round(self.level_A, 4)}))
+            return events
+        assert self.level_A is not None and self.slope_ref_A_per_deg is not None
+        ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
+        if not 1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max:
+            self.freeze(f"current ramp {ratio:.1f} x the reference slope (stuck knob or "
+                        "blocked tip?)")
+            events.append(("warning", "online estimate frozen", {**tag,
+                                                                 "reason": self.frozen_reason}))
+            return events
+        if self.frozen_for > 0:
+            self.frozen_for -= 1
+            return events
+        # Extrapolating the window's own slope back to the edge costs ~0.3 deg of noise per
+        # ramp; the reference slope through the window's centre ~0.1. The own slope is used
+        # only when it differs (the sheath's friction changed, e.g. with its curvature).
+        slope = (self.slope_ref_A_per_deg if abs(ratio - 1.0) <= o.same_slope_tolerance
+                 else None)
+        m = ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
+                         - self.residual_ref_deg)
+        self.last_measurement_deg = m
+        if abs(m - self.estimate_deg) <= o.gate_deg:
+            self.suspects.clear()
+            self.accepted = [*self.accepted, m][-o.window:]
+            self.estimate_deg = median(self.accepted)
+        else:
+            self.suspects = [*self.suspects, m][-o.confirm:]
+            if len(self.suspects) >= o.confirm and (max(self.suspects) - min(self.suspects)
+                                                    <= o.confirm_spread_deg):
+                events += self.follow(median(self.suspects), "consecutive ramps agree")
+        self._apply()
+        return events
+
+    def agrees_with(self, other: EdgeTracker) -> bool:
+        """Both edges of a knob have a suspect and they agree: the knob's shape changed (a
+        slack or curvature change moves both tendons' edges outward together; a spike does not
+        hit both tendons' ramps alike)."""
+        return (bool(self.suspects) and bool(other.suspects) and self.frozen_for == 0
+                and other.frozen_for == 0
+                and abs(self.suspects[-1] - other.suspects[-1]) <= self.options.confirm_spread_deg)
+
+    def follow(self, new_deg: float, why: str) -> list[tuple[str, str, dict[str, Any]]]:
+        """Take a confirmed change (within the bound) as the estimate; events to report."""
+        o = self.options
+        tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
+        kept = list(self.suspects)
+        self.suspects.clear()
+        if abs(new_deg) > o.max_offset_deg:
+            return [("warning", "online change beyond bounds, not followed",
+                     {**tag, "offset_deg": round(new_deg, 2), "bound_deg": o.max_offset_deg})]
+        events = [("warning", "online shape change followed",
+                   {**tag, "from_deg": round(self.estimate_deg, 2), "to_deg": round(new_deg, 2),
+                    "why": why})]
+        self.accepted = kept or [new_deg]
+        self.estimate_deg = new_deg
+        self._apply()
+        return events
+
+    def _apply(self) -> None:
+        o = self.options
+        if abs(self.estimate_deg - self.applied_deg) > o.deadband_deg:
+            self.applied_deg = max(-o.max_offset_deg, min(o.max_offset_deg, self.estimate_deg))
+
+    def status(self) -> dict[str, Any]:
+        state = ("learning" if self.learning else "frozen" if self.frozen_for > 0
+                 else "tracking")
+        return {"state": state, "offset_deg": round(self.applied_deg, 3),
+                "estimate_deg": round(self.estimate_deg, 3),
+                "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
+                "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None}

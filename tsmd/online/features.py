@@ -1,0 +1,191 @@
+"""What the motor current shows during ordinary motion: pure functions on arrays.
+
+A *stroke* is one knob's motion between two reversals of its command. When a stroke goes out of
+the dead zone, the tendon of that side engages and the direction-signed current climbs the
+loaded ramp: current against knob angle is close to a line whose foot is the dead-zone edge. A
+slack change moves that line along the knob axis by the change of the edge, a curvature change
+also tilts it (more wrap, more friction), so the feature is the line itself, fitted robustly on
+a window a few degrees beyond the edge, and the edge is where it crosses a fixed current level
+(the level the ramp had at the calibrated edge, learned by the estimator).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Stroke:
+    """One knob's samples between two reversals; ``direction`` +1 rising, -1 falling.
+
+    Only samples where the knob moved are kept (standing still shows static friction, not the
+    ramp). ``other_deg`` is the other knob's actual angle (the calibration grid's coordinate).
+    """
+
+    knob: int
+    direction: int
+    t_s: Array
+    cmd_deg: Array
+    pos_deg: Array
+    current_A: Array
+    other_deg: Array
+    slip_deg: Array
+    """Knob travel since it last stood still (or reversed): the handle's static friction
+    fades over the first degrees after a restart and lifts the current there."""
+
+
+@dataclass(frozen=True)
+class RampOptions:
+    """Where and how the loaded ramp is fitted; angles in knob degrees."""
+
+    margin_deg: float = 8.0
+    """The window starts this far beyond the expected edge (past the steep engagement)."""
+    width_deg: float = 14.0
+    """Knob travel the window spans; a stroke that turns back earlier gives no ramp."""
+    min_samples: int = 20
+    max_lag_deg: float = 3.0
+    """|command - position| above this inside the window: the motor does not follow (stall)."""
+    spike_sigma: float = 5.0
+    """Samples further than this many robust sigmas from the first fit are dropped (spikes)."""
+    handle_slip_deg: float = 3.0
+    """Knob travel over which the handle's static friction fades to kinetic after a restart
+    (a data-sheet constant of the handle; the simulated handle's). The fit carries a term
+    ``exp(-slip / handle_slip_deg)`` for it, so a restart near the edge does not bend the line."""
+    restart_skip_deg: float = 1.0
+    """Samples closer than this to a restart are left out (the stick itself)."""
+
+
+@dataclass(frozen=True)
+class LoadedRamp:
+    """The direction-signed current over a window of the loaded ramp, as a line.
+
+    ``side`` +1 is the tendon pulled by positive rotation (edge D_pos), -1 the other (D_neg).
+    ``u`` is the knob angle signed by ``side`` (distance outward), so the ramp always rises.
+    """
+
+    knob: int
+    side: int
+    u0_deg: float
+    current_at_u0_A: float
+    slope_A_per_deg: float
+    other_deg: float
+    t_s: float
+    n_samples: int
+    noise_A: float
+
+    def current_at(self, knob_deg: float) -> float:
+        """The line's current at a knob angle."""
+        return self.current_at_u0_A + self.slope_A_per_deg * (self.side * knob_deg - self.u0_deg)
+
+    def crossing_deg(self, level_A: float, slope_A_per_deg: float | None = None) -> float:
+        """Knob angle where the line crosses ``level_A`` (the edge for that level); with
+        ``slope_A_per_deg``, the line through the window's centre with that slope instead."""
+        slope = self.slope_A_per_deg if slope_A_per_deg is None else slope_A_per_deg
+        return self.side * (self.u0_deg + (level_A - self.current_at_u0_A) / slope)
+
+
+@dataclass(frozen=True)
+class Rejected:
+    """A stroke that gave no feature, and why (one line)."""
+
+    knob: int
+    reason: str
+    stall: bool = False
+
+
+def _line(x: Array, y: Array, stick: Array) -> tuple[float, float, Array]:
+    """(value at mean x, slope, residuals) of the least-squares line plus a fading stick term
+    (``stick`` = exp(-slip / handle_slip), left out when it does not vary in the window)."""
+    xm = float(x.mean())
+    columns = [np.ones_like(x), x - xm]
+    if float(stick.max() - stick.min()) > 0.05:
+        columns.append(stick)
+    a_mat = np.column_stack(columns)
+    coef, *_ = np.linalg.lstsq(a_mat, y, rcond=None)
+    return float(coef[0]), float(coef[1]), y - a_mat @ coef
+
+
+def _window(u: Array, slip_deg: Array, start: float, width: float, o: RampOptions,
+            skip_deg: float | None = None) -> NDArray[np.bool_]:
+    """Samples from ``start`` outward over ``width``; the window starts later where the knob
+    restarted too close to it."""
+    ok = slip_deg >= (o.restart_skip_deg if skip_deg is None else skip_deg)
+    beyond = ok & (u >= start)
+    if beyond.any():
+        start = float(u[beyond].min())
+    return beyond & (u <= start + width)
+
+
+def relocated_edge_deg(stroke: Stroke, expected_edge_deg: float, level_A: float,
+                       slope_A_per_deg: float, options: RampOptions | None = None) -> float:
+    """Where the edge is, from the reference ramp (level at the edge, slope), robustly.
+
+    Each sample of the window beyond ``expected_edge_deg`` implies an edge: its angle minus
+    the travel the reference ramp needs to climb from ``level_A`` to its current. Samples on
+    the loaded ramp all imply the true edge; samples still in the dead zone (the edge has moved
+    outward) imply edges further out, a minority as long as the window is mostly loaded, so the
+    median is the edge. Used to move the fitting window when the edge has moved.
+    """
+    o = options or RampOptions()
+    side = stroke.direction
+    u = side * stroke.pos_deg
+    start = side * expected_edge_deg + o.margin_deg
+    sel = _window(u, stroke.slip_deg, start - o.margin_deg, o.margin_deg + o.width_deg, o,
+                  3.0 * o.handle_slip_deg)
+    if np.count_nonzero(sel) < o.min_samples:
+        return expected_edge_deg
+    implied = u[sel] - (side * stroke.current_A[sel] - level_A) / slope_A_per_deg
+    implied = implied[np.isfinite(implied)]
+    if implied.size < o.min_samples:
+        return expected_edge_deg
+    return side * float(np.median(implied))
+
+
+def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
+                options: RampOptions | None = None) -> LoadedRamp | Rejected:
+    """The loaded ramp of a stroke that leaves the dead zone beyond ``expected_edge_deg``.
+
+    ``expected_edge_deg`` is the edge of the stroke's side (D_pos for a rising stroke, D_neg
+    for a falling one) where the ramp is expected to start (:func:`relocated_edge_deg`).
+    """
+    o = options or RampOptions()
+    side = stroke.direction
+    u = side * stroke.pos_deg
+    if float(u[0]) > side * expected_edge_deg - 1.0:
+        return Rejected(stroke.knob, "the stroke did not start in the dead zone (no engagement)")
+    start = side * expected_edge_deg + o.margin_deg
+    sel = _window(u, stroke.slip_deg, start, o.width_deg, o)
+    n = int(np.count_nonzero(sel))
+    if n < o.min_samples:
+        return Rejected(stroke.knob, f"{n} samples in the loaded window "
+                                     f"({start:.1f}..{start + o.width_deg:.1f} deg outward)")
+    x = u[sel]
+    if float(x.max() - x.min()) < 0.6 * o.width_deg:
+        return Rejected(stroke.knob, "the stroke turns back inside the loaded window")
+    lag = np.abs(stroke.cmd_deg[sel] - stroke.pos_deg[sel])
+    if float(lag.max()) > o.max_lag_deg:
+        return Rejected(stroke.knob, f"the motor lags its command by {float(lag.max()):.1f} deg "
+                                     "(stalled or blocked)", stall=True)
+    y = side * stroke.current_A[sel]
+    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(x))):
+        return Rejected(stroke.knob, "non-finite samples in the loaded window")
+    stick = np.exp(-stroke.slip_deg[sel] / o.handle_slip_deg)
+    a, b, r = _line(x, y, stick)
+    sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    if sigma > 0:
+        keep = np.abs(r) <= o.spike_sigma * sigma
+        if np.count_nonzero(keep) >= o.min_samples and not keep.all():
+            x, y, stick = x[keep], y[keep], stick[keep]
+            a, b, r = _line(x, y, stick)
+    if not b > 0:
+        return Rejected(stroke.knob, "the current does not rise in the loaded window")
+    noise = float(np.sqrt(np.mean(r * r))) if r.size else math.nan
+    return LoadedRamp(stroke.knob, side, float(x.mean()), a, b,
+                      float(np.median(stroke.other_deg[sel])), float(stroke.t_s[sel][-1]),
+                      int(x.size), noise)

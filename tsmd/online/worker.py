@@ -1,0 +1,283 @@
+"""Online re-estimation beside the control loop: per-tick samples in, compensator updates out.
+
+The loop calls :meth:`OnlineWorker.observe` once per tick (its ``observer`` hook): it appends
+the tick's row to a bounded deque (atomic, no lock) and, if the worker published new knobs
+since the last tick, hands them to the compensator, so an update always takes effect between
+two ticks. Everything else (cutting strokes, fitting ramps, estimating, building the shifted
+knobs) runs in :meth:`drain`, on the worker's own thread (:meth:`start`) or, for lockstep
+simulation and tests, called synchronously every ``drain_every`` ticks.
+"""
+
+from __future__ import annotations
+
+import collections
+import threading
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from tsmd.online.apply import (
+    ZERO_OFFSETS,
+    Offsets,
+    OnlineError,
+    apply_knobs,
+    edges_at,
+    shifted_knob,
+)
+from tsmd.online.estimator import EdgeTracker, EstimatorOptions
+from tsmd.online.features import (
+    LoadedRamp,
+    RampOptions,
+    Rejected,
+    Stroke,
+    loaded_ramp,
+    relocated_edge_deg,
+)
+from tsmd.online.segment import StrokeSegmenter
+
+RECORDING_COLUMNS: tuple[str, ...] = ("dz_off_pos1", "dz_off_neg1", "dz_off_pos2", "dz_off_neg2")
+"""Recording columns for the applied offsets (deg, outward), one value per tick."""
+
+EventSink = Callable[..., None]
+
+
+class OnlineWorker:
+    """Re-estimates each knob's dead-zone edge offsets and updates the compensator.
+
+    ``columns``: the loop's row layout (``tsmd.loop.ROW_COLUMNS``); the worker reads ``t``,
+    ``cmd1/2``, ``pos1/2``, ``cur1/2``. ``on_event(level, event, **fields)`` as the loop's.
+    """
+
+    def __init__(self, compensator: Any, period_s: float, columns: Sequence[str], *,
+                 estimator: EstimatorOptions | None = None, ramp: RampOptions | None = None,
+                 rate_deg_s: float = 4.0, queue_len: int = 8192, drain_every: int = 0,
+                 on_event: EventSink | None = None) -> None:
+        compensator = getattr(compensator, "inner", compensator)  # under a LimitedCompensator
+        knobs = getattr(compensator, "knobs", None)
+        if knobs is None or len(knobs) != 2:
+            raise OnlineError("online re-estimation needs the 'ours' or 'paper' compensator, "
+                              f"got {type(compensator).__name__}")
+        self.compensator = compensator
+        self.base_knobs: tuple[Any, Any] = (knobs[0], knobs[1])
+        for k in self.base_knobs:
+            shifted_knob(k, (0.0, 0.0))  # refuses a compensator it cannot shift, now
+        self.period_s = period_s
+        self.ramp_options = ramp or RampOptions()
+        self.trackers = {(knob, side): EdgeTracker(knob, side, estimator or EstimatorOptions())
+                         for knob in (0, 1) for side in (1, -1)}
+        self.rate_deg_s = rate_deg_s
+        self.queue: collections.deque[tuple[tuple[float, ...], bool]] = collections.deque(
+            maxlen=queue_len)
+        self.drain_every = drain_every
+        self.on_event = on_event
+        self.events: collections.deque[dict[str, Any]] = collections.deque(maxlen=256)
+        idx = {name: i for i, name in enumerate(columns)}
+        self._i = [idx[c] for c in ("t", "cmd1", "cmd2", "pos1", "pos2", "cur1", "cur2")]
+        self._segmenters = [StrokeSegmenter(0), StrokeSegmenter(1)]
+        self.enabled = True
+        self.published: tuple[int, Offsets, tuple[Any, Any]] = (0, ZERO_OFFSETS, self.base_knobs)
+        """(version, offsets, knobs): replaced whole by the worker, read by the loop thread."""
+        self._applied_version = 0
+        self._ticks = 0
+        self._t_last = None  # type: float | None
+        self._t_publish = 0.0
+        self._was_enabled = True
+        self._stalled = [False, False]
+        self._publish_lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    # --- loop thread -----------------------------------------------------------------------
+
+    def observe(self, row: tuple[float, ...], enabled: bool) -> None:
+        """The loop's per-tick hook: queue the row, pick up a published update."""
+        self.queue.append((row, enabled))
+        published = self.published
+        if published[0] != self._applied_version:
+            apply_knobs(self.compensator, published[2])
+            self._applied_version = published[0]
+        if self.drain_every:
+            self._ticks += 1
+            if self._ticks % self.drain_every == 0:
+                self.drain()
+
+    # --- worker thread ---------------------------------------------------------------------
+
+    def start(self, interval_s: float = 0.05) -> None:
+        """Run :meth:`drain` every ``interval_s`` on a thread of its own."""
+        if self._thread is not None:
+            return
+
+        def run() -> None:
+            while not self._stop.wait(interval_s):
+                self.drain()
+
+        self._thread = threading.Thread(target=run, name="tsmd-online", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+
+    def drain(self) -> int:
+        """Process every queued row; returns how many."""
+        n = 0
+        queue = self.queue
+        t_now = self._t_last
+        while queue:
+            row, enabled = queue.popleft()
+            n += 1
+            t_now = self._sample(row, enabled)
+        if t_now is not None:
+            with self._publish_lock:
+                self._publish(t_now)
+        return n
+
+    def _sample(self, row: tuple[float, ...], enabled: bool) -> float:
+        t, c1, c2, p1, p2, i1, i2 = (row[j] for j in self._i)
+        gap = self._t_last is not None and t - self._t_last > 2.5 * self.period_s
+        self._t_last = t
+        if not enabled or gap:
+            for seg in self._segmenters:
+                seg.discard()
+            if not enabled and self._was_enabled:
+                for tr in self.trackers.values():
+                    tr.freeze("the loop is not enabled (fault or stop)")
+                self._emit("warning", "online estimate frozen",
+                           reason="the loop is not enabled (fault or stop)")
+            self._was_enabled = enabled
+            return t
+        self._was_enabled = True
+        max_lag = self.ramp_options.max_lag_deg
+        for knob, (cmd, pos, cur, other) in enumerate(((c1, p1, i1, p2), (c2, p2, i2, p1))):
+            if abs(cmd - pos) > max_lag:  # the motor does not follow: stalled or blocked
+                self._segmenters[knob].discard()
+                if not self._stalled[knob]:
+                    self._stalled[knob] = True
+                    reason = f"the motor lags its command by more than {max_lag:g} deg"
+                    for side in (1, -1):
+                        self.trackers[(knob, side)].freeze(reason)
+                    self._emit("warning", "online estimate frozen", knob=knob, reason=reason)
+                continue
+            self._stalled[knob] = False
+            stroke = self._segmenters[knob].push(t, cmd, pos, cur, other)
+            if stroke is not None:
+                self._stroke(stroke)
+        return t
+
+    def _stroke(self, stroke: Stroke) -> None:
+        knob, side = stroke.knob, stroke.direction
+        tracker = self.trackers[(knob, side)]
+        stroke, edge = self._referred(stroke)
+        expected = edge + side * tracker.applied_deg
+        if tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
+            expected = relocated_edge_deg(stroke, expected, tracker.level_A,
+                                          tracker.slope_ref_A_per_deg, self.ramp_options)
+        ramp = loaded_ramp(stroke, expected, self.ramp_options)
+        if isinstance(ramp, Rejected):
+            if ramp.stall:
+                tracker.freeze(ramp.reason)
+                self._emit("warning", "online estimate frozen", knob=knob, reason=ramp.reason)
+            return
+        self._ramp(tracker, ramp)
+
+    def _referred(self, stroke: Stroke) -> tuple[Stroke, float]:
+        """The stroke with the profile's own edge motion taken out, and that edge.
+
+        The profile says how the edge moves with the other knob's angle; over one stroke the
+        other knob may move far. Each sample's angle is moved by the profile edge's change
+        from the stroke's middle, so the ramp's foot stays put unless the catheter changed.
+        """
+        f = self.base_knobs[stroke.knob].field
+        column = 0 if stroke.direction > 0 else 1
+        grid = np.asarray(f.grid_deg, dtype=float)
+        values = np.asarray(f.values, dtype=float)[:, column]
+        mid = float(np.median(stroke.other_deg))
+        edge = float(f.at(mid)[column])
+        moved = np.interp(stroke.other_deg, grid, values) - float(np.interp(mid, grid, values))
+        return replace(stroke, cmd_deg=stroke.cmd_deg - moved, pos_deg=stroke.pos_deg - moved,
+                       other_deg=np.full_like(stroke.other_deg, mid)), edge
+
+    def _ramp(self, tracker: EdgeTracker, ramp: LoadedRamp) -> None:
+        d_pos, d_neg = edges_at(self.base_knobs[ramp.knob], ramp.other_deg)
+        before = tracker.applied_deg
+        events = tracker.update(ramp, d_pos if ramp.side > 0 else d_neg)
+        other = self.trackers[(ramp.knob, -ramp.side)]
+        if tracker.agrees_with(other):
+            other_before = other.applied_deg
+            events += tracker.follow(tracker.suspects[-1], "both edges of the knob agree")
+            events += other.follow(other.suspects[-1], "both edges of the knob agree")
+            if other.applied_deg != other_before:
+                self._emit("info", "online offset", knob=ramp.knob,
+                           side="pos" if other.side > 0 else "neg",
+                           offset_deg=round(other.applied_deg, 3),
+                           confidence=round(other.confidence, 2))
+        for level, event, fields in events:
+            self._emit(level, event, **fields)
+        if tracker.applied_deg != before:
+            self._emit("info", "online offset", knob=ramp.knob,
+                       side="pos" if ramp.side > 0 else "neg",
+                       offset_deg=round(tracker.applied_deg, 3),
+                       confidence=round(tracker.confidence, 2))
+
+    def _targets(self) -> Offsets:
+        if not self.enabled:
+            return ZERO_OFFSETS
+        tr = self.trackers
+        return ((tr[(0, 1)].applied_deg, tr[(0, -1)].applied_deg),
+                (tr[(1, 1)].applied_deg, tr[(1, -1)].applied_deg))
+
+    def _publish(self, t_s: float) -> None:
+        """Move the published offsets towards the targets at ``rate_deg_s`` (smoothly)."""
+        version, current, _ = self.published
+        targets = self._targets()
+        dt = max(t_s - self._t_publish, 0.0)
+        self._t_publish = t_s
+        step = self.rate_deg_s * dt
+        moved = tuple(tuple(c + max(-step, min(step, g - c)) for c, g in zip(cur, tgt,
+                                                                               strict=True))
+                      for cur, tgt in zip(current, targets, strict=True))
+        new: Offsets = ((moved[0][0], moved[0][1]), (moved[1][0], moved[1][1]))
+        if new == current:
+            return
+        knobs = (shifted_knob(self.base_knobs[0], new[0]),
+                 shifted_knob(self.base_knobs[1], new[1]))
+        self.published = (version + 1, new, knobs)
+
+    # --- control and reporting (any thread) --------------------------------------------------
+
+    def set_enabled(self, enabled: bool) -> None:
+        """Switch re-estimation off (the profile's values come back at once) or on again."""
+        with self._publish_lock:  # not the loop's lock: the loop only reads ``published``
+            self.enabled = enabled
+            if not enabled:
+                version = self.published[0]
+                self.published = (version + 1, ZERO_OFFSETS, self.base_knobs)
+        self._emit("info", "online re-estimation", enabled=enabled)
+
+    def offsets(self) -> Offsets:
+        """The offsets in force (published to the loop)."""
+        return self.published[1]
+
+    def status(self) -> dict[str, Any]:
+        """For the API's ``status``: the offsets in force and each edge's estimator."""
+        off = self.published[1]
+        return {"enabled": self.enabled, "version": self.published[0],
+                "offsets_deg": [list(off[0]), list(off[1])],
+                "edges": {f"phi{k + 1}_{'pos' if s > 0 else 'neg'}": tr.status()
+                          for (k, s), tr in self.trackers.items()},
+                "events": list(self.events)[-5:]}
+
+    def recording_values(self) -> tuple[float, float, float, float]:
+        """The row for :data:`RECORDING_COLUMNS`."""
+        off = self.published[1]
+        return (off[0][0], off[0][1], off[1][0], off[1][1])
+
+    def _emit(self, level: str, event: str, **fields: Any) -> None:
+        self.events.append({"level": level, "event": event, "t": self._t_last, **fields})
+        if self.on_event is not None:
+            self.on_event(level, event, **fields)

@@ -355,11 +355,17 @@ class Daemon:
         self._stopped = True
         self.notifier.stopping()
         loop = self.loop
+        calibrating = self.service is not None and self.service.cancel_calibration("shutdown")
         if loop is not None and self._loop_thread is not None and self._loop_thread.is_alive():
             try:
                 loop.post("shutdown").result(timeout=5.0)
             except (LoopError, DriveError, TimeoutError) as exc:
                 self.log.error("shutdown command failed", reason=str(exc))
+            if calibrating:  # let it end on the still-ticking (now disabled) loop
+                deadline = time.monotonic() + 5.0
+                while self.service is not None and self.service.calibrating \
+                        and time.monotonic() < deadline:
+                    time.sleep(0.05)
         self._loop_stop.set()
         if self._loop_thread is not None:
             self._loop_thread.join(5.0)

@@ -45,6 +45,38 @@ from tsmd.service import CompensationChoice, Service
 from tsmd.stack import StackError, build_loop, make_compensator, open_sim
 
 SIM_EXAMPLE_PROFILE = "profiles/example-sim.yaml"
+BUS_EVENT_LOG_PER_S = 5
+"""At most this many CAN bus events logged per second (an error storm would flood the log)."""
+
+
+class RateLimitedLog:
+    """Emits at most ``per_s`` lines per second; then one line counting what it left out."""
+
+    def __init__(self, events: EventLog, per_s: int) -> None:
+        self.events = events
+        self.per_s = per_s
+        self._window_s = time.monotonic()
+        self._emitted = 0
+        self.suppressed = 0
+
+    def emit(self, level: str, event: str, **fields: Any) -> bool:
+        now = time.monotonic()
+        if now - self._window_s >= 1.0:
+            self.flush()
+            self._window_s = now
+            self._emitted = 0
+        if self._emitted >= self.per_s:
+            self.suppressed += 1
+            return False
+        self._emitted += 1
+        self.events.emit(level, event, **fields)
+        return True
+
+    def flush(self) -> None:
+        if self.suppressed:
+            self.events.emit("warning", "log lines suppressed (rate limit)",
+                             count=self.suppressed)
+            self.suppressed = 0
 
 
 class DaemonError(TsmdError):
@@ -97,7 +129,8 @@ class Daemon:
     """Owns every part; :meth:`start`, then :meth:`wait`, then :meth:`stop` (idempotent)."""
 
     def __init__(self, config: TsmdConfig, *, sim: bool = False, socket_path: str | None = None,
-                 profile_path: str | None = None, api: bool = True) -> None:
+                 profile_path: str | None = None, api: bool = True,
+                 home_at_start: bool = False) -> None:
         self.config = config
         self.sim = sim
         self.api = api
@@ -109,8 +142,11 @@ class Daemon:
             # processes while the loop thread (priority above) waits for the GIL.
             self._helper_rt_warning = set_fifo(1)
         self.events = EventLog(self.log)
+        self._bus_log = RateLimitedLog(self.events, per_s=BUS_EVENT_LOG_PER_S)
         self._socket_override = socket_path
         self._profile_path = profile_path
+        self._home_all = home_at_start
+        """``tsmd run --home``: home every drive that has a method, at start."""
         self.drives: KnobDrives | None = None
         self.rig: SimRig | None = None
         self.loop: ControlLoop | None = None
@@ -160,7 +196,8 @@ class Daemon:
         drive_cfgs = drive_configs(config)
         if self.sim:
             self.drives, self.rig = open_sim(config, config.sim.seed, lockstep=False,
-                                             receive="poll")
+                                             receive="poll",
+                                             timeouts=config.bus.timeouts.master())
         else:
             self.drives = self._open_bus_drives(drive_cfgs)
         try:
@@ -168,6 +205,27 @@ class Daemon:
         except DriveError as exc:
             raise DaemonError(f"drive boot failed: {exc}", "drive") from None
         self.log.info("drives booted", count=self.drives.count)
+        self._home_at_start()
+
+    def _home_at_start(self) -> None:
+        """Home the drives whose config says ``at_start`` (or all, with ``home_at_start``).
+
+        Before the loop thread exists, so homing owns the bus alone; a failure fails the start.
+        """
+        assert self.drives is not None
+        configs = drive_configs(self.config)
+        chosen = [i for i, c in enumerate(configs)
+                  if c.homing.method != 0 and (c.homing.at_start or self._home_all)]
+        if not chosen:
+            return
+        self.log.info("homing", drives=chosen,
+                      methods=[configs[i].homing.method_name for i in chosen])
+        try:
+            status = self.drives.home(chosen)
+        except DriveError as exc:
+            raise DaemonError(f"homing failed: {exc}", "homing") from None
+        self.log.info("homed", drives=chosen,
+                      offsets_deg=[status[i].home_offset_deg for i in chosen])
 
     def _open_bus_drives(self, drive_cfgs: list[DriveConfig]) -> KnobDrives:
         """The master on the configured bus; the loop thread polls it every tick.
@@ -188,7 +246,7 @@ class Daemon:
                               f"{bus_cfg.channel!r}: {exc}", "drive") from None
         bus = self._can_log(bus)
         return CanOpenDrives(bus, drive_cfgs, self.config.loop.period_s, receive="poll",
-                             own_bus=True)
+                             own_bus=True, timeouts=self.config.bus.timeouts.master())
 
     def _can_log(self, bus: can.BusABC) -> can.BusABC:
         """bus.log_format: every frame sent and received, in python-can's BLF or ASC writer."""
@@ -321,7 +379,10 @@ class Daemon:
         handlers = ApiHandlers(self.service, max_subscribe_hz=config.api.max_subscribe_hz)
         self.server = ApiServer(path, handlers, mode=config.api.socket_mode,
                                 max_line_bytes=config.api.max_line_bytes,
-                                max_clients=config.api.max_clients, on_event=self.events.emit,
+                                max_clients=config.api.max_clients,
+                                idle_timeout_s=config.api.idle_timeout_s,
+                                partial_line_timeout_s=config.api.partial_line_timeout_s,
+                                accepts_per_s=config.api.accepts_per_s, on_event=self.events.emit,
                                 loop_cpu=config.loop.realtime.cpu)
         self.server.start()
         self.socket_path = path
@@ -339,6 +400,7 @@ class Daemon:
             if remaining is not None and remaining <= 0:
                 break
             self.shutdown_requested.wait(tick if remaining is None else min(tick, remaining))
+            self.log_bus_events()
             loop = self.loop
             if loop is None:
                 continue
@@ -347,6 +409,22 @@ class Daemon:
                 last_ticks = loop.stats.ticks
             self.notifier.status(f"{loop.state.value}; ticks {loop.stats.ticks}; overruns "
                                  f"{loop.stats.overruns}; {loop.compensation_label}")
+
+    def log_bus_events(self) -> int:
+        """Log what the master decoded from CAN error frames since the last call (rate-limited).
+
+        Bus-off itself also reaches the loop as a fault; this is the operator's record of the
+        warnings, passive states and restarts around it. Returns how many events were read.
+        """
+        poll = getattr(self.drives, "poll_bus_events", None)
+        if poll is None:
+            return 0
+        events = poll()
+        for event in events:
+            state = getattr(self.drives, "bus_state", None)
+            self._bus_log.emit("warning", "CAN bus event", message=event.message,
+                               bus_state=getattr(state, "value", None))
+        return len(events)
 
     def stop(self) -> RunSummary | None:
         """Quick stop, disable, stop the loop, flush the recording, close everything."""
@@ -376,11 +454,13 @@ class Daemon:
             self.log.info("recording written", path=self.recorder.path,
                           rows=self.recorder.rows_written)
         if self.drives is not None:
+            self.log_bus_events()
             with contextlib.suppress(DriveError):
                 self.drives.close()
         if self.rig is not None:
             self.rig.close()
         summary = self.summary()
+        self._bus_log.flush()
         self.events.close()
         self.notifier.close()
         return summary

@@ -199,6 +199,10 @@ class Service:
                 profile = self._store().load(catheter)
             except ProfileError as exc:
                 raise ServiceError(str(exc), "profile") from None
+            except (ValueError, TypeError, LookupError, RecursionError) as exc:
+                # a defect the reader missed: name it, never echo the file's bytes
+                raise ServiceError(f"profile {catheter!r}: the file is not a valid profile "
+                                   f"({type(exc).__name__})", "profile") from None
             self._activate(profile, self.choice)
             return {"profile": catheter, "active": self.loop.compensation_label}
 

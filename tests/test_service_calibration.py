@@ -5,7 +5,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import socket
-import struct
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -53,10 +52,12 @@ def wait_until_idle(client: ApiClient, timeout_s: float = 30.0) -> dict[str, Any
 
 def test_a_client_closing_abruptly_ends_its_calibration_knobs_to_zero_nothing_saved(
         daemon: Daemon, tmp_path: Path) -> None:
-    sock = raw_calibrate(daemon.socket_path)  # type: ignore[arg-type]
-    time.sleep(2.0)  # the knobs are moving
-    # close with a reset (SO_LINGER 0), as a crashed client does
-    sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+    # The black-box probe: calibrate on a raw socket, read nothing, close after 3 s. The unread
+    # progress lines make the close a reset (ECONNRESET on the daemon's side).
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    sock.connect(str(tmp_path / "d.sock"))
+    sock.sendall(CALIBRATE)
+    time.sleep(3.0)
     sock.close()
     with ApiClient(tmp_path / "d.sock") as other:
         status = wait_until_idle(other)
@@ -67,6 +68,15 @@ def test_a_client_closing_abruptly_ends_its_calibration_knobs_to_zero_nothing_sa
         time.sleep(1.0)  # nothing moves on its own afterwards
         later = other.call("status")["sample"]["pos"]
         assert all(abs(a - b) < 0.5 for a, b in zip(position, later, strict=True)), later
+    assert not (tmp_path / "profiles" / "cath-y.yaml").exists()
+
+
+def test_a_client_closing_after_reading_progress_ends_its_calibration(
+        daemon: Daemon, tmp_path: Path) -> None:
+    sock = raw_calibrate(tmp_path / "d.sock")
+    sock.close()
+    with ApiClient(tmp_path / "d.sock") as other:
+        assert wait_until_idle(other)["calibrating"] is False
     assert not (tmp_path / "profiles" / "cath-y.yaml").exists()
 
 

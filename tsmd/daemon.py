@@ -32,6 +32,7 @@ from simrig.rig import SimRig
 from tsmd import __version__
 from tsmd.api.handlers import ApiHandlers
 from tsmd.api.server import ApiServer
+from tsmd.bus_events import BusEventLog
 from tsmd.compensation import Compensator
 from tsmd.config import TsmdConfig, drive_configs, resolve_data_path
 from tsmd.errors import TsmdError
@@ -45,38 +46,6 @@ from tsmd.service import CompensationChoice, Service
 from tsmd.stack import StackError, build_loop, make_compensator, open_sim
 
 SIM_EXAMPLE_PROFILE = "profiles/example-sim.yaml"
-BUS_EVENT_LOG_PER_S = 5
-"""At most this many CAN bus events logged per second (an error storm would flood the log)."""
-
-
-class RateLimitedLog:
-    """Emits at most ``per_s`` lines per second; then one line counting what it left out."""
-
-    def __init__(self, events: EventLog, per_s: int) -> None:
-        self.events = events
-        self.per_s = per_s
-        self._window_s = time.monotonic()
-        self._emitted = 0
-        self.suppressed = 0
-
-    def emit(self, level: str, event: str, **fields: Any) -> bool:
-        now = time.monotonic()
-        if now - self._window_s >= 1.0:
-            self.flush()
-            self._window_s = now
-            self._emitted = 0
-        if self._emitted >= self.per_s:
-            self.suppressed += 1
-            return False
-        self._emitted += 1
-        self.events.emit(level, event, **fields)
-        return True
-
-    def flush(self) -> None:
-        if self.suppressed:
-            self.events.emit("warning", "log lines suppressed (rate limit)",
-                             count=self.suppressed)
-            self.suppressed = 0
 
 
 class DaemonError(TsmdError):
@@ -142,7 +111,7 @@ class Daemon:
             # processes while the loop thread (priority above) waits for the GIL.
             self._helper_rt_warning = set_fifo(1)
         self.events = EventLog(self.log)
-        self._bus_log = RateLimitedLog(self.events, per_s=BUS_EVENT_LOG_PER_S)
+        self._bus_log = BusEventLog(self.events)
         self._socket_override = socket_path
         self._profile_path = profile_path
         self._home_all = home_at_start
@@ -411,20 +380,8 @@ class Daemon:
                                  f"{loop.stats.overruns}; {loop.compensation_label}")
 
     def log_bus_events(self) -> int:
-        """Log what the master decoded from CAN error frames since the last call (rate-limited).
-
-        Bus-off itself also reaches the loop as a fault; this is the operator's record of the
-        warnings, passive states and restarts around it. Returns how many events were read.
-        """
-        poll = getattr(self.drives, "poll_bus_events", None)
-        if poll is None:
-            return 0
-        events = poll()
-        for event in events:
-            state = getattr(self.drives, "bus_state", None)
-            self._bus_log.emit("warning", "CAN bus event", message=event.message,
-                               bus_state=getattr(state, "value", None))
-        return len(events)
+        """Log the CAN bus events decoded since the last call (rate-limited); how many."""
+        return self._bus_log.poll(self.drives)
 
     def stop(self) -> RunSummary | None:
         """Quick stop, disable, stop the loop, flush the recording, close everything."""

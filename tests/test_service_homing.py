@@ -119,6 +119,20 @@ def test_a_homing_failure_at_start_fails_the_start_with_a_clear_message(tmp_path
     assert "\n" not in str(info.value)
 
 
+def test_a_failed_home_command_answers_homing_naming_the_drive(tmp_path: Path) -> None:
+    config = config_with_homing(tmp_path, method="hard_stop_positive", timeout_s=0.05)
+    daemon = start(config, tmp_path)
+    try:
+        with ApiClient(tmp_path / "d.sock") as client:
+            response = client.request("home", drives=[0])
+            assert code_of(response) == "homing"
+            assert "drive 0 (node 1)" in response["error"]["message"]
+            status = client.call("status")
+            assert status["state"] == "DISABLED" and status["homing"][0]["homed"] is False
+    finally:
+        daemon.stop()
+
+
 def test_a_drive_reboot_loses_the_zero_reference_and_set_points_wait_for_homing(
         required: Daemon, tmp_path: Path) -> None:
     assert required.rig is not None

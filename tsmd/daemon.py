@@ -373,8 +373,9 @@ class Daemon:
             loop = self.loop
             if loop is None:
                 continue
-            if loop.stats.ticks != last_ticks:  # the loop is alive: feed the watchdog
-                self.notifier.watchdog()
+            homing = self.service is not None and self.service.homing
+            if loop.stats.ticks != last_ticks or homing:  # alive (a homing holds the loop
+                self.notifier.watchdog()                  # thread, bounded by its timeout_s)
                 last_ticks = loop.stats.ticks
             self.notifier.status(f"{loop.state.value}; ticks {loop.stats.ticks}; overruns "
                                  f"{loop.stats.overruns}; {loop.compensation_label}")

@@ -72,6 +72,9 @@ class Service:
         self._calibration_lock = threading.Lock()
         self._calibration_cancel: threading.Event | None = None
         self._cancel_reason: str | None = None
+        self.homing = False
+        """True while a ``home`` command holds the loop thread (the daemon keeps feeding the
+        systemd watchdog: the master bounds each homing by ``homing.timeout_s``)."""
 
     @property
     def calibrating(self) -> bool:
@@ -139,8 +142,6 @@ class Service:
 
     def home(self, drives: list[int] | None) -> dict[str, Any]:
         """Run the configured homing of the chosen drives (all by default) between two ticks."""
-        if self.calibrating:
-            raise ServiceError("home: a calibration is running", "busy")
         status = self.loop.drives.homing_status()
         if drives is not None:
             for i in drives:
@@ -148,6 +149,10 @@ class Service:
                     raise ServiceError(f"home: no drive {i} (drives 0..{len(status) - 1})",
                                        "bad_param")
         chosen = range(len(status)) if drives is None else drives
+        with self._calibration_lock:  # one motion owner at a time: homing or calibration
+            if self.calibrating or self.homing:
+                raise ServiceError("home: a calibration or a homing is running", "busy")
+            self.homing = True
         self._emit("info", "homing started", drives=list(chosen))
         try:
             self._wait("home", timeout_s=self._homing_budget_s(list(chosen)), drives=drives)
@@ -157,6 +162,8 @@ class Service:
             self._emit("error", "homing failed", reason=str(exc))
             code = "fault" if isinstance(exc, DriveUnreachableError) else "homing"
             raise ServiceError(f"home: {exc}", code) from None
+        finally:
+            self.homing = False
         result = [dataclasses.asdict(h) for h in self.loop.drives.homing_status()]
         self._emit("info", "homing finished", homing=result)
         return {"homing": result, "zero_referenced": self.loop.drives.zero_referenced()}
@@ -218,9 +225,9 @@ class Service:
         with the knobs back at 0 and nothing saved.
         """
         with self._calibration_lock:
-            if self._calibration_cancel is not None:
-                raise ServiceError("calibrate: a calibration is already running; cancel it "
-                                   "first", "busy")
+            if self._calibration_cancel is not None or self.homing:
+                raise ServiceError("calibrate: a calibration or a homing is already running",
+                                   "busy")
             self._calibration_cancel = cancel
             self._cancel_reason = None
         try:

@@ -56,6 +56,15 @@ def test_the_packaged_sim_config_is_valid_and_builds_two_drive_configs() -> None
     ("drives: [{node_id: 1}]", "drives", "expected 2"),
     ("recording: {flush_interval_s: 0}", "recording.flush_interval_s", "out of range"),
     ("foo: 1", "foo", "unknown key"),
+    ("drives: [{node_id: 1, homing: {method: spiral}}, {node_id: 2}]", "drives[0]",
+     "homing.method"),
+    ("drives: [{node_id: 1, homing: {required: true}}, {node_id: 2}]", "drives[0]",
+     "homing.required"),
+    ("api: {idle_timeout_s: 0}", "api.idle_timeout_s", "out of range"),
+    ("api: {partial_line_timeout_s: -1}", "api.partial_line_timeout_s", "out of range"),
+    ("api: {accepts_per_s: 0}", "api.accepts_per_s", "out of range"),
+    ("bus: {timeouts: {sdo_s: 0}}", "bus.timeouts.sdo_s", "out of range"),
+    ("bus: {timeouts: {boot: 2}}", "bus.timeouts.boot", "unknown key"),
 ])
 def test_bad_value_is_refused_naming_key_and_reason(tmp_path: Path, text: str, key: str,
                                                     reason: str) -> None:
@@ -95,6 +104,39 @@ def test_nested_values_are_read(tmp_path: Path) -> None:
     assert config.loop.realtime.cpu == 1
     assert config.sim.params == {"coupling": False}
     assert config.sim.seed == 7
+
+
+def test_api_limits_and_master_timeouts_are_read(tmp_path: Path) -> None:
+    config = load_config(write(tmp_path, "api: {idle_timeout_s: 60, partial_line_timeout_s: 2, "
+                                         "accepts_per_s: 50}\n"
+                                         "bus: {timeouts: {sdo_s: 1.5, boot_s: 10}}\n"))
+    assert (config.api.idle_timeout_s, config.api.partial_line_timeout_s,
+            config.api.accepts_per_s) == (60.0, 2.0, 50.0)
+    timeouts = config.bus.timeouts.master()
+    assert (timeouts.sdo_s, timeouts.boot_s, timeouts.enable_s) == (1.5, 10.0, 0.5)
+
+
+def test_homing_is_read_per_drive_and_defaults_to_none(tmp_path: Path) -> None:
+    config = load_config(write(tmp_path, yaml.safe_dump({"drives": [
+        {"node_id": 1, "homing": {"method": "current_position", "required": True}},
+        {"node_id": 2}]})))
+    first, second = drive_configs(config)
+    assert first.homing.method_name == "current_position" and first.homing.required
+    assert second.homing.method_name == "none" and not second.homing.at_start
+
+
+def test_yaml_nested_500_levels_is_a_one_line_error(tmp_path: Path) -> None:
+    path = write(tmp_path, "a: " + "[" * 500 + "]" * 500 + "\n")
+    with pytest.raises(ConfigError, match="nested too deeply") as exc:
+        load_config(path)
+    assert str(path) in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_a_config_that_is_not_utf8_is_a_one_line_error(tmp_path: Path) -> None:
+    path = tmp_path / "bad.yaml"
+    path.write_bytes(b"loop: {rate_hz: 100}\n# \xff\xfe\n")
+    with pytest.raises(ConfigError, match="not UTF-8"):
+        load_config(path)
 
 
 def test_the_example_in_docs_configuration_is_valid() -> None:

@@ -282,3 +282,28 @@ def test_injected_drive_fault_shows_on_the_api_and_reset_waits_for_the_cause(
             assert c.call("enable")["state"] == "ENABLED"
     finally:
         daemon.stop()
+
+
+BAD_FILES = {
+    "not_utf8": b"catheter_id: x\n# \xff\xfe\n",
+    "deep": b"a: " + b"[" * 500 + b"]" * 500 + b"\n",
+    "truncated": b"catheter_id: cath-1\nknobs:\n  - omega: 1.0\n    reference_pos: {knob_deg: 3",
+}
+
+
+@pytest.mark.parametrize("which", ["profile", "config"])
+@pytest.mark.parametrize("kind", sorted(BAD_FILES))
+def test_a_bad_profile_or_config_file_is_one_line_naming_it(tmp_path: Path, which: str,
+                                                            kind: str) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_bytes(BAD_FILES[kind])
+    config = bad if which == "config" else sim_config(tmp_path)
+    args = [sys.executable, "-m", "tsmd", "run", "--sim", "--no-demo", "--duration", "0.1",
+            "--socket", str(tmp_path / "d.sock"), "--config", str(config)]
+    if which == "profile":
+        args += ["--profile", str(bad)]
+    proc = subprocess.run(args, capture_output=True, text=True, timeout=60)
+    assert proc.returncode != 0
+    assert "Traceback" not in proc.stderr
+    errors = [line for line in proc.stderr.splitlines() if "error" in line]
+    assert len(errors) == 1 and str(bad) in errors[0], proc.stderr

@@ -148,6 +148,45 @@ def test_saved_file_is_plain_yaml(tmp_path: Path) -> None:
     assert data["schema_version"] == 1 and data["knobs"]["phi1"]["other_knob_deg"][0] == -90.0
 
 
+def test_a_profile_that_is_not_utf8_is_one_line_naming_the_file(tmp_path: Path) -> None:
+    path = tmp_path / "bad.yaml"
+    path.write_bytes(b"catheter_id: x\n# \xff\xfe\xc3\n")
+    with pytest.raises(ProfileError) as exc:
+        load_profile(path)
+    assert str(exc.value).startswith(f"{path}: not UTF-8 text")
+    assert "\n" not in str(exc.value) and "xff" not in str(exc.value)
+
+
+def test_a_profile_nested_500_levels_deep_is_one_line(tmp_path: Path) -> None:
+    path = tmp_path / "deep.yaml"
+    path.write_text("knobs: " + "[" * 500 + "]" * 500 + "\n")
+    with pytest.raises(ProfileError, match="nested too deeply") as exc:
+        load_profile(path)
+    assert str(path) in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_a_truncated_profile_is_one_line_wherever_it_is_cut(tmp_path: Path) -> None:
+    text = (tmp_path / "whole.yaml")
+    save_profile(make_profile("cath-t"), text)
+    full = text.read_text()
+    path = tmp_path / "cut.yaml"
+    for cut in range(1, len(full), max(1, len(full) // 60)):
+        path.write_text(full[:cut])
+        try:
+            load_profile(path)
+        except ProfileError as exc:
+            assert "\n" not in str(exc) and str(exc).startswith(str(path)), (cut, str(exc))
+
+
+def test_store_list_excludes_directories_and_other_files(tmp_path: Path) -> None:
+    store = ProfileStore(tmp_path)
+    store.save(make_profile("cath-a"))
+    (tmp_path / "cath-dir.yaml").mkdir()
+    (tmp_path / "notes.txt").write_text("x")
+    (tmp_path / ".hidden.yaml").write_text("x")
+    assert store.list() == ["cath-a"]
+
+
 def test_store_lists_saves_and_loads_by_catheter_id(tmp_path: Path) -> None:
     store = ProfileStore(tmp_path / "profiles")
     assert store.list() == []

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import configparser
+import os
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -29,15 +29,34 @@ def unit_values() -> dict[str, list[str]]:
     return values
 
 
+SHIPPED_EXEC = "/usr/local/bin/tsmd"
+"""Where the unit expects the console script (pip install as root); docs/configuration.md."""
+
+
 def installed_copy(tmp_path: Path) -> Path:
-    """The unit with ExecStart pointing at this machine's tsmd (verify checks the binary)."""
-    exe = shutil.which("tsmd") or sys.executable
-    text = UNIT.read_text()
-    if not Path("/usr/local/bin/tsmd").exists():
-        text = text.replace("/usr/local/bin/tsmd", exe)
+    """The unit with ExecStart pointing at this machine's installed tsmd (verify checks it)."""
+    exe = shutil.which("tsmd")
+    if exe is None:
+        pytest.skip("no tsmd console script on PATH: the unit's ExecStart cannot be checked")
     copy = tmp_path / "tsmd.service"
-    copy.write_text(text)
+    copy.write_text(UNIT.read_text().replace(SHIPPED_EXEC, str(Path(exe).resolve())))
     return copy
+
+
+def test_the_shipped_unit_runs_the_documented_tsmd_path() -> None:
+    exec_start = unit_values()["Service.ExecStart"][0]
+    assert exec_start.split()[0] == SHIPPED_EXEC
+    docs = (UNIT.parent.parent / "docs" / "configuration.md").read_text()
+    assert SHIPPED_EXEC in docs
+
+
+def test_the_verified_copy_runs_the_installed_tsmd(tmp_path: Path) -> None:
+    copy = installed_copy(tmp_path)
+    exec_start = next(line for line in copy.read_text().splitlines()
+                      if line.startswith("ExecStart="))
+    binary = Path(exec_start.removeprefix("ExecStart=").split()[0])
+    assert binary.is_file() and os.access(binary, os.X_OK)
+    assert exec_start.endswith("run --config /etc/tsmd/tsmd.yaml --log-format json")
 
 
 def test_unit_is_type_notify_with_watchdog_restart_and_directories() -> None:

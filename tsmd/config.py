@@ -20,9 +20,10 @@ from typing import Any, Literal
 import yaml
 
 from drivers.drive import DriveError
-from drivers.units import DriveConfig
+from drivers.units import DriveConfig, MasterTimeouts
 from tsmd.compensation.safety import DEFAULT_MAX_ACCEL_DEG_S2, DEFAULT_MAX_VELOCITY_DEG_S
 from tsmd.errors import TsmdError
+from tsmd.yamlfile import read_yaml
 
 DEFAULT_CONFIG_PATH = Path("/etc/tsmd/tsmd.yaml")
 
@@ -65,6 +66,22 @@ class LoopConfig:
 
 
 @dataclass(frozen=True)
+class TimeoutsConfig:
+    """How long the CANopen master waits (drivers.units.MasterTimeouts); each failure names the
+    drive, the step and the statusword seen."""
+
+    sdo_s: float = field(default=0.5, metadata=_range(0.01, 60.0))
+    boot_s: float = field(default=2.0, metadata=_range(0.05, 600.0))
+    enable_s: float = field(default=0.5, metadata=_range(0.01, 60.0))
+    disable_s: float = field(default=0.5, metadata=_range(0.01, 60.0))
+    quick_stop_s: float = field(default=0.5, metadata=_range(0.01, 60.0))
+    fault_reset_s: float = field(default=0.5, metadata=_range(0.01, 60.0))
+
+    def master(self) -> MasterTimeouts:
+        return MasterTimeouts(**dataclasses.asdict(self))
+
+
+@dataclass(frozen=True)
 class BusConfig:
     interface: str = "socketcan"
     """python-can interface name (socketcan in production, virtual in tests)."""
@@ -72,6 +89,7 @@ class BusConfig:
     bitrate: int = field(default=1_000_000, metadata=_range(10_000, 1_000_000))
     log_format: CanLogFormat = "none"
     """Log the CAN traffic with python-can's own writer (BLF or ASC) into recording.dir."""
+    timeouts: TimeoutsConfig = field(default_factory=TimeoutsConfig)
 
 
 @dataclass(frozen=True)
@@ -90,6 +108,12 @@ class ApiConfig:
     max_line_bytes: int = field(default=4096, metadata=_range(64, 1 << 20))
     max_clients: int = field(default=16, metadata=_range(1, 1024))
     max_subscribe_hz: float = field(default=250.0, metadata=_range(0.1, 1000.0))
+    idle_timeout_s: float = field(default=30.0, metadata=_range(0.1, 86_400.0))
+    """A client that sends no request (and streams nothing) for this long is closed."""
+    partial_line_timeout_s: float = field(default=5.0, metadata=_range(0.05, 3600.0))
+    """A request line must end within this long of its first byte."""
+    accepts_per_s: float = field(default=200.0, metadata=_range(1.0, 100_000.0))
+    """New connections accepted per second at most (a connect storm must not take ticks)."""
 
 
 @dataclass(frozen=True)
@@ -306,20 +330,11 @@ def parse_config(data: Any, source: str = "<config>") -> TsmdConfig:
 def load_config(path: str | Path = DEFAULT_CONFIG_PATH) -> TsmdConfig:
     """Read and validate a YAML configuration file."""
     p = Path(path)
+    data = read_yaml(p, ConfigError)
     try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ConfigError(f"{p}: cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f"{p}: not UTF-8 text ({exc.reason})") from None
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" line {mark.line + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or str(exc)
-        raise ConfigError(f"{p}:{where}: not valid YAML: {problem}") from None
-    return parse_config(data, source=str(p))
+        return parse_config(data, source=str(p))
+    except RecursionError:
+        raise ConfigError(f"{p}: nested too deeply to be a configuration") from None
 
 
 def default_sim_config() -> TsmdConfig:

@@ -32,6 +32,7 @@ from simrig.rig import SimRig
 from tsmd import __version__
 from tsmd.api.handlers import ApiHandlers
 from tsmd.api.server import ApiServer
+from tsmd.bus_events import BusEventLog
 from tsmd.compensation import Compensator
 from tsmd.config import TsmdConfig, drive_configs, resolve_data_path
 from tsmd.errors import TsmdError
@@ -97,7 +98,8 @@ class Daemon:
     """Owns every part; :meth:`start`, then :meth:`wait`, then :meth:`stop` (idempotent)."""
 
     def __init__(self, config: TsmdConfig, *, sim: bool = False, socket_path: str | None = None,
-                 profile_path: str | None = None, api: bool = True) -> None:
+                 profile_path: str | None = None, api: bool = True,
+                 home_at_start: bool = False) -> None:
         self.config = config
         self.sim = sim
         self.api = api
@@ -109,8 +111,11 @@ class Daemon:
             # processes while the loop thread (priority above) waits for the GIL.
             self._helper_rt_warning = set_fifo(1)
         self.events = EventLog(self.log)
+        self._bus_log = BusEventLog(self.events)
         self._socket_override = socket_path
         self._profile_path = profile_path
+        self._home_all = home_at_start
+        """``tsmd run --home``: home every drive that has a method, at start."""
         self.drives: KnobDrives | None = None
         self.rig: SimRig | None = None
         self.loop: ControlLoop | None = None
@@ -160,7 +165,8 @@ class Daemon:
         drive_cfgs = drive_configs(config)
         if self.sim:
             self.drives, self.rig = open_sim(config, config.sim.seed, lockstep=False,
-                                             receive="poll")
+                                             receive="poll",
+                                             timeouts=config.bus.timeouts.master())
         else:
             self.drives = self._open_bus_drives(drive_cfgs)
         try:
@@ -168,6 +174,27 @@ class Daemon:
         except DriveError as exc:
             raise DaemonError(f"drive boot failed: {exc}", "drive") from None
         self.log.info("drives booted", count=self.drives.count)
+        self._home_at_start()
+
+    def _home_at_start(self) -> None:
+        """Home the drives whose config says ``at_start`` (or all, with ``home_at_start``).
+
+        Before the loop thread exists, so homing owns the bus alone; a failure fails the start.
+        """
+        assert self.drives is not None
+        configs = drive_configs(self.config)
+        chosen = [i for i, c in enumerate(configs)
+                  if c.homing.method != 0 and (c.homing.at_start or self._home_all)]
+        if not chosen:
+            return
+        self.log.info("homing", drives=chosen,
+                      methods=[configs[i].homing.method_name for i in chosen])
+        try:
+            status = self.drives.home(chosen)
+        except DriveError as exc:
+            raise DaemonError(f"homing failed: {exc}", "homing") from None
+        self.log.info("homed", drives=chosen,
+                      offsets_deg=[status[i].home_offset_deg for i in chosen])
 
     def _open_bus_drives(self, drive_cfgs: list[DriveConfig]) -> KnobDrives:
         """The master on the configured bus; the loop thread polls it every tick.
@@ -188,7 +215,7 @@ class Daemon:
                               f"{bus_cfg.channel!r}: {exc}", "drive") from None
         bus = self._can_log(bus)
         return CanOpenDrives(bus, drive_cfgs, self.config.loop.period_s, receive="poll",
-                             own_bus=True)
+                             own_bus=True, timeouts=self.config.bus.timeouts.master())
 
     def _can_log(self, bus: can.BusABC) -> can.BusABC:
         """bus.log_format: every frame sent and received, in python-can's BLF or ASC writer."""
@@ -321,7 +348,10 @@ class Daemon:
         handlers = ApiHandlers(self.service, max_subscribe_hz=config.api.max_subscribe_hz)
         self.server = ApiServer(path, handlers, mode=config.api.socket_mode,
                                 max_line_bytes=config.api.max_line_bytes,
-                                max_clients=config.api.max_clients, on_event=self.events.emit,
+                                max_clients=config.api.max_clients,
+                                idle_timeout_s=config.api.idle_timeout_s,
+                                partial_line_timeout_s=config.api.partial_line_timeout_s,
+                                accepts_per_s=config.api.accepts_per_s, on_event=self.events.emit,
                                 loop_cpu=config.loop.realtime.cpu)
         self.server.start()
         self.socket_path = path
@@ -339,14 +369,20 @@ class Daemon:
             if remaining is not None and remaining <= 0:
                 break
             self.shutdown_requested.wait(tick if remaining is None else min(tick, remaining))
+            self.log_bus_events()
             loop = self.loop
             if loop is None:
                 continue
-            if loop.stats.ticks != last_ticks:  # the loop is alive: feed the watchdog
-                self.notifier.watchdog()
+            homing = self.service is not None and self.service.homing
+            if loop.stats.ticks != last_ticks or homing:  # alive (a homing holds the loop
+                self.notifier.watchdog()                  # thread, bounded by its timeout_s)
                 last_ticks = loop.stats.ticks
             self.notifier.status(f"{loop.state.value}; ticks {loop.stats.ticks}; overruns "
                                  f"{loop.stats.overruns}; {loop.compensation_label}")
+
+    def log_bus_events(self) -> int:
+        """Log the CAN bus events decoded since the last call (rate-limited); how many."""
+        return self._bus_log.poll(self.drives)
 
     def stop(self) -> RunSummary | None:
         """Quick stop, disable, stop the loop, flush the recording, close everything."""
@@ -355,11 +391,17 @@ class Daemon:
         self._stopped = True
         self.notifier.stopping()
         loop = self.loop
+        calibrating = self.service is not None and self.service.cancel_calibration("shutdown")
         if loop is not None and self._loop_thread is not None and self._loop_thread.is_alive():
             try:
                 loop.post("shutdown").result(timeout=5.0)
             except (LoopError, DriveError, TimeoutError) as exc:
                 self.log.error("shutdown command failed", reason=str(exc))
+            if calibrating:  # let it end on the still-ticking (now disabled) loop
+                deadline = time.monotonic() + 5.0
+                while self.service is not None and self.service.calibrating \
+                        and time.monotonic() < deadline:
+                    time.sleep(0.05)
         self._loop_stop.set()
         if self._loop_thread is not None:
             self._loop_thread.join(5.0)
@@ -370,11 +412,13 @@ class Daemon:
             self.log.info("recording written", path=self.recorder.path,
                           rows=self.recorder.rows_written)
         if self.drives is not None:
+            self.log_bus_events()
             with contextlib.suppress(DriveError):
                 self.drives.close()
         if self.rig is not None:
             self.rig.close()
         summary = self.summary()
+        self._bus_log.flush()
         self.events.close()
         self.notifier.close()
         return summary

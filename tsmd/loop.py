@@ -510,6 +510,14 @@ class ControlLoop:
         self._emit("info", "fault reset")
         return self.state.value
 
+    def _cmd_home(self, drives: list[int] | None = None) -> Any:
+        """Find the knobs' zero reference (CiA 402 Homing Mode); only while DISABLED."""
+        if self.state is not LoopState.DISABLED:
+            raise LoopError("not_disabled", f"home: the loop is {self.state.value}; "
+                                            "disable first")
+        self.schedule_reset = True  # homing cycles the bus itself for seconds
+        return self.drives.home(drives)
+
     def _cmd_set_compensator(self, compensator: Compensator, label: str) -> str:
         compensator.reset(self._q)
         self._compensator = compensator

@@ -36,6 +36,7 @@ from tsmd.compensation.tension_play import (
     tension_play_to_mapping,
 )
 from tsmd.errors import TsmdError
+from tsmd.yamlfile import read_yaml
 
 PROFILE_SCHEMA_VERSION = 1
 DEVICE_SCHEMA_VERSION = 1
@@ -417,21 +418,16 @@ def _plain(obj: Any) -> Any:
 
 
 def _read_yaml(path: Path) -> Any:
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ProfileError(f"{path}: no such file") from None
-    except OSError as exc:
-        raise ProfileError(f"{path}: cannot read: {exc.strerror}") from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise ProfileError(f"{path}: not valid YAML: {exc}") from None
+    return read_yaml(path, ProfileError)
 
 
 def load_profile(path: str | os.PathLike[str]) -> CatheterProfile:
-    """Read and validate a catheter profile."""
-    return profile_from_mapping(_read_yaml(Path(path)), str(path))
+    """Read and validate a catheter profile; any defect of the file is one ProfileError line."""
+    data = _read_yaml(Path(path))
+    try:
+        return profile_from_mapping(data, str(path))
+    except RecursionError:
+        raise ProfileError(f"{path}: nested too deeply to be a profile") from None
 
 
 def dump_profile(profile: CatheterProfile) -> str:
@@ -530,7 +526,8 @@ class ProfileStore:
     def list(self) -> list[str]:
         if not self.directory.is_dir():
             return []
-        return sorted(p.stem for p in self.directory.glob("*.yaml") if _ID_PATTERN.match(p.stem))
+        return sorted(p.stem for p in self.directory.glob("*.yaml")
+                      if _ID_PATTERN.match(p.stem) and p.is_file())
 
 
 def standard_grid() -> tuple[float, ...]:

@@ -34,6 +34,12 @@ class Services(Protocol):
     def calibrate(self, catheter: str, progress: Callable[[dict[str, Any]], None],
                   cancel: threading.Event) -> dict[str, Any]: ...
 
+    def cancel_calibration(self, reason: str) -> bool: ...
+
+    def require_zero_reference(self, what: str) -> None: ...
+
+    def home(self, drives: list[int] | None) -> dict[str, Any]: ...
+
 
 class ApiHandlers:
     """Turns a validated :class:`Request` into a response dict (or raises ApiError)."""
@@ -43,7 +49,6 @@ class ApiHandlers:
         self.services = services
         self.max_subscribe_hz = max_subscribe_hz
         self.command_timeout_s = command_timeout_s
-        self._calibration: tuple[threading.Event, Connection] | None = None
 
     @property
     def loop(self) -> ControlLoop:
@@ -73,13 +78,28 @@ class ApiHandlers:
     async def _status(self, request: Request, conn: Connection) -> dict[str, Any]:
         return self.services.status()
 
+    def _zero_referenced(self, what: str) -> None:
+        try:
+            self.services.require_zero_reference(what)
+        except TsmdError as exc:
+            raise ApiError(getattr(exc, "code", "not_homed"), str(exc)) from None
+
     async def _enable(self, request: Request, conn: Connection) -> dict[str, Any]:
+        self._zero_referenced("enable")
         return {"state": await self._loop_command("enable")}
 
+    async def _home(self, request: Request, conn: Connection) -> dict[str, Any]:
+        try:
+            return await asyncio.to_thread(self.services.home, request.params.get("drives"))
+        except TsmdError as exc:
+            raise ApiError(getattr(exc, "code", "homing"), str(exc)) from None
+
     async def _disable(self, request: Request, conn: Connection) -> dict[str, Any]:
+        self.services.cancel_calibration("disable")
         return {"state": await self._loop_command("disable")}
 
     async def _stop(self, request: Request, conn: Connection) -> dict[str, Any]:
+        self.services.cancel_calibration("stop")  # it must end, not fail on the stopped loop
         return {"state": await self._loop_command("stop")}
 
     async def _reset(self, request: Request, conn: Connection) -> dict[str, Any]:
@@ -96,6 +116,7 @@ class ApiHandlers:
             raise ApiError("not_enabled", f"set: the loop is {state.value}; send enable first")
         if self.loop.playing:
             raise ApiError("busy", "set: a calibration trajectory owns the knobs; cancel it first")
+        self._zero_referenced("set")
         self.loop.setpoint.set((q[0], q[1]))
         return {"q": q}
 
@@ -147,10 +168,7 @@ class ApiHandlers:
             raise ApiError(getattr(exc, "code", "profile"), str(exc)) from None
 
     async def _calibrate(self, request: Request, conn: Connection) -> dict[str, Any]:
-        if self._calibration is not None:
-            raise ApiError("busy", "calibrate: a calibration is already running")
         cancel = threading.Event()
-        self._calibration = (cancel, conn)
         aio = asyncio.get_running_loop()
 
         def progress(info: dict[str, Any]) -> None:
@@ -159,14 +177,17 @@ class ApiHandlers:
 
         watcher = asyncio.ensure_future(self._cancel_on_disconnect(conn, cancel))
         try:
-            result = await asyncio.to_thread(self.services.calibrate,
-                                             request.params["catheter"], progress, cancel)
+            return await asyncio.to_thread(self.services.calibrate,
+                                           request.params["catheter"], progress, cancel)
+        except asyncio.CancelledError:
+            # The connection closed (its tasks are cancelled): the worker thread would run on
+            # with nobody to answer, so the calibration ends with its client.
+            cancel.set()
+            raise
         except TsmdError as exc:
             raise ApiError(getattr(exc, "code", "calibration"), str(exc)) from None
         finally:
             watcher.cancel()
-            self._calibration = None
-        return result
 
     async def _cancel_on_disconnect(self, conn: Connection, cancel: threading.Event) -> None:
         while not conn.closed and not conn.writer.transport.is_closing():
@@ -174,8 +195,4 @@ class ApiHandlers:
         cancel.set()
 
     async def _cancel(self, request: Request, conn: Connection) -> dict[str, Any]:
-        running = self._calibration
-        if running is None:
-            return {"cancelled": False}
-        running[0].set()
-        return {"cancelled": True}
+        return {"cancelled": self.services.cancel_calibration("cancel command")}

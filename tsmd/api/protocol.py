@@ -46,6 +46,7 @@ COMMANDS: dict[str, dict[str, bool]] = {
     "profile": {"catheter": False},
     "calibrate": {"catheter": True},
     "cancel": {},
+    "home": {"drives": False},
 }
 
 METHODS = ("none", "paper", "ours")
@@ -128,6 +129,13 @@ def _check_types(cmd: str, params: dict[str, Any]) -> None:
         if "method" in params and params["method"] not in METHODS:
             raise ApiError("bad_param",
                            f"compensation: 'method' must be one of {', '.join(METHODS)}")
+    elif cmd == "home" and "drives" in params:
+        drives = params["drives"]
+        if (not isinstance(drives, list) or not drives or len(drives) > 16
+                or any(isinstance(i, bool) or not isinstance(i, int) or not 0 <= i < 16
+                       for i in drives) or len(set(drives)) != len(drives)):
+            raise ApiError("bad_param", "home: 'drives' must be a non-empty list of distinct "
+                                        "drive indices (0 = phi1, 1 = phi2)")
     elif cmd in ("profile", "calibrate") and "catheter" in params:
         catheter = params["catheter"]
         if not isinstance(catheter, str) or not is_catheter_id(catheter):

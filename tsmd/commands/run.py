@@ -43,6 +43,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--socket", metavar="PATH", help="socket path (overrides api.socket_path)")
     parser.add_argument("--profile", metavar="FILE", help="catheter profile file to load instead "
                                                            "of profiles.active")
+    parser.add_argument("--home", action="store_true",
+                        help="home every drive that has a homing method before the loop starts "
+                             "(drives[i].homing; a search moves the knobs)")
     parser.add_argument("--log-format", choices=("auto", "json", "console"), default="auto")
 
 
@@ -129,7 +132,8 @@ class Demo:
 def main(args: argparse.Namespace) -> int:
     configure_logging(args.log_format)
     config = _config(args)
-    daemon = Daemon(config, sim=args.sim, socket_path=args.socket, profile_path=args.profile)
+    daemon = Daemon(config, sim=args.sim, socket_path=args.socket, profile_path=args.profile,
+                    home_at_start=args.home)
 
     def on_signal(signum: int, frame: FrameType | None) -> None:
         daemon.shutdown_requested.set()

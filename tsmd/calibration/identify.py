@@ -21,6 +21,7 @@ decreasing ones (after the positive end) give ``B_pos`` and ``D_neg``, as in the
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -29,6 +30,7 @@ from numpy.typing import NDArray
 from scipy.signal import find_peaks
 
 from tsmd.calibration.errors import CalibrationError
+from tsmd.calibration.health import check_sensor, check_slip
 from tsmd.calibration.signal import Conditioned, FloatArray, condition, robust_sigma
 
 PARAMETERS: tuple[str, ...] = (
@@ -111,6 +113,8 @@ class SweepResult:
     half_cycles: tuple[HalfCycle, ...]
     values: dict[str, tuple[float, ...]] = field(default_factory=dict)
     """Each parameter's value from every half-cycle that gave one, in time order."""
+    resweeps: int = 0
+    """How many re-sweeps were pooled into this result."""
 
     def estimate(self, name: str) -> float:
         """Median over the half-cycles (NaN when none gave a value)."""
@@ -121,6 +125,13 @@ class SweepResult:
         """Largest minus smallest value over the half-cycles (0 with one value)."""
         v = self.values.get(name, ())
         return float(np.ptp(v)) if v else math.nan
+
+    def merged(self, other: SweepResult) -> SweepResult:
+        """This sweep's half-cycles pooled with a re-sweep's (the first sweep's signals kept)."""
+        values = {name: self.values.get(name, ()) + other.values.get(name, ())
+                  for name in PARAMETERS}
+        return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
+                           self.resweeps + 1)
 
     @property
     def snr(self) -> float:
@@ -375,6 +386,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
                         "the dead-zone edge was not reached")
     else:
         edge_deg = float(direction * grid[edge_k])
+        check_slip(grid[:end], yg[:end], edge_k, noise, where)
 
     def index_at(k: int | None) -> int | None:
         if k is None:
@@ -409,6 +421,28 @@ def check_following(data: Conditioned, opts: IdentifyOptions) -> None:
             f"(> {opts.max_tracking_error_deg:g} deg): motor stalled or too slow")
 
 
+def check_signal(data: Conditioned, halves: Sequence[HalfCycle], opts: IdentifyOptions) -> None:
+    """No half-cycle shows a load: tell a missing current signal from a catheter that never
+    leaves its dead zone. A working sensor still shows the drive's friction, which flips with
+    the direction of motion; a disconnected one reads noise that does not."""
+    if any(h.snr >= opts.min_snr for h in halves):
+        return
+    signed = np.concatenate([h.direction * data.current_filtered_A[h.start:h.stop]
+                             for h in halves])
+    friction = float(np.median(signed))
+    noise = max(data.filtered_noise_A, 1e-12)
+    best = max((h.snr for h in halves if math.isfinite(h.snr)), default=math.nan)
+    if abs(friction) < opts.min_snr * noise:
+        raise CalibrationError(
+            f"no current signal: the current does not follow the motion (direction-dependent "
+            f"part {friction * 1e3:.1f} mA, noise {noise * 1e3:.1f} mA); check the drive's "
+            "current feedback")
+    raise CalibrationError(
+        f"the sweep never leaves the dead zone: the current shows the drive's friction "
+        f"({friction * 1e3:.1f} mA) but no load in any half-cycle (best rise {best:.1f} x "
+        f"noise < {opts.min_snr:g}); tendon broken or slack beyond the travel")
+
+
 def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
                    pos_deg: NDArray[np.floating], current_A: NDArray[np.floating],
                    options: IdentifyOptions | None = None,
@@ -420,6 +454,10 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
     half-cycle is, and the first one (not after a reversal) gives only a dead-zone edge.
     """
     opts = options or IdentifyOptions()
+    raw = np.asarray(current_A, float)
+    if np.isfinite(raw).any() and np.nanmax(raw) == np.nanmin(raw):
+        raise CalibrationError("the current is constant: no current feedback from the drive")
+    check_sensor(np.asarray(t_s, float), np.asarray(pos_deg, float), raw)
     data = condition(np.asarray(t_s, float), np.asarray(cmd_deg, float),
                      np.asarray(pos_deg, float), np.asarray(current_A, float),
                      cutoff_hz=opts.cutoff_hz, order=opts.filter_order,
@@ -438,6 +476,7 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
         raise CalibrationError(
             f"the command never moves more than {opts.min_reversal_deg:g} deg: nothing to identify")
     halves = tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches)
+    check_signal(data, halves, opts)
     values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
     for h in halves:
         if math.isfinite(h.backlash_deg):

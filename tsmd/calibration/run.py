@@ -37,10 +37,12 @@ from tsmd.calibration.errors import (
     CalibrationError,
     CalibrationRefusedError,
 )
+from tsmd.calibration.estimate import EstimateOptions
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
 from tsmd.calibration.ours_fit import fit_ours_for_knob
 from tsmd.calibration.protocol import Protocol as SweepProtocol
-from tsmd.calibration.protocol import Sweep, paper_protocol, return_to_zero, sweep_run
+from tsmd.calibration.protocol import Sweep, SweepRun, paper_protocol, return_to_zero, sweep_run
+from tsmd.calibration.resweep import pooled, uncertain_points
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
@@ -147,7 +149,8 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
            source: str = "calibration from motor current") -> tuple[CatheterProfile,
                                                                    QualityReport]:
     """Quality checks, our compensator's fit and the profile (CalibrationError if refused)."""
-    report = check_quality(points, limits, amplitude_deg)
+    report = check_quality(points, limits, amplitude_deg,
+                           omegas=tuple(k.omega for k in device.knobs))
     # Before refusing: a backlash far below the data sheet's often explains cycles that disagree.
     cross_check_device(points, device, report)
     try:
@@ -167,12 +170,13 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
 
 
 class _Progress:
-    """Turns per-run fractions into overall progress with a time-left estimate."""
+    """Turns per-run fractions into overall progress with a time-left estimate; re-sweeps are
+    added as they are decided (the total grows)."""
 
     def __init__(self, callback: ProgressCallback | None, durations_s: Sequence[float]) -> None:
         self.callback = callback
         self.durations = list(durations_s)
-        self.total = float(sum(self.durations)) or 1.0
+        self.planned = len(self.durations)
         self.started = time.monotonic()
         self.index = 0
         self.label = ""
@@ -183,9 +187,15 @@ class _Progress:
         self.label = label
         self.report(0.0)
 
+    def add(self, duration_s: float) -> int:
+        """A re-sweep joins the plan; returns its index."""
+        self.durations.append(duration_s)
+        return len(self.durations) - 1
+
     def overall(self, fraction: float) -> float:
+        total = float(sum(self.durations)) or 1.0
         done = sum(self.durations[:self.index]) + fraction * self.durations[self.index]
-        return min(1.0, done / self.total)
+        return min(1.0, done / total)
 
     def report(self, fraction: float, phase: str = "") -> None:
         self.fraction = fraction
@@ -193,7 +203,10 @@ class _Progress:
             return
         overall = self.overall(fraction)
         elapsed = time.monotonic() - self.started
-        text = f"sweep {self.index + 1}/{len(self.durations)}: {self.label}"
+        if self.index < self.planned:
+            text = f"sweep {self.index + 1}/{self.planned}: {self.label}"
+        else:
+            text = f"re-sweep {self.index + 1 - self.planned}: {self.label}"
         if phase:
             text += f" ({phase})"
         if overall > 1e-3:
@@ -203,11 +216,15 @@ class _Progress:
 
 @dataclass
 class SweepRuns:
-    """Every sweep of a protocol, run and identified (no quality check yet)."""
+    """Every sweep of a protocol, run and identified, re-sweeps pooled (no quality check yet)."""
 
     points: list[GridPoint]
     motion_time_s: float
     wall_time_s: float
+    resweep_time_s: float = 0.0
+    """Extra sweeping spent on re-sweeps (within the protocol's budget)."""
+    resweeps: list[str] = field(default_factory=list)
+    """One line per re-sweep: which grid point and why."""
 
 
 def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *,
@@ -216,7 +233,8 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
                     cancel: threading.Event | None = None,
                     options: IdentifyOptions | None = None,
                     limits: QualityLimits | None = None, isolate: bool = False) -> Calibration:
-    """Run every sweep, identify each as it ends, return the knobs to 0, build the profile.
+    """Run every sweep, identify each as it ends, sweep uncertain grid points again, return the
+    knobs to 0, build the profile.
 
     Any failure or a cancel sends the knobs back to 0 first; then CalibrationError (or
     CalibrationCancelledError) is raised and nothing is returned to be saved.
@@ -224,18 +242,27 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
     proto = protocol or paper_protocol()
     proto.validate(tuple((k.limits.min_deg, k.limits.max_deg)  # type: ignore[arg-type]
                          for k in device.knobs))
+    omegas = tuple(k.omega for k in device.knobs)
     runs = run_sweeps(runner, proto, period_s=period_s, progress=progress, cancel=cancel,
-                      options=options, isolate=isolate)
+                      options=options, isolate=isolate, omegas=omegas,
+                      estimate=(limits or QualityLimits()).estimate)
     profile, report = finish(catheter_id, device, runs.points, limits=limits,
                              amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
-    return Calibration(profile, runs.points, report, proto.name, proto.sweep_time_s,
-                       runs.motion_time_s, runs.wall_time_s)
+    calibration = Calibration(profile, runs.points, report, proto.name,
+                              proto.sweep_time_s + runs.resweep_time_s, runs.motion_time_s,
+                              runs.wall_time_s)
+    calibration.notes.extend(runs.resweeps)
+    return calibration
 
 
 def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *, period_s: float = 0.004,
                progress: ProgressCallback | None = None, cancel: threading.Event | None = None,
-               options: IdentifyOptions | None = None, isolate: bool = False) -> SweepRuns:
-    """Run and identify each sweep in turn; the knobs end at 0 whatever happens.
+               options: IdentifyOptions | None = None, isolate: bool = False,
+               omegas: Sequence[float] | None = None,
+               estimate: EstimateOptions | None = None) -> SweepRuns:
+    """Run and identify each sweep in turn, then re-sweep uncertain grid points within the
+    protocol's budget (``omegas`` given: the data sheet's slopes for the tip-error gate); the
+    knobs end at 0 whatever happens.
 
     ``isolate``: identify in a separate process, overlapped with the next sweep. The
     change-point search is pure Python and holds the GIL; in the daemon's process it delays a
@@ -243,68 +270,103 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *, period_s: floa
     """
     wall0 = time.monotonic()
     identifier = _Identifier(options, isolate)
-    q_now = np.zeros(2)
-    runs_durations = []
+    player = _Player(runner, proto, period_s, cancel)
     plan = []
+    q_now = np.zeros(2)
     for sweep in proto.sweeps:
         run = sweep_run(sweep, q_now, period_s, proto)
         plan.append(run)
-        runs_durations.append(len(run.q_deg) * period_s)
         q_now = run.q_deg[-1].copy()
-    tracker = _Progress(progress, runs_durations)
-    points: list[GridPoint] = []
-    motion_s = 0.0
-    q_last = np.zeros(2)
+    tracker = _Progress(progress, [len(r.q_deg) * period_s for r in plan])
+    resweep_s = 0.0
+    notes: list[str] = []
     try:
         for i, planned in enumerate(plan):
-            if cancel is not None and cancel.is_set():
-                raise CalibrationCancelledError(f"cancelled before sweep {i + 1} of {len(plan)}")
-            # Re-plan from where the knobs really are.
-            run = sweep_run(planned.sweep, q_last, period_s, proto) if i else planned
-            tracker.begin(i, run.sweep.label)
-            try:
-                rec = runner.run(run.t_s, run.q_deg, False, cancel, tracker.report)
-            except TsmdError as exc:
-                q_last = _where_now(runner, run.q_deg, tracker.fraction)
-                if cancel is not None and cancel.is_set():
-                    raise CalibrationCancelledError(
-                        f"cancelled during sweep {i + 1} of {len(plan)} ({run.sweep.label})"
-                    ) from None
-                raise CalibrationError(f"{run.sweep.label}: {exc}") from None
-            motion_s += len(rec) * period_s
-            q_last = _last_command(rec, run.q_deg)
-            if cancel is not None and cancel.is_set():
-                raise CalibrationCancelledError(
-                    f"cancelled during sweep {i + 1} of {len(plan)} ({run.sweep.label})")
-            if len(rec) < len(run.q_deg):
-                raise CalibrationError(f"{run.sweep.label}: the runner stopped after "
-                                       f"{len(rec)} of {len(run.q_deg)} ticks")
-            t0 = float(rec["t"][0]) - float(run.t_s[0])
-            rec.metadata.update(sweep_metadata(run.sweep, t0 + float(run.t_s[run.sweep_start])))
-            tracker.report(1.0, "identifying")
-            identifier.submit(rec, run.sweep.label)
+            tracker.begin(i, planned.sweep.label)
+            rec = player.play(planned.sweep, f"sweep {i + 1} of {len(plan)}", tracker,
+                              planned if i == 0 else None)
+            identifier.submit(rec, planned.sweep.label)
             identifier.check()  # a sweep that cannot be identified stops the protocol early
-        motion_s += _return_to_zero(runner, q_last, period_s)
         points = identifier.results()
+        while omegas is not None:
+            todo = uncertain_points(points, omegas, estimate)
+            if not todo:
+                break
+            again = proto.resweep(plan[todo[0].index].sweep)
+            if resweep_s + again.duration_s > proto.resweep_budget_s + 1e-6:
+                break
+            why = todo[0].describe(points)
+            notes.append(f"re-sweep {len(notes) + 1}: {why}; {again.cycles:g} more cycles")
+            run = sweep_run(again, player.q_last, period_s, proto)
+            tracker.begin(tracker.add(len(run.q_deg) * period_s), f"{again.label} ({why})")
+            rec = player.play(again, f"re-sweep {len(notes)}", tracker, run)
+            point = points[todo[0].index]
+            points[todo[0].index] = pooled(point, identify_recording(rec, options, again.label))
+            resweep_s += again.duration_s
+        player.return_to_zero()
     except BaseException as exc:
         identifier.close()
-        if not isinstance(exc, _AfterReturnError):
-            motion_s += _return_to_zero(runner, q_last, period_s)
+        player.return_to_zero()
         if isinstance(exc, CalibrationCancelledError):
             raise CalibrationCancelledError(f"{exc}; knobs returned to 0, nothing saved") from None
         raise
     identifier.close()
-    return SweepRuns(points, motion_s, time.monotonic() - wall0)
+    return SweepRuns(points, player.motion_s, time.monotonic() - wall0, resweep_s, notes)
+
+
+class _Player:
+    """Plays sweeps one after the other over the runner and tracks where the knobs are."""
+
+    def __init__(self, runner: TrajectoryRunner, proto: SweepProtocol, period_s: float,
+                 cancel: threading.Event | None) -> None:
+        self.runner = runner
+        self.proto = proto
+        self.period_s = period_s
+        self.cancel = cancel
+        self.q_last = np.zeros(2)
+        self.motion_s = 0.0
+        self.at_zero = True
+
+    def play(self, sweep: Sweep, what: str, tracker: _Progress,
+             run: SweepRun | None = None) -> Recording:
+        """Run one sweep from where the knobs are (re-planned unless ``run`` is given); the
+        recording carries the sweep's metadata."""
+        cancel = self.cancel
+        if cancel is not None and cancel.is_set():
+            raise CalibrationCancelledError(f"cancelled before {what}")
+        run = run or sweep_run(sweep, self.q_last, self.period_s, self.proto)
+        self.at_zero = False
+        try:
+            rec = self.runner.run(run.t_s, run.q_deg, False, cancel, tracker.report)
+        except TsmdError as exc:
+            self.q_last = _where_now(self.runner, run.q_deg, tracker.fraction)
+            if cancel is not None and cancel.is_set():
+                raise CalibrationCancelledError(
+                    f"cancelled during {what} ({sweep.label})") from None
+            raise CalibrationError(f"{sweep.label}: {exc}") from None
+        self.motion_s += len(rec) * self.period_s
+        self.q_last = _last_command(rec, run.q_deg)
+        if cancel is not None and cancel.is_set():
+            raise CalibrationCancelledError(f"cancelled during {what} ({sweep.label})")
+        if len(rec) < len(run.q_deg):
+            raise CalibrationError(f"{sweep.label}: the runner stopped after "
+                                   f"{len(rec)} of {len(run.q_deg)} ticks")
+        t0 = float(rec["t"][0]) - float(run.t_s[0])
+        rec.metadata.update(sweep_metadata(sweep, t0 + float(run.t_s[run.sweep_start])))
+        tracker.report(1.0, "identifying")
+        return rec
+
+    def return_to_zero(self) -> None:
+        """Bring the knobs back to 0 once (never cancelled: this is the safe end)."""
+        if not self.at_zero:
+            self.motion_s += _return_to_zero(self.runner, self.q_last, self.period_s)
+            self.at_zero = True
 
 
 def _lower_priority() -> None:
     """Worker initializer: run identification at a lower CPU priority than the daemon."""
     with contextlib.suppress(OSError):
         os.nice(10)
-
-
-class _AfterReturnError(CalibrationError):
-    """Marker: raised after the knobs are already back at 0."""
 
 
 class _Identifier:
@@ -335,10 +397,7 @@ class _Identifier:
                 raise future.exception()  # type: ignore[misc]
 
     def results(self) -> list[GridPoint]:
-        try:
-            return self.points + [f.result() for f in self.pending]
-        except CalibrationError as exc:
-            raise _AfterReturnError(str(exc)) from None
+        return self.points + [f.result() for f in self.pending]
 
     def close(self) -> None:
         if self.pool is not None:

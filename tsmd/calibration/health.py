@@ -1,0 +1,101 @@
+"""Refusals for what is really wrong with a sweep, each named: a current sensor stuck or
+saturated, a knob that slips, a motor that stalls.
+
+These look at the raw readings (before spike removal and the low-pass, which would hide a stuck
+or clipped sensor) and at the loaded stretch of each half-cycle. Thresholds are set so that the
+real TEE acquisitions (quantised current, 2.69 mA steps: at most 10 equal readings in a row,
+at most 0.2 % of the samples at the extreme) and the simulated catheters pass with wide margin.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+from tsmd.calibration.errors import CalibrationError
+from tsmd.calibration.signal import FloatArray
+
+
+@dataclass(frozen=True)
+class HealthLimits:
+    """What a working current sensor and coupling never show."""
+
+    stuck_min_s: float = 2.0
+    """Identical readings for this long ..."""
+    stuck_min_travel_deg: float = 10.0
+    """... while the knob travels this far: the sensor is stuck."""
+    saturated_fraction: float = 0.02
+    """This share of the samples exactly at the largest (or smallest) reading: clipped."""
+    slip_drop_fraction: float = 0.3
+    """A loaded current falling by this share of its rise ..."""
+    slip_drop_deg: float = 1.0
+    """... within this much knob travel in the direction of motion: the knob slipped."""
+    slip_min_noise: float = 8.0
+    """A slip drop must also exceed this many noise sigmas."""
+
+
+def _longest_equal_run(x: FloatArray) -> tuple[int, int]:
+    """(start, length) of the longest run of exactly equal consecutive values."""
+    same = np.concatenate([[False], np.diff(x) == 0, [False]])
+    edges = np.diff(same.astype(np.int8))
+    starts = np.flatnonzero(edges == 1)
+    stops = np.flatnonzero(edges == -1)
+    if starts.size == 0:
+        return 0, 1
+    lengths = stops - starts
+    k = int(np.argmax(lengths))
+    return int(starts[k]), int(lengths[k]) + 1
+
+
+def check_sensor(t_s: FloatArray, pos_deg: FloatArray, current_A: FloatArray,
+                 limits: HealthLimits | None = None) -> None:
+    """Refuse a stuck or saturated current sensor (raw readings, NaNs ignored)."""
+    lim = limits or HealthLimits()
+    ok = np.isfinite(current_A) & np.isfinite(pos_deg)
+    cur, pos, t = current_A[ok], pos_deg[ok], t_s[ok]
+    if cur.size < 3:
+        return
+    for label, extreme in (("highest", float(cur.max())), ("lowest", float(cur.min()))):
+        share = float(np.mean(cur == extreme))
+        if share >= lim.saturated_fraction and float(np.ptp(cur)) > 0:
+            raise CalibrationError(
+                f"the current sensor is saturated: {share:.0%} of the readings sit exactly at "
+                f"its {label} value {extreme * 1e3:.1f} mA (clipped)")
+    start, length = _longest_equal_run(cur)
+    stop = start + length - 1
+    duration = float(t[stop] - t[start])
+    travel = float(np.ptp(pos[start:stop + 1]))
+    if duration >= lim.stuck_min_s and travel >= lim.stuck_min_travel_deg:
+        raise CalibrationError(
+            f"the current sensor is stuck at {cur[start] * 1e3:.1f} mA from t={t[start]:.1f} s "
+            f"to t={t[stop]:.1f} s while the knob moved {travel:.0f} deg")
+
+
+def check_slip(grid_deg: FloatArray, yg: FloatArray, edge_k: int, noise_A: float,
+               where: str, limits: HealthLimits | None = None) -> None:
+    """Refuse a loaded current that drops while the knob moves on (stick-slip of the knob).
+
+    ``yg`` is the direction-signed filtered current on a uniform angle grid; past the dead-zone
+    edge ``edge_k`` a healthy catheter's load only grows with the travel.
+    """
+    lim = limits or HealthLimits()
+    if edge_k >= yg.size - 2:
+        return
+    step = float(grid_deg[1] - grid_deg[0])
+    loaded = yg[edge_k:]
+    rise = float(loaded.max() - loaded[0])
+    if rise <= 0:
+        return
+    width = max(1, round(lim.slip_drop_deg / step))
+    padded = np.concatenate([loaded, np.full(width, loaded[-1])])
+    # Largest fall from any point to the lowest value within the next `width` grid steps.
+    falls = loaded - sliding_window_view(padded[1:], width).min(axis=1)
+    k = int(np.argmax(falls))
+    drop = float(falls[k])
+    if drop > lim.slip_drop_fraction * rise and drop > lim.slip_min_noise * noise_A:
+        raise CalibrationError(
+            f"{where}: the loaded current drops by {drop * 1e3:.0f} mA within "
+            f"{lim.slip_drop_deg:g} deg at {grid_deg[edge_k + k]:.1f} deg while the knob moves "
+            "on: the knob slips (coupling or tendon)")

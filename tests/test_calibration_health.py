@@ -12,7 +12,7 @@ import pytest
 from test_calibration_helpers import sweep_recording
 
 from tsmd.calibration import CalibrationError, Sweep, identify_sweep
-from tsmd.calibration.estimate import knob_estimates
+from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.health import check_slip
 from tsmd.calibration.identify import SweepResult
 from tsmd.recording import Recording
@@ -41,7 +41,7 @@ def test_noise_and_spikes_move_each_parameter_less_than_its_stated_uncertainty(
     cur += (rng.random(len(rec)) < 0.01) * rng.choice([-1.0, 1.0], len(rec)) * 0.1
     noisy = _identify(rec, cur)
     assert any("spikes removed" in n for n in noisy.data.notes)
-    (stated,) = knob_estimates([noisy])
+    (stated,) = point_estimates([noisy])
     for name, values in clean.values.items():
         assert values, name
         assert np.isfinite(stated[name].u95_deg), name

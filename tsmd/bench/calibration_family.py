@@ -2,11 +2,11 @@
 wall time split between the stack and the plant, and refusal of injected faults.
 
 One *run* is one catheter (a plant built with a unit seed) and one noise seed (current sensor
-and tracker). Each run plays the paper protocol and the fast one on fresh rigs; the truth at
-each of the paper's 7 grid points per knob is read off the tracked tip of the paper protocol's
-sweep there (:func:`tsmd.bench.calibration.tip_truth`), so both profiles are judged on the same
-56 values per catheter (the fast one interpolated over the other knob's angle as the profile
-is, pchip).
+and tracker). Each run plays the chosen protocols on fresh rigs; the truth at each of the
+paper's 7 grid points per knob is read off the tracked tip of the paper protocol's sweep there
+(:func:`tsmd.bench.calibration.tip_truth`), or, when the paper protocol is not run, of one cycle
+of the same sweep (:func:`truth_sweeps`), so every profile is judged on the same 56 values per
+catheter (the fast one interpolated over the other knob's angle as the profile is, pchip).
 """
 
 from __future__ import annotations
@@ -145,6 +145,29 @@ def score(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]]) ->
                 run.errors.append(abs(value - truth[(knob, other)].get(name, math.nan)))
 
 
+def truth_sweeps(config: TsmdConfig, noise_seed: int) -> list[Any]:
+    """Without the paper protocol's run: one cycle of its sweep at each of its grid points,
+    only to read the tip (same waveform and speed, so the same D and B on the tip)."""
+    from tsmd.calibration.protocol import sweep_run
+    from tsmd.calibration.run import sweep_metadata
+    from tsmd.replay import LockstepRunner
+
+    proto = paper_protocol()
+    points = []
+    q = np.zeros(2)
+    with LockstepRunner(config, seed=noise_seed) as runner:
+        for sweep in proto.sweeps:
+            one = dataclasses.replace(sweep, cycles=1.0)
+            run = sweep_run(one, q, config.loop.period_s, proto)
+            rec = runner.run(run.t_s, run.q_deg, False)
+            t0 = float(rec["t"][0]) - float(run.t_s[0])
+            rec.metadata.update(sweep_metadata(one, t0 + float(run.t_s[run.sweep_start])))
+            q = np.array([rec["cmd1"][-1], rec["cmd2"][-1]], dtype=float)
+            points.append(GridPoint(sweep.knob, sweep.other_deg, None,  # type: ignore[arg-type]
+                                    rec))
+    return points
+
+
 @dataclass
 class CatheterRun:
     """Both protocols on one catheter with one noise seed."""
@@ -164,11 +187,11 @@ def run_catheter(plant: str, params: dict[str, Any], unit_key: str, unit: int, n
 
     cfg = unit_config(config or default_sim_config(), plant, params, unit_key, unit)
     makers = {"paper": paper_protocol, "fast": fast_protocol}
-    runs = {"paper": play_protocol(cfg, device, paper_protocol(), noise_seed)}
-    truth = {(p.knob, p.other_deg): tip_truth(p) for p in runs["paper"].points}
-    for name in protocols:
-        if name != "paper":
-            runs[name] = play_protocol(cfg, device, makers[name](), noise_seed)
+    runs = {name: play_protocol(cfg, device, makers[name](), noise_seed) for name in protocols}
+    paper = runs.get("paper")
+    full = paper is not None and len(paper.points) == len(paper_protocol().sweeps)
+    truth_points = paper.points if full and paper else truth_sweeps(cfg, noise_seed)
+    truth = {(p.knob, p.other_deg): tip_truth(p) for p in truth_points}
     for run in runs.values():
         score(run, truth)
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0

@@ -83,8 +83,7 @@ def check_quality(points: Sequence[GridPoint], limits: QualityLimits | None = No
     """
     lim = limits or QualityLimits()
     report = QualityReport()
-    estimates = point_estimates([p.knob for p in points], [p.result for p in points],
-                                lim.estimate)
+    estimates = point_estimates([p.result for p in points], lim.estimate)
     by_point = {id(p): e for p, e in zip(points, estimates, strict=True)}
     for knob in (0, 1):
         mine = [p for p in points if p.knob == knob]
@@ -137,7 +136,7 @@ def _check_point(p: GridPoint, lim: QualityLimits, amplitude_deg: float, problem
     for name, b in (("backlash_pos_deg", b_pos), ("backlash_neg_deg", b_neg)):
         if math.isfinite(b) and not 0.0 <= b <= lim.max_backlash_deg:
             problems.append(f"{p.name}: {name} {b:.1f} outside [0, {lim.max_backlash_deg:g}]")
-    snr = r.snr
+    snr = r.median_snr
     if math.isfinite(snr) and snr < lim.min_snr:
         problems.append(f"{p.name}: current signal too weak (SNR {snr:.1f} < {lim.min_snr:g})")
 

@@ -139,6 +139,12 @@ class SweepResult:
         return float(min(values)) if values else math.nan
 
     @property
+    def median_snr(self) -> float:
+        """The typical half-cycle's signal (one weak half-cycle gives no value, not a verdict)."""
+        values = [h.snr for h in self.half_cycles if math.isfinite(h.snr)]
+        return float(np.median(values)) if values else math.nan
+
+    @property
     def problems(self) -> tuple[str, ...]:
         return tuple(p for h in self.half_cycles for p in h.problems)
 

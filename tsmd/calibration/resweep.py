@@ -36,8 +36,8 @@ class Uncertain:
 
 def point_estimates(points: Sequence[GridPoint],
                     options: EstimateOptions | None = None) -> list[dict[str, Estimate]]:
-    """Estimates for every grid point, the scatter pooled per knob."""
-    return estimate_points([p.knob for p in points], [p.result for p in points], options)
+    """Estimates for every grid point, the scatter pooled over all of them."""
+    return estimate_points([p.result for p in points], options)
 
 
 def uncertain_points(points: Sequence[GridPoint], omegas: Sequence[float],

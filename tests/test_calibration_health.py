@@ -13,7 +13,7 @@ from test_calibration_helpers import sweep_recording
 
 from tsmd.calibration import CalibrationError, Sweep, identify_sweep
 from tsmd.calibration.estimate import point_estimates
-from tsmd.calibration.health import check_slip
+from tsmd.calibration.health import check_slips, find_slip
 from tsmd.calibration.identify import SweepResult
 from tsmd.recording import Recording
 
@@ -97,16 +97,29 @@ def test_a_clipped_sensor_is_refused_as_saturated(rec: Recording) -> None:
         _identify(rec, np.clip(cur, -limit, limit))
 
 
-def test_a_loaded_current_that_drops_while_moving_on_is_a_slipping_knob() -> None:
-    grid = np.arange(0.0, 60.0, 0.25)
-    load = np.maximum(grid - 20.0, 0.0) * 0.01
-    load[grid > 45.0] -= 0.15  # the coupling lets go
-    with pytest.raises(CalibrationError, match="the knob slips"):
-        check_slip(grid, load, int(np.searchsorted(grid, 20.0)), 0.002, "test")
-
-
-def test_a_loaded_current_that_keeps_rising_is_no_slip() -> None:
+def _load(drop_at_deg: float | None) -> tuple[np.ndarray, np.ndarray, int]:
     grid = np.arange(0.0, 60.0, 0.25)
     load = np.maximum(grid - 20.0, 0.0) * 0.01
     load += np.random.default_rng(0).normal(0.0, 0.002, grid.size)
-    check_slip(grid, load, int(np.searchsorted(grid, 20.0)), 0.002, "test")
+    if drop_at_deg is not None:
+        load[grid > drop_at_deg] -= 0.15  # the coupling lets go
+    return grid, load, int(np.searchsorted(grid, 20.0))
+
+
+def test_a_loaded_current_that_drops_while_moving_on_is_found() -> None:
+    grid, load, edge = _load(45.0)
+    assert "drops by" in (find_slip(grid, load, edge, 0.002) or "")
+
+
+def test_a_loaded_current_that_keeps_rising_is_no_slip() -> None:
+    grid, load, edge = _load(None)
+    assert find_slip(grid, load, edge, 0.002) is None
+
+
+def test_a_knob_that_slips_on_most_strokes_is_refused_naming_it() -> None:
+    with pytest.raises(CalibrationError, match=r"the knob slips .* on 3 of 4 loaded strokes"):
+        check_slips(["drops by 150 mA", None, "drops by 140 mA", "drops by 160 mA"])
+
+
+def test_one_disturbed_stroke_is_not_a_slip() -> None:
+    check_slips([None, "drops by 80 mA", None, None])

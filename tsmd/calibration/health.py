@@ -9,6 +9,7 @@ at most 0.2 % of the samples at the extreme) and the simulated catheters pass wi
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -73,21 +74,23 @@ def check_sensor(t_s: FloatArray, pos_deg: FloatArray, current_A: FloatArray,
             f"to t={t[stop]:.1f} s while the knob moved {travel:.0f} deg")
 
 
-def check_slip(grid_deg: FloatArray, yg: FloatArray, edge_k: int, noise_A: float,
-               where: str, limits: HealthLimits | None = None) -> None:
-    """Refuse a loaded current that drops while the knob moves on (stick-slip of the knob).
+def find_slip(grid_deg: FloatArray, yg: FloatArray, edge_k: int, noise_A: float,
+              limits: HealthLimits | None = None) -> str | None:
+    """A loaded current that drops while the knob moves on (the knob slipped), described; None
+    when the load only grows.
 
     ``yg`` is the direction-signed filtered current on a uniform angle grid; past the dead-zone
-    edge ``edge_k`` a healthy catheter's load only grows with the travel.
+    edge ``edge_k`` a healthy catheter's load only grows with the travel. One such drop can be
+    a disturbance; :func:`check_slips` refuses a sweep where most loaded strokes show one.
     """
     lim = limits or HealthLimits()
     if edge_k >= yg.size - 2:
-        return
+        return None
     step = float(grid_deg[1] - grid_deg[0])
     loaded = yg[edge_k:]
     rise = float(loaded.max() - loaded[0])
     if rise <= 0:
-        return
+        return None
     width = max(1, round(lim.slip_drop_deg / step))
     padded = np.concatenate([loaded, np.full(width, loaded[-1])])
     # Largest fall from any point to the lowest value within the next `width` grid steps.
@@ -95,7 +98,16 @@ def check_slip(grid_deg: FloatArray, yg: FloatArray, edge_k: int, noise_A: float
     k = int(np.argmax(falls))
     drop = float(falls[k])
     if drop > lim.slip_drop_fraction * rise and drop > lim.slip_min_noise * noise_A:
+        return (f"the loaded current drops by {drop * 1e3:.0f} mA within {lim.slip_drop_deg:g} "
+                f"deg at {grid_deg[edge_k + k]:.1f} deg while the knob moves on")
+    return None
+
+
+def check_slips(findings: Sequence[str | None]) -> None:
+    """Refuse a sweep where most loaded strokes (at least two) show a slip: a coupling or
+    tendon that slips does so on every stroke past its holding torque."""
+    slips = [f for f in findings if f]
+    if len(slips) >= 2 and 2 * len(slips) >= len(findings):
         raise CalibrationError(
-            f"{where}: the loaded current drops by {drop * 1e3:.0f} mA within "
-            f"{lim.slip_drop_deg:g} deg at {grid_deg[edge_k + k]:.1f} deg while the knob moves "
-            "on: the knob slips (coupling or tendon)")
+            f"the knob slips (coupling or tendon): on {len(slips)} of {len(findings)} loaded "
+            f"strokes {slips[0]}")

@@ -30,11 +30,13 @@ from numpy.typing import NDArray
 from scipy.signal import find_peaks
 
 from tsmd.calibration.errors import CalibrationError
-from tsmd.calibration.health import check_sensor, check_slip
+from tsmd.calibration.health import check_sensor, check_slips, find_slip
 from tsmd.calibration.signal import Conditioned, FloatArray, condition, robust_sigma
 
 PARAMETERS: tuple[str, ...] = (
     "dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_pos_deg", "backlash_neg_deg")
+SHORT = {"dead_zone_pos_deg": "D_pos", "dead_zone_neg_deg": "D_neg",
+         "backlash_pos_deg": "B_pos", "backlash_neg_deg": "B_neg"}
 
 
 @dataclass(frozen=True)
@@ -95,6 +97,8 @@ class HalfCycle:
     rise_A: float = math.nan
     snr: float = math.nan
     problems: tuple[str, ...] = ()
+    slip: str | None = None
+    """Where the loaded current dropped while the knob moved on, if it did."""
 
     @property
     def backlash_name(self) -> str:
@@ -383,6 +387,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     rise = float(np.median(yg[max(end - min_size, plateau_run[0]):end]) - plateau)
     snr = rise / noise
     edge_deg = math.nan
+    slip: str | None = None
     if snr < opts.min_snr:
         problems.append(
             f"{where}: no current rise out of the dead zone (rise {rise * 1e3:.1f} mA = "
@@ -392,7 +397,9 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
                         "the dead-zone edge was not reached")
     else:
         edge_deg = float(direction * grid[edge_k])
-        check_slip(grid[:end], yg[:end], edge_k, noise, where)
+        slip = find_slip(grid[:end], yg[:end], edge_k, noise)
+        if slip:
+            slip = f"{where}: {slip}"
 
     def index_at(k: int | None) -> int | None:
         if k is None:
@@ -408,7 +415,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         else None,
         edge_index=index_at(edge_k) if math.isfinite(edge_deg) else None,
         backlash_deg=backlash_deg, edge_deg=edge_deg, plateau_A=direction * plateau,
-        rise_A=rise, snr=snr, problems=tuple(problems))
+        rise_A=rise, snr=snr, problems=tuple(problems), slip=slip)
 
 
 def check_following(data: Conditioned, opts: IdentifyOptions) -> None:
@@ -483,6 +490,7 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
             f"the command never moves more than {opts.min_reversal_deg:g} deg: nothing to identify")
     halves = tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches)
     check_signal(data, halves, opts)
+    check_slips([h.slip for h in halves if math.isfinite(h.edge_deg)])
     values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
     for h in halves:
         if math.isfinite(h.backlash_deg):

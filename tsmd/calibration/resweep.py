@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from tsmd.calibration.assemble import KNOB_LABELS, GridPoint
 from tsmd.calibration.estimate import Estimate, EstimateOptions
 from tsmd.calibration.estimate import point_estimates as estimate_points
-from tsmd.calibration.offline import SHORT
+from tsmd.calibration.identify import SHORT
 
 
 @dataclass(frozen=True)
@@ -78,3 +78,18 @@ def uncertainty_table(points: Sequence[GridPoint],
         cells.append(str(p.result.resweeps))
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def pool_repeats(points: Sequence[GridPoint]) -> list[GridPoint]:
+    """Logged sweeps of the same grid point (knob and other-knob angle) pooled into one, in
+    the order their grid points first appear (repeated acquisitions are re-sweeps)."""
+    out: list[GridPoint] = []
+    where: dict[tuple[int, float], int] = {}
+    for p in points:
+        key = (p.knob, round(float(p.other_deg), 6))
+        if key in where:
+            out[where[key]] = pooled(out[where[key]], p)
+        else:
+            where[key] = len(out)
+            out.append(p)
+    return out

@@ -42,7 +42,7 @@ from tsmd.calibration.identify import IdentifyOptions, identify_sweep
 from tsmd.calibration.ours_fit import fit_ours_for_knob
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import Sweep, SweepRun, paper_protocol, return_to_zero, sweep_run
-from tsmd.calibration.resweep import pooled, uncertain_points
+from tsmd.calibration.resweep import pool_repeats, pooled, uncertain_points
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
@@ -432,6 +432,7 @@ def calibration_from_points(points: list[GridPoint], catheter_id: str, device: D
     """Quality checks and profile from sweeps already identified (logged or just run)."""
     if not points:
         raise CalibrationError("no sweeps given")
+    points = pool_repeats(points)
     amplitude = max(float(np.nanmax(np.abs(p.result.data.cmd_deg))) for p in points)
     profile, report = finish(catheter_id, device, points, limits=limits, amplitude_deg=amplitude,
                              source="calibration from logged motor current")

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from tsmd.calibration.assemble import GridPoint
-from tsmd.calibration.errors import CalibrationRefusedError
+from tsmd.calibration.errors import CalibrationError, CalibrationRefusedError
 from tsmd.calibration.identify import IdentifyOptions
 from tsmd.errors import TsmdError
 
@@ -201,17 +201,35 @@ def _write_sweeps(out: Path, points: Sequence[GridPoint]) -> None:
 
 
 def _from_recordings(args: argparse.Namespace) -> int:
-    from tsmd.calibration.offline import identification_table, read_sweep_file
+    from tsmd.calibration.offline import data_report, identification_table, read_sweep_file
+    from tsmd.calibration.resweep import pool_repeats
     from tsmd.calibration.run import calibration_from_points, identify_recording
 
     config = _config(args, sim=False) if args.config else None
     device = _device(args, config)
     options = IdentifyOptions(edge=args.edge)
-    points = [identify_recording(read_sweep_file(f, args.steps_per_knob_deg), options,
-                                 source=str(f))
-              for f in args.from_recording]
-    print(identification_table(points))
-    cal = calibration_from_points(points, args.catheter, device)
+    points = []
+    failures = []
+    for f in args.from_recording:
+        try:
+            points.append(identify_recording(read_sweep_file(f, args.steps_per_knob_deg),
+                                             options, source=str(f)))
+        except CalibrationError as exc:
+            # Every file is looked at: the report then says what each gave or lacked.
+            failures.append((str(f), str(exc).removeprefix(f"{f} ")))
+    if points:
+        print(identification_table(points))
+    unusable = "; ".join(f"{Path(f).name}: {why}" for f, why in failures)
+    try:
+        if not points:
+            raise CalibrationError(f"no recording could be used: {unusable}")
+        cal = calibration_from_points(points, args.catheter, device)
+        if failures:
+            raise CalibrationError(f"{len(failures)} recording(s) could not be used: {unusable}")
+    except CalibrationError as exc:
+        # Repeated acquisitions of one grid point are pooled, as a re-sweep would be.
+        print("\n" + data_report(pool_repeats(points), failures, str(exc)))
+        raise
     _save(args, config, cal)
     return 0
 

@@ -22,9 +22,10 @@ import json
 import math
 import os
 import resource
+import sys
 import time
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 import numpy as np
@@ -93,11 +94,19 @@ def family(args: argparse.Namespace) -> str:
     tasks = [(args.plant, params, args.unit_key, u, s, device, protocols)
              for u in range(args.first_unit, args.first_unit + args.units) for s in seeds]
     t0 = time.monotonic()
-    if args.jobs > 1:
-        with ProcessPoolExecutor(max_workers=args.jobs) as pool:
-            results = list(pool.map(run_catheter_summary, *zip(*tasks, strict=True)))
-    else:
-        results = [run_catheter_summary(*t) for t in tasks]
+    results = []
+    with ProcessPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        futures = [pool.submit(run_catheter_summary, *t) for t in tasks]
+        for future in as_completed(futures):
+            results.append(future.result())
+            c = results[-1]
+            # One line per catheter as it ends (a long family run shows where it is).
+            print(f"unit {c.unit} seed {c.noise_seed}: " + "; ".join(
+                f"{name} {'accepted' if r.accepted else 'REFUSED'}, {r.within}/"
+                f"{len(r.errors)} within 2 deg, max {r.max_error:.2f}, {len(r.resweeps)} "
+                f"re-sweeps, {r.wall_s:.0f} s" for name, r in c.runs.items()),
+                file=sys.stderr, flush=True)
+    results.sort(key=lambda c: (c.unit, c.noise_seed))
     wall = time.monotonic() - t0
     out = [f"## Plant {args.plant} {json.dumps(params)}: units {args.first_unit}-"
            f"{args.first_unit + args.units - 1} ({args.unit_key}), noise seeds "

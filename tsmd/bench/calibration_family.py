@@ -4,9 +4,10 @@ wall time split between the stack and the plant, and refusal of injected faults.
 One *run* is one catheter (a plant built with a unit seed) and one noise seed (current sensor
 and tracker). Each run plays the chosen protocols on fresh rigs; the truth at each of the
 paper's 7 grid points per knob is read off the tracked tip of the paper protocol's sweep there
-(:func:`tsmd.bench.calibration.tip_truth`), or, when the paper protocol is not run, of one cycle
-of the same sweep (:func:`truth_sweeps`), so every profile is judged on the same 56 values per
-catheter (the fast one interpolated over the other knob's angle as the profile is, pchip).
+(:func:`tsmd.bench.calibration.tip_truth`), or, when the paper protocol is not run, of the
+same sweeps played on the plant alone (:func:`truth_sweeps`), so every profile is judged on the
+same 56 values per catheter (the fast one interpolated over the other knob's angle as the
+profile is, pchip).
 """
 
 from __future__ import annotations
@@ -145,26 +146,33 @@ def score(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]]) ->
                 run.errors.append(abs(value - truth[(knob, other)].get(name, math.nan)))
 
 
-def truth_sweeps(config: TsmdConfig, noise_seed: int) -> list[Any]:
-    """Without the paper protocol's run: one cycle of its sweep at each of its grid points,
-    only to read the tip (same waveform and speed, so the same D and B on the tip)."""
+def truth_sweeps(config: TsmdConfig) -> list[GridPoint]:
+    """Without the paper protocol's run: its sweeps applied to a fresh plant of the unit
+    directly as knob angles, only to read the noise-free tip. Cheaper than the full stack,
+    whose servo lag only shifts the knob by a fraction of a degree; D and B are read against
+    the knob angle either way."""
     from tsmd.calibration.protocol import sweep_run
     from tsmd.calibration.run import sweep_metadata
-    from tsmd.replay import LockstepRunner
+    from tsmd.recording import Recording
 
     proto = paper_protocol()
+    period = config.loop.period_s
+    plant = load_plant(config.sim.plant, config.sim.params)
+    plant.reset()
     points = []
-    q = np.zeros(2)
-    with LockstepRunner(config, seed=noise_seed) as runner:
-        for sweep in proto.sweeps:
-            one = dataclasses.replace(sweep, cycles=1.0)
-            run = sweep_run(one, q, config.loop.period_s, proto)
-            rec = runner.run(run.t_s, run.q_deg, False)
-            t0 = float(rec["t"][0]) - float(run.t_s[0])
-            rec.metadata.update(sweep_metadata(one, t0 + float(run.t_s[run.sweep_start])))
-            q = np.array([rec["cmd1"][-1], rec["cmd2"][-1]], dtype=float)
-            points.append(GridPoint(sweep.knob, sweep.other_deg, None,  # type: ignore[arg-type]
-                                    rec))
+    q_now = np.zeros(2)
+    for one in proto.sweeps:
+        run = sweep_run(one, q_now, period, proto)
+        tip = np.array([plant.step(period, q).tip_deg for q in run.q_deg], dtype=float)
+        columns = {"t": run.t_s.copy()}
+        for k in (1, 2):
+            columns[f"cmd{k}"] = run.q_deg[:, k - 1].copy()
+            columns[f"pos{k}"] = run.q_deg[:, k - 1].copy()
+            columns[f"tip{k}"] = tip[:, k - 1].copy()
+        rec = Recording(columns, sweep_metadata(one, float(run.t_s[run.sweep_start])))
+        points.append(GridPoint(one.knob, one.other_deg, None,  # type: ignore[arg-type]
+                                rec))
+        q_now = run.q_deg[-1].copy()
     return points
 
 
@@ -190,7 +198,7 @@ def run_catheter(plant: str, params: dict[str, Any], unit_key: str, unit: int, n
     runs = {name: play_protocol(cfg, device, makers[name](), noise_seed) for name in protocols}
     paper = runs.get("paper")
     full = paper is not None and len(paper.points) == len(paper_protocol().sweeps)
-    truth_points = paper.points if full and paper else truth_sweeps(cfg, noise_seed)
+    truth_points = paper.points if full and paper else truth_sweeps(cfg)
     truth = {(p.knob, p.other_deg): tip_truth(p) for p in truth_points}
     for run in runs.values():
         score(run, truth)

@@ -20,6 +20,7 @@ from tsmd.calibration import (
     CalibrationCancelledError,
     CalibrationError,
     Protocol,
+    QualityLimits,
     Sweep,
     fast_protocol,
     identify_recording,
@@ -208,6 +209,9 @@ def test_each_sweep_starts_at_minus_a_after_coming_down() -> None:
 
 # --- a whole calibration ----------------------------------------------------------------------
 
+# SMALL's quick 1.5-cycle sweeps give one half-cycle of B_pos per sweep: too uncertain for the
+# real gate (tests/test_calibration_resweep.py tests that); these tests are about the profile.
+LAX = QualityLimits(refuse_tip_error_deg=10.0)
 SMALL = Protocol("small", tuple(Sweep(k, o, 90.0, 0.1, 1.5, "triangle")
                                 for k in (0, 1) for o in (-30.0, 0.0, 30.0)))
 
@@ -218,7 +222,7 @@ def small_cal():
     runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
     seen: list[tuple[float, str]] = []
     cal = run_calibration(runner, "cat-1", device, protocol=SMALL, period_s=PERIOD_S,
-                          progress=lambda f, text: seen.append((f, text)))
+                          progress=lambda f, text: seen.append((f, text)), limits=LAX)
     return cal, runner, seen
 
 
@@ -245,7 +249,7 @@ def test_logged_sweeps_give_the_same_profile_offline(small_cal, tmp_path: Path) 
         files.append(tmp_path / f"sweep{i}.csv")
         write_recording(files[-1], point.recording)
     offline = calibrate_from_recordings([(str(f), read_recording(f)) for f in files], "cat-1",
-                                        load_device_model(DEVICE))
+                                        load_device_model(DEVICE), limits=LAX)
     for live, off in zip(cal.profile.knobs, offline.profile.knobs, strict=True):
         np.testing.assert_allclose(off.grid_array(), live.grid_array(), atol=1e-9)
 

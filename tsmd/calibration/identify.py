@@ -31,7 +31,7 @@ from scipy.signal import find_peaks
 
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.health import check_sensor, check_slips, find_slip
-from tsmd.calibration.signal import Conditioned, FloatArray, condition, robust_sigma
+from tsmd.calibration.signal import Conditioned, FloatArray, condition
 
 PARAMETERS: tuple[str, ...] = (
     "dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_pos_deg", "backlash_neg_deg")
@@ -468,16 +468,15 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
     """
     opts = options or IdentifyOptions()
     raw = np.asarray(current_A, float)
-    if np.isfinite(raw).any() and np.nanmax(raw) == np.nanmin(raw):
-        raise CalibrationError("the current is constant: no current feedback from the drive")
-    check_sensor(np.asarray(t_s, float), np.asarray(pos_deg, float), raw)
     data = condition(np.asarray(t_s, float), np.asarray(cmd_deg, float),
-                     np.asarray(pos_deg, float), np.asarray(current_A, float),
+                     np.asarray(pos_deg, float), raw,
                      cutoff_hz=opts.cutoff_hz, order=opts.filter_order,
                      max_gap_s=opts.max_gap_s)
-    check_following(data, opts)
-    if robust_sigma(data.current_A) == 0 and np.ptp(data.current_A) == 0:
+    if np.isfinite(raw).any() and np.nanmax(raw) == np.nanmin(raw):
         raise CalibrationError("the current is constant: no current feedback from the drive")
+    # On the raw readings: spike removal and the low-pass would hide a stuck or clipped sensor.
+    check_sensor(np.asarray(t_s, float), np.asarray(pos_deg, float), raw)
+    check_following(data, opts)
     stretches = split_half_cycles(data.cmd_deg, opts.min_reversal_deg)
     if sweep_start_s is not None:
         # The protocol brings the knob to -A going down: the sweep's first stretch follows a

@@ -29,8 +29,8 @@ from tsmd.calibration import (
     run_calibration,
 )
 from tsmd.calibration.identify import IdentifyOptions, SweepResult
+from tsmd.calibration.player import sweep_metadata
 from tsmd.calibration.protocol import sweep_run
-from tsmd.calibration.run import sweep_metadata
 from tsmd.calibration.signal import lowpass
 from tsmd.profile import ProfileStore, load_device_model
 from tsmd.recording import Recording, read_recording, write_recording

@@ -136,8 +136,8 @@ def sweep_recording(sweep: object, runner: LockstepPlantRunner | None = None,
                     period_s: float = 0.004) -> Recording:
     """One protocol sweep (with its move to -A) on the built-in plant, with its metadata."""
     from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
+    from tsmd.calibration.player import sweep_metadata
     from tsmd.calibration.protocol import Protocol, sweep_run
-    from tsmd.calibration.run import sweep_metadata
 
     runner = runner or LockstepPlantRunner(make_tendon_sheath_plant(), period_s)
     run = sweep_run(sweep, np.zeros(2), period_s,  # type: ignore[arg-type]

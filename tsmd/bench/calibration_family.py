@@ -151,8 +151,8 @@ def truth_sweeps(config: TsmdConfig) -> list[GridPoint]:
     directly as knob angles, only to read the noise-free tip. Cheaper than the full stack,
     whose servo lag only shifts the knob by a fraction of a degree; D and B are read against
     the knob angle either way."""
+    from tsmd.calibration.player import sweep_metadata
     from tsmd.calibration.protocol import sweep_run
-    from tsmd.calibration.run import sweep_metadata
     from tsmd.recording import Recording
 
     proto = paper_protocol()

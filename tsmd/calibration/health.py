@@ -9,6 +9,7 @@ at most 0.2 % of the samples at the extreme) and the simulated catheters pass wi
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -16,7 +17,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from tsmd.calibration.errors import CalibrationError
-from tsmd.calibration.signal import FloatArray
+from tsmd.calibration.signal import Conditioned, FloatArray
 
 
 @dataclass(frozen=True)
@@ -111,3 +112,43 @@ def check_slips(findings: Sequence[str | None]) -> None:
         raise CalibrationError(
             f"the knob slips (coupling or tendon): on {len(slips)} of {len(findings)} loaded "
             f"strokes {slips[0]}")
+
+
+def check_following(data: Conditioned, min_travel_deg: float, min_follow_ratio: float,
+                    max_lag_deg: float) -> None:
+    """A stalled or lagging knob makes the current meaningless: refuse it, saying how much."""
+    commanded = float(np.ptp(data.cmd_deg))
+    actual = float(np.ptp(data.pos_deg))
+    if commanded > min_travel_deg and actual < min_follow_ratio * commanded:
+        raise CalibrationError(
+            f"the knob did not follow the command (moved {actual:.1f} deg of {commanded:.1f} "
+            f"deg commanded): motor stalled or blocked")
+    lag = np.abs(data.cmd_deg - data.pos_deg)
+    if float(lag.max()) > max_lag_deg:
+        k = int(np.argmax(lag))
+        raise CalibrationError(
+            f"the knob lags the command by {lag[k]:.1f} deg at t={data.t_s[k]:.2f} s "
+            f"(> {max_lag_deg:g} deg): motor stalled or too slow")
+
+
+def check_signal(data: Conditioned, halves: Sequence[tuple[int, int, int, float]],
+                 min_snr: float) -> None:
+    """No half-cycle (direction, start, stop, SNR) shows a load: tell a missing current signal
+    from a catheter that never leaves its dead zone. A working sensor still shows the drive's
+    friction, which flips with the direction of motion; a disconnected one reads noise that
+    does not."""
+    if not halves or any(snr >= min_snr for *_, snr in halves):
+        return
+    signed = np.concatenate([d * data.current_filtered_A[a:b] for d, a, b, _ in halves])
+    friction = float(np.median(signed))
+    noise = max(data.filtered_noise_A, 1e-12)
+    best = max((snr for *_, snr in halves if math.isfinite(snr)), default=math.nan)
+    if abs(friction) < min_snr * noise:
+        raise CalibrationError(
+            f"no current signal: the current does not follow the motion (direction-dependent "
+            f"part {friction * 1e3:.1f} mA, noise {noise * 1e3:.1f} mA); check the drive's "
+            "current feedback")
+    raise CalibrationError(
+        f"the sweep never leaves the dead zone: the current shows the drive's friction "
+        f"({friction * 1e3:.1f} mA) but no load in any half-cycle (best rise {best:.1f} x "
+        f"noise < {min_snr:g}); tendon broken or slack beyond the travel")

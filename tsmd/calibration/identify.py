@@ -21,7 +21,6 @@ decreasing ones (after the positive end) give ``B_pos`` and ``D_neg``, as in the
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -30,7 +29,13 @@ from numpy.typing import NDArray
 from scipy.signal import find_peaks
 
 from tsmd.calibration.errors import CalibrationError
-from tsmd.calibration.health import check_sensor, check_slips, find_slip
+from tsmd.calibration.health import (
+    check_following,
+    check_sensor,
+    check_signal,
+    check_slips,
+    find_slip,
+)
 from tsmd.calibration.signal import Conditioned, FloatArray, condition
 
 PARAMETERS: tuple[str, ...] = (
@@ -418,44 +423,6 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         rise_A=rise, snr=snr, problems=tuple(problems), slip=slip)
 
 
-def check_following(data: Conditioned, opts: IdentifyOptions) -> None:
-    """A stalled or lagging knob makes the current meaningless: refuse it, saying how much."""
-    commanded = float(np.ptp(data.cmd_deg))
-    actual = float(np.ptp(data.pos_deg))
-    if commanded > opts.min_reversal_deg and actual < opts.min_follow_ratio * commanded:
-        raise CalibrationError(
-            f"the knob did not follow the command (moved {actual:.1f} deg of {commanded:.1f} "
-            f"deg commanded): motor stalled or blocked")
-    error = float(np.max(np.abs(data.cmd_deg - data.pos_deg)))
-    if error > opts.max_tracking_error_deg:
-        k = int(np.argmax(np.abs(data.cmd_deg - data.pos_deg)))
-        raise CalibrationError(
-            f"the knob lags the command by {error:.1f} deg at t={data.t_s[k]:.2f} s "
-            f"(> {opts.max_tracking_error_deg:g} deg): motor stalled or too slow")
-
-
-def check_signal(data: Conditioned, halves: Sequence[HalfCycle], opts: IdentifyOptions) -> None:
-    """No half-cycle shows a load: tell a missing current signal from a catheter that never
-    leaves its dead zone. A working sensor still shows the drive's friction, which flips with
-    the direction of motion; a disconnected one reads noise that does not."""
-    if any(h.snr >= opts.min_snr for h in halves):
-        return
-    signed = np.concatenate([h.direction * data.current_filtered_A[h.start:h.stop]
-                             for h in halves])
-    friction = float(np.median(signed))
-    noise = max(data.filtered_noise_A, 1e-12)
-    best = max((h.snr for h in halves if math.isfinite(h.snr)), default=math.nan)
-    if abs(friction) < opts.min_snr * noise:
-        raise CalibrationError(
-            f"no current signal: the current does not follow the motion (direction-dependent "
-            f"part {friction * 1e3:.1f} mA, noise {noise * 1e3:.1f} mA); check the drive's "
-            "current feedback")
-    raise CalibrationError(
-        f"the sweep never leaves the dead zone: the current shows the drive's friction "
-        f"({friction * 1e3:.1f} mA) but no load in any half-cycle (best rise {best:.1f} x "
-        f"noise < {opts.min_snr:g}); tendon broken or slack beyond the travel")
-
-
 def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
                    pos_deg: NDArray[np.floating], current_A: NDArray[np.floating],
                    options: IdentifyOptions | None = None,
@@ -476,7 +443,8 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
         raise CalibrationError("the current is constant: no current feedback from the drive")
     # On the raw readings: spike removal and the low-pass would hide a stuck or clipped sensor.
     check_sensor(np.asarray(t_s, float), np.asarray(pos_deg, float), raw)
-    check_following(data, opts)
+    check_following(data, opts.min_reversal_deg, opts.min_follow_ratio,
+                    opts.max_tracking_error_deg)
     stretches = split_half_cycles(data.cmd_deg, opts.min_reversal_deg)
     if sweep_start_s is not None:
         # The protocol brings the knob to -A going down: the sweep's first stretch follows a
@@ -488,7 +456,7 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
         raise CalibrationError(
             f"the command never moves more than {opts.min_reversal_deg:g} deg: nothing to identify")
     halves = tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches)
-    check_signal(data, halves, opts)
+    check_signal(data, [(h.direction, h.start, h.stop, h.snr) for h in halves], opts.min_snr)
     check_slips([h.slip for h in halves if math.isfinite(h.edge_deg)])
     values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
     for h in halves:

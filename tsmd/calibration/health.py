@@ -29,7 +29,8 @@ class HealthLimits:
     stuck_min_travel_deg: float = 10.0
     """... while the knob travels this far: the sensor is stuck."""
     saturated_fraction: float = 0.02
-    """This share of the samples exactly at the largest (or smallest) reading: clipped."""
+    """This share of the samples exactly at one of the largest readings, in separate runs:
+    clipped."""
     slip_drop_fraction: float = 0.3
     """A loaded current falling by this share of its rise ..."""
     slip_drop_deg: float = 1.0
@@ -59,12 +60,18 @@ def check_sensor(t_s: FloatArray, pos_deg: FloatArray, current_A: FloatArray,
     cur, pos, t = current_A[ok], pos_deg[ok], t_s[ok]
     if cur.size < 3:
         return
-    for label, extreme in (("highest", float(cur.max())), ("lowest", float(cur.min()))):
-        share = float(np.mean(cur == extreme))
-        if share >= lim.saturated_fraction and float(np.ptp(cur)) > 0:
-            raise CalibrationError(
-                f"the current sensor is saturated: {share:.0%} of the readings sit exactly at "
-                f"its {label} value {extreme * 1e3:.1f} mA (clipped)")
+    # Clipped: one reading among the largest magnitudes recurs, in several separate runs (every
+    # stroke that loads past the limit); a stuck sensor repeats one value in one run instead.
+    values, counts = np.unique(cur, return_counts=True)
+    k = int(np.argmax(counts))
+    value, share = float(values[k]), float(counts[k]) / cur.size
+    at = np.concatenate([[False], cur == value, [False]]).astype(np.int8)
+    runs = int(np.sum(np.diff(at) == 1))
+    large = abs(value) >= float(np.quantile(np.abs(cur), 0.9))
+    if share >= lim.saturated_fraction and large and runs >= 2 and float(np.ptp(cur)) > 0:
+        raise CalibrationError(
+            f"the current sensor is saturated: {share:.0%} of the readings sit exactly at "
+            f"{value * 1e3:.1f} mA, in {runs} separate stretches (clipped)")
     start, length = _longest_equal_run(cur)
     stop = start + length - 1
     duration = float(t[stop] - t[start])
@@ -75,20 +82,21 @@ def check_sensor(t_s: FloatArray, pos_deg: FloatArray, current_A: FloatArray,
             f"to t={t[stop]:.1f} s while the knob moved {travel:.0f} deg")
 
 
-def find_slip(grid_deg: FloatArray, yg: FloatArray, edge_k: int, noise_A: float,
+def find_slip(grid_deg: FloatArray, yg: FloatArray, start_k: int, noise_A: float,
               limits: HealthLimits | None = None) -> str | None:
     """A loaded current that drops while the knob moves on (the knob slipped), described; None
     when the load only grows.
 
-    ``yg`` is the direction-signed filtered current on a uniform angle grid; past the dead-zone
-    edge ``edge_k`` a healthy catheter's load only grows with the travel. One such drop can be
-    a disturbance; :func:`check_slips` refuses a sweep where most loaded strokes show one.
+    ``yg`` is the direction-signed filtered current on a uniform angle grid; from ``start_k``
+    (the release after a reversal has settled) a healthy catheter's load only grows with the
+    travel. One such drop can be a disturbance; :func:`check_slips` refuses a sweep where most
+    loaded strokes show one.
     """
     lim = limits or HealthLimits()
-    if edge_k >= yg.size - 2:
+    if start_k >= yg.size - 2:
         return None
     step = float(grid_deg[1] - grid_deg[0])
-    loaded = yg[edge_k:]
+    loaded = yg[start_k:]
     rise = float(loaded.max() - loaded[0])
     if rise <= 0:
         return None
@@ -100,7 +108,7 @@ def find_slip(grid_deg: FloatArray, yg: FloatArray, edge_k: int, noise_A: float,
     drop = float(falls[k])
     if drop > lim.slip_drop_fraction * rise and drop > lim.slip_min_noise * noise_A:
         return (f"the loaded current drops by {drop * 1e3:.0f} mA within {lim.slip_drop_deg:g} "
-                f"deg at {grid_deg[edge_k + k]:.1f} deg while the knob moves on")
+                f"deg at {grid_deg[start_k + k]:.1f} deg while the knob moves on")
     return None
 
 

@@ -402,9 +402,10 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
                         "the dead-zone edge was not reached")
     else:
         edge_deg = float(direction * grid[edge_k])
-        slip = find_slip(grid[:end], yg[:end], edge_k, noise)
-        if slip:
-            slip = f"{where}: {slip}"
+    if snr >= opts.min_snr:
+        # From where the release has settled on: a slipping knob may hide the edge itself.
+        found = find_slip(grid[:end], yg[:end], max(plateau_run[0], settle), noise)
+        slip = f"{where}: {found}" if found else None
 
     def index_at(k: int | None) -> int | None:
         if k is None:
@@ -457,7 +458,7 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
             f"the command never moves more than {opts.min_reversal_deg:g} deg: nothing to identify")
     halves = tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches)
     check_signal(data, [(h.direction, h.start, h.stop, h.snr) for h in halves], opts.min_snr)
-    check_slips([h.slip for h in halves if math.isfinite(h.edge_deg)])
+    check_slips([h.slip for h in halves if h.snr >= opts.min_snr])
     values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
     for h in halves:
         if math.isfinite(h.backlash_deg):

@@ -404,8 +404,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         edge_deg = float(direction * grid[edge_k])
     if snr >= opts.min_snr:
         # From where the release has settled on: a slipping knob may hide the edge itself.
-        found = find_slip(grid[:end], yg[:end], max(plateau_run[0], settle), noise)
-        slip = f"{where}: {found}" if found else None
+        dropped = find_slip(grid[:end], yg[:end], max(plateau_run[0], settle), noise)
+        slip = f"{where}: {dropped}" if dropped else None
 
     def index_at(k: int | None) -> int | None:
         if k is None:

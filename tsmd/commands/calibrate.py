@@ -37,9 +37,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="tsmd config (default: /etc/tsmd/tsmd.yaml, or the sim default "
                              "with --sim)")
     parser.add_argument("--fast", action="store_true",
-                        help="the fast protocol (218 s: the other knob at -90/0/+90 only, sine at "
-                             "0.055 Hz) instead of the paper's (700 s: 7 grid points, 0.04 Hz); "
-                             "--sim and recordings only")
+                        help="the fast protocol (200 s: the other knob at -90/0/+90 only, sine at "
+                             "0.06 Hz, re-sweeps up to 233 s in all) instead of the paper's "
+                             "(700 s: 7 grid points, 0.04 Hz, re-sweeps up to 900 s); --sim "
+                             "and recordings only")
     parser.add_argument("--report", metavar="DIR",
                         help="write a calibration report (Markdown + PNG plots) into DIR")
     parser.add_argument("--from-recording", nargs="+", metavar="FILE",

@@ -29,8 +29,8 @@ from tsmd.calibration import (
     run_calibration,
 )
 from tsmd.calibration.identify import IdentifyOptions, SweepResult
+from tsmd.calibration.player import sweep_metadata
 from tsmd.calibration.protocol import sweep_run
-from tsmd.calibration.run import sweep_metadata
 from tsmd.calibration.signal import lowpass
 from tsmd.profile import ProfileStore, load_device_model
 from tsmd.recording import Recording, read_recording, write_recording
@@ -138,12 +138,11 @@ def test_a_stalled_motor_is_refused() -> None:
         _identify(rec)
 
 
-def test_a_sweep_that_never_leaves_the_dead_zone_gives_no_edge_and_says_why() -> None:
+def test_a_sweep_that_never_leaves_the_dead_zone_is_refused_saying_so() -> None:
     small = Sweep(0, 0.0, 12.0, 0.1, 1.5, "triangle")
     rec = _sweep(small)
-    result = _identify(rec)
-    assert result.values["dead_zone_pos_deg"] == ()
-    assert any("never leave the dead zone" in p for p in result.problems)
+    with pytest.raises(CalibrationError, match="never leaves the dead zone"):
+        _identify(rec)
 
 
 def test_constant_current_is_refused_as_no_feedback(sweep_rec: Recording) -> None:
@@ -210,6 +209,9 @@ def test_each_sweep_starts_at_minus_a_after_coming_down() -> None:
 
 # --- a whole calibration ----------------------------------------------------------------------
 
+# SMALL's quick 1.5-cycle sweeps give one half-cycle of B_pos per sweep: too uncertain for the
+# real gate (tests/test_calibration_resweep.py tests that); these tests are about the profile.
+LAX = QualityLimits(refuse_tip_error_deg=10.0)
 SMALL = Protocol("small", tuple(Sweep(k, o, 90.0, 0.1, 1.5, "triangle")
                                 for k in (0, 1) for o in (-30.0, 0.0, 30.0)))
 
@@ -220,8 +222,7 @@ def small_cal():
     runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
     seen: list[tuple[float, str]] = []
     cal = run_calibration(runner, "cat-1", device, protocol=SMALL,
-                          progress=lambda f, text: seen.append((f, text)),
-                          limits=QualityLimits(max_cycle_spread_deg=10.0))
+                          progress=lambda f, text: seen.append((f, text)), limits=LAX)
     return cal, runner, seen
 
 
@@ -248,8 +249,7 @@ def test_logged_sweeps_give_the_same_profile_offline(small_cal, tmp_path: Path) 
         files.append(tmp_path / f"sweep{i}.csv")
         write_recording(files[-1], point.recording)
     offline = calibrate_from_recordings([(str(f), read_recording(f)) for f in files], "cat-1",
-                                        load_device_model(DEVICE),
-                                        limits=QualityLimits(max_cycle_spread_deg=10.0))
+                                        load_device_model(DEVICE), limits=LAX)
     for live, off in zip(cal.profile.knobs, offline.profile.knobs, strict=True):
         np.testing.assert_allclose(off.grid_array(), live.grid_array(), atol=1e-9)
 
@@ -276,45 +276,6 @@ def test_a_cancelled_calibration_returns_the_knobs_to_zero_and_saves_nothing(
     assert np.allclose(runner.pos, 0.0, atol=0.5)
     assert np.allclose(runner.trajectories[-1][-1], 0.0)
     assert ProfileStore(tmp_path).list() == []
-
-
-def test_cycles_that_disagree_are_refused_with_the_spread() -> None:
-    from tsmd.calibration.assemble import check_quality
-    d = _identify(_sweep(SHORT_SWEEP)).values["dead_zone_pos_deg"][0]
-    report = check_quality(_with_cycles("dead_zone_pos_deg", d, d + 9.0))
-    with pytest.raises(CalibrationError, match=r"cycles disagree on dead_zone_pos_deg by 9\.0"):
-        report.raise_if_bad()
-
-
-def _with_cycles(name: str, first: float, second: float) -> list:
-    from tsmd.calibration.assemble import GridPoint
-    base = _identify(_sweep(SHORT_SWEEP))
-    values = dict(base.values)
-    values[name] = (first, second)
-    odd = SweepResult(base.data, base.half_cycles, values)
-    return [GridPoint(0, 0.0, odd), GridPoint(0, 30.0, base),
-            GridPoint(1, 0.0, base), GridPoint(1, 30.0, base)]
-
-
-def test_backlash_cycles_may_differ_by_their_measured_scatter() -> None:
-    from tsmd.calibration.assemble import check_quality
-    report = check_quality(_with_cycles("backlash_pos_deg", 24.0, 28.0))
-    assert not [p for p in report.problems if "backlash_pos_deg" in p]
-
-
-def test_backlash_cycles_further_apart_than_that_are_refused() -> None:
-    from tsmd.calibration.assemble import check_quality
-    report = check_quality(_with_cycles("backlash_pos_deg", 20.0, 26.5))
-    with pytest.raises(CalibrationError,
-                       match=r"cycles disagree on backlash_pos_deg by 6\.5 deg .*allowed 5\)"):
-        report.raise_if_bad()
-
-
-def test_dead_zone_cycles_keep_the_tighter_limit() -> None:
-    from tsmd.calibration.assemble import check_quality
-    report = check_quality(_with_cycles("dead_zone_pos_deg", 18.0, 22.0))
-    with pytest.raises(CalibrationError, match=r"dead_zone_pos_deg by 4\.0 deg .*allowed 3\)"):
-        report.raise_if_bad()
 
 
 def test_a_grid_without_the_zero_sweep_is_refused() -> None:
@@ -434,7 +395,7 @@ def test_a_routed_handle_makes_the_calibration_warn_that_its_backlash_is_implaus
 def test_the_nominal_straight_handle_shows_its_backlash_in_the_current() -> None:
     # The paper's class of handle: B from the current is the tip's within the 2 deg
     # (tip measured on the tracked tip by the benchmark's function) and passes the cross-check.
-    from tsmd.bench.calibration import tip_truth
+    from tsmd.bench.tip_truth import tip_truth
 
     report, ratios, points = _one_point_cross_check({})
     assert len(ratios) == 4
@@ -449,7 +410,7 @@ def test_the_nominal_straight_handle_shows_its_backlash_in_the_current() -> None
 def test_the_default_dead_zone_edge_is_where_the_tip_starts_to_move() -> None:
     # tsmd's default (knee) edge against the tracked tip, and the paper's rise edge beside it:
     # the current rises when the tendon engages, a few degrees before the tip moves.
-    from tsmd.bench.calibration import tip_truth
+    from tsmd.bench.tip_truth import tip_truth
     from tsmd.calibration.run import identify_recording
 
     _, _, points = _one_point_cross_check({})

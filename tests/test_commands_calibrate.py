@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -48,3 +49,19 @@ def test_tee_files_are_identified_and_the_profile_refused(
     assert "| phi1 sweep, phi2 at +0 deg | phi1 |" in captured.out
     assert code == 2 and "calibration refused" in captured.err
     assert not list(tmp_path.glob("*.yaml"))
+
+
+@pytest.mark.realdata
+@pytest.mark.skipif(not default_tee_dir().is_dir(), reason="no TEE data")
+def test_tee_files_get_a_report_of_what_they_give_and_lack(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    files = sorted(default_tee_dir().glob("motor1_current60__*.csv"))
+    code = main(["calibrate", "--catheter", "tee", "--device", DEVICE, "--profiles",
+                 str(tmp_path), "--from-recording", *map(str, files)])
+    out = capsys.readouterr().out
+    assert code == 2
+    # The three acquisitions of the same grid point are pooled: 3 half-cycles per value.
+    assert re.search(r"\| phi1, other \+0 \| -?\d+\.\d \+- \d+\.\d \(n=3\)", out)
+    assert "a profile needs >= 2 angles including 0" in out
+    assert "phi2: no sweep" in out
+    assert "no B_neg:" in out

@@ -130,3 +130,18 @@ class LockstepPlantRunner:
         order = (0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10)
         return Recording({name: data[:, j].copy() for name, j in zip(names, order, strict=True)},
                          {"source": "LockstepPlantRunner"})
+
+
+def sweep_recording(sweep: object, runner: LockstepPlantRunner | None = None,
+                    period_s: float = 0.004) -> Recording:
+    """One protocol sweep (with its move to -A) on the built-in plant, with its metadata."""
+    from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
+    from tsmd.calibration.player import sweep_metadata
+    from tsmd.calibration.protocol import Protocol, sweep_run
+
+    runner = runner or LockstepPlantRunner(make_tendon_sheath_plant(), period_s)
+    run = sweep_run(sweep, np.zeros(2), period_s,  # type: ignore[arg-type]
+                    Protocol("t", (sweep,)))  # type: ignore[arg-type]
+    rec = runner.run(run.t_s, run.q_deg)
+    rec.metadata.update(sweep_metadata(sweep, float(run.t_s[run.sweep_start])))  # type: ignore
+    return rec

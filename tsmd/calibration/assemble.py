@@ -15,6 +15,7 @@ from datetime import UTC, datetime
 import numpy as np
 
 from tsmd.calibration.errors import CalibrationError
+from tsmd.calibration.estimate import Estimate, EstimateOptions, point_estimates
 from tsmd.calibration.identify import PARAMETERS, SweepResult
 from tsmd.compensation.paper import height_from_reference
 from tsmd.profile import KNOB_NAMES, CatheterProfile, DeviceModel, KnobProfile
@@ -43,13 +44,11 @@ class GridPoint:
 class QualityLimits:
     """What a trustworthy calibration must show."""
 
-    max_cycle_spread_deg: float = 3.0
-    """Largest disagreement allowed between the cycles of one sweep, per dead-zone edge."""
-    max_backlash_cycle_spread_deg: float = 5.0
-    """The same for the backlash, whose end is a slanted join, not a corner: one half-cycle's B
-    scatters with a standard deviation of 1.2 deg on the simulator (knee edges: 0.5 deg), so two
-    cycles of a good sweep differ by more than 3 deg on about 2 % of sweeps and would refuse most
-    calibrations; 5 deg was never exceeded (84 sweeps, docs/calibration.md)."""
+    estimate: EstimateOptions = field(default_factory=EstimateOptions)
+    """Pooling of the half-cycles and the tip-error gate that triggers re-sweeps."""
+    refuse_tip_error_deg: float = 5.0
+    """After the re-sweep budget: a parameter whose 95 % uncertainty still costs more than this
+    on the tip is refused (between the gate and this it is accepted with a warning)."""
     max_backlash_deg: float = 60.0
     max_dead_zone_fraction: float = 0.8
     """A dead-zone edge beyond this fraction of the sweep amplitude is implausible."""
@@ -75,10 +74,17 @@ class QualityReport:
 
 
 def check_quality(points: Sequence[GridPoint], limits: QualityLimits | None = None,
-                  amplitude_deg: float = 90.0) -> QualityReport:
-    """Check every grid point; collect all problems (not just the first)."""
+                  amplitude_deg: float = 90.0,
+                  omegas: Sequence[float] = (1.0, 1.0)) -> QualityReport:
+    """Check every grid point; collect all problems (not just the first).
+
+    ``omegas``: the data sheet's tip/knob slope per knob, which turns a parameter's uncertainty
+    into what it costs on the tip.
+    """
     lim = limits or QualityLimits()
     report = QualityReport()
+    estimates = point_estimates([p.result for p in points], lim.estimate)
+    by_point = {id(p): e for p, e in zip(points, estimates, strict=True)}
     for knob in (0, 1):
         mine = [p for p in points if p.knob == knob]
         label = KNOB_LABELS[knob]
@@ -95,11 +101,15 @@ def check_quality(points: Sequence[GridPoint], limits: QualityLimits | None = No
                 f"{label}: no sweep with the other knob at 0 deg (design assumption 1 needs it)")
         spreads: list[float] = []
         snrs: list[float] = []
+        costs: list[float] = []
         for p in mine:
             _check_point(p, lim, amplitude_deg, report.problems, spreads)
+            costs += _check_uncertainty(p, by_point[id(p)], omegas[knob], lim, report)
             if math.isfinite(p.result.snr):
                 snrs.append(p.result.snr)
         report.figures[f"{label}_max_cycle_spread_deg"] = max(spreads) if spreads else 0.0
+        report.figures[f"{label}_max_tip_uncertainty_deg"] = max(costs) if costs else 0.0
+        report.figures[f"{label}_resweeps"] = float(sum(p.result.resweeps for p in mine))
         report.figures[f"{label}_min_snr"] = min(snrs) if snrs else 0.0
         report.figures[f"{label}_sweeps"] = float(len(mine))
     return report
@@ -115,14 +125,7 @@ def _check_point(p: GridPoint, lim: QualityLimits, amplitude_deg: float, problem
             problems.append(f"{p.name}: no {name} ({why})")
             continue
         if len(values) > 1:
-            spread = r.spread(name)
-            spreads.append(spread)
-            allowed = (lim.max_backlash_cycle_spread_deg if name.startswith("backlash")
-                       else lim.max_cycle_spread_deg)
-            if spread > allowed:
-                problems.append(f"{p.name}: cycles disagree on {name} by {spread:.1f} deg "
-                                f"(values {', '.join(f'{v:.1f}' for v in values)}; "
-                                f"allowed {allowed:g})")
+            spreads.append(r.spread(name))
     d_pos, d_neg = r.estimate("dead_zone_pos_deg"), r.estimate("dead_zone_neg_deg")
     b_pos, b_neg = r.estimate("backlash_pos_deg"), r.estimate("backlash_neg_deg")
     edge_max = lim.max_dead_zone_fraction * amplitude_deg
@@ -133,9 +136,31 @@ def _check_point(p: GridPoint, lim: QualityLimits, amplitude_deg: float, problem
     for name, b in (("backlash_pos_deg", b_pos), ("backlash_neg_deg", b_neg)):
         if math.isfinite(b) and not 0.0 <= b <= lim.max_backlash_deg:
             problems.append(f"{p.name}: {name} {b:.1f} outside [0, {lim.max_backlash_deg:g}]")
-    snr = r.snr
+    snr = r.median_snr
     if math.isfinite(snr) and snr < lim.min_snr:
         problems.append(f"{p.name}: current signal too weak (SNR {snr:.1f} < {lim.min_snr:g})")
+
+
+def _check_uncertainty(p: GridPoint, estimates: dict[str, Estimate], omega: float,
+                       lim: QualityLimits, report: QualityReport) -> list[float]:
+    """The gate after the re-sweeps: warn above the tip-error target, refuse far above it."""
+    costs = []
+    for name, e in estimates.items():
+        if e.n == 0:
+            continue  # named by _check_point with the half-cycles' reasons
+        cost = e.tip_cost_deg(omega)
+        values = ", ".join(f"{v:.1f}" for v in p.result.values.get(name, ()))
+        what = (f"{p.name}: {name} {e.value:.1f} +- {e.u95_deg:.1f} deg (95 %, {e.n} "
+                f"half-cycles: {values}; {p.result.resweeps} re-sweeps) costs up to "
+                f"{cost:.1f} deg on the tip")
+        if not math.isfinite(cost):
+            continue
+        costs.append(cost)
+        if cost > lim.refuse_tip_error_deg:
+            report.problems.append(f"{what} (> {lim.refuse_tip_error_deg:g} allowed)")
+        elif cost > lim.estimate.max_tip_error_deg:
+            report.warnings.append(f"{what} (target {lim.estimate.max_tip_error_deg:g})")
+    return costs
 
 
 BACKLASH_DATASHEET_MIN_RATIO = 0.8

@@ -29,10 +29,19 @@ from numpy.typing import NDArray
 from scipy.signal import find_peaks
 
 from tsmd.calibration.errors import CalibrationError
-from tsmd.calibration.signal import Conditioned, FloatArray, condition, robust_sigma
+from tsmd.calibration.health import (
+    check_following,
+    check_sensor,
+    check_signal,
+    check_slips,
+    find_slip,
+)
+from tsmd.calibration.signal import Conditioned, FloatArray, condition
 
 PARAMETERS: tuple[str, ...] = (
     "dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_pos_deg", "backlash_neg_deg")
+SHORT = {"dead_zone_pos_deg": "D_pos", "dead_zone_neg_deg": "D_neg",
+         "backlash_pos_deg": "B_pos", "backlash_neg_deg": "B_neg"}
 
 
 @dataclass(frozen=True)
@@ -93,6 +102,8 @@ class HalfCycle:
     rise_A: float = math.nan
     snr: float = math.nan
     problems: tuple[str, ...] = ()
+    slip: str | None = None
+    """Where the loaded current dropped while the knob moved on, if it did."""
 
     @property
     def backlash_name(self) -> str:
@@ -111,6 +122,8 @@ class SweepResult:
     half_cycles: tuple[HalfCycle, ...]
     values: dict[str, tuple[float, ...]] = field(default_factory=dict)
     """Each parameter's value from every half-cycle that gave one, in time order."""
+    resweeps: int = 0
+    """How many re-sweeps were pooled into this result."""
 
     def estimate(self, name: str) -> float:
         """Median over the half-cycles (NaN when none gave a value)."""
@@ -122,10 +135,23 @@ class SweepResult:
         v = self.values.get(name, ())
         return float(np.ptp(v)) if v else math.nan
 
+    def merged(self, other: SweepResult) -> SweepResult:
+        """This sweep's half-cycles pooled with a re-sweep's (the first sweep's signals kept)."""
+        values = {name: self.values.get(name, ()) + other.values.get(name, ())
+                  for name in PARAMETERS}
+        return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
+                           self.resweeps + 1)
+
     @property
     def snr(self) -> float:
         values = [h.snr for h in self.half_cycles if math.isfinite(h.snr)]
         return float(min(values)) if values else math.nan
+
+    @property
+    def median_snr(self) -> float:
+        """The typical half-cycle's signal (one weak half-cycle gives no value, not a verdict)."""
+        values = [h.snr for h in self.half_cycles if math.isfinite(h.snr)]
+        return float(np.median(values)) if values else math.nan
 
     @property
     def problems(self) -> tuple[str, ...]:
@@ -366,6 +392,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     rise = float(np.median(yg[max(end - min_size, plateau_run[0]):end]) - plateau)
     snr = rise / noise
     edge_deg = math.nan
+    slip: str | None = None
     if snr < opts.min_snr:
         problems.append(
             f"{where}: no current rise out of the dead zone (rise {rise * 1e3:.1f} mA = "
@@ -375,6 +402,10 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
                         "the dead-zone edge was not reached")
     else:
         edge_deg = float(direction * grid[edge_k])
+    if snr >= opts.min_snr:
+        # From where the release has settled on: a slipping knob may hide the edge itself.
+        dropped = find_slip(grid[:end], yg[:end], max(plateau_run[0], settle), noise)
+        slip = f"{where}: {dropped}" if dropped else None
 
     def index_at(k: int | None) -> int | None:
         if k is None:
@@ -390,23 +421,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         else None,
         edge_index=index_at(edge_k) if math.isfinite(edge_deg) else None,
         backlash_deg=backlash_deg, edge_deg=edge_deg, plateau_A=direction * plateau,
-        rise_A=rise, snr=snr, problems=tuple(problems))
-
-
-def check_following(data: Conditioned, opts: IdentifyOptions) -> None:
-    """A stalled or lagging knob makes the current meaningless: refuse it, saying how much."""
-    commanded = float(np.ptp(data.cmd_deg))
-    actual = float(np.ptp(data.pos_deg))
-    if commanded > opts.min_reversal_deg and actual < opts.min_follow_ratio * commanded:
-        raise CalibrationError(
-            f"the knob did not follow the command (moved {actual:.1f} deg of {commanded:.1f} "
-            f"deg commanded): motor stalled or blocked")
-    error = float(np.max(np.abs(data.cmd_deg - data.pos_deg)))
-    if error > opts.max_tracking_error_deg:
-        k = int(np.argmax(np.abs(data.cmd_deg - data.pos_deg)))
-        raise CalibrationError(
-            f"the knob lags the command by {error:.1f} deg at t={data.t_s[k]:.2f} s "
-            f"(> {opts.max_tracking_error_deg:g} deg): motor stalled or too slow")
+        rise_A=rise, snr=snr, problems=tuple(problems), slip=slip)
 
 
 def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
@@ -420,13 +435,17 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
     half-cycle is, and the first one (not after a reversal) gives only a dead-zone edge.
     """
     opts = options or IdentifyOptions()
+    raw = np.asarray(current_A, float)
     data = condition(np.asarray(t_s, float), np.asarray(cmd_deg, float),
-                     np.asarray(pos_deg, float), np.asarray(current_A, float),
+                     np.asarray(pos_deg, float), raw,
                      cutoff_hz=opts.cutoff_hz, order=opts.filter_order,
                      max_gap_s=opts.max_gap_s)
-    check_following(data, opts)
-    if robust_sigma(data.current_A) == 0 and np.ptp(data.current_A) == 0:
+    if np.isfinite(raw).any() and np.nanmax(raw) == np.nanmin(raw):
         raise CalibrationError("the current is constant: no current feedback from the drive")
+    # On the raw readings: spike removal and the low-pass would hide a stuck or clipped sensor.
+    check_sensor(np.asarray(t_s, float), np.asarray(pos_deg, float), raw)
+    check_following(data, opts.min_reversal_deg, opts.min_follow_ratio,
+                    opts.max_tracking_error_deg)
     stretches = split_half_cycles(data.cmd_deg, opts.min_reversal_deg)
     if sweep_start_s is not None:
         # The protocol brings the knob to -A going down: the sweep's first stretch follows a
@@ -438,6 +457,8 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
         raise CalibrationError(
             f"the command never moves more than {opts.min_reversal_deg:g} deg: nothing to identify")
     halves = tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches)
+    check_signal(data, [(h.direction, h.start, h.stop, h.snr) for h in halves], opts.min_snr)
+    check_slips([h.slip for h in halves if h.snr >= opts.min_snr])
     values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
     for h in halves:
         if math.isfinite(h.backlash_deg):

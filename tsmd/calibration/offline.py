@@ -7,13 +7,14 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+
 from tsmd.calibration.assemble import GridPoint
-from tsmd.calibration.identify import PARAMETERS
+from tsmd.calibration.identify import PARAMETERS, SHORT
+from tsmd.calibration.protocol import GRID_DEG
+from tsmd.calibration.resweep import point_estimates, uncertainty_table
 from tsmd.recording import Recording, RecordingError, read_recording
 from tsmd.tee import DEFAULT_STEPS_PER_KNOB_DEG, load_tee_acquisition
-
-SHORT = {"dead_zone_pos_deg": "D_pos", "dead_zone_neg_deg": "D_neg",
-         "backlash_pos_deg": "B_pos", "backlash_neg_deg": "B_neg"}
 
 
 def is_tee_acquisition(path: str | os.PathLike[str]) -> bool:
@@ -50,4 +51,43 @@ def identification_table(points: Sequence[GridPoint]) -> str:
         snr = p.result.snr
         cells.append(f"{snr:.0f}" if math.isfinite(snr) else "-")
         lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def data_report(points: Sequence[GridPoint], failures: Sequence[tuple[str, str]],
+                refusal: str | None) -> str:
+    """What logged sweeps give (estimates with their 95 % uncertainty) and what they lack for a
+    profile, against the paper's protocol: for a refused calibration from recordings."""
+    lines = ["## What the data give (median of the half-cycles +- 95 % uncertainty)", ""]
+    lines.append(uncertainty_table(points) if points else "(nothing: no file could be used)")
+    lines += ["", "## What they lack for a profile", ""]
+    for source, reason in failures:
+        lines.append(f"- {Path(source).name}: nothing could be estimated: {reason}")
+    for knob, label in ((0, "phi1"), (1, "phi2")):
+        mine = [p for p in points if p.knob == knob]
+        angles = sorted(p.other_deg for p in mine)
+        if len(angles) < len(GRID_DEG):
+            lines.append(
+                f"- {label}: sweeps at the other knob's {', '.join(f'{a:+.0f}' for a in angles)}"
+                f" deg ({len(angles)}); a profile needs >= 2 angles including 0, the paper's "
+                f"protocol sweeps {len(GRID_DEG)} ({', '.join(f'{a:+.0f}' for a in GRID_DEG)})"
+                if angles else f"- {label}: no sweep")
+    for p, est in zip(points, point_estimates(points), strict=True):
+        d = p.result.data
+        amplitude = 0.5 * float(np.ptp(d.cmd_deg))
+        passes = len(p.result.half_cycles)
+        takes = p.result.resweeps + 1
+        lines.append(
+            f"- {p.name}: {passes} passes over +-{amplitude:.0f} deg in {takes} acquisition(s) "
+            f"of {d.t_s[-1] - d.t_s[0]:.0f} s (the paper: 4 passes over +-90 deg at 0.04 Hz, "
+            f"50 s, at each of 7 grid points); median SNR "
+            f"{p.result.median_snr:.1f} (4 needed for an edge)")
+        for name, e in est.items():
+            if e.n == 0:
+                why = "; ".join(sorted({q.split(": ", 1)[-1] for q in p.result.problems}))
+                lines.append(f"  - no {SHORT[name]}: {why or 'no half-cycle gave it'}")
+            elif e.n == 1:
+                lines.append(f"  - {SHORT[name]} from one half-cycle only: no scatter of its own")
+    if refusal:
+        lines += ["", "## Refused because", "", refusal]
     return "\n".join(lines)

@@ -8,6 +8,7 @@ and the knob is sent there by a smooth move; repositioning moves are not counted
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -79,6 +80,19 @@ class Protocol:
     sweeps: tuple[Sweep, ...]
     move_speed_deg_s: float = 45.0
     settle_s: float = 0.5
+    resweep_cycles: float = 2.0
+    """Cycles of a re-sweep of a grid point whose estimates are too uncertain."""
+    resweep_budget_s: float = 0.0
+    """Extra sweeping allowed for re-sweeps, in seconds (0: none)."""
+
+    def resweep(self, sweep: Sweep) -> Sweep:
+        """The sweep that measures ``sweep``'s grid point again."""
+        return dataclasses.replace(sweep, cycles=self.resweep_cycles)
+
+    @property
+    def max_sweep_time_s(self) -> float:
+        """Sweeping including the whole re-sweep budget: the protocol's worst case."""
+        return self.sweep_time_s + self.resweep_budget_s
 
     @property
     def sweep_time_s(self) -> float:
@@ -111,18 +125,22 @@ def paper_protocol(grid_deg: tuple[float, ...] = GRID_DEG,
     """The published protocol: sine, 0.04 Hz, two cycles, each knob at each grid point."""
     sweeps = tuple(Sweep(knob, other, amplitude_deg, 0.04, 2.0, "sine")
                    for knob in (0, 1) for other in grid_deg)
-    return Protocol("paper", sweeps)
+    # Re-sweeps (beyond the paper): up to four grid points measured again, two cycles each.
+    return Protocol("paper", sweeps, resweep_cycles=2.0, resweep_budget_s=200.0)
 
 
 FAST_GRID_DEG: tuple[float, ...] = (-90.0, 0.0, 90.0)
+FAST_MAX_SWEEP_S = 700.0 / 3.0
+"""The fast protocol's sweeping, re-sweeps included, stays within a third of the paper's."""
 
 
 def fast_protocol(grid_deg: tuple[float, ...] = FAST_GRID_DEG, amplitude_deg: float = 90.0,
-                  frequency_hz: float = 0.055, cycles: float = 2.0) -> Protocol:
-    """Beyond the paper: fewer sweeps, a little faster: the paper's sine at 0.055 Hz (1.4x),
-    two cycles, with the other knob at -90, 0 and +90 deg only (6 sweeps, 218 s of sweeping,
-    31 % of the paper's 700 s); the profile interpolates D and B over the other knob's angle
-    between them as it does between the paper's seven.
+                  frequency_hz: float = 0.06, cycles: float = 2.0) -> Protocol:
+    """Beyond the paper: fewer sweeps, a little faster: the paper's sine at 0.06 Hz (1.5x),
+    two cycles, with the other knob at -90, 0 and +90 deg only (6 sweeps, 200 s of sweeping);
+    re-sweeps of one cycle fill the rest of a third of the paper's 700 s (two of them). The
+    profile interpolates D and B over the other knob's angle between the three grid points as
+    it does between the paper's seven.
 
     Why not simply faster sweeps: the backlash end is a slanted join of the current to its
     release level, read over the 25-30 deg after each reversal; the faster the knob speeds up
@@ -133,7 +151,9 @@ def fast_protocol(grid_deg: tuple[float, ...] = FAST_GRID_DEG, amplitude_deg: fl
     """
     sweeps = tuple(Sweep(knob, other, amplitude_deg, frequency_hz, cycles, "sine")
                    for knob in (0, 1) for other in grid_deg)
-    return Protocol("fast", sweeps)
+    sweeping = sum(s.duration_s for s in sweeps)
+    return Protocol("fast", sweeps, resweep_cycles=1.0,
+                    resweep_budget_s=max(0.0, FAST_MAX_SWEEP_S - sweeping))
 
 
 PROTOCOLS = {"paper": paper_protocol, "fast": fast_protocol}

@@ -15,34 +15,37 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tsmd.calibration.assemble import KNOB_LABELS, GridPoint, knob_grid
-from tsmd.calibration.identify import PARAMETERS
-from tsmd.calibration.offline import SHORT, identification_table
+from tsmd.calibration.identify import PARAMETERS, SHORT
+from tsmd.calibration.offline import identification_table
+from tsmd.calibration.resweep import point_estimates
 
 if TYPE_CHECKING:
     from tsmd.calibration.run import Calibration
 
 
 def grid_table(cal: Calibration) -> str:
-    """D and B per knob and grid point, with the cycle spread, as Markdown."""
+    """D and B per knob and grid point with their 95 % uncertainty, as Markdown."""
+    estimates = dict(zip((id(p) for p in cal.points), point_estimates(cal.points), strict=True))
     lines = []
     for knob in (0, 1):
-        grid, values = knob_grid(cal.points, knob)
+        grid, _ = knob_grid(cal.points, knob)
         if not grid:
             continue
         kp = cal.profile.knobs[knob]
         lines.append(f"{KNOB_LABELS[knob]}: H_pos {kp.height_pos_deg:.1f} deg, "
                      f"H_neg {kp.height_neg_deg:.1f} deg, omega {kp.omega:g}")
-        head = [f"{KNOB_LABELS[1 - knob]} (deg)", *(SHORT[p] for p in PARAMETERS),
-                "max cycle spread", "SNR"]
+        head = [f"{KNOB_LABELS[1 - knob]} (deg)", *(f"{SHORT[p]} +- 95 %" for p in PARAMETERS),
+                "re-sweeps", "SNR"]
         lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        for i, other in enumerate(grid):
+        for other in grid:
             point = next(p for p in cal.points if p.knob == knob and p.other_deg == other)
-            spread = max((point.result.spread(n) for n in PARAMETERS
-                          if len(point.result.values.get(n, ())) > 1), default=0.0)
-            cells = [f"{other:+.0f}", *(f"{values[n][i]:.1f}" for n in PARAMETERS),
-                     f"{spread:.1f}", f"{point.result.snr:.0f}"]
+            est = estimates[id(point)]
+            cells = [f"{other:+.0f}", *(f"{est[n].value:.1f} +- {est[n].u95_deg:.1f}"
+                                         for n in PARAMETERS),
+                     str(point.result.resweeps), f"{point.result.median_snr:.0f}"]
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
+    lines += [f"- {note}" for note in cal.notes]
     return "\n".join(lines)
 
 

@@ -14,12 +14,11 @@ import multiprocessing
 import os
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
 from tsmd import __version__
 from tsmd.calibration.assemble import (
@@ -36,19 +35,21 @@ from tsmd.calibration.errors import (
     CalibrationError,
     CalibrationRefusedError,
 )
+from tsmd.calibration.estimate import EstimateOptions
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
 from tsmd.calibration.ours_fit import fit_ours_for_knob
+from tsmd.calibration.player import (
+    Player,
+    Progress,
+    ProgressCallback,
+)
 from tsmd.calibration.protocol import Protocol as SweepProtocol
-from tsmd.calibration.protocol import Sweep, paper_protocol, return_to_zero, sweep_run
+from tsmd.calibration.protocol import paper_protocol, sweep_run
+from tsmd.calibration.resweep import pool_repeats, pooled, uncertain_points
 from tsmd.calibration.tension_play_fit import with_tension_play
-from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
 from tsmd.trajectory import TrajectoryRunner
-
-ProgressCallback = Callable[[float, str], None]
-"""Called with the overall fraction done (0..1) and a line such as
-``"sweep 3/14: phi1 sweep, phi2 at -30 deg; 412 s left"``."""
 
 
 @dataclass
@@ -65,19 +66,6 @@ class Calibration:
     """All knob motion including moves between sweeps."""
     wall_time_s: float = 0.0
     notes: list[str] = field(default_factory=list)
-
-
-def sweep_metadata(sweep: Sweep, sweep_start_s: float) -> dict[str, str]:
-    """The keys a sweep recording carries so that it can be identified offline."""
-    return {
-        "calibration_knob": KNOB_LABELS[sweep.knob],
-        "calibration_other_deg": repr(float(sweep.other_deg)),
-        "calibration_sweep_start_s": repr(float(sweep_start_s)),
-        "calibration_amplitude_deg": repr(float(sweep.amplitude_deg)),
-        "calibration_waveform": sweep.waveform,
-        "calibration_frequency_hz": repr(float(sweep.frequency_hz)),
-        "calibration_cycles": repr(float(sweep.cycles)),
-    }
 
 
 def _meta_float(rec: Recording, key: str) -> float | None:
@@ -137,7 +125,8 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
            source: str = "calibration from motor current") -> tuple[CatheterProfile,
                                                                    QualityReport]:
     """Quality checks, our compensator's fit and the profile (CalibrationError if refused)."""
-    report = check_quality(points, limits, amplitude_deg)
+    report = check_quality(points, limits, amplitude_deg,
+                           omegas=tuple(k.omega for k in device.knobs))
     # Before refusing: a backlash far below the data sheet's often explains cycles that disagree.
     cross_check_device(points, device, report)
     try:
@@ -160,48 +149,17 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
     return profile, report
 
 
-class _Progress:
-    """Turns per-run fractions into overall progress with a time-left estimate."""
-
-    def __init__(self, callback: ProgressCallback | None, durations_s: Sequence[float]) -> None:
-        self.callback = callback
-        self.durations = list(durations_s)
-        self.total = float(sum(self.durations)) or 1.0
-        self.started = time.monotonic()
-        self.index = 0
-        self.label = ""
-        self.fraction = 0.0
-
-    def begin(self, index: int, label: str) -> None:
-        self.index = index
-        self.label = label
-        self.report(0.0)
-
-    def overall(self, fraction: float) -> float:
-        done = sum(self.durations[:self.index]) + fraction * self.durations[self.index]
-        return min(1.0, done / self.total)
-
-    def report(self, fraction: float, phase: str = "") -> None:
-        self.fraction = fraction
-        if self.callback is None:
-            return
-        overall = self.overall(fraction)
-        elapsed = time.monotonic() - self.started
-        text = f"sweep {self.index + 1}/{len(self.durations)}: {self.label}"
-        if phase:
-            text += f" ({phase})"
-        if overall > 1e-3:
-            text += f"; {elapsed * (1.0 - overall) / overall:.0f} s left"
-        self.callback(overall, text)
-
-
 @dataclass
 class SweepRuns:
-    """Every sweep of a protocol, run and identified (no quality check yet)."""
+    """Every sweep of a protocol, run and identified, re-sweeps pooled (no quality check yet)."""
 
     points: list[GridPoint]
     motion_time_s: float
     wall_time_s: float
+    resweep_time_s: float = 0.0
+    """Extra sweeping spent on re-sweeps (within the protocol's budget)."""
+    resweeps: list[str] = field(default_factory=list)
+    """One line per re-sweep: which grid point and why."""
 
 
 def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *,
@@ -210,7 +168,8 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
                     cancel: threading.Event | None = None,
                     options: IdentifyOptions | None = None,
                     limits: QualityLimits | None = None, isolate: bool = False) -> Calibration:
-    """Run every sweep, identify each as it ends, return the knobs to 0, build the profile.
+    """Run every sweep, identify each as it ends, sweep uncertain grid points again, return the
+    knobs to 0, build the profile.
 
     Any failure or a cancel sends the knobs back to 0 first; then CalibrationError (or
     CalibrationCancelledError) is raised and nothing is returned to be saved.
@@ -218,18 +177,27 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
     proto = protocol or paper_protocol()
     proto.validate(tuple((k.limits.min_deg, k.limits.max_deg)  # type: ignore[arg-type]
                          for k in device.knobs))
+    omegas = tuple(k.omega for k in device.knobs)
     runs = run_sweeps(runner, proto, progress=progress, cancel=cancel, options=options,
-                      isolate=isolate)
+                      isolate=isolate, omegas=omegas,
+                      estimate=(limits or QualityLimits()).estimate)
     profile, report = finish(catheter_id, device, runs.points, limits=limits,
                              amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
-    return Calibration(profile, runs.points, report, proto.name, proto.sweep_time_s,
-                       runs.motion_time_s, runs.wall_time_s)
+    calibration = Calibration(profile, runs.points, report, proto.name,
+                              proto.sweep_time_s + runs.resweep_time_s, runs.motion_time_s,
+                              runs.wall_time_s)
+    calibration.notes.extend(runs.resweeps)
+    return calibration
 
 
 def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
                progress: ProgressCallback | None = None, cancel: threading.Event | None = None,
-               options: IdentifyOptions | None = None, isolate: bool = False) -> SweepRuns:
-    """Run and identify each sweep in turn; the knobs end at 0 whatever happens.
+               options: IdentifyOptions | None = None, isolate: bool = False,
+               omegas: Sequence[float] | None = None,
+               estimate: EstimateOptions | None = None) -> SweepRuns:
+    """Run and identify each sweep in turn, then re-sweep uncertain grid points within the
+    protocol's budget (``omegas`` given: the data sheet's slopes for the tip-error gate); the
+    knobs end at 0 whatever happens.
 
     ``isolate``: identify in a separate process, overlapped with the next sweep. The
     change-point search is pure Python and holds the GIL; in the daemon's process it delays a
@@ -238,68 +206,54 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
     period_s = runner.period_s  # sweeps are planned at the loop's own tick
     wall0 = time.monotonic()
     identifier = _Identifier(options, isolate)
-    q_now = np.zeros(2)
-    runs_durations = []
+    player = Player(runner, proto, period_s, cancel)
     plan = []
+    q_now = np.zeros(2)
     for sweep in proto.sweeps:
         run = sweep_run(sweep, q_now, period_s, proto)
         plan.append(run)
-        runs_durations.append(len(run.q_deg) * period_s)
         q_now = run.q_deg[-1].copy()
-    tracker = _Progress(progress, runs_durations)
-    points: list[GridPoint] = []
-    motion_s = 0.0
-    q_last = np.zeros(2)
+    tracker = Progress(progress, [len(r.q_deg) * period_s for r in plan])
+    resweep_s = 0.0
+    notes: list[str] = []
     try:
         for i, planned in enumerate(plan):
-            if cancel is not None and cancel.is_set():
-                raise CalibrationCancelledError(f"cancelled before sweep {i + 1} of {len(plan)}")
-            # Re-plan from where the knobs really are.
-            run = sweep_run(planned.sweep, q_last, period_s, proto) if i else planned
-            tracker.begin(i, run.sweep.label)
-            try:
-                rec = runner.run(run.t_s, run.q_deg, False, cancel, tracker.report)
-            except TsmdError as exc:
-                q_last = _where_now(runner, run.q_deg, tracker.fraction)
-                if cancel is not None and cancel.is_set():
-                    raise CalibrationCancelledError(
-                        f"cancelled during sweep {i + 1} of {len(plan)} ({run.sweep.label})"
-                    ) from None
-                raise CalibrationError(f"{run.sweep.label}: {exc}") from None
-            motion_s += len(rec) * period_s
-            q_last = _last_command(rec, run.q_deg)
-            if cancel is not None and cancel.is_set():
-                raise CalibrationCancelledError(
-                    f"cancelled during sweep {i + 1} of {len(plan)} ({run.sweep.label})")
-            if len(rec) < len(run.q_deg):
-                raise CalibrationError(f"{run.sweep.label}: the runner stopped after "
-                                       f"{len(rec)} of {len(run.q_deg)} ticks")
-            t0 = float(rec["t"][0]) - float(run.t_s[0])
-            rec.metadata.update(sweep_metadata(run.sweep, t0 + float(run.t_s[run.sweep_start])))
-            tracker.report(1.0, "identifying")
-            identifier.submit(rec, run.sweep.label)
+            tracker.begin(i, planned.sweep.label)
+            rec = player.play(planned.sweep, f"sweep {i + 1} of {len(plan)}", tracker,
+                              planned if i == 0 else None)
+            identifier.submit(rec, planned.sweep.label)
             identifier.check()  # a sweep that cannot be identified stops the protocol early
-        motion_s += _return_to_zero(runner, q_last, period_s)
         points = identifier.results()
+        while omegas is not None:
+            todo = uncertain_points(points, omegas, estimate)
+            if not todo:
+                break
+            again = proto.resweep(plan[todo[0].index].sweep)
+            if resweep_s + again.duration_s > proto.resweep_budget_s + 1e-6:
+                break
+            why = todo[0].describe(points)
+            notes.append(f"re-sweep {len(notes) + 1}: {why}; {again.cycles:g} more cycles")
+            run = sweep_run(again, player.q_last, period_s, proto)
+            tracker.begin(tracker.add(len(run.q_deg) * period_s), f"{again.label} ({why})")
+            rec = player.play(again, f"re-sweep {len(notes)}", tracker, run)
+            point = points[todo[0].index]
+            points[todo[0].index] = pooled(point, identifier.identify(rec, again.label))
+            resweep_s += again.duration_s
+        player.return_to_zero()
     except BaseException as exc:
         identifier.close()
-        if not isinstance(exc, _AfterReturnError):
-            motion_s += _return_to_zero(runner, q_last, period_s)
+        player.return_to_zero()
         if isinstance(exc, CalibrationCancelledError):
             raise CalibrationCancelledError(f"{exc}; knobs returned to 0, nothing saved") from None
         raise
     identifier.close()
-    return SweepRuns(points, motion_s, time.monotonic() - wall0)
+    return SweepRuns(points, player.motion_s, time.monotonic() - wall0, resweep_s, notes)
 
 
 def _lower_priority() -> None:
     """Worker initializer: run identification at a lower CPU priority than the daemon."""
     with contextlib.suppress(OSError):
         os.nice(10)
-
-
-class _AfterReturnError(CalibrationError):
-    """Marker: raised after the knobs are already back at 0."""
 
 
 class _Identifier:
@@ -324,16 +278,19 @@ class _Identifier:
         else:
             self.pending.append(self.pool.submit(identify_recording, rec, self.options, label))
 
+    def identify(self, rec: Recording, label: str) -> GridPoint:
+        """One sweep now (a re-sweep), in the worker process when isolating."""
+        if self.pool is None:
+            return identify_recording(rec, self.options, label)
+        return self.pool.submit(identify_recording, rec, self.options, label).result()
+
     def check(self) -> None:
         for future in self.pending:
             if future.done() and future.exception() is not None:
                 raise future.exception()  # type: ignore[misc]
 
     def results(self) -> list[GridPoint]:
-        try:
-            return self.points + [f.result() for f in self.pending]
-        except CalibrationError as exc:
-            raise _AfterReturnError(str(exc)) from None
+        return self.points + [f.result() for f in self.pending]
 
     def close(self) -> None:
         if self.pool is not None:
@@ -368,37 +325,10 @@ def calibration_from_points(points: list[GridPoint], catheter_id: str, device: D
     """Quality checks and profile from sweeps already identified (logged or just run)."""
     if not points:
         raise CalibrationError("no sweeps given")
+    points = pool_repeats(points)
     amplitude = max(float(np.nanmax(np.abs(p.result.data.cmd_deg))) for p in points)
     profile, report = finish(catheter_id, device, points, limits=limits, amplitude_deg=amplitude,
                              source="calibration from logged motor current")
     return Calibration(profile, points, report, "recordings")
 
 
-def _last_command(rec: Recording, planned: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Where the knobs were last sent (from the recording; the plan's start if it is empty)."""
-    if len(rec) == 0:
-        return np.asarray(planned[0], dtype=float).copy()
-    last = np.array([rec["cmd1"][-1], rec["cmd2"][-1]], dtype=float)
-    if not np.all(np.isfinite(last)):
-        last = np.array([rec["pos1"][-1], rec["pos2"][-1]], dtype=float)
-    return last
-
-
-def _where_now(runner: TrajectoryRunner, planned: NDArray[np.float64],
-               fraction: float) -> NDArray[np.float64]:
-    """Where the knobs were last commanded when a run ended without a recording: the loop's
-    latest sample when the runner exposes its loop, else the plan at the last progress."""
-    sample = getattr(getattr(runner, "loop", None), "latest_sample", None)
-    cmd = getattr(sample, "cmd_deg", None)
-    if cmd is not None and np.all(np.isfinite(np.asarray(cmd, dtype=float))):
-        return np.asarray(cmd, dtype=float).copy()
-    k = min(len(planned) - 1, max(0, round(fraction * len(planned))))
-    return np.asarray(planned[k], dtype=float).copy()
-
-
-def _return_to_zero(runner: TrajectoryRunner, q_deg: NDArray[np.float64],
-                    period_s: float) -> float:
-    """Smoothly bring both knobs back to 0 (never cancelled: this is the safe end)."""
-    t, q = return_to_zero(q_deg, period_s)
-    runner.run(t, q, False, None, None)
-    return len(q) * period_s

@@ -24,10 +24,11 @@ from typing import Any
 
 from tsmd.calibration import fast_protocol, paper_protocol, run_calibration
 from tsmd.calibration.assemble import GridPoint
-from tsmd.calibration.errors import CalibrationRefusedError
+from tsmd.calibration.errors import CalibrationError, CalibrationRefusedError
 from tsmd.calibration.identify import IdentifyOptions
-from tsmd.calibration.offline import identification_table, read_sweep_file
+from tsmd.calibration.offline import data_report, identification_table, read_sweep_file
 from tsmd.calibration.report import grid_table, write_report
+from tsmd.calibration.resweep import pool_repeats
 from tsmd.calibration.run import calibration_from_points, identify_recording
 from tsmd.config import default_sim_config, load_config, resolve_data_path
 from tsmd.errors import TsmdError
@@ -45,9 +46,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="tsmd config (default: /etc/tsmd/tsmd.yaml, or the sim default "
                              "with --sim)")
     parser.add_argument("--fast", action="store_true",
-                        help="the fast protocol (218 s: the other knob at -90/0/+90 only, sine at "
-                             "0.055 Hz) instead of the paper's (700 s: 7 grid points, 0.04 Hz); "
-                             "--sim and recordings only")
+                        help="the fast protocol (200 s: the other knob at -90/0/+90 only, sine at "
+                             "0.06 Hz, re-sweeps up to 233 s in all) instead of the paper's "
+                             "(700 s: 7 grid points, 0.04 Hz, re-sweeps up to 900 s); --sim "
+                             "and recordings only")
     parser.add_argument("--report", metavar="DIR",
                         help="write a calibration report (Markdown + PNG plots) into DIR")
     parser.add_argument("--from-recording", nargs="+", metavar="FILE",
@@ -196,11 +198,28 @@ def _from_recordings(args: argparse.Namespace) -> int:
     config = _config(args, sim=False) if args.config else None
     device = _device(args, config)
     options = IdentifyOptions(edge=args.edge)
-    points = [identify_recording(read_sweep_file(f, args.steps_per_knob_deg), options,
-                                 source=str(f))
-              for f in args.from_recording]
-    print(identification_table(points))
-    cal = calibration_from_points(points, args.catheter, device)
+    points = []
+    failures = []
+    for f in args.from_recording:
+        try:
+            points.append(identify_recording(read_sweep_file(f, args.steps_per_knob_deg),
+                                             options, source=str(f)))
+        except CalibrationError as exc:
+            # Every file is looked at: the report then says what each gave or lacked.
+            failures.append((str(f), str(exc).removeprefix(f"{f} ")))
+    if points:
+        print(identification_table(points))
+    unusable = "; ".join(f"{Path(f).name}: {why}" for f, why in failures)
+    try:
+        if not points:
+            raise CalibrationError(f"no recording could be used: {unusable}")
+        cal = calibration_from_points(points, args.catheter, device)
+        if failures:
+            raise CalibrationError(f"{len(failures)} recording(s) could not be used: {unusable}")
+    except CalibrationError as exc:
+        # Repeated acquisitions of one grid point are pooled, as a re-sweep would be.
+        print("\n" + data_report(pool_repeats(points), failures, str(exc)))
+        raise
     _save(args, config, cal)
     return 0
 

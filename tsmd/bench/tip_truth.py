@@ -1,0 +1,51 @@
+"""The truth a calibration is scored against: D and B read off the simulated tip of its sweeps.
+
+Shared by the calibration benchmark and its family runs; the tip is ground truth for evaluation
+only, never an input of the calibration.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simrig.analysis import SweepAnalysisError, measure_dead_zone_backlash
+from tsmd.calibration.assemble import GridPoint
+from tsmd.calibration.identify import split_half_cycles
+from tsmd.calibration.signal import lowpass
+
+TIP_THRESHOLD_DEG = 1.0
+"""How far the tip must move off its plateau for an edge or a backlash end (deg)."""
+
+
+def tip_truth(point: GridPoint) -> dict[str, float]:
+    """D and B measured on the tracked tip of the sweep (the plant package's analysis)."""
+    rec = point.recording
+    if rec is None:
+        return {}
+    k = point.knob + 1
+    start = float(rec.metadata["calibration_sweep_start_s"]) - 1.0  # include the way down to -A
+    m = rec["t"] >= start
+    t, pos, tip = rec["t"][m], rec[f"pos{k}"][m], rec[f"tip{k}"][m]
+    if not np.isfinite(tip).all():
+        return {}
+    rate = 1.0 / float(np.median(np.diff(t)))
+    tip_f, _ = lowpass(tip, rate)
+    knob = monotone_knob(rec[f"cmd{k}"][m], pos)
+    try:
+        truth = measure_dead_zone_backlash(knob, tip_f, threshold_deg=TIP_THRESHOLD_DEG)
+    except SweepAnalysisError:
+        return {}
+    return dict(truth._asdict())
+
+
+def monotone_knob(cmd_deg: np.ndarray, pos_deg: np.ndarray) -> np.ndarray:
+    """The actual knob angle made monotonic between the command's reversals.
+
+    At a speed change the drive's position wobbles back by ~0.02 deg; the plant analysis cuts
+    passes at every direction change, so without this a wobble becomes a "reversal" and the
+    tip's backlash comes out as the 1 deg threshold's knob travel.
+    """
+    out = np.asarray(pos_deg, dtype=float).copy()
+    for direction, a, b, _ in split_half_cycles(np.asarray(cmd_deg, dtype=float), 10.0):
+        out[a:b] = direction * np.maximum.accumulate(direction * out[a:b])
+    return out

@@ -190,6 +190,18 @@ def make_split(series: Sequence[GapSeries], holdout: float | Sequence[str] = 0.3
                        f"needs at least {MIN_BLOCKS}")
     if n_test == 0 or all(h.all() for h in held):
         raise GapError("the split leaves no training or no held-out data")
+    for c, channel in enumerate(("tip1", "tip2", "cur1", "cur2")):
+        tested = [s.name for s, h in zip(series, held, strict=True)
+                  if s.channel_valid[c] and h.any()]
+        trained = any(s.channel_valid[c] and not h.all() for s, h in zip(series, held,
+                                                                         strict=True))
+        if tested and not trained:
+            raise GapError(f"{channel} is measured in the held-out data ({', '.join(tested)}) "
+                           "but in no training row: nothing to fit it on; hold out other data")
+    if not any(s.channel_valid[c] and h.any() for s, h in zip(series, held, strict=True)
+               for c in (0, 1)):
+        raise GapError("the held-out data have no tip measurement (tip1 and tip2 never change "
+                       "there): nothing to score the gap on; hold out other data")
     n_test_blocks = len(split.test_blocks())
     if n_test_blocks < 3:
         raise GapError(f"only {n_test_blocks} held-out blocks: too few for a confidence interval")

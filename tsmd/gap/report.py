@@ -113,9 +113,10 @@ def plots(result: GapResult, out_dir: Path, prefix: str = "gap") -> dict[str, st
     views: list[View] = result.plot_data.get("views", [])
     base: Prediction | None = result.plot_data.get("base")
     top: Prediction | None = result.plot_data.get("top")
-    cands = [v for v in views if v.test.any()]
-    if cands and base is not None:
-        i = max(range(len(views)), key=lambda j: float(np.ptp(views[j].knob_deg[views[j].test])))
+    with_test = [j for j, v in enumerate(views) if v.test.any()]
+    if with_test and base is not None:
+        # the widest held-out motion, among the views that have held-out rows at all
+        i = max(with_test, key=lambda j: float(np.ptp(views[j].knob_deg[views[j].test])))
         v = views[i]
         knob = int(np.argmax(np.ptp(v.knob_deg, axis=0)))
         t = v.t_s - v.series.t_s[0]
@@ -179,19 +180,35 @@ def plots(result: GapResult, out_dir: Path, prefix: str = "gap") -> dict[str, st
 
 def write_report(result: GapResult, out_dir: Path, title: str,
                  extra: dict[str, Any] | None = None) -> tuple[Path, Path]:
-    """Write ``gap_report.md``, ``gap_report.json`` and the plots into ``out_dir``."""
+    """Write ``gap_report.json``, ``gap_report.md`` and the plots into ``out_dir``.
+
+    The figures are written first, and a failing plot stage costs only the plots (its reason is
+    kept in the report): minutes of diagnosis are never lost to a drawing problem.
+    """
     out_dir.mkdir(parents=True, exist_ok=True)
-    files = plots(result, out_dir)
-    md = out_dir / "gap_report.md"
-    md.write_text(markdown(result, title, files), encoding="utf-8")
     data = result.to_json()
     data["title"] = title
-    data["plots"] = files
     if extra:
         data.update(extra)
     js = out_dir / "gap_report.json"
-    js.write_text(json.dumps(finite_json(data), indent=2, default=_jsonable, allow_nan=False),
-                  encoding="utf-8")
+    md = out_dir / "gap_report.md"
+
+    def save(files: dict[str, str], plot_error: str | None) -> None:
+        data["plots"] = files
+        data["plot_error"] = plot_error
+        js.write_text(json.dumps(finite_json(data), indent=2, default=_jsonable,
+                                 allow_nan=False), encoding="utf-8")
+        text = markdown(result, title, files)
+        if plot_error:
+            text += f"\nPlots not drawn: {plot_error}\n"
+        md.write_text(text, encoding="utf-8")
+
+    save({}, None)
+    try:
+        files, error = plots(result, out_dir), None
+    except Exception as exc:  # any drawing failure must not lose the figures
+        files, error = {}, f"{type(exc).__name__}: {exc}"
+    save(files, error)
     return md, js
 
 

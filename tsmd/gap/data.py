@@ -35,6 +35,11 @@ class GapSeries:
     channel_valid: tuple[bool, bool, bool, bool] = (True, True, True, True)
     """Per channel (tip1, tip2, cur1, cur2): False when it never changes in this recording
     (a sensor that was not connected); such a channel is left out of fits and scores."""
+    config: str = ""
+    """Sheath shape / configuration label from the header (``configuration`` or
+    ``sheath_shape``); recordings with different labels let curvature be told from friction."""
+    catheter: str = ""
+    """Catheter id from the header (``catheter``), for the report."""
 
     def __len__(self) -> int:
         return len(self.t_s)
@@ -105,7 +110,17 @@ def series_from_recording(rec: Recording, name: str) -> GapSeries:
         knob_deg=np.column_stack([knob[0], knob[1]]),
         current_A=np.column_stack([cols["cur1"], cols["cur2"]]),
         tip_deg=np.column_stack([tips[0], tips[1]]),
-        knob_source=knob_source, channel_valid=valid)  # type: ignore[arg-type]
+        knob_source=knob_source, channel_valid=valid,  # type: ignore[arg-type]
+        config=condition_label(rec.metadata), catheter=rec.metadata.get("catheter", ""))
+
+
+CONFIG_KEYS: tuple[str, ...] = ("configuration", "sheath_shape")
+"""Header keys naming the condition a recording was taken in (first one present wins)."""
+
+
+def condition_label(metadata: dict[str, str]) -> str:
+    """The recording's configuration label from its header, '' when it has none."""
+    return next((metadata[k].strip() for k in CONFIG_KEYS if metadata.get(k, "").strip()), "")
 
 
 @dataclass(frozen=True)

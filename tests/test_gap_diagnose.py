@@ -24,7 +24,8 @@ SPECS = (ParamSpec("slack_deg", 5.0, 30.0), ParamSpec("play_deg", 0.0, 20.0),
          ParamSpec("friction_Nm", 0.0, 0.05))
 START = {"slack_deg": 15.0, "play_deg": 8.0, "friction_Nm": 0.01}
 CONFIG = GapConfig(fit_specs=SPECS, fit_max_rows=1200, rank_max_rows=2000, n_boot=500,
-                   base_evals=34, polish_evals=10, refine_evals=6, joint_top=0)
+                   base_evals=34, polish_evals=10, refine_evals=6, joint_top=0,
+                   method="candidates")
 
 
 @functools.cache

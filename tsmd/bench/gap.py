@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tsmd.gap.crosstest import parse_plant_spec, run_crosstest
+from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
 from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import GapConfig, diagnose
 from tsmd.gap.errors import GapError
@@ -149,7 +149,7 @@ def cross(args: argparse.Namespace) -> dict[str, object]:
         label = f"data {data.name} / simulator {sim.name}"
         print(f"cross-plant self-test, {label}:", flush=True)
         st = run_crosstest(data, sim, cases, sizes, seeds, args.selftest_rate_hz,
-                           GapConfig(fit_specs=sim.fit, method=args.method),
+                           cross_config(sim.fit, args.method),
                            progress=lambda c: print(
                                f"  {c.case:<11} {c.duration_s:5.0f} s seed {c.seed}: "
                                f"{c.verdict:<26} top={c.top or 'none':<11} ({c.wall_s:.1f} s)",

@@ -171,13 +171,12 @@ def _selftest(args: argparse.Namespace) -> int:
               f"top={c.top or 'none':<11} ({c.wall_s:.1f} s)", flush=True)
 
     if args.data_plant or args.sim_plant:
-        from tsmd.gap.crosstest import parse_plant_spec, run_crosstest
+        from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
 
         data = parse_plant_spec(args.data_plant or "capstan-other")
         sim = parse_plant_spec(args.sim_plant or "capstan")
         result = run_crosstest(data, sim, cases, sizes, seeds, args.rate_hz,
-                               GapConfig(fit_specs=sim.fit, method=args.method),
-                               progress=progress)
+                               cross_config(sim.fit, args.method), progress=progress)
     else:
         result = run_selftest(cases, sizes, seeds, args.rate_hz,
                               GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method),

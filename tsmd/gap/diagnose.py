@@ -70,7 +70,7 @@ class GapConfig:
     sig_max_rows: int = 30000
     final_max_rows: int = 40000
     """Held-out rows replayed for the how-far figures (all of them up to this many)."""
-    n_surrogates: int = 6
+    n_surrogates: int = 30
 
 
 @dataclass

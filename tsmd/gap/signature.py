@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import stats
 
 from tsmd.gap.model import View
 from tsmd.gap.simulate import lowpass
@@ -142,8 +143,8 @@ class Carriers:
     bend: FloatArray  # (n, 2) simulated tip / its 95th percentile
     loaded: FloatArray  # (n, 2) 1 where the simulated tip follows the knob
     sweep_speed: FloatArray  # (n, 2) |v| low-passed over 1 s / 90th percentile
-    load_at_rev: FloatArray  # (n, 2) |bend| at the last reversal
-    travel_since: FloatArray  # (n, 2) knob travel since the last reversal (deg)
+    sens: FloatArray | None = None  # (n, 4) slope of the layer's prediction against the knob
+    load: FloatArray | None = None  # (n, 2) signed simulated torque / its 95th percentile
 
 
 def carriers(d: SigData) -> Carriers:
@@ -154,8 +155,6 @@ def carriers(d: SigData) -> Carriers:
     bend = np.zeros((n, 2))
     loaded = np.zeros((n, 2))
     speed = np.zeros((n, 2))
-    load_rev = np.zeros((n, 2))
-    since = np.zeros((n, 2))
     for j in range(2):
         x = d.knob[:, j]
         v = d.vel[:, j]
@@ -180,39 +179,27 @@ def carriers(d: SigData) -> Carriers:
         loaded[:, j] = (slope > 0.3 * max(float(np.percentile(slope, 90)), 1e-9)).astype(float)
         speed[:, j] = np.concatenate([lowpass(d.t_s[seg], np.abs(v[seg]), 1.0)
                                       for seg in d.segments]) / v90
-        lr, ts = _per_recording_rev(d, x, np.abs(s))
-        load_rev[:, j], since[:, j] = lr, ts
-    return Carriers(layer, layer_cur, direction, bend, loaded, speed, load_rev, since)
+    return Carriers(layer, layer_cur, direction, bend, loaded, speed)
 
 
-def _per_recording_rev(d: SigData, x: FloatArray,
-                       load: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Per row: ``load`` at the last reversal of ``x`` (>= 1 deg back) and the travel since."""
-    at_rev = np.zeros(len(x))
-    since = np.zeros(len(x))
+def sensitivity(d: SigData, pred: FloatArray, x: FloatArray,
+                window_deg: float = 1.0) -> FloatArray:
+    """Slope of a prediction against the knob along the motion (0 where the knob rests).
+
+    Differences over the last ``window_deg`` of knob travel, so a slowly moving knob and a fast
+    one give the same slope; the loaded branch has the tip/knob gain, the dead zone about 0.
+    """
+    out = np.zeros(len(x))
     for seg in d.segments:
-        xs = x[seg].tolist()
-        ls = load[seg]
-        if not xs:
-            continue
-        ext_i, rising = 0, 0
-        lr, rev_x = float(ls[0]), xs[0]
-        out_l = np.empty(len(xs))
-        out_t = np.empty(len(xs))
-        for k, xk in enumerate(xs):
-            e = xs[ext_i]
-            if (rising >= 0 and xk >= e) or (rising <= 0 and xk <= e):
-                if rising == 0 and abs(xk - xs[0]) >= 1.0:
-                    rising = 1 if xk > xs[0] else -1
-                ext_i = k
-            elif rising != 0 and abs(xk - e) >= 1.0:
-                lr, rev_x = float(ls[ext_i]), e
-                rising = -rising
-                ext_i = k
-            out_l[k] = lr
-            out_t[k] = abs(xk - rev_x)
-        at_rev[seg], since[seg] = out_l, out_t
-    return at_rev, since
+        xs, ps = x[seg], pred[seg]
+        travel = np.concatenate([[0.0], np.cumsum(np.abs(np.diff(xs)))])
+        back = np.clip(np.searchsorted(travel, travel - window_deg, side="right") - 1, 0, None)
+        dx = xs - xs[back]
+        ok = np.abs(dx) >= 0.5 * window_deg
+        slope = np.zeros(len(xs))
+        slope[ok] = (ps[ok] - ps[back[ok]]) / dx[ok]
+        out[seg] = slope
+    return out
 
 
 def _shift(d: SigData, a: FloatArray, rng: np.random.Generator) -> FloatArray:
@@ -230,35 +217,40 @@ def signature_columns(name: str, d: SigData, c: Carriers, j: int, channel: str,
                       cond: FloatArray) -> FloatArray | None:
     """Regressors of signature ``name`` for knob ``j``'s ``channel`` ('tip' or 'cur').
 
-    ``cond`` is the signature's condition (true or surrogate); the carriers are the row's own
-    hysteresis state, so an effect that acts only while loaded or in one direction fits.
+    Most effects act like a change of the knob angle the tendon sees (a dead zone shifted by
+    the other knob, play widened by speed, stretch under load, slack creeping): to first order
+    the channel then moves by its sensitivity to the knob (``c.sens``, the slope of the
+    structural layer's prediction) times that change. So the regressors are sensitivity x
+    condition x the direction or side of the motion, plus a few direct terms.
     """
-    dirn, bend, loaded = c.direction[:, j], c.bend[:, j], c.loaded[:, j]
+    assert c.sens is not None and c.load is not None
+    ch = j if channel == "tip" else 2 + j
+    g = c.sens[:, ch]
+    dirn = c.direction[:, j]
+    side = np.tanh(d.knob[:, j] / 5.0)
     if name == "coupling":
         o = cond[:, 1 - j] / 90.0
-        cols = [f * g for f in (o, o * o) for g in (np.ones(len(o)), dirn, bend, loaded * dirn)]
+        cols = [g * o, g * o * o * side, g * o * o * dirn]
     elif name == "rate":
         sp = cond[:, j]
-        cols = [sp, sp * dirn, sp * bend, sp * loaded * dirn, sp * dirn * np.abs(bend)]
+        cols = [g * sp * dirn, g * sp * dirn * np.abs(c.load[:, j]), sp * dirn]
         if channel == "cur":
             tq = d.sim_torque[:, j] / max(float(np.percentile(np.abs(d.sim_torque[:, j]), 95)),
                                           1e-12)
-            cols += [sp * tq, sp * tq * dirn]
+            cols += [sp * tq]
     elif name == "compliance":
-        lr, tr = cond[:, j], c.travel_since[:, j]
-        cols = [lr * dirn * (1.0 - np.exp(-tr / w)) for w in (2.0, 8.0, 25.0)]
-        cols += [lr * dirn, lr * bend]
+        ld = cond[:, j]
+        cols = [g * ld]  # elastic: lost motion with the tension, whichever way the knob moves
     elif name == "drift":
         tt = cond[:, 0]
-        cols = [tt, tt * bend, tt * dirn, tt * np.maximum(bend, 0), tt * np.minimum(bend, 0)]
+        cols = [tt, g * tt * side, g * tt * dirn]
     elif name == "curvature":
         if d.n_configs < 2:
             return None
         cols = []
         for k in range(1, d.n_configs):
             z = (cond[:, 0] == k).astype(float)
-            cols += [z * dirn, z * bend, z * loaded * dirn, z * bend * np.abs(bend),
-                     z * c.layer[j][:, 3], z * c.layer[j][:, 5]]
+            cols += [z * g * dirn, z * g * side, z * dirn, z * g * d.knob[:, j] / 90.0]
     else:
         raise ValueError(f"unknown signature {name!r}")
     return np.column_stack(cols)
@@ -292,6 +284,8 @@ class SignatureScore:
     """Share it removes with the true condition, before subtracting the null."""
     null_share: float
     """Mean share its surrogates remove."""
+    z: float = float("nan")
+    """How many surrogate standard deviations the true condition's gain lies above theirs."""
 
 
 @dataclass
@@ -300,7 +294,8 @@ class SignatureResult:
 
     scores: list[SignatureScore]
     layer_excess: float
-    """Held-out excess of the structural layer (noise units, summed): what effects may explain."""
+    """Held-out excess of the structural layer (each channel in units of its own excess, so
+    about the number of measured channels): what effects may explain."""
     physics_excess: float
     """The same for the physics simulator alone (its own linear output map)."""
     layer_ratio: float
@@ -321,61 +316,101 @@ def _solve(a: FloatArray, b: FloatArray, ridge: float) -> FloatArray:
 
 
 class Layer:
-    """Fits a channel's columns on training rows and predicts every row."""
+    """The structural layer per channel, fitted on training rows; signatures are added to it.
 
-    def __init__(self, d: SigData, ridge: float = 1e-7) -> None:
+    Adding a signature's regressors E refits layer + E jointly, done cheaply by projection
+    (Frisch-Waugh): E minus its own layer fit, regressed on the layer's training residual. The
+    layer's pseudo-inverse is computed once per channel, so a signature and its many
+    surrogates cost a few narrow products each.
+    """
+
+    def __init__(self, d: SigData, columns: Sequence[FloatArray]) -> None:
         self.d = d
-        self.ridge = ridge
-        self.rec_cols = np.column_stack([(d.rec == i).astype(float)
-                                         for i in range(len(d.segments))])
+        rec_cols = np.column_stack([(d.rec == i).astype(float) for i in range(len(d.segments))])
+        self.design: list[FloatArray] = []
+        self.scale: list[FloatArray] = []
+        self.pinv: list[FloatArray] = []
+        self.rows: list[NDArray[np.bool_]] = []
+        self.pred = np.zeros((len(d), 4))
+        for ch, cols in enumerate(columns):
+            a = np.column_stack([cols, rec_cols])
+            scale = np.maximum(np.abs(a).max(axis=0), 1e-12)
+            a = a / scale
+            rows = d.train & d.valid[:, ch]
+            pinv = (np.linalg.pinv(a[rows], rcond=1e-9) if rows.any()
+                    else np.zeros((a.shape[1], 0)))
+            self.design.append(a)
+            self.pinv.append(pinv)
+            self.rows.append(rows)
+            if rows.any():
+                self.pred[:, ch] = a @ (pinv @ d.measured[rows, ch])
 
-    def fit_predict(self, ch: int, cols: FloatArray) -> FloatArray:
-        d = self.d
-        a = np.column_stack([cols, self.rec_cols])
-        rows = d.train & d.valid[:, ch]
+    def add(self, ch: int, extra: FloatArray) -> FloatArray:
+        """Prediction of channel ``ch`` by the layer and ``extra`` fitted jointly."""
+        rows = self.rows[ch]
         if not rows.any():
-            return np.zeros(len(d))
-        coef = _solve(a[rows], d.measured[rows, ch], self.ridge)
-        return np.asarray(a @ coef)
+            return self.pred[:, ch].copy()
+        e = extra / np.maximum(np.abs(extra).max(axis=0), 1e-12)
+        e_perp = e - self.design[ch] @ (self.pinv[ch] @ e[rows])
+        resid = self.d.measured[rows, ch] - self.pred[rows, ch]
+        coef, *_ = np.linalg.lstsq(e_perp[rows], resid, rcond=1e-9)
+        return np.asarray(self.pred[:, ch] + e_perp @ coef)
 
 
 def block_costs(d: SigData, pred: FloatArray, noise_var: FloatArray,
                 blocks: NDArray[np.int64]) -> tuple[FloatArray, FloatArray]:
-    """Per held-out block the noise-weighted squared residual and the number of values."""
+    """Per held-out block and channel the noise-weighted squared residual and the number of
+    values, both (n_blocks, 4)."""
     r = (pred - d.measured) * d.valid
-    w = np.sum(r * r / noise_var, axis=1)
+    w = r * r / noise_var
     idx = np.searchsorted(blocks, d.block[d.test])
-    cost = np.bincount(idx, weights=w[d.test], minlength=len(blocks)).astype(float)
-    count = np.bincount(idx, weights=d.valid[d.test].sum(axis=1).astype(float),
-                        minlength=len(blocks)).astype(float)
-    return cost, count
+    cost = np.column_stack([np.bincount(idx, weights=w[d.test, c], minlength=len(blocks))
+                            for c in range(4)]).astype(float)
+    count = np.column_stack([np.bincount(idx, weights=d.valid[d.test, c].astype(float),
+                                         minlength=len(blocks)) for c in range(4)])
+    return cost, count.astype(float)
+
+
+def channel_weights(base_cost: FloatArray, count: FloatArray) -> FloatArray:
+    """Per channel 1 / its held-out excess: every measured channel's gap counts the same.
+
+    In noise units a tip tracked to 0.1 deg outweighs a current measured to 4 mA a hundred
+    times, and an effect only in the current (sensor dynamics) would never show. A channel at
+    the noise counts as if its excess were half its noise level.
+    """
+    exc = (base_cost - count).sum(axis=0)
+    n = count.sum(axis=0)
+    return np.where(n > 0, 1.0 / np.maximum(exc, 0.5 * np.maximum(n, 1.0)), 0.0)
 
 
 def score_signatures(d: SigData, noise_var: FloatArray, physics_pred: FloatArray,
-                     seed: int = 0, n_surrogates: int = 6, n_boot: int = 2000,
+                     seed: int = 0, n_surrogates: int = 30, n_boot: int = 2000,
                      ci_level: float = 0.9, family_alpha: float = 0.05,
                      min_share: float = 0.05,
                      names: Sequence[str] | None = None) -> SignatureResult:
     """Fit the structural layer, then every signature against its surrogate null."""
     rng = np.random.default_rng(seed)
     c = carriers(d)
-    layer = Layer(d)
+    layer = Layer(d, [c.layer[0], c.layer[1], c.layer_cur[0], c.layer_cur[1]])
     blocks = np.unique(d.block[d.test])
-    base = np.zeros((len(d), 4))
-    for j in range(2):
-        base[:, j] = layer.fit_predict(j, c.layer[j])
-        base[:, 2 + j] = layer.fit_predict(2 + j, c.layer_cur[j])
-    base_cost, count = block_costs(d, base, noise_var, blocks)
-    phys_cost, _ = block_costs(d, physics_pred, noise_var, blocks)
-    excess = base_cost - count
+    base = layer.pred
+    c.sens = np.column_stack([sensitivity(d, base[:, ch], d.knob[:, ch % 2])
+                              for ch in range(4)])
+    c.load = d.sim_torque / np.maximum(np.percentile(np.abs(d.sim_torque), 95, axis=0), 1e-12)
+    load = c.load
+    base_cost_c, count_c = block_costs(d, base, noise_var, blocks)
+    phys_cost_c, _ = block_costs(d, physics_pred, noise_var, blocks)
+    weight = channel_weights(base_cost_c, count_c)
+    base_cost, count = base_cost_c @ weight, count_c @ weight
+    phys_cost = phys_cost_c @ weight
+    excess = np.maximum(base_cost_c - count_c, 0.0) @ weight
     total_excess = float(excess.sum())
     conditions: dict[str, Callable[[np.random.Generator | None], FloatArray]] = {
         "coupling": lambda g: d.knob if g is None else _shift(d, d.knob, g),
         "rate": lambda g: c.sweep_speed if g is None else _shift(d, c.sweep_speed, g),
-        "compliance": lambda g: (c.load_at_rev if g is None
-                                 else _shift(d, c.load_at_rev, g)),
+        "compliance": lambda g: load if g is None else _shift(d, load, g),
         "drift": lambda g: (d.frac_run[:, None] if g is None
-                            else _shift(d, d.frac_run[:, None], g)),
+                            else _slow_wave(d, g)[:, None]),
         "curvature": lambda g: (d.config[:, None].astype(float) if g is None
                                 else _pseudo_configs(d, g)[:, None]),
     }
@@ -387,46 +422,68 @@ def score_signatures(d: SigData, noise_var: FloatArray, physics_pred: FloatArray
         if name == "curvature" and d.n_configs < 2:
             continue
 
-        def augmented(cond_for: Callable[[int], FloatArray | None]) -> FloatArray:
+        def augmented(extra: dict[int, FloatArray | None]) -> FloatArray:
+            """The layer and the signature's regressors fitted jointly on training rows."""
             out = base.copy()
-            for j in range(2):
-                for ch, lay in ((j, c.layer[j]), (2 + j, c.layer_cur[j])):
-                    extra = cond_for(ch)
-                    if extra is None:
-                        continue
-                    out[:, ch] = layer.fit_predict(ch, np.column_stack([lay, extra]))
+            for ch, cols in extra.items():
+                if cols is not None:
+                    out[:, ch] = layer.add(ch, cols)
             return out
 
-        def columns(cond: FloatArray, name: str = name) -> Callable[[int], FloatArray | None]:
-            return lambda ch: signature_columns(name, d, c, ch % 2, "tip" if ch < 2 else "cur",
-                                                cond)
+        def columns(cond: FloatArray, name: str = name) -> dict[int, FloatArray | None]:
+            return {ch: signature_columns(name, d, c, ch % 2, "tip" if ch < 2 else "cur", cond)
+                    for ch in range(4)}
 
+        strongest: FloatArray | None = None
         if name == "sensor":
-            true_pred = augmented(lambda ch: None if ch < 2 else _lag_features(
-                d, base[:, ch], lead=False))
-            null_preds = [augmented(lambda ch: None if ch < 2 else _lag_features(
-                d, base[:, ch], lead=True))]
+            lag = {ch: _lag_features(d, base[:, ch], lead=False) for ch in (2, 3)}
+            true_pred = augmented(dict(lag))
+            strongest = augmented({ch: _lag_features(d, base[:, ch], lead=True)
+                                   for ch in (2, 3)})
+            null_preds = [augmented({ch: _shift(d, lag[ch], rng) for ch in (2, 3)})
+                          for _ in range(n_surrogates)]
         else:
             cond_fn = conditions[name]
             true_pred = augmented(columns(cond_fn(None)))
             null_preds = [augmented(columns(cond_fn(rng))) for _ in range(n_surrogates)]
-        true_cost, _ = block_costs(d, true_pred, noise_var, blocks)
-        null_cost = np.mean([block_costs(d, p, noise_var, blocks)[0] for p in null_preds],
-                            axis=0)
+        true_cost = block_costs(d, true_pred, noise_var, blocks)[0] @ weight
+        null_costs = np.array([block_costs(d, p, noise_var, blocks)[0] @ weight
+                               for p in null_preds])
+        null_cost = null_costs.mean(axis=0)
+        if strongest is not None:  # a lead is the null a lag must beat
+            null_cost = np.minimum(null_cost, block_costs(d, strongest, noise_var,
+                                                          blocks)[0] @ weight)
         gain = null_cost - true_cost  # what the true condition removes beyond its surrogates
         denom = np.maximum(excess, 0.0) if total_excess > 0 else count
         share, lo, hi = bootstrap_ratio_ci(gain, denom, seed, n_boot, ci_level)
         _, strict_lo, _ = bootstrap_ratio_ci(gain, denom, seed, n_boot,
                                              1.0 - 2.0 * family_alpha / max(n_tried, 1))
+        # the surrogates' spread: is the true condition's gain outside what chance alignment of
+        # any condition with this residual gives? (one-sided, Bonferroni over the signatures)
+        spread = float(np.std(null_costs.sum(axis=1), ddof=1)) if n_surrogates > 1 else 0.0
+        z = float((null_cost.sum() - true_cost.sum()) / max(spread, 1e-12))
+        z_crit = float(stats.norm.ppf(1.0 - family_alpha / max(n_tried, 1)))
         raw = float((base_cost - true_cost).sum() / max(float(denom.sum()), 1e-12))
         null = float((base_cost - null_cost).sum() / max(float(denom.sum()), 1e-12))
         title, condition = SIGNATURES[name]
         scores.append(SignatureScore(name, title, condition, share, (lo, hi),
-                                     bool(strict_lo > 0 and share >= min_share), raw, null))
+                                     bool(strict_lo > 0 and share >= min_share and z > z_crit),
+                                     raw, null, z))
         preds[name] = true_pred
     scores.sort(key=lambda s: -s.share)
-    return SignatureResult(scores, total_excess, float((phys_cost - count).sum()),
+    return SignatureResult(scores, float((base_cost - count).sum()),
+                           float((phys_cost - count).sum()),
                            float(base_cost.sum() / max(float(count.sum()), 1e-12)), preds)
+
+
+def _slow_wave(d: SigData, rng: np.random.Generator) -> FloatArray:
+    """A slow wave over each recording (0.5..1.5 cycles, random phase): the null of a drift.
+
+    A slowly structured residual (a loop shape that changes with the slow cycles of the motion)
+    fits a ramp about as well as a wave of the same time scale; a real drift fits the ramp.
+    """
+    cycles, phase = rng.uniform(0.5, 1.5), rng.uniform(0.0, 2.0 * np.pi)
+    return np.sin(2.0 * np.pi * cycles * d.frac_run + phase)
 
 
 def _pseudo_configs(d: SigData, rng: np.random.Generator) -> FloatArray:

@@ -451,7 +451,8 @@ def _signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
                             n_surrogates=cfg.n_surrogates, n_boot=cfg.n_boot,
                             ci_level=cfg.ci_level, family_alpha=cfg.family_alpha,
                             min_share=cfg.min_share)
-    sig = [s for s in sres.scores if s.significant]
+    gap_present = sres.physics_excess > cfg.gap_floor * (sres.physics_excess + sres.noise_level)
+    sig = [s for s in sres.scores if s.significant] if gap_present else []
     top = [sig[0].name] if sig else []
     figures = {"physics": heldout_metrics(d, sres.predictions["physics"], cfg.seed),
                "layer": heldout_metrics(d, sres.predictions["layer"], cfg.seed)}
@@ -459,7 +460,6 @@ def _signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         figures["top"] = heldout_metrics(d, sres.predictions[top[0]], cfg.seed)
     absorbed = (1.0 - sres.layer_excess / sres.physics_excess if sres.physics_excess > 0
                 else float("nan"))
-    gap_present = sres.physics_excess > cfg.gap_floor * (sres.physics_excess + d.test.sum())
     verdict, summary = _structure_verdict(gap_present, absorbed, sres.layer_ratio, sig, figures)
     cands = [CandidateScore(s.name, s.title, f"depends on {s.condition}", {}, s.share, s.ci,
                             s.significant, s.raw_share, {}, {}, "signature")

@@ -34,12 +34,15 @@ from tsmd.gap.model import View
 from tsmd.gap.simulate import lowpass
 from tsmd.gap.stats import bootstrap_ratio_ci
 
-PLAY_WIDTHS_DEG: tuple[float, ...] = (1.0, 3.0, 8.0, 20.0, 45.0)
+PLAY_WIDTHS_DEG: tuple[float, ...] = (0.3, 1.0, 3.0, 8.0, 20.0, 45.0)
 """Play operator half-widths of the structural layer: a dead zone of a few degrees up to a loop
 as wide as half the knob range."""
 
 DEAD_ZONES_DEG: tuple[float, ...] = (8.0, 16.0, 24.0, 32.0)
 """Dead zones applied to the play outputs in the tip layer (slack of 10 to 40 deg of knob)."""
+
+START_TRAVEL_DEG: tuple[float, ...] = (100.0, 400.0)
+"""Knob travel over which the start transient of the structural layer decays."""
 
 SIGNATURES: dict[str, tuple[str, str]] = {
     "coupling": ("coupling between the knobs", "the other knob's angle"),
@@ -159,21 +162,34 @@ def carriers(d: SigData) -> Carriers:
         x = d.knob[:, j]
         v = d.vel[:, j]
         v90 = max(float(np.percentile(np.abs(v), 90)), 1e-6)
-        direction[:, j] = np.tanh(v / (0.05 * v90))
         plays = np.vstack([play_bank(x[seg], PLAY_WIDTHS_DEG) for seg in d.segments])
         states = (x[:, None] - plays) / np.asarray(PLAY_WIDTHS_DEG)
+        # the direction of motion as the narrowest play's state: it flips after 2 x 0.3 deg of
+        # travel at any speed (a velocity sign smoothed in time flips later when fast, which
+        # would read as a rate effect)
+        direction[:, j] = states[:, 0]
         load = np.abs(x)[:, None] / 90.0
         p = plays / 90.0
         s_scale = max(float(np.percentile(np.abs(d.sim_tip[:, j]), 95)), 1e-6)
         s = d.sim_tip[:, j] / s_scale
         tq_scale = max(float(np.percentile(np.abs(d.sim_torque[:, j]), 95)), 1e-12)
         tq = d.sim_torque[:, j] / tq_scale
-        common = [x / 90.0, (x / 90.0) ** 3, p, p * np.abs(p), states, states * load]
+        # the start from a straight, unloaded catheter is a state no later motion returns to:
+        # a transient over the first sweeps (decaying with the knob travel since the start)
+        travel = np.concatenate([np.concatenate([[0.0], np.cumsum(np.abs(np.diff(x[seg])))])
+                                 for seg in d.segments])
+        start = [np.exp(-travel / w) for w in START_TRAVEL_DEG]
+        common = [x / 90.0, (x / 90.0) ** 3, p, p * np.abs(p), states, states * load, *start,
+                  *(st * x / 90.0 for st in start)]
         # a dead zone after the friction: the slack of a real catheter need not be the model's
         dead = [np.sign(p) * np.maximum(np.abs(p) - dz / 90.0, 0.0) for dz in DEAD_ZONES_DEG]
+        # ... and before it (slack first, then the sheath's friction): plays of the dead-zoned knob
+        for dz in DEAD_ZONES_DEG:
+            xd = np.sign(x) * np.maximum(np.abs(x) - dz, 0.0)
+            dead.append(np.vstack([play_bank(xd[seg], PLAY_WIDTHS_DEG[1:5])
+                                   for seg in d.segments]) / 90.0)
         layer.append(np.column_stack([s, s * np.abs(s), s**3, *common, *dead]))
-        layer_cur.append(np.column_stack([tq, tq * np.abs(tq), direction[:, j], v / v90,
-                                          s, *common]))
+        layer_cur.append(np.column_stack([tq, tq * np.abs(tq), v / v90, s, *common]))
         bend[:, j] = s
         slope = np.abs(np.gradient(d.sim_tip[:, j])) / np.maximum(np.abs(np.gradient(x)), 1e-9)
         loaded[:, j] = (slope > 0.3 * max(float(np.percentile(slope, 90)), 1e-9)).astype(float)
@@ -243,7 +259,7 @@ def signature_columns(name: str, d: SigData, c: Carriers, j: int, channel: str,
         cols = [g * ld]  # elastic: lost motion with the tension, whichever way the knob moves
     elif name == "drift":
         tt = cond[:, 0]
-        cols = [tt, g * tt * side, g * tt * dirn]
+        cols = [tt, g * tt * side]
     elif name == "curvature":
         if d.n_configs < 2:
             return None
@@ -298,6 +314,8 @@ class SignatureResult:
     about the number of measured channels): what effects may explain."""
     physics_excess: float
     """The same for the physics simulator alone (its own linear output map)."""
+    noise_level: float
+    """What the held-out cost would be at the noise alone, in the same units."""
     layer_ratio: float
     """Held-out residual / noise of the structural layer (1 = noise only)."""
     predictions: dict[str, FloatArray]
@@ -472,7 +490,7 @@ def score_signatures(d: SigData, noise_var: FloatArray, physics_pred: FloatArray
         preds[name] = true_pred
     scores.sort(key=lambda s: -s.share)
     return SignatureResult(scores, float((base_cost - count).sum()),
-                           float((phys_cost - count).sum()),
+                           float((phys_cost - count).sum()), float(count.sum()),
                            float(base_cost.sum() / max(float(count.sum()), 1e-12)), preds)
 
 

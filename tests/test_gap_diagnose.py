@@ -14,10 +14,11 @@ from test_gap_support import StandInPlant, make_recording
 
 from tsmd.commands import gap as gap_command
 from tsmd.gap.data import series_from_recording
-from tsmd.gap.diagnose import GapConfig, GapResult, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
 from tsmd.gap.report import write_report
+from tsmd.gap.result import GapConfig, GapResult
 from tsmd.recording import Recording, write_recording
 
 SPECS = (ParamSpec("slack_deg", 5.0, 30.0), ParamSpec("play_deg", 0.0, 20.0),

@@ -12,9 +12,10 @@ from test_gap_support import StandInPlant, make_recording
 from tsmd import cli
 from tsmd.gap import report
 from tsmd.gap.data import make_split, series_from_recording
-from tsmd.gap.diagnose import GapConfig, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
+from tsmd.gap.result import GapConfig
 from tsmd.recording import Recording, write_recording
 
 START = {"slack_deg": 15.0, "play_deg": 8.0, "friction_Nm": 0.01}

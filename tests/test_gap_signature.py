@@ -9,9 +9,11 @@ import pytest
 from test_gap_support import StandInPlant, make_recording
 
 from tsmd.gap.data import make_split, series_from_recording
-from tsmd.gap.diagnose import GapConfig, GapResult, diagnose
+from tsmd.gap.diagnose import diagnose
+from tsmd.gap.layer import SigData, play_bank, sensitivity, stack_views
 from tsmd.gap.model import build_views
-from tsmd.gap.signature import SigData, _shift, _slow_wave, play_bank, sensitivity, stack_views
+from tsmd.gap.result import GapConfig, GapResult
+from tsmd.gap.signature import _shift, _slow_wave
 from tsmd.recording import Recording
 
 # the simulator is the stand-in with other physics than the data's (no base fit at all): a

@@ -19,8 +19,9 @@ import numpy as np
 
 from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
 from tsmd.gap.data import series_from_recording
-from tsmd.gap.diagnose import GapConfig, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
+from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,
     BUILTIN_PLANT,

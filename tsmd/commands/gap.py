@@ -14,10 +14,11 @@ from typing import Any
 import yaml
 
 from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
-from tsmd.gap.diagnose import GapConfig, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
 from tsmd.gap.report import finite_json, write_report
+from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import BUILTIN_FIT_SPECS, BUILTIN_PLANT, EFFECTS, complete_knobs
 from tsmd.recording import Recording, read_recording
 

@@ -23,9 +23,10 @@ from simrig.current_sensor import CurrentSensor
 from simrig.plant import load_plant
 from simrig.tracker import EmTracker
 from tsmd.gap.data import series_from_recording
-from tsmd.gap.diagnose import GapConfig, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
+from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,
     BUILTIN_PLANT,

@@ -12,7 +12,6 @@ from __future__ import annotations
 import copy
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -25,7 +24,6 @@ from tsmd.gap.model import (
     Active,
     Candidate,
     Evaluator,
-    ParamSpec,
     Prediction,
     View,
     build_views,
@@ -35,110 +33,11 @@ from tsmd.gap.model import (
     joint_refine,
     polish_base,
 )
-from tsmd.gap.signature import heldout_metrics, score_signatures, stack_views
+from tsmd.gap.result import CandidateScore, GapConfig, GapResult
 from tsmd.gap.simulate import PlantFactory
 from tsmd.gap.stats import bootstrap_ratio_ci, noise_variance, pooled_ljung_box, ptpe, rmse
+from tsmd.gap.structure import signature_stage
 from tsmd.gap.where import BinRow, breakdown, label_knob
-
-
-@dataclass(frozen=True)
-class GapConfig:
-    """Settings of one diagnosis (defaults are what `tsmd gap` uses)."""
-
-    fit_specs: tuple[ParamSpec, ...] = ()
-    holdout: float | tuple[str, ...] = 0.3
-    block_s: float | None = None
-    fit_max_rows: int = 2000
-    rank_max_rows: int = 6000
-    base_evals: int = 120
-    polish_evals: int = 20
-    refine_evals: int = 10
-    joint_top: int = 2
-    candidate_evals: int = 8
-    seed: int = 0
-    n_boot: int = 2000
-    ci_level: float = 0.9
-    family_alpha: float = 0.05
-    min_share: float = 0.05
-    explained_share: float = 0.5
-    gap_floor: float = 0.1
-    max_combined: int = 3
-    candidates: tuple[str, ...] | None = None
-    method: str = "signature"
-    """'signature': effects by their condition signature on top of a structural layer (robust
-    to wrong base physics); 'candidates': the earlier candidate transforms around the plant."""
-    sig_max_rows: int = 30000
-    final_max_rows: int = 40000
-    """Held-out rows replayed for the how-far figures (all of them up to this many)."""
-    n_surrogates: int = 30
-
-
-@dataclass
-class CandidateScore:
-    name: str
-    title: str
-    physics: str
-    params: dict[str, float]
-    share: float
-    ci: tuple[float, float]
-    significant: bool
-    train_cost_drop: float
-    ljung_box_q: dict[str, float]
-    metrics: dict[str, float]
-    stage: str = "screen"
-
-
-@dataclass
-class GapResult:
-    """Everything the report shows; :meth:`to_json` gives the same figures as plain data."""
-
-    verdict: str
-    summary: str
-    split: str
-    base_params: dict[str, Any]
-    fitted_params: dict[str, float]
-    noise_std: dict[str, float]
-    gap_ratio: tuple[float, float, float]
-    before: dict[str, float]
-    after_top: dict[str, float] | None
-    after_combined: dict[str, float] | None
-    top: list[str]
-    combined: list[str]
-    combined_share: tuple[float, float, float] | None
-    candidates: list[CandidateScore]
-    where_shares: dict[str, dict[str, float]]
-    where_bins: dict[str, list[BinRow]]
-    ljung_box_base: dict[str, float]
-    timing_s: dict[str, float]
-    rows: dict[str, int]
-    structure: dict[str, Any] | None = None
-    """Signature method: base mismatch and the effect on top (see tsmd.gap.signature)."""
-    plot_data: dict[str, Any] = field(default_factory=dict)
-
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "verdict": self.verdict, "summary": self.summary, "split": self.split,
-            "base_params": self.base_params, "fitted_params": self.fitted_params,
-            "noise_std": self.noise_std,
-            "gap_ratio": {"point": self.gap_ratio[0], "ci": list(self.gap_ratio[1:])},
-            "before": self.before, "after_top": self.after_top,
-            "after_combined": self.after_combined, "top": self.top, "combined": self.combined,
-            "combined_share": (None if self.combined_share is None else
-                               {"point": self.combined_share[0],
-                                "ci": list(self.combined_share[1:])}),
-            "candidates": [{
-                "name": c.name, "title": c.title, "physics": c.physics, "params": c.params,
-                "share": c.share, "ci": list(c.ci), "significant": c.significant,
-                "train_cost_drop": c.train_cost_drop, "ljung_box_q": c.ljung_box_q,
-                "stage": c.stage,
-                "metrics": c.metrics} for c in self.candidates],
-            "where": {
-                group: {"shares": self.where_shares[group],
-                        "bins": [vars(b) for b in self.where_bins[group]]}
-                for group in self.where_shares},
-            "ljung_box_base": self.ljung_box_base, "timing_s": self.timing_s, "rows": self.rows,
-            "structure": self.structure,
-        }
 
 
 def _strides(series: Sequence[GapSeries], max_rows: int) -> list[int]:
@@ -308,7 +207,7 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     timing["where"] = clock() - t2
 
     if cfg.method == "signature":
-        result = _signature_stage(series, split, ev, base_fit, strides, noise_var, cfg)
+        result = signature_stage(series, split, ev, base_fit, strides, noise_var, cfg)
         result.before = _metrics(final_views, base_final)
         result.where_shares, result.where_bins = where_shares, where_bins
         result.ljung_box_base = _whiteness(rank_views, base_rank)
@@ -435,73 +334,3 @@ def _verdict(cfg: GapConfig, gap_present: bool, gap_ratio: tuple[float, float, f
         f"Top effect: {sig[0].title} removes {sig[0].share:.0%} "
         f"(90% CI {sig[0].ci[0]:.0%}..{sig[0].ci[1]:.0%}) of the excess held-out gap; "
         f"with {names}: {best:.0%}.")
-
-
-def _signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
-                     base_fit: Prediction, strides: Sequence[int], noise_var: NDArray[np.float64],
-                     cfg: GapConfig) -> GapResult:
-    """Structural layer + condition signatures on a thinned grid (every row's state kept)."""
-    t0 = time.perf_counter()
-    total = sum(len(s) for s in series)
-    sig_stride = [max(-(-total // cfg.sig_max_rows), 1)] * len(series)
-    views = build_views(series, split, sig_stride, "fit")
-    phys = ev.predict(views, [], coefs=base_fit.coefs)
-    d = stack_views(views, [s.config for s in series])
-    sres = score_signatures(d, noise_var, np.vstack(phys.values), seed=cfg.seed,
-                            n_surrogates=cfg.n_surrogates, n_boot=cfg.n_boot,
-                            ci_level=cfg.ci_level, family_alpha=cfg.family_alpha,
-                            min_share=cfg.min_share)
-    gap_present = sres.physics_excess > cfg.gap_floor * (sres.physics_excess + sres.noise_level)
-    sig = [s for s in sres.scores if s.significant] if gap_present else []
-    top = [sig[0].name] if sig else []
-    figures = {"physics": heldout_metrics(d, sres.predictions["physics"], cfg.seed),
-               "layer": heldout_metrics(d, sres.predictions["layer"], cfg.seed)}
-    if top:
-        figures["top"] = heldout_metrics(d, sres.predictions[top[0]], cfg.seed)
-    absorbed = (1.0 - sres.layer_excess / sres.physics_excess if sres.physics_excess > 0
-                else float("nan"))
-    verdict, summary = _structure_verdict(gap_present, absorbed, sres.layer_ratio, sig, figures)
-    cands = [CandidateScore(s.name, s.title, f"depends on {s.condition}", {}, s.share, s.ci,
-                            s.significant, s.raw_share, {}, {}, "signature")
-             for s in sres.scores]
-    structure = {
-        "grid_rows": len(d), "grid_held_out_rows": int(d.test.sum()),
-        "configurations": sorted({s.config for s in series}),
-        "catheters": sorted({s.catheter for s in series if s.catheter}),
-        "physics_excess": sres.physics_excess, "layer_excess": sres.layer_excess,
-        "layer_absorbs": absorbed, "layer_ratio": sres.layer_ratio,
-        "signatures": [vars(s) for s in sres.scores], "figures": figures}
-    return GapResult(
-        verdict=verdict, summary=summary, split="", base_params={}, fitted_params={},
-        noise_std={n: float(np.sqrt(v)) for n, v in zip(CHANNELS, noise_var, strict=True)},
-        gap_ratio=(sres.layer_ratio, float("nan"), float("nan")), before={},
-        after_top=figures.get("top"), after_combined=figures.get("top"), top=top,
-        combined=top, combined_share=(sig[0].share, *sig[0].ci) if sig else None,
-        candidates=cands, where_shares={}, where_bins={}, ljung_box_base={},
-        timing_s={"signatures": time.perf_counter() - t0}, rows={"grid": len(d)},
-        structure=structure)
-
-
-def _structure_verdict(gap_present: bool, absorbed: float, layer_ratio: float,
-                       sig: list[Any], figures: dict[str, dict[str, float]]) -> tuple[str, str]:
-    phys, lay = figures["physics"], figures["layer"]
-
-    def tip(m: dict[str, float]) -> str:
-        return " / ".join(f"{m[f'tip{k}_rmse_deg']:.3g}" for k in (1, 2)
-                          if np.isfinite(m[f"tip{k}_rmse_deg"]))
-
-    base = (f"the physics simulator leaves {tip(phys)} deg held-out tip RMSE; a hysteresis "
-            f"layer fitted on training data takes it to {tip(lay)} deg ({absorbed:.0%} of the "
-            f"excess over noise is base mismatch; what is left is {layer_ratio:.2f}x noise)")
-    if not gap_present:
-        return "none significant", (f"The simulator matches the held-out data to within the "
-                                    f"noise: {base}.")
-    if sig:
-        s = sig[0]
-        return f"identified: {s.name}", (
-            f"Base physics: {base}. On top of it, {s.title} (signature: {s.condition}) removes "
-            f"{s.share:.0%} (90 % CI {s.ci[0]:.0%}..{s.ci[1]:.0%}) of the remaining excess "
-            f"beyond its surrogate null; with it the tip RMSE is {tip(figures['top'])} deg.")
-    return "base physics differ", (
-        f"Base physics: {base}. No effect's signature beats its surrogate null: the gap is in "
-        f"the base physics (dead zone, friction law, loop shape), not a missing effect.")

@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from tsmd.gap.diagnose import GapResult
 from tsmd.gap.model import Prediction, View
+from tsmd.gap.result import GapResult
 
 
 def _f(x: float | None, digits: int = 3) -> str:

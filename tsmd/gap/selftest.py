@@ -26,8 +26,9 @@ from simrig.current_sensor import CurrentSensor
 from simrig.plant import load_plant
 from simrig.tracker import EmTracker
 from tsmd.gap.data import series_from_recording
-from tsmd.gap.diagnose import GapConfig, GapResult, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.model import ParamSpec
+from tsmd.gap.result import GapConfig, GapResult
 from tsmd.gap.simulate import simulate
 from tsmd.recording import Recording
 

@@ -189,6 +189,19 @@ def sensitivity(d: SigData, pred: FloatArray, x: FloatArray,
     return out
 
 
+RIDGE = 1e-6
+"""Ridge of the layer's fits, relative to the mean diagonal of the normal equations: nothing for
+well-posed fits, but a held-out recording whose motion leaves the training range (another
+acquisition held out whole) is not extrapolated along near-singular directions."""
+
+
+def _ridge_pinv(a: FloatArray) -> FloatArray:
+    """(A'A + r I)^-1 A' with r = RIDGE x mean diagonal of A'A."""
+    g = a.T @ a
+    r = RIDGE * float(np.trace(g)) / max(g.shape[0], 1)
+    return np.asarray(np.linalg.solve(g + r * np.eye(g.shape[0]), a.T))
+
+
 class Layer:
     """The structural layer per channel, fitted on training rows; signatures are added to it.
 
@@ -211,8 +224,7 @@ class Layer:
             scale = np.maximum(np.abs(a).max(axis=0), 1e-12)
             a = a / scale
             rows = d.train & d.valid[:, ch]
-            pinv = (np.linalg.pinv(a[rows], rcond=1e-9) if rows.any()
-                    else np.zeros((a.shape[1], 0)))
+            pinv = _ridge_pinv(a[rows]) if rows.any() else np.zeros((a.shape[1], 0))
             self.design.append(a)
             self.pinv.append(pinv)
             self.rows.append(rows)
@@ -227,7 +239,7 @@ class Layer:
         e = extra / np.maximum(np.abs(extra).max(axis=0), 1e-12)
         e_perp = e - self.design[ch] @ (self.pinv[ch] @ e[rows])
         resid = self.d.measured[rows, ch] - self.pred[rows, ch]
-        coef, *_ = np.linalg.lstsq(e_perp[rows], resid, rcond=1e-9)
+        coef = _ridge_pinv(e_perp[rows]) @ resid
         return np.asarray(self.pred[:, ch] + e_perp @ coef)
 
 

@@ -111,9 +111,10 @@ def structure_lines(r: GapResult) -> list[str]:
                      f"{_pct(sgn['null_share'])} |")
     lines += ["", "Shares are of the excess the structural layer leaves on held-out blocks; "
               "'beyond null' subtracts what the same regressors built from a surrogate condition "
-              "(shifted in time, configurations re-drawn, a lead for a lag) remove. Significant: "
-              "the one-sided bootstrap bound at 5 % / number of signatures is above zero and the "
-              "share is at least 5 %.", ""]
+              "(shifted in time, a slow wave for time, configurations re-drawn, a lead for a lag) "
+              "remove. Significant: the true condition's gain lies above the surrogates' spread "
+              "(z above the one-sided 5 % / number of signatures point), the one-sided block-"
+              "bootstrap bound at that level is above zero, and the share is at least 5 %.", ""]
     return lines
 
 

@@ -39,7 +39,7 @@ from tsmd.gap.stats import bootstrap_ratio_ci
 SIGNATURES: dict[str, tuple[str, str]] = {
     "coupling": ("coupling between the knobs", "the other knob's angle"),
     "rate": ("rate dependence", "the sweep speed"),
-    "compliance": ("tendon compliance", "the load at the last reversal and the travel since"),
+    "compliance": ("tendon compliance", "the tendon load (simulated knob torque)"),
     "drift": ("drift / creep", "time in the run"),
     "sensor": ("current-sensor dynamics", "the current's lag against the knob"),
     "curvature": ("sheath curvature / shape", "the recording's sheath configuration"),

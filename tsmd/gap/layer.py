@@ -198,7 +198,7 @@ acquisition held out whole) is not extrapolated along near-singular directions."
 def _ridge_pinv(a: FloatArray) -> FloatArray:
     """(A'A + r I)^-1 A' with r = RIDGE x mean diagonal of A'A."""
     g = a.T @ a
-    r = RIDGE * float(np.trace(g)) / max(g.shape[0], 1)
+    r = RIDGE * float(np.trace(g)) / max(g.shape[0], 1) + 1e-12  # all-zero columns: 0
     return np.asarray(np.linalg.solve(g + r * np.eye(g.shape[0]), a.T))
 
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from test_profile import make_profile
+from support.profiles import make_profile
 
 from tsmd.calibration.tension_play_fit import (
     SweepCurrent,

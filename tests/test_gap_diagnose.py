@@ -14,17 +14,19 @@ from support.gap import StandInPlant, make_recording
 
 from tsmd.commands import gap as gap_command
 from tsmd.gap.data import series_from_recording
-from tsmd.gap.diagnose import GapConfig, GapResult, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
 from tsmd.gap.report import write_report
+from tsmd.gap.result import GapConfig, GapResult
 from tsmd.recording import Recording, write_recording
 
 SPECS = (ParamSpec("slack_deg", 5.0, 30.0), ParamSpec("play_deg", 0.0, 20.0),
          ParamSpec("friction_Nm", 0.0, 0.05))
 START = {"slack_deg": 15.0, "play_deg": 8.0, "friction_Nm": 0.01}
 CONFIG = GapConfig(fit_specs=SPECS, fit_max_rows=1200, rank_max_rows=2000, n_boot=500,
-                   base_evals=34, polish_evals=10, refine_evals=6, joint_top=0)
+                   base_evals=34, polish_evals=10, refine_evals=6, joint_top=0,
+                   method="candidates")
 
 
 @functools.cache

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from tsmd.gap.data import GapSeries, series_from_recording
-from tsmd.gap.diagnose import GapConfig, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.model import ParamSpec
+from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import builtin_factory
 
 pytestmark = pytest.mark.realdata

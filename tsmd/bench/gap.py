@@ -17,8 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
+from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
 from tsmd.gap.data import series_from_recording
-from tsmd.gap.diagnose import GapConfig, diagnose
+from tsmd.gap.diagnose import diagnose
+from tsmd.gap.errors import GapError
+from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,
     BUILTIN_PLANT,
@@ -33,7 +36,7 @@ from tsmd.gap.selftest import (
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--duration-s", type=float, default=600.0)
+    parser.add_argument("--duration-s", type=float, default=1800.0)
     parser.add_argument("--rate-hz", type=float, default=250.0)
     parser.add_argument("--case", default="coupling", choices=sorted(EFFECTS))
     parser.add_argument("--skip-speed", action="store_true", help="only the self-test")
@@ -51,6 +54,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--effect-plant", default=BUILTIN_PLANT,
                         help="plant factory measured by --effect-sizes (module:factory; its "
                              "module must define DEFAULT_KNOBS)")
+    parser.add_argument("--cross", default=None, metavar="DATA,SIM",
+                        help="also run the blind cross-plant self-test in both directions "
+                             "between these two plants (presets or module:factory[@json]), "
+                             "e.g. capstan-other,capstan")
+    parser.add_argument("--method", default="signature", choices=("signature", "candidates"))
     parser.add_argument("--out", default=None, help="also write the figures as JSON here")
 
 
@@ -90,7 +98,8 @@ def main(args: argparse.Namespace) -> int:
         series = series_from_recording(rec, f"bench-{args.case}")
         t1 = time.perf_counter()
         c1 = time.process_time()
-        result = diagnose([series], builtin_factory(), {}, GapConfig(fit_specs=BUILTIN_FIT_SPECS))
+        result = diagnose([series], builtin_factory(), {},
+                          GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method))
         wall = time.perf_counter() - t1
         cpu = time.process_time() - c1
         print(f"recording: {len(series)} rows ({args.duration_s:.0f} s at {args.rate_hz:.0f} Hz, "
@@ -113,12 +122,40 @@ def main(args: argparse.Namespace) -> int:
                           progress=lambda c: print(
                               f"  {c.case:<11} {c.duration_s:5.0f} s seed {c.seed}: "
                               f"{c.verdict:<26} top={c.top or 'none':<11} ({c.wall_s:.1f} s)",
-                              flush=True), motion=args.trajectory)
+                              flush=True), motion=args.trajectory,
+                          config=GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method))
         print(selftest_markdown(st))
         figures["selftest"] = {"summary": st.summary(), "confusion": st.confusion(),
                                "cases": [vars(c) for c in st.cases]}
+    if args.cross:
+        figures["cross"] = cross(args)
     if args.out:
         path = Path(args.out)
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(json.dumps(figures, indent=2), encoding="utf-8")
     return 0
+
+
+def cross(args: argparse.Namespace) -> dict[str, object]:
+    """The cross-plant self-test, data of each plant diagnosed with the other as simulator."""
+    names = [x.strip() for x in args.cross.split(",")]
+    if len(names) != 2:
+        raise GapError(f"--cross {args.cross!r}: give two plants, DATA,SIM")
+    plants = [parse_plant_spec(n) for n in names]
+    cases = [c for c in args.cases.split(",") if c]
+    sizes = [float(x) for x in args.sizes.split(",")]
+    seeds = [int(x) for x in args.seeds.split(",")]
+    out: dict[str, object] = {}
+    for data, sim in (plants, plants[::-1]):
+        label = f"data {data.name} / simulator {sim.name}"
+        print(f"cross-plant self-test, {label}:", flush=True)
+        st = run_crosstest(data, sim, cases, sizes, seeds, args.selftest_rate_hz,
+                           cross_config(sim.fit, args.method),
+                           progress=lambda c: print(
+                               f"  {c.case:<11} {c.duration_s:5.0f} s seed {c.seed}: "
+                               f"{c.verdict:<26} top={c.top or 'none':<11} ({c.wall_s:.1f} s)",
+                               flush=True))
+        print(selftest_markdown(st), flush=True)
+        out[label] = {"summary": st.summary(), "confusion": st.confusion(),
+                      "cases": [vars(c) for c in st.cases]}
+    return out

@@ -14,11 +14,13 @@ from typing import Any
 import yaml
 
 from simrig.plant import load_plant
+from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
 from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
-from tsmd.gap.diagnose import GapConfig, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
 from tsmd.gap.report import finite_json, write_report
+from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,
     BUILTIN_PLANT,
@@ -65,6 +67,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cases", default=",".join(EFFECTS),
                         help=f"selftest: cases ({', '.join(EFFECTS)})")
     parser.add_argument("--rate-hz", type=float, default=50.0, help="selftest: sample rate")
+    parser.add_argument("--method", default="signature", choices=("signature", "candidates"),
+                        help="effects by their condition signature on top of a structural "
+                             "hysteresis layer (default; holds when the base physics differ), "
+                             "or the earlier candidate transforms around the plant")
+    parser.add_argument("--data-plant", default=None, metavar="SPEC",
+                        help="selftest across plants: the plant that makes the 'real' data "
+                             "(preset capstan / capstan-other, or module:factory[@{json}])")
+    parser.add_argument("--sim-plant", default=None, metavar="SPEC",
+                        help="selftest across plants: the plant used as the simulator")
 
 
 def _load_params(text: str | None) -> dict[str, Any]:
@@ -137,7 +148,8 @@ def main(args: argparse.Namespace) -> int:
     config = GapConfig(fit_specs=specs,
                        holdout=holdout if isinstance(holdout, float) else tuple(holdout),
                        block_s=args.block_s, fit_max_rows=max(args.fit_rows, 200),
-                       joint_top=max(args.joint_top, 0), seed=args.seed)
+                       joint_top=max(args.joint_top, 0), seed=args.seed,
+                       method=args.method)
     result = diagnose(series, _factory(args.plant, params), params, config)
     out = Path(args.out)
     md, js = write_report(result, out, ", ".join(names),
@@ -163,7 +175,16 @@ def _selftest(args: argparse.Namespace) -> int:
         print(f"  {c.case:<11} {c.duration_s:5.0f} s seed {c.seed}: {c.verdict:<26} "
               f"top={c.top or 'none':<11} ({c.wall_s:.1f} s)", flush=True)
 
-    result = run_selftest(cases, sizes, seeds, args.rate_hz, progress=progress)
+    if args.data_plant or args.sim_plant:
+
+        data = parse_plant_spec(args.data_plant or "capstan-other")
+        sim = parse_plant_spec(args.sim_plant or "capstan")
+        result = run_crosstest(data, sim, cases, sizes, seeds, args.rate_hz,
+                               cross_config(sim.fit, args.method), progress=progress)
+    else:
+        result = run_selftest(cases, sizes, seeds, args.rate_hz,
+                              GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method),
+                              progress=progress)
     text = selftest_markdown(result)
     print(text)
     out = Path(args.out)

@@ -35,6 +35,11 @@ class GapSeries:
     channel_valid: tuple[bool, bool, bool, bool] = (True, True, True, True)
     """Per channel (tip1, tip2, cur1, cur2): False when it never changes in this recording
     (a sensor that was not connected); such a channel is left out of fits and scores."""
+    config: str = ""
+    """Sheath shape / configuration label from the header (``configuration`` or
+    ``sheath_shape``); recordings with different labels let curvature be told from friction."""
+    catheter: str = ""
+    """Catheter id from the header (``catheter``), for the report."""
 
     def __len__(self) -> int:
         return len(self.t_s)
@@ -105,7 +110,17 @@ def series_from_recording(rec: Recording, name: str) -> GapSeries:
         knob_deg=np.column_stack([knob[0], knob[1]]),
         current_A=np.column_stack([cols["cur1"], cols["cur2"]]),
         tip_deg=np.column_stack([tips[0], tips[1]]),
-        knob_source=knob_source, channel_valid=valid)  # type: ignore[arg-type]
+        knob_source=knob_source, channel_valid=valid,  # type: ignore[arg-type]
+        config=condition_label(rec.metadata), catheter=rec.metadata.get("catheter", ""))
+
+
+CONFIG_KEYS: tuple[str, ...] = ("configuration", "sheath_shape")
+"""Header keys naming the condition a recording was taken in (first one present wins)."""
+
+
+def condition_label(metadata: dict[str, str]) -> str:
+    """The recording's configuration label from its header, '' when it has none."""
+    return next((metadata[k].strip() for k in CONFIG_KEYS if metadata.get(k, "").strip()), "")
 
 
 @dataclass(frozen=True)
@@ -190,6 +205,18 @@ def make_split(series: Sequence[GapSeries], holdout: float | Sequence[str] = 0.3
                        f"needs at least {MIN_BLOCKS}")
     if n_test == 0 or all(h.all() for h in held):
         raise GapError("the split leaves no training or no held-out data")
+    for c, channel in enumerate(("tip1", "tip2", "cur1", "cur2")):
+        tested = [s.name for s, h in zip(series, held, strict=True)
+                  if s.channel_valid[c] and h.any()]
+        trained = any(s.channel_valid[c] and not h.all() for s, h in zip(series, held,
+                                                                         strict=True))
+        if tested and not trained:
+            raise GapError(f"{channel} is measured in the held-out data ({', '.join(tested)}) "
+                           "but in no training row: nothing to fit it on; hold out other data")
+    if not any(s.channel_valid[c] and h.any() for s, h in zip(series, held, strict=True)
+               for c in (0, 1)):
+        raise GapError("the held-out data have no tip measurement (tip1 and tip2 never change "
+                       "there): nothing to score the gap on; hold out other data")
     n_test_blocks = len(split.test_blocks())
     if n_test_blocks < 3:
         raise GapError(f"only {n_test_blocks} held-out blocks: too few for a confidence interval")

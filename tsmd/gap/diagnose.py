@@ -12,7 +12,6 @@ from __future__ import annotations
 import copy
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -25,7 +24,6 @@ from tsmd.gap.model import (
     Active,
     Candidate,
     Evaluator,
-    ParamSpec,
     Prediction,
     View,
     build_views,
@@ -35,99 +33,11 @@ from tsmd.gap.model import (
     joint_refine,
     polish_base,
 )
+from tsmd.gap.result import CandidateScore, GapConfig, GapResult
 from tsmd.gap.simulate import PlantFactory
 from tsmd.gap.stats import bootstrap_ratio_ci, noise_variance, pooled_ljung_box, ptpe, rmse
+from tsmd.gap.structure import signature_stage
 from tsmd.gap.where import BinRow, breakdown, label_knob
-
-
-@dataclass(frozen=True)
-class GapConfig:
-    """Settings of one diagnosis (defaults are what `tsmd gap` uses)."""
-
-    fit_specs: tuple[ParamSpec, ...] = ()
-    holdout: float | tuple[str, ...] = 0.3
-    block_s: float | None = None
-    fit_max_rows: int = 2000
-    rank_max_rows: int = 6000
-    base_evals: int = 120
-    polish_evals: int = 20
-    refine_evals: int = 10
-    joint_top: int = 2
-    candidate_evals: int = 8
-    seed: int = 0
-    n_boot: int = 2000
-    ci_level: float = 0.9
-    family_alpha: float = 0.05
-    min_share: float = 0.05
-    explained_share: float = 0.5
-    gap_floor: float = 0.1
-    max_combined: int = 3
-    candidates: tuple[str, ...] | None = None
-
-
-@dataclass
-class CandidateScore:
-    name: str
-    title: str
-    physics: str
-    params: dict[str, float]
-    share: float
-    ci: tuple[float, float]
-    significant: bool
-    train_cost_drop: float
-    ljung_box_q: dict[str, float]
-    metrics: dict[str, float]
-    stage: str = "screen"
-
-
-@dataclass
-class GapResult:
-    """Everything the report shows; :meth:`to_json` gives the same figures as plain data."""
-
-    verdict: str
-    summary: str
-    split: str
-    base_params: dict[str, Any]
-    fitted_params: dict[str, float]
-    noise_std: dict[str, float]
-    gap_ratio: tuple[float, float, float]
-    before: dict[str, float]
-    after_top: dict[str, float] | None
-    after_combined: dict[str, float] | None
-    top: list[str]
-    combined: list[str]
-    combined_share: tuple[float, float, float] | None
-    candidates: list[CandidateScore]
-    where_shares: dict[str, dict[str, float]]
-    where_bins: dict[str, list[BinRow]]
-    ljung_box_base: dict[str, float]
-    timing_s: dict[str, float]
-    rows: dict[str, int]
-    plot_data: dict[str, Any] = field(default_factory=dict)
-
-    def to_json(self) -> dict[str, Any]:
-        return {
-            "verdict": self.verdict, "summary": self.summary, "split": self.split,
-            "base_params": self.base_params, "fitted_params": self.fitted_params,
-            "noise_std": self.noise_std,
-            "gap_ratio": {"point": self.gap_ratio[0], "ci": list(self.gap_ratio[1:])},
-            "before": self.before, "after_top": self.after_top,
-            "after_combined": self.after_combined, "top": self.top, "combined": self.combined,
-            "combined_share": (None if self.combined_share is None else
-                               {"point": self.combined_share[0],
-                                "ci": list(self.combined_share[1:])}),
-            "candidates": [{
-                "name": c.name, "title": c.title, "physics": c.physics, "params": c.params,
-                "share": c.share, "ci": list(c.ci), "significant": c.significant,
-                "train_cost_drop": c.train_cost_drop, "ljung_box_q": c.ljung_box_q,
-                "stage": c.stage,
-                "metrics": c.metrics} for c in self.candidates],
-            "where": {
-                group: {"shares": self.where_shares[group],
-                        "bins": [vars(b) for b in self.where_bins[group]]}
-                for group in self.where_shares},
-            "ljung_box_base": self.ljung_box_base, "timing_s": self.timing_s, "rows": self.rows,
-        }
 
 
 def _strides(series: Sequence[GapSeries], max_rows: int) -> list[int]:
@@ -266,7 +176,8 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     rank_stride = [max(-(-n_held // cfg.rank_max_rows), 1)] * len(series)
     fit_views = build_views(series, split, strides, "fit")
     rank_views = build_views(series, split, strides, "eval", rank_stride)
-    final_views = build_views(series, split, strides, "eval")
+    final_stride = [max(-(-n_held // cfg.final_max_rows), 1)] * len(series)
+    final_views = build_views(series, split, strides, "eval", final_stride)
     noise_var = _noise_var(series, split)
     v0 = np.maximum(0.02 * np.percentile(
         np.abs(np.vstack([v.vel_deg_s for v in fit_views])), 95, axis=0), 0.1)
@@ -294,6 +205,26 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     t2 = clock()
     where_shares, where_bins = _where(final_views, base_final)
     timing["where"] = clock() - t2
+
+    if cfg.method == "signature":
+        result = signature_stage(series, split, ev, base_fit, strides, noise_var, cfg)
+        result.before = _metrics(final_views, base_final)
+        result.where_shares, result.where_bins = where_shares, where_bins
+        result.ljung_box_base = _whiteness(rank_views, base_rank)
+        result.base_params = base_params
+        result.fitted_params = {sp.name: float(get_param(base_params, sp.name) or 0.0)
+                                for sp in cfg.fit_specs if "+" not in sp.name}
+        result.split = split.description
+        timing.update(result.timing_s)
+        timing["total"] = clock() - t0
+        result.timing_s = timing
+        result.rows.update({"total": int(sum(len(s) for s in series)), "held_out": n_held,
+                            "simulated": int(ev.sim_rows),
+                            "model_evaluations": int(ev.evaluations),
+                            "fit_stride": int(strides[0])})
+        result.plot_data = {"views": final_views, "base": base_final, "top": None,
+                            "combined": None}
+        return result
 
     # (4) which
     t3 = clock()

@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from tsmd.gap.diagnose import GapResult
 from tsmd.gap.model import Prediction, View
+from tsmd.gap.result import GapResult
 
 
 def _f(x: float | None, digits: int = 3) -> str:
@@ -52,6 +52,11 @@ def markdown(result: GapResult, title: str, plots: dict[str, str]) -> str:
               f"(90 % CI {r.gap_ratio[1]:.2f}..{r.gap_ratio[2]:.2f}; 1 = noise only).", ""]
     if "timeseries" in plots:
         lines += [f"![held-out time series]({plots['timeseries']})", ""]
+    if r.structure is not None:
+        lines += structure_lines(r)
+        if "candidates" in plots:
+            lines += [f"![signature ranking]({plots['candidates']})", ""]
+        return "\n".join(lines + where_lines(r, plots) + fit_lines(r))
     lines += ["## Which effect (candidates fitted on training data, scored on held-out)", "",
               "| rank | effect | share of excess gap | 90 % CI | significant | fitted | "
               "Ljung-Box Q tip1/cur1 |", "| ---: | --- | ---: | --- | --- | --- | --- |"]
@@ -65,7 +70,57 @@ def markdown(result: GapResult, title: str, plots: dict[str, str]) -> str:
               f"{_f(r.ljung_box_base['cur1'])} (20 lags; smaller = whiter residual).", ""]
     if "candidates" in plots:
         lines += [f"![candidate ranking]({plots['candidates']})", ""]
-    lines += ["## Where the gap is (base simulator, held-out residuals)", "",
+    return "\n".join(lines + where_lines(r, plots) + fit_lines(r))
+
+
+def structure_lines(r: GapResult) -> list[str]:
+    """Signature method: base mismatch, then the effect identified on top of it."""
+    st = r.structure or {}
+    fig = st.get("figures", {})
+    cols = [("physics", "physics simulator"), ("layer", "+ structural layer"),
+            ("top", f"+ {r.top[0]}" if r.top else "+ effect (none)")]
+    lines = ["## Base physics and the effect on top (held-out rows of the signature grid)", "",
+             "| figure | " + " | ".join(c[1] for c in cols) + " |",
+             "| --- |" + " ---: |" * len(cols)]
+    for key, label in METRICS:
+        cells = []
+        for name, _ in cols:
+            m = fig.get(name)
+            if m is None:
+                cells.append("-")
+                continue
+            cell = _f(m.get(key))
+            lo, hi = key.replace("_rmse_", "_rmse_lo_"), key.replace("_rmse_", "_rmse_hi_")
+            if "_rmse_" in key and lo in m:
+                cell += f" ({_f(m[lo])}..{_f(m[hi])})"
+            cells.append(cell)
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    lines += ["", f"RMSE with its 90 % block-bootstrap interval. The structural layer (a "
+              f"generalized Prandtl-Ishlinskii hysteresis of each knob around the simulator, "
+              f"fitted on training rows) absorbs {_pct(st.get('layer_absorbs', math.nan))} of "
+              f"the simulator's held-out excess over noise: that part of the gap is the base "
+              f"physics. What it leaves is {st.get('layer_ratio', math.nan):.2f}x the noise.",
+              "", "## Which effect (signatures against surrogate nulls)", "",
+              "| rank | effect | depends on | share beyond null | 90 % CI | significant | "
+              "true condition | surrogates |",
+              "| ---: | --- | --- | ---: | --- | --- | ---: | ---: |"]
+    for i, sgn in enumerate(st.get("signatures", []), 1):
+        lines.append(f"| {i} | {sgn['title']} | {sgn['condition']} | {_pct(sgn['share'])} | "
+                     f"{_pct(sgn['ci'][0])}..{_pct(sgn['ci'][1])} | "
+                     f"{'yes' if sgn['significant'] else 'no'} | {_pct(sgn['raw_share'])} | "
+                     f"{_pct(sgn['null_share'])} |")
+    lines += ["", "Shares are of the excess the structural layer leaves on held-out blocks; "
+              "'beyond null' subtracts what the same regressors built from a surrogate condition "
+              "(shifted in time, a slow wave for time, configurations re-drawn, a lead for a lag) "
+              "remove. Significant: the true condition's gain lies above the surrogates' spread "
+              "(z above the one-sided 5 % / number of signatures point), the one-sided block-"
+              "bootstrap bound at that level is above zero, and the share is at least 5 %.", ""]
+    return lines
+
+
+def where_lines(r: GapResult, plots: dict[str, str]) -> list[str]:
+    """Where the simulator's held-out gap lies."""
+    lines = ["## Where the gap is (base simulator, held-out residuals)", "",
               "Share of the residual sum of squares that one constant offset removes, and that "
               "each factor's bin means remove beyond it:", "",
               "| factor | tip | current |", "| --- | ---: | ---: |"]
@@ -85,7 +140,12 @@ def markdown(result: GapResult, title: str, plots: dict[str, str]) -> str:
                              f"{_f(b.rms)} | {_f(b.mean)} |")
     if "where" in plots:
         lines += ["", f"![where the gap is]({plots['where']})"]
-    lines += ["", "## Base fit", "",
+    return lines
+
+
+def fit_lines(r: GapResult) -> list[str]:
+    """Split, fitted parameters, noise floor and cost."""
+    return ["", "## Base fit", "",
               f"- Split: {r.split}; {r.rows['held_out']} of {r.rows['total']} rows held out.",
               "- Fitted plant parameters: " + (", ".join(
                   f"{k}={v:.4g}" for k, v in r.fitted_params.items()) or "none"),
@@ -98,7 +158,6 @@ def markdown(result: GapResult, title: str, plots: dict[str, str]) -> str:
               "significant when it removes at least 5 % and its one-sided bootstrap lower bound "
               "(over held-out time blocks) at 5 % / number of candidates tried is above zero "
               "(Bonferroni); the table shows the 90 % interval.", ""]
-    return "\n".join(lines)
 
 
 def plots(result: GapResult, out_dir: Path, prefix: str = "gap") -> dict[str, str]:
@@ -113,9 +172,10 @@ def plots(result: GapResult, out_dir: Path, prefix: str = "gap") -> dict[str, st
     views: list[View] = result.plot_data.get("views", [])
     base: Prediction | None = result.plot_data.get("base")
     top: Prediction | None = result.plot_data.get("top")
-    cands = [v for v in views if v.test.any()]
-    if cands and base is not None:
-        i = max(range(len(views)), key=lambda j: float(np.ptp(views[j].knob_deg[views[j].test])))
+    with_test = [j for j, v in enumerate(views) if v.test.any()]
+    if with_test and base is not None:
+        # the widest held-out motion, among the views that have held-out rows at all
+        i = max(with_test, key=lambda j: float(np.ptp(views[j].knob_deg[views[j].test])))
         v = views[i]
         knob = int(np.argmax(np.ptp(v.knob_deg, axis=0)))
         t = v.t_s - v.series.t_s[0]
@@ -179,19 +239,35 @@ def plots(result: GapResult, out_dir: Path, prefix: str = "gap") -> dict[str, st
 
 def write_report(result: GapResult, out_dir: Path, title: str,
                  extra: dict[str, Any] | None = None) -> tuple[Path, Path]:
-    """Write ``gap_report.md``, ``gap_report.json`` and the plots into ``out_dir``."""
+    """Write ``gap_report.json``, ``gap_report.md`` and the plots into ``out_dir``.
+
+    The figures are written first, and a failing plot stage costs only the plots (its reason is
+    kept in the report): minutes of diagnosis are never lost to a drawing problem.
+    """
     out_dir.mkdir(parents=True, exist_ok=True)
-    files = plots(result, out_dir)
-    md = out_dir / "gap_report.md"
-    md.write_text(markdown(result, title, files), encoding="utf-8")
     data = result.to_json()
     data["title"] = title
-    data["plots"] = files
     if extra:
         data.update(extra)
     js = out_dir / "gap_report.json"
-    js.write_text(json.dumps(finite_json(data), indent=2, default=_jsonable, allow_nan=False),
-                  encoding="utf-8")
+    md = out_dir / "gap_report.md"
+
+    def save(files: dict[str, str], plot_error: str | None) -> None:
+        data["plots"] = files
+        data["plot_error"] = plot_error
+        js.write_text(json.dumps(finite_json(data), indent=2, default=_jsonable,
+                                 allow_nan=False), encoding="utf-8")
+        text = markdown(result, title, files)
+        if plot_error:
+            text += f"\nPlots not drawn: {plot_error}\n"
+        md.write_text(text, encoding="utf-8")
+
+    save({}, None)
+    try:
+        files, error = plots(result, out_dir), None
+    except Exception as exc:  # any drawing failure must not lose the figures
+        files, error = {}, f"{type(exc).__name__}: {exc}"
+    save(files, error)
     return md, js
 
 

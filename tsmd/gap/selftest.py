@@ -24,10 +24,12 @@ from numpy.typing import NDArray
 
 from simrig.current_sensor import CurrentSensor
 from simrig.plant import load_plant
+from simrig.plants.capstan import DEFAULT_KNOBS
 from simrig.tracker import EmTracker
 from tsmd.gap.data import series_from_recording
-from tsmd.gap.diagnose import GapConfig, GapResult, diagnose
+from tsmd.gap.diagnose import diagnose
 from tsmd.gap.model import ParamSpec
+from tsmd.gap.result import GapConfig, GapResult
 from tsmd.gap.simulate import simulate
 from tsmd.recording import Recording
 
@@ -122,8 +124,6 @@ def unit_knobs(seed: int, variation: float,
     fit is the effect put in (plus noise). ``defaults``: the plant's per-knob constants (default:
     the built-in plant's ``DEFAULT_KNOBS``).
     """
-    from simrig.plants.capstan.tendon_sheath import DEFAULT_KNOBS
-
     rng = np.random.default_rng(1000 + seed)
     names = ("slack_pos_mm", "slack_neg_mm", "sheath_friction")
     return [{k: float(getattr(knob, k)) * (1.0 + variation * rng.uniform(-1, 1)) for k in names}
@@ -239,6 +239,10 @@ class SelftestCase:
     cur_rmse_before: float
     cur_rmse_after: float | None
     wall_s: float
+    excess_shrink: float | None = None
+    """Held-out: share of the remaining excess the named effect removes (signature method)."""
+    physics_tip_rmse: float | None = None
+    """Held-out tip RMSE of the physics simulator alone (the base mismatch, signature method)."""
 
     @property
     def correct(self) -> bool:
@@ -276,7 +280,21 @@ class SelftestResult:
             "median_current_rmse_shrink_when_correct": float(np.median(cur_shrink))
             if cur_shrink else float("nan"),
             "median_wall_s": float(np.median([c.wall_s for c in self.cases])),
+            "median_excess_shrink_when_correct": _median(
+                [c.excess_shrink for c in effect_cases if c.correct]),
+            "worst_excess_shrink_when_correct": _min(
+                [c.excess_shrink for c in effect_cases if c.correct]),
         }
+
+
+def _median(values: Sequence[float | None]) -> float:
+    found = [v for v in values if v is not None]
+    return float(np.median(found)) if found else float("nan")
+
+
+def _min(values: Sequence[float | None]) -> float:
+    found = [v for v in values if v is not None]
+    return float(np.min(found)) if found else float("nan")
 
 
 def _tip_rmse(m: dict[str, float] | None) -> float | None:
@@ -336,6 +354,9 @@ def selftest_markdown(result: SelftestResult) -> str:
              f"{s['median_tip_rmse_shrink_when_correct']:.0%} |",
              f"| median held-out current RMSE shrink, correct cases | "
              f"{s['median_current_rmse_shrink_when_correct']:.0%} |",
+             f"| median / worst held-out shrink of the named effect's excess, correct cases | "
+             f"{s['median_excess_shrink_when_correct']:.0%} / "
+             f"{s['worst_excess_shrink_when_correct']:.0%} |",
              f"| median wall time per diagnosis | {s['median_wall_s']:.1f} s |", "",
              "Confusion matrix (rows: effect in the data; columns: top-1 diagnosis):", ""]
     conf = result.confusion()

@@ -137,6 +137,8 @@ def breakdown(resid: Sequence[NDArray[np.float64]], labels: Sequence[KnobLabels]
 
     ``resid`` and ``labels`` are parallel lists (one entry per knob-channel and series).
     """
+    if not resid:  # no held-out row measures this channel group
+        return {"constant offset": 0.0, **{f: 0.0 for f in FACTORS}}, []
     r = np.concatenate([np.asarray(x, dtype=float) for x in resid]) * weight
     total = float(np.sum(r * r))
     offset = float(r.size * r.mean() ** 2) if r.size else 0.0

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import re
+import typing
 from pathlib import Path
 
 import pytest
 import yaml
 
+from tsmd.compensation import METHODS
 from tsmd.config import (
+    CompensationMethod,
     ConfigError,
     TsmdConfig,
     default_sim_config,
@@ -148,3 +151,7 @@ def test_the_example_in_docs_configuration_is_valid() -> None:
     config = parse_config(yaml.safe_load(match.group(1)), "docs example")
     assert [d["node_id"] for d in config.drives] == [1, 2]
     assert config.loop.realtime.cpu == 1
+
+
+def test_the_config_accepts_exactly_the_compensation_methods_there_are() -> None:
+    assert set(typing.get_args(CompensationMethod)) == set(METHODS)

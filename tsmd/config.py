@@ -27,7 +27,7 @@ from tsmd.yamlfile import read_yaml
 
 DEFAULT_CONFIG_PATH = Path("/etc/tsmd/tsmd.yaml")
 
-CompensationMethod = Literal["none", "paper", "ours"]
+CompensationMethod = Literal["none", "paper", "ours", "tension"]
 CanLogFormat = Literal["none", "blf", "asc"]
 
 

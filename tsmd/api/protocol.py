@@ -12,6 +12,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from tsmd.compensation import METHODS
+
 MAX_ID_CHARS = 128
 
 
@@ -49,7 +51,6 @@ COMMANDS: dict[str, dict[str, bool]] = {
     "home": {"drives": False},
 }
 
-METHODS = ("none", "paper", "ours")
 
 
 def _reject_constant(name: str) -> Any:

@@ -14,6 +14,7 @@ from typing import Any, cast
 
 import numpy as np
 
+from tsmd.compensation import METHODS
 from tsmd.config import (
     DEFAULT_CONFIG_PATH,
     TsmdConfig,
@@ -38,7 +39,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     comp.add_argument("--profile", metavar="ID|FILE",
                       help="catheter profile: an id in profiles.dir or a YAML file "
                            "(default profiles.active)")
-    parser.add_argument("--method", choices=("paper", "ours"),
+    parser.add_argument("--method", choices=[m for m in METHODS if m != "none"],
                         help="compensator (default compensation.method of the config)")
     parser.add_argument("--sim", action="store_true",
                         help="lockstep on the in-process simulated rig (deterministic)")

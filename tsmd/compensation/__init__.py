@@ -37,6 +37,7 @@ if TYPE_CHECKING:
     from tsmd.profile import CatheterProfile
 
 METHODS: tuple[str, ...] = ("none", "paper", "ours", "tension")
+"""Also the config's ``CompensationMethod`` (a test keeps the two equal)."""
 
 __all__ = [
     "METHODS",

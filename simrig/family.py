@@ -228,3 +228,13 @@ def family(plant: str, units: int, held_out: bool = False, variants: bool = Fals
     if variants:
         members += [family_member(plant, 0, v, seed=seed) for v in VARIANTS]
     return members
+
+
+def make_family_plant(plant: str = "capstan", unit: int = 0, variant: str | None = None,
+                      seed: int = 0) -> Plant:
+    """A ``module:factory`` entry for one family member's plant
+    (``simrig.family:make_family_plant`` with ``{"plant": "lumped", "unit": 101}``), so that
+    anything taking a plant factory (config ``sim.plant``, ``tsmd datasheet``, the benchmarks)
+    can draw units of either plant. The member's motor and sensor variants are not applied here:
+    they belong to the rig (:meth:`FamilyMember.rig_kwargs`)."""
+    return family_member(plant, unit, variant, seed).build()

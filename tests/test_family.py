@@ -14,7 +14,7 @@ from simrig.family import (
     family,
     family_member,
 )
-from simrig.plant import Plant, PlantLoadError, load_plant
+from simrig.plant import Plant, PlantLoadError, as_plant_step, load_plant
 from simrig.rig import DEFAULT_CURRENT_SENSOR
 
 
@@ -97,3 +97,14 @@ def test_family_lists_nominal_units_then_variants() -> None:
 def test_bad_member_requests_are_refused(kwargs: dict[str, object], message: str) -> None:
     with pytest.raises(PlantLoadError, match=message):
         family_member(**kwargs)  # type: ignore[arg-type]
+
+
+def test_a_family_member_can_be_built_through_the_plant_loader() -> None:
+    direct = family_member("lumped", 101).build()
+    loaded = load_plant("simrig.family:make_family_plant", {"plant": "lumped", "unit": 101})
+    knob = np.array([30.0, -20.0])
+    for _ in range(50):
+        a = as_plant_step(direct.step(0.004, knob))
+        b = as_plant_step(loaded.step(0.004, knob))
+    assert np.array_equal(a.tip_deg, b.tip_deg)
+    assert np.array_equal(a.knob_torque_Nm, b.knob_torque_Nm)

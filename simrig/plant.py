@@ -6,6 +6,7 @@ Users plug their own catheter model in with ``module:factory`` and keyword param
 from __future__ import annotations
 
 import importlib
+import math
 from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
@@ -81,3 +82,19 @@ def load_plant(spec: str, params: dict[str, Any] | None = None) -> Plant:
     if not isinstance(plant, Plant):
         raise PlantLoadError(f"{spec!r} returned {type(plant).__name__}, which is not a Plant")
     return plant
+
+
+def step_inputs(dt_s: float, knob_deg: Any) -> tuple[float, float]:
+    """A plant step's arguments checked: ``dt_s >= 0`` and two finite knob angles (deg).
+
+    Part of the protocol so that every plant refuses bad input the same way (``ValueError``).
+    """
+    if not dt_s >= 0.0:
+        raise ValueError(f"dt_s must be >= 0, got {dt_s!r}")
+    try:
+        q0, q1 = (float(x) for x in knob_deg)
+    except (TypeError, ValueError):
+        raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}") from None
+    if not (math.isfinite(q0) and math.isfinite(q1)):
+        raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}")
+    return q0, q1

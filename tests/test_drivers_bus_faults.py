@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+from support.drives import open_enabled_rig, tick
 from support.plants import SpringPlant
 
 from drivers import can_errors as ce
@@ -16,21 +17,10 @@ PERIOD_S = 0.004
 
 @pytest.fixture()
 def enabled():
-    drives, rig = open_sim_rig(SpringPlant(), None, PERIOD_S, seed=2)
-    drives.boot()
-    drives.enable()
-    assert drives.poll_events() == []
+    drives, rig = open_enabled_rig(2, PERIOD_S)
     yield drives, rig
     drives.close()
     rig.close()
-
-
-def tick(drives, rig, q=(0.0, 0.0), n: int = 1) -> None:
-    for _ in range(n):
-        drives.write_targets(q)
-        drives.sync()
-        rig.exchange()
-        drives.pump()
 
 
 # --- error frames ----------------------------------------------------------------------------

@@ -7,6 +7,7 @@ import time
 import can
 import numpy as np
 import pytest
+from support.drives import open_enabled_rig, tick
 from support.plants import SpringPlant
 
 from drivers.canopen_master import CanOpenDrives
@@ -20,21 +21,10 @@ PERIOD_S = 0.004
 
 @pytest.fixture()
 def enabled():
-    drives, rig = open_sim_rig(SpringPlant(), None, PERIOD_S, seed=5)
-    drives.boot()
-    drives.enable()
-    assert drives.poll_events() == []
+    drives, rig = open_enabled_rig(5, PERIOD_S)
     yield drives, rig
     drives.close()
     rig.close()
-
-
-def tick(drives, rig, q=(0.0, 0.0), n: int = 1) -> None:
-    for _ in range(n):
-        drives.write_targets(q)
-        drives.sync()
-        rig.exchange()
-        drives.pump()
 
 
 def run_until(drives, rig, kind: FaultKind, max_ticks: int, q=(0.0, 0.0)):

@@ -7,10 +7,13 @@ fields to produce faults. Every target written is kept, so tests can assert limi
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
 from drivers.drive import DriveError, DriveFeedback, DriveState, FaultEvent, FaultKind, KnobDrives
+from simrig.rig import open_sim_rig
+from support.plants import SpringPlant
 
 
 class FakeDrives(KnobDrives):
@@ -99,3 +102,21 @@ class FakeDrives(KnobDrives):
 
     def targets_array(self) -> np.ndarray:
         return np.array(self.targets, dtype=float).reshape(-1, 2)
+
+
+def open_enabled_rig(seed: int, period_s: float = 0.004) -> tuple[Any, Any]:
+    """Two simulated drives on a spring plant, booted and enabled, with no fault pending."""
+    drives, rig = open_sim_rig(SpringPlant(), None, period_s, seed=seed)
+    drives.boot()
+    drives.enable()
+    assert drives.poll_events() == []
+    return drives, rig
+
+
+def tick(drives: Any, rig: Any, q: Sequence[float] = (0.0, 0.0), n: int = 1) -> None:
+    """``n`` lockstep ticks of the master and the rig with the knob targets ``q``."""
+    for _ in range(n):
+        drives.write_targets(q)
+        drives.sync()
+        rig.exchange()
+        drives.pump()

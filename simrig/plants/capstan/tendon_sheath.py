@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from simrig.plant import PlantLoadError, PlantStep
+from simrig.plant import PlantLoadError, PlantStep, step_inputs
 from simrig.plants.capstan.tendon import (
     TendonGeometry,
     apply_pull,
@@ -458,14 +458,7 @@ class TendonSheathPlant:
 
     def step(self, dt_s: float, knob_deg: NDArray[np.float64]) -> PlantStep:
         """Move the knobs to ``knob_deg`` (degrees, shape (2,)) and settle."""
-        if not dt_s >= 0.0:
-            raise ValueError(f"dt_s must be >= 0, got {dt_s!r}")
-        try:
-            q0, q1 = (float(x) for x in knob_deg)
-        except (TypeError, ValueError):
-            raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}") from None
-        if not (math.isfinite(q0) and math.isfinite(q1)):
-            raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}")
+        q0, q1 = step_inputs(dt_s, knob_deg)
         k0, k1 = self._knobs
         tips = (k0.tip_rad, k1.tip_rad)
         tip0, tau0 = k0.step(dt_s, math.radians(q0), tips[1], self.effects)

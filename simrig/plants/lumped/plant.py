@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from simrig.plant import PlantLoadError, PlantStep
+from simrig.plant import PlantLoadError, PlantStep, step_inputs
 from simrig.plants.lumped.params import NOMINAL_KNOBS, LumpedEffects, LumpedKnobParams
 
 _EPS_N_PER_M = 1.0
@@ -319,14 +319,7 @@ class LumpedPlant:
 
     def step(self, dt_s: float, knob_deg: NDArray[np.float64]) -> PlantStep:
         """Move the knobs to ``knob_deg`` (degrees, shape (2,)) and settle."""
-        if not dt_s >= 0.0:
-            raise ValueError(f"dt_s must be >= 0, got {dt_s!r}")
-        try:
-            q0, q1 = (float(x) for x in knob_deg)
-        except (TypeError, ValueError):
-            raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}") from None
-        if not (math.isfinite(q0) and math.isfinite(q1)):
-            raise ValueError(f"knob_deg must be 2 finite angles, got {knob_deg!r}")
+        q0, q1 = step_inputs(dt_s, knob_deg)
         k0, k1 = self._knobs
         tips = (k0.tip_rad, k1.tip_rad)
         loads = (sum(k0.proximal_N), sum(k1.proximal_N))

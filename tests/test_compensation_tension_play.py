@@ -95,7 +95,8 @@ def test_zero_backlash_gain_is_a_play_without_backlash() -> None:
 @settings(max_examples=200, deadline=None)
 def test_rising_branch_never_above_falling_branch(p: TensionPlayParams, x: float) -> None:
     b = knob_branches(p)
-    assert b.rising(x) <= b.falling(x)
+    # where the branches meet they are equal up to rounding (hypothesis found a 1-ulp case)
+    assert b.rising(x) <= b.falling(x) + 1e-9 * max(1.0, abs(b.falling(x)))
 
 
 @given(random_params, desired_paths)

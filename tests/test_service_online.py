@@ -13,16 +13,18 @@ import pytest
 from tsmd.api.client import ApiClient, ApiClientError
 from tsmd.config import TsmdConfig, default_sim_config, resolve_data_path
 from tsmd.daemon import SIM_EXAMPLE_PROFILE, Daemon
+from tsmd.online import RECORDING_COLUMNS
 from tsmd.online.apply import edges_at
 from tsmd.online.worker import OnlineWorker
 from tsmd.profile import load_profile
+from tsmd.recording import REQUIRED_COLUMNS, read_recording
 from tsmd.stack import make_compensator
 
 CATHETER = "example-sim"
 OTHER_KNOB_DEG = (-40.0, 0.0, 25.0)
 
 
-def sim_config(tmp_path: Path, *, online: bool) -> TsmdConfig:
+def sim_config(tmp_path: Path, *, online: bool, recording: bool = False) -> TsmdConfig:
     """The packaged sim config with the example profile in a store of its own."""
     store = tmp_path / "profiles"
     store.mkdir(exist_ok=True)
@@ -30,15 +32,17 @@ def sim_config(tmp_path: Path, *, online: bool) -> TsmdConfig:
     base = default_sim_config()
     return dataclasses.replace(
         base, profiles=dataclasses.replace(base.profiles, dir=str(store), active=CATHETER),
-        online=dataclasses.replace(base.online, enabled=online))
+        online=dataclasses.replace(base.online, enabled=online),
+        recording=dataclasses.replace(base.recording, enabled=recording,
+                                      dir=str(tmp_path / "rec"), flush_interval_s=0.1))
 
 
 @pytest.fixture
-def start_daemon(tmp_path: Path) -> Iterator[Callable[[bool], Daemon]]:
+def start_daemon(tmp_path: Path) -> Iterator[Callable[..., Daemon]]:
     started: list[Daemon] = []
 
-    def start(online: bool) -> Daemon:
-        d = Daemon(sim_config(tmp_path, online=online), sim=True,
+    def start(online: bool, recording: bool = False) -> Daemon:
+        d = Daemon(sim_config(tmp_path, online=online, recording=recording), sim=True,
                    socket_path=str(tmp_path / "d.sock"))
         started.append(d)
         d.start()
@@ -82,7 +86,7 @@ def estimate(worker: OnlineWorker, offset_deg: float, timeout_s: float = 10.0) -
     time.sleep(0.1)  # a few ticks: the loop thread hands the published knobs over
 
 
-def test_status_shows_online_disabled_by_default(start_daemon: Callable[[bool], Daemon]
+def test_status_shows_online_disabled_by_default(start_daemon: Callable[..., Daemon]
                                                  ) -> None:
     daemon = start_daemon(False)
     with client(daemon) as c:
@@ -91,7 +95,7 @@ def test_status_shows_online_disabled_by_default(start_daemon: Callable[[bool], 
 
 
 def test_online_enabled_in_the_config_starts_a_worker_on_the_loop(
-        start_daemon: Callable[[bool], Daemon]) -> None:
+        start_daemon: Callable[..., Daemon]) -> None:
     daemon = start_daemon(True)
     worker = running_worker(daemon)
     assert daemon.loop is not None and daemon.loop.observer == worker.observe
@@ -102,7 +106,7 @@ def test_online_enabled_in_the_config_starts_a_worker_on_the_loop(
     assert set(online["edges"]) == {"phi1_pos", "phi1_neg", "phi2_pos", "phi2_neg"}
 
 
-def test_an_estimate_moves_the_compensators_edge(start_daemon: Callable[[bool], Daemon]
+def test_an_estimate_moves_the_compensators_edge(start_daemon: Callable[..., Daemon]
                                                  ) -> None:
     daemon = start_daemon(True)
     worker = running_worker(daemon)
@@ -114,7 +118,7 @@ def test_an_estimate_moves_the_compensators_edge(start_daemon: Callable[[bool], 
 
 
 def test_the_online_command_off_restores_the_profiles_edges(
-        start_daemon: Callable[[bool], Daemon]) -> None:
+        start_daemon: Callable[..., Daemon]) -> None:
     daemon = start_daemon(True)
     worker = running_worker(daemon)
     estimate(worker, 2.0)
@@ -128,7 +132,7 @@ def test_the_online_command_off_restores_the_profiles_edges(
 
 
 def test_the_online_command_on_starts_a_worker_not_configured_at_start(
-        start_daemon: Callable[[bool], Daemon]) -> None:
+        start_daemon: Callable[..., Daemon]) -> None:
     daemon = start_daemon(False)
     with client(daemon) as c:
         assert c.call("online", enabled=True)["enabled"] is True
@@ -137,7 +141,7 @@ def test_the_online_command_on_starts_a_worker_not_configured_at_start(
 
 
 def test_online_without_a_compensator_it_can_re_estimate_is_refused(
-        start_daemon: Callable[[bool], Daemon]) -> None:
+        start_daemon: Callable[..., Daemon]) -> None:
     daemon = start_daemon(False)
     with client(daemon) as c:
         c.call("compensation", enabled=False)
@@ -149,7 +153,7 @@ def test_online_without_a_compensator_it_can_re_estimate_is_refused(
 
 
 def test_a_new_profile_rebuilds_the_worker_on_the_new_compensator(
-        start_daemon: Callable[[bool], Daemon]) -> None:
+        start_daemon: Callable[..., Daemon]) -> None:
     daemon = start_daemon(True)
     old = running_worker(daemon)
     estimate(old, 2.0)
@@ -164,7 +168,7 @@ def test_a_new_profile_rebuilds_the_worker_on_the_new_compensator(
 
 
 def test_online_save_writes_a_new_version_and_leaves_the_calibrated_profile_intact(
-        start_daemon: Callable[[bool], Daemon], tmp_path: Path) -> None:
+        start_daemon: Callable[..., Daemon], tmp_path: Path) -> None:
     daemon = start_daemon(True)
     calibrated = tmp_path / "profiles" / f"{CATHETER}.yaml"
     before = calibrated.read_bytes()
@@ -185,7 +189,7 @@ def test_online_save_writes_a_new_version_and_leaves_the_calibrated_profile_inta
     assert loaded["profile"] == path.stem
 
 
-def test_online_save_while_online_is_off_is_refused(start_daemon: Callable[[bool], Daemon],
+def test_online_save_while_online_is_off_is_refused(start_daemon: Callable[..., Daemon],
                                                     tmp_path: Path) -> None:
     daemon = start_daemon(False)
     with client(daemon) as c, pytest.raises(ApiClientError) as exc:
@@ -194,17 +198,37 @@ def test_online_save_while_online_is_off_is_refused(start_daemon: Callable[[bool
     assert sorted(p.name for p in (tmp_path / "profiles").iterdir()) == [f"{CATHETER}.yaml"]
 
 
-def test_online_enabled_must_be_a_boolean(start_daemon: Callable[[bool], Daemon]) -> None:
+def test_online_enabled_must_be_a_boolean(start_daemon: Callable[..., Daemon]) -> None:
     daemon = start_daemon(False)
     with client(daemon) as c, pytest.raises(ApiClientError) as exc:
         c.call("online", enabled="yes")
     assert exc.value.code == "bad_param"
 
 
-def test_shutdown_stops_the_worker(start_daemon: Callable[[bool], Daemon]) -> None:
+def test_shutdown_stops_the_worker(start_daemon: Callable[..., Daemon]) -> None:
     daemon = start_daemon(True)
     worker = running_worker(daemon)
     thread = worker._thread
     daemon.stop()
     assert thread is not None and not thread.is_alive()
     assert daemon.loop is not None and daemon.loop.observer is None
+
+
+def test_a_recording_with_online_on_carries_the_offsets_in_force(
+        start_daemon: Callable[..., Daemon], tmp_path: Path) -> None:
+    daemon = start_daemon(True, recording=True)
+    estimate(running_worker(daemon), 2.0)
+    daemon.stop()
+    (path,) = (tmp_path / "rec").glob("tsmd-*.csv")
+    rec = read_recording(path)
+    assert tuple(rec.columns) == REQUIRED_COLUMNS + RECORDING_COLUMNS
+    assert rec["dz_off_pos1"][0] == 0.0 and rec["dz_off_pos1"][-1] == 2.0
+    assert not rec["dz_off_neg1"].any() and not rec["dz_off_pos2"].any()
+
+
+def test_a_recording_with_online_off_keeps_the_required_columns_only(
+        start_daemon: Callable[..., Daemon], tmp_path: Path) -> None:
+    daemon = start_daemon(False, recording=True)
+    daemon.stop()
+    (path,) = (tmp_path / "rec").glob("tsmd-*.csv")
+    assert tuple(read_recording(path).columns) == REQUIRED_COLUMNS

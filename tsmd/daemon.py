@@ -39,6 +39,7 @@ from tsmd.errors import TsmdError
 from tsmd.log import EventLog, get_logger
 from tsmd.loop import BackgroundRecorder, ControlLoop, LoopError
 from tsmd.notify import Notifier, watchdog_interval_s
+from tsmd.online import RECORDING_COLUMNS
 from tsmd.online.attach import OnlineAttachment
 from tsmd.profile import CatheterProfile, ProfileError, ProfileStore, load_profile
 from tsmd.replay import LiveTrajectoryRunner
@@ -272,12 +273,16 @@ class Daemon:
                 str(directory / f"tsmd-{stamp}.csv"),
                 {"source": "tsmd run", "version": __version__, "rate_hz": config.loop.rate_hz,
                  "profile": getattr(profile, "catheter_id", "none"), "compensation": label,
-                 "sim": self.sim}, config.recording.flush_interval_s)
+                 "sim": self.sim}, config.recording.flush_interval_s,
+                # the file's columns are fixed at its start: online offsets only if on by config
+                RECORDING_COLUMNS if config.online.enabled else ())
         tip_source = self.rig.tip_deg if self.rig is not None else None
         self.loop = build_loop(config, self.drives, compensator, MonotonicClock(),
                                compensation_label=label, tip_source=tip_source,
                                recorder=self.recorder, on_event=self.events.emit)
         self.online = OnlineAttachment(config.online, self.loop, on_event=self.events.emit)
+        if self.recorder is not None and config.online.enabled:
+            self.loop.recorder = self.online.recording(self.recorder)
         self.online.attach(compensator)
         self.service = Service(
             config, self.loop, profile, choice,

@@ -15,8 +15,8 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from tsmd.config import OnlineConfig
-from tsmd.loop import ROW_COLUMNS
-from tsmd.online.apply import OnlineError, save_online_version
+from tsmd.loop import ROW_COLUMNS, TickRecorder
+from tsmd.online.apply import ZERO_OFFSETS, OnlineError, save_online_version
 from tsmd.online.estimator import EstimatorOptions
 from tsmd.online.worker import OnlineWorker
 from tsmd.profile import CatheterProfile
@@ -85,6 +85,17 @@ class OnlineAttachment:
             raise OnlineError("online_save: no catheter profile is loaded")
         return save_online_version(profile, worker.offsets(), directory)
 
+    def offsets_row(self) -> tuple[float, ...]:
+        """The offsets in force, in :data:`tsmd.online.RECORDING_COLUMNS` order (0: none)."""
+        worker = self.worker
+        if worker is None:
+            return (*ZERO_OFFSETS[0], *ZERO_OFFSETS[1])
+        return worker.recording_values()
+
+    def recording(self, recorder: TickRecorder) -> TickRecorder:
+        """``recorder`` with the offsets in force appended to every row."""
+        return _WithOffsets(recorder, self)
+
     def _status(self) -> dict[str, Any]:
         if self.worker is None:
             out: dict[str, Any] = {"enabled": False}
@@ -116,3 +127,14 @@ class OnlineAttachment:
         self.loop.observer = None
         if worker is not None:
             worker.stop()
+
+
+class _WithOffsets:
+    """A tick recorder that appends the online offsets in force to each row."""
+
+    def __init__(self, inner: TickRecorder, attachment: OnlineAttachment) -> None:
+        self.inner = inner
+        self.attachment = attachment
+
+    def append(self, row: tuple[float, ...]) -> None:
+        self.inner.append(row + self.attachment.offsets_row())

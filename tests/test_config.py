@@ -19,6 +19,7 @@ from tsmd.config import (
     load_config,
     parse_config,
 )
+from tsmd.online import EstimatorOptions
 
 
 def write(tmp_path: Path, text: str) -> Path:
@@ -68,6 +69,9 @@ def test_the_packaged_sim_config_is_valid_and_builds_two_drive_configs() -> None
     ("api: {accepts_per_s: 0}", "api.accepts_per_s", "out of range"),
     ("bus: {timeouts: {sdo_s: 0}}", "bus.timeouts.sdo_s", "out of range"),
     ("bus: {timeouts: {boot: 2}}", "bus.timeouts.boot", "unknown key"),
+    ("online: {enabled: maybe}", "online.enabled", "true or false"),
+    ("online: {max_offset_deg: 0}", "online.max_offset_deg", "out of range"),
+    ("online: {window: 3}", "online.window", "unknown key"),
 ])
 def test_bad_value_is_refused_naming_key_and_reason(tmp_path: Path, text: str, key: str,
                                                     reason: str) -> None:
@@ -155,3 +159,13 @@ def test_the_example_in_docs_configuration_is_valid() -> None:
 
 def test_the_config_accepts_exactly_the_compensation_methods_there_are() -> None:
     assert set(typing.get_args(CompensationMethod)) == set(METHODS)
+
+
+def test_online_re_estimation_is_off_by_default() -> None:
+    assert TsmdConfig().online.enabled is False
+
+
+def test_the_online_defaults_are_the_estimators_own() -> None:
+    online, options = TsmdConfig().online, EstimatorOptions()
+    assert (online.gate_deg, online.max_offset_deg, online.deadband_deg) == (
+        options.gate_deg, options.max_offset_deg, options.deadband_deg)

@@ -222,3 +222,18 @@ def test_device_release_constants_go_together(tmp_path: Path) -> None:
     path.write_text(yaml.safe_dump(data))
     with pytest.raises(ProfileError, match="knobs.phi1: release_omega, reference_backlash"):
         load_device_model(path)
+
+
+def test_store_loads_a_version_file_of_the_same_catheter(tmp_path: Path) -> None:
+    store = ProfileStore(tmp_path)
+    save_profile(make_profile("cath-a"), tmp_path / "cath-a.online-20261123T190000.yaml")
+    assert store.load("cath-a.online-20261123T190000").catheter_id == "cath-a"
+
+
+def test_store_refuses_a_file_named_for_another_catheter(tmp_path: Path) -> None:
+    store = ProfileStore(tmp_path)
+    save_profile(make_profile("cath-b"), tmp_path / "cath-a.online-1.yaml")
+    save_profile(make_profile("cath"), tmp_path / "cath-a.yaml")
+    for name in ("cath-a.online-1", "cath-a"):
+        with pytest.raises(ProfileError, match="expected"):
+            store.load(name)

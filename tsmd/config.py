@@ -132,6 +132,25 @@ class CompensationConfig:
 
 
 @dataclass(frozen=True)
+class OnlineConfig:
+    """Online re-estimation of the dead-zone edges from motor current (docs/online.md).
+
+    The numbers are :class:`tsmd.online.EstimatorOptions`' and the worker's; off by default
+    until validated on a real probe.
+    """
+
+    enabled: bool = False
+    rate_deg_s: float = field(default=4.0, metadata=_range(0.1, 100.0))
+    """How fast an applied offset moves towards a new estimate."""
+    max_offset_deg: float = field(default=12.0, metadata=_range(0.5, 45.0))
+    """A larger change is not followed: a warning, the offset stays."""
+    deadband_deg: float = field(default=0.4, metadata=_range(0.0, 5.0))
+    """Changes smaller than this are not applied (hysteresis against noise)."""
+    gate_deg: float = field(default=1.5, metadata=_range(0.1, 20.0))
+    """A measurement this far from the estimate is a suspect until confirmed."""
+
+
+@dataclass(frozen=True)
 class RecordingConfig:
     enabled: bool = False
     dir: str = "/var/lib/tsmd/recordings"
@@ -166,6 +185,7 @@ class TsmdConfig:
     api: ApiConfig = field(default_factory=ApiConfig)
     profiles: ProfilesConfig = field(default_factory=ProfilesConfig)
     compensation: CompensationConfig = field(default_factory=CompensationConfig)
+    online: OnlineConfig = field(default_factory=OnlineConfig)
     recording: RecordingConfig = field(default_factory=RecordingConfig)
     sim: SimConfig = field(default_factory=SimConfig)
 

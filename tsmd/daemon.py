@@ -39,6 +39,8 @@ from tsmd.errors import TsmdError
 from tsmd.log import EventLog, get_logger
 from tsmd.loop import BackgroundRecorder, ControlLoop, LoopError
 from tsmd.notify import Notifier, watchdog_interval_s
+from tsmd.online import RECORDING_COLUMNS
+from tsmd.online.attach import OnlineAttachment
 from tsmd.profile import CatheterProfile, ProfileError, ProfileStore, load_profile
 from tsmd.replay import LiveTrajectoryRunner
 from tsmd.rt import FixedRateScheduler, RealtimeReport, apply_realtime, set_fifo
@@ -120,6 +122,7 @@ class Daemon:
         self.rig: SimRig | None = None
         self.loop: ControlLoop | None = None
         self.service: Service | None = None
+        self.online: OnlineAttachment | None = None
         self.server: ApiServer | None = None
         self.scheduler: FixedRateScheduler | None = None
         self.recorder: BackgroundRecorder | None = None
@@ -270,15 +273,22 @@ class Daemon:
                 str(directory / f"tsmd-{stamp}.csv"),
                 {"source": "tsmd run", "version": __version__, "rate_hz": config.loop.rate_hz,
                  "profile": getattr(profile, "catheter_id", "none"), "compensation": label,
-                 "sim": self.sim}, config.recording.flush_interval_s)
+                 "sim": self.sim}, config.recording.flush_interval_s,
+                # the file's columns are fixed at its start: online offsets only if on by config
+                RECORDING_COLUMNS if config.online.enabled else ())
         tip_source = self.rig.tip_deg if self.rig is not None else None
         self.loop = build_loop(config, self.drives, compensator, MonotonicClock(),
                                compensation_label=label, tip_source=tip_source,
                                recorder=self.recorder, on_event=self.events.emit)
+        self.online = OnlineAttachment(config.online, self.loop, on_event=self.events.emit)
+        if self.recorder is not None and config.online.enabled:
+            self.loop.recorder = self.online.recording(self.recorder)
+        self.online.attach(compensator)
         self.service = Service(
             config, self.loop, profile, choice,
             profiles_dir=resolve_data_path(config.profiles.dir), on_event=self.events.emit,
-            runner_factory=self._live_runner, extra_status=self._extra_status)
+            runner_factory=self._live_runner, extra_status=self._extra_status,
+            online=self.online)
 
     def _live_runner(self) -> LiveTrajectoryRunner:
         assert self.loop is not None
@@ -405,6 +415,8 @@ class Daemon:
         self._loop_stop.set()
         if self._loop_thread is not None:
             self._loop_thread.join(5.0)
+        if self.online is not None:
+            self.online.detach()
         if self.server is not None:
             self.server.stop()
         if self.recorder is not None:

@@ -153,9 +153,10 @@ class BackgroundRecorder:
     writer thread. :meth:`close` writes what is left, so a clean stop loses nothing.
     """
 
-    def __init__(self, path: str, metadata: dict[str, object], flush_interval_s: float) -> None:
+    def __init__(self, path: str, metadata: dict[str, object], flush_interval_s: float,
+                 extra_columns: tuple[str, ...] = ()) -> None:
         self.path = path
-        self._writer = RecordingWriter(path, metadata)
+        self._writer = RecordingWriter(path, metadata, extra_columns)
         self._rows: collections.deque[tuple[float, ...]] = collections.deque()
         self._interval_s = flush_interval_s
         self._stop = threading.Event()

@@ -513,7 +513,9 @@ class ProfileStore:
         if not path.exists():
             raise ProfileError(f"no profile for catheter {catheter_id!r} in {self.directory}")
         profile = load_profile(path)
-        if profile.catheter_id != catheter_id:
+        # <id>.<version>.yaml (e.g. an online re-estimate) is a version of catheter <id>
+        if profile.catheter_id != catheter_id \
+                and not catheter_id.startswith(profile.catheter_id + "."):
             raise ProfileError(f"{path}: catheter_id is {profile.catheter_id!r}, "
                                f"expected {catheter_id!r}")
         return profile

@@ -18,6 +18,8 @@ from tsmd import __version__, calibration
 from tsmd.config import TsmdConfig, resolve_data_path
 from tsmd.errors import TsmdError
 from tsmd.loop import ControlLoop, LoopError
+from tsmd.online.apply import OnlineError
+from tsmd.online.attach import OnlineAttachment
 from tsmd.profile import ProfileError, ProfileStore, load_device_model
 from tsmd.rt import set_normal_scheduling
 from tsmd.stack import StackError, knob_limits, make_compensator
@@ -59,7 +61,8 @@ class Service:
                  choice: CompensationChoice, *, profiles_dir: Path,
                  on_event: Callable[..., None] | None = None,
                  runner_factory: Callable[[], TrajectoryRunner] | None = None,
-                 extra_status: Callable[[], dict[str, Any]] | None = None) -> None:
+                 extra_status: Callable[[], dict[str, Any]] | None = None,
+                 online: OnlineAttachment | None = None) -> None:
         self.config = config
         self.loop = loop
         self.profile = profile
@@ -68,6 +71,8 @@ class Service:
         self._on_event = on_event
         self._runner_factory = runner_factory
         self._extra_status = extra_status
+        self.online = online
+        """The online re-estimation worker's owner (None: not offered by this daemon)."""
         self._lock = threading.Lock()
         self._calibration_lock = threading.Lock()
         self._calibration_cancel: threading.Event | None = None
@@ -125,6 +130,7 @@ class Service:
             "sample": sample.as_dict() if sample is not None else None,
             "last_events": [f"drive {e.drive}: {e.kind.value}: {e.message}"
                             for e in list(loop.last_events)[-4:]],
+            "online": self.online.status() if self.online is not None else {"enabled": False},
         }
         if self._extra_status is not None:
             out.update(self._extra_status())
@@ -184,6 +190,39 @@ class Service:
         self._wait("set_compensator", compensator=compensator, label=label)
         self.profile = profile
         self.choice = choice
+        if self.online is not None:  # a new worker, on the new compensator's own values
+            self.online.attach(compensator)
+
+    def set_online(self, enabled: bool | None) -> dict[str, Any]:
+        """Switch online re-estimation; off puts the profile's values back at once."""
+        online = self._online("online")
+        if enabled is None:
+            return online.status()
+        with self._lock:
+            try:
+                return online.set_enabled(enabled)
+            except OnlineError as exc:
+                raise ServiceError(str(exc), "online") from None
+
+    def save_online(self) -> dict[str, Any]:
+        """Save the online estimates as a new profile version next to the calibrated one."""
+        online = self._online("online_save")
+        with self._lock:
+            try:
+                path = online.save(self.profile, self.profiles_dir)
+            except OnlineError as exc:
+                raise ServiceError(str(exc), "online") from None
+            except OSError as exc:
+                raise ServiceError(f"online_save: cannot write to {self.profiles_dir}: "
+                                   f"{exc.strerror or exc}", "online") from None
+        self._emit("info", "online estimates saved", path=str(path))
+        return {"path": str(path), "profile": getattr(self.profile, "catheter_id", None)}
+
+    def _online(self, what: str) -> OnlineAttachment:
+        if self.online is None:
+            raise ServiceError(f"{what}: online re-estimation is not available here",
+                               "unavailable")
+        return self.online
 
     def set_compensation(self, enabled: bool | None, method: str | None) -> dict[str, Any]:
         with self._lock:

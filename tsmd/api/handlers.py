@@ -40,6 +40,10 @@ class Services(Protocol):
 
     def home(self, drives: list[int] | None) -> dict[str, Any]: ...
 
+    def set_online(self, enabled: bool | None) -> dict[str, Any]: ...
+
+    def save_online(self) -> dict[str, Any]: ...
+
 
 class ApiHandlers:
     """Turns a validated :class:`Request` into a response dict (or raises ApiError)."""
@@ -196,3 +200,16 @@ class ApiHandlers:
 
     async def _cancel(self, request: Request, conn: Connection) -> dict[str, Any]:
         return {"cancelled": self.services.cancel_calibration("cancel command")}
+
+    async def _online(self, request: Request, conn: Connection) -> dict[str, Any]:
+        try:
+            return await asyncio.to_thread(self.services.set_online,
+                                           request.params.get("enabled"))
+        except TsmdError as exc:
+            raise ApiError(getattr(exc, "code", "online"), str(exc)) from None
+
+    async def _online_save(self, request: Request, conn: Connection) -> dict[str, Any]:
+        try:
+            return await asyncio.to_thread(self.services.save_online)
+        except TsmdError as exc:
+            raise ApiError(getattr(exc, "code", "online"), str(exc)) from None

@@ -49,6 +49,8 @@ COMMANDS: dict[str, dict[str, bool]] = {
     "calibrate": {"catheter": True},
     "cancel": {},
     "home": {"drives": False},
+    "online": {"enabled": False},
+    "online_save": {},
 }
 
 
@@ -130,6 +132,8 @@ def _check_types(cmd: str, params: dict[str, Any]) -> None:
         if "method" in params and params["method"] not in METHODS:
             raise ApiError("bad_param",
                            f"compensation: 'method' must be one of {', '.join(METHODS)}")
+    elif cmd == "online" and "enabled" in params and not isinstance(params["enabled"], bool):
+        raise ApiError("bad_param", "online: 'enabled' must be true or false")
     elif cmd == "home" and "drives" in params:
         drives = params["drives"]
         if (not isinstance(drives, list) or not drives or len(drives) > 16

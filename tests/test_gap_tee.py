@@ -37,8 +37,9 @@ def test_tee_diagnosis_fits_the_moved_knob_and_answers() -> None:
     cfg = GapConfig(fit_specs=specs, fit_max_rows=600, base_evals=16, refine_evals=4,
                     candidate_evals=4, n_boot=300)
     result = diagnose(series, builtin_factory(), {}, cfg)
-    assert result.verdict in {"none significant", "unexplained"} or result.verdict.startswith(
-        "identified")
+    # the structural method's verdicts (tsmd.gap.structure); on this probe: "base physics differ"
+    assert result.verdict in {"none significant", "base physics differ", "unexplained"} or (
+        result.verdict.startswith("identified"))
     assert np.isfinite(result.before["tip1_rmse_deg"])
     assert np.isnan(result.before["tip2_rmse_deg"])  # knob 2 never moved: not scored
     # the fitted simulator follows the real tip to within a fraction of its +-40 deg swing

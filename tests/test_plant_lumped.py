@@ -6,30 +6,19 @@ from typing import Any
 
 import numpy as np
 import pytest
+from support.plants import knob1_sweep
 
 from simrig.analysis import DeadZoneBacklash, loaded_slope, measure_dead_zone_backlash
 from simrig.plant import Plant, PlantLoadError, load_plant
-from simrig.plants.lumped import LumpedPlant, make_lumped_plant
+from simrig.plants.lumped import make_lumped_plant
 
 SPEC = "simrig.plants.lumped:make_lumped_plant"
 DT_S = 0.008  # quasi-static plant, rate-independent unless viscous drag is on
 
 
-def sweep(plant: LumpedPlant, freq_hz: float = 0.04, cycles: float = 1.5,
-          other_deg: float = 0.0, dt_s: float = DT_S
-          ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Knob 1 swept +-90 deg (sine from 0), knob 2 held; (knob, tip, torque) of knob 1."""
-    t = np.arange(0.0, cycles / freq_hz, dt_s)
-    q = 90.0 * np.sin(2.0 * np.pi * freq_hz * t)
-    tip = np.empty_like(q)
-    tau = np.empty_like(q)
-    cmd = np.array([0.0, other_deg])
-    for i, qi in enumerate(q):
-        cmd[0] = qi
-        step = plant.step(dt_s, cmd)
-        tip[i] = step.tip_deg[0]
-        tau[i] = step.knob_torque_Nm[0]
-    return q, tip, tau
+def sweep(plant: Any, freq_hz: float = 0.04, cycles: float = 1.5, other_deg: float = 0.0,
+          dt_s: float = DT_S) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return knob1_sweep(plant, freq_hz, cycles, other_deg, dt_s)
 
 
 def measured(freq_hz: float = 0.04, cycles: float = 1.5, other_deg: float = 0.0,

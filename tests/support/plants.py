@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
-from simrig.plant import PlantStep
+from simrig.plant import PlantStep, as_plant_step
 
 
 class SpringPlant:
@@ -27,3 +29,22 @@ class PairPlant(SpringPlant):
              knob_deg: np.ndarray) -> tuple[list[float], list[float]]:
         return ([1.3 * float(x) for x in knob_deg],
                 [self.stiffness * float(x) for x in knob_deg])
+
+
+def knob1_sweep(plant: Any, freq_hz: float = 0.04, cycles: float = 1.5, other_deg: float = 0.0,
+                dt_s: float = 0.008) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Knob 1 swept +-90 deg (sine from 0), knob 2 held; (knob, tip, torque) of knob 1.
+
+    The built-in plants are quasi-static: the coarse default tick keeps plant tests fast.
+    """
+    t = np.arange(0.0, cycles / freq_hz, dt_s)
+    q = 90.0 * np.sin(2.0 * np.pi * freq_hz * t)
+    tip = np.empty_like(q)
+    tau = np.empty_like(q)
+    cmd = np.array([0.0, other_deg])
+    for i, qi in enumerate(q):
+        cmd[0] = qi
+        step = as_plant_step(plant.step(dt_s, cmd))
+        tip[i] = step.tip_deg[0]
+        tau[i] = step.knob_torque_Nm[0]
+    return q, tip, tau

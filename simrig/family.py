@@ -127,6 +127,12 @@ VARIANTS: dict[str, Variant] = {
                        "handle_friction_Nm": 1.5},
         },
     ),
+    "steel-tendon": Variant(
+        "stiffer (steel) tendons on a larger moment arm: the tip releases at about its loaded "
+        "slope, as on the real TEE probe, and the backlash is smaller",
+        factors={p: {"tendon_stiffness_N": 2.5, "tendon_offset_mm": 1.4, "sheath_friction": 1.2}
+                 for p in _NOMINAL},
+    ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",
         current_sensor={"noise_A": 0.010, "spike_rate_hz": 2.0, "lag_s": 0.005},

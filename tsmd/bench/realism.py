@@ -7,6 +7,10 @@ within a fraction of a degree: the full stack gives the same errors to 0.2 deg):
 * uncompensated errors on the paper's tracking protocol (``tsmd.bench.accuracy.scenarios``,
   after one conditioning cycle): RMSE 17-24 deg, PTPE 58-69 deg (the paper's uncompensated runs);
 * the loaded slope of both knobs: 1.2-1.6 (the paper's catheters, omega 1.32 +- 0.12 and more);
+* the release/loaded slope ratio of both knobs: 0.6-1.1. The paper's model has one slope for both
+  branches; the real TEE probe releases at 0.67-1.02 of its loaded slope (``release_load_ratio`` on
+  its acquisitions), never steeper. A plant that releases steeper than it loads cannot be
+  compensated by a one-slope model, whatever the calibration (docs/plant.md);
 * the knob-torque signature of the paper's Figure on a +-90 deg, 0.04 Hz sweep of knob 1 (the
   drive current is this torque through the gear plus the motor's own friction): flat in the dead
   zone, rise on engagement, fall at the reversal, near-constant while released;
@@ -32,7 +36,12 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.signal import medfilt
 
-from simrig.analysis import SweepAnalysisError, loaded_slope, measure_dead_zone_backlash
+from simrig.analysis import (
+    SweepAnalysisError,
+    loaded_slope,
+    measure_dead_zone_backlash,
+    releasing_slope,
+)
 from simrig.current_sensor import CurrentSensor
 from simrig.family import PLANT_ROLE, PLANT_SPECS, FamilyMember, family
 from simrig.plant import as_plant_step, load_plant
@@ -49,6 +58,7 @@ FloatArray = NDArray[np.float64]
 RMSE_RANGE_DEG = (17.0, 24.0)
 PTPE_RANGE_DEG = (58.0, 69.0)
 SLOPE_RANGE = (1.2, 1.6)
+RELEASE_RATIO_RANGE = (0.6, 1.1)
 PAPER_REDUCTION_PCT = (58.0, 73.0)
 REDUCTION_TOLERANCE_PCT = 15.0
 
@@ -156,6 +166,9 @@ def check_member(member: FamilyMember, scen: Sequence[Scenario]) -> MemberResult
             slope = math.nan
         res.checks.append(Check(f"loaded slope knob {knob + 1}", slope,
                                 _in(slope, *SLOPE_RANGE), "paper 1.2-1.6"))
+        ratio = release_load_ratio(rec.knob_deg, rec.tip_deg)
+        res.checks.append(Check(f"release/load slope knob {knob + 1}", ratio,
+                                _in(ratio, *RELEASE_RATIO_RANGE), "TEE probe 0.67-1.02"))
         if knob == 0:
             m = measure_dead_zone_backlash(rec.knob_deg, rec.tip_deg)
             res.checks.append(Check("D_pos knob 1 (deg, info)", m.dead_zone_pos_deg, True))
@@ -211,6 +224,32 @@ def calibrated_reduction(member: FamilyMember, device: Any, scen: Sequence[Scena
     return 100.0 * (none - paper) / none
 
 
+def release_load_ratio(knob_deg: FloatArray, tip_deg: FloatArray) -> float:
+    """Releasing over loaded tip/knob slope of a +-90 deg sweep, the worse side (furthest from 1).
+
+    Loaded: moving away from zero at 40-85 deg; released: moving back at 10-60 deg, past the
+    backlash. The sweep is centred on its own knob and tip midpoints, so a recording that does
+    not start at the middle (the TEE acquisitions) is measured the same way.
+    """
+    q = np.asarray(knob_deg, dtype=float)
+    y = np.asarray(tip_deg, dtype=float)
+    half = 0.5 * float(np.ptp(q))
+    if not half > 0.0:
+        return math.nan
+    scale = 90.0 / half
+    qc = (q - 0.5 * (float(q.max()) + float(q.min()))) * scale
+    yc = y - 0.5 * (float(y.max()) + float(y.min()))
+    try:
+        load = loaded_slope(qc, yc, 40.0, 85.0)
+        release = releasing_slope(qc, yc, 10.0, 60.0)
+    except SweepAnalysisError:
+        return math.nan
+    ratios = [r / lo for r, lo in zip(release, load, strict=True) if lo > 0.0]
+    if not ratios:
+        return math.nan
+    return float(max(ratios, key=lambda v: abs(math.log(v)) if v > 0.0 else math.inf))
+
+
 def conditioned_prefix(start_deg: FloatArray) -> FloatArray:
     """One +-90 deg cycle of both knobs at 0.08 Hz, then a 2 s move to ``start_deg``."""
     tc = np.arange(0.0, 12.5, PERIOD_S)
@@ -246,7 +285,7 @@ def tee_comparison(tee_dir: Path, spec: str, plot_path: Path | None) -> list[str
     if not files:
         raise TsmdError(f"no TEE acquisitions (motor*_*.csv) in {tee_dir}")
     lines = ["| acquisition | current halfway down (% of range) real / plant | tip moves back "
-             "(% of range) real / plant |", "|---|---|---|"]
+             "(% of range) real / plant | release/load slope real / plant |", "|---|---|---|---|"]
     panels = []
     for f in files:
         knob = knob_from_filename(f)
@@ -264,8 +303,10 @@ def tee_comparison(tee_dir: Path, spec: str, plot_path: Path | None) -> list[str
             sim[i] = step.tip_deg[knob - 1], step.knob_torque_Nm[knob - 1]
         real_shape = reversal_shape(q, tip, cur)
         sim_shape = reversal_shape(fine, sim[:, 0], sim[:, 1])
+        ratios = release_load_ratio(q, tip), release_load_ratio(fine, sim[:, 0])
         lines.append(f"| {f.stem} | {real_shape[0]:.1f} / {sim_shape[0]:.1f} | "
-                     f"{real_shape[1]:.1f} / {sim_shape[1]:.1f} |")
+                     f"{real_shape[1]:.1f} / {sim_shape[1]:.1f} | "
+                     f"{ratios[0]:.2f} / {ratios[1]:.2f} |")
         panels.append((f.stem, q, tip, cur, fine, sim))
     if plot_path is not None:
         _plot_tee(panels, plot_path, spec)

@@ -85,6 +85,22 @@ class _Drive:
         self.sdo: SdoClient
         self.rpdo = can.Message(arbitration_id=0x200 + self.node_id, is_extended_id=False,
                                 data=bytearray(_RPDO.size))
+        self.feedback_key: tuple[int, int, int, DriveState, int] | None = None
+        self.feedback: DriveFeedback | None = None
+        """The last DriveFeedback built, reused while ``feedback_key`` is unchanged."""
+
+    def snapshot(self) -> DriveFeedback:
+        """Feedback as a DriveFeedback; one object per change, not per call (hot path)."""
+        key = (self.position_counts, self.current_raw, self.statusword, self.state,
+               self.age_syncs)
+        fb = self.feedback
+        if fb is None or key != self.feedback_key:
+            fb = self.feedback = DriveFeedback(
+                position_deg=self.position_counts / self.cpd,
+                current_A=self.current_raw * self.scale_A, statusword=self.statusword,
+                state=self.state, age_syncs=self.age_syncs)
+            self.feedback_key = key
+        return fb
 
     def pack_rpdo(self) -> can.Message:
         _RPDO.pack_into(self.rpdo.data, 0, self.controlword, self.target_counts)
@@ -435,9 +451,7 @@ class CanOpenDrives(KnobDrives):
         self._supervise()
 
     def feedback(self) -> list[DriveFeedback]:
-        return [DriveFeedback(position_deg=d.position_counts / d.cpd,
-                              current_A=d.current_raw * d.scale_A, statusword=d.statusword,
-                              state=d.state, age_syncs=d.age_syncs) for d in self._drives]
+        return [d.snapshot() for d in self._drives]
 
     def heartbeat_lost(self) -> list[bool]:
         with self._lock:

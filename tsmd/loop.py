@@ -253,11 +253,13 @@ class ControlLoop:
 
     def tick(self) -> Sample:
         """One period: commands, supervision, setpoint, compensation, targets, SYNC, record."""
-        self._run_commands()
+        if self.commands:
+            self._run_commands()
+        drives = self.drives
         t_s = self.clock.now_s()
-        self.drives.pump()
-        events = self.drives.poll_events()
-        feedback = self.drives.feedback()
+        drives.pump()
+        events = drives.poll_events()
+        feedback = drives.feedback()
         pos = [feedback[0].position_deg, feedback[1].position_deg]
         if events:
             self.last_events.extend(events)
@@ -270,18 +272,24 @@ class ControlLoop:
         else:
             q = cmd = (np.array(pos) if _isfinite(pos[0]) and _isfinite(pos[1])
                        else self._last_cmd)
-        if _isfinite(cmd[0]) and _isfinite(cmd[1]):
+        c0, c1 = cmd.tolist()
+        if _isfinite(c0) and _isfinite(c1):
             self._last_cmd = cmd
-        self.drives.write_targets([float(cmd[0]), float(cmd[1])])
-        self.drives.sync()
+        drives.write_targets((c0, c1))
+        drives.sync()
         if self._after_sync is not None:
             self._after_sync()
-            self.drives.pump()
-            feedback = self.drives.feedback()
-        tip = tuple(self._tip_source()) if self._tip_source is not None else self._nan2
-        row = (t_s, float(q[0]), float(q[1]), float(cmd[0]), float(cmd[1]),
-               feedback[0].position_deg, feedback[1].position_deg,
-               feedback[0].current_A, feedback[1].current_A, float(tip[0]), float(tip[1]))
+            drives.pump()
+            feedback = drives.feedback()
+        tip = (self._tip_source() if self._tip_source is not None else self._nan2)
+        if isinstance(tip, np.ndarray) and tip.dtype == np.float64 and tip.shape == (2,):
+            tip0, tip1 = tip.tolist()
+        else:
+            tip0, tip1 = float(tip[0]), float(tip[1])
+        q0, q1 = q.tolist()
+        fb0, fb1 = feedback
+        row = (t_s, q0, q1, c0, c1, fb0.position_deg, fb1.position_deg,
+               fb0.current_A, fb1.current_A, tip0, tip1)
         self._record(row)
         if self.observer is not None:
             self.observer(row, self.state is LoopState.ENABLED)
@@ -335,11 +343,14 @@ class ControlLoop:
             self._fault(f"compensator gave {cmd.tolist()} for q {q.tolist()}")
             return q, self._last_cmd
         cmd = np.asarray(self._limiter.limit(cmd), dtype=float)
-        if cmd.shape != (2,) or not (_isfinite(cmd[0]) and _isfinite(cmd[1])):
+        if cmd.shape != (2,):
             self._fault(f"limiter gave {cmd.tolist()} for q {q.tolist()}")
             return q, self._last_cmd
-        return q, np.array((min(max(float(cmd[0]), lo[0]), hi[0]),
-                            min(max(float(cmd[1]), lo[1]), hi[1])))
+        c0, c1 = cmd.tolist()
+        if not (_isfinite(c0) and _isfinite(c1)):
+            self._fault(f"limiter gave {cmd.tolist()} for q {q.tolist()}")
+            return q, self._last_cmd
+        return q, np.array((min(max(c0, lo[0]), hi[0]), min(max(c1, lo[1]), hi[1])))
 
     def _record(self, row: tuple[float, ...]) -> None:
         if self.recorder is not None:

@@ -204,6 +204,11 @@ class SimDriveNode:
             self._rpdo_pending = None
 
     def _apply_rpdo(self, data: bytes | bytearray, now_s: float) -> None:
+        if self._rpdo_csp:  # the mapping the master writes: controlword, target position
+            cw, target = self._rpdo_struct.unpack(data)
+            self.write_controlword(cw)
+            self.target_counts = target
+            return
         for attr, value in zip(self._rpdo_attrs, self._rpdo_struct.unpack(data), strict=True):
             if attr == "controlword":
                 self.write_controlword(value)
@@ -456,6 +461,7 @@ class SimDriveNode:
         self._rpdo_struct = struct.Struct(fmt)
         self._rpdo_len = self._rpdo_struct.size
         self._rpdo_attrs = attrs
+        self._rpdo_csp = attrs == ["controlword", "target_counts"]
         cob = self._value(o.TPDO1_COMM, 1)
         self._tpdo_cob = None if cob & 0x80000000 else cob & 0x7FF
         trans = self._value(o.TPDO1_COMM, 2)

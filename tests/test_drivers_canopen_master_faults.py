@@ -10,8 +10,11 @@ import pytest
 from support.drives import open_enabled_rig, tick
 from support.plants import SpringPlant
 
+from drivers import canopen_master
 from drivers.canopen_master import CanOpenDrives
 from drivers.drive import DriveError, DriveState, FaultKind
+from drivers.master_homing import MasterHoming
+from drivers.master_supervision import MAX_PENDING_BUS_EVENTS
 from drivers.units import DriveConfig
 from simrig.lockstep_bus import LockstepBus
 from simrig.rig import SimRig, open_sim_rig
@@ -340,3 +343,8 @@ def test_sdo_abort_during_boot_is_a_boot_failure_naming_the_object():
     finally:
         drives.close()
         rig.close()
+
+
+def test_the_split_modules_are_one_master_behind_the_old_import_path() -> None:
+    assert issubclass(CanOpenDrives, MasterHoming)
+    assert canopen_master.MAX_PENDING_BUS_EVENTS == MAX_PENDING_BUS_EVENTS

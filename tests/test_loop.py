@@ -221,3 +221,29 @@ def test_a_fault_during_a_trajectory_ends_it_with_the_reason_and_clears_the_setp
     assert "emcy" in (playback.error or "")
     assert len(playback.rows) == 10
     assert loop.setpoint.get() is None
+
+
+def test_an_uncompensated_trajectory_sends_the_desired_angles_past_the_compensator() -> None:
+    comp = Offset(5.0)
+    loop, _drives = make_loop(comp)
+    loop.tick()
+    loop.execute("enable")
+    calls = len(comp.inputs)
+    playback = Playback(np.zeros((4, 2)), compensate=False)
+    loop.execute("play", playback=playback)
+    while not playback.done.is_set():
+        loop.tick()
+    assert len(comp.inputs) == calls
+    assert [row[3:5] for row in playback.rows] == [(0.0, 0.0)] * 4
+
+
+def test_latest_sample_is_the_last_tick_and_one_object_until_the_next() -> None:
+    loop, drives = make_loop()
+    assert loop.latest_sample is None
+    drives.pos = [4.0, -2.0]
+    returned = loop.tick()
+    assert loop.latest_sample is loop.latest_sample
+    assert loop.latest_sample == returned
+    assert returned.tick == 1 and returned.pos_deg == (4.0, -2.0)
+    loop.step()
+    assert loop.latest_sample is not None and loop.latest_sample.tick == 2

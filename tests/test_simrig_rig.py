@@ -232,3 +232,30 @@ def test_a_plant_answering_a_plain_pair_drives_the_rig_like_its_plantstep_twin()
 def test_a_plant_answer_that_is_neither_plantstep_nor_pair_is_named(answer: object) -> None:
     with pytest.raises(PlantOutputError, match="PlantStep or a pair"):
         as_plant_step(answer)  # type: ignore[arg-type]
+
+
+def test_feedback_ages_with_each_sync_and_is_fresh_again_after_the_answer(rig_pair):
+    drives, rig = rig_pair
+    drives.boot()
+    drives.enable()
+    before = drives.feedback()
+    drives.sync()
+    aged = drives.feedback()
+    rig.exchange()
+    drives.pump()
+    answered = drives.feedback()
+    assert [f.age_syncs for f in before] == [0, 0]
+    assert [f.age_syncs for f in aged] == [1, 1]
+    assert [f.age_syncs for f in answered] == [0, 0]
+
+
+def test_feedback_follows_a_changed_position_between_two_reads(rig_pair):
+    drives, rig = rig_pair
+    drives.boot()
+    drives.enable()
+    first = drives.feedback()
+    run(drives, rig, np.tile([10.0, -5.0], (100, 1)))
+    moved = drives.feedback()
+    assert moved[0].position_deg == pytest.approx(10.0, abs=0.5)
+    assert moved[1].position_deg == pytest.approx(-5.0, abs=0.5)
+    assert first[0].position_deg == pytest.approx(0.0, abs=0.1)

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 
 from drivers.clock import Clock
 from drivers.drive import DriveError, DriveFeedback, DriveState, FaultEvent, KnobDrives
-from tsmd.compensation import Compensator, NoCompensation
+from tsmd.compensation import Compensator
 from tsmd.compensation.safety import KnobLimiter, KnobLimits
 from tsmd.errors import TsmdError
 from tsmd.recording import RecordingWriter
@@ -205,7 +205,6 @@ class ControlLoop:
         self.overrun_fault_streak = overrun_fault_streak
         self._compensator = compensator
         self._compensation_label = compensation_label
-        self._no_compensation: Compensator | None = None
         self._limiter = limiter
         if limiter.dt_s != period_s:
             raise ValueError(f"the limiter steps {limiter.dt_s} s, the loop {period_s} s")
@@ -223,7 +222,8 @@ class ControlLoop:
         self.state = LoopState.DISABLED
         self.fault_reason: str | None = None
         self.stats = LoopStats()
-        self.latest_sample: Sample | None = None
+        self._latest: tuple[int, float, LoopState, tuple[float, ...], str | None] | None = None
+        self._sample_cache: tuple[object, Sample] | None = None
         self.last_events: collections.deque[FaultEvent] = collections.deque(maxlen=16)
         self.schedule_reset = False
         """Set after a command that blocked (enable): the scheduler re-anchors its deadlines."""
@@ -251,13 +251,37 @@ class ControlLoop:
 
     # --- the tick --------------------------------------------------------------------------
 
+    @property
+    def latest_sample(self) -> Sample | None:
+        """What the last tick did (built on demand: most ticks are never looked at)."""
+        latest = self._latest
+        if latest is None:
+            return None
+        cache = self._sample_cache
+        if cache is not None and cache[0] is latest:
+            return cache[1]
+        ticks, t_s, state, row, fault = latest
+        sample = Sample(ticks, t_s, state, (row[1], row[2]), (row[3], row[4]), (row[5], row[6]),
+                        (row[7], row[8]), (row[9], row[10]), fault)
+        self._sample_cache = (latest, sample)
+        return sample
+
     def tick(self) -> Sample:
+        """One period (:meth:`step`) and what it did."""
+        self.step()
+        sample = self.latest_sample
+        assert sample is not None  # step() always publishes one
+        return sample
+
+    def step(self) -> None:
         """One period: commands, supervision, setpoint, compensation, targets, SYNC, record."""
-        self._run_commands()
+        if self.commands:
+            self._run_commands()
+        drives = self.drives
         t_s = self.clock.now_s()
-        self.drives.pump()
-        events = self.drives.poll_events()
-        feedback = self.drives.feedback()
+        drives.pump()
+        events = drives.poll_events()
+        feedback = drives.feedback()
         pos = [feedback[0].position_deg, feedback[1].position_deg]
         if events:
             self.last_events.extend(events)
@@ -270,26 +294,29 @@ class ControlLoop:
         else:
             q = cmd = (np.array(pos) if _isfinite(pos[0]) and _isfinite(pos[1])
                        else self._last_cmd)
-        if _isfinite(cmd[0]) and _isfinite(cmd[1]):
+        c0, c1 = cmd.tolist()
+        if _isfinite(c0) and _isfinite(c1):
             self._last_cmd = cmd
-        self.drives.write_targets([float(cmd[0]), float(cmd[1])])
-        self.drives.sync()
+        drives.write_targets((c0, c1))
+        drives.sync()
         if self._after_sync is not None:
             self._after_sync()
-            self.drives.pump()
-            feedback = self.drives.feedback()
-        tip = tuple(self._tip_source()) if self._tip_source is not None else self._nan2
-        row = (t_s, float(q[0]), float(q[1]), float(cmd[0]), float(cmd[1]),
-               feedback[0].position_deg, feedback[1].position_deg,
-               feedback[0].current_A, feedback[1].current_A, float(tip[0]), float(tip[1]))
+            drives.pump()
+            feedback = drives.feedback()
+        tip = (self._tip_source() if self._tip_source is not None else self._nan2)
+        if isinstance(tip, np.ndarray) and tip.dtype == np.float64 and tip.shape == (2,):
+            tip0, tip1 = tip.tolist()
+        else:
+            tip0, tip1 = float(tip[0]), float(tip[1])
+        q0, q1 = q.tolist()
+        fb0, fb1 = feedback
+        row = (t_s, q0, q1, c0, c1, fb0.position_deg, fb1.position_deg,
+               fb0.current_A, fb1.current_A, tip0, tip1)
         self._record(row)
         if self.observer is not None:
             self.observer(row, self.state is LoopState.ENABLED)
         self.stats.ticks += 1
-        sample = Sample(self.stats.ticks, t_s, self.state, (row[1], row[2]), (row[3], row[4]),
-                        (row[5], row[6]), (row[7], row[8]), (row[9], row[10]), self.fault_reason)
-        self.latest_sample = sample
-        return sample
+        self._latest = (self.stats.ticks, t_s, self.state, row, self.fault_reason)
 
     def _supervise(self, events: list[FaultEvent], feedback: list[DriveFeedback],
                    pos: list[float]) -> str | None:
@@ -310,7 +337,7 @@ class ControlLoop:
 
     def _command(self, pos: list[float]) -> tuple[Array, Array]:
         playback = self._playback
-        compensator = self._compensator
+        compensator: Compensator | None = self._compensator
         if playback is not None:
             if playback.cancel is not None and playback.cancel.is_set():
                 self._end_playback("cancelled")
@@ -318,7 +345,7 @@ class ControlLoop:
             else:
                 q_raw = playback.q_deg[playback.index]
                 if not playback.compensate:
-                    compensator = self._uncompensated()
+                    compensator = None  # the desired angles as they are
         else:
             q_raw = self.setpoint.get()
         if q_raw is None:
@@ -330,16 +357,22 @@ class ControlLoop:
         lo, hi = self._min_f, self._max_f
         q = np.array((min(max(q0, lo[0]), hi[0]), min(max(q1, lo[1]), hi[1])))
         self._q = q
-        cmd = np.asarray(compensator.command(q), dtype=float)
-        if cmd.shape != (2,) or not (_isfinite(cmd[0]) and _isfinite(cmd[1])):
-            self._fault(f"compensator gave {cmd.tolist()} for q {q.tolist()}")
-            return q, self._last_cmd
+        if compensator is None:
+            cmd = q
+        else:
+            cmd = np.asarray(compensator.command(q), dtype=float)
+            if cmd.shape != (2,) or not (_isfinite(cmd[0]) and _isfinite(cmd[1])):
+                self._fault(f"compensator gave {cmd.tolist()} for q {q.tolist()}")
+                return q, self._last_cmd
         cmd = np.asarray(self._limiter.limit(cmd), dtype=float)
-        if cmd.shape != (2,) or not (_isfinite(cmd[0]) and _isfinite(cmd[1])):
+        if cmd.shape != (2,):
             self._fault(f"limiter gave {cmd.tolist()} for q {q.tolist()}")
             return q, self._last_cmd
-        return q, np.array((min(max(float(cmd[0]), lo[0]), hi[0]),
-                            min(max(float(cmd[1]), lo[1]), hi[1])))
+        c0, c1 = cmd.tolist()
+        if not (_isfinite(c0) and _isfinite(c1)):
+            self._fault(f"limiter gave {cmd.tolist()} for q {q.tolist()}")
+            return q, self._last_cmd
+        return q, np.array((min(max(c0, lo[0]), hi[0]), min(max(c1, lo[1]), hi[1])))
 
     def _record(self, row: tuple[float, ...]) -> None:
         if self.recorder is not None:
@@ -350,11 +383,6 @@ class ControlLoop:
             playback.index += 1
             if playback.index >= len(playback.q_deg):
                 self._end_playback(None)
-
-    def _uncompensated(self) -> Compensator:
-        if self._no_compensation is None:
-            self._no_compensation = NoCompensation()
-        return self._no_compensation
 
     def _end_playback(self, error: str | None) -> None:
         playback = self._playback

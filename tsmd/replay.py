@@ -107,7 +107,7 @@ class LockstepRunner:
         loop.execute("play", playback=playback)
         every = max(len(q) // 100, 1)
         while not playback.done.is_set():
-            loop.tick()
+            loop.step()
             if progress is not None and playback.index % every == 0:
                 progress(playback.progress)
         return self._finish(playback, ticks)

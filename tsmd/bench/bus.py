@@ -2,7 +2,8 @@
 
 Figures: frames per tick, bus load at the configured bit rate (frame bits counted exactly,
 stuff bits included, from the real frames), master CPU time per tick, SYNC-to-last-TPDO latency
-in real time (virtual bus, rig thread), and lockstep speed (simulated seconds per wall second).
+in real time (virtual bus, rig thread), lockstep speed (simulated seconds per wall second) of the
+drive layer, and of the whole stack as calibration runs it, split into stack and plant.
 """
 
 from __future__ import annotations
@@ -17,8 +18,9 @@ import can
 import numpy as np
 
 from simrig.lockstep_bus import LockstepBus
-from simrig.plant import PlantStep, load_plant
+from simrig.plant import Plant, PlantStep, load_plant
 from simrig.rig import DEFAULT_PLANT, open_sim_rig
+from tsmd.replay import LockstepRunner
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -29,6 +31,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--speed-seconds", type=float, default=700.0,
                         help="simulated seconds for the lockstep speed figure (default 700: "
                              "the calibration protocol)")
+    parser.add_argument("--stack-seconds", type=float, default=120.0,
+                        help="simulated seconds of the whole-stack split (loop + master + rig, "
+                             "as calibration runs it; default 120, 0: skip)")
+    parser.add_argument("--only-stack", action="store_true",
+                        help="only the whole-stack split (skip frames, latency, drive layer)")
     parser.add_argument("--rate-hz", type=float, default=250.0)
     parser.add_argument("--bitrate", type=int, default=1_000_000)
     parser.add_argument("--seed", type=int, default=0)
@@ -38,14 +45,22 @@ def main(args: argparse.Namespace) -> int:
     period_s = 1.0 / args.rate_hz
     print(f"tsmd bench bus: 2 drives, {args.rate_hz:g} Hz ({period_s * 1e3:g} ms), "
           f"{args.bitrate / 1e6:g} Mbit/s")
-    traffic = measure_traffic(args.ticks, period_s, args.bitrate, args.seed)
-    for line in traffic:
-        print(line)
-    for line in measure_latency(args.latency_ticks, period_s, args.seed):
-        print(line)
-    for line in measure_speed(args.speed_seconds, period_s, args.seed):
-        print(line)
+    if not args.only_stack:
+        for line in measure_traffic(args.ticks, period_s, args.bitrate, args.seed):
+            print(line)
+        for line in measure_latency(args.latency_ticks, period_s, args.seed):
+            print(line)
+        for line in measure_speed(args.speed_seconds, period_s, args.seed):
+            print(line)
+    if args.stack_seconds > 0:
+        print(f"load average before the stack split: {_loadavg()}")
+        for line in measure_stack(args.stack_seconds, args.seed):
+            print(line)
     return 0
+
+
+def _loadavg() -> str:
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
 # -- CAN frame bits ---------------------------------------------------------------------------
@@ -277,4 +292,56 @@ def measure_speed(seconds: float, period_s: float, seed: int) -> list[str]:
     lines.append(f"  of which the tendon-sheath plant.step alone: "
                  f"{(time.perf_counter() - w0) / n * 1e6:.1f} us/tick wall, "
                  f"{(time.thread_time() - c0) / n * 1e6:.1f} us/tick CPU")
+    return lines
+
+
+class _TimedPlant:
+    """Wraps a plant and adds up the wall time of its ``step`` calls (the plant's share)."""
+
+    def __init__(self, plant: Plant) -> None:
+        self.plant = plant
+        self.step_s = 0.0
+
+    def reset(self) -> None:
+        self.plant.reset()
+
+    def step(self, dt_s: float, knob_deg: np.ndarray) -> object:
+        t0 = time.perf_counter()
+        answer = self.plant.step(dt_s, knob_deg)
+        self.step_s += time.perf_counter() - t0
+        return answer
+
+
+def measure_stack(seconds: float, seed: int) -> list[str]:
+    """The whole stack as ``tsmd calibrate --sim`` runs it (LockstepRunner: control loop with
+    limiter, CANopen master, lockstep bus, simulated drives, motors, sensors, tracker), once with
+    a null plant and once with the tendon-sheath plant, in one process: stack vs plant per tick.
+    """
+    lines = []
+    plants = [("null plant (spring stand-in)", _spring()),
+              ("tendon-sheath plant", load_plant(DEFAULT_PLANT))]
+    for label, plant in plants:
+        timed = _TimedPlant(plant)  # type: ignore[arg-type]
+        with LockstepRunner(plant=timed, seed=seed) as runner:  # type: ignore[arg-type]
+            period_s = runner.period_s
+            ticks = round(seconds / period_s)
+            t = np.arange(ticks) * period_s
+            q = _trajectory(ticks, period_s)
+            timed.step_s = 0.0
+            w0 = time.perf_counter()
+            c0 = time.thread_time()
+            runner.run(t, q, compensate=False)
+            wall = time.perf_counter() - w0
+            cpu = time.thread_time() - c0
+        per_tick_us = wall / ticks * 1e6
+        plant_us = timed.step_s / ticks * 1e6
+        lines.append(f"whole stack, {label}: {ticks} ticks in {wall:.2f} s wall = "
+                     f"{ticks / wall:.0f} ticks/s ({per_tick_us:.1f} us/tick: plant.step "
+                     f"{plant_us:.1f}, stack {per_tick_us - plant_us:.1f}); CPU {cpu:.2f} s = "
+                     f"{ticks / cpu:.0f} ticks per CPU s ({cpu / ticks * 1e6:.1f} us/tick)")
+        if label.startswith("tendon"):
+            sweep_ticks = round(850.0 / period_s)
+            lines.append(f"  the paper protocol with 3 re-sweeps (850 s, {sweep_ticks} ticks) at "
+                         f"this rate: {sweep_ticks * per_tick_us * 1e-6:.0f} s wall of ticking, "
+                         f"of which plant {sweep_ticks * plant_us * 1e-6:.0f} s")
     return lines

@@ -62,28 +62,36 @@ def limit_step(state: LimiterState, target_deg: float, limits: KnobLimits,
     """
     if dt_s <= 0:
         raise ValueError(f"dt_s must be positive, got {dt_s}")
+    return LimiterState(*_step(state.q_deg, state.v_deg_s, state.target_deg, target_deg,
+                               limits, dt_s))
+
+
+def _step(q0: float, v0: float, last_target: float | None, target_deg: float,
+          limits: KnobLimits, dt_s: float) -> tuple[float, float, float]:
+    """:func:`limit_step` on plain floats (the loop's hot path: no object per tick)."""
     a = limits.max_accel_deg_s2
     v_max = limits.max_velocity_deg_s
-    target = limits.clip(target_deg) if math.isfinite(target_deg) else state.q_deg
+    finite = math.isfinite(target_deg)
+    target = limits.clip(target_deg) if finite else q0
     v_target = 0.0
-    if state.target_deg is not None and math.isfinite(target_deg):
-        v_target = (target - state.target_deg) / dt_s
+    if last_target is not None and finite:
+        v_target = (target - last_target) / dt_s
         if abs(v_target) > 1.05 * v_max:  # a jump, not a motion: chase it as standing still
             v_target = 0.0
-    d = target - state.q_deg
+    d = target - q0
     # The fastest approach speed from which the discrete decelerating sequence still stops on
     # the target (relative to its own motion).
     v_stop = math.sqrt(0.25 * a * a * dt_s * dt_s + 2.0 * a * abs(d)) - 0.5 * a * dt_s
     v_want = d / dt_s  # reach the target in this tick if the limits allow
     if (v_want - v_target) * math.copysign(1.0, d) > v_stop:  # closing in too fast to stop
         v_want = v_target + math.copysign(v_stop, d)
-    v = min(max(v_want, state.v_deg_s - a * dt_s), state.v_deg_s + a * dt_s)
+    v = min(max(v_want, v0 - a * dt_s), v0 + a * dt_s)
     v = min(max(v, -v_max), v_max)
-    q = state.q_deg + v * dt_s
+    q = q0 + v * dt_s
     if q < limits.min_deg or q > limits.max_deg:  # position first, whatever the speed
         q = limits.clip(q)
-        v = (q - state.q_deg) / dt_s
-    return LimiterState(q, v, target)
+        v = (q - q0) / dt_s
+    return q, v, target
 
 
 class KnobLimiter:
@@ -100,14 +108,17 @@ class KnobLimiter:
             raise ValueError(f"dt_s must be positive, got {dt_s}")
         self.limits = tuple(limits)
         self.dt_s = dt_s
-        self._states = [LimiterState(0.0) for _ in self.limits]
+        self._states: list[tuple[float, float, float | None]] = [(0.0, 0.0, None)] * 2
 
     def reset(self, cmd_deg: NDArray[np.float64], *, hold: bool = False) -> None:
         """Stand still at ``cmd_deg``; ``hold``: also take it as the last target (no jump)."""
-        self._states = [LimiterState(float(q), 0.0, float(q) if hold else None)
-                        for q in cmd_deg]
+        self._states = [(float(q), 0.0, float(q) if hold else None) for q in cmd_deg]
 
     def limit(self, cmd_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-        self._states = [limit_step(s, float(c), lim, self.dt_s)
-                        for s, c, lim in zip(self._states, cmd_deg, self.limits, strict=True)]
-        return np.array([s.q_deg for s in self._states])
+        dt = self.dt_s
+        lim0, lim1 = self.limits
+        s0, s1 = self._states
+        s0 = _step(s0[0], s0[1], s0[2], float(cmd_deg[0]), lim0, dt)
+        s1 = _step(s1[0], s1[1], s1[2], float(cmd_deg[1]), lim1, dt)
+        self._states = [s0, s1]
+        return np.array((s0[0], s1[0]))

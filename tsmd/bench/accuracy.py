@@ -25,7 +25,7 @@ from simrig.analysis import measure_dead_zone_backlash
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd import __version__
 from tsmd.calibration import calibrate
-from tsmd.calibration.ours_fit import SweepData, fit_ours_knob
+from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
 from tsmd.compensation import LimitedCompensator, build_compensator
 from tsmd.config import default_sim_config
 from tsmd.datasheet import analysed_from, settle, tip_sweep
@@ -160,8 +160,8 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
 
     The paper's calibration protocol (each knob +-90 deg at 0.04 Hz, two cycles after a
     conditioning cycle, the other knob held at each grid angle), uncompensated through the full
-    stack; D and B measured on the tip with ``simrig.analysis`` (ground truth); our extra
-    parameters from the same sweeps.
+    stack; D and B measured on the tip with ``simrig.analysis`` (ground truth); the tension
+    play's other parameters from the same sweeps' current.
     """
     knobs = []
     for knob in (0, 1):
@@ -173,14 +173,14 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
             pos = rec[f"pos{knob + 1}"][skip:]
             tip = rec[f"tip{knob + 1}"][skip:]
             m = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
-            sweeps.append(SweepData(rec["t"][skip:], rec[f"cmd{knob + 1}"][skip:], pos,
-                                    rec[f"cur{knob + 1}"][skip:], other, m.dead_zone_pos_deg,
-                                    m.dead_zone_neg_deg, m.backlash_pos_deg,
-                                    m.backlash_neg_deg))
+            sweeps.append(SweepCurrent(other, rec["t"][skip:], rec[f"cmd{knob + 1}"][skip:],
+                                       pos, rec[f"cur{knob + 1}"][skip:], m.dead_zone_pos_deg,
+                                       m.dead_zone_neg_deg, m.backlash_pos_deg,
+                                       m.backlash_neg_deg))
             log(f"  ground truth phi{knob + 1}, other {other:+.0f}: D {m.dead_zone_pos_deg:.1f}/"
                 f"{m.dead_zone_neg_deg:.1f}  B {m.backlash_pos_deg:.1f}/{m.backlash_neg_deg:.1f}")
         dk = device.knobs[knob]
-        ours = fit_ours_knob(sweeps, dk, GRID_DEG)
+        ours = fit_tension_play(sweeps, dk)
         knobs.append(make_knob_profile(
             dk, GRID_DEG, [s.dead_zone_pos_deg for s in sweeps],
             [s.dead_zone_neg_deg for s in sweeps], [s.backlash_pos_deg for s in sweeps],

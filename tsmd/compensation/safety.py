@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,9 +44,9 @@ class KnobLimits:
         return min(max(q_deg, self.min_deg), self.max_deg)
 
 
-@dataclass(frozen=True)
-class LimiterState:
-    """Where the limited command is, how fast it moves, and the last target it was given."""
+class LimiterState(NamedTuple):
+    """Where the limited command is, how fast it moves, and the last target it was given
+    (a named tuple: one is made per knob and tick)."""
 
     q_deg: float
     v_deg_s: float = 0.0

@@ -37,7 +37,7 @@ from tsmd.bench.accuracy import (
 )
 from tsmd.bench.realism import data_sheet
 from tsmd.errors import TsmdError
-from tsmd.profile import load_device_model
+from tsmd.profile import CatheterProfile, load_device_model, load_profile, save_profile
 
 FloatArray = NDArray[np.float64]
 DEFAULT_PLANT = "simrig.plants.capstan.tendon_sheath:make_tendon_sheath_plant"
@@ -93,6 +93,20 @@ def _pct(none: float, other: float) -> float:
     return 100.0 * (none - other) / none if none > 0 else math.nan
 
 
+def unit_profile(unit: int, device: Any, make: Callable[[], Any], directory: Path | None
+                 ) -> CatheterProfile:
+    """The unit's profile from ``tsmd calibrate`` (motor current), kept in ``directory``."""
+    path = None if directory is None else directory / f"unit-{unit}.yaml"
+    if path is not None and path.exists():
+        print(f"unit {unit}: profile {path}", flush=True)
+        return load_profile(path)
+    print(f"unit {unit}: calibrating from motor current ...", flush=True)
+    profile = calibrated_profile(device, make)
+    if path is not None:
+        save_profile(profile, path)
+    return profile
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--family", choices=sorted(PLANT_SPECS), default=None,
                         help="score units of a family plant (simrig.family) instead of --plant; "
@@ -112,6 +126,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--fresh", action="store_true", help="fresh plant, no conditioning")
     parser.add_argument("--device", type=Path, default=Path("profiles/devices/sim-catheter.yaml"))
     parser.add_argument("--report", type=Path, default=None)
+    parser.add_argument("--profiles", type=Path, default=None,
+                        help="keep each unit's calibrated profile here as unit-<n>.yaml and "
+                             "reuse it when present (scoring again without recalibrating)")
     parser.add_argument("--plots", type=Path, default=None,
                         help="directory for time and input-output figures of the first unit")
 
@@ -155,8 +172,7 @@ def main(args: argparse.Namespace) -> int:
             params.update(unit_variation=float(args.unit_variation), seed=seed)
         units.append((seed, plant_factory(args.plant, params)))
     for seed, make in units:
-        print(f"unit {seed}: calibrating from motor current ...", flush=True)
-        profile = calibrated_profile(device, make)
+        profile = unit_profile(seed, device, make, args.profiles)
         for s in scen:
             res = {m: run_scenario(s, m, 0, profile, make, not args.fresh) for m in methods}
             red = _pct(res["none"].rmse_deg, res["ours"].rmse_deg)

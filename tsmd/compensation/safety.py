@@ -63,27 +63,39 @@ def limit_step(state: LimiterState, target_deg: float, limits: KnobLimits,
     """
     if dt_s <= 0:
         raise ValueError(f"dt_s must be positive, got {dt_s}")
+    # called per knob and tick: plain comparisons instead of min/max and clip
     a = limits.max_accel_deg_s2
     v_max = limits.max_velocity_deg_s
-    target = limits.clip(target_deg) if math.isfinite(target_deg) else state.q_deg
+    lo, hi = limits.min_deg, limits.max_deg
+    q0, v0, last_target = state
+    finite = target_deg - target_deg == 0.0
+    if finite:
+        target = lo if target_deg < lo else (hi if target_deg > hi else target_deg)
+    else:
+        target = q0
     v_target = 0.0
-    if state.target_deg is not None and math.isfinite(target_deg):
-        v_target = (target - state.target_deg) / dt_s
+    if last_target is not None and finite:
+        v_target = (target - last_target) / dt_s
         if abs(v_target) > 1.05 * v_max:  # a jump, not a motion: chase it as standing still
             v_target = 0.0
-    d = target - state.q_deg
+    d = target - q0
     # The fastest approach speed from which the discrete decelerating sequence still stops on
     # the target (relative to its own motion).
-    v_stop = math.sqrt(0.25 * a * a * dt_s * dt_s + 2.0 * a * abs(d)) - 0.5 * a * dt_s
+    half_a_dt = 0.5 * a * dt_s
+    v_stop = math.sqrt(half_a_dt * half_a_dt + 2.0 * a * abs(d)) - half_a_dt
     v_want = d / dt_s  # reach the target in this tick if the limits allow
-    if (v_want - v_target) * math.copysign(1.0, d) > v_stop:  # closing in too fast to stop
-        v_want = v_target + math.copysign(v_stop, d)
-    v = min(max(v_want, state.v_deg_s - a * dt_s), state.v_deg_s + a * dt_s)
-    v = min(max(v, -v_max), v_max)
-    q = state.q_deg + v * dt_s
-    if q < limits.min_deg or q > limits.max_deg:  # position first, whatever the speed
-        q = limits.clip(q)
-        v = (q - state.q_deg) / dt_s
+    if d >= 0.0:
+        if v_want - v_target > v_stop:  # closing in too fast to stop
+            v_want = v_target + v_stop
+    elif v_target - v_want > v_stop:
+        v_want = v_target - v_stop
+    dv = a * dt_s
+    v = v0 - dv if v_want < v0 - dv else (v0 + dv if v_want > v0 + dv else v_want)
+    v = -v_max if v < -v_max else (v_max if v > v_max else v)
+    q = q0 + v * dt_s
+    if q < lo or q > hi:  # position first, whatever the speed
+        q = lo if q < lo else hi
+        v = (q - q0) / dt_s
     return LimiterState(q, v, target)
 
 

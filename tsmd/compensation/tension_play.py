@@ -149,10 +149,16 @@ class Branches:
 
 
 def _interp(x: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> float:
-    """Linear interpolation on strictly increasing ``xs``, extrapolating the end pieces."""
-    i = min(max(bisect_right(xs, x) - 1, 0), len(xs) - 2)
-    x0, x1 = xs[i], xs[i + 1]
-    return ys[i] + (ys[i + 1] - ys[i]) * (x - x0) / (x1 - x0)
+    """Linear interpolation on strictly increasing ``xs``, extrapolating the end pieces (called
+    every tick: plain comparisons, no builtins)."""
+    i = bisect_right(xs, x) - 1
+    if i < 0:
+        i = 0
+    elif i > len(xs) - 2:
+        i = len(xs) - 2
+    x0 = xs[i]
+    y0 = ys[i]
+    return y0 + (ys[i + 1] - y0) * (x - x0) / (xs[i + 1] - x0)
 
 
 def release_line(omega: float, height_deg: float, dead_zone_deg: float, beta: float,
@@ -231,19 +237,24 @@ def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
     An unchanged output keeps a held input; one on a branch follows the branch forward if the
     branches moved (the other knob's angle changed the dead zone).
     """
-    if not math.isfinite(y_deg):
+    if y_deg - y_deg != 0.0:  # not finite
         return state
-    if y_deg == state.y_deg:
-        if state.y_deg == state.held_deg:
+    x_prev, y_prev, direction, held = state
+    if y_deg == y_prev:
+        if y_prev == held:
             return state
-        direction = state.direction
     else:
-        direction = 1 if y_deg > state.y_deg else -1
-    held = state.held_deg if direction == state.direction else state.y_deg
+        turn = 1 if y_deg > y_prev else -1
+        if turn != direction:
+            direction, held = turn, y_prev
     if direction > 0:
-        x = max(b.rising_inverse(y_deg), state.x_deg)
+        x = _interp(y_deg, b.rising_deg, b.knots)
+        if x < x_prev:
+            x = x_prev
     else:
-        x = min(b.falling_inverse(y_deg), state.x_deg)
+        x = _interp(y_deg, b.falling_deg, b.knots)
+        if x > x_prev:
+            x = x_prev
     return PlayState(x, y_deg, direction, held)
 
 

@@ -105,6 +105,33 @@ def _inverse_along(y_deg: float, xs: tuple[float, ...], ys: tuple[float, ...]) -
     return xs[i] + (xs[i + 1] - xs[i]) * (y_deg - y0) / (ys[i + 1] - y0)
 
 
+class _KnobCommand:
+    """One knob's command state (slots: the tick reads and writes these attributes only)."""
+
+    __slots__ = ("ahead_s", "hold", "jump_deg", "lim", "limits", "omega", "out", "q_dir",
+                 "q_prev", "state", "sum", "target", "v", "window")
+
+    def __init__(self, limits: KnobLimits) -> None:
+        self.limits = limits
+        self.ahead_s = 0.0
+        self.jump_deg = 0.0
+        self.omega = 1.0
+        self.reset(PlayState(0.0, 0.0, 1, 0.0), 0.0, 1)
+
+    def reset(self, state: PlayState, q_deg: float, n_avg: int) -> None:
+        self.state = state
+        self.q_prev = q_deg
+        self.q_dir = state.direction
+        self.v = 0.0
+        self.target = q_deg
+        self.out = state.x_deg
+        self.hold = 0
+        x = self.limits.clip(state.x_deg)
+        self.lim = LimiterState(x)
+        self.window = [x] * n_avg
+        self.sum = x * n_avg
+
+
 class OursCompensator:
     """Two knobs of the tension play, as a :class:`tsmd.compensation.Compensator`.
 
@@ -132,25 +159,18 @@ class OursCompensator:
         self.v_max = min(lim.max_velocity_deg_s for lim in limits)
         self.a_max = min(lim.max_accel_deg_s2 for lim in limits)
         self._n_avg = max(1, round(smoothing_s / period_s))
-        self._states = [PlayState(0.0, 0.0, 1, 0.0), PlayState(0.0, 0.0, 1, 0.0)]
-        self._lim = [LimiterState(0.0), LimiterState(0.0)]
-        self._window: list[list[float]] = [[0.0] * self._n_avg, [0.0] * self._n_avg]
-        self._sum = [0.0, 0.0]
+        self._k = (_KnobCommand(self.limits[0]), _KnobCommand(self.limits[1]))
         self._slot = 0
-        self._q_prev = [0.0, 0.0]
-        self._v = [0.0, 0.0]
-        self._target = [0.0, 0.0]
-        self._out = [0.0, 0.0]
-        self._hold = [0, 0]
-        self._q_dir = [1, 1]
         self._set_constants()
         self.reset(np.zeros(2))
 
     def _set_constants(self) -> None:
-        k = self.knobs
         # faster than any knob can make the tip move (release slope <= 5 omega)
-        self._jump_deg = 5.0 * max(k[0].omega, k[1].omega) * self.v_max * self.period_s
-        self._ahead_s = [kn.lag_s + 0.5 * (self._n_avg - 1) * self.period_s for kn in k]
+        jump_deg = 5.0 * max(k.omega for k in self.knobs) * self.v_max * self.period_s
+        for kc, knob in zip(self._k, self.knobs, strict=True):
+            kc.ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
+            kc.jump_deg = jump_deg
+            kc.omega = knob.omega
 
     def replace_knobs(self, knobs: tuple[OursKnob, OursKnob]) -> None:
         """New parameters from the next tick on, state kept (online re-estimation)."""
@@ -160,83 +180,77 @@ class OursCompensator:
     def reset(self, q_deg: NDArray[np.float64]) -> None:
         q = [float(v) if math.isfinite(v) else 0.0 for v in np.asarray(q_deg, dtype=float)]
         x = [0.0, 0.0]
+        states = [PlayState(0.0, 0.0, 1, 0.0)] * 2
         for _ in range(3):  # each knob's branches depend on the other knob's command
-            self._states = [rest_state(q[i], self.knobs[i].at(x[1 - i])) for i in (0, 1)]
-            x = [s.x_deg for s in self._states]
-        self._q_prev = list(q)
-        self._v = [0.0, 0.0]
-        self._target = list(q)
-        self._out = list(x)
-        self._hold = [0, 0]
-        self._q_dir = [s.direction for s in self._states]
-        x = [self.limits[i].clip(x[i]) for i in (0, 1)]
-        self._lim = [LimiterState(x[0]), LimiterState(x[1])]
-        self._window = [[x[0]] * self._n_avg, [x[1]] * self._n_avg]
-        self._sum = [x[0] * self._n_avg, x[1] * self._n_avg]
+            states = [rest_state(q[i], self.knobs[i].at(x[1 - i])) for i in (0, 1)]
+            x = [s.x_deg for s in states]
+        for i in (0, 1):
+            self._k[i].reset(states[i], q[i], self._n_avg)
         self._slot = 0
 
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-        q0, q1 = float(q_deg[0]), float(q_deg[1])
-        states = self._states
-        b0 = self.knobs[0].at(states[1].x_deg)
-        b1 = self.knobs[1].at(states[0].x_deg)
+        k0, k1 = self._k
+        b0 = self.knobs[0].at(k1.state.x_deg)
+        b1 = self.knobs[1].at(k0.state.x_deg)
         slot = self._slot
         period = self.period_s
-        for i, qi, b in ((0, q0, b0), (1, q1, b1)):
+        out = []
+        for kc, qi, b in ((k0, float(q_deg[0]), b0), (k1, float(q_deg[1]), b1)):
             if qi - qi == 0.0:  # finite; otherwise the command stays where it is
-                self._track(i, qi, b)
-            lim = limit_step(self._lim[i], self._out[i], self.limits[i], period)
-            self._lim[i] = lim
-            window = self._window[i]
-            self._sum[i] += lim.q_deg - window[slot]
+                self._track(kc, qi, b)
+            lim = limit_step(kc.lim, kc.out, kc.limits, period)
+            kc.lim = lim
+            window = kc.window
+            kc.sum += lim.q_deg - window[slot]
             window[slot] = lim.q_deg
-        self._slot = slot + 1 if slot + 1 < self._n_avg else 0
+            out.append(kc.sum)
         n = self._n_avg
-        return np.array((self._sum[0] / n, self._sum[1] / n))
+        self._slot = slot + 1 if slot + 1 < n else 0
+        return np.array((out[0] / n, out[1] / n))
 
-    def _track(self, i: int, q_raw: float, b: Branches) -> None:
-        q_prev = self._q_prev[i]
+    def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
+        q_prev = kc.q_prev
         qi = q_prev
-        if (q_raw - q_prev) * self._q_dir[i] >= 0.0:
+        if (q_raw - q_prev) * kc.q_dir >= 0.0:
             qi = q_raw
         elif abs(q_raw - q_prev) >= REVERSAL_DEADBAND_DEG:  # a reversal, not jitter
             qi = q_raw
-            self._q_dir[i] = -self._q_dir[i]
+            kc.q_dir = -kc.q_dir
         dq = qi - q_prev
-        self._q_prev[i] = qi
-        v = 0.7 * self._v[i] + 0.3 * dq / self.period_s
-        if abs(dq) > self._jump_deg:  # a step, not a motion: nothing to predict from it
+        kc.q_prev = qi
+        v = 0.7 * kc.v + 0.3 * dq / self.period_s
+        if abs(dq) > kc.jump_deg:  # a step, not a motion: nothing to predict from it
             v = 0.0
-        self._v[i] = v
-        lead = self._ahead_s[i] * v
+        kc.v = v
+        lead = kc.ahead_s * v
         lead = -_MAX_LEAD_DEG if lead < -_MAX_LEAD_DEG else min(lead, _MAX_LEAD_DEG)
         target = qi + lead
         # The lead shrinks as the desired angle slows; it must never turn the target back while
         # the desired angle itself does not turn: a false reversal jumps across the backlash.
-        step = target - self._target[i]
-        state = self._states[i]
+        step = target - kc.target
+        state = kc.state
         if step * dq < 0.0 or (dq == 0.0 and step * state.direction < 0.0):
-            target = self._target[i]
-        self._target[i] = target
+            target = kc.target
+        kc.target = target
         state = inverse_step(state, target, b)
-        self._states[i] = state
-        self._out[i] = self._early_jump(i, state, target, v, b)
+        kc.state = state
+        kc.out = self._early_jump(kc, state, target, v, b)
 
-    def _early_jump(self, i: int, state: PlayState, target: float, v: float,
+    def _early_jump(self, kc: _KnobCommand, state: PlayState, target: float, v: float,
                     b: Branches) -> float:
         x, d = state.x_deg, state.direction
-        prev = self._out[i]
-        if self._hold[i] != 0:
-            if self._hold[i] == d and (x - prev) * d < 0.0:
+        prev = kc.out
+        if kc.hold != 0:
+            if kc.hold == d and (x - prev) * d < 0.0:
                 return prev  # the desired angle has not caught up with the early jump yet
-            self._hold[i] = 0
+            kc.hold = 0
         speed = abs(v)
         if speed < 1e-3 or (v > 0) != (d > 0):
             return x
         # moving on in direction d: the inverse ahead is the branch's inverse, never behind x
         ys = b.rising_deg if d > 0 else b.falling_deg
         horizon_s = 30.0 / self.v_max  # half the crossing time of a 60 deg jump
-        expected_per_s = speed / self.knobs[i].omega
+        expected_per_s = speed / kc.omega
         ahead = x
         for _ in range(2):
             ahead = _inverse_along(target + v * horizon_s, b.knots, ys)
@@ -247,7 +261,7 @@ class OursCompensator:
             if jump <= expected + _JUMP_MIN_DEG:
                 return x
             horizon_s = 0.5 * (jump / self.v_max + self.v_max / self.a_max)
-        self._hold[i] = d
+        kc.hold = d
         return ahead
 
 

@@ -69,10 +69,9 @@ def limit_step(state: LimiterState, target_deg: float, limits: KnobLimits,
     lo, hi = limits.min_deg, limits.max_deg
     q0, v0, last_target = state
     finite = target_deg - target_deg == 0.0
+    target = q0
     if finite:
         target = lo if target_deg < lo else (hi if target_deg > hi else target_deg)
-    else:
-        target = q0
     v_target = 0.0
     if last_target is not None and finite:
         v_target = (target - last_target) / dt_s

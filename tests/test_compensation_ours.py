@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -10,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tsmd.compensation.ours import OursCompensator, ours_knobs
+from tsmd.compensation.ours import MOVES_WITH_EDGE, OursCompensator, OursKnob, ours_knobs
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
     BETA_RANGE,
@@ -246,3 +247,40 @@ def test_parameters_follow_the_other_knobs_command() -> None:
     assert cmd[-1, 1] < -60.0
     assert cmd[-1, 0] == pytest.approx(knob_branches(far).rising_inverse(20.0), abs=0.05)
     assert cmd[0, 0] == pytest.approx(knob_branches(near).rising_inverse(20.0), abs=0.05)
+
+
+# ----------------------------------------------------------------------------------------------
+# Online re-estimation: moved edges
+
+
+def shifted(knob: OursKnob, shift_deg: float) -> OursKnob:
+    """``knob`` with both edges moved by ``shift_deg`` and what moves with them."""
+    moves = {edge: shift_deg for edge in MOVES_WITH_EDGE}
+    moves.update({MOVES_WITH_EDGE[edge]: shift_deg for edge in MOVES_WITH_EDGE})
+    return dataclasses.replace(knob, field=knob.field.shifted(moves))
+
+
+@given(random_params, st.floats(-5.0, 5.0), st.floats(-100.0, 100.0))
+@settings(max_examples=15, deadline=None)  # each knob builds its table
+def test_moving_the_edges_moves_the_whole_characteristic_along_the_knob(
+        p: TensionPlayParams, shift_deg: float, x: float) -> None:
+    knob = ours_knobs((p, p))[0]
+    moved = shifted(knob, shift_deg).at(0.0)
+    b = knob.at(0.0)
+    # up to the 1e-6 tilt that keeps the flats invertible
+    assert moved.rising(x + shift_deg) == pytest.approx(b.rising(x), abs=1e-4)
+    assert moved.falling(x + shift_deg) == pytest.approx(b.falling(x), abs=1e-4)
+
+
+def test_replaced_knobs_act_from_the_next_tick_and_keep_the_state() -> None:
+    comp = compensator()
+    comp.reset(np.array([40.0, 0.0]))
+    before = comp.command(np.array([40.0, 0.0]))
+    comp.replace_knobs(tuple(shifted(k, 3.0) for k in comp.knobs))  # type: ignore[arg-type]
+    cmd = run_on(comp, np.tile([40.0, 0.0], (300, 1)))
+    assert cmd[-1, 0] == pytest.approx(before[0] + 3.0, abs=1e-4)
+
+
+def run_on(comp: OursCompensator, q: np.ndarray) -> np.ndarray:
+    """Commands for ``q`` from the compensator's present state (no reset)."""
+    return np.array([comp.command(row) for row in q])

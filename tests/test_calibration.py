@@ -230,7 +230,7 @@ def test_a_small_calibration_builds_a_profile_that_saves_and_loads(small_cal,
                                                                    tmp_path: Path) -> None:
     cal, runner, seen = small_cal
     assert cal.profile.knobs[0].other_knob_deg == (-30.0, 0.0, 30.0)
-    assert all(k.ours is not None for k in cal.profile.knobs)  # our compensator's fit
+    assert all(k.tension_play is not None for k in cal.profile.knobs)  # method ours' fit
     assert seen[-1][0] == pytest.approx(1.0)
     assert "sweep 6/6" in seen[-1][1]
     assert np.allclose(runner.trajectories[-1][-1], 0.0)

@@ -50,12 +50,24 @@ def test_no_compensation_passes_desired_angles_through() -> None:
 
 
 def test_non_finite_setpoint_holds_the_last_command() -> None:
-    for method in ("none", "paper", "ours"):
+    for method in ("none", "paper"):
         comp = build_compensator(make_profile(), method, DT)
         comp.reset(np.zeros(2))
         a = comp.command(np.array([10.0, 5.0]))
         b = comp.command(np.array([math.nan, math.inf]))
         assert np.array_equal(a, b), method
+
+
+def test_non_finite_setpoint_keeps_ours_going_where_the_last_finite_one_led() -> None:
+    """Ours' command is rate limited: it may not stop dead, it keeps its target."""
+    held, repeated = (build_compensator(make_profile(), "ours", DT) for _ in range(2))
+    for comp in (held, repeated):
+        comp.reset(np.zeros(2))
+        comp.command(np.array([10.0, 5.0]))
+    for _ in range(200):
+        a = held.command(np.array([math.nan, math.inf]))
+        b = repeated.command(np.array([10.0, 5.0]))
+        assert np.array_equal(a, b)
 
 
 def test_unknown_method_and_missing_profile_are_refused() -> None:
@@ -68,8 +80,8 @@ def test_unknown_method_and_missing_profile_are_refused() -> None:
 def test_ours_without_its_parameters_is_refused_with_advice() -> None:
     profile = make_profile()
     knob = profile.knobs[0]
-    object.__setattr__(knob, "ours", None)
-    with pytest.raises(CompensationError, match="no 'ours' parameters for phi1"):
+    object.__setattr__(knob, "tension_play", None)
+    with pytest.raises(CompensationError, match="no parameters for method 'ours'.*recalibrate"):
         build_compensator(profile, "ours", DT)
 
 
@@ -180,7 +192,7 @@ def test_a_field_refuses_column_names_that_do_not_match_its_values() -> None:
 def test_our_knob_refuses_a_field_without_its_named_columns() -> None:
     unnamed = ParameterField([-90, 0, 90], np.zeros((3, 7)), "linear")
     with pytest.raises(ValueError, match="must hold"):
-        OursKnob(unnamed, 5.0, -5.0, 1.5, 0.0)
+        OursKnob(unnamed, 1.5, 5.0, -5.0, 0.0)
 
 
 def test_plateau_heights_come_from_the_reference_line_through_the_edge_at_zero() -> None:

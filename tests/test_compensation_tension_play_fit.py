@@ -82,11 +82,12 @@ def test_fit_gives_every_parameter_on_the_sweeps_grid() -> None:
     assert p.height_pos_deg == pytest.approx(100.0 - 1.5 * (90.0 - D_POS))
 
 
-def test_data_sheet_dead_zone_offset_moves_the_edges_outward() -> None:
-    knob = dataclasses.replace(DEVICE_KNOB, dead_zone_offset_deg=0.5)
+def test_edges_are_the_units_own_whatever_the_data_sheet_unit_showed() -> None:
+    knob = dataclasses.replace(DEVICE_KNOB, dead_zone_offset_deg=0.5, release_omega=2.0,
+                               reference_backlash_pos_deg=30.0, reference_backlash_neg_deg=30.0)
     p = fit_tension_play([synthetic_sweep(g) for g in (-90.0, 90.0)], knob)
-    assert p.dead_zone_pos_deg == (D_POS + 0.5,) * 2
-    assert p.dead_zone_neg_deg == (D_NEG - 0.5,) * 2
+    assert p == fit_tension_play([synthetic_sweep(g) for g in (-90.0, 90.0)], DEVICE_KNOB)
+    assert p.dead_zone_pos_deg == (D_POS,) * 2
 
 
 def test_plateau_heights_are_product_constants_with_the_data_sheet_units_edges() -> None:
@@ -154,12 +155,21 @@ def test_mapping_refuses_unknown_and_missing_keys() -> None:
         tension_play_from_mapping(m)
 
 
-def test_method_tension_needs_the_section() -> None:
-    with pytest.raises(CompensationError, match="no 'tension_play' parameters"):
-        build_compensator(make_profile(), "tension", PERIOD_S)
+def test_method_ours_on_a_profile_without_the_section_asks_for_recalibration() -> None:
+    profile = make_profile()
+    old = dataclasses.replace(profile, knobs=tuple(dataclasses.replace(k, tension_play=None)
+                                                    for k in profile.knobs))
+    with pytest.raises(CompensationError, match="recalibrate") as exc:
+        build_compensator(old, "ours", PERIOD_S)
+    assert "\n" not in str(exc.value)
 
 
-def test_method_tension_builds_from_a_profile_with_the_section() -> None:
-    comp = build_compensator(profile_with_tension_play(), "tension", PERIOD_S)
+def test_former_method_name_tension_is_refused_naming_ours() -> None:
+    with pytest.raises(CompensationError, match="'tension' is now called 'ours'"):
+        build_compensator(profile_with_tension_play(), "tension", PERIOD_S)
+
+
+def test_method_ours_builds_from_a_profile_with_the_section() -> None:
+    comp = build_compensator(profile_with_tension_play(), "ours", PERIOD_S)
     comp.reset(np.zeros(2))
     assert np.all(np.isfinite(comp.command(np.array([10.0, -10.0]))))

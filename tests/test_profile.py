@@ -69,14 +69,14 @@ def test_example_profile_and_device_model_load() -> None:
     (lambda m: m["knobs"].update(phi3={}), "knobs.phi3: unknown knob"),
     (lambda m: m["knobs"]["phi1"]["reference_pos"].__setitem__("knob_deg", -90.0),
      "reference_pos.knob_deg must be > 0"),
-    (lambda m: m["knobs"]["phi1"]["ours"].__setitem__("lag_s", -0.1), r"ours: lag_s\[0\]"),
-    (lambda m: m["knobs"]["phi1"]["ours"].pop("release_slope_pos"),
-     "ours: release_slope_pos: missing key"),
-    (lambda m: m["knobs"]["phi1"]["ours"]["release_pivot_neg_deg"].__setitem__(3, math.nan),
-     r"release_pivot_neg_deg\[3\]: is NaN"),
-    (lambda m: m["knobs"]["phi1"]["ours"]["release_slope_neg"].__setitem__(3, 0.0),
-     r"release_slope_neg\[3\]: 0.0 is outside"),
-    (lambda m: m["knobs"]["phi1"]["ours"].update(extra=1), "ours: extra: unknown key"),
+    (lambda m: m["knobs"]["phi1"]["tension_play"].__setitem__("lag_s", -0.1),
+     r"tension_play: lag_s: -0.1 is outside"),
+    (lambda m: m["knobs"]["phi1"]["tension_play"].pop("backlash_gain_pos"),
+     "tension_play: backlash_gain_pos: missing key"),
+    (lambda m: m["knobs"]["phi1"]["tension_play"]["zero_load_neg_deg"].__setitem__(3, math.nan),
+     r"zero_load_neg_deg\[3\]: is not finite"),
+    (lambda m: m["knobs"]["phi1"]["tension_play"].update(extra=1),
+     "tension_play: extra: unknown key"),
     (lambda m: m.update(catheter_id="../etc/passwd"), "catheter_id"),
 ])
 def test_bad_profile_is_refused_naming_the_problem(edit: Any, message: str | None) -> None:
@@ -237,3 +237,12 @@ def test_store_refuses_a_file_named_for_another_catheter(tmp_path: Path) -> None
     for name in ("cath-a.online-1", "cath-a"):
         with pytest.raises(ProfileError, match="expected"):
             store.load(name)
+
+
+def test_former_ours_block_is_ignored_with_a_warning(caplog: pytest.LogCaptureFixture) -> None:
+    m = copy.deepcopy(mapping())
+    m["knobs"]["phi1"]["ours"] = {"lag_s": 0.0, "release_slope_pos": [2.25] * 7}
+    with caplog.at_level("WARNING", logger="tsmd.profile"):
+        profile = profile_from_mapping(m, "old.yaml")
+    assert profile == profile_from_mapping(mapping(), "old.yaml")
+    assert "old.yaml: knobs.phi1.ours: parameters of the former 'ours'" in caplog.text

@@ -27,7 +27,7 @@ from tsmd.yamlfile import read_yaml
 
 DEFAULT_CONFIG_PATH = Path("/etc/tsmd/tsmd.yaml")
 
-CompensationMethod = Literal["none", "paper", "ours", "tension"]
+CompensationMethod = Literal["none", "paper", "ours"]
 CanLogFormat = Literal["none", "blf", "asc"]
 
 

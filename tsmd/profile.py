@@ -3,7 +3,10 @@
 A *device model* holds the data-sheet constants of a catheter type (slope omega, the reference
 points of design assumption 1, knob limits). A *profile* holds what calibration identified for one
 catheter: per knob the dead zone and backlash grids over the other knob's angle, H, the
-interpolation method, the parameters of our compensator and the quality figures.
+interpolation method, the tension play's parameters (method ``ours``) and the quality figures.
+A knob's ``ours`` block written by tsmd before the tension play is read past with a warning:
+its constants came from a data sheet measured on the scored unit; method ``ours`` then asks
+for a recalibration.
 
 Loading validates everything and raises :class:`ProfileError` naming the file, the key and the
 reason. Saving is atomic and keeps the previous profile as ``<file>.bak``.
@@ -13,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import itertools
+import logging
 import math
 import os
 import re
@@ -27,7 +31,6 @@ import numpy as np
 import yaml
 
 from tsmd.compensation.grid import CALIBRATION_GRID_DEG, INTERPOLATION_METHODS
-from tsmd.compensation.ours import OursParams, ours_params_from_mapping, ours_params_to_mapping
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
@@ -47,6 +50,7 @@ almost certainly in the wrong unit (radians are caught by the omega and range ch
 OMEGA_RANGE: tuple[float, float] = (0.2, 5.0)
 """Plausible tip-per-knob slopes; outside this the value is a unit or sign mistake."""
 _ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+_log = logging.getLogger(__name__)
 
 
 class ProfileError(TsmdError, ValueError):
@@ -70,17 +74,20 @@ class DeviceKnob:
     reference_neg: ReferencePoint
     limits: KnobLimits
     release_omega: float | None = None
-    """Optional: tip/knob slope of the release branches (used by our compensator only)."""
+    """Optional, measured on the data-sheet unit only (`tsmd datasheet`): tip/knob slope of the
+    release branches. No compensator uses it (it is that unit's, not the product's)."""
     reference_backlash_pos_deg: float | None = None
-    """Optional: backlash on the tip after the reversal at reference_pos (with release_omega)."""
+    """Optional: the data-sheet unit's tip backlash after the reversal at reference_pos
+    (calibration compares its own backlash with it as a plausibility check)."""
     reference_backlash_neg_deg: float | None = None
-    """Optional: backlash on the tip after the reversal at reference_neg."""
+    """Optional: the same after the reversal at reference_neg."""
     dead_zone_offset_deg: float | None = None
-    """Optional: how far beyond the edge the current shows the tip leaves the plateau."""
+    """Optional: on the data-sheet unit, how far beyond the current's edge the tip leaves the
+    plateau. Informational: no compensator uses it."""
     reference_dead_zone_pos_deg: float | None = None
     """Optional (with ``_neg``): the dead-zone edges tsmd's calibration found in the current of
     the unit the reference points were measured on (other knob at 0): the plateau heights are
-    then product constants and each unit's loaded line moves with its own edges (tension play)."""
+    then product constants and each unit's loaded line moves with its own edges (method ours)."""
     reference_dead_zone_neg_deg: float | None = None
 
 
@@ -112,8 +119,8 @@ class KnobProfile:
     dead_zone_neg_deg: tuple[float, ...]
     backlash_pos_deg: tuple[float, ...]
     backlash_neg_deg: tuple[float, ...]
-    ours: OursParams | None = None
     tension_play: TensionPlayParams | None = None
+    """The parameters of method ``ours`` (None: calibrated by an older tsmd)."""
 
     def grid_array(self) -> np.ndarray:
         """(n, 4) array: D_pos, D_neg, B_pos, B_neg per grid point."""
@@ -330,25 +337,16 @@ def _knob_from_mapping(r: _Reader, raw: Any, key: str) -> KnobProfile:
     d_neg = r.numbers(r.get(k, "dead_zone_neg_deg", p), p + "dead_zone_neg_deg", n, -90, 0, "deg")
     b_pos = r.numbers(r.get(k, "backlash_pos_deg", p), p + "backlash_pos_deg", n, 0, 90, "deg")
     b_neg = r.numbers(r.get(k, "backlash_neg_deg", p), p + "backlash_neg_deg", n, 0, 90, "deg")
-    ours = None
     if k.get("ours") is not None:
-        ours = _ours_from_mapping(r, k["ours"], p + "ours", n)
+        _log.warning("%s: %sours: parameters of the former 'ours' compensator ignored "
+                     "(recalibrate for method 'ours')", r.origin, p)
     tension = None
     if k.get("tension_play") is not None:
         try:
             tension = tension_play_from_mapping(r.mapping(k["tension_play"], p + "tension_play"))
         except ValueError as exc:
             raise r.fail(p + "tension_play", str(exc)) from None
-    return KnobProfile(omega, pos, neg, h_pos, h_neg, grid, d_pos, d_neg, b_pos, b_neg, ours,
-                       tension)
-
-
-def _ours_from_mapping(r: _Reader, raw: Any, key: str, n: int) -> OursParams:
-    m = r.mapping(raw, key)
-    try:
-        return ours_params_from_mapping(m, n)
-    except (KeyError, ValueError, TypeError) as exc:
-        raise r.fail(key, str(exc).strip("'\"")) from None
+    return KnobProfile(omega, pos, neg, h_pos, h_neg, grid, d_pos, d_neg, b_pos, b_neg, tension)
 
 
 def profile_from_mapping(data: Any, origin: str = "profile") -> CatheterProfile:
@@ -388,8 +386,6 @@ def profile_to_mapping(profile: CatheterProfile) -> dict[str, Any]:
             "backlash_pos_deg": list(k.backlash_pos_deg),
             "backlash_neg_deg": list(k.backlash_neg_deg),
         }
-        if k.ours is not None:
-            entry["ours"] = ours_params_to_mapping(k.ours)
         if k.tension_play is not None:
             entry["tension_play"] = tension_play_to_mapping(k.tension_play)
         knobs[name] = entry
@@ -540,7 +536,7 @@ def standard_grid() -> tuple[float, ...]:
 def make_knob_profile(device_knob: DeviceKnob, other_knob_deg: Sequence[float],
                       dead_zone_pos_deg: Sequence[float], dead_zone_neg_deg: Sequence[float],
                       backlash_pos_deg: Sequence[float], backlash_neg_deg: Sequence[float],
-                      ours: OursParams | None = None) -> KnobProfile:
+                      tension_play: TensionPlayParams | None = None) -> KnobProfile:
     """A knob's profile from identified grids and the data sheet.
 
     H_pos/H_neg follow design assumptions 1-3: the line of slope omega through the reference point
@@ -556,4 +552,4 @@ def make_knob_profile(device_knob: DeviceKnob, other_knob_deg: Sequence[float],
     return KnobProfile(k.omega, k.reference_pos, k.reference_neg, float(h_pos), float(h_neg),
                        floats(other_knob_deg), floats(dead_zone_pos_deg),
                        floats(dead_zone_neg_deg), floats(backlash_pos_deg),
-                       floats(backlash_neg_deg), ours)
+                       floats(backlash_neg_deg), tension_play)

@@ -25,7 +25,7 @@ from simrig.analysis import measure_dead_zone_backlash
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd import __version__
 from tsmd.calibration import calibrate
-from tsmd.calibration.ours_fit import SweepData, fit_ours_knob
+from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
 from tsmd.compensation import LimitedCompensator, build_compensator
 from tsmd.config import default_sim_config
 from tsmd.datasheet import analysed_from, settle, tip_sweep
@@ -160,8 +160,8 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
 
     The paper's calibration protocol (each knob +-90 deg at 0.04 Hz, two cycles after a
     conditioning cycle, the other knob held at each grid angle), uncompensated through the full
-    stack; D and B measured on the tip with ``simrig.analysis`` (ground truth); our extra
-    parameters from the same sweeps.
+    stack; D and B measured on the tip with ``simrig.analysis`` (ground truth); the tension
+    play's other parameters from the same sweeps' current.
     """
     knobs = []
     for knob in (0, 1):
@@ -173,14 +173,14 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
             pos = rec[f"pos{knob + 1}"][skip:]
             tip = rec[f"tip{knob + 1}"][skip:]
             m = measure_dead_zone_backlash(pos, tip, threshold_deg=1.0)
-            sweeps.append(SweepData(rec["t"][skip:], rec[f"cmd{knob + 1}"][skip:], pos,
-                                    rec[f"cur{knob + 1}"][skip:], other, m.dead_zone_pos_deg,
-                                    m.dead_zone_neg_deg, m.backlash_pos_deg,
-                                    m.backlash_neg_deg))
+            sweeps.append(SweepCurrent(other, rec["t"][skip:], rec[f"cmd{knob + 1}"][skip:],
+                                       pos, rec[f"cur{knob + 1}"][skip:], m.dead_zone_pos_deg,
+                                       m.dead_zone_neg_deg, m.backlash_pos_deg,
+                                       m.backlash_neg_deg))
             log(f"  ground truth phi{knob + 1}, other {other:+.0f}: D {m.dead_zone_pos_deg:.1f}/"
                 f"{m.dead_zone_neg_deg:.1f}  B {m.backlash_pos_deg:.1f}/{m.backlash_neg_deg:.1f}")
         dk = device.knobs[knob]
-        ours = fit_ours_knob(sweeps, dk, GRID_DEG)
+        ours = fit_tension_play(sweeps, dk)
         knobs.append(make_knob_profile(
             dk, GRID_DEG, [s.dead_zone_pos_deg for s in sweeps],
             [s.dead_zone_neg_deg for s in sweeps], [s.backlash_pos_deg for s in sweeps],
@@ -226,17 +226,28 @@ def run_scenario(s: Scenario, method: str, seed: int, profile: Any,
                      float(np.mean([e[1] for e in errs])), tt[skip:] - tt[skip], q, cmd, tip)
 
 
-def compute_time_us(profile: Any, method: str, n_ticks: int = 5000) -> tuple[float, float]:
-    """Median and p99 wall time of one ``command`` call for two knobs (microseconds)."""
+def compute_time_us(profile: Any, method: str, n_ticks: int = 5000, clock: str = "wall"
+                    ) -> tuple[float, float]:
+    """Median and p99 time of one ``command`` call for two knobs (microseconds).
+
+    ``clock="wall"``: elapsed time, which on a shared machine includes being preempted;
+    ``"cpu"``: this thread's CPU time (the cost of the computation itself), less the clock's
+    own cost (the median of empty readings).
+    """
+    read = {"wall": time.perf_counter_ns, "cpu": time.thread_time_ns}[clock]
     comp = build_compensator(profile if method != "none" else None, method, PERIOD_S)
     t = np.arange(n_ticks) * PERIOD_S
     q = np.column_stack([60 * np.sin(2 * math.pi * 0.04 * t), 60 * np.sin(2 * math.pi * 0.08 * t)])
     comp.reset(q[0])
     times = np.empty(n_ticks)
+    empty = np.empty(n_ticks)
     for i, row in enumerate(q):
-        t0 = time.perf_counter_ns()
+        t0 = read()
         comp.command(row)
-        times[i] = time.perf_counter_ns() - t0
+        t1 = read()
+        times[i] = t1 - t0
+        empty[i] = read() - t1
+    times -= float(np.median(empty)) if clock == "cpu" else 0.0
     return float(np.median(times) / 1e3), float(np.percentile(times, 99) / 1e3)
 
 
@@ -453,11 +464,14 @@ def main(args: argparse.Namespace) -> int:
     lines += format_table(groups, with_paper=True)
     lines += ["", "1-DOF periodic by the other knob's fixed angle (paper's Table 1d_fixed):", ""]
     lines += format_table(fixed, with_paper=False)
-    lines += ["", "Per-tick compute time of the compensator for two knobs (this machine):", "",
-              "| method | median µs | p99 µs |", "|---|---|---|"]
+    lines += ["", "Per-tick compute time of the compensator for two knobs (this machine; wall "
+              "includes preemption, CPU is this thread's):", "",
+              "| method | wall median µs | wall p99 µs | CPU median µs | CPU p99 µs |",
+              "|---|---|---|---|---|"]
     for method in METHODS:
         med, p99 = compute_time_us(profile, method)
-        lines.append(f"| {method} | {med:.1f} | {p99:.1f} |")
+        cpu_med, cpu_p99 = compute_time_us(profile, method, clock="cpu")
+        lines.append(f"| {method} | {med:.1f} | {p99:.1f} | {cpu_med:.1f} | {cpu_p99:.1f} |")
     lines += ["", "Rate/position limiter (device limits) on the compensators' commands, "
               "same trajectories offline:", "",
               "| method | RMS deviation deg | max deviation deg | ticks limited |",

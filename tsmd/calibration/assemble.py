@@ -199,9 +199,8 @@ def cross_check_device(points: Sequence[GridPoint], device: DeviceModel,
                 report.warnings.append(
                     f"{label}: backlash_{side}_deg from the current is {found:.1f} deg, "
                     f"{ratio:.0%} of the data sheet's reference backlash {reference:.1f} deg: "
-                    "the current settles before the tip moves on this catheter, so the paper's "
-                    "compensator will under-compensate reversals (ours takes the release branch "
-                    "from the data sheet)")
+                    "the current settles before the tip moves on this catheter, so the "
+                    "compensators will under-compensate reversals")
 
 
 def knob_grid(points: Sequence[GridPoint], knob: int) -> tuple[tuple[float, ...],
@@ -215,7 +214,7 @@ def knob_grid(points: Sequence[GridPoint], knob: int) -> tuple[tuple[float, ...]
 
 def build_profile(catheter_id: str, device: DeviceModel, points: Sequence[GridPoint], *,
                   quality: QualityReport, software_version: str,
-                  ours: Sequence[object | None] = (None, None), interpolation: str = "pchip",
+                  interpolation: str = "pchip",
                   source: str = "calibration from motor current") -> CatheterProfile:
     """The profile: grids per knob, H from the reference points at D(0) (assumptions 1-3)."""
     quality.raise_if_bad()
@@ -234,8 +233,7 @@ def build_profile(catheter_id: str, device: DeviceModel, points: Sequence[GridPo
             dead_zone_pos_deg=values["dead_zone_pos_deg"],
             dead_zone_neg_deg=values["dead_zone_neg_deg"],
             backlash_pos_deg=values["backlash_pos_deg"],
-            backlash_neg_deg=values["backlash_neg_deg"],
-            ours=ours[knob]))  # type: ignore[arg-type]
+            backlash_neg_deg=values["backlash_neg_deg"]))
     assert len(KNOB_NAMES) == 2
     return CatheterProfile(
         catheter_id=catheter_id, device_model=device.device_model,

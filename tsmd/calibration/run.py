@@ -37,7 +37,6 @@ from tsmd.calibration.errors import (
 )
 from tsmd.calibration.estimate import EstimateOptions
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
-from tsmd.calibration.ours_fit import fit_ours_for_knob
 from tsmd.calibration.player import (
     Player,
     Progress,
@@ -133,19 +132,12 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
         report.raise_if_bad()
     except CalibrationError as exc:
         raise CalibrationRefusedError(str(exc), points) from None
-    ours = []
-    for knob in (0, 1):
-        try:
-            ours.append(fit_ours_for_knob([p for p in points if p.knob == knob], device, knob))
-        except (ValueError, ArithmeticError) as exc:
-            raise CalibrationError(f"{KNOB_LABELS[knob]}: our compensator's fit failed: "
-                                   f"{exc}") from None
     profile = build_profile(catheter_id, device, points, quality=report,
-                            software_version=__version__, ours=ours, source=source)
+                            software_version=__version__, source=source)
     try:
         profile = with_tension_play(profile, points, device)
     except (ValueError, ArithmeticError) as exc:
-        raise CalibrationError(f"the tension-play fit failed: {exc}") from None
+        raise CalibrationError(f"our compensator's fit (tension play) failed: {exc}") from None
     return profile, report
 
 

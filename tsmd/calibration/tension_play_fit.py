@@ -3,9 +3,7 @@
 Per sweep (one knob swept +-A, the other held at a grid angle) and side:
 
 * the dead-zone edge ``D`` and the backlash at the amplitude ``B_A``: what the current analysis
-  (:mod:`tsmd.calibration.identify`) found, ``D`` moved outward by the data sheet's
-  ``dead_zone_offset_deg`` where it gives one (a per-product constant: where the tip leaves its
-  plateau beyond the current's edge);
+  (:mod:`tsmd.calibration.identify`) found (no data-sheet offset: that was one unit's);
 * the zero-tension point ``x0``: the loaded current ramp (from 10 deg past ``D`` to 5 deg before
   the turn) fitted by a line and extrapolated to the current that moves the knob the same way
   through the dead zone, where no tendon is loaded (friction and any sensor offset cancel);
@@ -35,7 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.calibration.lag import estimate_lag_s
-from tsmd.compensation.paper import at_other_knob_zero, offset_edges, plateau_heights
+from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.tension_play import BETA_RANGE, TensionPlayParams
 
 FloatArray = NDArray[np.float64]
@@ -132,7 +130,7 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     """One knob's parameters from all its sweeps (ValueError naming the sweep that fails).
 
     ``device_knob``: the data sheet's knob (``omega``, ``reference_pos``/``_neg`` and optionally
-    ``dead_zone_offset_deg``), measured once per product on another unit.
+    ``reference_dead_zone_*_deg``), measured once per product on another unit.
     """
     if len(sweeps) < 2:
         raise ValueError("needs sweeps at >= 2 other-knob angles")
@@ -140,7 +138,6 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     grid = [float(s.other_knob_deg) for s in order]
     if any(b <= a for a, b in itertools.pairwise(grid)):
         raise ValueError(f"two sweeps at the same other-knob angle: {grid}")
-    offset = float(getattr(device_knob, "dead_zone_offset_deg", None) or 0.0)
     pos_fits: list[SideFit] = []
     neg_fits: list[SideFit] = []
     for s in order:
@@ -153,8 +150,7 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         cur = np.asarray(s.current_A, float)
         ok = np.isfinite(pos) & np.isfinite(cur)
         pos, cur = pos[ok], cur[ok]
-        edge_pos, edge_neg = (float(e) for e in offset_edges(s.dead_zone_pos_deg,
-                                                              s.dead_zone_neg_deg, offset))
+        edge_pos, edge_neg = float(s.dead_zone_pos_deg), float(s.dead_zone_neg_deg)
         try:
             for sign, fits, d, b in ((1, pos_fits, edge_pos, s.backlash_pos_deg),
                                      (-1, neg_fits, edge_neg, s.backlash_neg_deg)):
@@ -170,10 +166,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     # with its edges); without them the paper's assumption (the line through the reference point)
     ref_pos = getattr(k, "reference_dead_zone_pos_deg", None)
     ref_neg = getattr(k, "reference_dead_zone_neg_deg", None)
-    ref_edges = offset_edges(0.0 if ref_pos is None else ref_pos,
-                             0.0 if ref_neg is None else ref_neg, offset)
-    edge_pos = at_other_knob_zero(grid, d_pos) if ref_pos is None else float(ref_edges[0])
-    edge_neg = at_other_knob_zero(grid, d_neg) if ref_neg is None else float(ref_edges[1])
+    edge_pos = at_other_knob_zero(grid, d_pos) if ref_pos is None else float(ref_pos)
+    edge_neg = at_other_knob_zero(grid, d_neg) if ref_neg is None else float(ref_neg)
     h_pos, h_neg = plateau_heights(k, edge_pos, edge_neg)
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
                                           np.asarray(s.pos_deg, float)) for s in order]))

@@ -2,9 +2,11 @@
 
 ``build_compensator(profile, method, period_s, limits)`` gives a :class:`Compensator`:
 ``"none"`` passes the desired angles through, ``"paper"`` is the published piecewise-linear
-inverse (:mod:`tsmd.compensation.paper`), ``"ours"`` removes its named weaknesses
-(:mod:`tsmd.compensation.ours`). With ``limits`` the output goes through the rate and position
-limiter of :mod:`tsmd.compensation.safety` last, so it never leaves the knobs' range.
+inverse (:mod:`tsmd.compensation.paper`), ``"ours"`` the inverse of the tension play
+(:mod:`tsmd.compensation.tension_play`, run by :mod:`tsmd.compensation.ours`), every parameter
+identified per catheter from its calibration current. With ``limits`` the output goes through
+the rate and position limiter of :mod:`tsmd.compensation.safety` last, so it never leaves the
+knobs' range.
 """
 
 from __future__ import annotations
@@ -16,28 +18,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
-from tsmd.compensation.ours import OursCompensator, OursKnob, ours_field
-from tsmd.compensation.paper import (
-    PaperCompensator,
-    PaperKnob,
-    at_other_knob_zero,
-    offset_edges,
-    plateau_heights,
-)
-from tsmd.compensation.safety import (
-    DEFAULT_MAX_ACCEL_DEG_S2,
-    DEFAULT_MAX_VELOCITY_DEG_S,
-    KnobLimiter,
-    KnobLimits,
-)
-from tsmd.compensation.tension_play import tension_play_compensator
+from tsmd.compensation.ours import OursCompensator, ours_knobs
+from tsmd.compensation.paper import PaperCompensator, PaperKnob
+from tsmd.compensation.safety import KnobLimiter, KnobLimits
 from tsmd.errors import TsmdError
 
 if TYPE_CHECKING:
     from tsmd.profile import CatheterProfile
 
-METHODS: tuple[str, ...] = ("none", "paper", "ours", "tension")
+METHODS: tuple[str, ...] = ("none", "paper", "ours")
 """Also the config's ``CompensationMethod`` (a test keeps the two equal)."""
+RENAMED_METHODS: dict[str, str] = {"tension": "ours"}
+"""Former method names, refused with the name to use (one line)."""
 
 __all__ = [
     "METHODS",
@@ -123,25 +115,15 @@ def paper_compensator(profile: CatheterProfile) -> PaperCompensator:
 
 
 def ours_compensator(profile: CatheterProfile, period_s: float,
-                     max_velocity_deg_s: float = DEFAULT_MAX_VELOCITY_DEG_S,
-                     max_accel_deg_s2: float = DEFAULT_MAX_ACCEL_DEG_S2) -> OursCompensator:
-    knobs = []
-    for name, k in zip(("phi1", "phi2"), profile.knobs, strict=True):
-        if k.ours is None:
-            raise CompensationError(
-                f"profile {profile.catheter_id!r} has no 'ours' parameters for {name}; "
-                "recalibrate with this tsmd version or use method 'paper'")
-        o = k.ours
-        # Our dead-zone edges: the current's, moved outward by the data sheet's offset; H from
-        # the reference points through them (design assumptions 1-3, as for the paper).
-        d_pos, d_neg = offset_edges(k.dead_zone_pos_deg, k.dead_zone_neg_deg,
-                                    o.dead_zone_offset_deg)
-        h_pos, h_neg = plateau_heights(k, at_other_knob_zero(k.other_knob_deg, d_pos),
-                                       at_other_knob_zero(k.other_knob_deg, d_neg))
-        field = ours_field(k.other_knob_deg, d_pos.tolist(), d_neg.tolist(), o,
-                           profile.interpolation)
-        knobs.append(OursKnob(field, h_pos, h_neg, k.omega, o.lag_s))
-    return OursCompensator((knobs[0], knobs[1]), period_s, max_velocity_deg_s, max_accel_deg_s2)
+                     limits: Sequence[KnobLimits] | None = None) -> OursCompensator:
+    """The tension play's inverse from the profile's per-knob ``tension_play`` parameters."""
+    params = [k.tension_play for k in profile.knobs]
+    if params[0] is None or params[1] is None:
+        raise CompensationError(
+            f"profile {profile.catheter_id!r} has no parameters for method 'ours' (it was "
+            "calibrated by an older tsmd): recalibrate it, or use method 'paper'")
+    return OursCompensator(ours_knobs((params[0], params[1]), profile.interpolation),
+                           period_s, limits)
 
 
 def build_compensator(profile: CatheterProfile | None, method: str, period_s: float,
@@ -149,9 +131,13 @@ def build_compensator(profile: CatheterProfile | None, method: str, period_s: fl
                       apply_limits: bool = True) -> Compensator:
     """The compensator for ``method`` ("none" | "paper" | "ours"), limited when ``limits``.
 
-    ``apply_limits=False`` only informs the compensator of the motor's limits (when ours must
-    start a jump): for a caller such as the control loop that applies the limiter itself, last.
+    ``apply_limits=False`` only informs the compensator of the motor's limits (ours plans its
+    jumps and limits its own command with them): for a caller such as the control loop that
+    applies the limiter itself, last.
     """
+    if method in RENAMED_METHODS:
+        raise CompensationError(f"compensation method {method!r} is now called "
+                                f"{RENAMED_METHODS[method]!r}")
     if method not in METHODS:
         raise CompensationError(f"compensation method {method!r} is not one of {list(METHODS)}")
     if not period_s > 0:
@@ -163,19 +149,8 @@ def build_compensator(profile: CatheterProfile | None, method: str, period_s: fl
         raise CompensationError(f"compensation method {method!r} needs a catheter profile")
     elif method == "paper":
         inner = paper_compensator(profile)
-    elif method == "tension":
-        params = [k.tension_play for k in profile.knobs]
-        if params[0] is None or params[1] is None:
-            raise CompensationError(f"profile {profile.catheter_id!r} has no 'tension_play' "
-                                    "parameters; recalibrate with this tsmd version")
-        inner = tension_play_compensator((params[0], params[1]), period_s, limits,
-                                         profile.interpolation)
     else:
-        # the motor's limits set when a jump must start; the simulated rig's when not given
-        v_max = (min(lim.max_velocity_deg_s for lim in limits) if limits
-                 else DEFAULT_MAX_VELOCITY_DEG_S)
-        a_max = min(lim.max_accel_deg_s2 for lim in limits) if limits else DEFAULT_MAX_ACCEL_DEG_S2
-        inner = ours_compensator(profile, period_s, v_max, a_max)
+        inner = ours_compensator(profile, period_s, limits)
     if limits is None or not apply_limits:
         return inner
     return LimitedCompensator(inner, limits, period_s)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,9 +44,9 @@ class KnobLimits:
         return min(max(q_deg, self.min_deg), self.max_deg)
 
 
-@dataclass(frozen=True)
-class LimiterState:
-    """Where the limited command is, how fast it moves, and the last target it was given."""
+class LimiterState(NamedTuple):
+    """Where the limited command is, how fast it moves, and the last target it was given
+    (a named tuple: one is made per knob and tick)."""
 
     q_deg: float
     v_deg_s: float = 0.0
@@ -68,11 +69,15 @@ def limit_step(state: LimiterState, target_deg: float, limits: KnobLimits,
 
 def _step(q0: float, v0: float, last_target: float | None, target_deg: float,
           limits: KnobLimits, dt_s: float) -> tuple[float, float, float]:
-    """:func:`limit_step` on plain floats (the loop's hot path: no object per tick)."""
+    """:func:`limit_step` on plain floats (the loop's hot path: no object per tick; plain
+    comparisons instead of min/max and clip)."""
     a = limits.max_accel_deg_s2
     v_max = limits.max_velocity_deg_s
-    finite = math.isfinite(target_deg)
-    target = limits.clip(target_deg) if finite else q0
+    lo, hi = limits.min_deg, limits.max_deg
+    finite = target_deg - target_deg == 0.0
+    target = q0
+    if finite:
+        target = lo if target_deg < lo else (hi if target_deg > hi else target_deg)
     v_target = 0.0
     if last_target is not None and finite:
         v_target = (target - last_target) / dt_s
@@ -81,15 +86,20 @@ def _step(q0: float, v0: float, last_target: float | None, target_deg: float,
     d = target - q0
     # The fastest approach speed from which the discrete decelerating sequence still stops on
     # the target (relative to its own motion).
-    v_stop = math.sqrt(0.25 * a * a * dt_s * dt_s + 2.0 * a * abs(d)) - 0.5 * a * dt_s
+    half_a_dt = 0.5 * a * dt_s
+    v_stop = math.sqrt(half_a_dt * half_a_dt + 2.0 * a * abs(d)) - half_a_dt
     v_want = d / dt_s  # reach the target in this tick if the limits allow
-    if (v_want - v_target) * math.copysign(1.0, d) > v_stop:  # closing in too fast to stop
-        v_want = v_target + math.copysign(v_stop, d)
-    v = min(max(v_want, v0 - a * dt_s), v0 + a * dt_s)
-    v = min(max(v, -v_max), v_max)
+    if d >= 0.0:
+        if v_want - v_target > v_stop:  # closing in too fast to stop
+            v_want = v_target + v_stop
+    elif v_target - v_want > v_stop:
+        v_want = v_target - v_stop
+    dv = a * dt_s
+    v = v0 - dv if v_want < v0 - dv else (v0 + dv if v_want > v0 + dv else v_want)
+    v = -v_max if v < -v_max else (v_max if v > v_max else v)
     q = q0 + v * dt_s
-    if q < limits.min_deg or q > limits.max_deg:  # position first, whatever the speed
-        q = limits.clip(q)
+    if q < lo or q > hi:  # position first, whatever the speed
+        q = lo if q < lo else hi
         v = (q - q0) / dt_s
     return q, v, target
 

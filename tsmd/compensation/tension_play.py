@@ -14,9 +14,8 @@ reference points that give the plateau heights are the data sheet's, as in the p
 
 Per knob the rising branch (moving up) is the lower envelope and the falling branch the upper
 envelope of the loaded lines, the plateaus and the two release lines; between them the output
-is held (play). The inverse is exact on every sloped part and jumps across flat parts; the
-command stage then starts dead-zone jumps early, limits velocity and acceleration and averages
-over ``smoothing_s`` (jerk <= 2 a_max / smoothing_s), see :class:`TensionPlayCompensator`.
+is held (play). The inverse is exact on every sloped part and jumps across flat parts. The
+compensator built on it (method ``ours``) is :class:`tsmd.compensation.ours.OursCompensator`.
 """
 
 from __future__ import annotations
@@ -26,31 +25,22 @@ import math
 from bisect import bisect_right
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
-
-from tsmd.compensation.grid import ParameterField
-from tsmd.compensation.safety import KnobLimits, LimiterState, limit_step
 
 BETA_RANGE: tuple[float, float] = (0.0, 0.8)
 """Backlash per knob degree of load: 0 = no backlash; 0.8 = release slope 5 omega."""
 _FLAT_SLOPE = 1e-6  # makes the envelopes strictly increasing so that they can be inverted
 _FAR_DEG = 1000.0
-_TABLE_STEP_DEG = 0.25  # resolution of the other knob's angle in the precomputed envelopes
-_MAX_LEAD_DEG = 10.0
-_JUMP_MIN_DEG = 3.0
-REVERSAL_DEADBAND_DEG = 0.1
-"""A desired angle that turns back by less than this is held: an exact inverse would make the
-motor cross the whole backlash for every jitter of the operator's input (error <= this)."""
 
 
 @dataclass(frozen=True)
 class TensionPlayParams:
     """One knob's tension-play parameters; tuples are sampled on ``other_knob_deg``.
 
-    ``dead_zone_*_deg``: where the tip leaves its plateau (current edge + data-sheet offset).
+    ``dead_zone_*_deg``: where the tip leaves its plateau (the current's edge).
     ``backlash_gain_*``: beta, knob degrees of backlash per knob degree of load at the reversal.
     ``zero_load_*_deg``: where the loaded current ramp extrapolates to zero (the tension's zero).
     ``height_*_deg``: plateau heights from the data sheet's reference points (paper, H).
@@ -159,10 +149,16 @@ class Branches:
 
 
 def _interp(x: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> float:
-    """Linear interpolation on strictly increasing ``xs``, extrapolating the end pieces."""
-    i = min(max(bisect_right(xs, x) - 1, 0), len(xs) - 2)
-    x0, x1 = xs[i], xs[i + 1]
-    return ys[i] + (ys[i + 1] - ys[i]) * (x - x0) / (x1 - x0)
+    """Linear interpolation on strictly increasing ``xs``, extrapolating the end pieces (called
+    every tick: plain comparisons, no builtins)."""
+    i = bisect_right(xs, x) - 1
+    if i < 0:
+        i = 0
+    elif i > len(xs) - 2:
+        i = len(xs) - 2
+    x0 = xs[i]
+    y0 = ys[i]
+    return y0 + (ys[i + 1] - y0) * (x - x0) / (xs[i + 1] - x0)
 
 
 def release_line(omega: float, height_deg: float, dead_zone_deg: float, beta: float,
@@ -178,15 +174,16 @@ def release_line(omega: float, height_deg: float, dead_zone_deg: float, beta: fl
     return slope, height_deg - omega * dead_zone_deg - slope * b * zero_load_deg
 
 
-def branches(p: TensionPlayParams, d_pos: float, d_neg: float, beta_pos: float,
-             beta_neg: float, x0_pos: float, x0_neg: float) -> Branches:
+def branches(omega: float, height_pos_deg: float, height_neg_deg: float, d_pos: float,
+             d_neg: float, beta_pos: float, beta_neg: float, x0_pos: float, x0_neg: float
+             ) -> Branches:
     """The two branches from the loaded lines, plateaus and release lines.
 
     rising  = H_pos + omega max(x - D_pos, 0) + min(R_neg(x) - H_pos, 0)
     falling = H_neg + omega min(x - D_neg, 0) + max(R_pos(x) - H_neg, 0)
     then lower/upper envelope of the two (continuous and invertible for any parameters).
     """
-    w, h_pos, h_neg = p.omega, p.height_pos_deg, p.height_neg_deg
+    w, h_pos, h_neg = omega, height_pos_deg, height_neg_deg
     s_pos, c_pos = release_line(w, h_pos, d_pos, beta_pos, x0_pos)
     s_neg, c_neg = release_line(w, h_neg, d_neg, beta_neg, x0_neg)
 
@@ -216,8 +213,7 @@ def branches(p: TensionPlayParams, d_pos: float, d_neg: float, beta_pos: float,
     return Branches(tuple(xs), tuple(lo), tuple(hi))
 
 
-@dataclass(frozen=True)
-class PlayState:
+class PlayState(NamedTuple):
     """Command x, model output y, direction of motion, output held since the last reversal."""
 
     x_deg: float
@@ -241,19 +237,24 @@ def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
     An unchanged output keeps a held input; one on a branch follows the branch forward if the
     branches moved (the other knob's angle changed the dead zone).
     """
-    if not math.isfinite(y_deg):
+    if y_deg - y_deg != 0.0:  # not finite
         return state
-    if y_deg == state.y_deg:
-        if state.y_deg == state.held_deg:
+    x_prev, y_prev, direction, held = state
+    if y_deg == y_prev:
+        if y_prev == held:
             return state
-        direction = state.direction
     else:
-        direction = 1 if y_deg > state.y_deg else -1
-    held = state.held_deg if direction == state.direction else state.y_deg
+        turn = 1 if y_deg > y_prev else -1
+        if turn != direction:
+            direction, held = turn, y_prev
     if direction > 0:
-        x = max(b.rising_inverse(y_deg), state.x_deg)
+        x = _interp(y_deg, b.rising_deg, b.knots)
+        if x < x_prev:
+            x = x_prev
     else:
-        x = min(b.falling_inverse(y_deg), state.x_deg)
+        x = _interp(y_deg, b.falling_deg, b.knots)
+        if x > x_prev:
+            x = x_prev
     return PlayState(x, y_deg, direction, held)
 
 
@@ -265,165 +266,3 @@ def rest_state(y_deg: float, b: Branches, home_deg: float = 0.0) -> PlayState:
     if hi < home_deg:  # arrived moving down along the falling branch
         return PlayState(lo, y_deg, -1, max(y_deg, b.falling(home_deg)))
     return PlayState(hi, y_deg, 1, min(y_deg, b.rising(home_deg)))
-
-
-class BranchTable:
-    """One knob's branches precomputed over the other knob's angle (the grid interpolated)."""
-
-    def __init__(self, p: TensionPlayParams, interpolation: str = "pchip") -> None:
-        self.params = p
-        field = ParameterField(p.other_knob_deg, p.columns(), interpolation)
-        self._lo = float(p.other_knob_deg[0])
-        n = max(2, round((p.other_knob_deg[-1] - self._lo) / _TABLE_STEP_DEG) + 1)
-        self._step = (float(p.other_knob_deg[-1]) - self._lo) / (n - 1)
-        self._table = [branches(p, *(float(v) for v in field.at(self._lo + i * self._step)))
-                       for i in range(n)]
-
-    def at(self, other_deg: float) -> Branches:
-        """The branches at the other knob's angle (nearest table row, clamped to the grid)."""
-        i = round((other_deg - self._lo) / self._step) if math.isfinite(other_deg) else 0
-        return self._table[min(max(i, 0), len(self._table) - 1)]
-
-
-# ----------------------------------------------------------------------------------------------
-# The compensator: inverse, early jumps, limits, smoothing
-
-
-class TensionPlayCompensator:
-    """Two knobs of the tension play, as a :class:`tsmd.compensation.Compensator`.
-
-    Each knob's branches follow the other knob's commanded angle (calibration held the other
-    *knob* at each grid angle). Per tick and knob: the desired angle is led by the drive lag plus
-    half the smoothing window; the inverse gives the command; a jump across a flat part seen
-    within half the motor's crossing time ahead is started now and then held until the desired
-    angle catches up (the crossing error is centred instead of all lag); the command then goes
-    through the knob's position/velocity/acceleration limits and a moving average over
-    ``smoothing_s``: the average of a feasible motion stays feasible, and its acceleration
-    changes by at most 2 a_max per window, so the jerk is at most 2 a_max / ``smoothing_s``.
-    """
-
-    def __init__(self, knobs: tuple[TensionPlayParams, TensionPlayParams], period_s: float,
-                 limits: Sequence[KnobLimits] | None = None, smoothing_s: float = 0.1,
-                 interpolation: str = "pchip") -> None:
-        if not period_s > 0:
-            raise ValueError(f"period_s must be positive, got {period_s}")
-        if limits is None:  # the simulated rig's drives, no position limit
-            limits = (KnobLimits(-1e9, 1e9, 120.0, 2000.0),) * 2
-        if len(limits) != 2:
-            raise ValueError(f"need limits for 2 knobs, got {len(limits)}")
-        self.params = knobs
-        self.period_s = period_s
-        self.limits = (limits[0], limits[1])
-        # jumps are planned with the slower knob's limits
-        self.v_max = min(lim.max_velocity_deg_s for lim in limits)
-        self.a_max = min(lim.max_accel_deg_s2 for lim in limits)
-        self._tables = (BranchTable(knobs[0], interpolation), BranchTable(knobs[1], interpolation))
-        self._n_avg = max(1, round(smoothing_s / period_s))
-        # faster than any knob can make the tip move (release slope <= 5 omega)
-        self._jump_deg = 5.0 * max(k.omega for k in knobs) * self.v_max * period_s
-        self._ahead_s = [k.lag_s + 0.5 * (self._n_avg - 1) * period_s for k in knobs]
-        self._states = [PlayState(0.0, 0.0, 1, 0.0), PlayState(0.0, 0.0, 1, 0.0)]
-        self._lim = [LimiterState(0.0), LimiterState(0.0)]
-        self._window: list[list[float]] = [[0.0] * self._n_avg, [0.0] * self._n_avg]
-        self._sum = [0.0, 0.0]
-        self._slot = 0
-        self._q_prev = [0.0, 0.0]
-        self._v = [0.0, 0.0]
-        self._target = [0.0, 0.0]
-        self._out = [0.0, 0.0]
-        self._hold = [0, 0]
-        self._q_dir = [1, 1]
-        self.reset(np.zeros(2))
-
-    def reset(self, q_deg: NDArray[np.float64]) -> None:
-        q = [float(v) if math.isfinite(v) else 0.0 for v in np.asarray(q_deg, dtype=float)]
-        x = [0.0, 0.0]
-        for _ in range(3):  # each knob's branches depend on the other knob's command
-            self._states = [rest_state(q[i], self._tables[i].at(x[1 - i])) for i in (0, 1)]
-            x = [s.x_deg for s in self._states]
-        self._q_prev = list(q)
-        self._v = [0.0, 0.0]
-        self._target = list(q)
-        self._out = list(x)
-        self._hold = [0, 0]
-        self._q_dir = [s.direction for s in self._states]
-        x = [self.limits[i].clip(x[i]) for i in (0, 1)]
-        self._lim = [LimiterState(x[0]), LimiterState(x[1])]
-        self._window = [[x[0]] * self._n_avg, [x[1]] * self._n_avg]
-        self._sum = [x[0] * self._n_avg, x[1] * self._n_avg]
-        self._slot = 0
-
-    def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-        q = (float(q_deg[0]), float(q_deg[1]))
-        others = (self._states[1].x_deg, self._states[0].x_deg)
-        slot = self._slot
-        for i in (0, 1):
-            qi = q[i]
-            if math.isfinite(qi):
-                self._track(i, qi, self._tables[i].at(others[i]))
-            # non-finite desired angle: the command stays where it is (limited, smoothed)
-            lim = limit_step(self._lim[i], self._out[i], self.limits[i], self.period_s)
-            self._lim[i] = lim
-            self._sum[i] += lim.q_deg - self._window[i][slot]
-            self._window[i][slot] = lim.q_deg
-        self._slot = (slot + 1) % self._n_avg
-        n = self._n_avg
-        return np.array([self._sum[0] / n, self._sum[1] / n])
-
-    def _track(self, i: int, q_raw: float, b: Branches) -> None:
-        qi = self._q_prev[i]
-        if (q_raw - qi) * self._q_dir[i] >= 0.0:
-            qi = q_raw
-        elif abs(q_raw - qi) >= REVERSAL_DEADBAND_DEG:  # a reversal, not jitter
-            qi = q_raw
-            self._q_dir[i] = -self._q_dir[i]
-        dq = qi - self._q_prev[i]
-        self._q_prev[i] = qi
-        v = 0.7 * self._v[i] + 0.3 * dq / self.period_s
-        if abs(dq) > self._jump_deg:  # a step, not a motion: nothing to predict from it
-            v = 0.0
-        self._v[i] = v
-        lead = min(max(self._ahead_s[i] * v, -_MAX_LEAD_DEG), _MAX_LEAD_DEG)
-        target = qi + lead
-        # The lead shrinks as the desired angle slows; it must never turn the target back while
-        # the desired angle itself does not turn: a false reversal jumps across the backlash.
-        step = target - self._target[i]
-        state = self._states[i]
-        if step * dq < 0.0 or (dq == 0.0 and step * state.direction < 0.0):
-            target = self._target[i]
-
-        self._target[i] = target
-        state = inverse_step(state, target, b)
-        self._states[i] = state
-        self._out[i] = self._early_jump(i, state, target, v, b)
-
-    def _early_jump(self, i: int, state: PlayState, target: float, v: float,
-                    b: Branches) -> float:
-        x, d = state.x_deg, state.direction
-        prev = self._out[i]
-        if self._hold[i] != 0:
-            if self._hold[i] == d and (x - prev) * d < 0.0:
-                return prev  # the desired angle has not caught up with the early jump yet
-            self._hold[i] = 0
-        speed = abs(v)
-        if speed < 1e-3 or (v > 0) != (d > 0):
-            return x
-        horizon_s = 30.0 / self.v_max  # half the crossing time of a 60 deg jump
-        ahead = x
-        for _ in range(2):
-            ahead = inverse_step(state, target + v * horizon_s, b).x_deg
-            expected = speed * horizon_s / self.params[i].omega
-            jump = (ahead - x) * d - expected
-            if jump <= expected + _JUMP_MIN_DEG:
-                return x
-            horizon_s = 0.5 * (jump / self.v_max + self.v_max / self.a_max)
-        self._hold[i] = d
-        return ahead
-
-
-def tension_play_compensator(knobs: Sequence[TensionPlayParams], period_s: float,
-                             limits: Sequence[KnobLimits] | None = None,
-                             interpolation: str = "pchip") -> TensionPlayCompensator:
-    """The compensator for two knobs, within the knobs' limits (the sim rig's when None)."""
-    return TensionPlayCompensator((knobs[0], knobs[1]), period_s, limits,
-                                  interpolation=interpolation)

@@ -2,7 +2,7 @@
 
 An offset moves one edge outward (positive: a wider dead zone, e.g. more slack after the shaft
 was bent). A slack change moves the tendon's whole characteristic along the knob axis, so the
-loaded line and (for our compensator) the release line of that tendon move with its edge,
+loaded line and (for our compensator) the zero-load point of that tendon move with its edge,
 while the plateau heights H stay: the tip's plateaus do not depend on where the tendon engages.
 """
 
@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from tsmd.compensation.ours import OursKnob
+from tsmd.compensation.ours import MOVES_WITH_EDGE, OursKnob
 from tsmd.compensation.paper import PaperKnob
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, KnobProfile, ReferencePoint, save_profile
@@ -34,12 +34,12 @@ class OnlineError(TsmdError):
 def shifted_knob(knob: Any, offset: tuple[float, float]) -> Any:
     """A copy of a compensator knob (ours or the paper's) with its edges moved outward.
 
-    Our release lines pivot at the edges, so their pivots move with them.
+    Ours: each tendon's zero-load point moves with its edge (the whole characteristic moves).
     """
     off_pos, off_neg = offset
     moves = {"dead_zone_pos_deg": off_pos, "dead_zone_neg_deg": -off_neg}
     if isinstance(knob, OursKnob):
-        moves.update(release_pivot_pos_deg=off_pos, release_pivot_neg_deg=-off_neg)
+        moves.update({MOVES_WITH_EDGE[edge]: move for edge, move in list(moves.items())})
     elif not isinstance(knob, PaperKnob):
         raise OnlineError(f"online re-estimation cannot shift a {type(knob).__name__}")
     return replace(knob, field=knob.field.shifted(moves))
@@ -70,13 +70,13 @@ def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str =
     """
     knobs = []
     for k, (off_pos, off_neg) in zip(profile.knobs, offsets, strict=True):
-        ours = k.ours
+        ours = k.tension_play
         if ours is not None:
-            ours = replace(ours,
-                           release_pivot_pos_deg=tuple(v + off_pos
-                                                       for v in ours.release_pivot_pos_deg),
-                           release_pivot_neg_deg=tuple(v - off_neg
-                                                       for v in ours.release_pivot_neg_deg))
+            ours = replace(
+                ours, dead_zone_pos_deg=tuple(v + off_pos for v in ours.dead_zone_pos_deg),
+                dead_zone_neg_deg=tuple(v - off_neg for v in ours.dead_zone_neg_deg),
+                zero_load_pos_deg=tuple(v + off_pos for v in ours.zero_load_pos_deg),
+                zero_load_neg_deg=tuple(v - off_neg for v in ours.zero_load_neg_deg))
         knobs.append(KnobProfile(
             k.omega, ReferencePoint(k.reference_pos.knob_deg + off_pos, k.reference_pos.tip_deg),
             ReferencePoint(k.reference_neg.knob_deg - off_neg, k.reference_neg.tip_deg),

@@ -176,7 +176,10 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     rank_stride = [max(-(-n_held // cfg.rank_max_rows), 1)] * len(series)
     signature = cfg.method == "signature"
     win_series, win_split = fit_windows(series, split, cfg.fit_window_s, cfg.fit_windows)
-    fit_rows = min(cfg.fit_max_rows, cfg.signature_fit_rows) if signature else cfg.fit_max_rows
+    # a long recording is fitted on windows; with the signature method also on a smaller
+    # budget (the layer takes what a longer fit would remove); short ones as they always were
+    reduced = signature and win_split is not split
+    fit_rows = min(cfg.fit_max_rows, cfg.signature_fit_rows) if reduced else cfg.fit_max_rows
     fit_views = build_views(win_series, win_split, _strides(win_series, fit_rows), "fit")
     final_stride = [max(-(-n_held // cfg.final_max_rows), 1)] * len(series)
     final_views = build_views(series, split, strides, "eval", final_stride)
@@ -189,12 +192,12 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     ev = Evaluator(factory, copy.deepcopy(plant_params), noise_var, v0)
 
     # (2) base fit on training rows of the thinned grid
-    base_evals, polish_evals = cfg.signature_fit_evals if signature else (cfg.base_evals,
-                                                                          cfg.polish_evals)
+    base_evals, polish_evals = cfg.signature_fit_evals if reduced else (cfg.base_evals,
+                                                                        cfg.polish_evals)
     fit_base(ev, fit_views, cfg.fit_specs, min(base_evals, cfg.base_evals))
     coarse_params, _ = polish_base(ev, fit_views, cfg.fit_specs,
                                    min(polish_evals, cfg.polish_evals))
-    if signature:  # the refinement is the candidate method's control, not needed here
+    if reduced:  # the refinement is the candidate method's control, not needed here
         base_params, base_cost = coarse_params, float("nan")
     else:
         base_params, _, base_cost = joint_refine(ev, fit_views, cfg.fit_specs, None,

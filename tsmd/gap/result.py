@@ -48,8 +48,8 @@ class GapConfig:
     signature_fit_evals: tuple[int, int] = (36, 8)
     signature_fit_rows: int = 800
     """Coordinate-search and simplex evaluations and grid rows of the base fit in the signature
-    method (the structural layer takes what a longer fit would remove; the fit sets its
-    carriers and the 'physics' figures)."""
+    method when it runs on windows (long recordings): the structural layer takes what a longer
+    fit would remove; the fit sets its carriers and the 'physics' figures."""
 
 
 @dataclass

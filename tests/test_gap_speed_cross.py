@@ -4,11 +4,13 @@ side of the cross-plant self-test."""
 from __future__ import annotations
 
 import numpy as np
-from support.gap import make_recording
+import pytest
+from support.gap import StandInPlant, make_recording
 
 from simrig.family import family_member
 from tsmd.gap.crosstest import PRESETS, make_session, parse_plant_spec
 from tsmd.gap.data import GapSeries, Split, fit_windows, make_split, series_from_recording
+from tsmd.gap.model import Evaluator, ParamSpec, build_views, fit_base
 from tsmd.gap.selftest import EFFECTS
 
 
@@ -38,6 +40,19 @@ def test_window_rows_before_both_knobs_reverse_are_not_fitted() -> None:
         trained = ~held
         assert trained.any()
         assert not np.any(trained & split.held_out[0][rows])  # held-out rows stay held out
+
+
+def test_base_fit_on_windows_recovers_the_dead_zone_of_the_whole_recording() -> None:
+    rec = make_recording(duration_s=600.0, rate_hz=20.0, slack_deg=18.0)
+    s = series_from_recording(rec, "long")
+    split = make_split([s], 0.3)
+    wins, wsplit = fit_windows([s], split, window_s=40.0, n_windows=4)
+    views = build_views(wins, wsplit, [2] * len(wins), "fit")
+    ev = Evaluator(lambda p: StandInPlant(**p), {"slack_deg": 10.0, "play_deg": 10.0},
+                   np.array([0.09, 0.09, 2.5e-5, 2.5e-5]), np.array([1.0, 1.0]))
+    params, _ = fit_base(ev, views, [ParamSpec("slack_deg", 5.0, 30.0)], max_evals=20)
+    assert params["slack_deg"] == pytest.approx(18.0, abs=1.0)
+    assert sum(len(v.rows) for v in views) < 0.3 * len(s) / 2  # a fraction of the rows
 
 
 def test_short_recordings_are_fitted_whole() -> None:

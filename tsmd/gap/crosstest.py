@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from simrig.current_sensor import CurrentSensor
+from simrig.family import PLANT_SPECS, family_member
 from simrig.plant import load_plant
 from simrig.tracker import EmTracker
 from tsmd.gap.data import series_from_recording
@@ -58,23 +59,58 @@ compliant *is* the compliance effect, so a base that differs along one of the si
 would make the self-test's truth ambiguous ("none" data that need compliance)."""
 
 
+LUMPED_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"coupling": 1.0},
+    "rate": {"viscous_N_s_per_m": 20.0},
+    "compliance": {"tendon_compliance": 1.0},
+    "curvature": {"sheath_curvature_deg": 120.0},
+    "creep": {"creep_compliance_mm_per_N": 0.05},
+}
+"""The self-test effects in the lumped plant's own physics (its keywords), at strengths that move
+the tip about as much as the capstan plant's do (2 x 120 s of the experiment motion, unit 1,
+noise-free, effect on minus off, capstan / lumped): coupling 1.5 / 1.6 deg, rate 1.7 / 1.9 deg,
+compliance 9.8 / 7.6 deg, curvature 12.0 / 8.5 deg, creep 0.35 / 0.42 deg (docs/gap.md)."""
+
+
 @dataclass(frozen=True)
 class PlantSpec:
-    """A plant as ``module:factory`` + fixed keyword parameters + what to fit as a simulator."""
+    """A plant as ``module:factory`` + fixed keyword parameters + what to fit as a simulator.
+
+    ``family`` names a :mod:`simrig.family` plant: its units (scatter by unit number: 1-8
+    development, 101-108 held out) are built from the family's draw; otherwise a unit is the
+    factory's own ``unit_variation``/``seed``. ``effects`` maps a self-test case to the plant's
+    effect keywords (default: :data:`tsmd.gap.selftest.EFFECTS`, the capstan plant's).
+    """
 
     factory: str
     params: dict[str, Any] = field(default_factory=dict)
     fit: tuple[ParamSpec, ...] = ()
     name: str = ""
+    family: str = ""
+    effects: dict[str, dict[str, float]] | None = None
 
     def build(self, **extra: Any) -> Any:
         return load_plant(self.factory, {**self.params, **extra})
+
+    def case_effects(self, case: str) -> dict[str, float]:
+        if self.effects is None:
+            return dict(EFFECTS[case][0])
+        return dict(self.effects.get(case, {}))
+
+    def build_unit(self, unit: int, unit_variation: float, **effects: float) -> Any:
+        """Catheter ``unit`` of this plant with ``effects`` switched on."""
+        if self.family:
+            member = family_member(self.family, unit)
+            return load_plant(member.spec, {**member.params, **self.params, **effects})
+        return self.build(unit_variation=unit_variation, seed=unit, **effects)
 
 
 PRESETS: dict[str, PlantSpec] = {
     "capstan": PlantSpec(BUILTIN_PLANT, {}, BUILTIN_FIT_SPECS, "capstan"),
     "capstan-other": PlantSpec(BUILTIN_PLANT, {"knobs": [dict(k) for k in OTHER_CAPSTAN_KNOBS]},
                                BUILTIN_FIT_SPECS, "capstan-other"),
+    "lumped": PlantSpec(PLANT_SPECS["lumped"], {}, (), "lumped", family="lumped",
+                        effects=LUMPED_EFFECTS),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 
@@ -119,13 +155,14 @@ def make_session(data: PlantSpec, case: str, duration_s: float, rate_hz: float, 
     The same unit (``seed``) in both configurations; curvature bends the sheath of the looped
     one only. Tracker and current noise differ per recording.
     """
-    effects, lag_s, _ = EFFECTS[case]
+    _, lag_s, _ = EFFECTS[case]
+    effects = data.case_effects(case)
     t, q = trajectory(duration_s / 2.0, rate_hz)
     out = []
     for i, config in enumerate(CONFIGS):
         eff = {k: v for k, v in effects.items()
                if k != "sheath_curvature_deg" or config == "looped"}
-        plant = data.build(unit_variation=unit_variation, seed=seed, **eff)
+        plant = data.build_unit(seed, unit_variation, **eff)
         true_tip, true_A = drive_plant(plant, q, rate_hz)
         noise_seed = 10 * seed + i
         tracker = EmTracker(noise_deg=tip_noise_deg, seed=noise_seed)

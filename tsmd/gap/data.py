@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.gap.errors import GapError
+from tsmd.gap.simulate import turning_points
 from tsmd.recording import Recording
 
 MIN_ROWS = 100
@@ -221,3 +222,43 @@ def make_split(series: Sequence[GapSeries], holdout: float | Sequence[str] = 0.3
     if n_test_blocks < 3:
         raise GapError(f"only {n_test_blocks} held-out blocks: too few for a confidence interval")
     return split
+
+
+def fit_windows(series: Sequence[GapSeries], split: Split, window_s: float,
+                n_windows: int) -> tuple[list[GapSeries], Split]:
+    """A segment-subsampled copy for the physics base fit: ``n_windows`` stretches of
+    ``window_s`` spread evenly over the recordings (at least one per recording).
+
+    Knob motion is slow against 250 Hz and a few plant constants are set by a few minutes of
+    varied motion as well as by half an hour, so the base fit need not replay every minute.
+    Each window is simulated from a reset plant; its rows up to the last knob's first reversal
+    (the hysteresis state is unknown before it) are marked held out, i.e. not fitted on.
+    Recordings short enough are returned whole.
+    """
+    total_s = sum(s.duration_s for s in series)
+    if total_s <= 1.5 * window_s * n_windows:
+        return list(series), split
+    out: list[GapSeries] = []
+    blocks, held = [], []
+    for s, blk, ho in zip(series, split.block, split.held_out, strict=True):
+        k = max(round(n_windows * s.duration_s / total_s), 1)
+        starts = s.t_s[0] + (np.arange(k) + 0.5) * s.duration_s / k - 0.5 * window_s
+        for i, t0 in enumerate(np.clip(starts, s.t_s[0], max(s.t_s[-1] - window_s, s.t_s[0]))):
+            rows = np.flatnonzero((s.t_s >= t0) & (s.t_s < t0 + window_s))
+            if len(rows) < MIN_ROWS:
+                continue
+            knob = s.knob_deg[rows]
+            first = [turning_points(knob[:, j], 0.5) for j in range(2)]
+            warm = max((int(f[0]) if len(f) else len(rows) // 3) for f in first)
+            mask = ho[rows].copy()
+            mask[:warm] = True
+            out.append(GapSeries(f"{s.name}[window {i}]", s.t_s[rows], knob,
+                                 s.current_A[rows], s.tip_deg[rows], s.knob_source,
+                                 s.channel_valid, s.config, s.catheter))
+            blocks.append(blk[rows])
+            held.append(mask)
+    if not out or all(h.all() for h in held):
+        return list(series), split
+    desc = f"{len(out)} windows of {window_s:.0f} s for the physics base fit"
+    return out, Split(tuple(blocks), tuple(held), split.block_s, desc)
+

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.gap.candidates import catalogue
-from tsmd.gap.data import GapSeries, Split, make_split
+from tsmd.gap.data import GapSeries, Split, fit_windows, make_split
 from tsmd.gap.model import (
     CHANNELS,
     Active,
@@ -174,20 +174,34 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     strides = _strides(series, cfg.fit_max_rows)
     n_held = sum(int(h.sum()) for h in split.held_out)
     rank_stride = [max(-(-n_held // cfg.rank_max_rows), 1)] * len(series)
-    fit_views = build_views(series, split, strides, "fit")
-    rank_views = build_views(series, split, strides, "eval", rank_stride)
+    signature = cfg.method == "signature"
+    win_series, win_split = fit_windows(series, split, cfg.fit_window_s, cfg.fit_windows)
+    # a long recording is fitted on windows; with the signature method also on a smaller
+    # budget (the layer takes what a longer fit would remove); short ones as they always were
+    reduced = signature and win_split is not split
+    fit_rows = min(cfg.fit_max_rows, cfg.signature_fit_rows) if reduced else cfg.fit_max_rows
+    fit_views = build_views(win_series, win_split, _strides(win_series, fit_rows), "fit")
     final_stride = [max(-(-n_held // cfg.final_max_rows), 1)] * len(series)
     final_views = build_views(series, split, strides, "eval", final_stride)
+    # the signature method ranks on its own grid: its ranking replay is the final one
+    rank_views = (final_views if signature
+                  else build_views(series, split, strides, "eval", rank_stride))
     noise_var = _noise_var(series, split)
     v0 = np.maximum(0.02 * np.percentile(
         np.abs(np.vstack([v.vel_deg_s for v in fit_views])), 95, axis=0), 0.1)
     ev = Evaluator(factory, copy.deepcopy(plant_params), noise_var, v0)
 
     # (2) base fit on training rows of the thinned grid
-    fit_base(ev, fit_views, cfg.fit_specs, cfg.base_evals)
-    coarse_params, _ = polish_base(ev, fit_views, cfg.fit_specs, cfg.polish_evals)
-    base_params, _, base_cost = joint_refine(ev, fit_views, cfg.fit_specs, None, np.zeros(0),
-                                             coarse_params, cfg.refine_evals, 0)
+    base_evals, polish_evals = cfg.signature_fit_evals if reduced else (cfg.base_evals,
+                                                                        cfg.polish_evals)
+    fit_base(ev, fit_views, cfg.fit_specs, min(base_evals, cfg.base_evals))
+    coarse_params, _ = polish_base(ev, fit_views, cfg.fit_specs,
+                                   min(polish_evals, cfg.polish_evals))
+    if reduced:  # the refinement is the candidate method's control, not needed here
+        base_params, base_cost = coarse_params, float("nan")
+    else:
+        base_params, _, base_cost = joint_refine(ev, fit_views, cfg.fit_specs, None,
+                                                 np.zeros(0), coarse_params, cfg.refine_evals, 0)
     _use(ev, base_params)
     base_fit = ev.predict(fit_views, [])
     timing["base_fit"] = clock() - t0
@@ -195,7 +209,8 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     # (1) replay every held-out row, with the linear terms from the fit
     t1 = clock()
     base_final = ev.predict(final_views, [], coefs=base_fit.coefs)
-    base_rank = ev.predict(rank_views, [], coefs=base_fit.coefs)
+    base_rank = (base_final if signature
+                 else ev.predict(rank_views, [], coefs=base_fit.coefs))
     base_blocks, counts = _block_costs(rank_views, base_rank, split, noise_var)
     excess = base_blocks - counts
     gap_ratio = bootstrap_ratio_ci(base_blocks, counts, cfg.seed, cfg.n_boot, cfg.ci_level)
@@ -206,7 +221,7 @@ def diagnose(series: Sequence[GapSeries], factory: PlantFactory,
     where_shares, where_bins = _where(final_views, base_final)
     timing["where"] = clock() - t2
 
-    if cfg.method == "signature":
+    if signature:
         result = signature_stage(series, split, ev, base_fit, strides, noise_var, cfg)
         result.before = _metrics(final_views, base_final)
         result.where_shares, result.where_bins = where_shares, where_bins

@@ -35,10 +35,21 @@ class GapConfig:
     method: str = "signature"
     """'signature': effects by their condition signature on top of a structural layer (robust
     to wrong base physics); 'candidates': the earlier candidate transforms around the plant."""
-    sig_max_rows: int = 30000
-    final_max_rows: int = 40000
+    sig_max_rows: int = 12000
+    final_max_rows: int = 20000
     """Held-out rows replayed for the how-far figures (all of them up to this many)."""
     n_surrogates: int = 30
+    fit_window_s: float = 60.0
+    fit_windows: int = 6
+    """The physics base fit sees ``fit_windows`` stretches of ``fit_window_s`` spread over the
+    training data (recordings shorter than 1.5x that in all are fitted whole): a few plant
+    constants are set by minutes of varied knob motion, and replaying half an hour for every
+    evaluation of the fit is what made a long recording slow."""
+    signature_fit_evals: tuple[int, int] = (36, 8)
+    signature_fit_rows: int = 800
+    """Coordinate-search and simplex evaluations and grid rows of the base fit in the signature
+    method when it runs on windows (long recordings): the structural layer takes what a longer
+    fit would remove; the fit sets its carriers and the 'physics' figures."""
 
 
 @dataclass

@@ -1,0 +1,93 @@
+"""The base fit on a segment-subsampled copy of long recordings, and the lumped plant as either
+side of the cross-plant self-test."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from support.gap import StandInPlant, make_recording
+
+from simrig.family import family_member
+from tsmd.gap.crosstest import PRESETS, make_session, parse_plant_spec
+from tsmd.gap.data import GapSeries, Split, fit_windows, make_split, series_from_recording
+from tsmd.gap.model import Evaluator, ParamSpec, build_views, fit_base
+from tsmd.gap.selftest import EFFECTS
+
+
+def _long_series(duration_s: float = 600.0) -> tuple[GapSeries, Split]:
+    rec = make_recording(duration_s=duration_s, rate_hz=20.0)
+    s = series_from_recording(rec, "long")
+    return s, make_split([s], 0.3)
+
+
+def test_long_recordings_are_fitted_on_windows_of_the_given_length() -> None:
+    s, split = _long_series()
+    wins, _ = fit_windows([s], split, window_s=40.0, n_windows=4)
+    assert len(wins) == 4
+    for w in wins:
+        assert w.duration_s <= 40.0
+        assert s.t_s[0] <= w.t_s[0] and w.t_s[-1] <= s.t_s[-1]
+    starts = [w.t_s[0] for w in wins]
+    assert starts[-1] - starts[0] > 0.5 * s.duration_s  # spread over the recording
+
+
+def test_window_rows_before_both_knobs_reverse_are_not_fitted() -> None:
+    s, split = _long_series()
+    wins, wsplit = fit_windows([s], split, window_s=40.0, n_windows=4)
+    for w, held in zip(wins, wsplit.held_out, strict=True):
+        assert held[0]  # the reset plant's state is unknown at the window's start
+        rows = np.searchsorted(s.t_s, w.t_s)
+        trained = ~held
+        assert trained.any()
+        assert not np.any(trained & split.held_out[0][rows])  # held-out rows stay held out
+
+
+def test_base_fit_on_windows_recovers_the_dead_zone_of_the_whole_recording() -> None:
+    rec = make_recording(duration_s=600.0, rate_hz=20.0, slack_deg=18.0)
+    s = series_from_recording(rec, "long")
+    split = make_split([s], 0.3)
+    wins, wsplit = fit_windows([s], split, window_s=40.0, n_windows=4)
+    views = build_views(wins, wsplit, [2] * len(wins), "fit")
+    ev = Evaluator(lambda p: StandInPlant(**p), {"slack_deg": 10.0, "play_deg": 10.0},
+                   np.array([0.09, 0.09, 2.5e-5, 2.5e-5]), np.array([1.0, 1.0]))
+    params, _ = fit_base(ev, views, [ParamSpec("slack_deg", 5.0, 30.0)], max_evals=20)
+    assert params["slack_deg"] == pytest.approx(18.0, abs=1.0)
+    assert sum(len(v.rows) for v in views) < 0.3 * len(s) / 2  # a fraction of the rows
+
+
+def test_short_recordings_are_fitted_whole() -> None:
+    s, split = _long_series(120.0)
+    wins, wsplit = fit_windows([s], split, window_s=60.0, n_windows=6)
+    assert wins == [s] and wsplit is split
+
+
+def test_lumped_preset_builds_the_family_unit_with_its_own_effect_keywords() -> None:
+    lumped = parse_plant_spec("lumped")
+    assert lumped is PRESETS["lumped"]
+    for case in ("coupling", "rate", "compliance", "curvature", "creep"):
+        assert lumped.case_effects(case)  # every plant effect has the plant's own keyword
+    assert lumped.case_effects("sensor") == {} and lumped.case_effects("none") == {}
+    plant = lumped.build_unit(101, 0.1, **lumped.case_effects("compliance"))
+    nominal = lumped.build_unit(0, 0.1)
+    assert type(plant).__name__ == type(nominal).__name__
+    assert family_member("lumped", 101).params["knobs"] != family_member("lumped", 0).params[
+        "knobs"]
+
+
+def test_capstan_preset_keeps_the_selftest_effects() -> None:
+    capstan = PRESETS["capstan"]
+    for case, (effects, _, _) in EFFECTS.items():
+        assert capstan.case_effects(case) == effects
+
+
+def test_lumped_session_has_two_configurations_and_bends_only_the_looped_one() -> None:
+    lumped = PRESETS["lumped"]
+    straight, looped = make_session(lumped, "curvature", 40.0, 20.0, seed=101)
+    assert straight.metadata["configuration"] == "straight"
+    assert looped.metadata["configuration"] == "looped"
+    assert straight.metadata["catheter"] == "unit-101"
+    none_s, none_l = make_session(lumped, "none", 40.0, 20.0, seed=101)
+    # same unit, same motion: without curvature the configurations differ only by noise
+    d_none = np.abs(none_l.columns["tip1"] - none_s.columns["tip1"]).mean()
+    d_curv = np.abs(looped.columns["tip1"] - straight.columns["tip1"]).mean()
+    assert d_curv > 5 * d_none

@@ -7,12 +7,12 @@ import math
 
 import numpy as np
 import pytest
+from support.plants import knob1_sweep
 
 from simrig.plant import PlantLoadError, PlantStep
 from simrig.plants.capstan import make_tendon_sheath_plant
 from simrig.plants.lumped import make_lumped_plant
 from simrig.scenario import ShapeChange, ShapeChangePlant
-from support.plants import knob1_sweep
 
 
 def tip_edge_deg(plant: object, dt_s: float = 0.004) -> float:
@@ -75,7 +75,7 @@ def test_lumped_slack_change_is_the_plant_built_with_that_slack() -> None:
     built = make_lumped_plant(knobs=[{"slack_pos_mm": 2.6 + 0.4, "slack_neg_mm": 2.7 - 0.2}, {}])
     reshaped = make_lumped_plant()
     reshaped.reshape(slack_delta_mm=((0.4, -0.2), (0.0, 0.0)))
-    q_a, tip_a, tau_a = knob1_sweep(built, cycles=1.0)
+    _, tip_a, tau_a = knob1_sweep(built, cycles=1.0)
     _, tip_b, tau_b = knob1_sweep(reshaped, cycles=1.0)
     np.testing.assert_allclose(tip_b, tip_a, atol=1e-9)
     np.testing.assert_allclose(tau_b, tau_a, atol=1e-12)

@@ -68,6 +68,7 @@ class _Knob:
         self.arm_m = p.tendon_offset_mm * 1e-3
         self.n_lumps = n_lumps
         self.slack_delta_m = (0.0, 0.0)
+        self._settled: tuple[float, float, float] | None = None
         self._shape(eff)
         self.drag_N = [0.0] + [p.sheath_drag_N / n_lumps] * n_lumps
         self.delta_m = p.presliding_mm * 1e-3
@@ -108,7 +109,7 @@ class _Knob:
         self.knob_deg: float | None = None
         self.creep_m = [0.0, 0.0]
         self.proximal_N = [0.0, 0.0]
-        self._settled: tuple[float, float, float] | None = None
+        self._settled = None
         self._pulley: list[float] | None = None
 
     # -- constitutive laws -----------------------------------------------------------------

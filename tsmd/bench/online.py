@@ -129,9 +129,10 @@ def calibrated(plant: str, unit: int, change: dict[str, Any] | None, device: Any
     return profile
 
 
-def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int
-        ) -> tuple[Any, Any]:
-    """One lockstep run with our compensator; returns (recording, worker or None)."""
+def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int,
+        device: Any = None) -> tuple[Any, Any]:
+    """One lockstep run with our compensator; returns (recording, worker or None). The
+    worker takes each knob's handle slip from ``device``'s data sheet."""
     from tsmd.daemon import make_compensator
     from tsmd.loop import ROW_COLUMNS
     from tsmd.online import OnlineWorker
@@ -142,8 +143,11 @@ def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int
         runner.loop.execute("set_compensator", compensator=comp, label="ours")
         worker = None
         if online:
+            slip = None if device is None else (device.knobs[0].handle_slip_deg,
+                                                 device.knobs[1].handle_slip_deg)
             worker = OnlineWorker(comp, runner.loop.period_s, ROW_COLUMNS,
-                                  drain_every=DRAIN_EVERY)
+                                  handle_slip_deg=slip, drain_every=DRAIN_EVERY,
+                                  fault_reason=lambda: runner.loop.fault_reason)
             runner.loop.observer = worker.observe
         rec = runner.run(t, q, compensate=True)
     return rec, worker
@@ -175,7 +179,7 @@ def change_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, A
     at = args.change_at
     t0 = time.perf_counter()
     rec_on, worker = run(before, make_unit(args.plant, unit, [ShapeChange(at, change)]),
-                         t, q, True, args.seed)
+                         t, q, True, args.seed, device)
     rec_off, _ = run(before, make_unit(args.plant, unit, [ShapeChange(at, change)]),
                      t, q, False, args.seed)
     rec_fresh, _ = run(fresh, make_unit(args.plant, unit, [ShapeChange(0.0, change)]),
@@ -245,7 +249,7 @@ def drift_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, An
     profile = calibrated(args.plant, unit, None, device, cache, "straight")
     t, q = drift_motion(args.drift_s, args.seed + 100)
     t0 = time.perf_counter()
-    rec_on, worker = run(profile, make_unit(args.plant, unit, []), t, q, True, args.seed)
+    rec_on, worker = run(profile, make_unit(args.plant, unit, []), t, q, True, args.seed, device)
     wall_on = time.perf_counter() - t0
     rec_off, _ = run(profile, make_unit(args.plant, unit, []), t, q, False, args.seed)
     assert worker is not None

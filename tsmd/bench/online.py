@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.errors import TsmdError
 
 Array = NDArray[np.float64]
@@ -174,7 +175,13 @@ def change_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, A
     change = shape_change(args.change)
     cache = Path(args.cache)
     before = calibrated(args.plant, unit, None, device, cache, "straight")
-    fresh = calibrated(args.plant, unit, change, device, cache, args.change.replace(":", "-"))
+    try:
+        fresh = calibrated(args.plant, unit, change, device, cache,
+                           args.change.replace(":", "-"))
+    except CalibrationRefusedError as exc:  # reported, compared with before the change only
+        fresh, refused = None, str(exc).split(":")[0]
+    else:
+        refused = ""
     t, q = mixed_motion(args.change_at + args.after_s, args.seed)
     at = args.change_at
     t0 = time.perf_counter()
@@ -182,23 +189,29 @@ def change_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, A
                          t, q, True, args.seed, device)
     rec_off, _ = run(before, make_unit(args.plant, unit, [ShapeChange(at, change)]),
                      t, q, False, args.seed)
-    rec_fresh, _ = run(fresh, make_unit(args.plant, unit, [ShapeChange(0.0, change)]),
-                       t, q, False, args.seed)
+    rec_fresh = None
+    if fresh is not None:
+        rec_fresh, _ = run(fresh, make_unit(args.plant, unit, [ShapeChange(0.0, change)]),
+                           t, q, False, args.seed)
     wall = time.perf_counter() - t0
-    out: dict[str, Any] = {"unit": unit, "wall_s": wall, "knobs": []}
+    out: dict[str, Any] = {"unit": unit, "wall_s": wall, "knobs": [], "refused": refused}
+
+    def fresh_rmse(knob: int, a: float, b: float = math.inf) -> float:
+        return math.nan if rec_fresh is None else rmse(rec_fresh, knob, a, b)
+
     for k in (0, 1):
         revs = reversal_times(t, q[:, k], at)
         if len(revs) < REVERSALS:
             raise TsmdError(f"only {len(revs)} reversals of knob {k + 1} after the change; "
                             "lengthen --after-s")
         t10 = float(revs[REVERSALS - 1])
-        trend = [rmse(rec_on, k, float(a), float(b)) / max(rmse(rec_fresh, k, float(a),
-                                                                  float(b)), 1e-9)
+        trend = [rmse(rec_on, k, float(a), float(b)) / max(fresh_rmse(k, float(a), float(b)),
+                                                            1e-9)
                  for a, b in itertools.pairwise(revs[:REVERSALS + 1])]
         out["knobs"].append({
             "before": rmse(rec_on, k, 10.0, at), "before_off": rmse(rec_off, k, 10.0, at),
             "on": rmse(rec_on, k, t10),
-            "off": rmse(rec_off, k, t10), "fresh": rmse(rec_fresh, k, t10), "t10": t10 - at,
+            "off": rmse(rec_off, k, t10), "fresh": fresh_rmse(k, t10), "t10": t10 - at,
             "trend": trend})
     assert worker is not None
     out["offsets"] = worker.offsets()
@@ -341,10 +354,14 @@ def main(args: argparse.Namespace) -> int:
                       f"{vs_before:.2f} | {ratio:.2f} | {kn['t10']:.0f} |")
             trend = " / ".join(" ".join(f"{x:.1f}" for x in kn["trend"]) for kn in r["knobs"])
             offsets = [[round(v, 2) for v in pair] for pair in r["offsets"]]
+            if r["refused"]:
+                print(f"|   | fresh calibration after the change: {r['refused']} "
+                      "| | | | | | | |")
             print(f"|   | offsets (deg, outward) {offsets}, largest before the change "
                   f"{r['max_before_deg']:.2f}; on/fresh per reversal "
                   f"interval phi1 / phi2: {trend}; {len(r['events'])} warnings; "
                   f"3 runs {r['wall_s']:.0f} s wall | | | | | | | |", flush=True)
+        ratios = [r for r in ratios if math.isfinite(r)] or [math.nan]
         print(f"\non / fresh: mean {np.mean(ratios):.2f}, worst {max(ratios):.2f} "
               f"(target <= 1.2); on / before: mean {np.mean(before_ratios):.2f}, worst "
               f"{max(before_ratios):.2f}")

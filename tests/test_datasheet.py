@@ -13,7 +13,7 @@ from support.profiles import DEVICE
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd.cli import main
 from tsmd.datasheet import CONDITIONING_CYCLES, analysed_from, settle, tip_sweep
-from tsmd.profile import load_device_model
+from tsmd.profile import DEFAULT_HANDLE_SLIP_DEG, load_device_model
 from tsmd.recording import Recording, write_recording
 
 PERIOD_S = 0.01
@@ -55,6 +55,8 @@ def test_tracked_sweeps_give_the_plants_data_sheet(sweep_files: list[Path], tmp_
         assert got.reference_backlash_pos_deg == pytest.approx(ref.reference_backlash_pos_deg,
                                                                abs=3.0)
         assert got.limits == ref.limits
+        assert got.handle_slip_deg == DEFAULT_HANDLE_SLIP_DEG  # the handle's design value
+    assert out.read_text().count("handle_slip_deg") == 2  # the sheet carries it, per knob
 
 
 def test_a_recording_without_tip_angles_is_refused_in_one_line(

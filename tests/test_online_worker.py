@@ -96,6 +96,57 @@ def test_a_fault_freezes_the_estimate(profile: Any) -> None:
     assert worker.status()["edges"]["phi1_pos"]["state"] == "frozen"
 
 
+def warnings(worker: OnlineWorker) -> list[str]:
+    return [e["event"] for e in worker.events if e["level"] == "warning"]
+
+
+def test_a_loop_disabled_at_start_does_not_warn(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    data = rows(60.0, profile_edges(base), seed=7)
+    feed(worker, data[:2500], enabled=False)  # the daemon starts with the drives disabled
+    feed(worker, data[2500:])
+    assert warnings(worker) == []
+    assert worker.status()["edges"]["phi1_pos"]["frozen_reason"] is None
+
+
+def test_a_stop_while_enabled_freezes_without_a_warning(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    data = rows(60.0, profile_edges(base), seed=8)
+    feed(worker, data[:10000])
+    feed(worker, data[10000:], enabled=False)
+    assert warnings(worker) == []
+    edge = worker.status()["edges"]["phi1_pos"]
+    assert edge["frozen_reason"] == "the loop was stopped or disabled"
+
+
+def test_a_fault_while_enabled_freezes_with_a_warning_naming_it(profile: Any) -> None:
+    comp = build_compensator(profile, "ours", 0.004)
+    fault: list[str | None] = [None]
+    worker = OnlineWorker(comp, 0.004, ROW_COLUMNS, drain_every=25,
+                          fault_reason=lambda: fault[0])
+    data = rows(60.0, profile_edges(comp.knobs), seed=9)
+    feed(worker, data[:10000])
+    fault[0] = "drive 0: heartbeat lost"
+    feed(worker, data[10000:], enabled=False)
+    frozen = [e for e in worker.events if e["event"] == "online estimate frozen"]
+    assert len(frozen) == 1 and frozen[0]["level"] == "warning"
+    assert "heartbeat lost" in frozen[0]["reason"]
+
+
+def test_the_data_sheets_handle_slip_is_used_per_knob(profile: Any) -> None:
+    comp = build_compensator(profile, "ours", 0.004)
+    worker = OnlineWorker(comp, 0.004, ROW_COLUMNS, handle_slip_deg=(1.5, 4.0))
+    assert [o.handle_slip_deg for o in worker._knob_ramp] == [1.5, 4.0]
+
+
+@pytest.mark.parametrize("slip", [(0.0, 3.0), (3.0, float("nan"))])
+def test_a_bad_handle_slip_is_refused_in_one_line(profile: Any,
+                                                  slip: tuple[float, float]) -> None:
+    comp = build_compensator(profile, "ours", 0.004)
+    with pytest.raises(OnlineError, match="handle_slip_deg must be > 0"):
+        OnlineWorker(comp, 0.004, ROW_COLUMNS, handle_slip_deg=slip)
+
+
 def test_switching_off_restores_the_profiles_values(profile: Any) -> None:
     worker, comp, base = make_worker(profile)
     original = comp.knobs

@@ -13,6 +13,7 @@ import yaml
 from support.profiles import DEVICE, ROOT, make_profile
 
 from tsmd.profile import (
+    DEFAULT_HANDLE_SLIP_DEG,
     ProfileError,
     ProfileStore,
     device_model_from_mapping,
@@ -213,6 +214,29 @@ def test_device_model_round_trip_keeps_our_optional_constants(tmp_path: Path) ->
     device = load_device_model(DEVICE)
     assert device.knobs[0].release_omega is not None
     assert device_model_from_mapping(device_model_to_mapping(device)) == device
+
+
+def test_a_data_sheet_without_handle_slip_gets_the_default() -> None:
+    data = yaml.safe_load(DEVICE.read_text())
+    for knob in data["knobs"].values():
+        knob.pop("handle_slip_deg", None)
+    device = device_model_from_mapping(data)
+    assert [k.handle_slip_deg for k in device.knobs] == [DEFAULT_HANDLE_SLIP_DEG] * 2
+
+
+def test_the_data_sheets_handle_slip_is_read_per_knob_and_written_back() -> None:
+    data = yaml.safe_load(DEVICE.read_text())
+    data["knobs"]["phi2"]["handle_slip_deg"] = 1.25
+    device = device_model_from_mapping(data)
+    assert device.knobs[1].handle_slip_deg == 1.25
+    assert device_model_to_mapping(device)["knobs"]["phi2"]["handle_slip_deg"] == 1.25
+
+
+def test_a_non_positive_handle_slip_is_refused_naming_the_key() -> None:
+    data = yaml.safe_load(DEVICE.read_text())
+    data["knobs"]["phi1"]["handle_slip_deg"] = 0.0
+    with pytest.raises(ProfileError, match=r"knobs.phi1.handle_slip_deg"):
+        device_model_from_mapping(data)
 
 
 def test_device_release_constants_go_together(tmp_path: Path) -> None:

@@ -172,6 +172,27 @@ def test_a_new_profile_rebuilds_the_worker_on_the_new_compensator(
     assert flat(applied_edges(new, 0)) == pytest.approx(flat(profile_edges(daemon, 0)))
 
 
+def test_subscribe_samples_carry_the_offsets_in_force(start_daemon: Callable[..., Daemon]
+                                                    ) -> None:
+    daemon = start_daemon(True)
+    estimate(running_worker(daemon), 2.0)
+    with client(daemon) as c:
+        c.request("subscribe", rate_hz=50)
+        samples = [c.read_message()["sample"] for _ in range(3)]
+        c.call("unsubscribe")
+        assert c.call("get")["sample"]["online_offsets_deg"] == [[2.0, 0.0], [0.0, 0.0]]
+    assert all(s["online_offsets_deg"] == [[2.0, 0.0], [0.0, 0.0]] for s in samples)
+
+
+def test_subscribe_samples_say_null_offsets_while_online_is_off(
+        start_daemon: Callable[..., Daemon]) -> None:
+    daemon = start_daemon(False)
+    with client(daemon) as c:
+        c.request("subscribe", rate_hz=50)
+        sample = c.read_message()["sample"]
+    assert "online_offsets_deg" in sample and sample["online_offsets_deg"] is None
+
+
 def test_online_save_writes_a_new_version_and_leaves_the_calibrated_profile_intact(
         start_daemon: Callable[..., Daemon], tmp_path: Path) -> None:
     daemon = start_daemon(True)

@@ -24,7 +24,7 @@ from tsmd.calibration.identify import identify_sweep
 from tsmd.compensation.safety import KnobLimits
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.errors import TsmdError
-from tsmd.profile import DeviceKnob, DeviceModel, ReferencePoint
+from tsmd.profile import DEFAULT_HANDLE_SLIP_DEG, DeviceKnob, DeviceModel, ReferencePoint
 from tsmd.recording import Recording
 from tsmd.replay import run_trajectory
 from tsmd.stack import knob_limits
@@ -61,6 +61,9 @@ class KnobConstants:
     reference_backlash_pos_deg: float
     reference_backlash_neg_deg: float
     dead_zone_offset_deg: float
+    handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
+    """The handle's design value (bearing and brake), not measured here: the sweep never stops
+    the knob, so it cannot show the static friction fading after a restart."""
 
     def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
         """The data sheet's knob entry, rounded as a data sheet is printed."""
@@ -74,7 +77,8 @@ class KnobConstants:
             limits, release_omega=r(self.release_omega),
             reference_backlash_pos_deg=r(self.reference_backlash_pos_deg),
             reference_backlash_neg_deg=r(self.reference_backlash_neg_deg),
-            dead_zone_offset_deg=r(self.dead_zone_offset_deg))
+            dead_zone_offset_deg=r(self.dead_zone_offset_deg),
+            handle_slip_deg=r(self.handle_slip_deg))
 
 
 def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,

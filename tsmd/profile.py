@@ -65,6 +65,10 @@ class ReferencePoint:
     tip_deg: float
 
 
+DEFAULT_HANDLE_SLIP_DEG = 3.0
+"""Handle slip of a data sheet written before it was a constant of the sheet."""
+
+
 @dataclass(frozen=True)
 class DeviceKnob:
     """Data-sheet constants of one knob."""
@@ -89,6 +93,9 @@ class DeviceKnob:
     the unit the reference points were measured on (other knob at 0): the plateau heights are
     then product constants and each unit's loaded line moves with its own edges (method ours)."""
     reference_dead_zone_neg_deg: float | None = None
+    handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
+    """Knob travel over which the handle's static friction fades to kinetic after a restart
+    (the online estimator models it; a sheet without it gets the default)."""
 
 
 @dataclass(frozen=True)
@@ -275,7 +282,9 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional(k.get("reference_dead_zone_pos_deg"), "reference_dead_zone_pos_deg", 0.0,
                      90.0, "deg"),
             optional(k.get("reference_dead_zone_neg_deg"), "reference_dead_zone_neg_deg", -90.0,
-                     0.0, "deg")))
+                     0.0, "deg"),
+            r.number(k.get("handle_slip_deg", DEFAULT_HANDLE_SLIP_DEG), key + ".handle_slip_deg",
+                     0.01, 45.0, "deg")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -300,6 +309,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         for key in ("reference_dead_zone_pos_deg", "reference_dead_zone_neg_deg"):
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
+        knobs[name]["handle_slip_deg"] = k.handle_slip_deg
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

@@ -136,6 +136,22 @@ class Service:
             out.update(self._extra_status())
         return out
 
+    def sample(self) -> dict[str, Any] | None:
+        """The latest tick for ``get``/``subscribe``, with the online offsets in force
+        (``online_offsets_deg`` [[phi1 pos, neg], [phi2 pos, neg]], null while online is off)."""
+        sample = self.loop.latest_sample
+        if sample is None:
+            return None
+        out = sample.as_dict()
+        online = self.online
+        worker = online.worker if online is not None else None
+        if worker is not None and worker.enabled:
+            off = worker.offsets()
+            out["online_offsets_deg"] = [list(off[0]), list(off[1])]
+        else:
+            out["online_offsets_deg"] = None
+        return out
+
     def require_zero_reference(self, what: str) -> None:
         """Refuse motion while the config requires homing and a knob has no zero reference."""
         drives = self.loop.drives

@@ -27,6 +27,8 @@ class Services(Protocol):
 
     def status(self) -> dict[str, Any]: ...
 
+    def sample(self) -> dict[str, Any] | None: ...
+
     def set_compensation(self, enabled: bool | None, method: str | None) -> dict[str, Any]: ...
 
     def load_profile(self, catheter: str | None) -> dict[str, Any]: ...
@@ -125,10 +127,10 @@ class ApiHandlers:
         return {"q": q}
 
     async def _get(self, request: Request, conn: Connection) -> dict[str, Any]:
-        sample = self.loop.latest_sample
+        sample = self.services.sample()
         if sample is None:
             raise ApiError("no_sample", "get: the loop has not ticked yet")
-        return {"sample": sample.as_dict()}
+        return {"sample": sample}
 
     async def _subscribe(self, request: Request, conn: Connection) -> dict[str, Any]:
         rate_hz = float(request.params.get("rate_hz", 50.0))
@@ -144,10 +146,12 @@ class ApiHandlers:
         loop = asyncio.get_running_loop()
         next_t = loop.time()
         while not conn.closed and not conn.writer.transport.is_closing():
-            sample = self.loop.latest_sample
-            if sample is not None and sample.tick != last_tick:
-                last_tick = sample.tick
-                conn.send_event({"id": req_id, "event": "sample", "sample": sample.as_dict()})
+            latest = self.loop.latest_sample
+            if latest is not None and latest.tick != last_tick:
+                sample = self.services.sample()
+                if sample is not None:
+                    last_tick = int(sample["tick"])
+                    conn.send_event({"id": req_id, "event": "sample", "sample": sample})
             next_t += period
             await asyncio.sleep(max(0.0, next_t - loop.time()))
 

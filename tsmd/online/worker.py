@@ -48,12 +48,19 @@ class OnlineWorker:
 
     ``columns``: the loop's row layout (``tsmd.loop.ROW_COLUMNS``); the worker reads ``t``,
     ``cmd1/2``, ``pos1/2``, ``cur1/2``. ``on_event(level, event, **fields)`` as the loop's.
+    ``handle_slip_deg``: each knob's handle slip from the data sheet
+    (:attr:`tsmd.profile.DeviceKnob.handle_slip_deg`); None keeps ``ramp``'s.
+    ``fault_reason``: the loop's fault (``lambda: loop.fault_reason``); when the loop leaves
+    ENABLED with a fault the freeze is a warning, otherwise (stop, disable, not yet enabled)
+    the estimate pauses silently.
     """
 
     def __init__(self, compensator: Any, period_s: float, columns: Sequence[str], *,
                  estimator: EstimatorOptions | None = None, ramp: RampOptions | None = None,
+                 handle_slip_deg: tuple[float, float] | None = None,
                  rate_deg_s: float = 4.0, queue_len: int = 8192, drain_every: int = 0,
-                 on_event: EventSink | None = None) -> None:
+                 on_event: EventSink | None = None,
+                 fault_reason: Callable[[], str | None] | None = None) -> None:
         compensator = getattr(compensator, "inner", compensator)  # under a LimitedCompensator
         knobs = getattr(compensator, "knobs", None)
         if knobs is None or len(knobs) != 2:
@@ -65,6 +72,12 @@ class OnlineWorker:
             shifted_knob(k, (0.0, 0.0))  # refuses a compensator it cannot shift, now
         self.period_s = period_s
         self.ramp_options = ramp or RampOptions()
+        slip = handle_slip_deg or (self.ramp_options.handle_slip_deg,) * 2
+        if not all(x > 0.0 for x in slip):  # also refuses NaN
+            raise OnlineError(f"handle_slip_deg must be > 0 deg, got {slip}")
+        self._knob_ramp = tuple(replace(self.ramp_options, handle_slip_deg=float(x))
+                                for x in slip)
+        self.fault_reason = fault_reason
         self.trackers = {(knob, side): EdgeTracker(knob, side, estimator or EstimatorOptions())
                          for knob in (0, 1) for side in (1, -1)}
         self.rate_deg_s = rate_deg_s
@@ -83,7 +96,7 @@ class OnlineWorker:
         self._ticks = 0
         self._t_last = None  # type: float | None
         self._t_publish = 0.0
-        self._was_enabled = True
+        self._was_enabled = False
         self._stalled = [False, False]
         self._publish_lock = threading.Lock()
         self._stop = threading.Event()
@@ -145,10 +158,7 @@ class OnlineWorker:
             for seg in self._segmenters:
                 seg.discard()
             if not enabled and self._was_enabled:
-                for tr in self.trackers.values():
-                    tr.freeze("the loop is not enabled (fault or stop)")
-                self._emit("warning", "online estimate frozen",
-                           reason="the loop is not enabled (fault or stop)")
+                self._left_enabled()
             self._was_enabled = enabled
             return t
         self._was_enabled = True
@@ -169,6 +179,17 @@ class OnlineWorker:
                 self._stroke(stroke)
         return t
 
+    def _left_enabled(self) -> None:
+        """The loop left ENABLED: the stroke under way is dropped and the edges freeze for
+        two ramps (the knobs may have been moved by hand meanwhile). Only a fault warns; a
+        stop or disable is ordinary use."""
+        fault = self.fault_reason() if self.fault_reason is not None else None
+        reason = f"the loop faulted ({fault})" if fault else "the loop was stopped or disabled"
+        for tr in self.trackers.values():
+            tr.freeze(reason)
+        if fault:
+            self._emit("warning", "online estimate frozen", reason=reason)
+
     def _stroke(self, stroke: Stroke) -> None:
         knob, side = stroke.knob, stroke.direction
         tracker = self.trackers[(knob, side)]
@@ -176,8 +197,8 @@ class OnlineWorker:
         expected = edge + side * tracker.applied_deg
         if tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
             expected = relocated_edge_deg(stroke, expected, tracker.level_A,
-                                          tracker.slope_ref_A_per_deg, self.ramp_options)
-        ramp = loaded_ramp(stroke, expected, self.ramp_options)
+                                          tracker.slope_ref_A_per_deg, self._knob_ramp[knob])
+        ramp = loaded_ramp(stroke, expected, self._knob_ramp[knob])
         if isinstance(ramp, Rejected):
             if ramp.stall:
                 tracker.freeze(ramp.reason)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,6 +66,22 @@ class _Knob:
         self.toe_m = p.toe_mm * 1e-3
         self.radius_m = p.pulley_radius_mm * 1e-3
         self.arm_m = p.tendon_offset_mm * 1e-3
+        self.n_lumps = n_lumps
+        self.slack_delta_m = (0.0, 0.0)
+        self._settled: tuple[float, float, float] | None = None
+        self._shape(eff)
+        self.drag_N = [0.0] + [p.sheath_drag_N / n_lumps] * n_lumps
+        self.delta_m = p.presliding_mm * 1e-3
+        self.viscous = [0.0] + [eff.viscous_N_s_per_m] * n_lumps
+        self.has_viscosity = eff.viscous_N_s_per_m > 0.0
+        self._no_viscosity = [0.0] * n
+        self.bend_delta_rad = math.radians(p.bend_presliding_deg)
+        self.handle_delta_deg = p.handle_presliding_deg
+        self.reset()
+
+    def _shape(self, eff: LumpedEffects) -> None:
+        """Wrap of each contact and the path shortening from the sheath's bend."""
+        p, n_lumps = self.p, self.n_lumps
         # Lumped capstan per contact: the share of incoming tension a sliding contact takes.
         wraps = [math.radians(p.guide_wrap_deg) * p.guide_friction]
         curve = math.radians(eff.sheath_curvature_deg)
@@ -72,15 +89,16 @@ class _Knob:
             extra = curve / math.ceil(n_lumps / 2) if j >= n_lumps // 2 else 0.0
             wraps.append((math.radians(p.sheath_wrap_deg) / n_lumps + extra) * p.sheath_friction)
         self.take = [1.0 - math.exp(-w) for w in wraps]
-        self.drag_N = [0.0] + [p.sheath_drag_N / n_lumps] * n_lumps
-        self.delta_m = p.presliding_mm * 1e-3
-        self.viscous = [0.0] + [eff.viscous_N_s_per_m] * n_lumps
-        self.has_viscosity = eff.viscous_N_s_per_m > 0.0
-        self._no_viscosity = [0.0] * n
         self.curve_slack_m = eff.lumen_clearance_mm * 1e-3 * curve
-        self.bend_delta_rad = math.radians(p.bend_presliding_deg)
-        self.handle_delta_deg = p.handle_presliding_deg
-        self.reset()
+
+    def reshape(self, eff: LumpedEffects, slack_delta_mm: tuple[float, float]) -> None:
+        """A new sheath shape mid-run: the distal lumps' wrap, the path length and each
+        tendon's slack change; node positions and Dahl forces carry over (the forces are
+        clipped to the new sliding levels at the next move)."""
+        self.eff = eff
+        self._shape(eff)
+        self.slack_delta_m = (slack_delta_mm[0] * 1e-3, slack_delta_mm[1] * 1e-3)
+        self._settled = None  # the equilibrium belongs to the old shape
 
     def reset(self) -> None:
         self.tendons = (_Tendon(self.n, self.k_seg), _Tendon(self.n, self.k_seg))
@@ -91,7 +109,7 @@ class _Knob:
         self.knob_deg: float | None = None
         self.creep_m = [0.0, 0.0]
         self.proximal_N = [0.0, 0.0]
-        self._settled: tuple[float, float, float] | None = None
+        self._settled = None
         self._pulley: list[float] | None = None
 
     # -- constitutive laws -----------------------------------------------------------------
@@ -112,7 +130,8 @@ class _Knob:
         prev = knob_deg if self.knob_deg is None else self.knob_deg
         self.knob_deg = knob_deg
         draw = self.radius_m * math.radians(knob_deg)
-        slack = [p.slack_pos_mm * 1e-3, p.slack_neg_mm * 1e-3]
+        slack = [p.slack_pos_mm * 1e-3 + self.slack_delta_m[0],
+                 p.slack_neg_mm * 1e-3 + self.slack_delta_m[1]]
         bend_friction = p.bend_friction_Nm
         if eff.coupling > 0.0:
             squeeze = eff.coupling_compression_mm_per_N * 1e-3 * other_tension_N
@@ -327,6 +346,28 @@ class LumpedPlant:
         tip1, tau1 = k1.step(dt_s, q1, tips[0], loads[0])
         return PlantStep(tip_deg=np.array([math.degrees(tip0), math.degrees(tip1)]),
                          knob_torque_Nm=np.array([tau0, tau1]))
+
+    def reshape(self, sheath_curvature_deg: float | None = None,
+                slack_delta_mm: Sequence[tuple[float, float]] = ((0.0, 0.0), (0.0, 0.0))
+                ) -> None:
+        """Change the sheath's shape now (``simrig.scenario``): its total bend (wrap of the
+        distal lumps and a shorter path) and per knob the tendons' slack (pos, neg) relative
+        to the built values, in mm; the tendons keep their state."""
+        eff = self.effects
+        if sheath_curvature_deg is not None:
+            eff = replace(eff, sheath_curvature_deg=float(sheath_curvature_deg)).validated()
+        if len(slack_delta_mm) != 2:
+            raise PlantLoadError(f"slack_delta_mm must list 2 knobs, got {len(slack_delta_mm)}")
+        deltas = [(float(d_pos), float(d_neg)) for d_pos, d_neg in slack_delta_mm]
+        for i, (knob, (d_pos, d_neg)) in enumerate(zip(self._knobs, deltas, strict=True)):
+            if not (math.isfinite(d_pos) and math.isfinite(d_neg)):
+                raise PlantLoadError(f"slack_delta_mm[{i}] must be finite, got {(d_pos, d_neg)}")
+            if knob.p.slack_pos_mm + d_pos < 0.0 or knob.p.slack_neg_mm + d_neg < 0.0:
+                raise PlantLoadError(f"slack_delta_mm[{i}] {(d_pos, d_neg)} makes a slack "
+                                     "negative")
+        self.effects = eff
+        for knob, delta in zip(self._knobs, deltas, strict=True):
+            knob.reshape(eff, delta)
 
     def tendon_tension_N(self) -> NDArray[np.float64]:
         """Tension of the four free segments, shape (2 knobs, 2 sides: pos, neg)."""

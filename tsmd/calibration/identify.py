@@ -28,6 +28,7 @@ import ruptures as rpt
 from numpy.typing import NDArray
 from scipy.signal import find_peaks
 
+from tsmd.calibration.branch_fit import fit_edge
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.health import (
     check_following,
@@ -65,17 +66,27 @@ class IdentifyOptions:
     """"Constant" current: rising slower than this fraction of the loaded ramp's slope."""
     penalty_k: float = 20.0
     """Change-point penalty in units of noise variance x log(n) (PELT)."""
-    edge: str = "knee"
-    """"knee" (beyond the paper, the default): where the steep first rise turns into the loaded
-    ramp, i.e. where the tip starts to move; "rise": the paper's edge, where the current starts
-    to rise (the tendon engages; the tip follows a few degrees later, and the exact start of a
-    gentle rise scatters by 3 deg from cycle to cycle; docs/calibration.md)."""
+    edge: str = "fit"
+    """"fit" (the default): the least-squares line intersection of the dead-zone level with the
+    loaded ramp, or with the end of a steep first rise where the current shows one
+    (:mod:`tsmd.calibration.branch_fit`); "knee": the same from the change points' pieces;
+    "rise": the paper's edge, where the current starts to rise (the tendon engages; the tip
+    follows a few degrees later, and the exact start of a gentle rise scatters by 3 deg from
+    cycle to cycle; docs/calibration.md)."""
     knee_slope_ratio: float = 1.5
+    fit_before_deg: float = 12.0
+    """``edge="fit"``: the window fitted starts this far before the rise the pieces show ..."""
+    fit_after_deg: float = 15.0
+    """... and ends this far after it (the loaded ramp)."""
     max_knee_deg: float = 15.0
     settle_hold_deg: float = 1.0
     """The current must stay on the constant level this long to count as settled."""
     backlash_tangent_deg: float = 3.0
     """Stretch of current before it settles that is extended to meet the constant level."""
+    backlash: str = "settle"
+    """"settle" (the paper's point a2): where the current joins the release level within the
+    noise; "fraction": where it has made up ``backlash_fraction`` of its jump to that level."""
+    backlash_fraction: float = 0.975
     min_level_deg: float = 3.0
     """A run of flat pieces shorter than this after a reversal is a pause in the transient (a
     turn of the filtered reversal, a speed change), not the release level, which lasts until
@@ -297,6 +308,35 @@ def _knee(yg: FloatArray, step: float, pieces: list[tuple[int, int]], rise_k: in
     return rise_k
 
 
+def _fitted_edge(grid: FloatArray, yg: FloatArray, plateau_start: int, rise_k: int,
+                 noise: float, opts: IdentifyOptions) -> int:
+    """The edge as the least-squares line intersection around the rise the pieces show
+    (:func:`tsmd.calibration.branch_fit.fit_edge`); the rise itself when nothing fits."""
+    step = float(grid[1] - grid[0])
+    a = max(plateau_start, rise_k - round(opts.fit_before_deg / step))
+    b = min(yg.size, rise_k + round(opts.fit_after_deg / step))
+    fit = fit_edge(grid[a:b], yg[a:b], noise, knee_slope_ratio=opts.knee_slope_ratio,
+                   max_knee_deg=opts.max_knee_deg, penalty_k=opts.penalty_k,
+                   search_step_deg=step)
+    if fit is None:
+        return rise_k
+    return min(int(np.searchsorted(grid, fit.edge_deg)), yg.size - 1)
+
+
+def _recovered(grid: FloatArray, yg: FloatArray, start_k: int, stop: int,
+               level: FloatArray, opts: IdentifyOptions) -> int:
+    """Where the current has made up ``backlash_fraction`` of its jump from the loaded current
+    before the reversal to the release level, and stays there for ``settle_hold_deg``."""
+    step = float(grid[1] - grid[0])
+    loaded = float(np.min(yg[:max(stop, 2)]))
+    target = loaded + opts.backlash_fraction * (np.polyval(level, grid[:stop]) - loaded)
+    above = yg[:stop] >= target
+    hold = max(2, round(opts.settle_hold_deg / step))
+    stays = np.convolve(above.astype(float), np.ones(hold), mode="valid") >= hold
+    hits = np.flatnonzero(stays[start_k:])
+    return start_k + int(hits[0]) if hits.size else stop - 1
+
+
 def _backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
                   pieces: list[tuple[int, int]], flat: list[bool], noise: float,
                   opts: IdentifyOptions) -> int | None:
@@ -320,6 +360,8 @@ def _backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
         return None
     a0, b0 = run
     level = np.polyfit(grid[a0:b0], yg[a0:b0], 1)
+    if opts.backlash == "fraction":
+        return _recovered(grid, yg, start_k, b0, level, opts)
     near = np.abs(yg[start_k:b0] - np.polyval(level, grid[start_k:b0])) <= opts.peak_noise_k * noise
     hold = max(2, round(opts.settle_hold_deg / step))
     stays = np.convolve(near.astype(float), np.ones(hold), mode="valid") >= hold
@@ -388,6 +430,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     edge_k: int | None = plateau_run[1] if plateau_run[1] < end else None
     if edge_k is not None and opts.edge == "knee":
         edge_k = _knee(yg[:end], step, pieces, edge_k, opts)
+    elif edge_k is not None and opts.edge == "fit":
+        edge_k = _fitted_edge(grid[:end], yg[:end], plateau_run[0], edge_k, noise, opts)
     plateau = float(np.median(yg[plateau_run[0]:plateau_run[1]]))
     rise = float(np.median(yg[max(end - min_size, plateau_run[0]):end]) - plateau)
     snr = rise / noise

@@ -11,7 +11,7 @@ tendon loads the tip again (dead-zone edge, ``D``). Here, per monotonic half-cyc
   with ``edge="knee"``, where the steep first rise turns into the loaded ramp;
 * the peak after the reversal: :func:`scipy.signal.find_peaks` on the direction-signed current;
   the backlash ends where the current then joins the constant level that follows (the first run
-  of flat pieces after the peak), see :func:`_backlash_end`.
+  of flat pieces after the peak), see :func:`backlash_end`.
 
 Increasing half-cycles (after the reversal at the negative end) give ``B_neg`` and ``D_pos``;
 decreasing ones (after the positive end) give ``B_pos`` and ``D_neg``, as in the paper's model
@@ -24,7 +24,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import ruptures as rpt
 from numpy.typing import NDArray
 from scipy.signal import find_peaks
 
@@ -36,53 +35,21 @@ from tsmd.calibration.health import (
     check_slips,
     find_slip,
 )
+from tsmd.calibration.options import IdentifyOptions
+from tsmd.calibration.pieces import (
+    backlash_end,
+    constant_phase,
+    fitted_edge,
+    flat_pieces,
+    knee_edge,
+    linear_pieces,
+)
 from tsmd.calibration.signal import Conditioned, FloatArray, condition
 
 PARAMETERS: tuple[str, ...] = (
     "dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_pos_deg", "backlash_neg_deg")
 SHORT = {"dead_zone_pos_deg": "D_pos", "dead_zone_neg_deg": "D_neg",
          "backlash_pos_deg": "B_pos", "backlash_neg_deg": "B_neg"}
-
-
-@dataclass(frozen=True)
-class IdentifyOptions:
-    """Tuning of the identification; the defaults follow the paper where it says something."""
-
-    cutoff_hz: float = 20.0
-    filter_order: int = 3
-    max_gap_s: float = 0.5
-    min_reversal_deg: float = 10.0
-    """Direction changes smaller than this are jitter, not reversals."""
-    grid_step_deg: float = 0.25
-    """The current is resampled on this knob-angle grid for change-point detection."""
-    min_snr: float = 4.0
-    """The current must rise by this many noise sigmas past the dead-zone edge."""
-    edge_margin_deg: float = 3.0
-    """An edge closer than this to the end of a half-cycle was not reached."""
-    peak_noise_k: float = 3.0
-    """A peak after a reversal must stand out of the noise by this many sigmas."""
-    flat_slope_fraction: float = 0.3
-    """"Constant" current: rising slower than this fraction of the loaded ramp's slope."""
-    penalty_k: float = 20.0
-    """Change-point penalty in units of noise variance x log(n) (PELT)."""
-    edge: str = "knee"
-    """"knee" (beyond the paper, the default): where the steep first rise turns into the loaded
-    ramp, i.e. where the tip starts to move; "rise": the paper's edge, where the current starts
-    to rise (the tendon engages; the tip follows a few degrees later, and the exact start of a
-    gentle rise scatters by 3 deg from cycle to cycle; docs/calibration.md)."""
-    knee_slope_ratio: float = 1.5
-    max_knee_deg: float = 15.0
-    settle_hold_deg: float = 1.0
-    """The current must stay on the constant level this long to count as settled."""
-    backlash_tangent_deg: float = 3.0
-    """Stretch of current before it settles that is extended to meet the constant level."""
-    min_level_deg: float = 3.0
-    """A run of flat pieces shorter than this after a reversal is a pause in the transient (a
-    turn of the filtered reversal, a speed change), not the release level, which lasts until
-    the dead-zone edge."""
-    max_tracking_error_deg: float = 10.0
-    min_follow_ratio: float = 0.5
-    """The knob must travel at least this fraction of the commanded travel (else: stalled)."""
 
 
 @dataclass(frozen=True)
@@ -210,133 +177,6 @@ def _resample_on_angle(x: FloatArray, y: FloatArray, direction: int,
     return grid, np.interp(grid, s[keep], y[keep])
 
 
-def _change_points(y: FloatArray, n_bkps: int, min_size: int) -> list[int]:
-    """Breakpoints of a continuous piecewise-linear fit (ruptures, exact dynamic programming)."""
-    if y.size < (n_bkps + 1) * min_size:
-        return []
-    algo = rpt.Dynp(model="clinear", min_size=min_size, jump=max(1, y.size // 200)).fit(y)
-    return [int(b) for b in algo.predict(n_bkps=n_bkps)[:-1]]
-
-
-def _slope(y: FloatArray, step: float) -> float:
-    if y.size < 2:
-        return 0.0
-    return float(np.polyfit(np.arange(y.size) * step, y, 1)[0])
-
-
-def _pieces(yg: FloatArray, noise: float, opts: IdentifyOptions) -> list[tuple[int, int]]:
-    """Linear pieces of the current against angle (ruptures PELT, continuous linear cost)."""
-    penalty = max(opts.penalty_k * noise ** 2 * math.log(max(yg.size, 2)), 1e-15)
-    jump = max(2, yg.size // 400)
-    algo = rpt.Pelt(model="clinear", min_size=2, jump=jump).fit(yg)
-    bkps = [int(b) for b in algo.predict(pen=penalty)]
-    return list(zip([0, *bkps[:-1]], bkps, strict=True))
-
-
-def _flat_pieces(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
-                 opts: IdentifyOptions) -> list[bool] | None:
-    """Which pieces are flat: rising slower than ``flat_slope_fraction`` of the loaded ramp
-    (the slope over the last quarter of the travel), or falling gently (a fall as steep as the
-    ramp is the peak after a reversal coming down, not a plateau). None without a ramp."""
-    loaded = _slope(yg[int(0.75 * yg.size):], step)
-    if loaded <= 0:
-        return None
-    slopes = [_slope(yg[a:b], step) for a, b in pieces]
-    return [-loaded < s < opts.flat_slope_fraction * loaded for s in slopes]
-
-
-def _plateau(pieces: list[tuple[int, int]], flat: list[bool], step: float,
-             opts: IdentifyOptions) -> tuple[int, int] | None:
-    """The constant-current stretch before the dead-zone edge (start, stop on the grid): the last
-    run of flat pieces at least ``min_level_deg`` long (else the longest run).
-
-    Not simply the longest: the release level after a reversal is flat too, and where the tip
-    re-enters the dead zone the released tendon drops its last tension, a short step that cuts
-    the two apart; the release run can then be the longer one (fast sweeps, phi2 at +90 deg).
-    """
-    runs = _flat_runs(pieces, flat)
-    long_enough = [r for r in runs if (r[1] - r[0]) * step >= opts.min_level_deg]
-    if long_enough:
-        return long_enough[-1]
-    return max(runs, key=lambda r: r[1] - r[0], default=None)
-
-
-def _flat_runs(pieces: list[tuple[int, int]], flat: list[bool]) -> list[tuple[int, int]]:
-    """Maximal runs of consecutive flat pieces, as (start, stop) on the grid, in order."""
-    runs: list[tuple[int, int]] = []
-    k = 0
-    while k < len(pieces):
-        if not flat[k]:
-            k += 1
-            continue
-        j = k
-        while j + 1 < len(pieces) and flat[j + 1]:
-            j += 1
-        runs.append((pieces[k][0], pieces[j][1]))
-        k = j + 1
-    return runs
-
-
-def _knee(yg: FloatArray, step: float, pieces: list[tuple[int, int]], rise_k: int,
-          opts: IdentifyOptions) -> int:
-    """Beyond the paper: where the steep first rise (the tendon stretching while the tip is
-    still held) turns into the loaded ramp (the tip moving). No steep part: the rise itself."""
-    loaded = _slope(yg[int(0.75 * yg.size):], step)
-    limit = rise_k + int(opts.max_knee_deg / step)
-    steep = False
-    for a, b in pieces:
-        if b <= rise_k:
-            continue
-        if a >= limit:
-            break
-        slope = _slope(yg[max(a, rise_k):b], step)
-        if slope > opts.knee_slope_ratio * loaded:
-            steep = True
-        elif steep:
-            return max(a, rise_k)
-    return rise_k
-
-
-def _backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
-                  pieces: list[tuple[int, int]], flat: list[bool], noise: float,
-                  opts: IdentifyOptions) -> int | None:
-    """Where the current becomes constant after the reversal (the paper's point a2).
-
-    While the sheath unloads, the current falls steeply, then less and less steeply as the slip
-    front runs distally; when the front reaches the tip the current joins the release level
-    (a line, nearly flat). That level is fitted on the first run of flat pieces after the peak
-    at least ``min_level_deg`` long; the backlash ends where the current reaches it and stays
-    within ``peak_noise_k`` noise sigmas for ``settle_hold_deg``,
-    refined to where the current's last ``backlash_tangent_deg`` before that, extended as a line,
-    meets the level (the current approaches the level at a slant, so a band alone ends early).
-    """
-    step = float(grid[1] - grid[0])
-    min_points = max(3, round(opts.min_level_deg / step))
-    # A run that the peak falls inside counts from the peak on (a noise peak at the start of
-    # the level must not hide the level).
-    runs = [(max(a, start_k), b) for a, b in _flat_runs(pieces, flat)]
-    run = next(((a, b) for a, b in runs if b - a >= min_points), None)
-    if run is None:
-        return None
-    a0, b0 = run
-    level = np.polyfit(grid[a0:b0], yg[a0:b0], 1)
-    near = np.abs(yg[start_k:b0] - np.polyval(level, grid[start_k:b0])) <= opts.peak_noise_k * noise
-    hold = max(2, round(opts.settle_hold_deg / step))
-    stays = np.convolve(near.astype(float), np.ones(hold), mode="valid") >= hold
-    hits = np.flatnonzero(stays)
-    settle = start_k + int(hits[0]) if hits.size else a0
-    width = round(opts.backlash_tangent_deg / step)
-    lo = max(start_k, settle - width)
-    if settle - lo >= 3:
-        tangent = np.polyfit(grid[lo:settle], yg[lo:settle], 1)
-        if abs(tangent[0] - level[0]) > 1e-12:
-            x = (level[1] - tangent[1]) / (tangent[0] - level[0])
-            k = int(np.searchsorted(grid, x))
-            if settle <= k <= settle + width:
-                settle = k
-    return settle
-
-
 def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
                        after_reversal: bool, opts: IdentifyOptions) -> HalfCycle:
     """Peak, backlash end and dead-zone edge in one monotonic stretch."""
@@ -356,9 +196,9 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
                          problems=(f"{where}: only {span:.1f} deg of travel",))
     # The last degrees before the next reversal belong to the motor's deceleration: left out.
     end = max(3 * min_size, yg.size - round(opts.edge_margin_deg / step))
-    pieces = _pieces(yg[:end], noise, opts)
-    flat = _flat_pieces(yg[:end], step, pieces, opts)
-    plateau_run = None if flat is None else _plateau(pieces, flat, step, opts)
+    pieces = linear_pieces(yg[:end], noise, opts)
+    flat = flat_pieces(yg[:end], step, pieces, opts)
+    plateau_run = None if flat is None else constant_phase(pieces, flat, step, opts)
     if plateau_run is None:
         plateau_run = (0, end)
         problems.append(f"{where}: no stretch of constant current")
@@ -375,7 +215,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         peak = int(peaks[0]) if peaks.size else None
         start_k = peak if peak is not None else 0
         found = (None if flat is None
-                 else _backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts))
+                 else backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts))
         if found is None:
             # No value rather than a guess: the quality checks then name this reason.
             problems.append(f"{where}: the current never becomes constant after the reversal")
@@ -387,7 +227,9 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     # The dead-zone edge: where the constant-current stretch ends and the current rises.
     edge_k: int | None = plateau_run[1] if plateau_run[1] < end else None
     if edge_k is not None and opts.edge == "knee":
-        edge_k = _knee(yg[:end], step, pieces, edge_k, opts)
+        edge_k = knee_edge(yg[:end], step, pieces, edge_k, opts)
+    elif edge_k is not None and opts.edge == "fit":
+        edge_k = fitted_edge(grid[:end], yg[:end], plateau_run[0], edge_k, noise, opts)
     plateau = float(np.median(yg[plateau_run[0]:plateau_run[1]]))
     rise = float(np.median(yg[max(end - min_size, plateau_run[0]):end]) - plateau)
     snr = rise / noise

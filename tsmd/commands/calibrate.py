@@ -68,10 +68,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--socket", metavar="PATH",
                         help="daemon socket (default: api.socket_path of the config)")
     parser.add_argument("--seed", type=int, default=0, help="--sim: noise seed")
-    parser.add_argument("--edge", choices=("knee", "rise"), default="knee",
-                        help="dead-zone edge: 'knee' (default, beyond the paper) = where the "
-                             "steep first rise turns into the loaded ramp, where the tip starts "
-                             "to move; 'rise' = the paper's, where the current starts to rise "
+    parser.add_argument("--edge", choices=("fit", "knee", "rise"), default="fit",
+                        help="dead-zone edge: 'fit' (default) = least-squares line intersection "
+                             "of the dead-zone level with the loaded ramp (or the end of a steep "
+                             "first rise); 'knee' = the same from change points; 'rise' = the "
+                             "paper's, where the current starts to rise "
                              "(--sim and recordings; the daemon uses the default)")
 
 

@@ -1,0 +1,56 @@
+"""Tuning of the identification of one sweep (:mod:`tsmd.calibration.identify`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class IdentifyOptions:
+    """Tuning of the identification; the defaults follow the paper where it says something."""
+
+    cutoff_hz: float = 20.0
+    filter_order: int = 3
+    max_gap_s: float = 0.5
+    min_reversal_deg: float = 10.0
+    """Direction changes smaller than this are jitter, not reversals."""
+    grid_step_deg: float = 0.25
+    """The current is resampled on this knob-angle grid for change-point detection."""
+    min_snr: float = 4.0
+    """The current must rise by this many noise sigmas past the dead-zone edge."""
+    edge_margin_deg: float = 3.0
+    """An edge closer than this to the end of a half-cycle was not reached."""
+    peak_noise_k: float = 3.0
+    """A peak after a reversal must stand out of the noise by this many sigmas."""
+    flat_slope_fraction: float = 0.3
+    """"Constant" current: rising slower than this fraction of the loaded ramp's slope."""
+    penalty_k: float = 20.0
+    """Change-point penalty in units of noise variance x log(n) (PELT)."""
+    edge: str = "fit"
+    """"fit" (the default): the least-squares line intersection of the dead-zone level with the
+    loaded ramp, or with the end of a steep first rise where the current shows one
+    (:mod:`tsmd.calibration.branch_fit`); "knee": the same from the change points' pieces;
+    "rise": the paper's edge, where the current starts to rise (the tendon engages; the tip
+    follows a few degrees later, and the exact start of a gentle rise scatters by 3 deg from
+    cycle to cycle; docs/calibration.md)."""
+    knee_slope_ratio: float = 1.5
+    fit_before_deg: float = 12.0
+    """``edge="fit"``: the window fitted starts this far before the rise the pieces show ..."""
+    fit_after_deg: float = 15.0
+    """... and ends this far after it (the loaded ramp)."""
+    max_knee_deg: float = 15.0
+    settle_hold_deg: float = 1.0
+    """The current must stay on the constant level this long to count as settled."""
+    backlash_tangent_deg: float = 3.0
+    """Stretch of current before it settles that is extended to meet the constant level."""
+    backlash: str = "settle"
+    """"settle" (the paper's point a2): where the current joins the release level within the
+    noise; "fraction": where it has made up ``backlash_fraction`` of its jump to that level."""
+    backlash_fraction: float = 0.975
+    min_level_deg: float = 3.0
+    """A run of flat pieces shorter than this after a reversal is a pause in the transient (a
+    turn of the filtered reversal, a speed change), not the release level, which lasts until
+    the dead-zone edge."""
+    max_tracking_error_deg: float = 10.0
+    min_follow_ratio: float = 0.5
+    """The knob must travel at least this fraction of the commanded travel (else: stalled)."""

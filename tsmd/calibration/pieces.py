@@ -1,0 +1,167 @@
+"""Detectors on the current of one half-cycle against knob angle: linear pieces (ruptures PELT),
+the constant-current phase, the dead-zone edge (knee, least-squares fit) and the backlash end.
+
+Each works on the direction-signed current resampled on a uniform grid of knob angle; indices
+are into that grid. :mod:`tsmd.calibration.identify` strings them together per half-cycle.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import ruptures as rpt
+
+from tsmd.calibration.branch_fit import fit_edge
+from tsmd.calibration.options import IdentifyOptions
+from tsmd.calibration.signal import FloatArray
+
+
+def slope_per_deg(y: FloatArray, step: float) -> float:
+    if y.size < 2:
+        return 0.0
+    return float(np.polyfit(np.arange(y.size) * step, y, 1)[0])
+
+
+def linear_pieces(yg: FloatArray, noise: float, opts: IdentifyOptions) -> list[tuple[int, int]]:
+    """Linear pieces of the current against angle (ruptures PELT, continuous linear cost)."""
+    penalty = max(opts.penalty_k * noise ** 2 * math.log(max(yg.size, 2)), 1e-15)
+    jump = max(2, yg.size // 400)
+    algo = rpt.Pelt(model="clinear", min_size=2, jump=jump).fit(yg)
+    bkps = [int(b) for b in algo.predict(pen=penalty)]
+    return list(zip([0, *bkps[:-1]], bkps, strict=True))
+
+
+def flat_pieces(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
+                 opts: IdentifyOptions) -> list[bool] | None:
+    """Which pieces are flat: rising slower than ``flat_slope_fraction`` of the loaded ramp
+    (the slope over the last quarter of the travel), or falling gently (a fall as steep as the
+    ramp is the peak after a reversal coming down, not a plateau). None without a ramp."""
+    loaded = slope_per_deg(yg[int(0.75 * yg.size):], step)
+    if loaded <= 0:
+        return None
+    slopes = [slope_per_deg(yg[a:b], step) for a, b in pieces]
+    return [-loaded < s < opts.flat_slope_fraction * loaded for s in slopes]
+
+
+def constant_phase(pieces: list[tuple[int, int]], flat: list[bool], step: float,
+             opts: IdentifyOptions) -> tuple[int, int] | None:
+    """The constant-current stretch before the dead-zone edge (start, stop on the grid): the last
+    run of flat pieces at least ``min_level_deg`` long (else the longest run).
+
+    Not simply the longest: the release level after a reversal is flat too, and where the tip
+    re-enters the dead zone the released tendon drops its last tension, a short step that cuts
+    the two apart; the release run can then be the longer one (fast sweeps, phi2 at +90 deg).
+    """
+    runs = flat_runs(pieces, flat)
+    long_enough = [r for r in runs if (r[1] - r[0]) * step >= opts.min_level_deg]
+    if long_enough:
+        return long_enough[-1]
+    return max(runs, key=lambda r: r[1] - r[0], default=None)
+
+
+def flat_runs(pieces: list[tuple[int, int]], flat: list[bool]) -> list[tuple[int, int]]:
+    """Maximal runs of consecutive flat pieces, as (start, stop) on the grid, in order."""
+    runs: list[tuple[int, int]] = []
+    k = 0
+    while k < len(pieces):
+        if not flat[k]:
+            k += 1
+            continue
+        j = k
+        while j + 1 < len(pieces) and flat[j + 1]:
+            j += 1
+        runs.append((pieces[k][0], pieces[j][1]))
+        k = j + 1
+    return runs
+
+
+def knee_edge(yg: FloatArray, step: float, pieces: list[tuple[int, int]], rise_k: int,
+          opts: IdentifyOptions) -> int:
+    """Beyond the paper: where the steep first rise (the tendon stretching while the tip is
+    still held) turns into the loaded ramp (the tip moving). No steep part: the rise itself."""
+    loaded = slope_per_deg(yg[int(0.75 * yg.size):], step)
+    limit = rise_k + int(opts.max_knee_deg / step)
+    steep = False
+    for a, b in pieces:
+        if b <= rise_k:
+            continue
+        if a >= limit:
+            break
+        slope = slope_per_deg(yg[max(a, rise_k):b], step)
+        if slope > opts.knee_slope_ratio * loaded:
+            steep = True
+        elif steep:
+            return max(a, rise_k)
+    return rise_k
+
+
+def fitted_edge(grid: FloatArray, yg: FloatArray, plateau_start: int, rise_k: int,
+                 noise: float, opts: IdentifyOptions) -> int:
+    """The edge as the least-squares line intersection around the rise the pieces show
+    (:func:`tsmd.calibration.branch_fit.fit_edge`); the rise itself when nothing fits."""
+    step = float(grid[1] - grid[0])
+    a = max(plateau_start, rise_k - round(opts.fit_before_deg / step))
+    b = min(yg.size, rise_k + round(opts.fit_after_deg / step))
+    fit = fit_edge(grid[a:b], yg[a:b], noise, knee_slope_ratio=opts.knee_slope_ratio,
+                   max_knee_deg=opts.max_knee_deg, penalty_k=opts.penalty_k,
+                   search_step_deg=step)
+    if fit is None:
+        return rise_k
+    return min(int(np.searchsorted(grid, fit.edge_deg)), yg.size - 1)
+
+
+def recovered_end(grid: FloatArray, yg: FloatArray, start_k: int, stop: int,
+               level: FloatArray, opts: IdentifyOptions) -> int:
+    """Where the current has made up ``backlash_fraction`` of its jump from the loaded current
+    before the reversal to the release level, and stays there for ``settle_hold_deg``."""
+    step = float(grid[1] - grid[0])
+    loaded = float(np.min(yg[:max(stop, 2)]))
+    target = loaded + opts.backlash_fraction * (np.polyval(level, grid[:stop]) - loaded)
+    above = yg[:stop] >= target
+    hold = max(2, round(opts.settle_hold_deg / step))
+    stays = np.convolve(above.astype(float), np.ones(hold), mode="valid") >= hold
+    hits = np.flatnonzero(stays[start_k:])
+    return start_k + int(hits[0]) if hits.size else stop - 1
+
+
+def backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
+                  pieces: list[tuple[int, int]], flat: list[bool], noise: float,
+                  opts: IdentifyOptions) -> int | None:
+    """Where the current becomes constant after the reversal (the paper's point a2).
+
+    While the sheath unloads, the current falls steeply, then less and less steeply as the slip
+    front runs distally; when the front reaches the tip the current joins the release level
+    (a line, nearly flat). That level is fitted on the first run of flat pieces after the peak
+    at least ``min_level_deg`` long; the backlash ends where the current reaches it and stays
+    within ``peak_noise_k`` noise sigmas for ``settle_hold_deg``,
+    refined to where the current's last ``backlash_tangent_deg`` before that, extended as a line,
+    meets the level (the current approaches the level at a slant, so a band alone ends early).
+    """
+    step = float(grid[1] - grid[0])
+    min_points = max(3, round(opts.min_level_deg / step))
+    # A run that the peak falls inside counts from the peak on (a noise peak at the start of
+    # the level must not hide the level).
+    runs = [(max(a, start_k), b) for a, b in flat_runs(pieces, flat)]
+    run = next(((a, b) for a, b in runs if b - a >= min_points), None)
+    if run is None:
+        return None
+    a0, b0 = run
+    level = np.polyfit(grid[a0:b0], yg[a0:b0], 1)
+    if opts.backlash == "fraction":
+        return recovered_end(grid, yg, start_k, b0, level, opts)
+    near = np.abs(yg[start_k:b0] - np.polyval(level, grid[start_k:b0])) <= opts.peak_noise_k * noise
+    hold = max(2, round(opts.settle_hold_deg / step))
+    stays = np.convolve(near.astype(float), np.ones(hold), mode="valid") >= hold
+    hits = np.flatnonzero(stays)
+    settle = start_k + int(hits[0]) if hits.size else a0
+    width = round(opts.backlash_tangent_deg / step)
+    lo = max(start_k, settle - width)
+    if settle - lo >= 3:
+        tangent = np.polyfit(grid[lo:settle], yg[lo:settle], 1)
+        if abs(tangent[0] - level[0]) > 1e-12:
+            x = (level[1] - tangent[1]) / (tangent[0] - level[0])
+            k = int(np.searchsorted(grid, x))
+            if settle <= k <= settle + width:
+                settle = k
+    return settle

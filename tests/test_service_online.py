@@ -9,6 +9,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
+import yaml
 
 from tsmd.api.client import ApiClient, ApiClientError
 from tsmd.config import TsmdConfig, default_sim_config, resolve_data_path
@@ -16,7 +17,7 @@ from tsmd.daemon import SIM_EXAMPLE_PROFILE, Daemon
 from tsmd.online import RECORDING_COLUMNS
 from tsmd.online.apply import edges_at
 from tsmd.online.worker import OnlineWorker
-from tsmd.profile import load_profile
+from tsmd.profile import device_model_to_mapping, load_device_model, load_profile
 from tsmd.recording import REQUIRED_COLUMNS, read_recording
 from tsmd.stack import make_compensator
 
@@ -258,3 +259,30 @@ def test_a_recording_with_online_off_keeps_the_required_columns_only(
     daemon.stop()
     (path,) = (tmp_path / "rec").glob("tsmd-*.csv")
     assert tuple(read_recording(path).columns) == REQUIRED_COLUMNS
+
+
+def test_the_worker_takes_the_handle_slip_from_the_data_sheet(tmp_path: Path) -> None:
+    config = sim_config(tmp_path, online=True)
+    assert config.profiles.device_model is not None
+    sheet = device_model_to_mapping(load_device_model(resolve_data_path(
+        config.profiles.device_model)))
+    sheet["knobs"]["phi1"]["handle_slip_deg"] = 4.5
+    sheet["knobs"]["phi2"]["handle_slip_deg"] = 2.0
+    (tmp_path / "sheet.yaml").write_text(yaml.safe_dump(sheet))
+    config = dataclasses.replace(config, profiles=dataclasses.replace(
+        config.profiles, device_model=str(tmp_path / "sheet.yaml")))
+    daemon = Daemon(config, sim=True, socket_path=str(tmp_path / "d.sock"))
+    daemon.start()
+    try:
+        ramps = running_worker(daemon)._knob_ramp
+        assert [r.handle_slip_deg for r in ramps] == [4.5, 2.0]
+    finally:
+        daemon.stop()
+
+
+def test_the_worker_reads_the_loops_fault_reason(start_daemon: Callable[..., Daemon]) -> None:
+    daemon = start_daemon(True)
+    worker = running_worker(daemon)
+    assert daemon.loop is not None and worker.fault_reason is not None
+    daemon.loop.fault_reason = "drive 1 (node 2) silent"
+    assert worker.fault_reason() == "drive 1 (node 2) silent"

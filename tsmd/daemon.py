@@ -41,7 +41,13 @@ from tsmd.loop import BackgroundRecorder, ControlLoop, LoopError
 from tsmd.notify import Notifier, watchdog_interval_s
 from tsmd.online import RECORDING_COLUMNS
 from tsmd.online.attach import OnlineAttachment
-from tsmd.profile import CatheterProfile, ProfileError, ProfileStore, load_profile
+from tsmd.profile import (
+    CatheterProfile,
+    ProfileError,
+    ProfileStore,
+    load_device_model,
+    load_profile,
+)
 from tsmd.replay import LiveTrajectoryRunner
 from tsmd.rt import FixedRateScheduler, RealtimeReport, apply_realtime, set_fifo
 from tsmd.service import CompensationChoice, Service
@@ -280,7 +286,8 @@ class Daemon:
         self.loop = build_loop(config, self.drives, compensator, MonotonicClock(),
                                compensation_label=label, tip_source=tip_source,
                                recorder=self.recorder, on_event=self.events.emit)
-        self.online = OnlineAttachment(config.online, self.loop, on_event=self.events.emit)
+        self.online = OnlineAttachment(config.online, self.loop, on_event=self.events.emit,
+                                       handle_slip_deg=self._handle_slip_deg(config))
         if self.recorder is not None and config.online.enabled:
             self.loop.recorder = self.online.recording(self.recorder)
         self.online.attach(compensator)
@@ -289,6 +296,19 @@ class Daemon:
             profiles_dir=resolve_data_path(config.profiles.dir), on_event=self.events.emit,
             runner_factory=self._live_runner, extra_status=self._extra_status,
             online=self.online)
+
+    def _handle_slip_deg(self, config: TsmdConfig) -> tuple[float, float] | None:
+        """The data sheet's handle slip per knob for online re-estimation (None: its default)."""
+        path = config.profiles.device_model
+        if path is None:
+            return None
+        try:
+            knobs = load_device_model(resolve_data_path(path)).knobs
+        except ProfileError as exc:
+            self.events.emit("warning", "online: data sheet unreadable, default handle slip",
+                             reason=str(exc))
+            return None
+        return knobs[0].handle_slip_deg, knobs[1].handle_slip_deg
 
     def _live_runner(self) -> LiveTrajectoryRunner:
         assert self.loop is not None

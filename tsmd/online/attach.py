@@ -23,23 +23,27 @@ from tsmd.profile import CatheterProfile
 
 
 class Observed(Protocol):
-    """What the attachment needs of the loop: its per-tick hook and its period."""
+    """What the attachment needs of the loop: its per-tick hook, its period and why it faulted."""
 
     observer: Callable[[tuple[float, ...], bool], None] | None
     period_s: float
+    fault_reason: str | None
 
 
 class OnlineAttachment:
     """Owns the loop's online worker; ``wanted`` survives compensator changes.
 
     ``on_event(level, event, **fields)`` receives the worker's events (the daemon's log).
+    ``handle_slip_deg`` per knob comes from the data sheet (None: the estimator's default).
     """
 
     def __init__(self, config: OnlineConfig, loop: Observed,
-                 on_event: Callable[..., None] | None = None) -> None:
+                 on_event: Callable[..., None] | None = None,
+                 handle_slip_deg: tuple[float, float] | None = None) -> None:
         self.config = config
         self.loop = loop
         self.on_event = on_event
+        self.handle_slip_deg = handle_slip_deg
         self.wanted = config.enabled
         self.worker: OnlineWorker | None = None
         self._compensator: Any = None
@@ -96,6 +100,10 @@ class OnlineAttachment:
         """``recorder`` with the offsets in force appended to every row."""
         return _WithOffsets(recorder, self)
 
+    def _fault_reason(self) -> str | None:
+        """The loop's fault, read by the worker: a fault freezes the estimate with a warning."""
+        return self.loop.fault_reason
+
     def _status(self) -> dict[str, Any]:
         if self.worker is None:
             out: dict[str, Any] = {"enabled": False}
@@ -111,7 +119,8 @@ class OnlineAttachment:
                 self._compensator, self.loop.period_s, ROW_COLUMNS,
                 estimator=EstimatorOptions(gate_deg=c.gate_deg, max_offset_deg=c.max_offset_deg,
                                            deadband_deg=c.deadband_deg),
-                rate_deg_s=c.rate_deg_s, on_event=self.on_event)
+                rate_deg_s=c.rate_deg_s, on_event=self.on_event,
+                handle_slip_deg=self.handle_slip_deg, fault_reason=self._fault_reason)
         except OnlineError as exc:
             self._why_not = str(exc)
             if self.on_event is not None:

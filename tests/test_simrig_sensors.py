@@ -105,3 +105,20 @@ def test_noiseless_tracker_is_exact() -> None:
 def test_tracker_refuses_negative_noise() -> None:
     with pytest.raises(ValueError, match="noise_deg"):
         EmTracker(noise_deg=-0.1)
+
+
+def test_tracker_block_draws_equal_per_tick_draws_across_block_edges() -> None:
+    tracker = EmTracker(noise_deg=0.3, seed=11)
+    rng = np.random.default_rng(11)
+    tip = np.array([5.0, -2.0])
+    for _ in range(EmTracker.block):  # two values per tick: crosses a block edge mid-run
+        expected = tip + 0.3 * rng.standard_normal(tip.shape)
+        assert np.array_equal(tracker.measure(tip), expected)
+
+
+def test_tracker_reset_restarts_the_noise_sequence() -> None:
+    tracker = EmTracker(noise_deg=0.3, seed=11)
+    first = [tracker.measure(np.zeros(2)) for _ in range(3)]
+    tracker.reset()
+    again = [tracker.measure(np.zeros(2)) for _ in range(3)]
+    assert all(np.array_equal(a, b) for a, b in zip(first, again, strict=True))

@@ -14,175 +14,37 @@ scheduler (:mod:`tsmd.rt`) on the monotonic clock, or a lockstep driver on the r
 from __future__ import annotations
 
 import collections
-import enum
 import math
-import threading
 from collections.abc import Callable
 from concurrent.futures import Future
-from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from drivers.clock import Clock
 from drivers.drive import DriveError, DriveFeedback, DriveState, FaultEvent, KnobDrives
 from tsmd.compensation import Compensator
 from tsmd.compensation.safety import KnobLimiter, KnobLimits
-from tsmd.errors import TsmdError
-from tsmd.recording import RecordingWriter
-
-Array = NDArray[np.float64]
-
-ROW_COLUMNS: tuple[str, ...] = (
-    "t", "q1", "q2", "cmd1", "cmd2", "pos1", "pos2", "cur1", "cur2", "tip1", "tip2",
+from tsmd.loop_recorders import BackgroundRecorder, MemoryRecorder
+from tsmd.loop_types import (
+    ROW_COLUMNS,
+    Array,
+    LatestSetpoint,
+    LoopCommand,
+    LoopError,
+    LoopState,
+    LoopStats,
+    Playback,
+    Sample,
+    TickRecorder,
 )
-"""The recording columns every tick produces (tsmd.recording.REQUIRED_COLUMNS)."""
 
+__all__ = [
+    "ROW_COLUMNS", "BackgroundRecorder", "ControlLoop", "LatestSetpoint", "LoopCommand",
+    "LoopError", "LoopState", "LoopStats", "MemoryRecorder", "Playback", "Sample", "TickRecorder",
+]
 
 _isfinite = math.isfinite
-
-
-class LoopState(enum.Enum):
-    DISABLED = "DISABLED"
-    ENABLED = "ENABLED"
-    FAULT = "FAULT"
-
-
-class LoopError(TsmdError):
-    """A loop command could not be carried out; the message says why."""
-
-    def __init__(self, code: str, message: str) -> None:
-        super().__init__(message)
-        self.code = code
-
-
-class TickRecorder(Protocol):
-    def append(self, row: tuple[float, ...]) -> None: ...
-
-
-@dataclass(frozen=True)
-class Sample:
-    """What one tick did; published to the API (``get``, ``subscribe``)."""
-
-    tick: int
-    t_s: float
-    state: LoopState
-    q_deg: tuple[float, float]
-    cmd_deg: tuple[float, float]
-    pos_deg: tuple[float, float]
-    current_A: tuple[float, float]
-    tip_deg: tuple[float, float]
-    fault: str | None
-
-    def as_dict(self) -> dict[str, Any]:
-        def clean(values: tuple[float, float]) -> list[float | None]:
-            return [v if math.isfinite(v) else None for v in values]
-
-        return {"tick": self.tick, "t": self.t_s, "state": self.state.value,
-                "q": clean(self.q_deg), "cmd": clean(self.cmd_deg), "pos": clean(self.pos_deg),
-                "cur": clean(self.current_A), "tip": clean(self.tip_deg), "fault": self.fault}
-
-
-class LatestSetpoint:
-    """The one value the API writes and the loop reads: replaced whole, never mutated."""
-
-    def __init__(self) -> None:
-        self._value: tuple[float, float] | None = None
-        self.version = 0
-
-    def set(self, q_deg: tuple[float, float]) -> None:
-        self._value = (float(q_deg[0]), float(q_deg[1]))
-        self.version += 1
-
-    def clear(self) -> None:
-        self._value = None
-
-    def get(self) -> tuple[float, float] | None:
-        return self._value
-
-
-@dataclass
-class LoopCommand:
-    """A request from another thread, executed by the loop thread between two ticks."""
-
-    name: str
-    args: dict[str, Any] = field(default_factory=dict)
-    future: Future[Any] = field(default_factory=Future)
-
-
-@dataclass
-class Playback:
-    """A trajectory the loop plays one sample per tick, recording each tick into ``rows``."""
-
-    q_deg: Array
-    compensate: bool
-    cancel: threading.Event | None = None
-    rows: list[tuple[float, ...]] = field(default_factory=list)
-    index: int = 0
-    done: threading.Event = field(default_factory=threading.Event)
-    error: str | None = None
-
-    @property
-    def progress(self) -> float:
-        return self.index / max(len(self.q_deg), 1)
-
-
-@dataclass
-class LoopStats:
-    ticks: int = 0
-    overruns: int = 0
-    overrun_streak: int = 0
-    faults: int = 0
-
-
-class MemoryRecorder:
-    """Keeps every row in memory (replay, tests)."""
-
-    def __init__(self) -> None:
-        self.rows: list[tuple[float, ...]] = []
-
-    def append(self, row: tuple[float, ...]) -> None:
-        self.rows.append(row)
-
-
-class BackgroundRecorder:
-    """Per-tick rows to a recording file, written by a thread every ``flush_interval_s``.
-
-    The hot path only appends a tuple to a deque; formatting, writing and fsync happen in the
-    writer thread. :meth:`close` writes what is left, so a clean stop loses nothing.
-    """
-
-    def __init__(self, path: str, metadata: dict[str, object], flush_interval_s: float,
-                 extra_columns: tuple[str, ...] = ()) -> None:
-        self.path = path
-        self._writer = RecordingWriter(path, metadata, extra_columns)
-        self._rows: collections.deque[tuple[float, ...]] = collections.deque()
-        self._interval_s = flush_interval_s
-        self._stop = threading.Event()
-        self.rows_written = 0
-        self._thread = threading.Thread(target=self._run, name="tsmd-recorder", daemon=True)
-        self._thread.start()
-
-    def append(self, row: tuple[float, ...]) -> None:
-        self._rows.append(row)
-
-    def _drain(self) -> None:
-        rows = self._rows
-        while rows:
-            self._writer.write_row(rows.popleft())
-            self.rows_written += 1
-        self._writer.flush()
-
-    def _run(self) -> None:
-        while not self._stop.wait(self._interval_s):
-            self._drain()
-
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join()
-        self._drain()
-        self._writer.close()
 
 
 class ControlLoop:

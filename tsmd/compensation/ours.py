@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from bisect import bisect_right
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -29,6 +28,7 @@ from tsmd.compensation.tension_play import (
     PlayState,
     TensionPlayParams,
     branches,
+    interp_linear,
     inverse_step,
     rest_state,
 )
@@ -92,17 +92,6 @@ class OursKnob:
             return table[0]
         i = int((other_deg - self._lo) / self._step + 0.5)
         return table[0 if i < 0 else (i if i < len(table) else len(table) - 1)]
-
-
-def _inverse_along(y_deg: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> float:
-    """Piecewise-linear interpolation of ``xs`` over strictly increasing ``ys`` (scalar, fast)."""
-    i = bisect_right(ys, y_deg) - 1
-    if i < 0:
-        i = 0
-    elif i > len(ys) - 2:
-        i = len(ys) - 2
-    y0 = ys[i]
-    return xs[i] + (xs[i + 1] - xs[i]) * (y_deg - y0) / (ys[i + 1] - y0)
 
 
 class _KnobCommand:
@@ -253,7 +242,7 @@ class OursCompensator:
         expected_per_s = speed / kc.omega
         ahead = x
         for _ in range(2):
-            ahead = _inverse_along(target + v * horizon_s, b.knots, ys)
+            ahead = interp_linear(target + v * horizon_s, ys, b.knots)
             if (ahead - x) * d < 0.0:
                 ahead = x
             expected = expected_per_s * horizon_s

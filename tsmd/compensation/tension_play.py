@@ -136,19 +136,19 @@ class Branches:
     falling_deg: tuple[float, ...]
 
     def rising(self, x_deg: float) -> float:
-        return _interp(x_deg, self.knots, self.rising_deg)
+        return interp_linear(x_deg, self.knots, self.rising_deg)
 
     def falling(self, x_deg: float) -> float:
-        return _interp(x_deg, self.knots, self.falling_deg)
+        return interp_linear(x_deg, self.knots, self.falling_deg)
 
     def rising_inverse(self, y_deg: float) -> float:
-        return _interp(y_deg, self.rising_deg, self.knots)
+        return interp_linear(y_deg, self.rising_deg, self.knots)
 
     def falling_inverse(self, y_deg: float) -> float:
-        return _interp(y_deg, self.falling_deg, self.knots)
+        return interp_linear(y_deg, self.falling_deg, self.knots)
 
 
-def _interp(x: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> float:
+def interp_linear(x: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> float:
     """Linear interpolation on strictly increasing ``xs``, extrapolating the end pieces (called
     every tick: plain comparisons, no builtins)."""
     i = bisect_right(xs, x) - 1
@@ -248,11 +248,11 @@ def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
         if turn != direction:
             direction, held = turn, y_prev
     if direction > 0:
-        x = _interp(y_deg, b.rising_deg, b.knots)
+        x = interp_linear(y_deg, b.rising_deg, b.knots)
         if x < x_prev:
             x = x_prev
     else:
-        x = _interp(y_deg, b.falling_deg, b.knots)
+        x = interp_linear(y_deg, b.falling_deg, b.knots)
         if x > x_prev:
             x = x_prev
     return PlayState(x, y_deg, direction, held)

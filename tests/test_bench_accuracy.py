@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import argparse
 import math
 
 import numpy as np
 import pytest
 
+from tsmd import cli
+from tsmd.bench import accuracy, family_accuracy
 from tsmd.bench.accuracy import PERIOD_S, _conditioned, scenarios, tracking_errors
 
 
@@ -64,3 +67,23 @@ def test_conditioned_start_adds_one_unscored_full_cycle_of_both_knobs() -> None:
         assert lead[:, k].min() == pytest.approx(-90.0, abs=0.01)
     assert np.all(np.abs(np.diff(cond, axis=0)) / PERIOD_S < 120.0)  # within the drive's limit
     assert np.allclose(np.diff(t), PERIOD_S)
+
+
+def test_accuracy_with_family_options_runs_the_family_bench_with_them(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    seen: list[argparse.Namespace] = []
+    monkeypatch.setattr(family_accuracy, "main", lambda ns: seen.append(ns) or 0)
+    assert cli.main(["bench", "accuracy", "--family", "lumped", "--units", "101,103",
+                     "--quick", "--no-extra"]) == 0
+    (ns,) = seen
+    assert (ns.family, ns.units, ns.quick, ns.no_extra) == ("lumped", "101,103", True, True)
+    assert ns.methods == "none,paper,ours" and ns.unit_seeds == "1,2,3"  # the family's defaults
+
+
+def test_accuracy_without_family_options_stays_the_single_catheter_bench(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    ran: list[str] = []
+    monkeypatch.setattr(family_accuracy, "main", lambda ns: ran.append("family") or 0)
+    monkeypatch.setattr(accuracy, "main", lambda ns: ran.append("accuracy") or 0)
+    assert cli.main(["bench", "accuracy", "--quick"]) == 0
+    assert ran == ["accuracy"]

@@ -398,6 +398,31 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="directory for the PNG figures (none by default)")
     parser.add_argument("--report", type=Path, default=None,
                         help="write the tables as Markdown to this file")
+    family = parser.add_argument_group(
+        "the catheter family", "any of these runs `tsmd bench family` instead: each unit "
+        "calibrated from its own current, one table per unit and the worst unit")
+    family.add_argument("--family", choices=("capstan", "lumped"), default=None,
+                        help="score units of this family plant (simrig.family)")
+    family.add_argument("--plant", default=None, help="plant factory module:factory")
+    family.add_argument("--params", default=None, help="JSON keyword parameters of the plant")
+    family.add_argument("--units", default=None,
+                        help="with --family: comma-separated unit numbers (101-108 held out)")
+    family.add_argument("--unit-seeds", default=None,
+                        help="with --plant: comma-separated unit seeds (passed as seed)")
+    family.add_argument("--methods", default=None, help="e.g. none,paper,ours")
+    family.add_argument("--no-extra", action="store_true", default=None,
+                        help="skip the extra scenarios")
+    family.add_argument("--profiles", type=Path, default=None,
+                        help="keep and reuse each unit's calibrated profile here")
+
+
+FAMILY_OPTIONS = ("family", "plant", "params", "units", "unit_seeds", "methods", "no_extra",
+                  "profiles")
+"""Options that make `tsmd bench accuracy` a family run (`tsmd.commands.bench` dispatches)."""
+
+
+def wants_family(args: argparse.Namespace) -> bool:
+    return any(getattr(args, name, None) is not None for name in FAMILY_OPTIONS)
 
 
 def main(args: argparse.Namespace) -> int:

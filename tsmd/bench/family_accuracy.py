@@ -107,6 +107,19 @@ def unit_profile(unit: int, device: Any, make: Callable[[], Any], directory: Pat
     return profile
 
 
+def namespace_from(args: argparse.Namespace) -> argparse.Namespace:
+    """This bench's options from another bench's (``tsmd bench accuracy --family ...``): its own
+    defaults, overridden by every option ``args`` sets to something other than None."""
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    out = parser.parse_args([])
+    for name in vars(out):
+        value = getattr(args, name, None)
+        if value is not None:
+            setattr(out, name, value)
+    return out
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--family", choices=sorted(PLANT_SPECS), default=None,
                         help="score units of a family plant (simrig.family) instead of --plant; "

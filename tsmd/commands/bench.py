@@ -28,4 +28,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    if args._bench is accuracy and accuracy.wants_family(args):
+        return int(family_accuracy.main(family_accuracy.namespace_from(args)))
     return int(args._bench.main(args))

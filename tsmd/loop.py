@@ -22,10 +22,11 @@ from typing import Any
 import numpy as np
 
 from drivers.clock import Clock
-from drivers.drive import DriveError, DriveFeedback, DriveState, FaultEvent, KnobDrives
+from drivers.drive import DriveError, FaultEvent, KnobDrives
 from tsmd.compensation import Compensator
 from tsmd.compensation.safety import KnobLimiter, KnobLimits
 from tsmd.loop_recorders import BackgroundRecorder, MemoryRecorder
+from tsmd.loop_supervision import remaining_fault_cause, silent_drive, tick_fault
 from tsmd.loop_types import (
     ROW_COLUMNS,
     Array,
@@ -122,9 +123,7 @@ class ControlLoop:
         cache = self._sample_cache
         if cache is not None and cache[0] is latest:
             return cache[1]
-        ticks, t_s, state, row, fault = latest
-        sample = Sample(ticks, t_s, state, (row[1], row[2]), (row[3], row[4]), (row[5], row[6]),
-                        (row[7], row[8]), (row[9], row[10]), fault)
+        sample = Sample.from_row(*latest)
         self._sample_cache = (latest, sample)
         return sample
 
@@ -148,7 +147,8 @@ class ControlLoop:
         if events:
             self.last_events.extend(events)
         if self.state is LoopState.ENABLED:
-            reason = self._supervise(events, feedback, pos)
+            reason = tick_fault(events, feedback, self.stale_feedback_syncs,
+                                self.stats.overrun_streak, self.overrun_fault_streak)
             if reason is not None:
                 self._fault(reason)
         if self.state is LoopState.ENABLED:
@@ -179,23 +179,6 @@ class ControlLoop:
             self.observer(row, self.state is LoopState.ENABLED)
         self.stats.ticks += 1
         self._latest = (self.stats.ticks, t_s, self.state, row, self.fault_reason)
-
-    def _supervise(self, events: list[FaultEvent], feedback: list[DriveFeedback],
-                   pos: list[float]) -> str | None:
-        if events:
-            ev = events[0]
-            return f"drive {ev.drive}: {ev.kind.value}: {ev.message}"
-        for i, fb in enumerate(feedback):
-            if fb.state is not DriveState.OPERATION_ENABLED:
-                return f"drive {i}: left OPERATION ENABLED (state {fb.state.value})"
-            if fb.age_syncs > self.stale_feedback_syncs:
-                return f"drive {i}: stale feedback ({fb.age_syncs} SYNCs without an answer)"
-            if not (math.isfinite(fb.position_deg) and math.isfinite(fb.current_A)):
-                return f"drive {i}: non-finite feedback (position {fb.position_deg}, " \
-                       f"current {fb.current_A})"
-        if self.stats.overrun_streak >= self.overrun_fault_streak:
-            return f"{self.stats.overrun_streak} overruns in a row"
-        return None
 
     def _command(self, pos: list[float]) -> tuple[Array, Array]:
         playback = self._playback
@@ -326,9 +309,9 @@ class ControlLoop:
             raise LoopError("fault", f"in FAULT ({self.fault_reason}); send reset first")
         if self.state is LoopState.ENABLED:
             return self.state.value
-        for i, lost in enumerate(self.drives.heartbeat_lost()):
-            if lost:
-                raise LoopError("drive", f"drive {i} sends no heartbeat; not enabling")
+        silent = silent_drive(self.drives)
+        if silent is not None:
+            raise LoopError("drive", f"{silent}; not enabling")
         self.schedule_reset = True
         try:
             self.drives.enable()
@@ -381,20 +364,9 @@ class ControlLoop:
         self.drives.fault_reset()
         self.drives.disable()
         self.drives.pump()
-        pending = self.drives.poll_events()
-        if pending:
-            ev = pending[0]
-            raise LoopError("fault", f"cause still present: drive {ev.drive}: "
-                                     f"{ev.kind.value}: {ev.message}")
-        for i, fb in enumerate(self.drives.feedback()):
-            if fb.age_syncs > self.stale_feedback_syncs:
-                raise LoopError("fault", f"cause still present: drive {i} feedback is stale "
-                                         f"({fb.age_syncs} SYNCs)")
-            if fb.state in (DriveState.FAULT, DriveState.FAULT_REACTION_ACTIVE):
-                raise LoopError("fault", f"cause still present: drive {i} is in {fb.state.value}")
-        for i, lost in enumerate(self.drives.heartbeat_lost()):
-            if lost:
-                raise LoopError("fault", f"cause still present: drive {i} sends no heartbeat")
+        cause = remaining_fault_cause(self.drives, self.stale_feedback_syncs)
+        if cause is not None:
+            raise LoopError("fault", f"cause still present: {cause}")
         self.state = LoopState.DISABLED
         self.fault_reason = None
         self.stats.overrun_streak = 0

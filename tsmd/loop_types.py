@@ -59,6 +59,13 @@ class Sample:
     tip_deg: tuple[float, float]
     fault: str | None
 
+    @classmethod
+    def from_row(cls, tick: int, t_s: float, state: LoopState, row: tuple[float, ...],
+                 fault: str | None) -> Sample:
+        """The sample of a recorded row (columns :data:`ROW_COLUMNS`)."""
+        return cls(tick, t_s, state, (row[1], row[2]), (row[3], row[4]), (row[5], row[6]),
+                   (row[7], row[8]), (row[9], row[10]), fault)
+
     def as_dict(self) -> dict[str, Any]:
         def clean(values: tuple[float, float]) -> list[float | None]:
             return [v if math.isfinite(v) else None for v in values]

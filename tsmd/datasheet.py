@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
 from tsmd.calibration.identify import identify_sweep
+from tsmd.calibration.signal import Conditioned
 from tsmd.compensation.safety import KnobLimits
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.errors import TsmdError
@@ -64,6 +65,9 @@ class KnobConstants:
     handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
     """The handle's design value (bearing and brake), not measured here: the sweep never stops
     the knob, so it cannot show the static friction fading after a restart."""
+    backlash_settle_fraction: float | None = None
+    """Share of the current's swing after a reversal made up when the tip starts back
+    (:func:`backlash_settle_fraction`; None: no reversal could be measured)."""
 
     def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
         """The data sheet's knob entry, rounded as a data sheet is printed."""
@@ -78,7 +82,9 @@ class KnobConstants:
             reference_backlash_pos_deg=r(self.reference_backlash_pos_deg),
             reference_backlash_neg_deg=r(self.reference_backlash_neg_deg),
             dead_zone_offset_deg=r(self.dead_zone_offset_deg),
-            handle_slip_deg=r(self.handle_slip_deg))
+            handle_slip_deg=r(self.handle_slip_deg),
+            backlash_settle_fraction=(None if self.backlash_settle_fraction is None
+                                      else round(float(self.backlash_settle_fraction), 3)))
 
 
 def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,
@@ -157,7 +163,37 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         reference_neg=ReferencePoint(-SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos < -top]))),
         reference_backlash_pos_deg=float(dz.backlash_pos_deg),
         reference_backlash_neg_deg=float(dz.backlash_neg_deg),
-        dead_zone_offset_deg=float(dz_offset))
+        dead_zone_offset_deg=float(dz_offset),
+        backlash_settle_fraction=backlash_settle_fraction(cur.data, t, tip))
+
+
+def backlash_settle_fraction(data: Conditioned, tip_t_s: NDArray[np.float64],
+                             tip_deg: NDArray[np.float64]) -> float | None:
+    """How far the (filtered) current has come back when the tip starts to move after a
+    reversal at the sweep's ends, as a share of its swing from the reversal to its release
+    level; median over the reversals. The release level is the current's median over the
+    5-20 deg of knob travel after the tip has started back (the tendon releasing freely)."""
+    pos, cur = data.pos_deg, data.current_filtered_A
+    tip = np.interp(data.t_s, tip_t_s, tip_deg)
+    shares = []
+    for a, b, direction in split_passes(pos):
+        if abs(pos[a]) < SWEEP_AMPLITUDE_DEG - 10.0:
+            continue
+        side = -direction  # +1 after the reversal at +90 deg
+        travel = side * (pos[a] - pos[a:b])
+        moved = np.flatnonzero(side * (tip[a] - tip[a:b]) > TIP_THRESHOLD_DEG)
+        if moved.size == 0:
+            continue
+        k = int(moved[0])
+        free = (travel > travel[k] + 5.0) & (travel < travel[k] + 20.0)
+        if np.count_nonzero(free) < 5:
+            continue
+        level = float(np.median(side * cur[a:b][free]))
+        swing = side * cur[a] - level
+        if swing <= 0.0:
+            continue
+        shares.append((side * cur[a] - side * cur[a + k]) / swing)
+    return float(np.median(shares)) if shares else None
 
 
 def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 2000,

@@ -96,6 +96,11 @@ class DeviceKnob:
     handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
     """Knob travel over which the handle's static friction fades to kinetic after a restart
     (the online estimator models it; a sheet without it gets the default)."""
+    backlash_settle_fraction: float | None = None
+    """Optional: on the data-sheet unit, the share of its swing after a reversal that the motor
+    current has made up when the tip starts back (the end of the backlash). Per product: where
+    it is below :data:`tsmd.calibration.options.SETTLED_FRACTION`, calibration ends the backlash
+    at this share instead of where the current has settled (old sheets: the settle rule)."""
 
 
 @dataclass(frozen=True)
@@ -284,7 +289,9 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional(k.get("reference_dead_zone_neg_deg"), "reference_dead_zone_neg_deg", -90.0,
                      0.0, "deg"),
             r.number(k.get("handle_slip_deg", DEFAULT_HANDLE_SLIP_DEG), key + ".handle_slip_deg",
-                     0.01, 45.0, "deg")))
+                     0.01, 45.0, "deg"),
+            optional(k.get("backlash_settle_fraction"), "backlash_settle_fraction", 0.5, 1.0,
+                     "")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -310,6 +317,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         knobs[name]["handle_slip_deg"] = k.handle_slip_deg
+        if k.backlash_settle_fraction is not None:
+            knobs[name]["backlash_settle_fraction"] = k.backlash_settle_fraction
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 
 @dataclass(frozen=True)
@@ -54,3 +54,19 @@ class IdentifyOptions:
     max_tracking_error_deg: float = 10.0
     min_follow_ratio: float = 0.5
     """The knob must travel at least this fraction of the commanded travel (else: stalled)."""
+
+
+SETTLED_FRACTION = 0.99
+"""A data sheet's settle fraction at or above this is "settled": within about 1 % of the swing
+the current's noise hides the rest (a few mA against a swing of 0.2-0.5 A), so the paper's rule
+(where the current joins its release level) already marks the tip's release there."""
+
+
+def for_product(options: IdentifyOptions, settle_fraction: float | None) -> IdentifyOptions:
+    """The identification for one knob of a product whose data sheet measured how far the
+    current has come back when the tip starts to move: below :data:`SETTLED_FRACTION` the
+    backlash ends at that share of the current's swing ("fraction"), else as ``options`` say."""
+    if settle_fraction is None or settle_fraction >= SETTLED_FRACTION \
+            or options.backlash != "settle":
+        return options
+    return replace(options, backlash="fraction", backlash_fraction=settle_fraction)

@@ -37,6 +37,7 @@ from tsmd.calibration.errors import (
 )
 from tsmd.calibration.estimate import EstimateOptions
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
+from tsmd.calibration.options import for_product
 from tsmd.calibration.player import (
     Player,
     Progress,
@@ -80,7 +81,19 @@ def _meta_float(rec: Recording, key: str) -> float | None:
     return value
 
 
-def identify_recording(rec: Recording, options: IdentifyOptions | None = None,
+KnobOptions = IdentifyOptions | tuple[IdentifyOptions, IdentifyOptions] | None
+"""One identification for both knobs, or one per knob (:func:`device_options`)."""
+
+
+def device_options(options: IdentifyOptions | None, device: DeviceModel
+                   ) -> tuple[IdentifyOptions, IdentifyOptions]:
+    """Each knob's identification with its product's backlash rule from the data sheet."""
+    base = options or IdentifyOptions()
+    return (for_product(base, device.knobs[0].backlash_settle_fraction),
+            for_product(base, device.knobs[1].backlash_settle_fraction))
+
+
+def identify_recording(rec: Recording, options: KnobOptions = None,
                        source: str = "recording") -> GridPoint:
     """One recording holding one sweep -> a grid point (swept knob and other angle inferred
     from the metadata when present, else from which knob moved)."""
@@ -112,7 +125,8 @@ def identify_recording(rec: Recording, options: IdentifyOptions | None = None,
         other = float(np.round(np.median(held), 1))
     k = knob + 1
     try:
-        result = identify_sweep(t, rec[f"cmd{k}"], rec[f"pos{k}"], rec[f"cur{k}"], options,
+        opts = options[knob] if isinstance(options, tuple) else options
+        result = identify_sweep(t, rec[f"cmd{k}"], rec[f"pos{k}"], rec[f"cur{k}"], opts,
                                 sweep_start_s=start_s)
     except CalibrationError as exc:
         raise CalibrationError(f"{source} ({KNOB_LABELS[knob]} sweep): {exc}") from None
@@ -170,8 +184,8 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
     proto.validate(tuple((k.limits.min_deg, k.limits.max_deg)  # type: ignore[arg-type]
                          for k in device.knobs))
     omegas = tuple(k.omega for k in device.knobs)
-    runs = run_sweeps(runner, proto, progress=progress, cancel=cancel, options=options,
-                      isolate=isolate, omegas=omegas,
+    runs = run_sweeps(runner, proto, progress=progress, cancel=cancel,
+                      options=device_options(options, device), isolate=isolate, omegas=omegas,
                       estimate=(limits or QualityLimits()).estimate)
     profile, report = finish(catheter_id, device, runs.points, limits=limits,
                              amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
@@ -184,7 +198,7 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
 
 def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
                progress: ProgressCallback | None = None, cancel: threading.Event | None = None,
-               options: IdentifyOptions | None = None, isolate: bool = False,
+               options: KnobOptions = None, isolate: bool = False,
                omegas: Sequence[float] | None = None,
                estimate: EstimateOptions | None = None) -> SweepRuns:
     """Run and identify each sweep in turn, then re-sweep uncertain grid points within the
@@ -251,7 +265,7 @@ def _lower_priority() -> None:
 class _Identifier:
     """Identifies sweeps in this process, or in a worker process overlapped with the run."""
 
-    def __init__(self, options: IdentifyOptions | None, isolate: bool) -> None:
+    def __init__(self, options: KnobOptions, isolate: bool) -> None:
         self.options = options
         self.pool: ProcessPoolExecutor | None = None
         if isolate:
@@ -308,7 +322,8 @@ def calibrate_from_recordings(recordings: Sequence[tuple[str, Recording]], cathe
                               options: IdentifyOptions | None = None,
                               limits: QualityLimits | None = None) -> Calibration:
     """Offline: the same identification and checks on logged sweeps (one sweep per recording)."""
-    points = [identify_recording(rec, options, name) for name, rec in recordings]
+    per_knob = device_options(options, device)
+    points = [identify_recording(rec, per_knob, name) for name, rec in recordings]
     return calibration_from_points(points, catheter_id, device, limits=limits)
 
 

@@ -1,0 +1,93 @@
+"""The per-product backlash rule: the data sheet measures how far the current has come back when
+the tip starts to move; calibration ends the backlash there when the current is still short of
+its release level (docs/calibration.md)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from support.profiles import DEVICE
+
+from tsmd.calibration.options import SETTLED_FRACTION, IdentifyOptions, for_product
+from tsmd.calibration.run import device_options
+from tsmd.calibration.signal import Conditioned
+from tsmd.datasheet import backlash_settle_fraction
+from tsmd.profile import ProfileError, device_model_to_mapping, load_device_model
+
+
+def _sweep_after_reversal(tip_start_deg: float, current_settles_deg: float
+                          ) -> tuple[Conditioned, np.ndarray, np.ndarray]:
+    """Knob 0 -> +90 -> -90 -> 0 deg. After the +90 deg reversal the current falls linearly
+    from 1 A to its release level 0 A over ``current_settles_deg`` of knob travel; the tip holds
+    for ``tip_start_deg`` and then comes back at the knob's slope."""
+    up = np.linspace(0.0, 90.0, 901)
+    down = np.linspace(90.0, -90.0, 1801)[1:]
+    back = np.linspace(-90.0, 0.0, 901)[1:]
+    pos = np.concatenate([up, down, back])
+    t = np.arange(pos.size) * 0.01
+    travel = 90.0 - down
+    current = np.concatenate([np.ones(up.size),
+                              np.clip(1.0 - travel / current_settles_deg, 0.0, 1.0),
+                              np.zeros(back.size)])
+    tip = np.concatenate([up, 90.0 - np.maximum(travel - tip_start_deg, 0.0),
+                          np.full(back.size, 90.0 - (180.0 - tip_start_deg))])
+    data = Conditioned(t, pos, pos, current, current, 100.0, 0.001, 0.0005, ())
+    return data, t, tip
+
+
+def test_the_share_of_the_current_swing_made_up_when_the_tip_moves_is_measured() -> None:
+    # the tip counts as moving once it is 1 deg back: at 19 deg of travel, 95 % of the swing
+    data, t, tip = _sweep_after_reversal(tip_start_deg=18.0, current_settles_deg=20.0)
+    assert backlash_settle_fraction(data, t, tip) == pytest.approx(0.95, abs=0.005)
+
+
+def test_a_current_settled_before_the_tip_moves_measures_as_one() -> None:
+    data, t, tip = _sweep_after_reversal(tip_start_deg=25.0, current_settles_deg=20.0)
+    assert backlash_settle_fraction(data, t, tip) == pytest.approx(1.0)
+
+
+def test_a_product_whose_current_is_short_of_its_level_uses_the_fraction_rule() -> None:
+    opts = for_product(IdentifyOptions(), 0.95)
+    assert (opts.backlash, opts.backlash_fraction) == ("fraction", 0.95)
+
+
+@pytest.mark.parametrize("share", [None, SETTLED_FRACTION, 1.0])
+def test_a_settled_or_unknown_product_keeps_the_papers_settle_rule(share: float | None) -> None:
+    assert for_product(IdentifyOptions(), share) == IdentifyOptions()
+
+
+def test_each_knob_gets_its_own_products_rule() -> None:
+    device = load_device_model(DEVICE)
+    knobs = (replace(device.knobs[0], backlash_settle_fraction=0.95),
+             replace(device.knobs[1], backlash_settle_fraction=None))
+    phi1, phi2 = device_options(None, replace(device, knobs=knobs))
+    assert phi1.backlash == "fraction" and phi2.backlash == "settle"
+
+
+def test_a_sheet_without_the_share_loads_and_keeps_the_settle_rule() -> None:
+    device = load_device_model(DEVICE)
+    assert all(k.backlash_settle_fraction is None for k in device.knobs) or all(
+        k.backlash_settle_fraction is not None for k in device.knobs)
+    stripped = device_model_to_mapping(device)
+    for k in stripped["knobs"].values():
+        k.pop("backlash_settle_fraction", None)
+    assert device_options(None, _load(stripped)) == (IdentifyOptions(), IdentifyOptions())
+
+
+def test_an_implausible_share_is_refused_naming_it(tmp_path: Path) -> None:
+    mapping = device_model_to_mapping(load_device_model(DEVICE))
+    mapping["knobs"]["phi2"]["backlash_settle_fraction"] = 1.5
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(mapping))
+    with pytest.raises(ProfileError, match="phi2.backlash_settle_fraction"):
+        load_device_model(path)
+
+
+def _load(mapping: dict[str, object]):  # type: ignore[no-untyped-def]
+    from tsmd.profile import device_model_from_mapping
+
+    return device_model_from_mapping(mapping, "test")

@@ -31,7 +31,7 @@ from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.identify import PARAMETERS
 from tsmd.calibration.player import sweep_metadata
 from tsmd.calibration.protocol import Protocol, fast_protocol, paper_protocol, sweep_run
-from tsmd.calibration.run import finish, run_sweeps
+from tsmd.calibration.run import device_options, finish, run_sweeps
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.profile import DeviceModel
 from tsmd.recording import Recording
@@ -112,7 +112,7 @@ def play_protocol(config: TsmdConfig, device: DeviceModel, proto: Protocol, nois
                             plant=wrap(plant) if wrap else plant) as runner:
             if inject is not None:
                 inject(runner)
-            runs = run_sweeps(runner, proto, omegas=omegas)
+            runs = run_sweeps(runner, proto, options=device_options(None, device), omegas=omegas)
         finish("bench", device, runs.points, amplitude_deg=90.0)
         accepted, reason = True, ""
     except CalibrationError as exc:

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
 from tsmd.calibration.identify import identify_sweep
+from tsmd.calibration.tension_play_fit import fit_sweep_sides
 from tsmd.compensation.safety import KnobLimits
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.errors import TsmdError
@@ -64,6 +65,9 @@ class KnobConstants:
     handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
     """The handle's design value (bearing and brake), not measured here: the sweep never stops
     the knob, so it cannot show the static friction fading after a restart."""
+    backlash_gain: float | None = None
+    """beta of this unit from the sweep's current (calibration's estimator, mean of both
+    sides): method ours scales omega per unit by ``1 - beta`` against it."""
 
     def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
         """The data sheet's knob entry, rounded as a data sheet is printed."""
@@ -78,7 +82,9 @@ class KnobConstants:
             reference_backlash_pos_deg=r(self.reference_backlash_pos_deg),
             reference_backlash_neg_deg=r(self.reference_backlash_neg_deg),
             dead_zone_offset_deg=r(self.dead_zone_offset_deg),
-            handle_slip_deg=r(self.handle_slip_deg))
+            handle_slip_deg=r(self.handle_slip_deg),
+            reference_backlash_gain=(None if self.backlash_gain is None
+                                     else round(float(self.backlash_gain), 3)))
 
 
 def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,
@@ -137,6 +143,15 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
     cur = identify_sweep(t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:])
     dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
                        + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
+    try:
+        sides = fit_sweep_sides(cur.data.pos_deg, cur.data.current_filtered_A,
+                                *(cur.estimate(k) for k in ("dead_zone_pos_deg",
+                                                            "dead_zone_neg_deg",
+                                                            "backlash_pos_deg",
+                                                            "backlash_neg_deg")))
+        gain: float | None = 0.5 * (sides[0].backlash_gain + sides[1].backlash_gain)
+    except ValueError:  # a current without a loaded ramp: the sheet keeps a per-product omega
+        gain = None
     loaded, released = [], []
     for a, b, direction in split_passes(pos):
         x, y = direction * pos[a:b], direction * tip[a:b]  # mirror falling passes
@@ -157,7 +172,8 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         reference_neg=ReferencePoint(-SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos < -top]))),
         reference_backlash_pos_deg=float(dz.backlash_pos_deg),
         reference_backlash_neg_deg=float(dz.backlash_neg_deg),
-        dead_zone_offset_deg=float(dz_offset))
+        dead_zone_offset_deg=float(dz_offset),
+        backlash_gain=gain)
 
 
 def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 2000,

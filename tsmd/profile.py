@@ -96,6 +96,9 @@ class DeviceKnob:
     handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
     """Knob travel over which the handle's static friction fades to kinetic after a restart
     (the online estimator models it; a sheet without it gets the default)."""
+    reference_backlash_gain: float | None = None
+    """Optional: the data-sheet unit's backlash gain beta (mean of both sides) from its own
+    sweep current (other knob at 0): method ours scales omega per unit by ``1 - beta``."""
 
 
 @dataclass(frozen=True)
@@ -284,7 +287,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional(k.get("reference_dead_zone_neg_deg"), "reference_dead_zone_neg_deg", -90.0,
                      0.0, "deg"),
             r.number(k.get("handle_slip_deg", DEFAULT_HANDLE_SLIP_DEG), key + ".handle_slip_deg",
-                     0.01, 45.0, "deg")))
+                     0.01, 45.0, "deg"),
+            optional(k.get("reference_backlash_gain"), "reference_backlash_gain", 0.0, 0.8, "")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -310,6 +314,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         knobs[name]["handle_slip_deg"] = k.handle_slip_deg
+        if k.reference_backlash_gain is not None:
+            knobs[name]["reference_backlash_gain"] = k.reference_backlash_gain
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

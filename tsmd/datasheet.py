@@ -65,6 +65,11 @@ class KnobConstants:
     handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
     """The handle's design value (bearing and brake), not measured here: the sweep never stops
     the knob, so it cannot show the static friction fading after a restart."""
+    dead_zone_pos_deg: float | None = None
+    """The dead-zone edges the calibration's current analysis finds on this sweep: with them
+    the plateau heights are product constants and each unit's loaded line moves with its own
+    edges (method ours); None: the paper's line through the reference point."""
+    dead_zone_neg_deg: float | None = None
     backlash_gain: float | None = None
     """beta of this unit from the sweep's current (calibration's estimator, mean of both
     sides): method ours scales omega per unit by ``1 - beta`` against it."""
@@ -83,6 +88,10 @@ class KnobConstants:
             reference_backlash_neg_deg=r(self.reference_backlash_neg_deg),
             dead_zone_offset_deg=r(self.dead_zone_offset_deg),
             handle_slip_deg=r(self.handle_slip_deg),
+            reference_dead_zone_pos_deg=(None if self.dead_zone_pos_deg is None
+                                         else r(self.dead_zone_pos_deg)),
+            reference_dead_zone_neg_deg=(None if self.dead_zone_neg_deg is None
+                                         else r(self.dead_zone_neg_deg)),
             reference_backlash_gain=(None if self.backlash_gain is None
                                      else round(float(self.backlash_gain), 3)))
 
@@ -173,7 +182,12 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         reference_backlash_pos_deg=float(dz.backlash_pos_deg),
         reference_backlash_neg_deg=float(dz.backlash_neg_deg),
         dead_zone_offset_deg=float(dz_offset),
-        backlash_gain=gain)
+        dead_zone_pos_deg=_finite_or_none(cur.estimate("dead_zone_pos_deg")),
+        dead_zone_neg_deg=_finite_or_none(cur.estimate("dead_zone_neg_deg")), backlash_gain=gain)
+
+
+def _finite_or_none(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
 
 
 def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 2000,

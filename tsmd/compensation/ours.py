@@ -45,6 +45,11 @@ TABLE_STEP_DEG = 0.25
 REVERSAL_DEADBAND_DEG = 0.1
 """A desired angle that turns back by less than this is held: an exact inverse would make the
 motor cross the whole backlash for every jitter of the operator's input (error <= this)."""
+DWELL_S = 0.4
+"""A desired angle standing still (within :data:`REVERSAL_DEADBAND_DEG`) this long is a dwell:
+the knob moves to the middle of the play that holds the tip there (the tip does not move), so
+the next move, whichever way it goes, crosses half the play instead of all of it (a causal
+feed-forward cannot know the direction: the middle halves the worse case)."""
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
 
@@ -97,8 +102,9 @@ class OursKnob:
 class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
-    __slots__ = ("ahead_s", "hold", "jump_deg", "lim", "limits", "omega", "out", "q_dir",
-                 "q_prev", "state", "sum", "target", "v", "window")
+    __slots__ = ("accel", "ahead_s", "hold", "jump_deg", "lim", "limits", "omega", "out",
+                 "q_dir", "q_prev", "state", "still_q", "still_s", "sum", "target", "v",
+                 "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
@@ -112,9 +118,12 @@ class _KnobCommand:
         self.q_prev = q_deg
         self.q_dir = state.direction
         self.v = 0.0
+        self.accel = 0.0
         self.target = q_deg
         self.out = state.x_deg
         self.hold = 0
+        self.still_q = q_deg
+        self.still_s = 0.0
         x = self.limits.clip(state.x_deg)
         self.lim = LimiterState(x)
         self.window = [x] * n_avg
@@ -198,6 +207,14 @@ class OursCompensator:
         return np.array((out[0] / n, out[1] / n))
 
     def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
+        if -REVERSAL_DEADBAND_DEG < q_raw - kc.still_q < REVERSAL_DEADBAND_DEG:
+            kc.still_s += self.period_s
+            if kc.still_s >= DWELL_S:
+                self._centre(kc, b)
+                return
+        else:
+            kc.still_q = q_raw
+            kc.still_s = 0.0
         q_prev = kc.q_prev
         qi = q_prev
         if (q_raw - q_prev) * kc.q_dir >= 0.0:
@@ -210,6 +227,7 @@ class OursCompensator:
         v = 0.7 * kc.v + 0.3 * dq / self.period_s
         if abs(dq) > kc.jump_deg:  # a step, not a motion: nothing to predict from it
             v = 0.0
+        kc.accel = 0.8 * kc.accel + 0.2 * (v - kc.v) / self.period_s
         kc.v = v
         lead = kc.ahead_s * v
         lead = -_MAX_LEAD_DEG if lead < -_MAX_LEAD_DEG else min(lead, _MAX_LEAD_DEG)
@@ -224,6 +242,19 @@ class OursCompensator:
         state = inverse_step(state, target, b)
         kc.state = state
         kc.out = self._early_jump(kc, state, target, v, b)
+
+    def _centre(self, kc: _KnobCommand, b: Branches) -> None:
+        """During a dwell: the knob to the middle of the play holding the model's output (the
+        other knob may move the branches: recomputed every tick)."""
+        state = kc.state
+        y = state.y_deg
+        x = 0.5 * (interp_linear(y, b.falling_deg, b.knots)
+                   + interp_linear(y, b.rising_deg, b.knots))
+        kc.state = PlayState(x, y, state.direction, y)
+        kc.v = 0.0
+        kc.accel = 0.0
+        kc.hold = 0
+        kc.out = x
 
     def _early_jump(self, kc: _KnobCommand, state: PlayState, target: float, v: float,
                     b: Branches) -> float:
@@ -240,9 +271,12 @@ class OursCompensator:
         ys = b.rising_deg if d > 0 else b.falling_deg
         horizon_s = 30.0 / self.v_max  # half the crossing time of a 60 deg jump
         expected_per_s = speed / kc.omega
+        # a desired angle speeding up (the start of a move) gets there sooner than v says
+        accel = kc.accel if kc.accel * v > 0.0 else 0.0
         ahead = x
         for _ in range(2):
-            ahead = interp_linear(target + v * horizon_s, ys, b.knots)
+            ahead = interp_linear(target + (v + 0.5 * accel * horizon_s) * horizon_s, ys,
+                                  b.knots)
             if (ahead - x) * d < 0.0:
                 ahead = x
             expected = expected_per_s * horizon_s

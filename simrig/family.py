@@ -133,6 +133,15 @@ VARIANTS: dict[str, Variant] = {
         factors={p: {"tendon_stiffness_N": 2.5, "tendon_offset_mm": 1.4, "sheath_friction": 1.2}
                  for p in _NOMINAL},
     ),
+    "compliant-tendon": Variant(
+        "compliant (polymer or thin) tendons: stretch takes a larger share of the draw-in while "
+        "loading than while releasing, so the tip releases steeper than it loads (outside the "
+        "real TEE probe); on capstan exactly the development plant's nominal unit before session 5",
+        factors={"capstan": {"tendon_stiffness_N": 0.5, "tendon_offset_mm": 1.0 / 1.4,
+                             "sheath_friction": 1.0 / 1.4, "slack_pos_mm": 1.0 / 1.2,
+                             "slack_neg_mm": 1.0 / 1.2},
+                 "lumped": {"tendon_stiffness_N": 0.4}},
+    ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",
         current_sensor={"noise_A": 0.010, "spike_rate_hz": 2.0, "lag_s": 0.005},

@@ -93,8 +93,11 @@ class Signature:
 def signature(rec: SweepRecord) -> Signature:
     """Measure the sweep's signature; the torque figures are for the positive reversal."""
     q, y, tau, t = rec.knob_deg, rec.tip_deg, rec.torque_Nm, rec.t_s
-    m = measure_dead_zone_backlash(q, y)
     period = float(t[-1] + t[1] - t[0]) / 2.0  # two cycles
+    # D and B from the passes after the first -90 deg reversal: the first release starts from
+    # a tension-free (virgin) plant and rests higher, which is not the product's behaviour.
+    conditioned = t >= 0.6 * period
+    m = measure_dead_zone_backlash(q[conditioned], y[conditioned])
     moving_up = np.gradient(q) > 0
     in_dz = moving_up & (np.abs(q) < 10.0) & (t > period / 2)
     # Second positive reversal: the torque dips below the released level right after it.

@@ -383,11 +383,11 @@ def test_a_routed_handle_makes_the_calibration_warn_that_its_backlash_is_implaus
 ) -> None:
     # The documented failure case of current-only backlash: with the tendon wrapped 360 deg
     # around the handle's routing right after the pulley, the knob torque collapses a few
-    # degrees after a reversal while the tip still holds ~20 deg.
+    # degrees after a reversal while the tip still holds ~16 deg.
     routed = {"knobs": [{"routing_wrap_deg": 360.0}, {"routing_wrap_deg": 360.0}]}
     report, ratios, _ = _one_point_cross_check(routed)
     assert len(ratios) == 4
-    assert all(r < 0.6 for r in ratios.values()), ratios  # measured 0.41-0.45
+    assert all(r < 0.7 for r in ratios.values()), ratios  # measured 0.57-0.62 (steel tendon)
     assert len(report.warnings) == 4
     assert all("the current settles before the tip moves" in w for w in report.warnings)
 

@@ -21,8 +21,12 @@ def sweep(plant: Any, freq_hz: float = 0.04, cycles: float = 1.5, other_deg: flo
 
 
 def measured(**params: Any) -> DeadZoneBacklash:
+    """D and B of a conditioned plant: one cycle first, so the first release is not the virgin
+    one (a tension-free plant rests higher after it, docs/plant.md)."""
     other = params.pop("other_deg", 0.0)
-    q, tip, _ = sweep(make_tendon_sheath_plant(**params), other_deg=other)
+    plant = make_tendon_sheath_plant(**params)
+    sweep(plant, cycles=1.0, other_deg=other)
+    q, tip, _ = sweep(plant, other_deg=other)
     return measure_dead_zone_backlash(q, tip)
 
 

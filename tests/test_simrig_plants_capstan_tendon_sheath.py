@@ -9,6 +9,7 @@ import pytest
 from numpy.typing import NDArray
 
 from simrig.analysis import loaded_slope, measure_dead_zone_backlash
+from simrig.family import family_member
 from simrig.plant import Plant, load_plant
 from simrig.plants.capstan import tendon_sheath
 from simrig.plants.capstan.tendon_sheath import TendonSheathPlant, make_tendon_sheath_plant
@@ -43,15 +44,15 @@ def test_straight_and_unloaded_at_rest() -> None:
 
 def test_sweep_shows_a_dead_zone_on_both_sides(default_sweep: SweepRecord) -> None:
     m = measure_dead_zone_backlash(default_sweep.knob_deg, default_sweep.tip_deg)
-    assert 15.0 <= m.dead_zone_pos_deg <= 25.0
-    assert -25.0 <= m.dead_zone_neg_deg <= -15.0
+    assert 15.0 <= m.dead_zone_pos_deg <= 30.0
+    assert -30.0 <= m.dead_zone_neg_deg <= -15.0
 
 
 def test_sweep_shows_backlash_after_both_reversals(default_sweep: SweepRecord) -> None:
     """The tip holds for tens of degrees after each reversal, about equally on both sides."""
     m = measure_dead_zone_backlash(default_sweep.knob_deg, default_sweep.tip_deg)
-    assert 15.0 <= m.backlash_pos_deg <= 30.0
-    assert 15.0 <= m.backlash_neg_deg <= 30.0
+    assert 12.0 <= m.backlash_pos_deg <= 30.0
+    assert 12.0 <= m.backlash_neg_deg <= 30.0
     assert abs(m.backlash_pos_deg - m.backlash_neg_deg) < 3.0
 
 
@@ -83,9 +84,12 @@ def backlash_end_corner_deg(s: SweepRecord) -> float:
 def test_backlash_end_is_rounded_by_the_bending_joints(knob: int) -> None:
     """The joints give way one after another, so the tip speeds up over a stretch of knob travel
     instead of snapping onto the releasing line; without joint friction it is a kink. (With the
-    stiff nominal tendon the corner is narrow, ~0.6 deg: docs/plant.md.)"""
-    nominal = run_sweep(make_tendon_sheath_plant(), knob)
-    frictionless = run_sweep(make_tendon_sheath_plant(knobs=[{"bend_friction_Nm": 0.0}] * 2), knob)
+    steel tendon of the nominal unit the corner shrinks to a kink either way, so this is measured
+    on the compliant-tendon variant, where it spans ~0.5 deg: docs/plant.md.)"""
+    compliant = family_member("capstan", 0, "compliant-tendon").params["knobs"]
+    nominal = run_sweep(make_tendon_sheath_plant(knobs=compliant), knob)
+    no_joint_friction = [{**k, "bend_friction_Nm": 0.0} for k in compliant]
+    frictionless = run_sweep(make_tendon_sheath_plant(knobs=no_joint_friction), knob)
     assert backlash_end_corner_deg(nominal) > 0.4
     assert backlash_end_corner_deg(frictionless) < 0.2
 
@@ -111,8 +115,8 @@ def test_torque_rises_once_the_tendon_engages(default_sweep: SweepRecord) -> Non
     assert np.corrcoef(q, tau)[0, 1] > 0.99
 
 
-def test_knob_torque_is_of_order_0_05_to_0_3_Nm(default_sweep: SweepRecord) -> None:
-    assert 0.05 <= np.max(np.abs(default_sweep.torque_Nm)) <= 0.3
+def test_knob_torque_is_of_order_0_05_to_0_6_Nm(default_sweep: SweepRecord) -> None:
+    assert 0.05 <= np.max(np.abs(default_sweep.torque_Nm)) <= 0.6
 
 
 def release_after_reversal(s: SweepRecord) -> tuple[FloatArray, FloatArray, float, float]:
@@ -142,10 +146,10 @@ def test_torque_decays_through_the_backlash_then_stays_near_zero(
     q, tau, level, backlash = release_after_reversal(s)
     swing = peak - level
     assert tau[0] > 0.8 * peak
-    assert np.interp(87.0, q[::-1], tau[::-1]) - level > 0.25 * swing  # 3 deg on: far from done
+    assert np.interp(87.0, q[::-1], tau[::-1]) - level > 0.15 * swing  # 3 deg on: far from done
     assert np.interp(90.0 - backlash / 2, q[::-1], tau[::-1]) - level > 0.05 * swing
     settled = settled_after_deg(q, tau, level, 0.02 * peak)
-    assert 0.7 * backlash < settled < backlash + 2.0
+    assert 0.5 * backlash < settled < backlash + 2.0
     released = (q < 90.0 - backlash - 2.0) & (q > 30.0)
     assert np.max(np.abs(tau[released])) < 0.1 * peak
     assert abs(level) < 0.06 * peak
@@ -158,7 +162,7 @@ def test_a_routed_handle_drops_the_torque_within_a_few_degrees(knob: int) -> Non
     s = run_sweep(make_tendon_sheath_plant(knobs=[{"routing_wrap_deg": 360.0}] * 2), knob)
     peak = float(np.max(s.torque_Nm))
     q, tau, level, backlash = release_after_reversal(s)
-    assert backlash > 20.0
+    assert backlash > 12.0
     assert np.interp(87.0, q[::-1], tau[::-1]) - level < 0.05 * (peak - level)
     assert settled_after_deg(q, tau, level, 0.02 * peak) < 5.0
 
@@ -199,7 +203,7 @@ def test_random_two_knob_motion_keeps_tendons_pulling_and_the_tip_bounded(seed: 
         step = plant.step(DT_S, qi)
         assert np.all(plant.tendon_tension_N() >= 0.0)
         assert np.all(np.abs(step.tip_deg) < 150.0)
-        assert np.all(np.abs(step.knob_torque_Nm) < 1.0)
+        assert np.all(np.abs(step.knob_torque_Nm) < 2.0)
 
 
 def test_bad_step_input_is_refused() -> None:

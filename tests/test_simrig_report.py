@@ -36,7 +36,7 @@ def test_report_says_where_the_torque_settles_after_a_reversal() -> None:
         run_sweep(make_tendon_sheath_plant(knobs=[{"routing_wrap_deg": 360.0}, {}]), 0)
     )
     assert straight.torque_settled_deg > 0.7 * straight.dz_bl.backlash_pos_deg
-    assert routed.torque_settled_deg < 6.0 < 20.0 < routed.dz_bl.backlash_pos_deg
+    assert routed.torque_settled_deg < 0.3 * routed.dz_bl.backlash_pos_deg
 
 
 def test_report_routing_study_prints_each_wrap_and_writes_the_figure(

@@ -17,17 +17,19 @@ class KnobParams:
     """Mechanical constants of one knob's tendon pair (units in the names)."""
 
     pulley_radius_mm: float = 6.0
-    slack_pos_mm: float = 2.0
+    slack_pos_mm: float = 2.4
     """Slack of the tendon pulled by positive knob rotation."""
-    slack_neg_mm: float = 2.15
-    tendon_offset_mm: float = 2.47
+    slack_neg_mm: float = 2.58
+    tendon_offset_mm: float = 3.46
     """Moment arm of the tendons in the bending section."""
-    tendon_stiffness_N: float = 6000.0
-    """Axial stiffness EA of the tendon."""
+    tendon_stiffness_N: float = 12000.0
+    """Axial stiffness EA of the tendon (a steel wire of about 0.3 mm; with a compliant tendon,
+    e.g. 6000 N, stretch takes a larger share of the draw-in while loading than while releasing
+    and the tip releases steeper than it loads, unlike the real TEE probe: docs/plant.md)."""
     sheath_length_m: float = 1.0
     free_length_m: float = 0.01
     """Tendon length between pulley and sheath entry (no friction)."""
-    sheath_friction: float = 0.25
+    sheath_friction: float = 0.35
     """Coulomb friction coefficient tendon/sheath."""
     sheath_wrap_deg: float = 480.0
     """Total wrap angle of the tendon in the (straight) sheath: coil helix and lumen contact."""
@@ -88,7 +90,7 @@ class KnobParams:
 # The anterior-posterior and right-left knobs of one catheter differ slightly.
 DEFAULT_KNOBS = (
     KnobParams(),
-    KnobParams(slack_pos_mm=2.15, slack_neg_mm=1.95, sheath_wrap_deg=450.0, tendon_offset_mm=2.43),
+    KnobParams(slack_pos_mm=2.58, slack_neg_mm=2.34, sheath_wrap_deg=450.0, tendon_offset_mm=3.40),
 )
 
 

@@ -46,10 +46,12 @@ REVERSAL_DEADBAND_DEG = 0.1
 """A desired angle that turns back by less than this is held: an exact inverse would make the
 motor cross the whole backlash for every jitter of the operator's input (error <= this)."""
 DWELL_S = 0.4
-"""A desired angle standing still (within :data:`REVERSAL_DEADBAND_DEG`) this long is a dwell:
+"""A desired angle standing still (within :data:`REVERSAL_DEADBAND_DEG`) this long after the
+command arrived is a dwell:
 the knob moves to the middle of the play that holds the tip there (the tip does not move), so
 the next move, whichever way it goes, crosses half the play instead of all of it (a causal
 feed-forward cannot know the direction: the middle halves the worse case)."""
+_SETTLED_DEG = 1e-3
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
 
@@ -208,7 +210,9 @@ class OursCompensator:
 
     def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
         if -REVERSAL_DEADBAND_DEG < q_raw - kc.still_q < REVERSAL_DEADBAND_DEG:
-            kc.still_s += self.period_s
+            # the dwell counts once the sent command has arrived (the tip got there first)
+            if abs(kc.sum / self._n_avg - kc.out) < _SETTLED_DEG:
+                kc.still_s += self.period_s
             if kc.still_s >= DWELL_S:
                 self._centre(kc, b)
                 return
@@ -270,16 +274,17 @@ class OursCompensator:
         # moving on in direction d: the inverse ahead is the branch's inverse, never behind x
         ys = b.rising_deg if d > 0 else b.falling_deg
         horizon_s = 30.0 / self.v_max  # half the crossing time of a 60 deg jump
-        expected_per_s = speed / kc.omega
-        # a desired angle speeding up (the start of a move) gets there sooner than v says
+        # a desired angle speeding up (the start of a move) gets there sooner than v says; no
+        # faster than the knob itself can speed up (beyond that it is a step, not a motion)
         accel = kc.accel if kc.accel * v > 0.0 else 0.0
+        accel = min(max(accel, -self.a_max), self.a_max)
         ahead = x
         for _ in range(2):
-            ahead = interp_linear(target + (v + 0.5 * accel * horizon_s) * horizon_s, ys,
-                                  b.knots)
+            travel = (v + 0.5 * accel * horizon_s) * horizon_s
+            ahead = interp_linear(target + travel, ys, b.knots)
             if (ahead - x) * d < 0.0:
                 ahead = x
-            expected = expected_per_s * horizon_s
+            expected = abs(travel) / kc.omega  # the knob moves that much on a loaded line
             jump = (ahead - x) * d - expected
             if jump <= expected + _JUMP_MIN_DEG:
                 return x

@@ -105,8 +105,8 @@ class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
     __slots__ = ("accel", "ahead_s", "hold", "jump_deg", "lim", "limits", "omega", "out",
-                 "q_dir", "q_prev", "state", "still_q", "still_s", "sum", "target", "v",
-                 "window")
+                 "q_dir", "q_prev", "q_raw", "state", "still_q", "still_s", "sum", "target", "v",
+                 "v_raw", "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
@@ -121,6 +121,8 @@ class _KnobCommand:
         self.q_dir = state.direction
         self.v = 0.0
         self.accel = 0.0
+        self.q_raw = q_deg
+        self.v_raw = 0.0
         self.target = q_deg
         self.out = state.x_deg
         self.hold = 0
@@ -231,8 +233,17 @@ class OursCompensator:
         v = 0.7 * kc.v + 0.3 * dq / self.period_s
         if abs(dq) > kc.jump_deg:  # a step, not a motion: nothing to predict from it
             v = 0.0
-        kc.accel = 0.8 * kc.accel + 0.2 * (v - kc.v) / self.period_s
         kc.v = v
+        # the acceleration from the desired angle itself: the jitter deadband above releases
+        # a held input in one step, which is no acceleration of the operator's hand
+        dq_raw = q_raw - kc.q_raw
+        kc.q_raw = q_raw
+        if abs(dq_raw) > kc.jump_deg:
+            kc.v_raw = kc.accel = 0.0
+        else:
+            v_raw = 0.7 * kc.v_raw + 0.3 * dq_raw / self.period_s
+            kc.accel = 0.8 * kc.accel + 0.2 * (v_raw - kc.v_raw) / self.period_s
+            kc.v_raw = v_raw
         lead = kc.ahead_s * v
         lead = -_MAX_LEAD_DEG if lead < -_MAX_LEAD_DEG else min(lead, _MAX_LEAD_DEG)
         target = qi + lead
@@ -255,8 +266,7 @@ class OursCompensator:
         x = 0.5 * (interp_linear(y, b.falling_deg, b.knots)
                    + interp_linear(y, b.rising_deg, b.knots))
         kc.state = PlayState(x, y, state.direction, y)
-        kc.v = 0.0
-        kc.accel = 0.0
+        kc.v = kc.v_raw = kc.accel = 0.0
         kc.hold = 0
         kc.out = x
 

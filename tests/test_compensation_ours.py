@@ -235,6 +235,14 @@ def test_dwell_moves_the_knob_to_the_middle_of_the_play_without_moving_the_tip()
     assert model_step(arrived, middle, b).y_deg == pytest.approx(50.0)
 
 
+def test_at_rest_on_a_plateau_the_knob_is_never_moved_on_its_own() -> None:
+    q = np.zeros((1500, 2))
+    q[100:400, 0] = 30.0  # out and back home: the tip rests on its plateau (H in [-3, 4])
+    q[400:, 0] = 1.0
+    cmd = run(compensator(), q)
+    assert np.ptp(cmd[900:, 0]) == 0.0
+
+
 def test_after_a_dwell_a_move_either_way_crosses_half_the_play() -> None:
     b = knob_branches(params())
     play_deg = b.rising_inverse(50.0) - b.falling_inverse(50.0)

@@ -47,11 +47,12 @@ REVERSAL_DEADBAND_DEG = 0.1
 motor cross the whole backlash for every jitter of the operator's input (error <= this)."""
 DWELL_S = 0.4
 """A desired angle standing still (within :data:`REVERSAL_DEADBAND_DEG`) this long after the
-command arrived is a dwell:
+command arrived, off the plateaus, is a dwell:
 the knob moves to the middle of the play that holds the tip there (the tip does not move), so
 the next move, whichever way it goes, crosses half the play instead of all of it (a causal
 feed-forward cannot know the direction: the middle halves the worse case)."""
 _SETTLED_DEG = 1e-3
+_PLATEAU_MARGIN_DEG = 1.0
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
 
@@ -105,14 +106,15 @@ class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
     __slots__ = ("accel", "ahead_s", "hold", "jump_deg", "lim", "limits", "omega", "out",
-                 "q_dir", "q_prev", "q_raw", "state", "still_q", "still_s", "sum", "target", "v",
-                 "v_raw", "window")
+                 "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "state",
+                 "still_q", "still_s", "sum", "target", "v", "v_raw", "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
         self.ahead_s = 0.0
         self.jump_deg = 0.0
         self.omega = 1.0
+        self.plateau_lo_deg = self.plateau_hi_deg = 0.0
         self.reset(PlayState(0.0, 0.0, 1, 0.0), 0.0, 1)
 
     def reset(self, state: PlayState, q_deg: float, n_avg: int) -> None:
@@ -173,6 +175,8 @@ class OursCompensator:
             kc.ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
             kc.jump_deg = jump_deg
             kc.omega = knob.omega
+            kc.plateau_lo_deg = min(knob.height_pos_deg, knob.height_neg_deg)
+            kc.plateau_hi_deg = max(knob.height_pos_deg, knob.height_neg_deg)
 
     def replace_knobs(self, knobs: tuple[OursKnob, OursKnob]) -> None:
         """New parameters from the next tick on, state kept (online re-estimation)."""
@@ -215,8 +219,7 @@ class OursCompensator:
             # the dwell counts once the sent command has arrived (the tip got there first)
             if abs(kc.sum / self._n_avg - kc.out) < _SETTLED_DEG:
                 kc.still_s += self.period_s
-            if kc.still_s >= DWELL_S:
-                self._centre(kc, b)
+            if kc.still_s >= DWELL_S and self._centre(kc, b):
                 return
         else:
             kc.still_q = q_raw
@@ -258,17 +261,21 @@ class OursCompensator:
         kc.state = state
         kc.out = self._early_jump(kc, state, target, v, b)
 
-    def _centre(self, kc: _KnobCommand, b: Branches) -> None:
+    def _centre(self, kc: _KnobCommand, b: Branches) -> bool:
         """During a dwell: the knob to the middle of the play holding the model's output (the
-        other knob may move the branches: recomputed every tick)."""
+        other knob may move the branches: recomputed every tick). Not at rest on a plateau
+        (both tendons slack, the catheter at home): there the knob is never moved on its own."""
         state = kc.state
         y = state.y_deg
+        if kc.plateau_lo_deg - _PLATEAU_MARGIN_DEG <= y <= kc.plateau_hi_deg + _PLATEAU_MARGIN_DEG:
+            return False
         x = 0.5 * (interp_linear(y, b.falling_deg, b.knots)
                    + interp_linear(y, b.rising_deg, b.knots))
         kc.state = PlayState(x, y, state.direction, y)
         kc.v = kc.v_raw = kc.accel = 0.0
         kc.hold = 0
         kc.out = x
+        return True
 
     def _early_jump(self, kc: _KnobCommand, state: PlayState, target: float, v: float,
                     b: Branches) -> float:

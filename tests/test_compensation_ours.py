@@ -218,7 +218,41 @@ def test_large_step_is_reached_within_the_limits() -> None:
     cmd = run(compensator(), q)
     assert_within_limits(cmd)
     b = knob_branches(params())
-    assert cmd[-1, 0] == pytest.approx(min(b.rising_inverse(80.0), 90.0), abs=1e-6)
+    assert cmd[:, 0].max() == pytest.approx(min(b.rising_inverse(80.0), 90.0), abs=0.01)
+
+
+def test_dwell_moves_the_knob_to_the_middle_of_the_play_without_moving_the_tip() -> None:
+    q = np.zeros((1500, 2))
+    q[100:, 0] = 50.0
+    cmd = run(compensator(), q)
+    assert_within_limits(cmd)
+    b = knob_branches(params())
+    loaded = b.rising_inverse(50.0)
+    middle = 0.5 * (b.falling_inverse(50.0) + loaded)
+    assert cmd[:, 0].max() == pytest.approx(loaded, abs=0.01)  # the tip got there first
+    assert cmd[-1, 0] == pytest.approx(middle, abs=1e-6)
+    arrived = model_step(PlayState(0.0, b.rising(0.0), 1, b.rising(0.0)), loaded, b)
+    assert model_step(arrived, middle, b).y_deg == pytest.approx(50.0)
+
+
+def test_at_rest_on_a_plateau_the_knob_is_never_moved_on_its_own() -> None:
+    q = np.zeros((1500, 2))
+    q[100:400, 0] = 30.0  # out and back home: the tip rests on its plateau (H in [-3, 4])
+    q[400:, 0] = 1.0
+    cmd = run(compensator(), q)
+    assert np.ptp(cmd[600:, 0]) == 0.0  # arrived by tick 600, a dwell would move it after
+
+
+def test_after_a_dwell_a_move_either_way_crosses_half_the_play() -> None:
+    b = knob_branches(params())
+    play_deg = b.rising_inverse(50.0) - b.falling_inverse(50.0)
+    for sign in (1, -1):
+        q = np.zeros((1800, 2))
+        q[100:, 0] = 50.0
+        q[1500:, 0] = 50.0 + sign * 2.0  # a small step after the dwell
+        cmd = run(compensator(), q)
+        before, after = cmd[1499, 0], cmd[-1, 0]
+        assert abs(after - before) <= 0.5 * play_deg + 2.0 / params().omega + 1e-6
 
 
 def test_dead_zone_jump_starts_before_the_desired_angle_reaches_the_plateau() -> None:
@@ -245,7 +279,9 @@ def test_parameters_follow_the_other_knobs_command() -> None:
     q[:, 1] = np.linspace(0.0, -80.0, 500)  # the other knob goes below -60 deg
     cmd = run(comp, q)
     assert cmd[-1, 1] < -60.0
-    assert cmd[-1, 0] == pytest.approx(knob_branches(far).rising_inverse(20.0), abs=0.05)
+    b_far = knob_branches(far)  # standing at 20 deg: a dwell, in the middle of far's play
+    middle = 0.5 * (b_far.rising_inverse(20.0) + b_far.falling_inverse(20.0))
+    assert cmd[-1, 0] == pytest.approx(middle, abs=0.05)
     assert cmd[0, 0] == pytest.approx(knob_branches(near).rising_inverse(20.0), abs=0.05)
 
 
@@ -273,12 +309,13 @@ def test_moving_the_edges_moves_the_whole_characteristic_along_the_knob(
 
 
 def test_replaced_knobs_act_from_the_next_tick_and_keep_the_state() -> None:
-    comp = compensator()
-    comp.reset(np.array([40.0, 0.0]))
-    before = comp.command(np.array([40.0, 0.0]))
+    comp, kept = compensator(), compensator()
+    for c in (comp, kept):
+        c.reset(np.array([40.0, 0.0]))
+        c.command(np.array([40.0, 0.0]))
     comp.replace_knobs(tuple(shifted(k, 3.0) for k in comp.knobs))  # type: ignore[arg-type]
-    cmd = run_on(comp, np.tile([40.0, 0.0], (300, 1)))
-    assert cmd[-1, 0] == pytest.approx(before[0] + 3.0, abs=1e-4)
+    q = np.tile([40.0, 0.0], (300, 1))
+    assert run_on(comp, q)[-1, 0] == pytest.approx(run_on(kept, q)[-1, 0] + 3.0, abs=1e-4)
 
 
 def run_on(comp: OursCompensator, q: np.ndarray) -> np.ndarray:

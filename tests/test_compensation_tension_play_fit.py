@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from support.profiles import make_profile
+from support.profiles import DEVICE, make_profile
 
 from tsmd.calibration.tension_play_fit import (
     SweepCurrent,
@@ -17,6 +17,7 @@ from tsmd.calibration.tension_play_fit import (
     fit_tension_play,
     friction_current_A,
     median_of_three,
+    unit_omega,
 )
 from tsmd.compensation import CompensationError, build_compensator
 from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
@@ -25,6 +26,9 @@ from tsmd.profile import (
     KnobLimits,
     ProfileError,
     ReferencePoint,
+    device_model_from_mapping,
+    device_model_to_mapping,
+    load_device_model,
     load_profile,
     profile_to_mapping,
     save_profile,
@@ -96,6 +100,45 @@ def test_plateau_heights_are_product_constants_with_the_data_sheet_units_edges()
     p = fit_tension_play([synthetic_sweep(g) for g in (-90.0, 90.0)], knob)
     assert p.height_pos_deg == pytest.approx(100.0 - 1.5 * (90.0 - 25.0))
     assert p.height_neg_deg == pytest.approx(-100.0 + 1.5 * (90.0 - 25.0))
+
+
+def test_unit_omega_is_the_products_release_slope_times_the_units_stretch_share() -> None:
+    # omega_sheet / (1 - beta_sheet) is the product's; the unit keeps 1 - beta of it
+    assert unit_omega(1.5, 0.3, 0.2) == pytest.approx(1.5 / 0.7 * 0.8)
+    assert unit_omega(1.5, 0.3, 0.3) == pytest.approx(1.5)
+
+
+def test_without_the_sheets_backlash_gain_omega_is_the_sheets() -> None:
+    p = fit_tension_play([synthetic_sweep(g) for g in (-90.0, 0.0, 90.0)], DEVICE_KNOB)
+    assert p.omega == 1.5
+    assert unit_omega(1.5, None, 0.6) == 1.5
+
+
+def test_fitted_omega_follows_the_units_backlash_gain_at_the_other_knobs_zero() -> None:
+    knob = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.2)
+    grid = (-90.0, 0.0, 90.0)
+    p = fit_tension_play([synthetic_sweep(g, backlash_deg=20.0 + 0.1 * g) for g in grid], knob)
+    beta_0 = 0.5 * (p.backlash_gain_pos[1] + p.backlash_gain_neg[1])
+    assert p.omega == pytest.approx(1.5 * (1.0 - beta_0) / 0.8)
+    assert beta_0 == pytest.approx(20.0 / (90.0 - 12.5), rel=0.03)
+
+
+def test_unit_omega_stays_within_the_plausible_slopes() -> None:
+    assert unit_omega(4.0, 0.8, 0.0) == 5.0
+    assert unit_omega(0.3, 0.0, 0.8) == 0.2
+
+
+def test_data_sheets_backlash_gain_round_trips_and_is_range_checked() -> None:
+    data = device_model_to_mapping(load_device_model(DEVICE))
+    data["knobs"]["phi1"]["reference_backlash_gain"] = 0.25
+    data["knobs"]["phi2"].pop("reference_backlash_gain", None)
+    device = device_model_from_mapping(data)
+    assert device.knobs[0].reference_backlash_gain == 0.25
+    assert device.knobs[1].reference_backlash_gain is None  # an older sheet: per-product omega
+    assert device_model_to_mapping(device)["knobs"]["phi1"]["reference_backlash_gain"] == 0.25
+    data["knobs"]["phi1"]["reference_backlash_gain"] = 1.5
+    with pytest.raises(ProfileError, match=r"knobs.phi1.reference_backlash_gain"):
+        device_model_from_mapping(data)
 
 
 def test_sweep_too_small_for_the_dead_zone_is_refused_naming_it() -> None:

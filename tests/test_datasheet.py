@@ -12,9 +12,9 @@ from support.profiles import DEVICE
 
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd.cli import main
-from tsmd.datasheet import CONDITIONING_CYCLES, analysed_from, settle, tip_sweep
+from tsmd.datasheet import CONDITIONING_CYCLES, analysed_from, knob_constants, settle, tip_sweep
 from tsmd.profile import DEFAULT_HANDLE_SLIP_DEG, load_device_model
-from tsmd.recording import Recording, write_recording
+from tsmd.recording import Recording, read_recording, write_recording
 
 PERIOD_S = 0.01
 
@@ -103,3 +103,19 @@ def test_tip_measurements_skip_the_conditioning_cycle() -> None:
     assert after.size * PERIOD_S == pytest.approx(2.25 / 0.04, abs=2 * PERIOD_S)
     assert abs(after[0]) < 0.1 and after[1] > after[0]  # the same start as without conditioning
     assert np.all(qq[skip:, 0] == 30.0)  # the other knob held (reached during the settle move)
+
+
+def test_a_tracked_sweep_gives_the_current_edges_and_backlash_gain(sweep_files: list[Path]
+                                                                   ) -> None:
+    """What method ours needs of the data-sheet unit, by calibration's own current analysis:
+    its edges (product-constant plateaus) and its backlash gain (per-unit omega)."""
+    shipped = load_device_model(DEVICE)
+    for knob, path in enumerate(sweep_files):
+        c = knob_constants(read_recording(path), knob)
+        ref = shipped.knobs[knob]
+        assert c.dead_zone_pos_deg == pytest.approx(ref.reference_dead_zone_pos_deg, abs=2.0)
+        assert c.dead_zone_neg_deg == pytest.approx(ref.reference_dead_zone_neg_deg, abs=2.0)
+        assert c.backlash_gain is not None and 0.05 < c.backlash_gain < 0.5
+        sheet = c.device_knob(ref.limits)
+        assert sheet.reference_backlash_gain == pytest.approx(c.backlash_gain, abs=1e-3)
+        assert sheet.reference_dead_zone_pos_deg == pytest.approx(c.dead_zone_pos_deg, abs=0.01)

@@ -22,6 +22,7 @@ from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
 from tsmd.calibration.identify import identify_sweep
 from tsmd.calibration.signal import Conditioned
+from tsmd.calibration.tension_play_fit import fit_sweep_sides
 from tsmd.compensation.safety import KnobLimits
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.errors import TsmdError
@@ -65,6 +66,14 @@ class KnobConstants:
     handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
     """The handle's design value (bearing and brake), not measured here: the sweep never stops
     the knob, so it cannot show the static friction fading after a restart."""
+    dead_zone_pos_deg: float | None = None
+    """The dead-zone edges the calibration's current analysis finds on this sweep: with them
+    the plateau heights are product constants and each unit's loaded line moves with its own
+    edges (method ours); None: the paper's line through the reference point."""
+    dead_zone_neg_deg: float | None = None
+    backlash_gain: float | None = None
+    """beta of this unit from the sweep's current (calibration's estimator, mean of both
+    sides): method ours scales omega per unit by ``1 - beta`` against it."""
     backlash_settle_fraction: float | None = None
     """Share of the current's swing after a reversal made up when the tip starts back
     (:func:`backlash_settle_fraction`; None: no reversal could be measured)."""
@@ -83,6 +92,12 @@ class KnobConstants:
             reference_backlash_neg_deg=r(self.reference_backlash_neg_deg),
             dead_zone_offset_deg=r(self.dead_zone_offset_deg),
             handle_slip_deg=r(self.handle_slip_deg),
+            reference_dead_zone_pos_deg=(None if self.dead_zone_pos_deg is None
+                                         else r(self.dead_zone_pos_deg)),
+            reference_dead_zone_neg_deg=(None if self.dead_zone_neg_deg is None
+                                         else r(self.dead_zone_neg_deg)),
+            reference_backlash_gain=(None if self.backlash_gain is None
+                                     else round(float(self.backlash_gain), 3)),
             backlash_settle_fraction=(None if self.backlash_settle_fraction is None
                                       else round(float(self.backlash_settle_fraction), 3)))
 
@@ -143,6 +158,15 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
     cur = identify_sweep(t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:])
     dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
                        + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
+    try:
+        sides = fit_sweep_sides(cur.data.pos_deg, cur.data.current_filtered_A,
+                                *(cur.estimate(k) for k in ("dead_zone_pos_deg",
+                                                            "dead_zone_neg_deg",
+                                                            "backlash_pos_deg",
+                                                            "backlash_neg_deg")))
+        gain: float | None = 0.5 * (sides[0].backlash_gain + sides[1].backlash_gain)
+    except ValueError:  # a current without a loaded ramp: the sheet keeps a per-product omega
+        gain = None
     loaded, released = [], []
     for a, b, direction in split_passes(pos):
         x, y = direction * pos[a:b], direction * tip[a:b]  # mirror falling passes
@@ -164,7 +188,13 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         reference_backlash_pos_deg=float(dz.backlash_pos_deg),
         reference_backlash_neg_deg=float(dz.backlash_neg_deg),
         dead_zone_offset_deg=float(dz_offset),
+        dead_zone_pos_deg=_finite_or_none(cur.estimate("dead_zone_pos_deg")),
+        dead_zone_neg_deg=_finite_or_none(cur.estimate("dead_zone_neg_deg")), backlash_gain=gain,
         backlash_settle_fraction=backlash_settle_fraction(cur.data, t, tip))
+
+
+def _finite_or_none(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
 
 
 def backlash_settle_fraction(data: Conditioned, tip_t_s: NDArray[np.float64],

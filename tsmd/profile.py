@@ -96,6 +96,9 @@ class DeviceKnob:
     handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
     """Knob travel over which the handle's static friction fades to kinetic after a restart
     (the online estimator models it; a sheet without it gets the default)."""
+    reference_backlash_gain: float | None = None
+    """Optional: the data-sheet unit's backlash gain beta (mean of both sides) from its own
+    sweep current (other knob at 0): method ours scales omega per unit by ``1 - beta``."""
     backlash_settle_fraction: float | None = None
     """Optional: on the data-sheet unit, the share of its swing after a reversal that the motor
     current has made up when the tip starts back (the end of the backlash). Per product: where
@@ -290,6 +293,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
                      0.0, "deg"),
             r.number(k.get("handle_slip_deg", DEFAULT_HANDLE_SLIP_DEG), key + ".handle_slip_deg",
                      0.01, 45.0, "deg"),
+            optional(k.get("reference_backlash_gain"), "reference_backlash_gain", 0.0, 0.8, ""),
             optional(k.get("backlash_settle_fraction"), "backlash_settle_fraction", 0.5, 1.0,
                      "")))
     desc = m.get("description", "")
@@ -317,6 +321,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         knobs[name]["handle_slip_deg"] = k.handle_slip_deg
+        if k.reference_backlash_gain is not None:
+            knobs[name]["reference_backlash_gain"] = k.reference_backlash_gain
         if k.backlash_settle_fraction is not None:
             knobs[name]["backlash_settle_fraction"] = k.backlash_settle_fraction
     return {"schema_version": device.schema_version, "device_model": device.device_model,

@@ -173,9 +173,10 @@ def main(args: argparse.Namespace) -> int:
             members = [family_member(args.family, u) for u in numbers]
         except (ValueError, PlantLoadError) as exc:
             raise TsmdError(f"--units: {exc}") from None
-        if args.family != "capstan":  # the packaged sheet is the capstan product's
-            print(f"measuring the data sheet on {args.family} unit 0 ...", flush=True)
-            device = data_sheet(family_member(args.family, 0), args.device)
+        # measured on unit 0 for every family (as `tsmd datasheet` would): it then carries
+        # every per-product constant this tsmd uses, whatever the packaged sheet predates
+        print(f"measuring the data sheet on {args.family} unit 0 ...", flush=True)
+        device = data_sheet(family_member(args.family, 0), args.device)
         lines[0] = (f"family plant {args.family} ({PLANT_ROLE[args.family]}); units {numbers}; "
                     f"data sheet from unit 0; start {'fresh' if args.fresh else 'conditioned'}")
         units = [(m.unit, m.build) for m in members]

@@ -8,6 +8,13 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   the turn) fitted by a line and extrapolated to the current that moves the knob the same way
   through the dead zone, where no tendon is loaded (friction and any sensor offset cancel);
 * ``beta = B_A / (A - x0)``: the backlash grows with the load, and the load with ``x - x0``;
+* the loaded slope ``omega``: per unit. The knob travel splits into tip motion and tendon
+  stretch; the stretch per degree of loaded tip motion is what the backlash gives back, so the
+  loaded slope is the release (kinematic) slope times ``1 - beta``. The release slope is a
+  product constant (pulley over moment arm), hence
+  ``omega_unit = omega_sheet (1 - beta_unit) / (1 - beta_sheet)`` with ``beta_sheet`` the
+  data-sheet unit's backlash gain from its own current (``reference_backlash_gain``, same
+  estimator); without it the data sheet's omega;
 * the plateau heights ``H``: product constants, from the data sheet's reference points through
   the edges the current showed on the data-sheet unit (``reference_dead_zone_*_deg``), so that
   each unit's loaded line moves with its own edges (more slack: the tip reaches less at +-90).
@@ -34,7 +41,7 @@ from numpy.typing import NDArray
 
 from tsmd.calibration.lag import estimate_lag_s
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
-from tsmd.compensation.tension_play import BETA_RANGE, TensionPlayParams
+from tsmd.compensation.tension_play import BETA_RANGE, OMEGA_RANGE, TensionPlayParams
 
 FloatArray = NDArray[np.float64]
 RAMP_START_DEG = 10.0
@@ -107,6 +114,35 @@ def fit_side(pos_deg: FloatArray, current_A: FloatArray, sign: int, dead_zone_de
     return SideFit(dead_zone_deg, backlash_deg, amplitude, x0, beta)
 
 
+def fit_sweep_sides(pos_deg: FloatArray, current_A: FloatArray, dead_zone_pos_deg: float,
+                    dead_zone_neg_deg: float, backlash_pos_deg: float, backlash_neg_deg: float
+                    ) -> tuple[SideFit, SideFit]:
+    """Both sides of one sweep (+, -); samples with a non-finite value are dropped. The data
+    sheet's ``reference_backlash_gain`` comes from the same function (one estimator)."""
+    pos = np.asarray(pos_deg, float)
+    cur = np.asarray(current_A, float)
+    ok = np.isfinite(pos) & np.isfinite(cur)
+    pos, cur = pos[ok], cur[ok]
+    fits = []
+    for sign, d, b in ((1, dead_zone_pos_deg, backlash_pos_deg),
+                       (-1, dead_zone_neg_deg, backlash_neg_deg)):
+        zero = friction_current_A(pos, cur, dead_zone_pos_deg, dead_zone_neg_deg, sign)
+        fits.append(fit_side(pos, cur, sign, float(d), float(b), zero))
+    return fits[0], fits[1]
+
+
+def unit_omega(sheet_omega: float, sheet_backlash_gain: float | None, unit_backlash_gain: float
+               ) -> float:
+    """The unit's loaded slope: the product's release slope ``omega_sheet / (1 - beta_sheet)``
+    times the unit's ``1 - beta`` (its own stretch share); the sheet's omega without
+    ``beta_sheet``."""
+    if sheet_backlash_gain is None:
+        return float(sheet_omega)
+    lo, hi = OMEGA_RANGE
+    w = sheet_omega * (1.0 - unit_backlash_gain) / (1.0 - sheet_backlash_gain)
+    return min(max(float(w), lo), hi)
+
+
 def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list[float]:
     """Least-squares polynomial over the grid (degree min(2, n - 2), 0 for n <= 2)."""
     g = np.asarray(grid_deg, float)
@@ -146,19 +182,12 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                   s.backlash_neg_deg)
         if not all(math.isfinite(v) for v in values):
             raise ValueError(f"{where}: no finite D/B from the current: {values}")
-        pos = np.asarray(s.pos_deg, float)
-        cur = np.asarray(s.current_A, float)
-        ok = np.isfinite(pos) & np.isfinite(cur)
-        pos, cur = pos[ok], cur[ok]
-        edge_pos, edge_neg = float(s.dead_zone_pos_deg), float(s.dead_zone_neg_deg)
         try:
-            for sign, fits, d, b in ((1, pos_fits, edge_pos, s.backlash_pos_deg),
-                                     (-1, neg_fits, edge_neg, s.backlash_neg_deg)):
-                zero = friction_current_A(pos, cur, s.dead_zone_pos_deg, s.dead_zone_neg_deg,
-                                          sign)
-                fits.append(fit_side(pos, cur, sign, d, b, zero))
+            fit_pos, fit_neg = fit_sweep_sides(s.pos_deg, s.current_A, *values)
         except ValueError as exc:
             raise ValueError(f"{where}: {exc}") from None
+        pos_fits.append(fit_pos)
+        neg_fits.append(fit_neg)
     d_pos = median_of_three([f.dead_zone_deg for f in pos_fits])
     d_neg = median_of_three([f.dead_zone_deg for f in neg_fits])
     k = device_knob
@@ -172,14 +201,18 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
                                           np.asarray(s.pos_deg, float)) for s in order]))
     lo, hi = BETA_RANGE
+    beta_pos = [min(max(b, lo), hi)
+                for b in smooth_over_grid(grid, [f.backlash_gain for f in pos_fits])]
+    beta_neg = [min(max(b, lo), hi)
+                for b in smooth_over_grid(grid, [f.backlash_gain for f in neg_fits])]
+    # the sheet measured its beta with the other knob at 0: compare the unit there
+    beta_0 = 0.5 * (at_other_knob_zero(grid, beta_pos) + at_other_knob_zero(grid, beta_neg))
+    omega = unit_omega(float(k.omega), getattr(k, "reference_backlash_gain", None), beta_0)
     return TensionPlayParams(
-        omega=float(k.omega), height_pos_deg=float(h_pos), height_neg_deg=float(h_neg),
+        omega=omega, height_pos_deg=float(h_pos), height_neg_deg=float(h_neg),
         other_knob_deg=tuple(grid), dead_zone_pos_deg=tuple(d_pos),
         dead_zone_neg_deg=tuple(d_neg),
-        backlash_gain_pos=tuple(min(max(b, lo), hi) for b in
-                                smooth_over_grid(grid, [f.backlash_gain for f in pos_fits])),
-        backlash_gain_neg=tuple(min(max(b, lo), hi) for b in
-                                smooth_over_grid(grid, [f.backlash_gain for f in neg_fits])),
+        backlash_gain_pos=tuple(beta_pos), backlash_gain_neg=tuple(beta_neg),
         zero_load_pos_deg=tuple(smooth_over_grid(grid, [f.zero_load_deg for f in pos_fits])),
         zero_load_neg_deg=tuple(smooth_over_grid(grid, [f.zero_load_deg for f in neg_fits])),
         lag_s=min(max(lag, 0.0), 1.0))

@@ -45,6 +45,14 @@ TABLE_STEP_DEG = 0.25
 REVERSAL_DEADBAND_DEG = 0.1
 """A desired angle that turns back by less than this is held: an exact inverse would make the
 motor cross the whole backlash for every jitter of the operator's input (error <= this)."""
+DWELL_S = 0.4
+"""A desired angle standing still (within :data:`REVERSAL_DEADBAND_DEG`) this long after the
+command arrived, off the plateaus, is a dwell:
+the knob moves to the middle of the play that holds the tip there (the tip does not move), so
+the next move, whichever way it goes, crosses half the play instead of all of it (a causal
+feed-forward cannot know the direction: the middle halves the worse case)."""
+_SETTLED_DEG = 1e-3
+_PLATEAU_MARGIN_DEG = 1.0
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
 
@@ -97,14 +105,16 @@ class OursKnob:
 class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
-    __slots__ = ("ahead_s", "hold", "jump_deg", "lim", "limits", "omega", "out", "q_dir",
-                 "q_prev", "state", "sum", "target", "v", "window")
+    __slots__ = ("accel", "ahead_s", "hold", "jump_deg", "lim", "limits", "omega", "out",
+                 "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "state",
+                 "still_q", "still_s", "sum", "target", "v", "v_raw", "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
         self.ahead_s = 0.0
         self.jump_deg = 0.0
         self.omega = 1.0
+        self.plateau_lo_deg = self.plateau_hi_deg = 0.0
         self.reset(PlayState(0.0, 0.0, 1, 0.0), 0.0, 1)
 
     def reset(self, state: PlayState, q_deg: float, n_avg: int) -> None:
@@ -112,9 +122,14 @@ class _KnobCommand:
         self.q_prev = q_deg
         self.q_dir = state.direction
         self.v = 0.0
+        self.accel = 0.0
+        self.q_raw = q_deg
+        self.v_raw = 0.0
         self.target = q_deg
         self.out = state.x_deg
         self.hold = 0
+        self.still_q = q_deg
+        self.still_s = 0.0
         x = self.limits.clip(state.x_deg)
         self.lim = LimiterState(x)
         self.window = [x] * n_avg
@@ -160,6 +175,8 @@ class OursCompensator:
             kc.ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
             kc.jump_deg = jump_deg
             kc.omega = knob.omega
+            kc.plateau_lo_deg = min(knob.height_pos_deg, knob.height_neg_deg)
+            kc.plateau_hi_deg = max(knob.height_pos_deg, knob.height_neg_deg)
 
     def replace_knobs(self, knobs: tuple[OursKnob, OursKnob]) -> None:
         """New parameters from the next tick on, state kept (online re-estimation)."""
@@ -198,6 +215,15 @@ class OursCompensator:
         return np.array((out[0] / n, out[1] / n))
 
     def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
+        if -REVERSAL_DEADBAND_DEG < q_raw - kc.still_q < REVERSAL_DEADBAND_DEG:
+            # the dwell counts once the sent command has arrived (the tip got there first)
+            if abs(kc.sum / self._n_avg - kc.out) < _SETTLED_DEG:
+                kc.still_s += self.period_s
+            if kc.still_s >= DWELL_S and self._centre(kc, b):
+                return
+        else:
+            kc.still_q = q_raw
+            kc.still_s = 0.0
         q_prev = kc.q_prev
         qi = q_prev
         if (q_raw - q_prev) * kc.q_dir >= 0.0:
@@ -211,6 +237,16 @@ class OursCompensator:
         if abs(dq) > kc.jump_deg:  # a step, not a motion: nothing to predict from it
             v = 0.0
         kc.v = v
+        # the acceleration from the desired angle itself: the jitter deadband above releases
+        # a held input in one step, which is no acceleration of the operator's hand
+        dq_raw = q_raw - kc.q_raw
+        kc.q_raw = q_raw
+        if abs(dq_raw) > kc.jump_deg:
+            kc.v_raw = kc.accel = 0.0
+        else:
+            v_raw = 0.7 * kc.v_raw + 0.3 * dq_raw / self.period_s
+            kc.accel = 0.8 * kc.accel + 0.2 * (v_raw - kc.v_raw) / self.period_s
+            kc.v_raw = v_raw
         lead = kc.ahead_s * v
         lead = -_MAX_LEAD_DEG if lead < -_MAX_LEAD_DEG else min(lead, _MAX_LEAD_DEG)
         target = qi + lead
@@ -224,6 +260,22 @@ class OursCompensator:
         state = inverse_step(state, target, b)
         kc.state = state
         kc.out = self._early_jump(kc, state, target, v, b)
+
+    def _centre(self, kc: _KnobCommand, b: Branches) -> bool:
+        """During a dwell: the knob to the middle of the play holding the model's output (the
+        other knob may move the branches: recomputed every tick). Not at rest on a plateau
+        (both tendons slack, the catheter at home): there the knob is never moved on its own."""
+        state = kc.state
+        y = state.y_deg
+        if kc.plateau_lo_deg - _PLATEAU_MARGIN_DEG <= y <= kc.plateau_hi_deg + _PLATEAU_MARGIN_DEG:
+            return False
+        x = 0.5 * (interp_linear(y, b.falling_deg, b.knots)
+                   + interp_linear(y, b.rising_deg, b.knots))
+        kc.state = PlayState(x, y, state.direction, y)
+        kc.v = kc.v_raw = kc.accel = 0.0
+        kc.hold = 0
+        kc.out = x
+        return True
 
     def _early_jump(self, kc: _KnobCommand, state: PlayState, target: float, v: float,
                     b: Branches) -> float:
@@ -239,13 +291,17 @@ class OursCompensator:
         # moving on in direction d: the inverse ahead is the branch's inverse, never behind x
         ys = b.rising_deg if d > 0 else b.falling_deg
         horizon_s = 30.0 / self.v_max  # half the crossing time of a 60 deg jump
-        expected_per_s = speed / kc.omega
+        # a desired angle speeding up (the start of a move) gets there sooner than v says; no
+        # faster than the knob itself can speed up (beyond that it is a step, not a motion)
+        accel = kc.accel if kc.accel * v > 0.0 else 0.0
+        accel = min(max(accel, -self.a_max), self.a_max)
         ahead = x
         for _ in range(2):
-            ahead = interp_linear(target + v * horizon_s, ys, b.knots)
+            travel = (v + 0.5 * accel * horizon_s) * horizon_s
+            ahead = interp_linear(target + travel, ys, b.knots)
             if (ahead - x) * d < 0.0:
                 ahead = x
-            expected = expected_per_s * horizon_s
+            expected = abs(travel) / kc.omega  # the knob moves that much on a loaded line
             jump = (ahead - x) * d - expected
             if jump <= expected + _JUMP_MIN_DEG:
                 return x

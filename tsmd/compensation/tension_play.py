@@ -32,6 +32,8 @@ from numpy.typing import NDArray
 
 BETA_RANGE: tuple[float, float] = (0.0, 0.8)
 """Backlash per knob degree of load: 0 = no backlash; 0.8 = release slope 5 omega."""
+OMEGA_RANGE: tuple[float, float] = (0.2, 5.0)
+"""Plausible loaded tip/knob slopes (tip deg per knob deg)."""
 _FLAT_SLOPE = 1e-6  # makes the envelopes strictly increasing so that they can be inverted
 _FAR_DEG = 1000.0
 
@@ -72,7 +74,7 @@ _ROWS: dict[str, tuple[float, float]] = {
     "zero_load_pos_deg": (-90.0, 90.0), "zero_load_neg_deg": (-90.0, 90.0),
 }
 _SCALARS: dict[str, tuple[float, float]] = {
-    "omega": (0.2, 5.0), "height_pos_deg": (-90.0, 90.0), "height_neg_deg": (-90.0, 90.0),
+    "omega": OMEGA_RANGE, "height_pos_deg": (-90.0, 90.0), "height_neg_deg": (-90.0, 90.0),
     "lag_s": (0.0, 1.0),
 }
 

@@ -321,3 +321,25 @@ def test_replaced_knobs_act_from_the_next_tick_and_keep_the_state() -> None:
 def run_on(comp: OursCompensator, q: np.ndarray) -> np.ndarray:
     """Commands for ``q`` from the compensator's present state (no reset)."""
     return np.array([comp.command(row) for row in q])
+
+
+def _accelerating_ramp(hold_ticks: int) -> np.ndarray:
+    """Both knobs speeding up from rest (a = 200 deg/s^2) for 0.4 s, each value held for
+    ``hold_ticks`` loop ticks (1: a trajectory played in the loop; 5: a client setting at 50 Hz)."""
+    held = (np.arange(100) // hold_ticks) * hold_ticks * PERIOD_S
+    q = 0.5 * 200.0 * held ** 2
+    return np.column_stack([q, q])
+
+
+def test_the_look_ahead_reads_acceleration_from_a_per_tick_trajectory() -> None:
+    comp = compensator()
+    run(comp, _accelerating_ramp(1))
+    assert all(k.accel > 50.0 for k in comp._k)
+
+
+def test_a_setpoint_stream_slower_than_the_loop_gives_no_acceleration_look_ahead() -> None:
+    """A staircase's per-tick differences are no motion: the daemon's 50 Hz demo tracked at
+    11.4 deg RMSE when they were read as acceleration (3.0 deg without)."""
+    comp = compensator()
+    run(comp, _accelerating_ramp(5))
+    assert all(k.accel == 0.0 for k in comp._k)

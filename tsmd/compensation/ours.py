@@ -105,7 +105,7 @@ class OursKnob:
 class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
-    __slots__ = ("accel", "ahead_s", "hold", "jump_deg", "lim", "limits", "omega", "out",
+    __slots__ = ("accel", "ahead_s", "held_s", "hold", "jump_deg", "lim", "limits", "omega", "out",
                  "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "state",
                  "still_q", "still_s", "sum", "target", "v", "v_raw", "window")
 
@@ -125,6 +125,7 @@ class _KnobCommand:
         self.accel = 0.0
         self.q_raw = q_deg
         self.v_raw = 0.0
+        self.held_s = 0.0
         self.target = q_deg
         self.out = state.x_deg
         self.hold = 0
@@ -237,16 +238,25 @@ class OursCompensator:
         if abs(dq) > kc.jump_deg:  # a step, not a motion: nothing to predict from it
             v = 0.0
         kc.v = v
-        # the acceleration from the desired angle itself: the jitter deadband above releases
-        # a held input in one step, which is no acceleration of the operator's hand
+        # The acceleration from the desired angle itself (the jitter deadband above releases a
+        # held input in one step, which is no acceleration of the operator's hand), only from a
+        # desired angle that changes every tick (a trajectory played in the loop). A client
+        # that sets 50 times a second holds each value for several ticks with its own timing
+        # jitter: the velocity of that staircase is readable, its acceleration is not (the
+        # daemon's demo: RMSE 11.4 / 6.8 deg with it, 3.0 / 3.0 without).
         dq_raw = q_raw - kc.q_raw
-        kc.q_raw = q_raw
-        if abs(dq_raw) > kc.jump_deg:
-            kc.v_raw = kc.accel = 0.0
-        else:
-            v_raw = 0.7 * kc.v_raw + 0.3 * dq_raw / self.period_s
-            kc.accel = 0.8 * kc.accel + 0.2 * (v_raw - kc.v_raw) / self.period_s
-            kc.v_raw = v_raw
+        kc.held_s += self.period_s
+        if dq_raw != 0.0:
+            kc.q_raw = q_raw
+            if abs(dq_raw) > kc.jump_deg or kc.held_s > 1.5 * self.period_s:
+                kc.v_raw = kc.accel = 0.0  # a step, a staircase, or a start after a pause
+            else:
+                v_raw = 0.7 * kc.v_raw + 0.3 * dq_raw / self.period_s
+                kc.accel = 0.8 * kc.accel + 0.2 * (v_raw - kc.v_raw) / self.period_s
+                kc.v_raw = v_raw
+            kc.held_s = 0.0
+        elif kc.held_s > 1.5 * self.period_s:
+            kc.accel = 0.0
         lead = kc.ahead_s * v
         lead = -_MAX_LEAD_DEG if lead < -_MAX_LEAD_DEG else min(lead, _MAX_LEAD_DEG)
         target = qi + lead

@@ -256,7 +256,7 @@ class OursCompensator:
                 kc.v_raw = v_raw
             kc.held_s = 0.0
         elif kc.held_s > 1.5 * self.period_s:
-            kc.accel = 0.0
+            kc.v_raw = kc.accel = 0.0  # standing: the next move starts from rest
         lead = kc.ahead_s * v
         lead = -_MAX_LEAD_DEG if lead < -_MAX_LEAD_DEG else min(lead, _MAX_LEAD_DEG)
         target = qi + lead

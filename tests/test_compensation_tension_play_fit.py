@@ -20,10 +20,10 @@ from tsmd.calibration.tension_play_fit import (
     unit_omega,
 )
 from tsmd.compensation import CompensationError, build_compensator
+from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
 from tsmd.profile import (
     DeviceKnob,
-    KnobLimits,
     ProfileError,
     ReferencePoint,
     device_model_from_mapping,

@@ -1,165 +1,36 @@
-"""Per-catheter profiles and device models (YAML, versioned schema).
-
-A *device model* holds the data-sheet constants of a catheter type (slope omega, the reference
-points of design assumption 1, knob limits). A *profile* holds what calibration identified for one
-catheter: per knob the dead zone and backlash grids over the other knob's angle, H, the
-interpolation method, the tension play's parameters (method ``ours``) and the quality figures.
-A knob's ``ours`` block written by tsmd before the tension play is read past with a warning:
-its constants came from a data sheet measured on the scored unit; method ``ours`` then asks
-for a recalibration.
-
-Loading validates everything and raises :class:`ProfileError` naming the file, the key and the
-reason. Saving is atomic and keeps the previous profile as ``<file>.bak``.
-"""
+"""Profiles and data sheets to and from plain mappings (the YAML documents), validated: every
+defect is one :class:`ProfileError` naming the origin, the key path and the reason."""
 
 from __future__ import annotations
 
-import contextlib
 import itertools
 import logging
 import math
-import os
-import re
-import shutil
-import tempfile
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
-from tsmd.compensation.grid import CALIBRATION_GRID_DEG, INTERPOLATION_METHODS
-from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
+from tsmd.compensation.grid import INTERPOLATION_METHODS
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import (
-    TensionPlayParams,
-    tension_play_from_mapping,
-    tension_play_to_mapping,
+from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
+from tsmd.profile.types import (
+    ANGLE_RANGE_DEG,
+    DEFAULT_HANDLE_SLIP_DEG,
+    DEVICE_SCHEMA_VERSION,
+    ID_PATTERN,
+    KNOB_NAMES,
+    OMEGA_RANGE,
+    PROFILE_SCHEMA_VERSION,
+    CatheterProfile,
+    DeviceKnob,
+    DeviceModel,
+    KnobProfile,
+    ProfileError,
+    ReferencePoint,
 )
-from tsmd.errors import TsmdError
-from tsmd.yamlfile import read_yaml
 
-PROFILE_SCHEMA_VERSION = 1
-DEVICE_SCHEMA_VERSION = 1
-KNOB_NAMES: tuple[str, str] = ("phi1", "phi2")
-ANGLE_RANGE_DEG = 360.0
-"""Every angle in a profile (knob or tip) must lie within +-ANGLE_RANGE_DEG: a larger value is
-almost certainly in the wrong unit (radians are caught by the omega and range checks instead)."""
-OMEGA_RANGE: tuple[float, float] = (0.2, 5.0)
-"""Plausible tip-per-knob slopes; outside this the value is a unit or sign mistake."""
-_ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
-_log = logging.getLogger(__name__)
-
-
-class ProfileError(TsmdError, ValueError):
-    """A profile or device model is missing, malformed or implausible; the message says why."""
-
-
-@dataclass(frozen=True)
-class ReferencePoint:
-    """A knob angle and the tip angle it gives (design assumption 1: other knob at 0 deg)."""
-
-    knob_deg: float
-    tip_deg: float
-
-
-DEFAULT_HANDLE_SLIP_DEG = 3.0
-"""Handle slip of a data sheet written before it was a constant of the sheet."""
-
-
-@dataclass(frozen=True)
-class DeviceKnob:
-    """Data-sheet constants of one knob."""
-
-    omega: float
-    reference_pos: ReferencePoint
-    reference_neg: ReferencePoint
-    limits: KnobLimits
-    release_omega: float | None = None
-    """Optional, measured on the data-sheet unit only (`tsmd datasheet`): tip/knob slope of the
-    release branches. No compensator uses it (it is that unit's, not the product's)."""
-    reference_backlash_pos_deg: float | None = None
-    """Optional: the data-sheet unit's tip backlash after the reversal at reference_pos
-    (calibration compares its own backlash with it as a plausibility check)."""
-    reference_backlash_neg_deg: float | None = None
-    """Optional: the same after the reversal at reference_neg."""
-    dead_zone_offset_deg: float | None = None
-    """Optional: on the data-sheet unit, how far beyond the current's edge the tip leaves the
-    plateau. Informational: no compensator uses it."""
-    reference_dead_zone_pos_deg: float | None = None
-    """Optional (with ``_neg``): the dead-zone edges tsmd's calibration found in the current of
-    the unit the reference points were measured on (other knob at 0): the plateau heights are
-    then product constants and each unit's loaded line moves with its own edges (method ours)."""
-    reference_dead_zone_neg_deg: float | None = None
-    handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
-    """Knob travel over which the handle's static friction fades to kinetic after a restart
-    (the online estimator models it; a sheet without it gets the default)."""
-    reference_backlash_gain: float | None = None
-    """Optional: the data-sheet unit's backlash gain beta (mean of both sides) from its own
-    sweep current (other knob at 0): method ours scales omega per unit by ``1 - beta``."""
-    backlash_settle_fraction: float | None = None
-    """Optional: on the data-sheet unit, the share of its swing after a reversal that the motor
-    current has made up when the tip starts back (the end of the backlash). Per product: where
-    it is below :data:`tsmd.calibration.options.SETTLED_FRACTION`, calibration ends the backlash
-    at this share instead of where the current has settled (old sheets: the settle rule)."""
-
-
-@dataclass(frozen=True)
-class DeviceModel:
-    """Data-sheet constants of a catheter type (omega, reference points, limits)."""
-
-    device_model: str
-    knobs: tuple[DeviceKnob, DeviceKnob]
-    description: str = ""
-    schema_version: int = DEVICE_SCHEMA_VERSION
-
-    @property
-    def limits(self) -> tuple[KnobLimits, KnobLimits]:
-        return (self.knobs[0].limits, self.knobs[1].limits)
-
-
-@dataclass(frozen=True)
-class KnobProfile:
-    """What calibration identified for one knob, over the other knob's angle."""
-
-    omega: float
-    reference_pos: ReferencePoint
-    reference_neg: ReferencePoint
-    height_pos_deg: float
-    height_neg_deg: float
-    other_knob_deg: tuple[float, ...]
-    dead_zone_pos_deg: tuple[float, ...]
-    dead_zone_neg_deg: tuple[float, ...]
-    backlash_pos_deg: tuple[float, ...]
-    backlash_neg_deg: tuple[float, ...]
-    tension_play: TensionPlayParams | None = None
-    """The parameters of method ``ours`` (None: calibrated by an older tsmd)."""
-
-    def grid_array(self) -> np.ndarray:
-        """(n, 4) array: D_pos, D_neg, B_pos, B_neg per grid point."""
-        return np.column_stack([self.dead_zone_pos_deg, self.dead_zone_neg_deg,
-                                self.backlash_pos_deg, self.backlash_neg_deg]).astype(float)
-
-
-@dataclass(frozen=True)
-class CatheterProfile:
-    """One catheter's calibration: everything the compensators need."""
-
-    catheter_id: str
-    device_model: str
-    calibrated_at: str
-    software_version: str
-    interpolation: str
-    knobs: tuple[KnobProfile, KnobProfile]
-    source: str = "calibration"
-    quality: dict[str, float] = field(default_factory=dict)
-    schema_version: int = PROFILE_SCHEMA_VERSION
-
-
-# ----------------------------------------------------------------------------------------------
-# Validation helpers: each names the key path and the reason.
+_log = logging.getLogger("tsmd.profile")
 
 
 class _Reader:
@@ -239,10 +110,6 @@ def _check_references(r: _Reader, key: str, pos: ReferencePoint, neg: ReferenceP
         raise r.fail(key, "reference_pos.knob_deg must be > 0 and reference_neg.knob_deg < 0")
     if not pos.tip_deg > neg.tip_deg:
         raise r.fail(key, "reference_pos.tip_deg must be above reference_neg.tip_deg")
-
-
-# ----------------------------------------------------------------------------------------------
-# Device model
 
 
 def device_model_from_mapping(data: Any, origin: str = "device model") -> DeviceModel:
@@ -329,15 +196,6 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             "description": device.description, "knobs": knobs}
 
 
-def load_device_model(path: str | os.PathLike[str]) -> DeviceModel:
-    """Read and validate a device model (data-sheet constants) from YAML."""
-    return device_model_from_mapping(_read_yaml(Path(path)), str(path))
-
-
-# ----------------------------------------------------------------------------------------------
-# Profile
-
-
 def _ref_map(p: ReferencePoint) -> dict[str, float]:
     return {"knob_deg": p.knob_deg, "tip_deg": p.tip_deg}
 
@@ -380,7 +238,7 @@ def profile_from_mapping(data: Any, origin: str = "profile") -> CatheterProfile:
     m = r.mapping(data, "top level")
     version = r.version(m, PROFILE_SCHEMA_VERSION)
     catheter_id = r.text(r.get(m, "catheter_id", ""), "catheter_id")
-    if not _ID_PATTERN.match(catheter_id):
+    if not ID_PATTERN.match(catheter_id):
         raise r.fail("catheter_id", f"{catheter_id!r} must be letters, digits, '.', '_' or '-'")
     device = r.text(r.get(m, "device_model", ""), "device_model")
     calibrated_at = r.text(str(r.get(m, "calibrated_at", "")), "calibrated_at")
@@ -427,154 +285,12 @@ def profile_to_mapping(profile: CatheterProfile) -> dict[str, Any]:
     }
 
 
-def _plain(obj: Any) -> Any:
+def plain_values(obj: Any) -> Any:
     """numpy scalars -> Python floats so the YAML stays readable by safe_load."""
     if isinstance(obj, dict):
-        return {k: _plain(v) for k, v in obj.items()}
+        return {k: plain_values(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
-        return [_plain(v) for v in obj]
+        return [plain_values(v) for v in obj]
     if isinstance(obj, np.generic):
         return obj.item()
     return obj
-
-
-def _read_yaml(path: Path) -> Any:
-    return read_yaml(path, ProfileError)
-
-
-def load_profile(path: str | os.PathLike[str]) -> CatheterProfile:
-    """Read and validate a catheter profile; any defect of the file is one ProfileError line."""
-    data = _read_yaml(Path(path))
-    try:
-        return profile_from_mapping(data, str(path))
-    except RecursionError:
-        raise ProfileError(f"{path}: nested too deeply to be a profile") from None
-
-
-def dump_profile(profile: CatheterProfile) -> str:
-    header = (f"# tsmd catheter profile, schema version {profile.schema_version}\n"
-              f"# source: {profile.source}\n")
-    return header + yaml.safe_dump(_plain(profile_to_mapping(profile)), sort_keys=False,
-                                   default_flow_style=None, width=100)
-
-
-def save_profile(profile: CatheterProfile, path: str | os.PathLike[str]) -> None:
-    """Write atomically: temp file in the same directory, fsync, keep the old file as .bak,
-    rename over, fsync the directory. A crash at any point leaves a complete profile on disk."""
-    target = Path(path)
-    text = dump_profile(profile)
-    profile_from_mapping(yaml.safe_load(text), str(target))  # never write what we cannot read
-    _write_atomically(target, text)
-
-
-def save_device_model(device: DeviceModel, path: str | os.PathLike[str],
-                      comment: str = "") -> None:
-    """Write a data sheet atomically (as :func:`save_profile`), ``comment`` as its YAML header."""
-    target = Path(path)
-    header = "".join(f"# {line}\n".replace("# \n", "#\n") for line in comment.splitlines())
-    text = header + yaml.safe_dump(_plain(device_model_to_mapping(device)), sort_keys=False,
-                                   allow_unicode=True)
-    device_model_from_mapping(yaml.safe_load(text), str(target))  # never write what we cannot read
-    _write_atomically(target, text)
-
-
-def _write_atomically(target: Path, text: str) -> None:
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        if target.exists():
-            backup = target.with_name(target.name + ".bak")
-            # A hard link keeps the old file under the backup name while the target name
-            # still points at it; replace() then swaps the target in one step.
-            with contextlib.suppress(FileNotFoundError):
-                backup.unlink()
-            try:
-                os.link(target, backup)
-            except OSError:  # no hard links on this file system: copy instead
-                shutil.copy2(target, backup)
-        os.replace(tmp_name, target)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp_name)
-        raise
-    _fsync_dir(target.parent)
-
-
-def _fsync_dir(directory: Path) -> None:
-    try:
-        fd = os.open(directory, os.O_RDONLY)
-    except OSError:
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
-
-
-class ProfileStore:
-    """Profiles kept as ``<dir>/<catheter_id>.yaml``."""
-
-    def __init__(self, directory: str | os.PathLike[str]) -> None:
-        self.directory = Path(directory)
-
-    def path(self, catheter_id: str) -> Path:
-        if not _ID_PATTERN.match(catheter_id):
-            raise ProfileError(
-                f"catheter id {catheter_id!r} must be letters, digits, '.', '_' or '-'")
-        return self.directory / f"{catheter_id}.yaml"
-
-    def load(self, catheter_id: str) -> CatheterProfile:
-        path = self.path(catheter_id)
-        if not path.exists():
-            raise ProfileError(f"no profile for catheter {catheter_id!r} in {self.directory}")
-        profile = load_profile(path)
-        # <id>.<version>.yaml (e.g. an online re-estimate) is a version of catheter <id>
-        if profile.catheter_id != catheter_id \
-                and not catheter_id.startswith(profile.catheter_id + "."):
-            raise ProfileError(f"{path}: catheter_id is {profile.catheter_id!r}, "
-                               f"expected {catheter_id!r}")
-        return profile
-
-    def save(self, profile: CatheterProfile) -> Path:
-        path = self.path(profile.catheter_id)
-        save_profile(profile, path)
-        return path
-
-    def list(self) -> list[str]:
-        if not self.directory.is_dir():
-            return []
-        return sorted(p.stem for p in self.directory.glob("*.yaml")
-                      if _ID_PATTERN.match(p.stem) and p.is_file())
-
-
-def standard_grid() -> tuple[float, ...]:
-    """The paper's calibration grid of the other knob's angle."""
-    return CALIBRATION_GRID_DEG
-
-
-def make_knob_profile(device_knob: DeviceKnob, other_knob_deg: Sequence[float],
-                      dead_zone_pos_deg: Sequence[float], dead_zone_neg_deg: Sequence[float],
-                      backlash_pos_deg: Sequence[float], backlash_neg_deg: Sequence[float],
-                      tension_play: TensionPlayParams | None = None) -> KnobProfile:
-    """A knob's profile from identified grids and the data sheet.
-
-    H_pos/H_neg follow design assumptions 1-3: the line of slope omega through the reference point
-    (other knob at 0 deg) meets the dead-zone edge D(0) at height H; H is then constant.
-    """
-    k = device_knob
-    h_pos, h_neg = plateau_heights(k, at_other_knob_zero(other_knob_deg, dead_zone_pos_deg),
-                                   at_other_knob_zero(other_knob_deg, dead_zone_neg_deg))
-
-    def floats(values: Sequence[float]) -> tuple[float, ...]:
-        return tuple(float(v) for v in values)
-
-    return KnobProfile(k.omega, k.reference_pos, k.reference_neg, float(h_pos), float(h_neg),
-                       floats(other_knob_deg), floats(dead_zone_pos_deg),
-                       floats(dead_zone_neg_deg), floats(backlash_pos_deg),
-                       floats(backlash_neg_deg), tension_play)

@@ -1,0 +1,158 @@
+"""The profile and data-sheet types: what calibration identified for one catheter, and what a
+manufacturer measured once per product (slope omega, reference points, limits)."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tsmd.compensation.grid import CALIBRATION_GRID_DEG
+from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
+from tsmd.compensation.safety import KnobLimits
+from tsmd.compensation.tension_play import TensionPlayParams
+from tsmd.errors import TsmdError
+
+PROFILE_SCHEMA_VERSION = 1
+DEVICE_SCHEMA_VERSION = 1
+KNOB_NAMES: tuple[str, str] = ("phi1", "phi2")
+ANGLE_RANGE_DEG = 360.0
+"""Every angle in a profile (knob or tip) must lie within +-ANGLE_RANGE_DEG: a larger value is
+almost certainly in the wrong unit (radians are caught by the omega and range checks instead)."""
+OMEGA_RANGE: tuple[float, float] = (0.2, 5.0)
+"""Plausible tip-per-knob slopes; outside this the value is a unit or sign mistake."""
+ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+
+
+class ProfileError(TsmdError, ValueError):
+    """A profile or device model is missing, malformed or implausible; the message says why."""
+
+
+@dataclass(frozen=True)
+class ReferencePoint:
+    """A knob angle and the tip angle it gives (design assumption 1: other knob at 0 deg)."""
+
+    knob_deg: float
+    tip_deg: float
+
+
+DEFAULT_HANDLE_SLIP_DEG = 3.0
+"""Handle slip of a data sheet written before it was a constant of the sheet."""
+
+
+@dataclass(frozen=True)
+class DeviceKnob:
+    """Data-sheet constants of one knob."""
+
+    omega: float
+    reference_pos: ReferencePoint
+    reference_neg: ReferencePoint
+    limits: KnobLimits
+    release_omega: float | None = None
+    """Optional, measured on the data-sheet unit only (`tsmd datasheet`): tip/knob slope of the
+    release branches. No compensator uses it (it is that unit's, not the product's)."""
+    reference_backlash_pos_deg: float | None = None
+    """Optional: the data-sheet unit's tip backlash after the reversal at reference_pos
+    (calibration compares its own backlash with it as a plausibility check)."""
+    reference_backlash_neg_deg: float | None = None
+    """Optional: the same after the reversal at reference_neg."""
+    dead_zone_offset_deg: float | None = None
+    """Optional: on the data-sheet unit, how far beyond the current's edge the tip leaves the
+    plateau. Informational: no compensator uses it."""
+    reference_dead_zone_pos_deg: float | None = None
+    """Optional (with ``_neg``): the dead-zone edges tsmd's calibration found in the current of
+    the unit the reference points were measured on (other knob at 0): the plateau heights are
+    then product constants and each unit's loaded line moves with its own edges (method ours)."""
+    reference_dead_zone_neg_deg: float | None = None
+    handle_slip_deg: float = DEFAULT_HANDLE_SLIP_DEG
+    """Knob travel over which the handle's static friction fades to kinetic after a restart
+    (the online estimator models it; a sheet without it gets the default)."""
+    reference_backlash_gain: float | None = None
+    """Optional: the data-sheet unit's backlash gain beta (mean of both sides) from its own
+    sweep current (other knob at 0): method ours scales omega per unit by ``1 - beta``."""
+    backlash_settle_fraction: float | None = None
+    """Optional: on the data-sheet unit, the share of its swing after a reversal that the motor
+    current has made up when the tip starts back (the end of the backlash). Per product: where
+    it is below :data:`tsmd.calibration.options.SETTLED_FRACTION`, calibration ends the backlash
+    at this share instead of where the current has settled (old sheets: the settle rule)."""
+
+
+@dataclass(frozen=True)
+class DeviceModel:
+    """Data-sheet constants of a catheter type (omega, reference points, limits)."""
+
+    device_model: str
+    knobs: tuple[DeviceKnob, DeviceKnob]
+    description: str = ""
+    schema_version: int = DEVICE_SCHEMA_VERSION
+
+    @property
+    def limits(self) -> tuple[KnobLimits, KnobLimits]:
+        return (self.knobs[0].limits, self.knobs[1].limits)
+
+
+@dataclass(frozen=True)
+class KnobProfile:
+    """What calibration identified for one knob, over the other knob's angle."""
+
+    omega: float
+    reference_pos: ReferencePoint
+    reference_neg: ReferencePoint
+    height_pos_deg: float
+    height_neg_deg: float
+    other_knob_deg: tuple[float, ...]
+    dead_zone_pos_deg: tuple[float, ...]
+    dead_zone_neg_deg: tuple[float, ...]
+    backlash_pos_deg: tuple[float, ...]
+    backlash_neg_deg: tuple[float, ...]
+    tension_play: TensionPlayParams | None = None
+    """The parameters of method ``ours`` (None: calibrated by an older tsmd)."""
+
+    def grid_array(self) -> np.ndarray:
+        """(n, 4) array: D_pos, D_neg, B_pos, B_neg per grid point."""
+        return np.column_stack([self.dead_zone_pos_deg, self.dead_zone_neg_deg,
+                                self.backlash_pos_deg, self.backlash_neg_deg]).astype(float)
+
+
+@dataclass(frozen=True)
+class CatheterProfile:
+    """One catheter's calibration: everything the compensators need."""
+
+    catheter_id: str
+    device_model: str
+    calibrated_at: str
+    software_version: str
+    interpolation: str
+    knobs: tuple[KnobProfile, KnobProfile]
+    source: str = "calibration"
+    quality: dict[str, float] = field(default_factory=dict)
+    schema_version: int = PROFILE_SCHEMA_VERSION
+
+
+def standard_grid() -> tuple[float, ...]:
+    """The paper's calibration grid of the other knob's angle."""
+    return CALIBRATION_GRID_DEG
+
+
+def make_knob_profile(device_knob: DeviceKnob, other_knob_deg: Sequence[float],
+                      dead_zone_pos_deg: Sequence[float], dead_zone_neg_deg: Sequence[float],
+                      backlash_pos_deg: Sequence[float], backlash_neg_deg: Sequence[float],
+                      tension_play: TensionPlayParams | None = None) -> KnobProfile:
+    """A knob's profile from identified grids and the data sheet.
+
+    H_pos/H_neg follow design assumptions 1-3: the line of slope omega through the reference point
+    (other knob at 0 deg) meets the dead-zone edge D(0) at height H; H is then constant.
+    """
+    k = device_knob
+    h_pos, h_neg = plateau_heights(k, at_other_knob_zero(other_knob_deg, dead_zone_pos_deg),
+                                   at_other_knob_zero(other_knob_deg, dead_zone_neg_deg))
+
+    def floats(values: Sequence[float]) -> tuple[float, ...]:
+        return tuple(float(v) for v in values)
+
+    return KnobProfile(k.omega, k.reference_pos, k.reference_neg, float(h_pos), float(h_neg),
+                       floats(other_knob_deg), floats(dead_zone_pos_deg),
+                       floats(dead_zone_neg_deg), floats(backlash_pos_deg),
+                       floats(backlash_neg_deg), tension_play)

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
-from tsmd.compensation.safety import KnobLimits, LimiterState, limit_step
+from tsmd.compensation.safety import KnobLimits, step_floats
 from tsmd.compensation.tension_play import (
     Branches,
     PlayState,
@@ -105,9 +105,10 @@ class OursKnob:
 class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
-    __slots__ = ("accel", "ahead_s", "held_s", "hold", "jump_deg", "lim", "limits", "omega", "out",
-                 "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "state",
-                 "still_q", "still_s", "sum", "target", "v", "v_raw", "window")
+    __slots__ = ("accel", "ahead_s", "held_s", "hold", "jump_deg", "lim_deg", "lim_target",
+                 "lim_v", "limits", "omega", "out", "plateau_hi_deg", "plateau_lo_deg", "q_dir",
+                 "q_prev", "q_raw", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
+                 "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
@@ -132,7 +133,10 @@ class _KnobCommand:
         self.still_q = q_deg
         self.still_s = 0.0
         x = self.limits.clip(state.x_deg)
-        self.lim = LimiterState(x)
+        # the limiter's state as plain floats (safety.step_floats): no object per tick
+        self.lim_deg = x
+        self.lim_v = 0.0
+        self.lim_target: float | None = None
         self.window = [x] * n_avg
         self.sum = x * n_avg
 
@@ -205,11 +209,12 @@ class OursCompensator:
         for kc, qi, b in ((k0, float(q_deg[0]), b0), (k1, float(q_deg[1]), b1)):
             if qi - qi == 0.0:  # finite; otherwise the command stays where it is
                 self._track(kc, qi, b)
-            lim = limit_step(kc.lim, kc.out, kc.limits, period)
-            kc.lim = lim
+            x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target, kc.out,
+                                                     kc.limits, period)
+            kc.lim_deg = x
             window = kc.window
-            kc.sum += lim.q_deg - window[slot]
-            window[slot] = lim.q_deg
+            kc.sum += x - window[slot]
+            window[slot] = x
             out.append(kc.sum)
         n = self._n_avg
         self._slot = slot + 1 if slot + 1 < n else 0
@@ -258,7 +263,10 @@ class OursCompensator:
         elif kc.held_s > 1.5 * self.period_s:
             kc.v_raw = kc.accel = 0.0  # standing: the next move starts from rest
         lead = kc.ahead_s * v
-        lead = -_MAX_LEAD_DEG if lead < -_MAX_LEAD_DEG else min(lead, _MAX_LEAD_DEG)
+        if lead < -_MAX_LEAD_DEG:
+            lead = -_MAX_LEAD_DEG
+        elif lead > _MAX_LEAD_DEG:
+            lead = _MAX_LEAD_DEG
         target = qi + lead
         # The lead shrinks as the desired angle slows; it must never turn the target back while
         # the desired angle itself does not turn: a false reversal jumps across the backlash.
@@ -304,7 +312,11 @@ class OursCompensator:
         # a desired angle speeding up (the start of a move) gets there sooner than v says; no
         # faster than the knob itself can speed up (beyond that it is a step, not a motion)
         accel = kc.accel if kc.accel * v > 0.0 else 0.0
-        accel = min(max(accel, -self.a_max), self.a_max)
+        a_max = self.a_max
+        if accel > a_max:
+            accel = a_max
+        elif accel < -a_max:
+            accel = -a_max
         ahead = x
         for _ in range(2):
             travel = (v + 0.5 * accel * horizon_s) * horizon_s

@@ -51,6 +51,13 @@ command arrived, off the plateaus, is a dwell:
 the knob moves to the middle of the play that holds the tip there (the tip does not move), so
 the next move, whichever way it goes, crosses half the play instead of all of it (a causal
 feed-forward cannot know the direction: the middle halves the worse case)."""
+REST_S = 0.4
+REST_DEG = 0.01
+"""A desired angle standing this long within this band is at rest: the next motion is a move
+from rest (point-to-point), which speeds up along a planned profile. A continuous motion's
+turning points stand within the reversal deadband for 0.2-1.2 s (the multisine): not rests."""
+MOVE_FROM_REST_S = 1.0
+"""How long after leaving rest the look-ahead trusts the desired angle's acceleration fully."""
 _SETTLED_DEG = 1e-3
 _PLATEAU_MARGIN_DEG = 1.0
 _MAX_LEAD_DEG = 10.0
@@ -106,9 +113,9 @@ class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
     __slots__ = ("accel", "ahead_s", "held_s", "hold", "jump_deg", "lim_deg", "lim_target",
-                 "lim_v", "limits", "omega", "out", "plateau_hi_deg", "plateau_lo_deg", "q_dir",
-                 "q_prev", "q_raw", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
-                 "window")
+                 "lim_v", "limits", "move_s", "omega", "out", "plateau_hi_deg", "plateau_lo_deg",
+                 "q_dir", "q_prev", "q_raw", "rest_q", "stand_s", "state", "still_q", "still_s",
+                 "sum", "target", "v", "v_raw", "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
@@ -132,6 +139,9 @@ class _KnobCommand:
         self.hold = 0
         self.still_q = q_deg
         self.still_s = 0.0
+        self.rest_q = q_deg
+        self.stand_s = 0.0
+        self.move_s = math.inf
         x = self.limits.clip(state.x_deg)
         # the limiter's state as plain floats (safety.step_floats): no object per tick
         self.lim_deg = x
@@ -221,6 +231,14 @@ class OursCompensator:
         return np.array((out[0] / n, out[1] / n))
 
     def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
+        kc.move_s += self.period_s
+        if -REST_DEG < q_raw - kc.rest_q < REST_DEG:
+            kc.stand_s += self.period_s
+        else:
+            if kc.stand_s >= REST_S:
+                kc.move_s = 0.0  # a move from rest starts
+            kc.stand_s = 0.0
+            kc.rest_q = q_raw
         if -REVERSAL_DEADBAND_DEG < q_raw - kc.still_q < REVERSAL_DEADBAND_DEG:
             # the dwell counts once the sent command has arrived (the tip got there first)
             if abs(kc.sum / self._n_avg - kc.out) < _SETTLED_DEG:
@@ -312,6 +330,12 @@ class OursCompensator:
         # a desired angle speeding up (the start of a move) gets there sooner than v says; no
         # faster than the knob itself can speed up (beyond that it is a step, not a motion)
         accel = kc.accel if kc.accel * v > 0.0 else 0.0
+        # Early in a move from rest, the crossing is timed so that the error it leaves at its
+        # start and at its end are equal: it starts when the mean of the desired angle now and
+        # at the horizon end passes the flat (a move from rest speeds up: centring on the time
+        # the desired angle passes the flat left errors of +9 / -20 deg). Elsewhere (a
+        # continuous motion: its acceleration is no trend) centred in time as before.
+        gain = 1.0 if kc.move_s < MOVE_FROM_REST_S else 0.5
         a_max = self.a_max
         if accel > a_max:
             accel = a_max
@@ -319,7 +343,7 @@ class OursCompensator:
             accel = -a_max
         ahead = x
         for _ in range(2):
-            travel = (v + 0.5 * accel * horizon_s) * horizon_s
+            travel = (v + gain * accel * horizon_s) * horizon_s
             ahead = interp_linear(target + travel, ys, b.knots)
             if (ahead - x) * d < 0.0:
                 ahead = x

@@ -119,3 +119,31 @@ def test_a_tracked_sweep_gives_the_current_edges_and_backlash_gain(sweep_files: 
         sheet = c.device_knob(ref.limits)
         assert sheet.reference_backlash_gain == pytest.approx(c.backlash_gain, abs=1e-3)
         assert sheet.reference_dead_zone_pos_deg == pytest.approx(c.dead_zone_pos_deg, abs=0.01)
+
+
+def test_the_backlash_gain_uses_the_backlash_rule_calibration_will_use() -> None:
+    """On a product whose current has not settled when the tip starts back (lumped: settle
+    fraction < 0.99), calibration ends each unit's backlash at that fraction; the sheet's
+    backlash gain must come from the same rule, or every unit's omega is biased by the ratio."""
+    from simrig.plants.lumped import make_lumped_plant
+    from tsmd.calibration.identify import identify_sweep
+    from tsmd.calibration.options import IdentifyOptions, for_product
+    from tsmd.calibration.tension_play_fit import fit_sweep_sides
+
+    runner = LockstepPlantRunner(make_lumped_plant(), PERIOD_S, seed=0)
+    t, q, skip = settle(*tip_sweep(0, 0.0, PERIOD_S), PERIOD_S)
+    rec = runner.run(t, q)
+    first = analysed_from(skip, PERIOD_S)
+    c = knob_constants(rec, 0, first)
+    assert c.backlash_settle_fraction is not None and c.backlash_settle_fraction < 0.99
+    keys = ("dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_pos_deg", "backlash_neg_deg")
+    gains = {}
+    for name, options in (("settle", IdentifyOptions()),
+                          ("product", for_product(IdentifyOptions(), c.backlash_settle_fraction))):
+        cur = identify_sweep(rec["t"][first:], rec["cmd1"][first:], rec["pos1"][first:],
+                             rec["cur1"][first:], options)
+        sides = fit_sweep_sides(cur.data.pos_deg, cur.data.current_filtered_A,
+                                *(cur.estimate(k) for k in keys))
+        gains[name] = 0.5 * (sides[0].backlash_gain + sides[1].backlash_gain)
+    assert abs(gains["product"] - gains["settle"]) > 0.01  # the two rules differ here
+    assert c.backlash_gain == pytest.approx(gains["product"], abs=1e-9)

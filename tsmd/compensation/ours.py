@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
-from tsmd.compensation.safety import KnobLimits, LimiterState, limit_step
+from tsmd.compensation.safety import KnobLimits, step_floats
 from tsmd.compensation.tension_play import (
     Branches,
     PlayState,
@@ -51,6 +51,13 @@ command arrived, off the plateaus, is a dwell:
 the knob moves to the middle of the play that holds the tip there (the tip does not move), so
 the next move, whichever way it goes, crosses half the play instead of all of it (a causal
 feed-forward cannot know the direction: the middle halves the worse case)."""
+REST_S = 0.4
+REST_DEG = 0.01
+"""A desired angle standing this long within this band is at rest: the next motion is a move
+from rest (point-to-point), which speeds up along a planned profile. A continuous motion's
+turning points stand within the reversal deadband for 0.2-1.2 s (the multisine): not rests."""
+MOVE_FROM_REST_S = 1.0
+"""How long after leaving rest the look-ahead trusts the desired angle's acceleration fully."""
 _SETTLED_DEG = 1e-3
 _PLATEAU_MARGIN_DEG = 1.0
 _MAX_LEAD_DEG = 10.0
@@ -105,9 +112,10 @@ class OursKnob:
 class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
-    __slots__ = ("accel", "ahead_s", "held_s", "hold", "jump_deg", "lim", "limits", "omega", "out",
-                 "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "state",
-                 "still_q", "still_s", "sum", "target", "v", "v_raw", "window")
+    __slots__ = ("accel", "ahead_s", "held_s", "hold", "jump_deg", "lim_deg", "lim_target",
+                 "lim_v", "limits", "move_s", "omega", "out", "plateau_hi_deg", "plateau_lo_deg",
+                 "q_dir", "q_prev", "q_raw", "rest_q", "stand_s", "state", "still_q", "still_s",
+                 "sum", "target", "v", "v_raw", "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
@@ -131,8 +139,14 @@ class _KnobCommand:
         self.hold = 0
         self.still_q = q_deg
         self.still_s = 0.0
+        self.rest_q = q_deg
+        self.stand_s = 0.0
+        self.move_s = math.inf
         x = self.limits.clip(state.x_deg)
-        self.lim = LimiterState(x)
+        # the limiter's state as plain floats (safety.step_floats): no object per tick
+        self.lim_deg = x
+        self.lim_v = 0.0
+        self.lim_target: float | None = None
         self.window = [x] * n_avg
         self.sum = x * n_avg
 
@@ -205,17 +219,26 @@ class OursCompensator:
         for kc, qi, b in ((k0, float(q_deg[0]), b0), (k1, float(q_deg[1]), b1)):
             if qi - qi == 0.0:  # finite; otherwise the command stays where it is
                 self._track(kc, qi, b)
-            lim = limit_step(kc.lim, kc.out, kc.limits, period)
-            kc.lim = lim
+            x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target, kc.out,
+                                                     kc.limits, period)
+            kc.lim_deg = x
             window = kc.window
-            kc.sum += lim.q_deg - window[slot]
-            window[slot] = lim.q_deg
+            kc.sum += x - window[slot]
+            window[slot] = x
             out.append(kc.sum)
         n = self._n_avg
         self._slot = slot + 1 if slot + 1 < n else 0
         return np.array((out[0] / n, out[1] / n))
 
     def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
+        kc.move_s += self.period_s
+        if -REST_DEG < q_raw - kc.rest_q < REST_DEG:
+            kc.stand_s += self.period_s
+        else:
+            if kc.stand_s >= REST_S:
+                kc.move_s = 0.0  # a move from rest starts
+            kc.stand_s = 0.0
+            kc.rest_q = q_raw
         if -REVERSAL_DEADBAND_DEG < q_raw - kc.still_q < REVERSAL_DEADBAND_DEG:
             # the dwell counts once the sent command has arrived (the tip got there first)
             if abs(kc.sum / self._n_avg - kc.out) < _SETTLED_DEG:
@@ -258,7 +281,10 @@ class OursCompensator:
         elif kc.held_s > 1.5 * self.period_s:
             kc.v_raw = kc.accel = 0.0  # standing: the next move starts from rest
         lead = kc.ahead_s * v
-        lead = -_MAX_LEAD_DEG if lead < -_MAX_LEAD_DEG else min(lead, _MAX_LEAD_DEG)
+        if lead < -_MAX_LEAD_DEG:
+            lead = -_MAX_LEAD_DEG
+        elif lead > _MAX_LEAD_DEG:
+            lead = _MAX_LEAD_DEG
         target = qi + lead
         # The lead shrinks as the desired angle slows; it must never turn the target back while
         # the desired angle itself does not turn: a false reversal jumps across the backlash.
@@ -304,10 +330,20 @@ class OursCompensator:
         # a desired angle speeding up (the start of a move) gets there sooner than v says; no
         # faster than the knob itself can speed up (beyond that it is a step, not a motion)
         accel = kc.accel if kc.accel * v > 0.0 else 0.0
-        accel = min(max(accel, -self.a_max), self.a_max)
+        # Early in a move from rest, the crossing is timed so that the error it leaves at its
+        # start and at its end are equal: it starts when the mean of the desired angle now and
+        # at the horizon end passes the flat (a move from rest speeds up: centring on the time
+        # the desired angle passes the flat left errors of +9 / -20 deg). Elsewhere (a
+        # continuous motion: its acceleration is no trend) centred in time as before.
+        gain = 1.0 if kc.move_s < MOVE_FROM_REST_S else 0.5
+        a_max = self.a_max
+        if accel > a_max:
+            accel = a_max
+        elif accel < -a_max:
+            accel = -a_max
         ahead = x
         for _ in range(2):
-            travel = (v + 0.5 * accel * horizon_s) * horizon_s
+            travel = (v + gain * accel * horizon_s) * horizon_s
             ahead = interp_linear(target + travel, ys, b.knots)
             if (ahead - x) * d < 0.0:
                 ahead = x

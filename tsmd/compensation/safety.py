@@ -63,11 +63,11 @@ def limit_step(state: LimiterState, target_deg: float, limits: KnobLimits,
     """
     if dt_s <= 0:
         raise ValueError(f"dt_s must be positive, got {dt_s}")
-    return LimiterState(*_step(state.q_deg, state.v_deg_s, state.target_deg, target_deg,
+    return LimiterState(*step_floats(state.q_deg, state.v_deg_s, state.target_deg, target_deg,
                                limits, dt_s))
 
 
-def _step(q0: float, v0: float, last_target: float | None, target_deg: float,
+def step_floats(q0: float, v0: float, last_target: float | None, target_deg: float,
           limits: KnobLimits, dt_s: float) -> tuple[float, float, float]:
     """:func:`limit_step` on plain floats (the loop's hot path: no object per tick; plain
     comparisons instead of min/max and clip)."""
@@ -128,7 +128,7 @@ class KnobLimiter:
         dt = self.dt_s
         lim0, lim1 = self.limits
         s0, s1 = self._states
-        s0 = _step(s0[0], s0[1], s0[2], float(cmd_deg[0]), lim0, dt)
-        s1 = _step(s1[0], s1[1], s1[2], float(cmd_deg[1]), lim1, dt)
+        s0 = step_floats(s0[0], s0[1], s0[2], float(cmd_deg[0]), lim0, dt)
+        s1 = step_floats(s1[0], s1[1], s1[2], float(cmd_deg[1]), lim1, dt)
         self._states = [s0, s1]
         return np.array((s0[0], s1[0]))

@@ -75,14 +75,22 @@ def test_a_change_beyond_the_bound_is_refused_with_a_warning() -> None:
     assert any("beyond bounds" in name for _, name, _ in events)
 
 
-def test_a_much_steeper_ramp_freezes_the_estimate() -> None:
+def test_a_much_steeper_ramp_is_refused_and_voids_the_suspects() -> None:
     tracker = learned()
-    events = tracker.update(ramp_with_edge(EDGE_DEG + 5.0, slope=5 * SLOPE), EDGE_DEG)
-    assert tracker.frozen_for > 0 and tracker.status()["state"] == "frozen"
-    assert any("frozen" in name for _, name, _ in events)
-    for _ in range(2):  # the frozen ramps after it do not count, even consistent ones
-        tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)  # a suspect
+    events = tracker.update(ramp_with_edge(EDGE_DEG + 4.0, slope=5 * SLOPE), EDGE_DEG)
+    assert any(level == "warning" and "refused" in name for level, name, _ in events)
+    assert tracker.suspects == [] and tracker.status()["refused_ramps"] == 1
+    tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)  # a suspect again, not a second
     assert tracker.applied_deg == 0.0
+
+
+def test_ramps_of_the_usual_slope_after_a_refused_one_measure_again() -> None:
+    tracker = learned()
+    tracker.update(ramp_with_edge(EDGE_DEG + 4.0, slope=0.25 * SLOPE), EDGE_DEG)
+    for _ in range(2):  # a slack change, seen from the stroke across it on
+        tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    assert tracker.applied_deg == pytest.approx(4.0, abs=0.05)
 
 
 def test_confidence_grows_with_agreeing_measurements() -> None:

@@ -16,8 +16,8 @@ coupling the profile knows is not mistaken for a change).
 - **Bounds**: an offset beyond ``max_offset_deg`` is never followed (warning, estimate kept).
 - **Hysteresis**: the applied offset moves only when the estimate leaves a band of
   ``deadband_deg`` around it.
-- **Freeze**: a stalled motor, a fault, or a ramp much steeper or flatter than the reference
-  (a stuck knob, a blocked tip) freezes the tracker for ``freeze_ramps`` ramps.
+- **Freeze**: a stalled motor or a fault freezes the tracker for ``freeze_ramps`` ramps; a
+  ramp much steeper or flatter than the reference (a stuck knob, a blocked tip) is refused.
 """
 
 from __future__ import annotations
@@ -76,6 +76,8 @@ class EdgeTracker:
     last_measurement_deg: float = math.nan
     recent_slopes: list[float] = field(default_factory=list)
     n_odd_slope: int = 0
+    n_refused: int = 0
+    """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
 
@@ -120,10 +122,14 @@ class EdgeTracker:
         assert self.level_A is not None and self.slope_ref_A_per_deg is not None
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
         if not 1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max:
-            self.freeze(f"current ramp {ratio:.1f} x the reference slope (stuck knob or "
-                        "blocked tip?)")
-            events.append(("warning", "online estimate frozen", {**tag,
-                                                                 "reason": self.frozen_reason}))
+            # A stuck knob, a blocked tip, or a stroke across a shape change: this ramp is
+            # refused and the suspects before it are void, but the ramps after it measure
+            # (freezing them delayed a slack change by two ramps per side, 40 s).
+            self.suspects.clear()
+            self.n_refused += 1
+            events.append(("warning", "online ramp refused", {
+                **tag, "reason": f"current ramp {ratio:.1f} x the reference slope (stuck knob "
+                                 "or blocked tip?)"}))
             return events
         if self.frozen_for > 0:
             self.frozen_for -= 1
@@ -192,5 +198,5 @@ class EdgeTracker:
         return {"state": state, "offset_deg": round(self.applied_deg, 3),
                 "estimate_deg": round(self.estimate_deg, 3),
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
-                "odd_slope_ramps": self.n_odd_slope,
+                "odd_slope_ramps": self.n_odd_slope, "refused_ramps": self.n_refused,
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None}

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tsmd.online.estimator import EdgeTracker, EstimatorOptions
+from tsmd.online.estimator import EdgeTracker, EstimatorOptions, shrunk_ratio
 from tsmd.online.features import LoadedRamp
 
 EDGE_DEG = 20.0
@@ -17,6 +17,13 @@ def ramp_with_edge(edge_deg: float, slope: float = SLOPE) -> LoadedRamp:
     """A ramp whose crossing of LEVEL_A is at ``edge_deg`` (positive side)."""
     u0 = edge_deg + 10.0
     return LoadedRamp(0, 1, u0, LEVEL_A + slope * 10.0, slope, 0.0, 0.0, 200, 0.003)
+
+
+def ramp_through(edge_deg: float, slope: float) -> LoadedRamp:
+    """A ramp of ``slope`` whose window centre carries the current of a reference-slope ramp
+    with its edge at ``edge_deg``: the same engagement, only the slope measured differently."""
+    return LoadedRamp(0, 1, edge_deg + 10.0, LEVEL_A + SLOPE * 10.0, slope, 0.0, 0.0, 200,
+                      0.003)
 
 
 def learned(options: EstimatorOptions | None = None) -> EdgeTracker:
@@ -68,14 +75,22 @@ def test_a_change_beyond_the_bound_is_refused_with_a_warning() -> None:
     assert any("beyond bounds" in name for _, name, _ in events)
 
 
-def test_a_much_steeper_ramp_freezes_the_estimate() -> None:
+def test_a_much_steeper_ramp_is_refused_and_voids_the_suspects() -> None:
     tracker = learned()
-    events = tracker.update(ramp_with_edge(EDGE_DEG + 5.0, slope=5 * SLOPE), EDGE_DEG)
-    assert tracker.frozen_for > 0 and tracker.status()["state"] == "frozen"
-    assert any("frozen" in name for _, name, _ in events)
-    for _ in range(2):  # the frozen ramps after it do not count, even consistent ones
-        tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)  # a suspect
+    events = tracker.update(ramp_with_edge(EDGE_DEG + 4.0, slope=5 * SLOPE), EDGE_DEG)
+    assert any(level == "warning" and "refused" in name for level, name, _ in events)
+    assert tracker.suspects == [] and tracker.status()["refused_ramps"] == 1
+    tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)  # a suspect again, not a second
     assert tracker.applied_deg == 0.0
+
+
+def test_ramps_of_the_usual_slope_after_a_refused_one_measure_again() -> None:
+    tracker = learned()
+    tracker.update(ramp_with_edge(EDGE_DEG + 4.0, slope=0.25 * SLOPE), EDGE_DEG)
+    for _ in range(2):  # a slack change, seen from the stroke across it on
+        tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    assert tracker.applied_deg == pytest.approx(4.0, abs=0.05)
 
 
 def test_confidence_grows_with_agreeing_measurements() -> None:
@@ -103,3 +118,33 @@ def test_edges_of_a_knob_that_disagree_confirm_nothing() -> None:
     pos.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
     neg.update(ramp_with_edge(EDGE_DEG - 3.0), EDGE_DEG)
     assert not pos.agrees_with(neg)
+
+
+def test_one_ramp_with_an_odd_slope_measures_nothing() -> None:
+    tracker = learned()
+    tracker.update(ramp_through(EDGE_DEG, 1.3 * SLOPE), EDGE_DEG)  # its own slope: 2.3 deg
+    assert np.isnan(tracker.last_measurement_deg)
+    assert tracker.suspects == [] and tracker.status()["odd_slope_ramps"] == 1
+
+
+def test_slopes_within_their_scatter_leave_the_edge_at_the_reference_slopes() -> None:
+    tracker = learned()
+    for ratio in (0.9, 0.87, 0.92, 0.88, 0.86, 0.9):  # persistently a little flatter
+        tracker.update(ramp_through(EDGE_DEG, ratio * SLOPE), EDGE_DEG)
+    assert abs(tracker.last_measurement_deg) < 0.3
+    assert tracker.applied_deg == 0.0
+
+
+def test_a_friction_change_is_followed_with_the_new_slope() -> None:
+    tracker = learned()
+    for _ in range(3):  # a bend: the ramp 2.5 x steeper and its edge 3 deg further out
+        tracker.update(ramp_with_edge(EDGE_DEG + 3.0, slope=2.5 * SLOPE), EDGE_DEG)
+    assert tracker.applied_deg == pytest.approx(3.0, abs=0.05)
+
+
+def test_the_slope_in_use_does_not_jump_at_the_tolerance() -> None:
+    tol = 0.15
+    for edge in (1.0 + tol, 1.0 + 2 * tol, 1.0 - tol, 1.0 - 2 * tol):
+        assert shrunk_ratio(edge + 1e-6, tol) == pytest.approx(shrunk_ratio(edge - 1e-6, tol),
+                                                               abs=1e-4)
+    assert shrunk_ratio(1.1, tol) == 1.0 and shrunk_ratio(2.5, tol) == 2.5

@@ -16,8 +16,8 @@ coupling the profile knows is not mistaken for a change).
 - **Bounds**: an offset beyond ``max_offset_deg`` is never followed (warning, estimate kept).
 - **Hysteresis**: the applied offset moves only when the estimate leaves a band of
   ``deadband_deg`` around it.
-- **Freeze**: a stalled motor, a fault, or a ramp much steeper or flatter than the reference
-  (a stuck knob, a blocked tip) freezes the tracker for ``freeze_ramps`` ramps.
+- **Freeze**: a stalled motor or a fault freezes the tracker for ``freeze_ramps`` ramps; a
+  ramp much steeper or flatter than the reference (a stuck knob, a blocked tip) is refused.
 """
 
 from __future__ import annotations
@@ -42,6 +42,18 @@ class EstimatorOptions:
     slope_ratio_max: float = 3.0
     freeze_ramps: int = 2
     same_slope_tolerance: float = 0.15
+    slope_window: int = 3
+    """The slope a measurement uses comes from the median of this edge's last
+    ``slope_window`` ramps, never from one ramp alone (see :meth:`EdgeTracker.update`)."""
+
+
+def shrunk_ratio(ratio: float, tolerance: float) -> float:
+    """A slope ratio whose change within ``tolerance`` counts as none (the slopes' scatter),
+    beyond twice the tolerance counts in full (a friction change), and in between grows
+    linearly: the slope used, and so the edge, never jumps at a threshold."""
+    change = abs(ratio - 1.0)
+    kept = change if change >= 2.0 * tolerance else 2.0 * max(change - tolerance, 0.0)
+    return 1.0 + math.copysign(kept, ratio - 1.0)
 
 
 @dataclass
@@ -62,6 +74,11 @@ class EdgeTracker:
     frozen_reason: str = ""
     n_ramps: int = 0
     last_measurement_deg: float = math.nan
+    recent_slopes: list[float] = field(default_factory=list)
+    n_odd_slope: int = 0
+    n_refused: int = 0
+    """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
+    """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
 
     @property
@@ -95,6 +112,7 @@ class EdgeTracker:
             if len(self._baseline) >= o.baseline_ramps:
                 self.level_A = median(r.current_at(d) for r, d in self._baseline)
                 self.slope_ref_A_per_deg = median(r.slope_A_per_deg for r, _ in self._baseline)
+                self.recent_slopes = [r.slope_A_per_deg for r, _ in self._baseline]
                 self.residual_ref_deg = median(
                     r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
                     for r, d in self._baseline)
@@ -104,19 +122,31 @@ class EdgeTracker:
         assert self.level_A is not None and self.slope_ref_A_per_deg is not None
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
         if not 1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max:
-            self.freeze(f"current ramp {ratio:.1f} x the reference slope (stuck knob or "
-                        "blocked tip?)")
-            events.append(("warning", "online estimate frozen", {**tag,
-                                                                 "reason": self.frozen_reason}))
+            # A stuck knob, a blocked tip, or a stroke across a shape change: this ramp is
+            # refused and the suspects before it are void, but the ramps after it measure
+            # (freezing them delayed a slack change by two ramps per side, 40 s).
+            self.suspects.clear()
+            self.n_refused += 1
+            events.append(("warning", "online ramp refused", {
+                **tag, "reason": f"current ramp {ratio:.1f} x the reference slope (stuck knob "
+                                 "or blocked tip?)"}))
             return events
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
-        # Extrapolating the window's own slope back to the edge costs ~0.3 deg of noise per
-        # ramp; the reference slope through the window's centre ~0.1. The own slope is used
-        # only when it differs (the sheath's friction changed, e.g. with its curvature).
-        slope = (self.slope_ref_A_per_deg if abs(ratio - 1.0) <= o.same_slope_tolerance
-                 else None)
+        # The crossing is taken on a line through the window's centre; its slope decides how
+        # far back the edge is (~15 deg of extrapolation: 10 % of slope is 1.5 deg). One
+        # ramp's slope scatters by 25 % and more (the knob speeding up or slowing down in the
+        # window); a friction change (sheath curvature: 2-4 x) shows in every ramp from then
+        # on. So the slope in use is the median of the last ramps' (its change beyond the
+        # tolerance only), and a ramp that disagrees with it measures nothing.
+        self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
+        slope = self.slope_ref_A_per_deg * shrunk_ratio(
+            median(self.recent_slopes) / self.slope_ref_A_per_deg, o.same_slope_tolerance)
+        if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
+            self.n_odd_slope += 1
+            self.last_measurement_deg = math.nan
+            return events
         m = ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
                          - self.residual_ref_deg)
         self.last_measurement_deg = m
@@ -168,4 +198,5 @@ class EdgeTracker:
         return {"state": state, "offset_deg": round(self.applied_deg, 3),
                 "estimate_deg": round(self.estimate_deg, 3),
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
+                "odd_slope_ramps": self.n_odd_slope, "refused_ramps": self.n_refused,
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None}

@@ -30,6 +30,13 @@ Triple = tuple[FloatArray, FloatArray, FloatArray]
 DECIDES: dict[str, str] = {"rate": "rate", "coupling": "coupling", "creep": "drift"}
 """Protocol test -> the signature it replaces when the recordings carry it."""
 
+UNMATCHED: frozenset[str] = frozenset({"compliance"})
+"""Signatures the protocol has no matched contrast for. Their null (the load shifted in time)
+breaks the link between the condition and the knob history, which the base mismatch shares:
+on catheters of other physics they beat it without an effect (tendon stretch and sheath
+friction both grow with the tension, so no knob motion tells them apart). With the protocol
+they are still scored and shown, but not named."""
+
 CONDITIONS: dict[str, str] = {
     "rate": "the same loops at two speeds (matched segments)",
     "coupling": "the same loop with the other knob held at -, 0, + (matched segments)",

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tsmd.gap.contrast import contrast_scores, segments_present
+from tsmd.gap.contrast import UNMATCHED, contrast_scores, segments_present
 from tsmd.gap.data import GapSeries, Split
 from tsmd.gap.layer import heldout_metrics, stack_views
 from tsmd.gap.model import CHANNELS, Evaluator, Prediction, View, build_views
@@ -38,8 +38,10 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         found = contrast_scores(series, _residuals(series, split, ev, base_fit),
                                 len(sres.scores), cfg.family_alpha, cfg.min_share)
         names = {c.name for c in found}
-        sres.scores = sorted([s for s in sres.scores if s.name not in names] + found,
-                             key=lambda s: -s.share)
+        kept = [s for s in sres.scores if s.name not in names]
+        for s in kept:
+            s.significant = s.significant and s.name not in UNMATCHED
+        sres.scores = sorted(kept + found, key=lambda s: -s.share)
     gap_present = sres.physics_excess > cfg.gap_floor * (sres.physics_excess + sres.noise_level)
     sig = [s for s in sres.scores if s.significant] if gap_present else []
     top = [sig[0].name] if sig else []

@@ -82,12 +82,20 @@ def test_capstan_preset_keeps_the_selftest_effects() -> None:
 
 def test_lumped_session_has_two_configurations_and_bends_only_the_looped_one() -> None:
     lumped = PRESETS["lumped"]
-    straight, looped = make_session(lumped, "curvature", 40.0, 20.0, seed=101)
+    straight, looped = make_session(lumped, "curvature", 40.0, 20.0, seed=101, matched=False)
     assert straight.metadata["configuration"] == "straight"
     assert looped.metadata["configuration"] == "looped"
     assert straight.metadata["catheter"] == "unit-101"
-    none_s, none_l = make_session(lumped, "none", 40.0, 20.0, seed=101)
+    none_s, none_l = make_session(lumped, "none", 40.0, 20.0, seed=101, matched=False)
     # same unit, same motion: without curvature the configurations differ only by noise
     d_none = np.abs(none_l.columns["tip1"] - none_s.columns["tip1"]).mean()
     d_curv = np.abs(looped.columns["tip1"] - straight.columns["tip1"]).mean()
     assert d_curv > 5 * d_none
+
+
+def test_a_session_records_the_matched_protocol_in_each_configuration() -> None:
+    recs = make_session(PRESETS["lumped"], "none", 40.0, 20.0, seed=101)
+    protocols = [r for r in recs if "segments" in r.metadata]
+    assert sorted(r.metadata["configuration"] for r in protocols) == ["looped", "straight"]
+    series = series_from_recording(protocols[0], "p")
+    assert series.segment is not None and len(series.segments) > 0

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from simrig.current_sensor import CurrentSensor
 from simrig.family import PLANT_SPECS, family_member
@@ -27,6 +28,7 @@ from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.model import ParamSpec
+from tsmd.gap.protocol import Segment, encode_table, protocol
 from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,
@@ -40,6 +42,8 @@ from tsmd.gap.selftest import (
     trajectory,
 )
 from tsmd.recording import Recording
+
+FloatArray = NDArray[np.float64]
 
 OTHER_CAPSTAN_KNOBS: tuple[dict[str, float], ...] = (
     {"sheath_friction": 0.12, "sheath_wrap_deg": 300.0, "slack_pos_mm": 1.2, "slack_neg_mm": 1.5,
@@ -149,45 +153,62 @@ CONFIGS: tuple[str, str] = ("straight", "looped")
 
 def make_session(data: PlantSpec, case: str, duration_s: float, rate_hz: float, seed: int,
                  unit_variation: float = 0.1, tip_noise_deg: float = 0.1,
-                 current_noise_A: float = 0.004) -> list[Recording]:
+                 current_noise_A: float = 0.004, matched: bool = True) -> list[Recording]:
     """One unit's session: half the time in each sheath configuration, the effect switched on.
 
     The same unit (``seed``) in both configurations; curvature bends the sheath of the looped
-    one only. Tracker and current noise differ per recording.
+    one only. With ``matched`` each configuration also gets a recording of the
+    matched-condition protocol (:mod:`tsmd.gap.protocol`), the identification experiment's
+    second part. Tracker and current noise differ per recording.
     """
-    _, lag_s, _ = EFFECTS[case]
     effects = data.case_effects(case)
-    t, q = trajectory(duration_s / 2.0, rate_hz)
+    t_e, q_e = trajectory(duration_s / 2.0, rate_hz)
+    motions: list[tuple[str, FloatArray, FloatArray, FloatArray | None, list[Segment]]] = [
+        ("experiment", t_e, q_e, None, [])]
+    if matched:
+        motions.append(("protocol", *protocol(rate_hz)))
     out = []
     for i, config in enumerate(CONFIGS):
         eff = {k: v for k, v in effects.items()
                if k != "sheath_curvature_deg" or config == "looped"}
-        plant = data.build_unit(seed, unit_variation, **eff)
-        true_tip, true_A = drive_plant(plant, q, rate_hz)
-        noise_seed = 10 * seed + i
-        tracker = EmTracker(noise_deg=tip_noise_deg, seed=noise_seed)
-        sensors = [CurrentSensor(lag_s=lag_s, offset_A=0.003 * (1 - 2 * k),
-                                 noise_A=current_noise_A, seed=7 * noise_seed + k)
-                   for k in range(2)]
-        dt = 1.0 / rate_hz
-        tip = np.array([tracker.measure(row) for row in true_tip])
-        cur = np.array([[sensors[j].measure(dt, float(row[j])) for j in range(2)]
-                        for row in true_A])
-        cols = {"t": t, "q1": q[:, 0], "q2": q[:, 1], "cmd1": q[:, 0], "cmd2": q[:, 1],
-                "pos1": q[:, 0], "pos2": q[:, 1], "cur1": cur[:, 0], "cur2": cur[:, 1],
-                "tip1": tip[:, 0], "tip2": tip[:, 1]}
-        out.append(Recording({k: np.array(v, dtype=float) for k, v in cols.items()},
-                             {"source": f"gap cross-plant selftest ({data.name or data.factory})",
-                              "catheter": f"unit-{seed}", "configuration": config}))
+        for m, (kind, t, q, seg, table) in enumerate(motions):
+            plant = data.build_unit(seed, unit_variation, **eff)
+            meta = {"source": f"gap cross-plant selftest ({data.name or data.factory}, {kind})",
+                    "catheter": f"unit-{seed}", "configuration": config}
+            cols = _measure(plant, t, q, rate_hz, EFFECTS[case][1], 10 * seed + i + 2 * m,
+                            tip_noise_deg, current_noise_A)
+            if seg is not None:
+                cols["segment"] = np.asarray(seg, dtype=float)
+                meta["segments"] = encode_table(table)
+            out.append(Recording(cols, meta))
     return out
+
+
+def _measure(plant: Any, t: FloatArray, q: FloatArray, rate_hz: float, lag_s: float,
+             noise_seed: int, tip_noise_deg: float,
+             current_noise_A: float) -> dict[str, FloatArray]:
+    """Drive ``plant`` along ``q``; the recording's columns as tracker and sensors read them."""
+    true_tip, true_A = drive_plant(plant, q, rate_hz)
+    tracker = EmTracker(noise_deg=tip_noise_deg, seed=noise_seed)
+    sensors = [CurrentSensor(lag_s=lag_s, offset_A=0.003 * (1 - 2 * k),
+                             noise_A=current_noise_A, seed=7 * noise_seed + k)
+               for k in range(2)]
+    dt = 1.0 / rate_hz
+    tip = np.array([tracker.measure(row) for row in true_tip])
+    cur = np.array([[sensors[j].measure(dt, float(row[j])) for j in range(2)]
+                    for row in true_A])
+    cols = {"t": t, "q1": q[:, 0], "q2": q[:, 1], "cmd1": q[:, 0], "cmd2": q[:, 1],
+            "pos1": q[:, 0], "pos2": q[:, 1], "cur1": cur[:, 0], "cur2": cur[:, 1],
+            "tip1": tip[:, 0], "tip2": tip[:, 1]}
+    return {k: np.array(v, dtype=float) for k, v in cols.items()}
 
 
 def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float, seed: int,
                    rate_hz: float = 50.0, config: GapConfig | None = None) -> SelftestCase:
     """Make one session and diagnose it blind with the other plant as the simulator."""
     recs = make_session(data, case, duration_s, rate_hz, seed)
-    series = [series_from_recording(r, f"{case}-{seed}-{r.metadata['configuration']}")
-              for r in recs]
+    series = [series_from_recording(r, f"{case}-{seed}-{r.metadata['configuration']}-{i}")
+              for i, r in enumerate(recs)]
     cfg = config or GapConfig(fit_specs=sim.fit, seed=seed)
 
     def factory(params: dict[str, Any]) -> Any:

@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.gap.errors import GapError
+from tsmd.gap.protocol import Segment, decode_table
 from tsmd.gap.simulate import turning_points
 from tsmd.recording import Recording
 
@@ -41,6 +42,10 @@ class GapSeries:
     ``sheath_shape``); recordings with different labels let curvature be told from friction."""
     catheter: str = ""
     """Catheter id from the header (``catheter``), for the report."""
+    segment: NDArray[np.int64] | None = None
+    """Matched-condition protocol (:mod:`tsmd.gap.protocol`): per row the index into
+    ``segments`` (-1 outside the matched windows); None when the recording carries none."""
+    segments: tuple[Segment, ...] = ()
 
     def __len__(self) -> int:
         return len(self.t_s)
@@ -106,13 +111,33 @@ def series_from_recording(rec: Recording, name: str) -> GapSeries:
     valid = tuple(bool(np.ptp(c) > 0) for c in (tips[0], tips[1], cols["cur1"], cols["cur2"]))
     if not (valid[0] or valid[1]):
         raise GapError(f"{name}: tip1 and tip2 never change: no tip measurement to compare with")
+    segment, table = _protocol_columns(rec, name)
     return GapSeries(
         name=name, t_s=t.copy(),
         knob_deg=np.column_stack([knob[0], knob[1]]),
         current_A=np.column_stack([cols["cur1"], cols["cur2"]]),
         tip_deg=np.column_stack([tips[0], tips[1]]),
         knob_source=knob_source, channel_valid=valid,  # type: ignore[arg-type]
-        config=condition_label(rec.metadata), catheter=rec.metadata.get("catheter", ""))
+        config=condition_label(rec.metadata), catheter=rec.metadata.get("catheter", ""),
+        segment=segment, segments=table)
+
+
+def _protocol_columns(rec: Recording, name: str) -> tuple[NDArray[np.int64] | None,
+                                                           tuple[Segment, ...]]:
+    """The ``segment`` column and the ``segments`` header, checked against each other."""
+    col = _column(rec, "segment", name)
+    text = rec.metadata.get("segments", "").strip()
+    if col is None and not text:
+        return None, ()
+    if col is None or not text:
+        raise GapError(f"{name}: a matched-condition recording needs both the 'segment' column "
+                       "and the 'segments' header line")
+    table = tuple(decode_table(text, name))
+    if not np.all(np.isfinite(col)) or np.any(col != np.round(col)) or np.any(col < -1) or \
+            np.any(col >= len(table)):
+        raise GapError(f"{name}: column 'segment' must hold whole numbers -1..{len(table) - 1} "
+                       "(indices into the 'segments' header)")
+    return col.astype(np.int64), table
 
 
 CONFIG_KEYS: tuple[str, ...] = ("configuration", "sheath_shape")

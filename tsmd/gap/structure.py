@@ -9,11 +9,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.gap.contrast import UNMATCHED, contrast_scores, segments_present
 from tsmd.gap.data import GapSeries, Split
 from tsmd.gap.layer import heldout_metrics, stack_views
-from tsmd.gap.model import CHANNELS, Evaluator, Prediction, build_views
+from tsmd.gap.model import CHANNELS, Evaluator, Prediction, View, build_views
 from tsmd.gap.result import CandidateScore, GapConfig, GapResult
 from tsmd.gap.signature import score_signatures
+from tsmd.gap.simulate import smooth_velocity
 
 
 def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
@@ -30,6 +32,16 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
                             n_surrogates=cfg.n_surrogates, n_boot=cfg.n_boot,
                             ci_level=cfg.ci_level, family_alpha=cfg.family_alpha,
                             min_share=cfg.min_share)
+    if segments_present(series):
+        # matched segments decide the effects they test: their contrast cancels the base
+        # mismatch, which the signatures of the same effects compete with
+        found = contrast_scores(series, _residuals(series, split, ev, base_fit),
+                                len(sres.scores), cfg.family_alpha, cfg.min_share)
+        names = {c.name for c in found}
+        kept = [s for s in sres.scores if s.name not in names]
+        for s in kept:
+            s.significant = s.significant and s.name not in UNMATCHED
+        sres.scores = sorted(kept + found, key=lambda s: -s.share)
     gap_present = sres.physics_excess > cfg.gap_floor * (sres.physics_excess + sres.noise_level)
     sig = [s for s in sres.scores if s.significant] if gap_present else []
     top = [sig[0].name] if sig else []
@@ -59,6 +71,21 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         candidates=cands, where_shares={}, where_bins={}, ljung_box_base={},
         timing_s={"signatures": time.perf_counter() - t0}, rows={"grid": len(d)},
         structure=structure)
+
+
+def _residuals(series: Sequence[GapSeries], split: Split, ev: Evaluator,
+               base_fit: Prediction) -> list[NDArray[np.float64]]:
+    """Data minus the physics simulator on every row of the protocol recordings (others: 0)."""
+    out = []
+    for s, blk, ho in zip(series, split.block, split.held_out, strict=True):
+        if s.segment is None:
+            out.append(np.zeros((len(s), 4)))
+            continue
+        rows = np.arange(len(s))
+        view = View(s, rows, ~ho, ho, blk, smooth_velocity(s.t_s, s.knob_deg))
+        pred = ev.predict([view], [], coefs=base_fit.coefs).values[0]
+        out.append(view.measured - pred)
+    return out
 
 
 def _structure_verdict(gap_present: bool, absorbed: float, layer_ratio: float,

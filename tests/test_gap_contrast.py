@@ -1,0 +1,170 @@
+"""Matched-condition protocol and its contrast tests: effects as differences inside the data."""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+
+from tsmd.gap.contrast import contrast_scores
+from tsmd.gap.data import GapSeries, series_from_recording
+from tsmd.gap.errors import GapError
+from tsmd.gap.protocol import Segment, decode_table, encode_table, protocol
+from tsmd.gap.signature import SignatureScore
+from tsmd.recording import Recording
+
+RATE_HZ = 25.0
+Arr = NDArray[np.float64]
+Effect = Callable[[Arr, Arr], Arr]
+
+
+@functools.cache
+def _design() -> tuple[Arr, Arr, NDArray[np.int64], tuple[Segment, ...]]:
+    t, q, seg, table = protocol(RATE_HZ)
+    return t, q, seg.astype(np.int64), tuple(table)
+
+
+def _play(x: Arr, width: Arr) -> Arr:
+    """A play operator whose half-width may change from row to row."""
+    out = np.empty(len(x))
+    y = float(x[0])
+    for k, (xk, w) in enumerate(zip(x.tolist(), width.tolist(), strict=True)):
+        y = min(max(y, xk - w), xk + w)
+        out[k] = y
+    return out
+
+
+def _base_mismatch(t: Arr, q: Arr) -> Arr:
+    """Residual of a simulator with other base physics: a different play and dead zone."""
+    out = np.empty((len(t), 4))
+    for j in range(2):
+        dead = np.sign(q[:, j]) * np.maximum(np.abs(q[:, j]) - 6.0, 0.0)
+        out[:, j] = 0.8 * _play(dead, np.full(len(t), 5.0)) - _play(q[:, j], np.full(len(t), 2.0))
+        out[:, 2 + j] = 0.002 * out[:, j]
+    return out
+
+
+def _scores(effect: Effect | None = None, seed: int = 0) -> dict[str, SignatureScore]:
+    t, q, seg, table = _design()
+    rng = np.random.default_rng(seed)
+    series, residuals = [], []
+    for config in ("straight", "looped"):
+        res = _base_mismatch(t, q)
+        if effect is not None:
+            res = res + effect(t, q)
+        res[:, :2] += rng.normal(0.0, 0.1, (len(t), 2))
+        res[:, 2:] += rng.normal(0.0, 0.004, (len(t), 2))
+        series.append(GapSeries(f"p-{config}", t, q, res[:, 2:], res[:, :2], "pos",
+                                config=config, segment=seg, segments=table))
+        residuals.append(res)
+    return {s.name: s for s in contrast_scores(series, residuals, n_tried=6)}
+
+
+def _named(scores: dict[str, SignatureScore]) -> set[str]:
+    return {n for n, s in scores.items() if s.significant}
+
+
+def test_matched_segments_of_every_speed_sample_the_same_knob_angles() -> None:
+    _, q, seg, table = _design()
+    angles: dict[str, list[set[float]]] = {}
+    for i, s in enumerate(table):
+        if s.test == "rate":
+            angles.setdefault(s.level, []).append(set(np.round(q[seg == i, 0], 9)))
+    fast = angles["fast"][0]
+    assert fast == angles["fast"][1]
+    assert fast <= angles["slow"][0] and fast <= angles["slow"][1]
+
+
+def test_each_level_sits_at_the_same_mean_time_so_a_linear_drift_cancels() -> None:
+    t, _, seg, table = _design()
+    for test in ("rate", "coupling"):
+        for knob in (-1, 0, 1):
+            means: dict[str, list[float]] = {}
+            for i, s in enumerate(table):
+                if s.test == test and s.knob == knob:
+                    means.setdefault(s.level, []).append(float(t[seg == i].mean()))
+            centres = [np.mean(v) for v in means.values()]
+            if centres:
+                assert np.ptp(centres) < 0.05 * (t[-1] - t[0])
+
+
+def test_a_base_mismatch_alone_makes_no_contrast_significant() -> None:
+    scores = _scores()
+    assert set(scores) == {"rate", "coupling", "drift"}
+    assert _named(scores) == set()
+
+
+def _speed(t: Arr, q: Arr) -> Arr:
+    return np.abs(np.gradient(q, t, axis=0))
+
+
+def test_a_play_that_widens_with_speed_is_named_rate() -> None:
+    def rate(t: Arr, q: Arr) -> Arr:
+        out = np.zeros((len(t), 4))
+        sp = _speed(t, q)
+        for j in range(2):
+            out[:, j] = _play(q[:, j], 0.02 * sp[:, j]) - q[:, j]
+        return out
+    scores = _scores(rate)
+    assert _named(scores) == {"rate"}
+    assert scores["rate"].share > 0.5
+
+
+def test_a_tip_that_follows_the_other_knob_is_named_coupling() -> None:
+    def coupling(t: Arr, q: Arr) -> Arr:
+        out = np.zeros((len(t), 4))
+        out[:, 0], out[:, 1] = 0.02 * q[:, 1], 0.02 * q[:, 0]
+        return out
+    scores = _scores(coupling)
+    assert _named(scores) == {"coupling"}
+    assert scores["coupling"].share > 0.5
+
+
+def _creep(t: Arr, q: Arr) -> Arr:
+    """Current relaxing in proportion to the time spent under load (slack creeping)."""
+    dt = np.diff(t, prepend=t[0])
+    load = np.maximum(np.abs(q) - 6.0, 0.0)
+    out = np.zeros((len(t), 4))
+    out[:, 2:] = -2e-5 * np.cumsum(load * dt[:, None], axis=0) * np.sign(q)
+    return out
+
+
+def test_creep_under_load_is_named_drift() -> None:
+    scores = _scores(_creep)
+    assert _named(scores) == {"drift"}
+
+
+def test_a_tracker_drifting_in_time_alone_is_not_creep() -> None:
+    def tracker(t: Arr, q: Arr) -> Arr:
+        out = np.zeros((len(t), 4))
+        out[:, :2] = 0.004 * t[:, None]
+        return out
+    assert "drift" not in _named(_scores(tracker))
+
+
+def _recording(**meta: str) -> Recording:
+    t, q, seg, _ = _design()
+    n = 200
+    cols = {"t": t[:n], "pos1": q[:n, 0], "pos2": q[:n, 1], "cur1": 0.01 * q[:n, 0],
+            "cur2": 0.01 * q[:n, 1], "tip1": q[:n, 0], "tip2": q[:n, 1],
+            "segment": seg[:n].astype(float)}
+    return Recording({k: np.asarray(v, dtype=float) for k, v in cols.items()}, dict(meta))
+
+
+def test_the_segments_header_reaches_the_series() -> None:
+    table = list(_design()[3])
+    s = series_from_recording(_recording(segments=encode_table(table)), "p")
+    assert s.segment is not None and list(s.segments) == table
+
+
+def test_a_segment_column_without_its_header_is_one_line() -> None:
+    with pytest.raises(GapError, match="needs both"):
+        series_from_recording(_recording(), "p")
+
+
+def test_a_malformed_segments_entry_is_one_line() -> None:
+    with pytest.raises(GapError, match="entry 1"):
+        decode_table("rate:slow:0:-1;rate:fast:x:-1", "p")

@@ -31,6 +31,7 @@ from pathlib import Path
 from simrig.analysis import _rising_pass_measures
 from tsmd.bench.calibration_family import family_table, run_catheter_summary
 from tsmd.bench.calibration_faults import fault_table
+from tsmd.bench.calibration_time import main_time
 from tsmd.bench.tip_truth import TIP_THRESHOLD_DEG
 from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.errors import CalibrationError
@@ -68,9 +69,27 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-tee", action="store_true", help="skip the real TEE data")
     parser.add_argument("--tee-dir", metavar="DIR",
                         help="TEE data directory (default: $TSMD_TEE_DATA or ../shared/data/tee)")
+    parser.add_argument("--time", action="store_true",
+                        help="only time one calibration as `tsmd calibrate --sim` runs it (sim "
+                             "config's plant, --protocol paper or fast, noise seed = first of "
+                             "--noise-seeds): wall, CPU, peak RSS, where a tick goes")
+    parser.add_argument("--plant-step-us", type=float, default=0.0, metavar="US",
+                        help="--time: every plant step lasts at least this long (busy wait)")
+    parser.add_argument("--split-ticks", type=int, default=12500, metavar="N",
+                        help="--time: ticks of the per-layer split (default 12500: one sweep)")
 
 
 def main(args: argparse.Namespace) -> int:
+    if args.time:
+        if args.protocol == "both" or args.split_ticks < 1 or not args.plant_step_us >= 0:
+            raise TsmdError("--time needs --protocol paper or fast, --split-ticks >= 1 and "
+                            "--plant-step-us >= 0")
+        seed = int(str(args.noise_seeds).split(",")[0])
+        device = load_device_model(resolve_data_path(args.device))
+        print("\n".join(main_time(device, fast=args.protocol == "fast",
+                                   plant_step_us=args.plant_step_us,
+                                   split_n=args.split_ticks, seed=seed)))
+        return 0
     if not args.no_sim:
         print(family(args))
     if not args.no_tee:

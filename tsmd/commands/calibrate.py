@@ -170,9 +170,10 @@ def _sim(args: argparse.Namespace) -> int:
     previous = signal.signal(signal.SIGINT, lambda *_: cancel.set())
     try:
         with LockstepRunner(config, seed=args.seed) as runner:
+            # isolate: each sweep is identified on the other core while the next one runs
             cal = run_calibration(runner, args.catheter, device, protocol=protocol,
                                   progress=bar, cancel=cancel,
-                                  options=IdentifyOptions(edge=args.edge))
+                                  options=IdentifyOptions(edge=args.edge), isolate=True)
     except CalibrationRefusedError as exc:
         # A refused calibration's sweeps are what its user needs to see why.
         if args.save_sweeps:

@@ -47,13 +47,14 @@ def _base_mismatch(t: Arr, q: Arr) -> Arr:
     return out
 
 
-def _scores(effect: Effect | None = None, seed: int = 0) -> dict[str, SignatureScore]:
+def _scores(effect: Effect | None = None, seed: int = 0,
+            looped_only: bool = False) -> dict[str, SignatureScore]:
     t, q, seg, table = _design()
     rng = np.random.default_rng(seed)
     series, residuals = [], []
     for config in ("straight", "looped"):
         res = _base_mismatch(t, q)
-        if effect is not None:
+        if effect is not None and (config == "looped" or not looped_only):
             res = res + effect(t, q)
         res[:, :2] += rng.normal(0.0, 0.1, (len(t), 2))
         res[:, 2:] += rng.normal(0.0, 0.004, (len(t), 2))
@@ -93,7 +94,7 @@ def test_each_level_sits_at_the_same_mean_time_so_a_linear_drift_cancels() -> No
 
 def test_a_base_mismatch_alone_makes_no_contrast_significant() -> None:
     scores = _scores()
-    assert set(scores) == {"rate", "coupling", "drift"}
+    assert set(scores) == {"rate", "coupling", "drift", "curvature"}
     assert _named(scores) == set()
 
 
@@ -121,6 +122,17 @@ def test_a_tip_that_follows_the_other_knob_is_named_coupling() -> None:
     scores = _scores(coupling)
     assert _named(scores) == {"coupling"}
     assert scores["coupling"].share > 0.5
+
+
+def test_a_loop_that_is_wider_in_one_configuration_is_named_curvature() -> None:
+    def wider(t: Arr, q: Arr) -> Arr:
+        out = np.zeros((len(t), 4))
+        for j in range(2):
+            out[:, j] = _play(q[:, j], np.full(len(t), 3.0)) - q[:, j]
+        return out
+    scores = _scores(wider, looped_only=True)
+    assert _named(scores) == {"curvature"}
+    assert scores["curvature"].share > 0.5
 
 
 def _creep(t: Arr, q: Arr) -> Arr:

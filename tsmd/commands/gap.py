@@ -76,6 +76,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(preset capstan / capstan-other, or module:factory[@{json}])")
     parser.add_argument("--sim-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant used as the simulator")
+    parser.add_argument("--no-protocol", action="store_true",
+                        help="selftest across plants: sessions without the matched-condition "
+                             "protocol recordings (the experiment motion only, as before)")
 
 
 def _load_params(text: str | None) -> dict[str, Any]:
@@ -180,7 +183,8 @@ def _selftest(args: argparse.Namespace) -> int:
         data = parse_plant_spec(args.data_plant or "capstan-other")
         sim = parse_plant_spec(args.sim_plant or "capstan")
         result = run_crosstest(data, sim, cases, sizes, seeds, args.rate_hz,
-                               cross_config(sim.fit, args.method), progress=progress)
+                               cross_config(sim.fit, args.method), progress=progress,
+                               matched=not args.no_protocol)
     else:
         result = run_selftest(cases, sizes, seeds, args.rate_hz,
                               GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method),

@@ -27,8 +27,10 @@ FloatArray = NDArray[np.float64]
 Triple = tuple[FloatArray, FloatArray, FloatArray]
 """One channel of a matched loop: knob angle, residual, measured tip."""
 
-DECIDES: dict[str, str] = {"rate": "rate", "coupling": "coupling", "creep": "drift"}
-"""Protocol test -> the signature it replaces when the recordings carry it."""
+DECIDES: dict[str, str] = {"rate": "rate", "coupling": "coupling", "creep": "drift",
+                           "curvature": "curvature"}
+"""Protocol test -> the signature it replaces when the recordings carry it (curvature: the
+rate and coupling tests' loops compared across configurations)."""
 
 UNMATCHED: frozenset[str] = frozenset({"compliance"})
 """Signatures the protocol has no matched contrast for. Their null (the load shifted in time)
@@ -41,6 +43,7 @@ CONDITIONS: dict[str, str] = {
     "rate": "the same loops at two speeds (matched segments)",
     "coupling": "the same loop with the other knob held at -, 0, + (matched segments)",
     "creep": "tip and current drift in loaded against unloaded dwells",
+    "curvature": "the same loops in two sheath configurations (matched segments)",
 }
 
 
@@ -153,15 +156,16 @@ def _noise_ss(lp: Loops) -> float:
 def _design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
     """Effect-model regressors per point: shift along the knob (slope), widening (slope x
     branch, also growing with the bend), a branch offset and an offset, per knob/channel."""
+    g = np.zeros(len(lp.knob))
+    # the slope along each branch: runs of points of one part and direction
+    edges = np.flatnonzero((np.diff(lp.part) != 0) | (np.diff(lp.dirn) != 0)) + 1
+    for run in np.split(np.arange(len(g)), edges):
+        if len(run) > 2:
+            g[run] = np.gradient(mean_loop[run], lp.knob[run])
+    load = np.abs(lp.knob)
     cols = []
     for p in np.unique(lp.part):
         z = (lp.part == p).astype(float)
-        g = np.zeros(len(z))
-        for sign in (-1.0, 1.0):
-            m = (lp.part == p) & (lp.dirn == sign)
-            if m.sum() > 2:
-                g[m] = np.gradient(mean_loop[m])
-        load = np.abs(lp.knob)
         cols += [z * g, z * g * lp.dirn, z * g * lp.dirn * load, z * lp.dirn,
                  z * lp.dirn * load, z]
     return np.column_stack(cols)
@@ -229,7 +233,7 @@ def drift_shrink(train: Sequence[Drift], held: Drift) -> float:
 
 
 def _z(p: float) -> float:
-    return float(min(stats.norm.isf(max(p, 1e-300)), 40.0))
+    return float(np.clip(stats.norm.isf(min(max(p, 1e-300), 1.0 - 1e-16)), -40.0, 40.0))
 
 
 @dataclass
@@ -255,7 +259,15 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
     crit = family_alpha / max(n_tried, 1)
     for test, name in DECIDES.items():
         per_cfg = [d[test] for d in by_config.values() if test in d]
-        if test == "creep":
+        if test == "curvature":
+            loops = [lp for lp in (_across_configs([d[t] for d in by_config.values() if t in d])
+                                   for t in ("rate", "coupling")) if lp is not None]
+            if len(loops) < 2:
+                continue
+            p = anova(loops)[3]
+            # fitted on one motion's configuration contrast, scored on the other motion's
+            shrinks = [loop_shrink([loops[1 - i]], loops[i]) for i in range(2)]
+        elif test == "creep":
             drifts = [d for d in (_drift(t) for t in per_cfg) if d.diff.size]
             if not drifts:
                 continue
@@ -278,6 +290,28 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
         out.append(SignatureScore(name, title, CONDITIONS[test], share, lo_hi, sig, share, 0.0,
                                   _z(p)))
     return out
+
+
+def _across_configs(per_cfg: Sequence[TestData]) -> Loops | None:
+    """One test's loops with the configurations as the levels (all its levels side by side),
+    each loop's mean removed: an offset between sessions (tracker registration) is no shape."""
+    if len(per_cfg) < 2:
+        return None
+    found = [loop_contrast(t.loops, t.levels) for t in per_cfg]
+    loops = [lp for lp in found if lp is not None]
+    if len(loops) < 2 or len({lp.y.shape for lp in loops}) > 1:
+        return None
+    n_lev, n_rep, k = loops[0].y.shape
+    y = np.array([lp.y.transpose(1, 0, 2).reshape(n_rep, n_lev * k) for lp in loops])
+    part = np.tile(loops[0].part, n_lev)
+    for p in np.unique(part):
+        for lv in range(n_lev):
+            cols = np.zeros(n_lev * k, dtype=bool)
+            cols[lv * k:(lv + 1) * k] = loops[0].part == p
+            y[:, :, cols] -= y[:, :, cols].mean(axis=2, keepdims=True)
+    first = loops[0]
+    return Loops(y, np.tile(np.mean([lp.tip for lp in loops], axis=0), n_lev),
+                 np.tile(first.knob, n_lev), np.tile(first.dirn, n_lev), part)
 
 
 def _collect(s: GapSeries, res: FloatArray, tests: dict[str, TestData]) -> None:

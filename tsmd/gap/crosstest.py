@@ -204,9 +204,10 @@ def _measure(plant: Any, t: FloatArray, q: FloatArray, rate_hz: float, lag_s: fl
 
 
 def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float, seed: int,
-                   rate_hz: float = 50.0, config: GapConfig | None = None) -> SelftestCase:
+                   rate_hz: float = 50.0, config: GapConfig | None = None,
+                   matched: bool = True) -> SelftestCase:
     """Make one session and diagnose it blind with the other plant as the simulator."""
-    recs = make_session(data, case, duration_s, rate_hz, seed)
+    recs = make_session(data, case, duration_s, rate_hz, seed, matched=matched)
     series = [series_from_recording(r, f"{case}-{seed}-{r.metadata['configuration']}-{i}")
               for i, r in enumerate(recs)]
     cfg = config or GapConfig(fit_specs=sim.fit, seed=seed)
@@ -236,12 +237,13 @@ def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float
 def run_crosstest(data: PlantSpec, sim: PlantSpec, cases: Sequence[str],
                   sizes_s: Sequence[float], seeds: Sequence[int], rate_hz: float = 50.0,
                   config: GapConfig | None = None,
-                  progress: Callable[[SelftestCase], None] | None = None) -> SelftestResult:
+                  progress: Callable[[SelftestCase], None] | None = None,
+                  matched: bool = True) -> SelftestResult:
     result = SelftestResult()
     for size in sizes_s:
         for seed in seeds:
             for case in cases:
-                c = run_cross_case(data, sim, case, size, seed, rate_hz, config)
+                c = run_cross_case(data, sim, case, size, seed, rate_hz, config, matched)
                 result.cases.append(c)
                 if progress is not None:
                     progress(c)

@@ -46,6 +46,10 @@ SIGNATURES: dict[str, tuple[str, str]] = {
 }
 """Signature name -> (effect, the condition it depends on)."""
 
+ACTS_ON: dict[str, tuple[int, ...]] = {"sensor": (2, 3)}
+"""Channels (tip1, tip2, cur1, cur2) an effect acts on, when not all: a share is of their excess."""
+
+
 def _shift(d: SigData, a: FloatArray, rng: np.random.Generator) -> FloatArray:
     """``a`` circularly shifted within each recording by 20..80 % of its length (a surrogate)."""
     out = a.copy()
@@ -121,7 +125,8 @@ class SignatureScore:
     title: str
     condition: str
     share: float
-    """Share of the structural layer's held-out excess the signature removes beyond its null."""
+    """Share of the structural layer's held-out excess (in the channels the effect acts on)
+    that the signature removes beyond its null."""
     ci: tuple[float, float]
     significant: bool
     raw_share: float
@@ -221,7 +226,11 @@ def score_signatures(d: SigData, noise_var: FloatArray, physics_pred: FloatArray
             null_cost = np.minimum(null_cost, block_costs(d, strongest, noise_var,
                                                           blocks)[0] @ weight)
         gain = null_cost - true_cost  # what the true condition removes beyond its surrogates
-        denom = np.maximum(excess, 0.0) if total_excess > 0 else count
+        # its share is of the excess in the channels it acts on (sensor dynamics: the currents)
+        acts = np.zeros(4)
+        acts[list(ACTS_ON.get(name, range(4)))] = 1.0
+        own = np.maximum(base_cost_c - count_c, 0.0) @ (weight * acts)
+        denom = own if total_excess > 0 and float(own.sum()) > 0 else count
         share, lo, hi = bootstrap_ratio_ci(gain, denom, seed, n_boot, ci_level)
         _, strict_lo, _ = bootstrap_ratio_ci(gain, denom, seed, n_boot,
                                              1.0 - 2.0 * family_alpha / max(n_tried, 1))

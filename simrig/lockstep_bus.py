@@ -135,7 +135,10 @@ class LockstepBus(can.BusABC):
             raise can.CanOperationError(f"lockstep bus {self._name!r} is shut down")
         for peer in self._peers:
             if peer is not self and not peer._bus_off:
-                peer._deliver(msg)
+                if peer._frames is None:
+                    peer._queue.append(msg)
+                else:
+                    peer._frames.append(_as_frame(msg))
 
     @property
     def reads_frames(self) -> bool:

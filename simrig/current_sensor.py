@@ -15,7 +15,8 @@ import numpy as np
 class CurrentSensor:
     """First-order lag, gain and offset error, Gaussian noise and occasional spikes.
 
-    Deterministic for a given ``seed``. ``measure`` is called once per control period.
+    Deterministic for a given ``seed``. ``measure`` is called once per control period. The
+    parameters are fixed at construction (the per-period factors are kept per ``dt_s``).
     """
 
     def __init__(
@@ -53,22 +54,37 @@ class CurrentSensor:
     def reset(self) -> None:
         """Forget the filter state and restart the random sequence."""
         self._rng = np.random.default_rng(self.seed)
+        self._normal = self._rng.standard_normal
+        self._uniform = self._rng.random
         self._filtered_A: float | None = None
+        self._dt_s = math.nan
+        self._lag_gain = 1.0
+        self._spike_p = 0.0
+
+    def _per_period(self, dt_s: float) -> None:
+        """The filter gain and the spike probability of a period of ``dt_s`` (computed once
+        per period length, by the same expressions)."""
+        self._dt_s = dt_s
+        if self.lag_s != 0.0:
+            self._lag_gain = 1.0 - math.exp(-dt_s / self.lag_s)
+        self._spike_p = -math.expm1(-self.spike_rate_hz * dt_s)
 
     def measure(self, dt_s: float, true_current_A: float) -> float:
         """The reading after ``dt_s`` more seconds of ``true_current_A`` (amperes)."""
-        if not dt_s >= 0.0:
-            raise ValueError(f"dt_s must be >= 0, got {dt_s!r}")
+        if dt_s != self._dt_s:
+            if not dt_s >= 0.0:
+                raise ValueError(f"dt_s must be >= 0, got {dt_s!r}")
+            self._per_period(dt_s)
         x = float(true_current_A)
-        if self._filtered_A is None or self.lag_s == 0.0:
-            self._filtered_A = x
+        filtered = self._filtered_A
+        if filtered is None or self.lag_s == 0.0:
+            filtered = x
         else:
-            self._filtered_A += (1.0 - math.exp(-dt_s / self.lag_s)) * (x - self._filtered_A)
-        reading = self.gain * self._filtered_A + self.offset_A
+            filtered += self._lag_gain * (x - filtered)
+        self._filtered_A = filtered
+        reading = self.gain * filtered + self.offset_A
         if self.noise_A > 0.0:
-            reading += self.noise_A * float(self._rng.standard_normal())
-        if self.spike_rate_hz > 0.0 and self._rng.random() < -math.expm1(
-            -self.spike_rate_hz * dt_s
-        ):
-            reading += self.spike_A * (1.0 if self._rng.random() < 0.5 else -1.0)
+            reading += self.noise_A * self._normal()
+        if self.spike_rate_hz > 0.0 and self._uniform() < self._spike_p:
+            reading += self.spike_A * (1.0 if self._uniform() < 0.5 else -1.0)
         return reading

@@ -54,14 +54,35 @@ make_message = (_make_message if set(getattr(can.Message, "__slots__", ())) == _
                 else _checked_message)
 
 
-class LockstepBus(can.BusABC):
-    """A ``virtual``-like bus for one thread; ``recv`` with a timeout only sleeps-and-polls."""
+Frame = tuple[int, bytes, int]
+"""A received frame as :meth:`LockstepBus.take_frames` gives it: COB-ID, data and flags
+(0 for a plain data frame, else :data:`EXTENDED` | :data:`REMOTE` | :data:`ERROR`)."""
+EXTENDED, REMOTE, ERROR = 1, 2, 4
 
-    def __init__(self, channel: str, **kwargs: Any) -> None:
+
+def _flags(msg: can.Message) -> int:
+    return ((EXTENDED if msg.is_extended_id else 0) | (REMOTE if msg.is_remote_frame else 0)
+            | (ERROR if msg.is_error_frame else 0))
+
+
+def _as_frame(msg: can.Message) -> Frame:
+    return msg.arbitration_id, bytes(msg.data), _flags(msg)
+
+
+class LockstepBus(can.BusABC):
+    """A ``virtual``-like bus for one thread; ``recv`` with a timeout only sleeps-and-polls.
+
+    ``frames=True``: this end is read with :meth:`take_frames` (the simulated rig), so its
+    peers queue a ``(cob_id, bytes, plain)`` tuple per frame instead of a ``Message`` copy;
+    ``recv`` still works on it and builds the ``Message`` when asked.
+    """
+
+    def __init__(self, channel: str, *, frames: bool = False, **kwargs: Any) -> None:
         super().__init__(channel=channel, **kwargs)
         self.channel_info = f"lockstep channel {channel!r}"
         self._name = channel
         self._queue: collections.deque[can.Message] = collections.deque()
+        self._frames: list[Frame] | None = [] if frames else None
         self._peers = _CHANNELS.setdefault(channel, [])
         self._peers.append(self)
         self._open = True
@@ -75,8 +96,17 @@ class LockstepBus(can.BusABC):
         self._bus_off = on
         if on:
             self._queue.clear()
-        self._queue.append(make_message(CAN_ERR_BUSOFF if on else CAN_ERR_RESTARTED,
-                                        bytes(8), error=True))
+            if self._frames is not None:
+                self._frames.clear()
+        self._deliver(make_message(CAN_ERR_BUSOFF if on else CAN_ERR_RESTARTED, bytes(8),
+                                   error=True))
+
+    def _deliver(self, msg: can.Message) -> None:
+        """Queue a frame that nobody else holds."""
+        if self._frames is not None:
+            self._frames.append(_as_frame(msg))
+        else:
+            self._queue.append(msg)
 
     def others(self) -> list[LockstepBus]:
         """The other buses on this channel (the rig reaches the master's controller here)."""
@@ -90,8 +120,14 @@ class LockstepBus(can.BusABC):
         data = msg.data
         for peer in self._peers:
             if peer is not self and not peer._bus_off:
-                peer._queue.append(make_message(msg.arbitration_id, data, msg.is_extended_id,
-                                                msg.is_remote_frame, msg.is_error_frame))
+                frames = peer._frames
+                if frames is not None:
+                    plain = not (msg.is_extended_id or msg.is_remote_frame or msg.is_error_frame)
+                    frames.append((msg.arbitration_id, bytes(data), 0 if plain else _flags(msg)))
+                else:
+                    peer._queue.append(make_message(msg.arbitration_id, data,
+                                                    msg.is_extended_id, msg.is_remote_frame,
+                                                    msg.is_error_frame))
 
     def send_owned(self, msg: can.Message) -> None:
         """Send a frame the caller will never touch again: peers get the object itself."""
@@ -99,20 +135,47 @@ class LockstepBus(can.BusABC):
             raise can.CanOperationError(f"lockstep bus {self._name!r} is shut down")
         for peer in self._peers:
             if peer is not self and not peer._bus_off:
-                peer._queue.append(msg)
+                if peer._frames is None:
+                    peer._queue.append(msg)
+                else:
+                    peer._frames.append(_as_frame(msg))
+
+    @property
+    def reads_frames(self) -> bool:
+        """Opened with ``frames=True``: read with :meth:`take_frames`."""
+        return self._frames is not None
+
+    def take_frames(self) -> list[Frame]:
+        """Every frame received since the last call, oldest first (``frames=True`` ends)."""
+        frames = self._frames
+        if frames is None:
+            raise RuntimeError("take_frames needs a bus opened with frames=True")
+        if not frames:
+            return frames
+        self._frames = []
+        return frames
 
     def recv(self, timeout: float | None = None) -> can.Message | None:
         queue = self._queue
         if queue:
             return queue.popleft()
+        if self._frames:
+            return self._pop_frame()
         if not timeout:
             return None
         deadline = time.monotonic() + timeout
-        while not queue:
+        while not (queue or self._frames):
             if time.monotonic() >= deadline:
                 return None
             time.sleep(0.0002)
-        return queue.popleft()
+        return queue.popleft() if queue else self._pop_frame()
+
+    def _pop_frame(self) -> can.Message:
+        """The oldest frame of a ``frames=True`` end as a ``Message`` (read the python-can way)."""
+        assert self._frames
+        cid, data, flags = self._frames.pop(0)
+        return make_message(cid, data, bool(flags & EXTENDED), bool(flags & REMOTE),
+                            bool(flags & ERROR))
 
     def _recv_internal(self, timeout: float | None) -> tuple[can.Message | None, bool]:
         return self.recv(timeout), True

@@ -72,6 +72,8 @@ class SimRig:
         self._sim_clock = self.clock if isinstance(self.clock, SimClock) else None
         self._own_bus = own_bus
         self._send_owned = bus.send_owned if isinstance(bus, LockstepBus) else None
+        self._take_frames = (bus.take_frames if isinstance(bus, LockstepBus) and bus.reads_frames
+                             else None)
         params = motor or MotorParams()
         self.motors = [Motor(params, c.gear_ratio, period_s) for c in drive_configs]
         self.nodes = [
@@ -95,20 +97,29 @@ class SimRig:
     # -- lockstep --------------------------------------------------------------------------
     def exchange(self) -> None:
         """Process all pending frames, advance one period, send the TPDOs due."""
-        recv = self.bus.recv
         nodes = self.nodes
         now = self.clock.now_s()
         sync = False
-        while (msg := recv(0)) is not None:
-            cid = msg.arbitration_id
-            if cid == 0x080:
-                sync = True
-                for n in nodes:
-                    n.on_sync(now)
-            elif not (msg.is_error_frame or msg.is_remote_frame or msg.is_extended_id):
-                data = msg.data
-                for n in nodes:
-                    n.on_frame(cid, data, now)
+        if self._take_frames is not None:  # the lockstep bus's frames, no Message objects
+            for cid, data, flags in self._take_frames():
+                if cid == 0x080:
+                    sync = True
+                    for n in nodes:
+                        n.on_sync(now)
+                elif not flags:
+                    for n in nodes:
+                        n.on_frame(cid, data, now)
+        else:
+            recv = self.bus.recv
+            while (msg := recv(0)) is not None:
+                cid = msg.arbitration_id
+                if cid == 0x080:
+                    sync = True
+                    for n in nodes:
+                        n.on_sync(now)
+                elif not (msg.is_error_frame or msg.is_remote_frame or msg.is_extended_id):
+                    for n in nodes:
+                        n.on_frame(cid, msg.data, now)
         self._advance(sync)
 
     def _advance(self, sync: bool) -> None:
@@ -141,6 +152,17 @@ class SimRig:
     def tip_deg(self) -> NDArray[np.float64]:
         """EM tracker reading of the tip angle (ground truth for evaluation, with its noise)."""
         return np.asarray(self.tracker.measure(np.array(self._tip, dtype=float)), dtype=float)
+
+    def tip_pair(self) -> tuple[float, float]:
+        """:meth:`tip_deg` as two floats (the same values and noise draws; the loop's hot path)."""
+        tip = self._tip
+        pair = getattr(self.tracker, "measure_pair", None)
+        if pair is None or not (type(tip) is np.ndarray and tip.dtype == np.float64
+                                and tip.shape == (2,)):
+            a, b = self.tip_deg().tolist()
+            return a, b
+        t0, t1 = tip.tolist()
+        return pair(t0, t1)
 
     def true_tip_deg(self) -> NDArray[np.float64]:
         """Noise-free tip angle."""
@@ -288,7 +310,7 @@ def open_sim_rig(plant: Plant | None, drive_configs: Sequence[DriveConfig] | Non
     if interface == "lockstep":
         if not lockstep:
             raise ValueError("the lockstep bus is single-threaded; use interface='virtual'")
-        rig_bus: can.BusABC = LockstepBus(channel)
+        rig_bus: can.BusABC = LockstepBus(channel, frames=True)
         master_bus: can.BusABC = LockstepBus(channel)
     elif interface == "virtual":
         rig_bus = can.Bus(interface="virtual", channel=channel, receive_own_messages=False)

@@ -29,15 +29,15 @@ class EmTracker:
     def reset(self) -> None:
         """Restart the noise sequence."""
         self._rng = np.random.default_rng(self.seed)
-        self._noise: NDArray[np.float64] = np.empty(0)
+        self._noise: list[float] = []
         self._next = 0
 
-    def _standard_normal(self, n: int) -> NDArray[np.float64]:
+    def _standard_normal(self, n: int) -> list[float]:
         """The next ``n`` values of the generator's standard normal stream."""
         end = self._next + n
-        if end > self._noise.size:
+        if end > len(self._noise):
             rest = self._noise[self._next:]
-            self._noise = np.concatenate((rest, self._rng.standard_normal(max(self.block, n))))
+            self._noise = rest + self._rng.standard_normal(max(self.block, n)).tolist()
             self._next, end = 0, n
         out = self._noise[self._next:end]
         self._next = end
@@ -48,4 +48,19 @@ class EmTracker:
         true = np.asarray(tip_deg, dtype=np.float64)
         if self.noise_deg == 0.0:
             return true.copy()
-        return true + self.noise_deg * self._standard_normal(true.size).reshape(true.shape)
+        noise = np.array(self._standard_normal(true.size), dtype=np.float64)
+        return true + self.noise_deg * noise.reshape(true.shape)
+
+    def measure_pair(self, tip0_deg: float, tip1_deg: float) -> tuple[float, float]:
+        """:meth:`measure` of two angles as floats (same draws, same arithmetic, no arrays)."""
+        s = self.noise_deg
+        if s == 0.0:
+            return tip0_deg, tip1_deg
+        i = self._next
+        noise = self._noise
+        if i + 2 > len(noise):
+            z0, z1 = self._standard_normal(2)
+        else:
+            z0, z1 = noise[i], noise[i + 1]
+            self._next = i + 2
+        return tip0_deg + s * z0, tip1_deg + s * z1

@@ -30,3 +30,11 @@ def test_knob_limiter_reset_with_hold_takes_the_position_as_the_last_target() ->
     limiter.reset(np.array([10.0, 20.0]), hold=True)
     held = limiter.limit(np.array([10.0, 20.0]))
     assert held.tolist() == [10.0, 20.0]
+
+
+def test_limit_pair_equals_limit() -> None:
+    rng = np.random.default_rng(7)
+    targets = np.cumsum(rng.normal(0.0, 3.0, (300, 2)), axis=0)
+    by_array, by_pair = KnobLimiter(LIMITS, DT), KnobLimiter(LIMITS, DT)
+    for target in targets:
+        assert by_array.limit(target).tolist() == list(by_pair.limit_pair(*target.tolist()))

@@ -259,3 +259,22 @@ def test_feedback_follows_a_changed_position_between_two_reads(rig_pair):
     assert moved[0].position_deg == pytest.approx(10.0, abs=0.5)
     assert moved[1].position_deg == pytest.approx(-5.0, abs=0.5)
     assert first[0].position_deg == pytest.approx(0.0, abs=0.1)
+
+
+def test_tip_pair_gives_the_tip_deg_values_of_a_twin_rig() -> None:
+    runs = []
+    for use_pair in (False, True):
+        drives, rig = open_sim_rig(SpringPlant(), None, PERIOD_S, seed=5)
+        drives.boot()
+        drives.enable()
+        tips = []
+        for q in sine(50):
+            drives.write_targets(q)
+            drives.sync()
+            rig.exchange()
+            drives.pump()
+            tips.append(list(rig.tip_pair()) if use_pair else rig.tip_deg().tolist())
+        runs.append(tips)
+        drives.close()
+        rig.close()
+    assert runs[0] == runs[1]

@@ -122,3 +122,37 @@ def test_tracker_reset_restarts_the_noise_sequence() -> None:
     tracker.reset()
     again = [tracker.measure(np.zeros(2)) for _ in range(3)]
     assert all(np.array_equal(a, b) for a, b in zip(first, again, strict=True))
+
+
+def test_tracker_pair_draws_the_same_noise_as_measure_across_block_edges() -> None:
+    by_array = EmTracker(noise_deg=0.3, seed=5)
+    by_pair = EmTracker(noise_deg=0.3, seed=5)
+    for k in range(EmTracker.block + 3):  # crosses a block edge
+        tip = (0.01 * k, -0.02 * k)
+        assert list(by_pair.measure_pair(*tip)) == by_array.measure(np.array(tip)).tolist()
+
+
+def test_tracker_pair_and_measure_share_one_noise_sequence() -> None:
+    mixed = EmTracker(noise_deg=0.3, seed=5)
+    arrays = EmTracker(noise_deg=0.3, seed=5)
+    got = [mixed.measure_pair(1.0, 2.0), tuple(mixed.measure(np.array([1.0, 2.0])))]
+    want = [tuple(arrays.measure(np.array([1.0, 2.0]))) for _ in range(2)]
+    assert got == want
+
+
+def test_sensor_lag_follows_a_change_of_period() -> None:
+    lag_s = 0.01
+    sensor = CurrentSensor(lag_s=lag_s)
+    sensor.measure(0.004, 0.0)
+    first = sensor.measure(0.004, 1.0)
+    second = sensor.measure(0.002, 1.0)
+    assert first == 1.0 - np.exp(-0.004 / lag_s)
+    assert second == pytest.approx(first + (1.0 - np.exp(-0.002 / lag_s)) * (1.0 - first),
+                                   rel=1e-15)
+
+
+def test_sensor_refuses_a_negative_period_after_a_valid_one() -> None:
+    sensor = CurrentSensor(lag_s=0.01)
+    sensor.measure(0.004, 0.0)
+    with pytest.raises(ValueError, match="dt_s"):
+        sensor.measure(-0.004, 0.0)

@@ -282,7 +282,7 @@ class Daemon:
                  "sim": self.sim}, config.recording.flush_interval_s,
                 # the file's columns are fixed at its start: online offsets only if on by config
                 RECORDING_COLUMNS if config.online.enabled else ())
-        tip_source = self.rig.tip_deg if self.rig is not None else None
+        tip_source = self.rig.tip_pair if self.rig is not None else None
         self.loop = build_loop(config, self.drives, compensator, MonotonicClock(),
                                compensation_label=label, tip_source=tip_source,
                                recorder=self.recorder, on_event=self.events.emit)

@@ -46,6 +46,7 @@ __all__ = [
 ]
 
 _isfinite = math.isfinite
+Pair = tuple[float, float]
 
 
 class ControlLoop:
@@ -93,8 +94,11 @@ class ControlLoop:
         self._playback: Playback | None = None
         self.observer: Callable[[tuple[float, ...], bool], None] | None = None
         """Called with each tick's row and whether the loop is enabled (tsmd.online)."""
-        self._q = np.zeros(2)
-        self._last_cmd = np.zeros(2)
+        self._q: Pair = (0.0, 0.0)
+        """The last desired angles, clamped (floats: the hot path makes no arrays)."""
+        self._last_cmd: Pair = (0.0, 0.0)
+        self._play_q: list[list[float]] = []
+        """The playing trajectory as Python floats (converted once, not per tick)."""
         self._nan2 = (math.nan, math.nan)
 
     # --- configuration read by the API -----------------------------------------------------
@@ -154,9 +158,9 @@ class ControlLoop:
         if self.state is LoopState.ENABLED:
             q, cmd = self._command(pos)
         else:
-            q = cmd = (np.array(pos) if _isfinite(pos[0]) and _isfinite(pos[1])
+            q = cmd = ((pos[0], pos[1]) if _isfinite(pos[0]) and _isfinite(pos[1])
                        else self._last_cmd)
-        c0, c1 = cmd.tolist()
+        c0, c1 = cmd
         if _isfinite(c0) and _isfinite(c1):
             self._last_cmd = cmd
         drives.write_targets((c0, c1))
@@ -170,7 +174,7 @@ class ControlLoop:
             tip0, tip1 = tip.tolist()
         else:
             tip0, tip1 = float(tip[0]), float(tip[1])
-        q0, q1 = q.tolist()
+        q0, q1 = q
         fb0, fb1 = feedback
         row = (t_s, q0, q1, c0, c1, fb0.position_deg, fb1.position_deg,
                fb0.current_A, fb1.current_A, tip0, tip1)
@@ -180,7 +184,7 @@ class ControlLoop:
         self.stats.ticks += 1
         self._latest = (self.stats.ticks, t_s, self.state, row, self.fault_reason)
 
-    def _command(self, pos: list[float]) -> tuple[Array, Array]:
+    def _command(self, pos: list[float]) -> tuple[Pair, Pair]:
         playback = self._playback
         compensator: Compensator | None = self._compensator
         if playback is not None:
@@ -188,7 +192,7 @@ class ControlLoop:
                 self._end_playback("cancelled")
                 q_raw: Any = self._q
             else:
-                q_raw = playback.q_deg[playback.index]
+                q_raw = self._play_q[playback.index]
                 if not playback.compensate:
                     compensator = None  # the desired angles as they are
         else:
@@ -200,24 +204,21 @@ class ControlLoop:
             self._fault(f"non-finite setpoint {[q0, q1]}")
             return self._q, self._last_cmd
         lo, hi = self._min_f, self._max_f
-        q = np.array((min(max(q0, lo[0]), hi[0]), min(max(q1, lo[1]), hi[1])))
+        q = (min(max(q0, lo[0]), hi[0]), min(max(q1, lo[1]), hi[1]))
         self._q = q
         if compensator is None:
-            cmd = q
+            c0, c1 = q
         else:
-            cmd = np.asarray(compensator.command(q), dtype=float)
+            cmd = np.asarray(compensator.command(np.array(q)), dtype=float)
             if cmd.shape != (2,) or not (_isfinite(cmd[0]) and _isfinite(cmd[1])):
-                self._fault(f"compensator gave {cmd.tolist()} for q {q.tolist()}")
+                self._fault(f"compensator gave {cmd.tolist()} for q {list(q)}")
                 return q, self._last_cmd
-        cmd = np.asarray(self._limiter.limit(cmd), dtype=float)
-        if cmd.shape != (2,):
-            self._fault(f"limiter gave {cmd.tolist()} for q {q.tolist()}")
-            return q, self._last_cmd
-        c0, c1 = cmd.tolist()
+            c0, c1 = cmd.tolist()
+        c0, c1 = self._limiter.limit_pair(c0, c1)
         if not (_isfinite(c0) and _isfinite(c1)):
-            self._fault(f"limiter gave {cmd.tolist()} for q {q.tolist()}")
+            self._fault(f"limiter gave {[c0, c1]} for q {list(q)}")
             return q, self._last_cmd
-        return q, np.array((min(max(c0, lo[0]), hi[0]), min(max(c1, lo[1]), hi[1])))
+        return q, (min(max(c0, lo[0]), hi[0]), min(max(c1, lo[1]), hi[1]))
 
     def _record(self, row: tuple[float, ...]) -> None:
         if self.recorder is not None:
@@ -235,8 +236,8 @@ class ControlLoop:
             return
         self._playback = None
         playback.error = error
-        self.setpoint.set((float(self._q[0]), float(self._q[1])))
-        self._compensator.reset(self._q)
+        self.setpoint.set(self._q)
+        self._compensator.reset(np.array(self._q))
         playback.done.set()
 
     # --- faults ----------------------------------------------------------------------------
@@ -326,8 +327,7 @@ class ControlLoop:
             self._emit("warning", "drive event during enable", drive=event.drive,
                        kind=event.kind.value, message=event.message)
         pos = self._hold_position()
-        self._q = pos
-        self._last_cmd = pos
+        self._q = self._last_cmd = (float(pos[0]), float(pos[1]))
         self._compensator.reset(pos)
         self._limiter.reset(pos)
         self.setpoint.set((float(pos[0]), float(pos[1])))
@@ -382,7 +382,7 @@ class ControlLoop:
         return self.drives.home(drives)
 
     def _cmd_set_compensator(self, compensator: Compensator, label: str) -> str:
-        compensator.reset(self._q)
+        compensator.reset(np.array(self._q))
         self._compensator = compensator
         self._compensation_label = label
         self._emit("info", "compensation", method=label)
@@ -394,7 +394,8 @@ class ControlLoop:
         if self._playback is not None:
             raise LoopError("busy", "a trajectory is already playing")
         if playback.compensate:
-            self._compensator.reset(self._q)
+            self._compensator.reset(np.array(self._q))
+        self._play_q = np.asarray(playback.q_deg, dtype=float).reshape(-1, 2).tolist()
         self._playback = playback
 
     def _cmd_shutdown(self) -> str:

@@ -83,7 +83,7 @@ class LockstepRunner:
         self.drives, self.rig = open_sim(cfg, seed, lockstep=True, plant=plant)
         self.loop = build_loop(cfg, self.drives, make_compensator(profile, method, cfg),
                                self.rig.clock, compensation_label=method,
-                               tip_source=self.rig.tip_deg, after_sync=self.rig.exchange)
+                               tip_source=self.rig.tip_pair, after_sync=self.rig.exchange)
         try:
             self.drives.boot()
             self.loop.tick()

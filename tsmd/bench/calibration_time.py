@@ -115,7 +115,8 @@ def time_protocol(config: TsmdConfig, device: DeviceModel, *, fast: bool = False
         timed = _TimedRunner(runner)
         try:
             cal = run_calibration(timed, "time", device,
-                                  protocol=proto, isolate=True)  # as `calibrate --sim`
+                                  protocol=proto, isolate=True,  # as `calibrate --sim`
+                                  wait_for_worker=False)
             notes = cal.notes
         except Exception as exc:
             accepted = False

@@ -173,7 +173,8 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
                     progress: ProgressCallback | None = None,
                     cancel: threading.Event | None = None,
                     options: IdentifyOptions | None = None,
-                    limits: QualityLimits | None = None, isolate: bool = False) -> Calibration:
+                    limits: QualityLimits | None = None, isolate: bool = False,
+                    wait_for_worker: bool = True) -> Calibration:
     """Run every sweep, identify each as it ends, sweep uncertain grid points again, return the
     knobs to 0, build the profile.
 
@@ -185,7 +186,8 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
                          for k in device.knobs))
     omegas = tuple(k.omega for k in device.knobs)
     runs = run_sweeps(runner, proto, progress=progress, cancel=cancel,
-                      options=device_options(options, device), isolate=isolate, omegas=omegas,
+                      options=device_options(options, device), isolate=isolate,
+                      wait_for_worker=wait_for_worker, omegas=omegas,
                       estimate=(limits or QualityLimits()).estimate)
     profile, report = finish(catheter_id, device, runs.points, limits=limits,
                              amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
@@ -199,6 +201,7 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
 def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
                progress: ProgressCallback | None = None, cancel: threading.Event | None = None,
                options: KnobOptions = None, isolate: bool = False,
+               wait_for_worker: bool = True,
                omegas: Sequence[float] | None = None,
                estimate: EstimateOptions | None = None) -> SweepRuns:
     """Run and identify each sweep in turn, then re-sweep uncertain grid points within the
@@ -208,10 +211,13 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
     ``isolate``: identify in a separate process, overlapped with the next sweep. The
     change-point search is pure Python and holds the GIL; in the daemon's process it delays a
     4 ms control loop by up to 11 ms (measured), so the live daemon must isolate it.
+    ``wait_for_worker``: the worker's start (imports: a burst of CPU) is waited for before the
+    first sweep, so that it never competes with a live loop; in lockstep it need not be, and
+    overlaps the first sweep instead.
     """
     period_s = runner.period_s  # sweeps are planned at the loop's own tick
     wall0 = time.monotonic()
-    identifier = _Identifier(options, isolate)
+    identifier = _Identifier(options, isolate, wait_for_worker)
     player = Player(runner, proto, period_s, cancel)
     plan = []
     q_now = np.zeros(2)
@@ -265,7 +271,7 @@ def _lower_priority() -> None:
 class _Identifier:
     """Identifies sweeps in this process, or in a worker process overlapped with the run."""
 
-    def __init__(self, options: KnobOptions, isolate: bool) -> None:
+    def __init__(self, options: KnobOptions, isolate: bool, wait: bool = True) -> None:
         self.options = options
         self.pool: ProcessPoolExecutor | None = None
         if isolate:
@@ -274,7 +280,9 @@ class _Identifier:
             self.pool = ProcessPoolExecutor(max_workers=1,
                                             mp_context=multiprocessing.get_context("spawn"),
                                             initializer=_lower_priority)
-            self.pool.submit(os.getpid).result()
+            started = self.pool.submit(os.getpid)
+            if wait:
+                started.result()
         self.pending: list[Future[GridPoint]] = []
         self.points: list[GridPoint] = []
 

@@ -125,10 +125,14 @@ class KnobLimiter:
         self._states = [(float(q), 0.0, float(q) if hold else None) for q in cmd_deg]
 
     def limit(self, cmd_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.array(self.limit_pair(float(cmd_deg[0]), float(cmd_deg[1])))
+
+    def limit_pair(self, cmd0_deg: float, cmd1_deg: float) -> tuple[float, float]:
+        """:meth:`limit` on two floats (the control loop's hot path: no arrays)."""
         dt = self.dt_s
         lim0, lim1 = self.limits
         s0, s1 = self._states
-        s0 = step_floats(s0[0], s0[1], s0[2], float(cmd_deg[0]), lim0, dt)
-        s1 = step_floats(s1[0], s1[1], s1[2], float(cmd_deg[1]), lim1, dt)
+        s0 = step_floats(s0[0], s0[1], s0[2], cmd0_deg, lim0, dt)
+        s1 = step_floats(s1[0], s1[1], s1[2], cmd1_deg, lim1, dt)
         self._states = [s0, s1]
-        return np.array((s0[0], s1[0]))
+        return s0[0], s1[0]

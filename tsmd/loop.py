@@ -28,6 +28,7 @@ from tsmd.compensation.safety import KnobLimiter, KnobLimits
 from tsmd.loop_recorders import BackgroundRecorder, MemoryRecorder
 from tsmd.loop_supervision import remaining_fault_cause, silent_drive, tick_fault
 from tsmd.loop_types import (
+    ROW,
     ROW_COLUMNS,
     Array,
     LatestSetpoint,
@@ -47,6 +48,7 @@ __all__ = [
 
 _isfinite = math.isfinite
 Pair = tuple[float, float]
+_pack_row = ROW.pack
 
 
 class ControlLoop:
@@ -225,7 +227,7 @@ class ControlLoop:
             self.recorder.append(row)
         playback = self._playback
         if playback is not None and self.state is LoopState.ENABLED:
-            playback.rows.append(row)
+            playback.rows += _pack_row(*row)
             playback.index += 1
             if playback.index >= len(playback.q_deg):
                 self._end_playback(None)
@@ -235,6 +237,7 @@ class ControlLoop:
         if playback is None:
             return
         self._playback = None
+        self._play_q = []
         playback.error = error
         self.setpoint.set(self._q)
         self._compensator.reset(np.array(self._q))

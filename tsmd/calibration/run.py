@@ -16,7 +16,7 @@ import threading
 import time
 from collections.abc import Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -262,6 +262,12 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
     return SweepRuns(points, player.motion_s, time.monotonic() - wall0, resweep_s, notes)
 
 
+def _identify_detached(rec: Recording, options: KnobOptions, label: str) -> GridPoint:
+    """:func:`identify_recording` in the worker, answered without the recording (the caller
+    has it: sending it back would be a second copy of every sweep)."""
+    return replace(identify_recording(rec, options, label), recording=None)
+
+
 def _lower_priority() -> None:
     """Worker initializer: run identification at a lower CPU priority than the daemon."""
     with contextlib.suppress(OSError):
@@ -283,28 +289,31 @@ class _Identifier:
             started = self.pool.submit(os.getpid)
             if wait:
                 started.result()
-        self.pending: list[Future[GridPoint]] = []
+        self.pending: list[tuple[Future[GridPoint], Recording]] = []
         self.points: list[GridPoint] = []
 
     def submit(self, rec: Recording, label: str) -> None:
         if self.pool is None:
             self.points.append(identify_recording(rec, self.options, label))
         else:
-            self.pending.append(self.pool.submit(identify_recording, rec, self.options, label))
+            self.pending.append((self.pool.submit(_identify_detached, rec, self.options, label),
+                                 rec))
 
     def identify(self, rec: Recording, label: str) -> GridPoint:
         """One sweep now (a re-sweep), in the worker process when isolating."""
         if self.pool is None:
             return identify_recording(rec, self.options, label)
-        return self.pool.submit(identify_recording, rec, self.options, label).result()
+        point = self.pool.submit(_identify_detached, rec, self.options, label).result()
+        return replace(point, recording=rec)
 
     def check(self) -> None:
-        for future in self.pending:
+        for future, _ in self.pending:
             if future.done() and future.exception() is not None:
                 raise future.exception()  # type: ignore[misc]
 
     def results(self) -> list[GridPoint]:
-        return self.points + [f.result() for f in self.pending]
+        """Every sweep's grid point, holding the recording this process already has."""
+        return self.points + [replace(f.result(), recording=rec) for f, rec in self.pending]
 
     def close(self) -> None:
         if self.pool is not None:

@@ -317,7 +317,7 @@ def test_identification_in_a_worker_process_keeps_the_recording_that_was_played(
     proto = Protocol("one", (SHORT_SWEEP,))
     here = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto)
     isolated = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto,
-                          isolate=True, wait_for_worker=False)
+                          isolate=True, live_loop=False)
     rec, again = here.points[0].recording, isolated.points[0].recording
     assert rec is not None and again is not None
     assert all(np.array_equal(rec[c], again[c], equal_nan=True) for c in rec.columns)
@@ -455,3 +455,29 @@ def test_a_refused_calibration_keeps_its_sweeps_for_examination() -> None:
     with pytest.raises(CalibrationRefusedError, match="design assumption 1") as refused:
         finish("cat-3", load_device_model(DEVICE), points)
     assert refused.value.points == tuple(points)
+
+
+def test_identification_worker_of_a_live_loop_runs_niced() -> None:
+    import os
+
+    from tsmd.calibration.run import _Identifier
+
+    identifier = _Identifier(None, isolate=True, live_loop=True)
+    assert identifier.pool is not None
+    try:
+        assert identifier.pool.submit(os.nice, 0).result() == min(os.nice(0) + 10, 19)
+    finally:
+        identifier.close()
+
+
+def test_identification_worker_in_lockstep_runs_at_the_callers_priority() -> None:
+    import os
+
+    from tsmd.calibration.run import _Identifier
+
+    identifier = _Identifier(None, isolate=True, live_loop=False)
+    assert identifier.pool is not None
+    try:
+        assert identifier.pool.submit(os.nice, 0).result() == os.nice(0)
+    finally:
+        identifier.close()

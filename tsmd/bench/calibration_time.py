@@ -116,7 +116,7 @@ def time_protocol(config: TsmdConfig, device: DeviceModel, *, fast: bool = False
         try:
             cal = run_calibration(timed, "time", device,
                                   protocol=proto, isolate=True,  # as `calibrate --sim`
-                                  wait_for_worker=False)
+                                  live_loop=False)
             notes = cal.notes
         except Exception as exc:
             accepted = False

@@ -174,7 +174,7 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
                     cancel: threading.Event | None = None,
                     options: IdentifyOptions | None = None,
                     limits: QualityLimits | None = None, isolate: bool = False,
-                    wait_for_worker: bool = True) -> Calibration:
+                    live_loop: bool = True) -> Calibration:
     """Run every sweep, identify each as it ends, sweep uncertain grid points again, return the
     knobs to 0, build the profile.
 
@@ -187,7 +187,7 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
     omegas = tuple(k.omega for k in device.knobs)
     runs = run_sweeps(runner, proto, progress=progress, cancel=cancel,
                       options=device_options(options, device), isolate=isolate,
-                      wait_for_worker=wait_for_worker, omegas=omegas,
+                      live_loop=live_loop, omegas=omegas,
                       estimate=(limits or QualityLimits()).estimate)
     profile, report = finish(catheter_id, device, runs.points, limits=limits,
                              amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
@@ -201,7 +201,7 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
 def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
                progress: ProgressCallback | None = None, cancel: threading.Event | None = None,
                options: KnobOptions = None, isolate: bool = False,
-               wait_for_worker: bool = True,
+               live_loop: bool = True,
                omegas: Sequence[float] | None = None,
                estimate: EstimateOptions | None = None) -> SweepRuns:
     """Run and identify each sweep in turn, then re-sweep uncertain grid points within the
@@ -211,13 +211,14 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
     ``isolate``: identify in a separate process, overlapped with the next sweep. The
     change-point search is pure Python and holds the GIL; in the daemon's process it delays a
     4 ms control loop by up to 11 ms (measured), so the live daemon must isolate it.
-    ``wait_for_worker``: the worker's start (imports: a burst of CPU) is waited for before the
-    first sweep, so that it never competes with a live loop; in lockstep it need not be, and
-    overlaps the first sweep instead.
+    ``live_loop`` (the runner's loop runs in real time in this process): the worker's start
+    (imports: a burst of CPU) is waited for before the first sweep and the worker runs niced,
+    so that it never competes with the loop. In lockstep (False) neither: its start overlaps
+    the first sweep and it runs at the caller's priority.
     """
     period_s = runner.period_s  # sweeps are planned at the loop's own tick
     wall0 = time.monotonic()
-    identifier = _Identifier(options, isolate, wait_for_worker)
+    identifier = _Identifier(options, isolate, live_loop)
     player = Player(runner, proto, period_s, cancel)
     plan = []
     q_now = np.zeros(2)
@@ -277,17 +278,17 @@ def _lower_priority() -> None:
 class _Identifier:
     """Identifies sweeps in this process, or in a worker process overlapped with the run."""
 
-    def __init__(self, options: KnobOptions, isolate: bool, wait: bool = True) -> None:
+    def __init__(self, options: KnobOptions, isolate: bool, live_loop: bool = True) -> None:
         self.options = options
         self.pool: ProcessPoolExecutor | None = None
         if isolate:
-            # Started now, while the knobs are still at rest (spawning imports numpy, scipy and
-            # ruptures: a burst of CPU), and niced so that it yields to the control loop.
+            # Live: started now, while the knobs are still at rest (spawning imports numpy, scipy
+            # and ruptures: a burst of CPU), and niced so that it yields to the control loop.
             self.pool = ProcessPoolExecutor(max_workers=1,
                                             mp_context=multiprocessing.get_context("spawn"),
-                                            initializer=_lower_priority)
+                                            initializer=_lower_priority if live_loop else None)
             started = self.pool.submit(os.getpid)
-            if wait:
+            if live_loop:
                 started.result()
         self.pending: list[tuple[Future[GridPoint], Recording]] = []
         self.points: list[GridPoint] = []

@@ -207,8 +207,54 @@ def split_ticks(config: TsmdConfig, ticks: int, *, plant_step_us: float = 0.0,
     return split, totals[1], totals[0]
 
 
+class _KnobLog:
+    """The rig's plant, remembering every knob position it was stepped to."""
+
+    def __init__(self, plant: Plant) -> None:
+        self.plant = plant
+        self.knobs: list[NDArray[np.float64]] = []
+
+    def reset(self) -> None:
+        self.plant.reset()
+
+    def step(self, dt_s: float, knob_deg: NDArray[np.float64]) -> Any:
+        self.knobs.append(knob_deg.copy())
+        return self.plant.step(dt_s, knob_deg)
+
+
+def min_cpu_per_tick(config: TsmdConfig, *, reps: int = 30, ticks: int = 1000,
+                     seed: int = 0) -> tuple[float, float, float, float]:
+    """CPU of this thread per tick (us), min and median over ``reps`` runs of ``ticks`` ticks
+    of a paper sweep, and of the plant's ``step`` alone along the same knob path. On a shared
+    machine the minimum is the figure that other jobs disturb least."""
+    period_s = config.loop.period_s
+    n = reps * ticks
+    t = np.arange(n) * period_s
+    q = np.column_stack([90.0 * np.sin(2 * np.pi * 0.04 * t), np.zeros(n)])
+    log = _KnobLog(load_plant(config.sim.plant, config.sim.params))
+    tick_us = []
+    with LockstepRunner(config, seed=seed, plant=log) as runner:
+        start = len(log.knobs)
+        for k in range(reps):
+            c0 = time.thread_time()
+            runner.run(t[k * ticks:(k + 1) * ticks], q[k * ticks:(k + 1) * ticks], False)
+            tick_us.append((time.thread_time() - c0) / ticks * 1e6)
+        knobs = log.knobs[start:]
+    plant = load_plant(config.sim.plant, config.sim.params)
+    plant.reset()
+    plant_us = []
+    chunk = max(len(knobs) // reps, 1)
+    for k in range(reps):
+        part = knobs[k * chunk:(k + 1) * chunk]
+        c0 = time.thread_time()
+        for knob in part:
+            plant.step(period_s, knob)
+        plant_us.append((time.thread_time() - c0) / max(len(part), 1) * 1e6)
+    return (min(tick_us), float(np.median(tick_us)), min(plant_us), float(np.median(plant_us)))
+
+
 def report(run: TimeRun, split: dict[str, float], timed_us: float, plain_us: float,
-           split_ticks_n: int) -> list[str]:
+           split_ticks_n: int, cpu: tuple[float, float, float, float]) -> list[str]:
     per_tick = run.ticking_s / max(run.ticks, 1) * 1e6
     plant_us = run.plant_s / max(run.ticks, 1) * 1e6
     lines = [
@@ -227,6 +273,9 @@ def report(run: TimeRun, split: dict[str, float], timed_us: float, plain_us: flo
     for name in SPLIT_ORDER:
         value = split.get(name, float("nan"))
         lines.append(f"  {name:<24} {value:7.1f}  {100.0 * value / timed_us:5.1f} %")
+    lines.append(f"CPU per tick, unpaced plant (min / median of 30 runs of 1000 ticks): whole "
+                 f"tick {cpu[0]:.1f} / {cpu[1]:.1f} us, plant.step alone {cpu[2]:.1f} / "
+                 f"{cpu[3]:.1f} us")
     return lines
 
 
@@ -240,7 +289,9 @@ def main_time(device: DeviceModel, *, fast: bool, plant_step_us: float, split_n:
     cfg = config or default_sim_config()
     run = time_protocol(cfg, device, fast=fast, plant_step_us=plant_step_us, seed=seed)
     split, timed_us, plain_us = split_ticks(cfg, split_n, plant_step_us=plant_step_us, seed=seed)
-    return report(run, split, timed_us, plain_us, split_n)
+    cpu = min_cpu_per_tick(cfg, seed=seed)
+    return report(run, split, timed_us, plain_us, split_n, cpu)
 
 
-__all__ = ["PacedPlant", "PlantStep", "TimeRun", "main_time", "split_ticks", "time_protocol"]
+__all__ = ["PacedPlant", "PlantStep", "TimeRun", "main_time", "min_cpu_per_tick", "split_ticks",
+           "time_protocol"]

@@ -43,3 +43,11 @@ def test_time_with_both_protocols_is_a_one_line_error() -> None:
     args = parser.parse_args(["--time"])  # --protocol defaults to both
     with pytest.raises(TsmdError, match="--protocol paper or fast"):
         calibration.main(args)
+
+
+def test_a_cpu_paced_plant_step_costs_its_pace_in_cpu_time() -> None:
+    paced = PacedPlant(load_plant(DEFAULT_PLANT), step_us=2000.0, cpu=True)
+    paced.reset()
+    c0 = time.thread_time()
+    paced.step(0.004, np.array([5.0, -3.0]))
+    assert time.thread_time() - c0 >= 2e-3

@@ -399,7 +399,7 @@ class ControlLoop:
             raise LoopError("busy", "a trajectory is already playing")
         if playback.compensate:
             self._compensator.reset(np.array(self._q))
-        self._play_q = np.asarray(playback.q_deg, dtype=float).reshape(-1, 2).tolist()
+        self._play_q = np.asarray(playback.q_deg, dtype=float)[:, :2].tolist()
         self._playback = playback
 
     def _cmd_shutdown(self) -> str:

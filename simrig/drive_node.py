@@ -32,6 +32,11 @@ NMT_OPERATIONAL = 0x05
 NMT_PRE_OPERATIONAL = 0x7F
 
 _QS_HOLD_OPTIONS = (5, 6, 7, 8)
+# The states a period checks, as module constants: an enum member read through its class costs
+# several times a global read on Python 3.11, and these are read by both drives every tick.
+_OPERATION_ENABLED = DriveState.OPERATION_ENABLED
+_FAULT_REACTION_ACTIVE = DriveState.FAULT_REACTION_ACTIVE
+_QUICK_STOP_ACTIVE = DriveState.QUICK_STOP_ACTIVE
 _POWERED = frozenset((DriveState.OPERATION_ENABLED, DriveState.QUICK_STOP_ACTIVE,
                       DriveState.FAULT_REACTION_ACTIVE))
 
@@ -120,6 +125,9 @@ class SimDriveNode(DriveObjectStore):
         self.following_error_counts = 0
         self.current_raw = 0
         self.statusword = 0
+        self._sw_key: tuple[DriveState, bool, bool, bool, bool] | None = None
+        self._sw_base = 0
+        """The last statusword key and its statusword before the homing bits."""
         self._fe_since_s: float | None = None
         self._sync_count = 0
         self._rpdo_pending: bytes | bytearray | None = None
@@ -204,7 +212,7 @@ class SimDriveNode(DriveObjectStore):
         """Apply a controlword (level-triggered, except fault reset and QUICK STOP -> ENABLED,
         which need a change of the controlword)."""
         previous = self.controlword
-        if cw == previous and self.state is DriveState.OPERATION_ENABLED:
+        if cw == previous and self.state is _OPERATION_ENABLED:
             return
         rising_reset = bool(cw & 0x80) and not self.controlword & 0x80
         self.controlword = cw
@@ -286,9 +294,13 @@ class SimDriveNode(DriveObjectStore):
     def _update_statusword(self) -> None:
         key = (self.state, self.halted, self.internal_limit, self.following_error,
                bool(self.error_register))
-        sw = _STATUSWORDS.get(key)
-        if sw is None:
-            sw = _STATUSWORDS[key] = _statusword(*key)
+        if key == self._sw_key:  # compared member by member: no enum hash per tick
+            sw = self._sw_base
+        else:
+            known = _STATUSWORDS.get(key)
+            sw = known if known is not None else _statusword(*key)
+            _STATUSWORDS[key] = sw
+            self._sw_key, self._sw_base = key, sw
         if self.mode_display == o.HOMING_MODE:  # bits 10, 12, 13 mean homing progress here
             sw = (sw & ~HOMING_BITS) | self.homing.bits
         self.statusword = sw
@@ -311,9 +323,8 @@ class SimDriveNode(DriveObjectStore):
     # -- one period of motion -------------------------------------------------------------
     def motion_target_deg(self) -> float:
         """Where the motor goes this period (called after SYNC, before the physics step)."""
-        S = DriveState
         dt = self.motor.dt_s
-        if self.state is S.OPERATION_ENABLED and not self.halted:
+        if self.state is _OPERATION_ENABLED and not self.halted:
             if self.mode_display == o.HOMING_MODE:
                 self._internal_target_deg = self.homing.target_deg(dt)
                 return self._internal_target_deg
@@ -351,9 +362,8 @@ class SimDriveNode(DriveObjectStore):
         self.velocity_counts_s = round(motor.velocity_deg_s * cpd)
         raw = round(measured_current_A * self._raw_per_A) if self.powered else 0
         self.current_raw = -32768 if raw < -32768 else 32767 if raw > 32767 else raw
-        S = DriveState
         state = self.state
-        if state is S.OPERATION_ENABLED and not self.halted:
+        if state is _OPERATION_ENABLED and not self.halted:
             err = round((self._internal_target_deg - motor.position_deg) * cpd)
             self.following_error_counts = err
             window = self._fe_window
@@ -367,14 +377,14 @@ class SimDriveNode(DriveObjectStore):
                 self._fe_since_s = None
         else:
             self._fe_since_s = None
-        if state is S.OPERATION_ENABLED and self.homing.active:
+        if state is _OPERATION_ENABLED and self.homing.active:
             self.homing.after_step(measured_current_A)
             self.position_counts = round((motor.position_deg - self.encoder_zero_deg) * cpd)
-        if state is S.FAULT_REACTION_ACTIVE and self._qs_velocity_deg_s == 0.0:
-            self._set_state(S.FAULT)
-        elif state is S.QUICK_STOP_ACTIVE and self._qs_velocity_deg_s == 0.0 and (
+        if state is _FAULT_REACTION_ACTIVE and self._qs_velocity_deg_s == 0.0:
+            self._set_state(DriveState.FAULT)
+        elif state is _QUICK_STOP_ACTIVE and self._qs_velocity_deg_s == 0.0 and (
                 self._value(o.QUICK_STOP_OPTION, 0) in (1, 2)):
-            self._set_state(S.SWITCH_ON_DISABLED)
+            self._set_state(DriveState.SWITCH_ON_DISABLED)
         self._supervise_master(now_s)
         self._update_statusword()
 

@@ -311,6 +311,28 @@ def test_identification_in_a_worker_process_gives_the_same_values() -> None:
     assert isolated.points[0].result.values == here.points[0].result.values
 
 
+def test_identification_in_a_worker_process_keeps_the_recording_that_was_played() -> None:
+    from tsmd.calibration.run import run_sweeps
+
+    proto = Protocol("one", (SHORT_SWEEP,))
+    here = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto)
+    isolated = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto,
+                          isolate=True, live_loop=False)
+    rec, again = here.points[0].recording, isolated.points[0].recording
+    assert rec is not None and again is not None
+    assert all(np.array_equal(rec[c], again[c], equal_nan=True) for c in rec.columns)
+
+
+def test_conditioning_a_complete_sweep_keeps_its_arrays_without_a_copy() -> None:
+    from tsmd.calibration.signal import condition
+
+    t = np.arange(500) * PERIOD_S
+    cmd = 30.0 * np.sin(2 * np.pi * 0.5 * t)
+    data = condition(t, cmd, cmd.copy(), 0.1 * np.sin(t))
+    assert data.t_s is t or np.shares_memory(data.t_s, t)
+    assert np.shares_memory(data.cmd_deg, cmd)
+
+
 def _with_backlash(base: SweepResult, backlash_deg: float) -> SweepResult:
     values = dict(base.values)
     values["backlash_pos_deg"] = (backlash_deg, backlash_deg)
@@ -433,3 +455,29 @@ def test_a_refused_calibration_keeps_its_sweeps_for_examination() -> None:
     with pytest.raises(CalibrationRefusedError, match="design assumption 1") as refused:
         finish("cat-3", load_device_model(DEVICE), points)
     assert refused.value.points == tuple(points)
+
+
+def test_identification_worker_of_a_live_loop_runs_niced() -> None:
+    import os
+
+    from tsmd.calibration.run import _Identifier
+
+    identifier = _Identifier(None, isolate=True, live_loop=True)
+    assert identifier.pool is not None
+    try:
+        assert identifier.pool.submit(os.nice, 0).result() == min(os.nice(0) + 10, 19)
+    finally:
+        identifier.close()
+
+
+def test_identification_worker_in_lockstep_runs_at_the_callers_priority() -> None:
+    import os
+
+    from tsmd.calibration.run import _Identifier
+
+    identifier = _Identifier(None, isolate=True, live_loop=False)
+    assert identifier.pool is not None
+    try:
+        assert identifier.pool.submit(os.nice, 0).result() == os.nice(0)
+    finally:
+        identifier.close()

@@ -219,7 +219,7 @@ def test_a_fault_during_a_trajectory_ends_it_with_the_reason_and_clears_the_setp
     loop.tick()
     assert playback.done.is_set()
     assert "emcy" in (playback.error or "")
-    assert len(playback.rows) == 10
+    assert len(playback.table()) == 10
     assert loop.setpoint.get() is None
 
 
@@ -234,7 +234,7 @@ def test_an_uncompensated_trajectory_sends_the_desired_angles_past_the_compensat
     while not playback.done.is_set():
         loop.tick()
     assert len(comp.inputs) == calls
-    assert [row[3:5] for row in playback.rows] == [(0.0, 0.0)] * 4
+    assert playback.table()[:, 3:5].tolist() == [[0.0, 0.0]] * 4
 
 
 def test_latest_sample_is_the_last_tick_and_one_object_until_the_next() -> None:

@@ -141,3 +141,23 @@ def test_reset_recovers_after_the_injected_fault_is_cleared() -> None:
         assert runner.loop.execute("enable") == "ENABLED"
         rec = runner.run(t, q, compensate=False)
     assert len(rec) == int(np.floor(t[-1] / PERIOD_S + 1e-9)) + 1
+
+
+def test_a_played_recording_holds_the_rows_the_loop_recorded() -> None:
+    from tsmd.loop import MemoryRecorder
+    from tsmd.loop_types import ROW_COLUMNS
+
+    t, q = sine(1.0)
+    with LockstepRunner(seed=2) as runner:
+        recorder = MemoryRecorder()
+        runner.loop.recorder = recorder
+        rec = runner.run(t, q, compensate=False)
+    rows = np.array(recorder.rows)
+    for j, name in enumerate(ROW_COLUMNS[1:], start=1):
+        assert np.array_equal(rec[name], rows[:, j], equal_nan=True), name
+
+
+def test_a_played_recording_has_contiguous_columns() -> None:
+    t, q = sine(1.0)
+    rec = run_trajectory(t, q)
+    assert all(column.flags.c_contiguous for column in rec.columns.values())

@@ -28,6 +28,7 @@ from tsmd.compensation.safety import KnobLimiter, KnobLimits
 from tsmd.loop_recorders import BackgroundRecorder, MemoryRecorder
 from tsmd.loop_supervision import remaining_fault_cause, silent_drive, tick_fault
 from tsmd.loop_types import (
+    ROW,
     ROW_COLUMNS,
     Array,
     LatestSetpoint,
@@ -47,6 +48,8 @@ __all__ = [
 
 _isfinite = math.isfinite
 Pair = tuple[float, float]
+_ENABLED = LoopState.ENABLED  # read several times a tick: a global, not an enum class lookup
+_pack_row = ROW.pack
 
 
 class ControlLoop:
@@ -150,12 +153,12 @@ class ControlLoop:
         pos = [feedback[0].position_deg, feedback[1].position_deg]
         if events:
             self.last_events.extend(events)
-        if self.state is LoopState.ENABLED:
+        if self.state is _ENABLED:
             reason = tick_fault(events, feedback, self.stale_feedback_syncs,
                                 self.stats.overrun_streak, self.overrun_fault_streak)
             if reason is not None:
                 self._fault(reason)
-        if self.state is LoopState.ENABLED:
+        if self.state is _ENABLED:
             q, cmd = self._command(pos)
         else:
             q = cmd = ((pos[0], pos[1]) if _isfinite(pos[0]) and _isfinite(pos[1])
@@ -180,7 +183,7 @@ class ControlLoop:
                fb0.current_A, fb1.current_A, tip0, tip1)
         self._record(row)
         if self.observer is not None:
-            self.observer(row, self.state is LoopState.ENABLED)
+            self.observer(row, self.state is _ENABLED)
         self.stats.ticks += 1
         self._latest = (self.stats.ticks, t_s, self.state, row, self.fault_reason)
 
@@ -224,8 +227,8 @@ class ControlLoop:
         if self.recorder is not None:
             self.recorder.append(row)
         playback = self._playback
-        if playback is not None and self.state is LoopState.ENABLED:
-            playback.rows.append(row)
+        if playback is not None and self.state is _ENABLED:
+            playback.rows += _pack_row(*row)
             playback.index += 1
             if playback.index >= len(playback.q_deg):
                 self._end_playback(None)
@@ -235,6 +238,7 @@ class ControlLoop:
         if playback is None:
             return
         self._playback = None
+        self._play_q = []
         playback.error = error
         self.setpoint.set(self._q)
         self._compensator.reset(np.array(self._q))
@@ -395,7 +399,7 @@ class ControlLoop:
             raise LoopError("busy", "a trajectory is already playing")
         if playback.compensate:
             self._compensator.reset(np.array(self._q))
-        self._play_q = np.asarray(playback.q_deg, dtype=float).reshape(-1, 2).tolist()
+        self._play_q = np.asarray(playback.q_deg, dtype=float)[:, :2].tolist()
         self._playback = playback
 
     def _cmd_shutdown(self) -> str:

@@ -12,6 +12,8 @@ from collections.abc import Sequence
 
 from drivers.drive import DriveFeedback, DriveState, FaultEvent, KnobDrives
 
+_OPERATION_ENABLED = DriveState.OPERATION_ENABLED  # read every tick: a global, not an enum lookup
+
 
 def tick_fault(events: Sequence[FaultEvent], feedback: Sequence[DriveFeedback],
                stale_feedback_syncs: int, overrun_streak: int,
@@ -22,7 +24,7 @@ def tick_fault(events: Sequence[FaultEvent], feedback: Sequence[DriveFeedback],
         ev = events[0]
         return f"drive {ev.drive}: {ev.kind.value}: {ev.message}"
     for i, fb in enumerate(feedback):
-        if fb.state is not DriveState.OPERATION_ENABLED:
+        if fb.state is not _OPERATION_ENABLED:
             return f"drive {i}: left OPERATION ENABLED (state {fb.state.value})"
         if fb.age_syncs > stale_feedback_syncs:
             return f"drive {i}: stale feedback ({fb.age_syncs} SYNCs without an answer)"

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import enum
 import math
+import struct
 import threading
 from concurrent.futures import Future
 from dataclasses import dataclass, field
@@ -24,7 +25,8 @@ ROW_COLUMNS: tuple[str, ...] = (
     "t", "q1", "q2", "cmd1", "cmd2", "pos1", "pos2", "cur1", "cur2", "tip1", "tip2",
 )
 """The recording columns every tick produces (tsmd.recording.REQUIRED_COLUMNS)."""
-
+ROW = struct.Struct(f"@{len(ROW_COLUMNS)}d")
+"""One row packed as native float64s, as a trajectory's rows are kept while it plays."""
 
 
 class LoopState(enum.Enum):
@@ -109,7 +111,9 @@ class Playback:
     q_deg: Array
     compensate: bool
     cancel: threading.Event | None = None
-    rows: list[tuple[float, ...]] = field(default_factory=list)
+    rows: bytearray = field(default_factory=bytearray)
+    """Every recorded row packed with :data:`ROW`, one after the other: no Python object per
+    tick, and read back by :meth:`table` without a conversion."""
     index: int = 0
     done: threading.Event = field(default_factory=threading.Event)
     error: str | None = None
@@ -117,6 +121,11 @@ class Playback:
     @property
     def progress(self) -> float:
         return self.index / max(len(self.q_deg), 1)
+
+    def table(self) -> Array:
+        """The recorded rows, shape (ticks, len(ROW_COLUMNS)), viewing :attr:`rows` (read it
+        once the playback is done: the buffer cannot grow while viewed)."""
+        return np.frombuffer(self.rows, dtype=np.float64).reshape(-1, len(ROW_COLUMNS))
 
 
 @dataclass

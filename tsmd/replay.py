@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 import threading
-from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -53,13 +52,14 @@ def resample(t_s: ArrayLike, q_deg: ArrayLike, period_s: float
     return ticks, out
 
 
-def rows_to_recording(rows: Sequence[tuple[float, ...]], t_ticks: NDArray[np.float64],
+def rows_to_recording(rows: NDArray[np.float64], t_ticks: NDArray[np.float64],
                       metadata: dict[str, str]) -> Recording:
-    """Rows from the loop as a recording whose ``t`` is the trajectory's own time."""
-    data = np.asarray(rows, dtype=float).reshape(-1, len(ROW_COLUMNS))
-    columns = {name: data[:, j].copy() for j, name in enumerate(ROW_COLUMNS)}
-    columns["t"] = t_ticks[: len(data)].copy()
-    return Recording(columns, metadata)
+    """A playback's table (:meth:`Playback.table`) as a recording whose ``t`` is the
+    trajectory's own time; one copy, column by column contiguous."""
+    table = np.asarray(rows, dtype=float).reshape(-1, len(ROW_COLUMNS))
+    data = table[:, 1:].T.copy()  # the loop's own time (column 0) is replaced by the ticks'
+    columns = {name: data[j] for j, name in enumerate(ROW_COLUMNS[1:])}
+    return Recording({"t": t_ticks[: len(table)].copy(), **columns}, metadata)
 
 
 class LockstepRunner:
@@ -123,7 +123,7 @@ class LockstepRunner:
                 "seed": str(self.seed), "plant": self.config.sim.plant}
         if playback.error == "cancelled":
             meta["cancelled"] = "true"
-        return rows_to_recording(playback.rows, ticks, meta)
+        return rows_to_recording(playback.table(), ticks, meta)
 
     def close(self) -> None:
         for obj in (self.drives, self.rig):
@@ -178,4 +178,4 @@ class LiveTrajectoryRunner:
                 "compensation": loop.compensation_label if compensate else "none"}
         if playback.error == "cancelled":
             meta["cancelled"] = "true"
-        return rows_to_recording(playback.rows, ticks, meta)
+        return rows_to_recording(playback.table(), ticks, meta)

@@ -75,6 +75,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "--noise-seeds): wall, CPU, peak RSS, where a tick goes")
     parser.add_argument("--plant-step-us", type=float, default=0.0, metavar="US",
                         help="--time: every plant step lasts at least this long (busy wait)")
+    parser.add_argument("--pace-cpu", action="store_true",
+                        help="--time: pace the plant on CPU time (the run's CPU is then what an "
+                             "idle core would take, whatever the load)")
     parser.add_argument("--split-ticks", type=int, default=12500, metavar="N",
                         help="--time: ticks of the per-layer split (default 12500: one sweep)")
 
@@ -88,7 +91,8 @@ def main(args: argparse.Namespace) -> int:
         device = load_device_model(resolve_data_path(args.device))
         print("\n".join(main_time(device, fast=args.protocol == "fast",
                                    plant_step_us=args.plant_step_us,
-                                   split_n=args.split_ticks, seed=seed)))
+                                   split_n=args.split_ticks, seed=seed,
+                                   pace_cpu=args.pace_cpu)))
         return 0
     if not args.no_sim:
         print(family(args))

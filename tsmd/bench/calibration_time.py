@@ -34,19 +34,25 @@ SPLIT_ORDER = ("plant", "simulated drives", "EM tracker", "CAN bus", "CANopen ma
 
 class PacedPlant:
     """A plant whose ``step`` lasts at least ``step_us`` (busy wait after its own work): the
-    cost of a heavier physics model, with the same physics."""
+    cost of a heavier physics model, with the same physics.
 
-    def __init__(self, plant: Plant, step_us: float = 0.0) -> None:
+    ``cpu=True`` paces on this thread's CPU time instead of the wall clock: every step then
+    costs the process ``step_us`` of CPU whatever else runs on the machine, so the run's CPU
+    time is what an idle core would take (a loaded machine only stretches the wall time).
+    """
+
+    def __init__(self, plant: Plant, step_us: float = 0.0, *, cpu: bool = False) -> None:
         self.plant = plant
         self.step_s = max(step_us, 0.0) * 1e-6
+        self.clock = time.thread_time if cpu else time.perf_counter
         self.spent_s = 0.0
-        """Wall time inside ``step`` (own work and wait)."""
+        """Time inside ``step`` (own work and wait) on the pacing clock."""
 
     def reset(self) -> None:
         self.plant.reset()
 
     def step(self, dt_s: float, knob_deg: NDArray[np.float64]) -> Any:
-        clock = time.perf_counter
+        clock = self.clock
         t0 = clock()
         answer = self.plant.step(dt_s, knob_deg)
         end = t0 + self.step_s
@@ -72,6 +78,7 @@ class TimeRun:
     rss_MiB: float
     accepted: bool
     plant_step_us: float
+    pace_cpu: bool = False
     notes: list[str] = field(default_factory=list)
 
 
@@ -104,9 +111,10 @@ class _TimedRunner:
 
 
 def time_protocol(config: TsmdConfig, device: DeviceModel, *, fast: bool = False,
-                  plant_step_us: float = 0.0, seed: int = 0) -> TimeRun:
+                  plant_step_us: float = 0.0, seed: int = 0, pace_cpu: bool = False) -> TimeRun:
     """One calibration in lockstep on the config's plant, paced to ``plant_step_us``."""
-    plant = PacedPlant(load_plant(config.sim.plant, config.sim.params), plant_step_us)
+    plant = PacedPlant(load_plant(config.sim.plant, config.sim.params), plant_step_us,
+                       cpu=pace_cpu)
     proto = fast_protocol() if fast else paper_protocol()
     w0, c0 = time.perf_counter(), _cpu_s()
     accepted = True
@@ -116,14 +124,14 @@ def time_protocol(config: TsmdConfig, device: DeviceModel, *, fast: bool = False
         try:
             cal = run_calibration(timed, "time", device,
                                   protocol=proto, isolate=True,  # as `calibrate --sim`
-                                  wait_for_worker=False)
+                                  live_loop=False)
             notes = cal.notes
         except Exception as exc:
             accepted = False
             notes = [f"{type(exc).__name__}: {exc}"]
         ticks = runner.loop.stats.ticks
     return TimeRun(proto.name, ticks, time.perf_counter() - w0, _cpu_s() - c0, plant.spent_s,
-                   timed.run_s, _rss_MiB(), accepted, plant_step_us, notes)
+                   timed.run_s, _rss_MiB(), accepted, plant_step_us, pace_cpu, notes)
 
 
 class _Timers:
@@ -207,18 +215,65 @@ def split_ticks(config: TsmdConfig, ticks: int, *, plant_step_us: float = 0.0,
     return split, totals[1], totals[0]
 
 
+class _KnobLog:
+    """The rig's plant, remembering every knob position it was stepped to."""
+
+    def __init__(self, plant: Plant) -> None:
+        self.plant = plant
+        self.knobs: list[NDArray[np.float64]] = []
+
+    def reset(self) -> None:
+        self.plant.reset()
+
+    def step(self, dt_s: float, knob_deg: NDArray[np.float64]) -> Any:
+        self.knobs.append(knob_deg.copy())
+        return self.plant.step(dt_s, knob_deg)
+
+
+def min_cpu_per_tick(config: TsmdConfig, *, reps: int = 30, ticks: int = 1000,
+                     seed: int = 0) -> tuple[float, float, float, float]:
+    """CPU of this thread per tick (us), min and median over ``reps`` runs of ``ticks`` ticks
+    of a paper sweep, and of the plant's ``step`` alone along the same knob path. On a shared
+    machine the minimum is the figure that other jobs disturb least."""
+    period_s = config.loop.period_s
+    n = reps * ticks
+    t = np.arange(n) * period_s
+    q = np.column_stack([90.0 * np.sin(2 * np.pi * 0.04 * t), np.zeros(n)])
+    log = _KnobLog(load_plant(config.sim.plant, config.sim.params))
+    tick_us = []
+    with LockstepRunner(config, seed=seed, plant=log) as runner:
+        start = len(log.knobs)
+        for k in range(reps):
+            c0 = time.thread_time()
+            runner.run(t[k * ticks:(k + 1) * ticks], q[k * ticks:(k + 1) * ticks], False)
+            tick_us.append((time.thread_time() - c0) / ticks * 1e6)
+        knobs = log.knobs[start:]
+    plant = load_plant(config.sim.plant, config.sim.params)
+    plant.reset()
+    plant_us = []
+    chunk = max(len(knobs) // reps, 1)
+    for k in range(reps):
+        part = knobs[k * chunk:(k + 1) * chunk]
+        c0 = time.thread_time()
+        for knob in part:
+            plant.step(period_s, knob)
+        plant_us.append((time.thread_time() - c0) / max(len(part), 1) * 1e6)
+    return (min(tick_us), float(np.median(tick_us)), min(plant_us), float(np.median(plant_us)))
+
+
 def report(run: TimeRun, split: dict[str, float], timed_us: float, plain_us: float,
-           split_ticks_n: int) -> list[str]:
+           split_ticks_n: int, cpu: tuple[float, float, float, float]) -> list[str]:
     per_tick = run.ticking_s / max(run.ticks, 1) * 1e6
     plant_us = run.plant_s / max(run.ticks, 1) * 1e6
     lines = [
-        f"{run.protocol} protocol in lockstep, plant step paced to >= {run.plant_step_us:g} us: "
+        f"{run.protocol} protocol in lockstep, plant step paced to >= {run.plant_step_us:g} us "
+        f"of {'CPU' if run.pace_cpu else 'wall'} time: "
         f"{'accepted' if run.accepted else 'NOT accepted'}; {run.ticks} ticks",
         f"  wall {run.wall_s:.1f} s (target < 30 s), CPU of this process {run.cpu_s:.1f} s, "
         f"peak RSS {run.rss_MiB:.0f} MiB, load average {_loadavg()} on {os.cpu_count()} CPUs",
-        f"  ticking {run.ticking_s:.1f} s = {per_tick:.1f} us/tick (plant.step {plant_us:.1f}, "
-        f"stack {per_tick - plant_us:.1f}); outside the ticks (identification, plan, fit) "
-        f"{run.wall_s - run.ticking_s:.1f} s",
+        f"  ticking {run.ticking_s:.1f} s wall = {per_tick:.1f} us/tick; plant.step "
+        f"{plant_us:.1f} us " + ("of CPU" if run.pace_cpu else f"(stack {per_tick - plant_us:.1f})")
+        + f"; outside the ticks (identification, plan, fit) {run.wall_s - run.ticking_s:.1f} s",
     ]
     lines += [f"  {note}" for note in run.notes]
     lines.append(f"where a tick goes ({split_ticks_n} ticks of a 0.04 Hz +-90 deg sweep, us/tick "
@@ -227,6 +282,9 @@ def report(run: TimeRun, split: dict[str, float], timed_us: float, plain_us: flo
     for name in SPLIT_ORDER:
         value = split.get(name, float("nan"))
         lines.append(f"  {name:<24} {value:7.1f}  {100.0 * value / timed_us:5.1f} %")
+    lines.append(f"CPU per tick, unpaced plant (min / median of 30 runs of 1000 ticks): whole "
+                 f"tick {cpu[0]:.1f} / {cpu[1]:.1f} us, plant.step alone {cpu[2]:.1f} / "
+                 f"{cpu[3]:.1f} us")
     return lines
 
 
@@ -235,12 +293,16 @@ def _loadavg() -> str:
 
 
 def main_time(device: DeviceModel, *, fast: bool, plant_step_us: float, split_n: int,
-              seed: int = 0, config: TsmdConfig | None = None) -> list[str]:
+              seed: int = 0, config: TsmdConfig | None = None,
+              pace_cpu: bool = False) -> list[str]:
     """The ``--time`` figures as printed lines."""
     cfg = config or default_sim_config()
-    run = time_protocol(cfg, device, fast=fast, plant_step_us=plant_step_us, seed=seed)
+    run = time_protocol(cfg, device, fast=fast, plant_step_us=plant_step_us, seed=seed,
+                        pace_cpu=pace_cpu)
     split, timed_us, plain_us = split_ticks(cfg, split_n, plant_step_us=plant_step_us, seed=seed)
-    return report(run, split, timed_us, plain_us, split_n)
+    cpu = min_cpu_per_tick(cfg, seed=seed)
+    return report(run, split, timed_us, plain_us, split_n, cpu)
 
 
-__all__ = ["PacedPlant", "PlantStep", "TimeRun", "main_time", "split_ticks", "time_protocol"]
+__all__ = ["PacedPlant", "PlantStep", "TimeRun", "main_time", "min_cpu_per_tick", "split_ticks",
+           "time_protocol"]

@@ -16,7 +16,7 @@ import threading
 import time
 from collections.abc import Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -174,7 +174,7 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
                     cancel: threading.Event | None = None,
                     options: IdentifyOptions | None = None,
                     limits: QualityLimits | None = None, isolate: bool = False,
-                    wait_for_worker: bool = True) -> Calibration:
+                    live_loop: bool = True) -> Calibration:
     """Run every sweep, identify each as it ends, sweep uncertain grid points again, return the
     knobs to 0, build the profile.
 
@@ -187,7 +187,7 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
     omegas = tuple(k.omega for k in device.knobs)
     runs = run_sweeps(runner, proto, progress=progress, cancel=cancel,
                       options=device_options(options, device), isolate=isolate,
-                      wait_for_worker=wait_for_worker, omegas=omegas,
+                      live_loop=live_loop, omegas=omegas,
                       estimate=(limits or QualityLimits()).estimate)
     profile, report = finish(catheter_id, device, runs.points, limits=limits,
                              amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
@@ -201,7 +201,7 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
 def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
                progress: ProgressCallback | None = None, cancel: threading.Event | None = None,
                options: KnobOptions = None, isolate: bool = False,
-               wait_for_worker: bool = True,
+               live_loop: bool = True,
                omegas: Sequence[float] | None = None,
                estimate: EstimateOptions | None = None) -> SweepRuns:
     """Run and identify each sweep in turn, then re-sweep uncertain grid points within the
@@ -211,13 +211,14 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
     ``isolate``: identify in a separate process, overlapped with the next sweep. The
     change-point search is pure Python and holds the GIL; in the daemon's process it delays a
     4 ms control loop by up to 11 ms (measured), so the live daemon must isolate it.
-    ``wait_for_worker``: the worker's start (imports: a burst of CPU) is waited for before the
-    first sweep, so that it never competes with a live loop; in lockstep it need not be, and
-    overlaps the first sweep instead.
+    ``live_loop`` (the runner's loop runs in real time in this process): the worker's start
+    (imports: a burst of CPU) is waited for before the first sweep and the worker runs niced,
+    so that it never competes with the loop. In lockstep (False) neither: its start overlaps
+    the first sweep and it runs at the caller's priority.
     """
     period_s = runner.period_s  # sweeps are planned at the loop's own tick
     wall0 = time.monotonic()
-    identifier = _Identifier(options, isolate, wait_for_worker)
+    identifier = _Identifier(options, isolate, live_loop)
     player = Player(runner, proto, period_s, cancel)
     plan = []
     q_now = np.zeros(2)
@@ -262,6 +263,12 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
     return SweepRuns(points, player.motion_s, time.monotonic() - wall0, resweep_s, notes)
 
 
+def _identify_detached(rec: Recording, options: KnobOptions, label: str) -> GridPoint:
+    """:func:`identify_recording` in the worker, answered without the recording (the caller
+    has it: sending it back would be a second copy of every sweep)."""
+    return replace(identify_recording(rec, options, label), recording=None)
+
+
 def _lower_priority() -> None:
     """Worker initializer: run identification at a lower CPU priority than the daemon."""
     with contextlib.suppress(OSError):
@@ -271,40 +278,43 @@ def _lower_priority() -> None:
 class _Identifier:
     """Identifies sweeps in this process, or in a worker process overlapped with the run."""
 
-    def __init__(self, options: KnobOptions, isolate: bool, wait: bool = True) -> None:
+    def __init__(self, options: KnobOptions, isolate: bool, live_loop: bool = True) -> None:
         self.options = options
         self.pool: ProcessPoolExecutor | None = None
         if isolate:
-            # Started now, while the knobs are still at rest (spawning imports numpy, scipy and
-            # ruptures: a burst of CPU), and niced so that it yields to the control loop.
+            # Live: started now, while the knobs are still at rest (spawning imports numpy, scipy
+            # and ruptures: a burst of CPU), and niced so that it yields to the control loop.
             self.pool = ProcessPoolExecutor(max_workers=1,
                                             mp_context=multiprocessing.get_context("spawn"),
-                                            initializer=_lower_priority)
+                                            initializer=_lower_priority if live_loop else None)
             started = self.pool.submit(os.getpid)
-            if wait:
+            if live_loop:
                 started.result()
-        self.pending: list[Future[GridPoint]] = []
+        self.pending: list[tuple[Future[GridPoint], Recording]] = []
         self.points: list[GridPoint] = []
 
     def submit(self, rec: Recording, label: str) -> None:
         if self.pool is None:
             self.points.append(identify_recording(rec, self.options, label))
         else:
-            self.pending.append(self.pool.submit(identify_recording, rec, self.options, label))
+            self.pending.append((self.pool.submit(_identify_detached, rec, self.options, label),
+                                 rec))
 
     def identify(self, rec: Recording, label: str) -> GridPoint:
         """One sweep now (a re-sweep), in the worker process when isolating."""
         if self.pool is None:
             return identify_recording(rec, self.options, label)
-        return self.pool.submit(identify_recording, rec, self.options, label).result()
+        point = self.pool.submit(_identify_detached, rec, self.options, label).result()
+        return replace(point, recording=rec)
 
     def check(self) -> None:
-        for future in self.pending:
+        for future, _ in self.pending:
             if future.done() and future.exception() is not None:
                 raise future.exception()  # type: ignore[misc]
 
     def results(self) -> list[GridPoint]:
-        return self.points + [f.result() for f in self.pending]
+        """Every sweep's grid point, holding the recording this process already has."""
+        return self.points + [replace(f.result(), recording=rec) for f, rec in self.pending]
 
     def close(self) -> None:
         if self.pool is not None:

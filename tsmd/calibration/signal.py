@@ -113,7 +113,8 @@ def condition(t_s: FloatArray, cmd_deg: FloatArray, pos_deg: FloatArray, current
     if keep.sum() < min_samples:
         raise CalibrationError(f"only {int(keep.sum())} samples with a time stamp "
                                f"(need >= {min_samples})")
-    t, cmd, pos, cur = (a[keep] for a in (t, cmd, pos, cur))
+    if not keep.all():  # else the recording's own arrays: no copy of a sweep per stage
+        t, cmd, pos, cur = (a[keep] for a in (t, cmd, pos, cur))
     dt = np.diff(t)
     if np.any(dt <= 0):
         k = int(np.flatnonzero(dt <= 0)[0])

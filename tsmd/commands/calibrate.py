@@ -171,11 +171,11 @@ def _sim(args: argparse.Namespace) -> int:
     try:
         with LockstepRunner(config, seed=args.seed) as runner:
             # isolate: each sweep is identified in a worker process (the other core) while the
-            # next one runs; no live loop to protect here, so its start is not waited for
+            # next one runs; no live loop to protect here (not waited for, not niced)
             cal = run_calibration(runner, args.catheter, device, protocol=protocol,
                                   progress=bar, cancel=cancel,
                                   options=IdentifyOptions(edge=args.edge), isolate=True,
-                                  wait_for_worker=False)
+                                  live_loop=False)
     except CalibrationRefusedError as exc:
         # A refused calibration's sweeps are what its user needs to see why.
         if args.save_sweeps:

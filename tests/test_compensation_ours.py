@@ -366,3 +366,31 @@ def test_a_move_from_rest_crosses_the_dead_zone_with_balanced_errors() -> None:
     e = (np.array(tip) - q[:, 0])[250:]  # from the rest on
     assert e.max() > 0.0 > e.min()  # the crossing leaves both signs
     assert abs(e.max() + e.min()) <= 0.3 * (e.max() - e.min())
+
+
+@given(random_params, st.floats(-60.0, 60.0), st.lists(st.floats(-60.0, 60.0), min_size=1,
+                                                       max_size=4), st.integers(1, 300))
+@settings(max_examples=30, deadline=None)
+def test_moves_from_rest_respect_the_rate_limits(p: TensionPlayParams, rest_deg: float,
+                                                 goals: list[float], move_ticks: int) -> None:
+    """The move-from-rest look-ahead (full acceleration term) never breaks the velocity,
+    acceleration or jerk limit or gives a non-finite command, whatever the moves after each
+    rest. (The knob range is wide here: at the range's ends position wins over acceleration,
+    by design of the limiter.)"""
+    q_rows = [np.full(150, rest_deg)]
+    start = rest_deg
+    for goal in goals:  # raised-cosine moves of random length, each followed by a rest
+        s = np.arange(1, move_ticks + 1) / move_ticks
+        q_rows += [start + (goal - start) * (0.5 - 0.5 * np.cos(math.pi * s)), np.full(120, goal)]
+        start = goal
+    q1 = np.concatenate(q_rows)
+    wide = KnobLimits(-1e3, 1e3, LIMITS.max_velocity_deg_s, LIMITS.max_accel_deg_s2)
+    comp = OursCompensator(ours_knobs((p, p)), PERIOD_S, (wide, wide))
+    cmd = run(comp, np.column_stack([q1, q1[::-1]]))
+    assert np.all(np.isfinite(cmd))
+    v = np.diff(cmd, axis=0) / PERIOD_S
+    assert np.all(np.abs(v) <= wide.max_velocity_deg_s * (1 + 1e-9) + 1e-6)
+    a = np.diff(v, axis=0) / PERIOD_S
+    assert np.all(np.abs(a) <= wide.max_accel_deg_s2 * (1 + 1e-6) + 1e-3)
+    j = np.diff(a, axis=0) / PERIOD_S
+    assert np.all(np.abs(j) <= 2.0 * wide.max_accel_deg_s2 / 0.1 * (1 + 1e-6) + 1.0)

@@ -20,8 +20,7 @@ from numpy.typing import NDArray
 
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
-from tsmd.calibration.identify import identify_sweep
-from tsmd.calibration.options import IdentifyOptions, for_product
+from tsmd.calibration.identify import identify_sweep, settle_rule_backlash
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.tension_play_fit import fit_sweep_sides
 from tsmd.compensation.safety import KnobLimits
@@ -160,18 +159,13 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
     dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
                        + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
     fraction = backlash_settle_fraction(cur.data, t, tip)
-    # The backlash gain with the backlash rule calibration will use on this product's units
-    # (one estimator: a gain from the settle rule against the units' fraction rule biased each
-    # unit's omega by the ratio of the two, 5-10 % on lumped)
-    options = for_product(IdentifyOptions(), fraction)
-    gain_cur = cur if options == IdentifyOptions() else identify_sweep(
-        t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:], options)
+    # The backlash gain exactly as the tension-play fit measures every unit's (one estimator:
+    # the settle rule's backlash whatever the product's rule for the paper's B)
     try:
-        sides = fit_sweep_sides(gain_cur.data.pos_deg, gain_cur.data.current_filtered_A,
-                                *(gain_cur.estimate(k) for k in ("dead_zone_pos_deg",
-                                                                 "dead_zone_neg_deg",
-                                                                 "backlash_pos_deg",
-                                                                 "backlash_neg_deg")))
+        sides = fit_sweep_sides(cur.data.pos_deg, cur.data.current_filtered_A,
+                                cur.estimate("dead_zone_pos_deg"),
+                                cur.estimate("dead_zone_neg_deg"),
+                                *settle_rule_backlash(cur.data))
         gain: float | None = 0.5 * (sides[0].backlash_gain + sides[1].backlash_gain)
     except ValueError:  # a current without a loaded ramp: the sheet keeps a per-product omega
         gain = None

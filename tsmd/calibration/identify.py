@@ -21,7 +21,7 @@ decreasing ones (after the positive end) give ``B_pos`` and ``D_neg``, as in the
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -308,3 +308,25 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
         if math.isfinite(h.edge_deg):
             values[h.edge_name].append(h.edge_deg)
     return SweepResult(data, halves, {k: tuple(v) for k, v in values.items()})
+
+
+def settle_rule_backlash(data: Conditioned, options: IdentifyOptions | None = None
+                         ) -> tuple[float, float]:
+    """(B_pos, B_neg) of a conditioned sweep by the paper's settle rule, median over the
+    half-cycles after a reversal, whatever rule the product's calibration uses for the paper's B.
+
+    The tension play's straight release line starts where the release has settled: a
+    fraction rule's earlier end (where the tip starts to move, on a Dahl-friction catheter)
+    gives its backlash gain the curved start of the release, not its slope.
+    """
+    opts = replace(options or IdentifyOptions(), backlash="settle")
+    values: dict[str, list[float]] = {"backlash_pos_deg": [], "backlash_neg_deg": []}
+    for d, a, b, after in split_half_cycles(data.cmd_deg, opts.min_reversal_deg):
+        if not after:
+            continue
+        h = analyse_half_cycle(data, d, a, b, True, opts)
+        if math.isfinite(h.backlash_deg):
+            values[h.backlash_name].append(h.backlash_deg)
+    pos, neg = values["backlash_pos_deg"], values["backlash_neg_deg"]
+    return (float(np.median(pos)) if pos else math.nan,
+            float(np.median(neg)) if neg else math.nan)

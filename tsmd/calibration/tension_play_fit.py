@@ -2,8 +2,11 @@
 
 Per sweep (one knob swept +-A, the other held at a grid angle) and side:
 
-* the dead-zone edge ``D`` and the backlash at the amplitude ``B_A``: what the current analysis
-  (:mod:`tsmd.calibration.identify`) found (no data-sheet offset: that was one unit's);
+* the dead-zone edge ``D``: what the current analysis (:mod:`tsmd.calibration.identify`) found
+  (no data-sheet offset: that was one unit's); the backlash at the amplitude ``B_A``: the same
+  analysis by the paper's settle rule (``settle_rule_backlash``), whatever rule the product's
+  calibration uses for the paper's B: the straight release line starts where the release has
+  settled (a fraction rule ends B where the tip starts to move, inside the curved start);
 * the zero-tension point ``x0``: the loaded current ramp (from 10 deg past ``D`` to 5 deg before
   the turn) fitted by a line and extrapolated to the current that moves the knob the same way
   through the dead zone, where no tendon is loaded (friction and any sensor offset cancel);
@@ -39,6 +42,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.tension_play import BETA_RANGE, OMEGA_RANGE, TensionPlayParams
@@ -226,10 +230,11 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
             continue
         d = p.result.data
         est = p.result.estimate
+        # the backlash by the settle rule, whatever rule the product's paper B uses
+        b_pos, b_neg = settle_rule_backlash(d)
         out.append(SweepCurrent(float(p.other_deg), d.t_s, d.cmd_deg, d.pos_deg,
                                 d.current_filtered_A, est("dead_zone_pos_deg"),
-                                est("dead_zone_neg_deg"), est("backlash_pos_deg"),
-                                est("backlash_neg_deg")))
+                                est("dead_zone_neg_deg"), b_pos, b_neg))
     return out
 
 

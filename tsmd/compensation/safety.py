@@ -64,11 +64,11 @@ def limit_step(state: LimiterState, target_deg: float, limits: KnobLimits,
     if dt_s <= 0:
         raise ValueError(f"dt_s must be positive, got {dt_s}")
     return LimiterState(*step_floats(state.q_deg, state.v_deg_s, state.target_deg, target_deg,
-                               limits, dt_s))
+                                     limits, dt_s))
 
 
 def step_floats(q0: float, v0: float, last_target: float | None, target_deg: float,
-          limits: KnobLimits, dt_s: float) -> tuple[float, float, float]:
+                limits: KnobLimits, dt_s: float) -> tuple[float, float, float]:
     """:func:`limit_step` on plain floats (the loop's hot path: no object per tick; plain
     comparisons instead of min/max and clip)."""
     a = limits.max_accel_deg_s2

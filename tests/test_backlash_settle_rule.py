@@ -13,6 +13,7 @@ import yaml
 from support.profiles import DEVICE
 
 from tsmd.calibration.options import SETTLED_FRACTION, IdentifyOptions, for_product
+from tsmd.calibration.pieces import recovered_end
 from tsmd.calibration.run import device_options
 from tsmd.calibration.signal import Conditioned
 from tsmd.datasheet import backlash_settle_fraction
@@ -91,3 +92,15 @@ def _load(mapping: dict[str, object]):  # type: ignore[no-untyped-def]
     from tsmd.profile import device_model_from_mapping
 
     return device_model_from_mapping(mapping, "test")
+
+
+def test_the_fraction_is_of_the_swing_to_the_current_s_median_after_the_end() -> None:
+    # direction-signed current after a reversal: from -1 A it rises linearly to its release
+    # level 0 A over 20 deg and stays there; 95 % of the swing is made up at 19 deg
+    grid = np.arange(0.0, 60.0, 0.25)
+    current = np.clip(-1.0 + grid / 20.0, -1.0, 0.0)
+    opts = replace(IdentifyOptions(), backlash="fraction", backlash_fraction=0.95)
+    # a level line read off a short first flat run, 0.1 A low: the end must not follow it
+    biased_level = np.array([0.0, -0.1])
+    k = recovered_end(grid, current, 0, grid.size, biased_level, opts)
+    assert grid[k] == pytest.approx(19.0, abs=0.3)

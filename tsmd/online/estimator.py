@@ -56,12 +56,13 @@ def shrunk_ratio(ratio: float, tolerance: float) -> float:
     return 1.0 + math.copysign(kept, ratio - 1.0)
 
 
-def common_change(a: float, b: float) -> float:
-    """The change two edges agree on: the smaller when both go the same way, else none (a
-    sheath's friction changes both tendons of a knob alike)."""
-    if a * b <= 0.0:
+def common_change(own: float, partner: float, tolerance: float) -> float:
+    """An edge's slope change as far as the knob's other edge confirms it (a sheath's friction
+    changes both tendons of a knob alike): none when the partner's goes the other way or
+    stays within ``tolerance``, the edge's own beyond twice the tolerance, linear between."""
+    if own * partner <= 0.0:
         return 0.0
-    return math.copysign(min(abs(a), abs(b)), a)
+    return own * min(max(abs(partner) / tolerance - 1.0, 0.0), 1.0)
 
 
 @dataclass
@@ -160,8 +161,8 @@ class EdgeTracker:
         # disagrees with it measures nothing.
         self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         slope = self.slope_ref_A_per_deg * shrunk_ratio(
-            1.0 + common_change(self.slope_change,
-                                self.slope_change if partner is None else partner.slope_change),
+            1.0 + (self.slope_change if partner is None else common_change(
+                self.slope_change, partner.slope_change, o.same_slope_tolerance)),
             o.same_slope_tolerance)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
             self.n_odd_slope += 1

@@ -148,3 +148,20 @@ def test_the_slope_in_use_does_not_jump_at_the_tolerance() -> None:
         assert shrunk_ratio(edge + 1e-6, tol) == pytest.approx(shrunk_ratio(edge - 1e-6, tol),
                                                                abs=1e-4)
     assert shrunk_ratio(1.1, tol) == 1.0 and shrunk_ratio(2.5, tol) == 2.5
+
+
+def test_a_slope_change_on_one_edge_alone_is_no_friction_change() -> None:
+    pos, neg = learned(), learned()
+    for _ in range(4):  # one tendon's ramps 25 % steeper, the other's as before
+        pos.update(ramp_through(EDGE_DEG, 1.25 * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_through(EDGE_DEG, SLOPE), EDGE_DEG, pos)
+    assert pos.applied_deg == 0.0 and pos.suspects == []
+
+
+def test_a_friction_change_on_both_edges_is_followed() -> None:
+    pos, neg = learned(), learned()
+    for _ in range(4):  # a bend: both tendons' ramps 2.5 x steeper, edges 3 deg out
+        pos.update(ramp_with_edge(EDGE_DEG + 3.0, slope=2.5 * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_with_edge(EDGE_DEG + 3.0, slope=2.5 * SLOPE), EDGE_DEG, pos)
+    assert pos.applied_deg == pytest.approx(3.0, abs=0.05)
+    assert neg.applied_deg == pytest.approx(3.0, abs=0.05)

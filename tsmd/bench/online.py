@@ -343,7 +343,12 @@ def main(args: argparse.Namespace) -> int:
         ratios: list[float] = []
         before_ratios: list[float] = []
         for u in units:
-            r = change_unit(u, args, device)
+            try:
+                r = change_unit(u, args, device)
+            except CalibrationRefusedError as exc:  # the unit's own calibration: next unit
+                print(f"| {u} | calibration before the change refused: "
+                      f"{str(exc).split(':')[0]} | | | | | | | |", flush=True)
+                continue
             for k, kn in enumerate(r["knobs"]):
                 ratio = kn["on"] / kn["fresh"]
                 vs_before = kn["on"] / kn["before"]
@@ -362,6 +367,7 @@ def main(args: argparse.Namespace) -> int:
                   f"interval phi1 / phi2: {trend}; {len(r['events'])} warnings; "
                   f"3 runs {r['wall_s']:.0f} s wall | | | | | | | |", flush=True)
         ratios = [r for r in ratios if math.isfinite(r)] or [math.nan]
+        before_ratios = before_ratios or [math.nan]
         print(f"\non / fresh: mean {np.mean(ratios):.2f}, worst {max(ratios):.2f} "
               f"(target <= 1.2); on / before: mean {np.mean(before_ratios):.2f}, worst "
               f"{max(before_ratios):.2f}")
@@ -373,7 +379,12 @@ def main(args: argparse.Namespace) -> int:
               "RMSE on (phi1, phi2) | RMSE off | warnings | wall s (on) |")
         print("|---|---|---|---|---|---|---|---|")
         for u in units:
-            d = drift_unit(u, args, device)
+            try:
+                d = drift_unit(u, args, device)
+            except CalibrationRefusedError as exc:
+                print(f"| {u} | calibration refused: {str(exc).split(':')[0]} | | | | | | |",
+                      flush=True)
+                continue
             big = d["largest"]
             within = all(v <= CALIBRATION_UNCERTAINTY_DEG for v in big.values())
             print(f"| {u} | {big['phi1_pos']:.2f}/{big['phi1_neg']:.2f}, "

@@ -56,6 +56,15 @@ def shrunk_ratio(ratio: float, tolerance: float) -> float:
     return 1.0 + math.copysign(kept, ratio - 1.0)
 
 
+def common_change(own: float, partner: float, tolerance: float) -> float:
+    """An edge's slope change as far as the knob's other edge confirms it (a sheath's friction
+    changes both tendons of a knob alike): none when the partner's goes the other way or
+    stays within ``tolerance``, the edge's own beyond twice the tolerance, linear between."""
+    if own * partner <= 0.0:
+        return 0.0
+    return own * min(max(abs(partner) / tolerance - 1.0, 0.0), 1.0)
+
+
 @dataclass
 class EdgeTracker:
     """The offset of one dead-zone edge (knob, side) from the profile's; see the module."""
@@ -100,9 +109,18 @@ class EdgeTracker:
         self.frozen_reason = reason
         self.suspects.clear()
 
-    def update(self, ramp: LoadedRamp, profile_edge_deg: float) -> list[tuple[str, str, dict[str,
-                                                                                             Any]]]:
-        """Take one ramp; returns events (level, name, fields) to report."""
+    @property
+    def slope_change(self) -> float:
+        """The median of the last ramps' slopes against the reference, minus 1 (0 while
+        learning)."""
+        if self.slope_ref_A_per_deg is None or not self.recent_slopes:
+            return 0.0
+        return median(self.recent_slopes) / self.slope_ref_A_per_deg - 1.0
+
+    def update(self, ramp: LoadedRamp, profile_edge_deg: float,
+               partner: EdgeTracker | None = None) -> list[tuple[str, str, dict[str, Any]]]:
+        """Take one ramp; returns events (level, name, fields) to report. ``partner``: the
+        other edge of the same knob (its slopes confirm a friction change)."""
         o = self.options
         self.n_ramps += 1
         events: list[tuple[str, str, dict[str, Any]]] = []
@@ -136,13 +154,16 @@ class EdgeTracker:
             return events
         # The crossing is taken on a line through the window's centre; its slope decides how
         # far back the edge is (~15 deg of extrapolation: 10 % of slope is 1.5 deg). One
-        # ramp's slope scatters by 25 % and more (the knob speeding up or slowing down in the
-        # window); a friction change (sheath curvature: 2-4 x) shows in every ramp from then
-        # on. So the slope in use is the median of the last ramps' (its change beyond the
-        # tolerance only), and a ramp that disagrees with it measures nothing.
+        # ramp's slope scatters by 25 % and more, and one edge's for a few ramps in a row
+        # (fast random moves); a friction change of the sheath (curvature: 2-4 x) shows in
+        # every ramp of both tendons from then on. So the slope in use moves by the change
+        # both edges' last ramps agree on (beyond the tolerance only), and a ramp that
+        # disagrees with it measures nothing.
         self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         slope = self.slope_ref_A_per_deg * shrunk_ratio(
-            median(self.recent_slopes) / self.slope_ref_A_per_deg, o.same_slope_tolerance)
+            1.0 + (self.slope_change if partner is None else common_change(
+                self.slope_change, partner.slope_change, o.same_slope_tolerance)),
+            o.same_slope_tolerance)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
             self.n_odd_slope += 1
             self.last_measurement_deg = math.nan

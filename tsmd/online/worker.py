@@ -226,8 +226,8 @@ class OnlineWorker:
     def _ramp(self, tracker: EdgeTracker, ramp: LoadedRamp) -> None:
         d_pos, d_neg = edges_at(self.base_knobs[ramp.knob], ramp.other_deg)
         before = tracker.applied_deg
-        events = tracker.update(ramp, d_pos if ramp.side > 0 else d_neg)
         other = self.trackers[(ramp.knob, -ramp.side)]
+        events = tracker.update(ramp, d_pos if ramp.side > 0 else d_neg, other)
         if tracker.agrees_with(other):
             other_before = other.applied_deg
             events += tracker.follow(tracker.suspects[-1], "both edges of the knob agree")

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tsmd.gap.contrast import UNMATCHED, contrast_scores, segments_present
+from tsmd.gap.contrast import UNMATCHED, contrast_scores, lag_share, segments_present
 from tsmd.gap.data import GapSeries, Split
 from tsmd.gap.layer import heldout_metrics, stack_views
 from tsmd.gap.model import CHANNELS, Evaluator, Prediction, View, build_views
@@ -35,12 +35,20 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
     if segments_present(series):
         # matched segments decide the effects they test: their contrast cancels the base
         # mismatch, which the signatures of the same effects compete with
-        found = contrast_scores(series, _residuals(series, split, ev, base_fit),
-                                len(sres.scores), cfg.family_alpha, cfg.min_share)
+        residuals = _residuals(series, split, ev, base_fit)
+        found = contrast_scores(series, residuals, len(sres.scores), cfg.family_alpha,
+                                cfg.min_share)
         names = {c.name for c in found}
         kept = [s for s in sres.scores if s.name not in names]
+        lag = lag_share(series, residuals)
         for s in kept:
             s.significant = s.significant and s.name not in UNMATCHED
+            if s.name == "sensor" and lag is not None:
+                # named by its signature (a lag beats the same filter as a lead); its share is
+                # measured where the effect is isolated: the current of the matched loops
+                s.share = s.raw_share = lag[0]
+                s.ci = lag[1:]
+                s.significant = s.significant and lag[0] >= cfg.min_share
         sres.scores = sorted(kept + found, key=lambda s: -s.share)
     gap_present = sres.physics_excess > cfg.gap_floor * (sres.physics_excess + sres.noise_level)
     sig = [s for s in sres.scores if s.significant] if gap_present else []

@@ -69,7 +69,8 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         "catheters": sorted({s.catheter for s in series if s.catheter}),
         "physics_excess": sres.physics_excess, "layer_excess": sres.layer_excess,
         "layer_absorbs": absorbed, "layer_ratio": sres.layer_ratio,
-        "signatures": [vars(s) for s in sres.scores], "figures": figures}
+        "signatures": [vars(s) for s in sres.scores], "figures": figures,
+        "protocol": segments_present(series)}
     return GapResult(
         verdict=verdict, summary=summary, split="", base_params={}, fitted_params={},
         noise_std={n: float(np.sqrt(v)) for n, v in zip(CHANNELS, noise_var, strict=True)},

@@ -9,7 +9,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tsmd.gap.contrast import UNMATCHED, contrast_scores, lag_share, segments_present
+from tsmd.gap.contrast import (
+    DECIDES,
+    UNMATCHED,
+    contrast_scores,
+    lag_share,
+    segments_present,
+)
 from tsmd.gap.data import GapSeries, Split
 from tsmd.gap.layer import heldout_metrics, stack_views
 from tsmd.gap.model import CHANNELS, Evaluator, Prediction, View, build_views
@@ -59,7 +65,8 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         figures["top"] = heldout_metrics(d, sres.predictions[top[0]], cfg.seed)
     absorbed = (1.0 - sres.layer_excess / sres.physics_excess if sres.physics_excess > 0
                 else float("nan"))
-    verdict, summary = _structure_verdict(gap_present, absorbed, sres.layer_ratio, sig, figures)
+    verdict, summary = _structure_verdict(gap_present, absorbed, sres.layer_ratio, sig, figures,
+                                          segments_present(series))
     cands = [CandidateScore(s.name, s.title, f"depends on {s.condition}", {}, s.share, s.ci,
                             s.significant, s.raw_share, {}, {}, "signature")
              for s in sres.scores]
@@ -97,8 +104,14 @@ def _residuals(series: Sequence[GapSeries], split: Split, ev: Evaluator,
     return out
 
 
+def _matched_score(score: Any) -> bool:
+    """Whether a score came from the matched protocol (its share is of a matched contrast)."""
+    return score.name in DECIDES.values() or score.name == "sensor"
+
+
 def _structure_verdict(gap_present: bool, absorbed: float, layer_ratio: float,
-                       sig: list[Any], figures: dict[str, dict[str, float]]) -> tuple[str, str]:
+                       sig: list[Any], figures: dict[str, dict[str, float]],
+                       matched: bool = False) -> tuple[str, str]:
     phys, lay = figures["physics"], figures["layer"]
 
     def tip(m: dict[str, float]) -> str:
@@ -111,6 +124,13 @@ def _structure_verdict(gap_present: bool, absorbed: float, layer_ratio: float,
     if not gap_present:
         return "none significant", (f"The simulator matches the held-out data to within the "
                                     f"noise: {base}.")
+    if sig and matched and _matched_score(sig[0]):
+        s = sig[0]
+        return f"identified: {s.name}", (
+            f"Base physics: {base}. On top of it, {s.title} ({s.condition}): its effect model, "
+            f"fitted on one configuration, removes {s.share:.0%} of the matched contrast of "
+            f"another (range {s.ci[0]:.0%}..{s.ci[1]:.0%}); with its per-row signature the "
+            f"tip RMSE is {tip(figures['top'])} deg.")
     if sig:
         s = sig[0]
         return f"identified: {s.name}", (

@@ -180,9 +180,14 @@ def _design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
 
 def lag_design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
     """A lag of the measured signal: its loop delayed along the knob, i.e. widened by the
-    slope times the branch direction, per knob."""
+    slope times the branch direction, per knob; plus a branch offset (what the simulator's
+    fitted viscous term of the current already took of the lag)."""
     g = _slope(lp, mean_loop)
-    return np.column_stack([(lp.part == p) * g * lp.dirn for p in np.unique(lp.part)])
+    cols = []
+    for p in np.unique(lp.part):
+        z = (lp.part == p).astype(float)
+        cols += [z * g * lp.dirn, z * lp.dirn]
+    return np.column_stack(cols)
 
 
 def loop_shrink(train: Sequence[Loops], held: Loops,

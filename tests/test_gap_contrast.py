@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
-from tsmd.gap.contrast import contrast_scores
+from tsmd.gap.contrast import contrast_scores, lag_share
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.errors import GapError
 from tsmd.gap.protocol import Segment, decode_table, encode_table, protocol
@@ -37,6 +37,12 @@ def _play(x: Arr, width: Arr) -> Arr:
     return out
 
 
+def _simulated(t: Arr, q: Arr) -> Arr:
+    """The simulator's tip and current: a play of 2 deg, tip 1:1, 10 mA per degree."""
+    loops = np.column_stack([_play(q[:, j], np.full(len(t), 2.0)) for j in range(2)])
+    return np.column_stack([loops, 0.01 * loops])
+
+
 def _base_mismatch(t: Arr, q: Arr) -> Arr:
     """Residual of a simulator with other base physics: a different play and dead zone."""
     out = np.empty((len(t), 4))
@@ -47,8 +53,8 @@ def _base_mismatch(t: Arr, q: Arr) -> Arr:
     return out
 
 
-def _scores(effect: Effect | None = None, seed: int = 0,
-            looped_only: bool = False) -> dict[str, SignatureScore]:
+def _session(effect: Effect | None = None, seed: int = 0,
+             looped_only: bool = False) -> tuple[list[GapSeries], list[Arr]]:
     t, q, seg, table = _design()
     rng = np.random.default_rng(seed)
     series, residuals = [], []
@@ -58,9 +64,17 @@ def _scores(effect: Effect | None = None, seed: int = 0,
             res = res + effect(t, q)
         res[:, :2] += rng.normal(0.0, 0.1, (len(t), 2))
         res[:, 2:] += rng.normal(0.0, 0.004, (len(t), 2))
-        series.append(GapSeries(f"p-{config}", t, q, res[:, 2:], res[:, :2], "pos",
-                                config=config, segment=seg, segments=table))
+        sim = _simulated(t, q)  # what the simulator predicts; the data are it plus the residual
+        series.append(GapSeries(f"p-{config}", t, q, sim[:, 2:] + res[:, 2:],
+                                sim[:, :2] + res[:, :2], "pos", config=config, segment=seg,
+                                segments=table))
         residuals.append(res)
+    return series, residuals
+
+
+def _scores(effect: Effect | None = None, seed: int = 0,
+            looped_only: bool = False) -> dict[str, SignatureScore]:
+    series, residuals = _session(effect, seed, looped_only)
     return {s.name: s for s in contrast_scores(series, residuals, n_tried=6)}
 
 
@@ -155,6 +169,27 @@ def test_a_tracker_drifting_in_time_alone_is_not_creep() -> None:
         out[:, :2] = 0.004 * t[:, None]
         return out
     assert "drift" not in _named(_scores(tracker))
+
+
+def _lagged_current(t: Arr, q: Arr) -> Arr:
+    """A current sensor lagging by 0.1 s: its reading minus the true current."""
+    true = _simulated(t, q)[:, 2]
+    a = np.exp(-np.diff(t, prepend=t[0]) / 0.1)
+    lagged = true.copy()
+    for k in range(1, len(t)):
+        lagged[k] = a[k] * lagged[k - 1] + (1.0 - a[k]) * true[k]
+    out = np.zeros((len(t), 4))
+    out[:, 2] = lagged - true
+    return out
+
+
+def test_a_lagging_current_is_explained_by_a_lag_of_the_matched_loops() -> None:
+    share = lag_share(*_session(_lagged_current))
+    assert share is not None and share[0] > 0.5
+
+
+def test_without_a_current_contrast_there_is_no_lag_share() -> None:
+    assert lag_share(*_session()) is None
 
 
 def _recording(**meta: str) -> Recording:

@@ -13,7 +13,7 @@ contrast a small effect model fitted on the other configuration removes.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -153,15 +153,22 @@ def _noise_ss(lp: Loops) -> float:
     return (n_lev - 1) * k * var / n_rep
 
 
-def _design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
-    """Effect-model regressors per point: shift along the knob (slope), widening (slope x
-    branch, also growing with the bend), a branch offset and an offset, per knob/channel."""
+def _slope(lp: Loops, mean_loop: FloatArray) -> FloatArray:
+    """Slope of the mean loop against the knob along each branch (runs of one part and
+    direction)."""
     g = np.zeros(len(lp.knob))
     # the slope along each branch: runs of points of one part and direction
     edges = np.flatnonzero((np.diff(lp.part) != 0) | (np.diff(lp.dirn) != 0)) + 1
     for run in np.split(np.arange(len(g)), edges):
         if len(run) > 2:
             g[run] = np.gradient(mean_loop[run], lp.knob[run])
+    return g
+
+
+def _design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
+    """Effect-model regressors per point: shift along the knob (slope), widening (slope x
+    branch, also growing with the bend), a branch offset and an offset, per knob/channel."""
+    g = _slope(lp, mean_loop)
     load = np.abs(lp.knob)
     cols = []
     for p in np.unique(lp.part):
@@ -171,21 +178,35 @@ def _design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
     return np.column_stack(cols)
 
 
-def loop_shrink(train: Sequence[Loops], held: Loops) -> float:
+def lag_design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
+    """A lag of the measured signal: its loop delayed along the knob, i.e. widened by the
+    slope times the branch direction, per knob; plus a branch offset (what the simulator's
+    fitted viscous term of the current already took of the lag)."""
+    g = _slope(lp, mean_loop)
+    cols = []
+    for p in np.unique(lp.part):
+        z = (lp.part == p).astype(float)
+        cols += [z * g * lp.dirn, z * lp.dirn]
+    return np.column_stack(cols)
+
+
+def loop_shrink(train: Sequence[Loops], held: Loops,
+                design: Callable[[Loops, FloatArray], FloatArray] | None = None) -> float:
     """Share of the held-out configuration's level contrast (above repeat noise) that an
     effect model fitted on the training configurations removes."""
+    design = design or _design
     c_ho = _contrast(held)
     excess = float((c_ho**2).sum()) - _noise_ss(held)
     if excess <= _noise_ss(held) or not train:  # no contrast above the repeats' noise
         return float("nan")
     coef = []
     for lp in train:
-        a = _design(lp, lp.tip)
+        a = design(lp, lp.tip)
         c = _contrast(lp)
         coef.append(np.array([np.linalg.lstsq(a, c[lv], rcond=None)[0]
                               for lv in range(c.shape[0])]))
     beta = np.mean(coef, axis=0)
-    a_ho = _design(held, held.tip)
+    a_ho = design(held, held.tip)
     resid = c_ho - beta @ a_ho.T
     return min(1.0 - (float((resid**2).sum()) - _noise_ss(held)) / excess, 1.0)
 
@@ -243,6 +264,8 @@ class TestData:
     levels: list[str]
     loops: dict[tuple[str, int], list[Triple | None]]
     dwells: dict[tuple[str, int], tuple[FloatArray, FloatArray]]
+    currents: dict[tuple[str, int], list[Triple | None]]
+    """The same loops' currents (knob, residual, measured current)."""
 
 
 def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray],
@@ -321,7 +344,7 @@ def _collect(s: GapSeries, res: FloatArray, tests: dict[str, TestData]) -> None:
         rows = np.flatnonzero(s.segment == i)
         if len(rows) < 5:
             continue
-        data = tests.setdefault(seg.test, TestData([], {}, {}))
+        data = tests.setdefault(seg.test, TestData([], {}, {}, {}))
         if seg.level not in data.levels:
             data.levels.append(seg.level)
         key = (seg.level, seg.rep)
@@ -336,6 +359,8 @@ def _collect(s: GapSeries, res: FloatArray, tests: dict[str, TestData]) -> None:
             parts[seg.knob] = windows[0]
         else:
             data.loops.setdefault(key, []).extend(windows)
+            data.currents.setdefault(key, []).extend(
+                (s.knob_deg[rows, j], res[rows, 2 + j], s.current_A[rows, j]) for j in knobs)
 
 
 def _drift(data: TestData) -> Drift:
@@ -356,6 +381,24 @@ def _drift(data: TestData) -> Drift:
         vars_.append(row_v)
     return Drift(np.array(diffs, dtype=float).reshape(len(diffs), -1),
                  np.array(vars_, dtype=float).reshape(len(vars_), -1))
+
+
+def lag_share(series: Sequence[GapSeries],
+              residuals: Sequence[FloatArray]) -> tuple[float, float, float] | None:
+    """Share of the rate test's current contrast (fast against slow loops) that a lag of the
+    current explains, fitted on one configuration and scored on the other (mean, lowest,
+    highest over the held-out configurations); None without such a contrast."""
+    by_config: dict[str, dict[str, TestData]] = {}
+    for s, res in zip(series, residuals, strict=True):
+        if s.segment is not None:
+            _collect(s, res, by_config.setdefault(s.config, {}))
+    found = [loop_contrast(d["rate"].currents, d["rate"].levels)
+             for d in by_config.values() if "rate" in d]
+    loops = [lp for lp in found if lp is not None]
+    shrinks = [loop_shrink(loops[:i] + loops[i + 1:], loops[i], lag_design)
+               for i in range(len(loops))]
+    finite = [x for x in shrinks if np.isfinite(x)]
+    return (float(np.mean(finite)), min(finite), max(finite)) if finite else None
 
 
 def segments_present(series: Sequence[GapSeries]) -> bool:

@@ -115,6 +115,14 @@ def structure_lines(r: GapResult) -> list[str]:
               "remove. Significant: the true condition's gain lies above the surrogates' spread "
               "(z above the one-sided 5 % / number of signatures point), the one-sided block-"
               "bootstrap bound at that level is above zero, and the share is at least 5 %.", ""]
+    if st.get("protocol"):
+        lines += ["The recordings carry the matched-condition protocol: rate, coupling, drift / "
+                  "creep and curvature are scored by the difference between matched segments "
+                  "instead (z from the analysis of variance against repeats of the same "
+                  "condition; share: what an effect model fitted on one configuration's "
+                  "contrast removes of another's); sensor dynamics keeps its signature, its "
+                  "share measured on the matched loops' current; compliance is shown but not "
+                  "named (docs/gap.md, the matched-condition protocol).", ""]
     return lines
 
 

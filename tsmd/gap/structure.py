@@ -9,7 +9,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tsmd.gap.contrast import UNMATCHED, contrast_scores, segments_present
+from tsmd.gap.contrast import (
+    DECIDES,
+    UNMATCHED,
+    contrast_scores,
+    lag_share,
+    segments_present,
+)
 from tsmd.gap.data import GapSeries, Split
 from tsmd.gap.layer import heldout_metrics, stack_views
 from tsmd.gap.model import CHANNELS, Evaluator, Prediction, View, build_views
@@ -35,12 +41,20 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
     if segments_present(series):
         # matched segments decide the effects they test: their contrast cancels the base
         # mismatch, which the signatures of the same effects compete with
-        found = contrast_scores(series, _residuals(series, split, ev, base_fit),
-                                len(sres.scores), cfg.family_alpha, cfg.min_share)
+        residuals = _residuals(series, split, ev, base_fit)
+        found = contrast_scores(series, residuals, len(sres.scores), cfg.family_alpha,
+                                cfg.min_share)
         names = {c.name for c in found}
         kept = [s for s in sres.scores if s.name not in names]
+        lag = lag_share(series, residuals)
         for s in kept:
             s.significant = s.significant and s.name not in UNMATCHED
+            if s.name == "sensor" and lag is not None:
+                # named by its signature (a lag beats the same filter as a lead); its share is
+                # measured where the effect is isolated: the current of the matched loops
+                s.share = s.raw_share = lag[0]
+                s.ci = lag[1:]
+                s.significant = s.significant and lag[0] >= cfg.min_share
         sres.scores = sorted(kept + found, key=lambda s: -s.share)
     gap_present = sres.physics_excess > cfg.gap_floor * (sres.physics_excess + sres.noise_level)
     sig = [s for s in sres.scores if s.significant] if gap_present else []
@@ -51,7 +65,8 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         figures["top"] = heldout_metrics(d, sres.predictions[top[0]], cfg.seed)
     absorbed = (1.0 - sres.layer_excess / sres.physics_excess if sres.physics_excess > 0
                 else float("nan"))
-    verdict, summary = _structure_verdict(gap_present, absorbed, sres.layer_ratio, sig, figures)
+    verdict, summary = _structure_verdict(gap_present, absorbed, sres.layer_ratio, sig, figures,
+                                          segments_present(series))
     cands = [CandidateScore(s.name, s.title, f"depends on {s.condition}", {}, s.share, s.ci,
                             s.significant, s.raw_share, {}, {}, "signature")
              for s in sres.scores]
@@ -61,7 +76,8 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         "catheters": sorted({s.catheter for s in series if s.catheter}),
         "physics_excess": sres.physics_excess, "layer_excess": sres.layer_excess,
         "layer_absorbs": absorbed, "layer_ratio": sres.layer_ratio,
-        "signatures": [vars(s) for s in sres.scores], "figures": figures}
+        "signatures": [vars(s) for s in sres.scores], "figures": figures,
+        "protocol": segments_present(series)}
     return GapResult(
         verdict=verdict, summary=summary, split="", base_params={}, fitted_params={},
         noise_std={n: float(np.sqrt(v)) for n, v in zip(CHANNELS, noise_var, strict=True)},
@@ -88,8 +104,14 @@ def _residuals(series: Sequence[GapSeries], split: Split, ev: Evaluator,
     return out
 
 
+def _matched_score(score: Any) -> bool:
+    """Whether a score came from the matched protocol (its share is of a matched contrast)."""
+    return score.name in DECIDES.values() or score.name == "sensor"
+
+
 def _structure_verdict(gap_present: bool, absorbed: float, layer_ratio: float,
-                       sig: list[Any], figures: dict[str, dict[str, float]]) -> tuple[str, str]:
+                       sig: list[Any], figures: dict[str, dict[str, float]],
+                       matched: bool = False) -> tuple[str, str]:
     phys, lay = figures["physics"], figures["layer"]
 
     def tip(m: dict[str, float]) -> str:
@@ -102,6 +124,13 @@ def _structure_verdict(gap_present: bool, absorbed: float, layer_ratio: float,
     if not gap_present:
         return "none significant", (f"The simulator matches the held-out data to within the "
                                     f"noise: {base}.")
+    if sig and matched and _matched_score(sig[0]):
+        s = sig[0]
+        return f"identified: {s.name}", (
+            f"Base physics: {base}. On top of it, {s.title} ({s.condition}): its effect model, "
+            f"fitted on one configuration, removes {s.share:.0%} of the matched contrast of "
+            f"another (range {s.ci[0]:.0%}..{s.ci[1]:.0%}); with its per-row signature the "
+            f"tip RMSE is {tip(figures['top'])} deg.")
     if sig:
         s = sig[0]
         return f"identified: {s.name}", (

@@ -16,9 +16,11 @@ import numpy as np
 import pytest
 import yaml
 
+from tsmd import daemon_drives
 from tsmd.api.client import ApiClient
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.daemon import Daemon, resolve_socket_path
+from tsmd.log import get_logger
 from tsmd.notify import Notifier, watchdog_interval_s
 from tsmd.recording import read_recording
 from tsmd.replay import LiveTrajectoryRunner
@@ -192,16 +194,13 @@ def test_calibrate_over_the_socket_streams_progress_and_cancel_saves_nothing(
 @pytest.mark.parametrize("fmt", ["blf", "asc"])
 def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: str) -> None:
     base = TsmdConfig()
-    rt = dataclasses.replace(base.loop.realtime, priority=0)  # leave pytest's thread alone
     config = dataclasses.replace(
-        base, loop=dataclasses.replace(base.loop, realtime=rt),
-        bus=dataclasses.replace(base.bus, log_format=fmt),  # type: ignore[arg-type]
+        base, bus=dataclasses.replace(base.bus, log_format=fmt),  # type: ignore[arg-type]
         recording=dataclasses.replace(base.recording, dir=str(tmp_path)))
-    daemon = Daemon(config)
     channel = f"tsmd-canlog-{os.getpid()}-{fmt}"
     bus = can.Bus(interface="virtual", channel=channel)
     peer = can.Bus(interface="virtual", channel=channel)
-    logged = daemon._can_log(bus)
+    logged = daemon_drives.can_log(config, bus, get_logger("tsmd.test"))
     try:
         logged.send(can.Message(arbitration_id=0x080, data=b"", is_extended_id=False))
         peer.send(can.Message(arbitration_id=0x181, data=b"\x27\x00", is_extended_id=False))
@@ -209,7 +208,6 @@ def test_can_traffic_is_logged_with_python_cans_own_writer(tmp_path: Path, fmt: 
     finally:
         logged.shutdown()  # stops the writer, then the bus it wraps
         peer.shutdown()
-        daemon.events.close()
     (log,) = tmp_path.glob(f"tsmd-can-*.{fmt}")
     ids = [m.arbitration_id for m in can.LogReader(str(log))]
     assert ids == [0x080, 0x181]

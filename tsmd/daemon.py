@@ -20,22 +20,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import can
 import numpy as np
 
-from drivers.canlog import TappedBus
-from drivers.canopen_master import CanOpenDrives
 from drivers.clock import MonotonicClock
 from drivers.drive import DriveError, KnobDrives
-from drivers.units import DriveConfig
 from simrig.rig import SimRig
-from tsmd import __version__
+from tsmd import __version__, daemon_drives
 from tsmd.api.handlers import ApiHandlers
 from tsmd.api.server import ApiServer
 from tsmd.bus_events import BusEventLog
 from tsmd.compensation import Compensator
 from tsmd.config import TsmdConfig, drive_configs, resolve_data_path
-from tsmd.errors import TsmdError
+from tsmd.errors import DaemonError
 from tsmd.log import EventLog, get_logger
 from tsmd.loop import BackgroundRecorder, ControlLoop, LoopError
 from tsmd.notify import Notifier, watchdog_interval_s
@@ -54,14 +50,6 @@ from tsmd.service import CompensationChoice, Service
 from tsmd.stack import StackError, build_loop, make_compensator, open_sim
 
 SIM_EXAMPLE_PROFILE = "profiles/example-sim.yaml"
-
-
-class DaemonError(TsmdError):
-    """The daemon could not start (drives, profile, socket); the message says which and why."""
-
-    def __init__(self, message: str, code: str = "daemon") -> None:
-        super().__init__(message)
-        self.code = code
 
 
 def resolve_socket_path(configured: str, explicit: str | None = None) -> tuple[Path, str | None]:
@@ -177,67 +165,13 @@ class Daemon:
                                              receive="poll",
                                              timeouts=config.bus.timeouts.master())
         else:
-            self.drives = self._open_bus_drives(drive_cfgs)
+            self.drives = daemon_drives.open_bus_drives(config, drive_cfgs, self.log)
         try:
             self.drives.boot()
         except DriveError as exc:
             raise DaemonError(f"drive boot failed: {exc}", "drive") from None
         self.log.info("drives booted", count=self.drives.count)
-        self._home_at_start()
-
-    def _home_at_start(self) -> None:
-        """Home the drives whose config says ``at_start`` (or all, with ``home_at_start``).
-
-        Before the loop thread exists, so homing owns the bus alone; a failure fails the start.
-        """
-        assert self.drives is not None
-        configs = drive_configs(self.config)
-        chosen = [i for i, c in enumerate(configs)
-                  if c.homing.method != 0 and (c.homing.at_start or self._home_all)]
-        if not chosen:
-            return
-        self.log.info("homing", drives=chosen,
-                      methods=[configs[i].homing.method_name for i in chosen])
-        try:
-            status = self.drives.home(chosen)
-        except DriveError as exc:
-            raise DaemonError(f"homing failed: {exc}", "homing") from None
-        self.log.info("homed", drives=chosen,
-                      offsets_deg=[status[i].home_offset_deg for i in chosen])
-
-    def _open_bus_drives(self, drive_cfgs: list[DriveConfig]) -> KnobDrives:
-        """The master on the configured bus; the loop thread polls it every tick.
-
-        Polling (no python-can notifier thread) leaves one thread touching the bus and one
-        fewer thread competing with the loop for the GIL.
-        """
-        bus_cfg = self.config.bus
-        kwargs: dict[str, Any] = {}
-        if bus_cfg.interface == "udp_multicast":  # it echoes our own frames: accept only theirs
-            kwargs["can_filters"] = [{"can_id": base + c.node_id, "can_mask": 0x7FF}
-                                     for c in drive_cfgs for base in (0x080, 0x180, 0x580, 0x700)]
-        try:
-            bus: can.BusABC = can.Bus(interface=bus_cfg.interface, channel=bus_cfg.channel,
-                                      bitrate=bus_cfg.bitrate, **kwargs)
-        except (can.CanError, OSError, ValueError, ImportError) as exc:
-            raise DaemonError(f"cannot open CAN interface {bus_cfg.interface!r} channel "
-                              f"{bus_cfg.channel!r}: {exc}", "drive") from None
-        bus = self._can_log(bus)
-        return CanOpenDrives(bus, drive_cfgs, self.config.loop.period_s, receive="poll",
-                             own_bus=True, timeouts=self.config.bus.timeouts.master())
-
-    def _can_log(self, bus: can.BusABC) -> can.BusABC:
-        """bus.log_format: every frame sent and received, in python-can's BLF or ASC writer."""
-        fmt = self.config.bus.log_format
-        if fmt == "none":
-            return bus
-        directory = resolve_data_path(self.config.recording.dir)
-        directory.mkdir(parents=True, exist_ok=True)
-        stamp = time.strftime("%Y%m%dT%H%M%SZ", time.gmtime())
-        path = directory / f"tsmd-can-{stamp}.{fmt}"
-        self.log.info("logging CAN traffic", path=str(path), format=fmt)
-        # the bus owns the writer: closing the drives stops it after the last frame
-        return TappedBus(bus, [can.Logger(str(path))])
+        daemon_drives.home_at_start(self.drives, drive_cfgs, self._home_all, self.log)
 
     def _load_profile(self) -> CatheterProfile | None:
         config = self.config

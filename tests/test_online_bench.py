@@ -30,3 +30,24 @@ def test_mixed_motion_stays_inside_the_knob_range_and_starts_at_rest() -> None:
     t, q = mixed_motion(120.0, 3)
     assert np.all(np.abs(q) <= 60.0) and np.allclose(q[0], 0.0)
     assert len(reversal_times(t, q[:, 0], 0.0)) >= 20
+
+
+def test_a_unit_whose_calibration_is_refused_is_one_line_and_the_bench_goes_on(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    import argparse
+
+    from tsmd.bench import online
+    from tsmd.calibration.errors import CalibrationRefusedError
+
+    def refused(unit: int, *_: object) -> dict[str, object]:
+        raise CalibrationRefusedError(f"calibration refused (unit {unit}): too uncertain", [])
+
+    monkeypatch.setattr(online, "device_for", lambda *_: None)
+    monkeypatch.setattr(online, "hot_path_us", lambda: (1.0, 2.0, 3.0))
+    monkeypatch.setattr(online, "change_unit", refused)
+    monkeypatch.setattr(online, "drift_unit", refused)
+    parser = argparse.ArgumentParser()
+    online.add_arguments(parser)
+    assert online.main(parser.parse_args(["--units", "7,8", "--drift-s", "10"])) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if "refused" in ln]
+    assert len(lines) == 4 and "| 7 |" in lines[0] and "| 8 |" in lines[1]

@@ -85,9 +85,9 @@ class EdgeTracker:
     last_measurement_deg: float = math.nan
     recent_slopes: list[float] = field(default_factory=list)
     n_odd_slope: int = 0
+    """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
-    """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
 
     @property
@@ -142,7 +142,7 @@ class EdgeTracker:
         if not 1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max:
             # A stuck knob, a blocked tip, or a stroke across a shape change: this ramp is
             # refused and the suspects before it are void, but the ramps after it measure
-            # (freezing them delayed a slack change by two ramps per side, 40 s).
+            # (freezing them delayed a slack change by two ramps per side).
             self.suspects.clear()
             self.n_refused += 1
             events.append(("warning", "online ramp refused", {

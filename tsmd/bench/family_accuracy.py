@@ -31,10 +31,10 @@ from tsmd.bench.accuracy import (
     Scenario,
     calibrated_profile,
     compute_time_us,
-    plot_runs,
     run_scenario,
     scenarios,
 )
+from tsmd.bench.accuracy_report import plot_runs
 from tsmd.bench.realism import data_sheet
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, load_device_model, load_profile, save_profile

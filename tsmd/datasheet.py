@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
-from tsmd.calibration.identify import identify_sweep, settle_rule_backlash
+from tsmd.calibration.identify import identify_sweep
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.tension_play_fit import fit_sweep_sides
 from tsmd.compensation.safety import KnobLimits
@@ -158,14 +158,15 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
     cur = identify_sweep(t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:])
     dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
                        + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
-    fraction = backlash_settle_fraction(cur.data, t, tip)
-    # The backlash gain exactly as the tension-play fit measures every unit's (one estimator:
-    # the settle rule's backlash whatever the product's rule for the paper's B)
+    # The backlash gain exactly as the tension-play fit measures every unit's: by the settle
+    # rule's backlash (`settle_rule_backlash`), which is what this sweep's own identification
+    # (default options: the settle rule) already found
     try:
         sides = fit_sweep_sides(cur.data.pos_deg, cur.data.current_filtered_A,
-                                cur.estimate("dead_zone_pos_deg"),
-                                cur.estimate("dead_zone_neg_deg"),
-                                *settle_rule_backlash(cur.data))
+                                *(cur.estimate(k) for k in ("dead_zone_pos_deg",
+                                                            "dead_zone_neg_deg",
+                                                            "backlash_pos_deg",
+                                                            "backlash_neg_deg")))
         gain: float | None = 0.5 * (sides[0].backlash_gain + sides[1].backlash_gain)
     except ValueError:  # a current without a loaded ramp: the sheet keeps a per-product omega
         gain = None
@@ -192,7 +193,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         dead_zone_offset_deg=float(dz_offset),
         dead_zone_pos_deg=_finite_or_none(cur.estimate("dead_zone_pos_deg")),
         dead_zone_neg_deg=_finite_or_none(cur.estimate("dead_zone_neg_deg")), backlash_gain=gain,
-        backlash_settle_fraction=fraction)
+        backlash_settle_fraction=backlash_settle_fraction(cur.data, t, tip))
 
 
 def _finite_or_none(value: float) -> float | None:

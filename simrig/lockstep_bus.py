@@ -65,7 +65,9 @@ def _flags(msg: can.Message) -> int:
             | (ERROR if msg.is_error_frame else 0))
 
 
-def _as_frame(msg: can.Message) -> Frame:
+def as_frame(msg: can.Message) -> Frame:
+    """A ``Message`` as the ``(cob_id, bytes, flags)`` tuple that
+    :meth:`LockstepBus.take_frames` gives."""
     return msg.arbitration_id, bytes(msg.data), _flags(msg)
 
 
@@ -104,7 +106,7 @@ class LockstepBus(can.BusABC):
     def _deliver(self, msg: can.Message) -> None:
         """Queue a frame that nobody else holds."""
         if self._frames is not None:
-            self._frames.append(_as_frame(msg))
+            self._frames.append(as_frame(msg))
         else:
             self._queue.append(msg)
 
@@ -138,7 +140,7 @@ class LockstepBus(can.BusABC):
                 if peer._frames is None:
                     peer._queue.append(msg)
                 else:
-                    peer._frames.append(_as_frame(msg))
+                    peer._frames.append(as_frame(msg))
 
     @property
     def reads_frames(self) -> bool:

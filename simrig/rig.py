@@ -24,7 +24,7 @@ from drivers.clock import Clock, MonotonicClock, SimClock
 from drivers.units import DriveConfig
 from simrig.current_sensor import CurrentSensor
 from simrig.drive_node import SimDriveNode
-from simrig.lockstep_bus import LockstepBus, make_message
+from simrig.lockstep_bus import Frame, LockstepBus, as_frame, make_message
 from simrig.motor import Motor, MotorParams
 from simrig.plant import Plant, as_plant_step, load_plant
 from simrig.tracker import EmTracker
@@ -100,27 +100,26 @@ class SimRig:
         nodes = self.nodes
         now = self.clock.now_s()
         sync = False
-        if self._take_frames is not None:  # the lockstep bus's frames, no Message objects
-            for cid, data, flags in self._take_frames():
-                if cid == 0x080:
-                    sync = True
-                    for n in nodes:
-                        n.on_sync(now)
-                elif not flags:
-                    for n in nodes:
-                        n.on_frame(cid, data, now)
-        else:
-            recv = self.bus.recv
-            while (msg := recv(0)) is not None:
-                cid = msg.arbitration_id
-                if cid == 0x080:
-                    sync = True
-                    for n in nodes:
-                        n.on_sync(now)
-                elif not (msg.is_error_frame or msg.is_remote_frame or msg.is_extended_id):
-                    for n in nodes:
-                        n.on_frame(cid, msg.data, now)
+        for cid, data, flags in self._pending_frames():
+            if cid == 0x080:
+                sync = True
+                for n in nodes:
+                    n.on_sync(now)
+            elif not flags:  # a plain data frame
+                for n in nodes:
+                    n.on_frame(cid, data, now)
         self._advance(sync)
+
+    def _pending_frames(self) -> list[Frame]:
+        """Every frame received since the last tick: the lockstep bus's own tuples (no
+        ``Message`` objects), or those of any other python-can bus, read until empty."""
+        if self._take_frames is not None:
+            return self._take_frames()
+        frames = []
+        recv = self.bus.recv
+        while (msg := recv(0)) is not None:
+            frames.append(as_frame(msg))
+        return frames
 
     def _advance(self, sync: bool) -> None:
         dt = self.period_s

@@ -38,7 +38,8 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
                             n_surrogates=cfg.n_surrogates, n_boot=cfg.n_boot,
                             ci_level=cfg.ci_level, family_alpha=cfg.family_alpha,
                             min_share=cfg.min_share)
-    if segments_present(series):
+    matched = segments_present(series)
+    if matched:
         # matched segments decide the effects they test: their contrast cancels the base
         # mismatch, which the signatures of the same effects compete with
         residuals = _residuals(series, split, ev, base_fit)
@@ -66,7 +67,7 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
     absorbed = (1.0 - sres.layer_excess / sres.physics_excess if sres.physics_excess > 0
                 else float("nan"))
     verdict, summary = _structure_verdict(gap_present, absorbed, sres.layer_ratio, sig, figures,
-                                          segments_present(series))
+                                          matched)
     cands = [CandidateScore(s.name, s.title, f"depends on {s.condition}", {}, s.share, s.ci,
                             s.significant, s.raw_share, {}, {}, "signature")
              for s in sres.scores]
@@ -77,7 +78,7 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         "physics_excess": sres.physics_excess, "layer_excess": sres.layer_excess,
         "layer_absorbs": absorbed, "layer_ratio": sres.layer_ratio,
         "signatures": [vars(s) for s in sres.scores], "figures": figures,
-        "protocol": segments_present(series)}
+        "protocol": matched}
     return GapResult(
         verdict=verdict, summary=summary, split="", base_params={}, fitted_params={},
         noise_std={n: float(np.sqrt(v)) for n, v in zip(CHANNELS, noise_var, strict=True)},

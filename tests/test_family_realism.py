@@ -9,7 +9,7 @@ import pytest
 
 from simrig.family import family_member
 from simrig.report import run_sweep
-from tsmd.bench import realism
+from tsmd.bench import realism, realism_tee
 from tsmd.compensation.paper import PaperParams, initial_state, model_step
 from tsmd.tee import default_tee_dir, knob_from_filename, load_tee_acquisition
 
@@ -42,7 +42,7 @@ def test_reversal_shape_reads_a_current_drop_and_a_tip_hold_on_a_textbook_loop()
     # Tip: play of 10 deg (10 % of the range) after the top reversal, slope 1 elsewhere.
     tip = np.concatenate([up, np.minimum(up[::-1][1:] + 10.0, 50.0)])
     current = np.concatenate([np.where(up > 0, up / 50.0, 0.0), np.zeros(1000)])
-    fall_pct, hold_pct = realism.reversal_shape(q, tip, current)
+    fall_pct, hold_pct = realism_tee.reversal_shape(q, tip, current)
     assert fall_pct < 1.0
     assert hold_pct == pytest.approx(10.0 + 3.0, abs=0.5)  # the play + the 3 % tip threshold
 
@@ -84,7 +84,7 @@ def _triangle() -> np.ndarray:
 
 def test_a_one_slope_loop_releases_at_its_loaded_slope() -> None:
     q = _triangle()
-    assert realism.release_load_ratio(q, _paper_loop(q)) == pytest.approx(1.0, abs=0.02)
+    assert realism_tee.release_load_ratio(q, _paper_loop(q)) == pytest.approx(1.0, abs=0.02)
 
 
 def test_a_tip_that_releases_steeper_than_it_loads_fails_the_ratio_range() -> None:
@@ -92,7 +92,7 @@ def test_a_tip_that_releases_steeper_than_it_loads_fails_the_ratio_range() -> No
     tip = _paper_loop(q)
     toward_zero = np.sign(np.gradient(q)) != np.sign(q)
     tip = np.where(toward_zero, 1.5 * tip, tip)
-    ratio = realism.release_load_ratio(q, tip)
+    ratio = realism_tee.release_load_ratio(q, tip)
     assert ratio == pytest.approx(1.5, abs=0.05)
     assert not realism.RELEASE_RATIO_RANGE[0] <= ratio <= realism.RELEASE_RATIO_RANGE[1]
 
@@ -100,8 +100,8 @@ def test_a_tip_that_releases_steeper_than_it_loads_fails_the_ratio_range() -> No
 def test_the_ratio_is_measured_about_the_sweeps_own_middle() -> None:
     q = _triangle()
     tip = _paper_loop(q)
-    shifted = realism.release_load_ratio(0.3 * q + 1600.0, tip + 12.0)
-    assert shifted == pytest.approx(realism.release_load_ratio(q, tip), abs=1e-9)
+    shifted = realism_tee.release_load_ratio(0.3 * q + 1600.0, tip + 12.0)
+    assert shifted == pytest.approx(realism_tee.release_load_ratio(q, tip), abs=1e-9)
 
 
 @pytest.mark.skipif(not TEE_DIR.is_dir(), reason=f"TEE data not found at {TEE_DIR}")
@@ -109,7 +109,7 @@ def test_the_real_probe_releases_inside_the_ratio_range() -> None:
     for f in sorted(TEE_DIR.glob("motor*_*.csv")):
         knob = knob_from_filename(f)
         rec = load_tee_acquisition(f)
-        ratio = realism.release_load_ratio(rec[f"pos{knob}"], rec[f"tip{knob}"])
+        ratio = realism_tee.release_load_ratio(rec[f"pos{knob}"], rec[f"tip{knob}"])
         assert realism.RELEASE_RATIO_RANGE[0] <= ratio <= realism.RELEASE_RATIO_RANGE[1], f.name
 
 
@@ -117,17 +117,18 @@ def test_a_compliant_tendon_releases_steeper_than_the_real_probe() -> None:
     """The development plant's nominal unit before session 5 (docs/plant.md), kept visible."""
     member = family_member("capstan", 0, "compliant-tendon")
     rec = run_sweep(member.build(), 0, cycles=2.0, dt_s=0.008)
-    assert realism.release_load_ratio(rec.knob_deg, rec.tip_deg) > realism.RELEASE_RATIO_RANGE[1]
+    ratio = realism_tee.release_load_ratio(rec.knob_deg, rec.tip_deg)
+    assert ratio > realism.RELEASE_RATIO_RANGE[1]
 
 
 def test_the_capstan_plant_releases_inside_the_ratio_range() -> None:
     rec = run_sweep(family_member("capstan", 0).build(), 0, cycles=2.0, dt_s=0.008)
-    ratio = realism.release_load_ratio(rec.knob_deg, rec.tip_deg)
+    ratio = realism_tee.release_load_ratio(rec.knob_deg, rec.tip_deg)
     assert realism.RELEASE_RATIO_RANGE[0] <= ratio <= realism.RELEASE_RATIO_RANGE[1]
 
 
 def test_the_lumped_plant_releases_inside_the_ratio_range(
         lumped_sweep: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]) -> None:
     q, tip, _, _ = lumped_sweep
-    ratio = realism.release_load_ratio(q, tip)
+    ratio = realism_tee.release_load_ratio(q, tip)
     assert realism.RELEASE_RATIO_RANGE[0] <= ratio <= realism.RELEASE_RATIO_RANGE[1]

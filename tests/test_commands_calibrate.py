@@ -65,3 +65,41 @@ def test_tee_files_get_a_report_of_what_they_give_and_lack(
     assert "a profile needs >= 2 angles including 0" in out
     assert "phi2: no sweep" in out
     assert "no B_neg:" in out
+
+
+def test_without_device_or_config_the_missing_device_model_is_named(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rec = tmp_path / "sweep.csv"
+    rec.write_text("x,y\n1,2\n")
+    code = main(["calibrate", "--catheter", "c1", "--profiles", str(tmp_path),
+                 "--from-recording", str(rec)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "no device model" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.fixture
+def rig_must_not_move(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A check that belongs before the sweeps fails the test if the simulated rig is built."""
+    def refuse(*_args: object, **_kwargs: object) -> None:
+        raise AssertionError("the rig was started before the save target was checked")
+    monkeypatch.setattr("tsmd.commands.calibrate.LockstepRunner", refuse)
+
+
+@pytest.mark.usefixtures("rig_must_not_move")
+def test_a_bad_catheter_id_is_refused_before_anything_moves(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["calibrate", "--catheter", "../etc", "--sim", "--profiles", str(tmp_path)])
+    assert code == 2
+    assert "catheter id '../etc'" in capsys.readouterr().err
+
+
+@pytest.mark.usefixtures("rig_must_not_move")
+def test_an_unwritable_profiles_directory_is_refused_before_anything_moves(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    code = main(["calibrate", "--catheter", "c1", "--sim", "--profiles", str(blocker / "dir")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "cannot write" in err and len(err.strip().splitlines()) == 1

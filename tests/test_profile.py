@@ -270,3 +270,10 @@ def test_former_ours_block_is_ignored_with_a_warning(caplog: pytest.LogCaptureFi
         profile = profile_from_mapping(m, "old.yaml")
     assert profile == profile_from_mapping(mapping(), "old.yaml")
     assert "old.yaml: knobs.phi1.ours: parameters of the former 'ours'" in caplog.text
+
+
+def test_a_store_that_cannot_be_written_is_a_profile_error(tmp_path: Path) -> None:
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    with pytest.raises(ProfileError, match="cannot save"):
+        ProfileStore(blocker / "profiles").save(make_profile())

@@ -16,6 +16,7 @@ import json
 import signal
 import socket
 import sys
+import tempfile
 import threading
 import time
 from collections.abc import Sequence
@@ -99,25 +100,42 @@ def _config(args: argparse.Namespace, sim: bool) -> Any:
 
 
 def _device(args: argparse.Namespace, config: Any) -> Any:
-    path = args.device or getattr(config.profiles, "device_model", None)
+    path = args.device or (config.profiles.device_model if config is not None else None)
     if path is None:
         raise TsmdError("no device model: pass --device FILE or set profiles.device_model")
 
     return load_device_model(resolve_data_path(str(path)))
 
 
-def _save(args: argparse.Namespace, config: Any, cal: Any) -> None:
+def _store(args: argparse.Namespace, config: Any) -> ProfileStore | None:
+    """Where the profile will go, checked before anything moves: a calibration that runs for
+    minutes must not end in "cannot save" (a bad id, no directory, a read-only directory)."""
+    if args.no_save:
+        return None
+    directory = args.profiles or (config.profiles.dir if config is not None else None)
+    if directory is None:
+        raise TsmdError("no profiles directory: pass --profiles DIR or --config FILE")
+    store = ProfileStore(directory)
+    store.path(args.catheter)
+    try:
+        store.directory.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=store.directory):
+            pass
+    except OSError as exc:
+        raise TsmdError(f"profiles directory {store.directory}: cannot write "
+                        f"({exc.strerror or exc})") from None
+    return store
+
+
+def _save(args: argparse.Namespace, store: ProfileStore | None, cal: Any) -> None:
     _print_result(cal)
     if args.report:
         index = write_report(cal, Path(args.report))
         print(f"report: {index}")
-    if args.no_save:
+    if store is None:
         print("not saved (--no-save)")
         return
-    directory = args.profiles or (config.profiles.dir if config is not None else None)
-    if directory is None:
-        raise TsmdError("no profiles directory: pass --profiles DIR or --config FILE")
-    path = ProfileStore(directory).save(cal.profile)
+    path = store.save(cal.profile)
     print(f"saved profile {cal.profile.catheter_id!r} to {path}")
 
 
@@ -164,6 +182,7 @@ class _Bar:
 def _sim(args: argparse.Namespace) -> int:
     config = _config(args, sim=True)
     device = _device(args, config)
+    store = _store(args, config)
     protocol = fast_protocol() if args.fast else paper_protocol()
     cancel = threading.Event()
     bar = _Bar()
@@ -186,7 +205,7 @@ def _sim(args: argparse.Namespace) -> int:
         bar.done()
     if args.save_sweeps:
         _write_sweeps(Path(args.save_sweeps), cal.points)
-    _save(args, config, cal)
+    _save(args, store, cal)
     return 0
 
 
@@ -201,6 +220,7 @@ def _write_sweeps(out: Path, points: Sequence[GridPoint]) -> None:
 def _from_recordings(args: argparse.Namespace) -> int:
     config = _config(args, sim=False) if args.config else None
     device = _device(args, config)
+    store = _store(args, config)
     options = IdentifyOptions(edge=args.edge)
     points = []
     failures = []
@@ -224,7 +244,7 @@ def _from_recordings(args: argparse.Namespace) -> int:
         # Repeated acquisitions of one grid point are pooled, as a re-sweep would be.
         print("\n" + data_report(pool_repeats(points), failures, str(exc)))
         raise
-    _save(args, config, cal)
+    _save(args, store, cal)
     return 0
 
 

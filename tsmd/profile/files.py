@@ -133,7 +133,11 @@ class ProfileStore:
 
     def save(self, profile: CatheterProfile) -> Path:
         path = self.path(profile.catheter_id)
-        save_profile(profile, path)
+        try:
+            save_profile(profile, path)
+        except OSError as exc:
+            raise ProfileError(f"{path}: cannot save ({exc.strerror or exc}); the previous "
+                               "profile, if any, is unchanged") from None
         return path
 
     def list(self) -> list[str]:

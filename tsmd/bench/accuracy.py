@@ -33,7 +33,7 @@ from tsmd.bench.accuracy_report import (
 from tsmd.calibration import calibrate
 from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
 from tsmd.compensation import LimitedCompensator, build_compensator
-from tsmd.config import default_sim_config
+from tsmd.config import default_sim_config, resolve_data_path
 from tsmd.datasheet import analysed_from, settle, tip_sweep
 from tsmd.errors import TsmdError
 from tsmd.profile import (
@@ -284,7 +284,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="use this profile file instead of calibrating")
     parser.add_argument("--save-profile", type=Path, default=None,
                         help="write the profile the benchmark used here")
-    parser.add_argument("--device", type=Path, default=Path("profiles/devices/sim-catheter.yaml"))
+    parser.add_argument("--device", type=Path,
+                        default=resolve_data_path("profiles/devices/sim-catheter.yaml"))
     parser.add_argument("--coupling", type=float, default=0.0,
                         help="plant knob-coupling strength (0 = the default simulated catheter)")
     parser.add_argument("--unit-variation", type=float, default=0.0,

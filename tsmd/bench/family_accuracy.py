@@ -36,6 +36,7 @@ from tsmd.bench.accuracy import (
 )
 from tsmd.bench.accuracy_report import plot_runs
 from tsmd.bench.realism import data_sheet
+from tsmd.config import resolve_data_path
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, load_device_model, load_profile, save_profile
 
@@ -137,7 +138,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quick", action="store_true", help="the paper's quick scenario set")
     parser.add_argument("--no-extra", action="store_true", help="skip the extra scenarios")
     parser.add_argument("--fresh", action="store_true", help="fresh plant, no conditioning")
-    parser.add_argument("--device", type=Path, default=Path("profiles/devices/sim-catheter.yaml"))
+    parser.add_argument("--device", type=Path,
+                        default=resolve_data_path("profiles/devices/sim-catheter.yaml"))
     parser.add_argument("--report", type=Path, default=None)
     parser.add_argument("--profiles", type=Path, default=None,
                         help="keep each unit's calibrated profile here as unit-<n>.yaml and "

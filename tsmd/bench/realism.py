@@ -45,7 +45,7 @@ from simrig.family import PLANT_ROLE, PLANT_SPECS, FamilyMember, family
 from simrig.report import run_sweep
 from tsmd.bench.accuracy import PERIOD_S, Scenario, scenarios, tracking_errors
 from tsmd.bench.realism_tee import release_load_ratio, tee_comparison
-from tsmd.config import default_sim_config
+from tsmd.config import default_sim_config, resolve_data_path
 from tsmd.datasheet import device_model, measure_device_constants
 from tsmd.errors import TsmdError
 from tsmd.profile import load_device_model
@@ -258,7 +258,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --tee: write PNG_PREFIX-<plant>.png")
     parser.add_argument("--skip-checks", action="store_true",
                         help="only the TEE comparison (with --tee)")
-    parser.add_argument("--device", type=Path, default=Path("profiles/devices/sim-catheter.yaml"),
+    parser.add_argument("--device", type=Path,
+                        default=resolve_data_path("profiles/devices/sim-catheter.yaml"),
                         help="data sheet whose limits are used (slope and references are "
                         "re-measured on the plant's nominal unit)")
 

@@ -33,6 +33,10 @@ class GridPoint:
     result: SweepResult
     recording: Recording | None = None
     label: str = ""
+    settle_backlash_deg: tuple[float, float] | None = None
+    """(B_pos, B_neg) of this sweep's own signals by the settle rule, for the tension-play fit
+    (:func:`tsmd.calibration.tension_play_fit.with_settle_backlash`), when already analysed (in
+    the identification worker, overlapped with the next sweep); None: the fit analyses it."""
 
     @property
     def name(self) -> str:

@@ -222,6 +222,19 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         lag_s=min(max(lag, 0.0), 1.0))
 
 
+def with_settle_backlash(point: Any) -> Any:
+    """``point`` (a grid point) with its settle-rule backlash, analysed once from its own sweep's
+    signals: a re-sweep pooled into it later keeps the first sweep's signals, hence this value.
+
+    Not the identification's own half-cycles: this pass splits the whole recording at its
+    reversals again (a first sweep's way down to -A counts, the first half-cycle of a recording
+    that starts at -A does not), so it is a second pass over every half-cycle (~0.2 s a paper
+    sweep), which the calibration runs in the identification worker while the next sweep plays."""
+    if point.settle_backlash_deg is not None:
+        return point
+    return replace(point, settle_backlash_deg=settle_rule_backlash(point.result.data))
+
+
 def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
     """:class:`SweepCurrent` of one knob from the calibration's grid points."""
     out = []
@@ -231,7 +244,7 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
         d = p.result.data
         est = p.result.estimate
         # the backlash by the settle rule, whatever rule the product's paper B uses
-        b_pos, b_neg = settle_rule_backlash(d)
+        b_pos, b_neg = with_settle_backlash(p).settle_backlash_deg
         out.append(SweepCurrent(float(p.other_deg), d.t_s, d.cmd_deg, d.pos_deg,
                                 d.current_filtered_A, est("dead_zone_pos_deg"),
                                 est("dead_zone_neg_deg"), b_pos, b_neg))

@@ -40,9 +40,24 @@ def test_the_split_puts_a_paced_plant_step_in_the_plant_share() -> None:
 def test_time_with_both_protocols_is_a_one_line_error() -> None:
     parser = argparse.ArgumentParser()
     calibration.add_arguments(parser)
-    args = parser.parse_args(["--time"])  # --protocol defaults to both
+    args = parser.parse_args(["--time", "--protocol", "both"])
     with pytest.raises(TsmdError, match="--protocol paper or fast"):
         calibration.main(args)
+
+
+def test_time_without_a_protocol_times_the_paper_protocol(monkeypatch: pytest.MonkeyPatch
+                                                          ) -> None:
+    asked: dict[str, object] = {}
+
+    def fake_main_time(device: object, **kwargs: object) -> list[str]:
+        asked.update(kwargs)
+        return []
+
+    monkeypatch.setattr(calibration, "main_time", fake_main_time)
+    parser = argparse.ArgumentParser()
+    calibration.add_arguments(parser)
+    assert calibration.main(parser.parse_args(["--time"])) == 0
+    assert asked["fast"] is False
 
 
 def test_a_cpu_paced_plant_step_costs_its_pace_in_cpu_time() -> None:

@@ -46,7 +46,7 @@ from tsmd.calibration.player import (
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import paper_protocol, sweep_run
 from tsmd.calibration.resweep import pool_repeats, pooled, uncertain_points
-from tsmd.calibration.tension_play_fit import with_settle_backlash, with_tension_play
+from tsmd.calibration.tension_play_fit import with_prefit, with_tension_play
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
 from tsmd.trajectory import TrajectoryRunner
@@ -264,14 +264,14 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
 
 
 def _identify_detached(rec: Recording, options: KnobOptions, label: str,
-                       settle: bool = True) -> GridPoint:
+                       prefit: bool = True) -> GridPoint:
     """:func:`identify_recording` in the worker, answered without the recording (the caller
-    has it: sending it back would be a second copy of every sweep). ``settle``: the tension-play
-    fit's settle-rule backlash too (a protocol sweep's; a re-sweep's is never used), so that
+    has it: sending it back would be a second copy of every sweep). ``prefit``: the tension-play
+    fit's per-sweep analysis too (a protocol sweep's; a re-sweep's is never used), so that
     :func:`finish` is left with the cheap combination."""
     point = identify_recording(rec, options, label)
-    if settle:
-        point = with_settle_backlash(point)
+    if prefit:
+        point = with_prefit(point)
     return replace(point, recording=None)
 
 

@@ -78,3 +78,17 @@ def test_a_sweep_the_worker_cannot_identify_stops_the_protocol_with_one_line() -
     assert "\n" not in message
     assert "current is constant" in message
     assert SHORT_SWEEP.label in message
+
+
+def test_a_prefit_that_fails_in_the_worker_is_left_to_the_fit(
+        isolated: SweepRuns, monkeypatch: pytest.MonkeyPatch) -> None:
+    import tsmd.calibration.tension_play_fit as fit
+    from tsmd.calibration.run import _identify_detached
+
+    def broken(data: object) -> SweepPrefit:
+        raise ValueError("no reversal")
+
+    monkeypatch.setattr(fit, "prefit_sweep", broken)
+    rec = isolated.points[0].recording
+    assert rec is not None
+    assert _identify_detached(rec, None, "sweep").prefit is None

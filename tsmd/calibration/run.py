@@ -271,7 +271,9 @@ def _identify_detached(rec: Recording, options: KnobOptions, label: str,
     :func:`finish` is left with the cheap combination."""
     point = identify_recording(rec, options, label)
     if prefit:
-        point = with_prefit(point)
+        with contextlib.suppress(ValueError, ArithmeticError):
+            # left empty: finish analyses it again and refuses with its own clear line
+            point = with_prefit(point)
     return replace(point, recording=None)
 
 

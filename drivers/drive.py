@@ -11,6 +11,7 @@ import abc
 import enum
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 
 class DriveState(enum.Enum):
@@ -41,9 +42,10 @@ class FaultKind(enum.Enum):
     DRIVE_REBOOTED = "drive_rebooted"
 
 
-@dataclass(frozen=True)
-class DriveFeedback:
-    """Latest feedback of one knob drive, from its TPDO."""
+class DriveFeedback(NamedTuple):
+    """Latest feedback of one knob drive, from its TPDO. A named tuple, not a frozen dataclass:
+    the master builds one per drive and tick, and a tuple costs a quarter of the dataclass's
+    ``__init__`` (0.46 against 1.9 us)."""
 
     position_deg: float
     current_A: float

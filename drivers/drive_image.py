@@ -63,10 +63,9 @@ class DriveImage:
                self.age_syncs)
         fb = self.feedback
         if fb is None or key != self.feedback_key:
-            fb = self.feedback = DriveFeedback(
-                position_deg=self.position_counts / self.cpd,
-                current_A=self.current_raw * self.scale_A, statusword=self.statusword,
-                state=self.state, age_syncs=self.age_syncs)
+            fb = self.feedback = DriveFeedback(  # position_deg, current_A, statusword, ...
+                self.position_counts / self.cpd, self.current_raw * self.scale_A,
+                self.statusword, self.state, self.age_syncs)
             self.feedback_key = key
         return fb
 

@@ -40,9 +40,24 @@ def test_the_split_puts_a_paced_plant_step_in_the_plant_share() -> None:
 def test_time_with_both_protocols_is_a_one_line_error() -> None:
     parser = argparse.ArgumentParser()
     calibration.add_arguments(parser)
-    args = parser.parse_args(["--time"])  # --protocol defaults to both
+    args = parser.parse_args(["--time", "--protocol", "both"])
     with pytest.raises(TsmdError, match="--protocol paper or fast"):
         calibration.main(args)
+
+
+def test_time_without_a_protocol_times_the_paper_protocol(monkeypatch: pytest.MonkeyPatch
+                                                          ) -> None:
+    asked: dict[str, object] = {}
+
+    def fake_main_time(device: object, **kwargs: object) -> list[str]:
+        asked.update(kwargs)
+        return []
+
+    monkeypatch.setattr(calibration, "main_time", fake_main_time)
+    parser = argparse.ArgumentParser()
+    calibration.add_arguments(parser)
+    assert calibration.main(parser.parse_args(["--time"])) == 0
+    assert asked["fast"] is False
 
 
 def test_a_cpu_paced_plant_step_costs_its_pace_in_cpu_time() -> None:
@@ -51,3 +66,23 @@ def test_a_cpu_paced_plant_step_costs_its_pace_in_cpu_time() -> None:
     c0 = time.thread_time()
     paced.step(0.004, np.array([5.0, -3.0]))
     assert time.thread_time() - c0 >= 2e-3
+
+
+def _burn_cpu(seconds: float) -> None:
+    end = time.process_time() + seconds
+    while time.process_time() < end:
+        pass
+
+
+def test_a_worker_shut_down_without_waiting_has_its_cpu_counted() -> None:
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from tsmd.bench.calibration_time import _children_cpu_s, _wait_for_children
+
+    before = _children_cpu_s()
+    pool = ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("fork"))
+    pool.submit(_burn_cpu, 0.3).result()
+    pool.shutdown(wait=False)
+    _wait_for_children()
+    assert _children_cpu_s() - before >= 0.25

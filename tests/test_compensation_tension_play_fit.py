@@ -216,3 +216,11 @@ def test_method_ours_builds_from_a_profile_with_the_section() -> None:
     comp = build_compensator(profile_with_tension_play(), "ours", PERIOD_S)
     comp.reset(np.zeros(2))
     assert np.all(np.isfinite(comp.command(np.array([10.0, -10.0]))))
+
+
+def test_a_sweeps_lag_already_estimated_is_used_as_it_is() -> None:
+    from dataclasses import replace
+
+    sweeps = [synthetic_sweep(g) for g in (-90.0, 0.0, 90.0)]
+    p = fit_tension_play([replace(s, lag_s=0.3) for s in sweeps], DEVICE_KNOB)
+    assert p.lag_s == 0.3

@@ -59,7 +59,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="first unit seed (default 100: units 0-9 were used to develop)")
     parser.add_argument("--noise-seeds", default="0", metavar="LIST",
                         help="comma-separated noise seeds per catheter (default 0)")
-    parser.add_argument("--protocol", choices=("paper", "fast", "both"), default="both")
+    parser.add_argument("--protocol", choices=("paper", "fast", "both"), default=None,
+                        help="default: both (--time: paper, the target's protocol)")
     parser.add_argument("--device", metavar="FILE", default=DEFAULT_DEVICE,
                         help="device model (data sheet) used by the calibration")
     parser.add_argument("--jobs", type=int, default=1, help="catheters run in parallel")
@@ -71,8 +72,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="TEE data directory (default: $TSMD_TEE_DATA or ../shared/data/tee)")
     parser.add_argument("--time", action="store_true",
                         help="only time one calibration as `tsmd calibrate --sim` runs it (sim "
-                             "config's plant, --protocol paper or fast, noise seed = first of "
-                             "--noise-seeds): wall, CPU, peak RSS, where a tick goes")
+                             "config's plant, --protocol paper (default) or fast, noise seed = "
+                             "first of --noise-seeds): wall, CPU, peak RSS, where a tick goes")
     parser.add_argument("--plant-step-us", type=float, default=0.0, metavar="US",
                         help="--time: every plant step lasts at least this long (busy wait)")
     parser.add_argument("--pace-cpu", action="store_true",
@@ -114,7 +115,7 @@ def family(args: argparse.Namespace) -> str:
     if not isinstance(params, dict):
         raise TsmdError("--params must be a JSON object")
     device = load_device_model(resolve_data_path(args.device))
-    protocols = ("paper", "fast") if args.protocol == "both" else (args.protocol,)
+    protocols = ("paper", "fast") if args.protocol in (None, "both") else (args.protocol,)
     tasks = [(args.plant, params, args.unit_key, u, s, device, protocols)
              for u in range(args.first_unit, args.first_unit + args.units) for s in seeds]
     t0 = time.monotonic()

@@ -12,6 +12,8 @@ own work included): the target's condition is a plant step of up to 100 us.
 
 from __future__ import annotations
 
+import math
+import multiprocessing
 import os
 import resource
 import time
@@ -80,11 +82,27 @@ class TimeRun:
     plant_step_us: float
     pace_cpu: bool = False
     notes: list[str] = field(default_factory=list)
+    worker_cpu_s: float = math.nan
+    """CPU of the identification worker (child processes ended during the run)."""
 
 
 def _cpu_s() -> float:
     usage = resource.getrusage(resource.RUSAGE_SELF)
     return usage.ru_utime + usage.ru_stime
+
+
+def _children_cpu_s() -> float:
+    """CPU (user + system) of the child processes that have ended and been waited for."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def _wait_for_children(timeout_s: float = 10.0) -> None:
+    """Let the identification worker (shut down without waiting) exit and be reaped, so that its
+    CPU shows in ``RUSAGE_CHILDREN``."""
+    deadline = time.monotonic() + timeout_s
+    while multiprocessing.active_children() and time.monotonic() < deadline:
+        time.sleep(0.02)
 
 
 def _rss_MiB() -> float:
@@ -116,7 +134,7 @@ def time_protocol(config: TsmdConfig, device: DeviceModel, *, fast: bool = False
     plant = PacedPlant(load_plant(config.sim.plant, config.sim.params), plant_step_us,
                        cpu=pace_cpu)
     proto = fast_protocol() if fast else paper_protocol()
-    w0, c0 = time.perf_counter(), _cpu_s()
+    w0, c0, k0 = time.perf_counter(), _cpu_s(), _children_cpu_s()
     accepted = True
     notes: list[str] = []
     with LockstepRunner(config, seed=seed, plant=plant) as runner:
@@ -130,8 +148,10 @@ def time_protocol(config: TsmdConfig, device: DeviceModel, *, fast: bool = False
             accepted = False
             notes = [f"{type(exc).__name__}: {exc}"]
         ticks = runner.loop.stats.ticks
-    return TimeRun(proto.name, ticks, time.perf_counter() - w0, _cpu_s() - c0, plant.spent_s,
-                   timed.run_s, _rss_MiB(), accepted, plant_step_us, pace_cpu, notes)
+    wall_s, cpu_s = time.perf_counter() - w0, _cpu_s() - c0
+    _wait_for_children()
+    return TimeRun(proto.name, ticks, wall_s, cpu_s, plant.spent_s, timed.run_s, _rss_MiB(),
+                   accepted, plant_step_us, pace_cpu, notes, _children_cpu_s() - k0)
 
 
 class _Timers:
@@ -269,8 +289,9 @@ def report(run: TimeRun, split: dict[str, float], timed_us: float, plain_us: flo
         f"{run.protocol} protocol in lockstep, plant step paced to >= {run.plant_step_us:g} us "
         f"of {'CPU' if run.pace_cpu else 'wall'} time: "
         f"{'accepted' if run.accepted else 'NOT accepted'}; {run.ticks} ticks",
-        f"  wall {run.wall_s:.1f} s (target < 30 s), CPU of this process {run.cpu_s:.1f} s, "
-        f"peak RSS {run.rss_MiB:.0f} MiB, load average {_loadavg()} on {os.cpu_count()} CPUs",
+        f"  wall {run.wall_s:.1f} s (target < 30 s), CPU of this process {run.cpu_s:.1f} s "
+        f"+ identification worker {run.worker_cpu_s:.1f} s, peak RSS {run.rss_MiB:.0f} MiB "
+        f"(this process), load average {_loadavg()} on {os.cpu_count()} CPUs",
         f"  ticking {run.ticking_s:.1f} s wall = {per_tick:.1f} us/tick; plant.step "
         f"{plant_us:.1f} us " + ("of CPU" if run.pace_cpu else f"(stack {per_tick - plant_us:.1f})")
         + f"; outside the ticks (identification, plan, fit) {run.wall_s - run.ticking_s:.1f} s",

@@ -17,6 +17,7 @@ import numpy as np
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.estimate import Estimate, EstimateOptions, point_estimates
 from tsmd.calibration.identify import PARAMETERS, SweepResult
+from tsmd.calibration.tension_play_fit import SweepPrefit
 from tsmd.compensation.paper import height_from_reference
 from tsmd.profile import KNOB_NAMES, CatheterProfile, DeviceModel, KnobProfile
 from tsmd.recording import Recording
@@ -33,6 +34,9 @@ class GridPoint:
     result: SweepResult
     recording: Recording | None = None
     label: str = ""
+    prefit: SweepPrefit | None = None
+    """What the tension-play fit takes from this sweep's own signals, when already analysed (in
+    the identification worker, overlapped with the next sweep); None: the fit analyses it."""
 
     @property
     def name(self) -> str:

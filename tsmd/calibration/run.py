@@ -46,7 +46,7 @@ from tsmd.calibration.player import (
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import paper_protocol, sweep_run
 from tsmd.calibration.resweep import pool_repeats, pooled, uncertain_points
-from tsmd.calibration.tension_play_fit import with_tension_play
+from tsmd.calibration.tension_play_fit import with_prefit, with_tension_play
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
 from tsmd.trajectory import TrajectoryRunner
@@ -263,10 +263,18 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
     return SweepRuns(points, player.motion_s, time.monotonic() - wall0, resweep_s, notes)
 
 
-def _identify_detached(rec: Recording, options: KnobOptions, label: str) -> GridPoint:
+def _identify_detached(rec: Recording, options: KnobOptions, label: str,
+                       prefit: bool = True) -> GridPoint:
     """:func:`identify_recording` in the worker, answered without the recording (the caller
-    has it: sending it back would be a second copy of every sweep)."""
-    return replace(identify_recording(rec, options, label), recording=None)
+    has it: sending it back would be a second copy of every sweep). ``prefit``: the tension-play
+    fit's per-sweep analysis too (a protocol sweep's; a re-sweep's is never used), so that
+    :func:`finish` is left with the cheap combination."""
+    point = identify_recording(rec, options, label)
+    if prefit:
+        with contextlib.suppress(ValueError, ArithmeticError):
+            # left empty: finish analyses it again and refuses with its own clear line
+            point = with_prefit(point)
+    return replace(point, recording=None)
 
 
 def _lower_priority() -> None:
@@ -304,7 +312,7 @@ class _Identifier:
         """One sweep now (a re-sweep), in the worker process when isolating."""
         if self.pool is None:
             return identify_recording(rec, self.options, label)
-        point = self.pool.submit(_identify_detached, rec, self.options, label).result()
+        point = self.pool.submit(_identify_detached, rec, self.options, label, False).result()
         return replace(point, recording=rec)
 
     def check(self) -> None:

@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
+from tsmd.calibration.signal import Conditioned
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.tension_play import BETA_RANGE, OMEGA_RANGE, TensionPlayParams
 
@@ -69,6 +70,8 @@ class SweepCurrent:
     dead_zone_neg_deg: float
     backlash_pos_deg: float
     backlash_neg_deg: float
+    lag_s: float | None = None
+    """The drive's lag when already estimated; None: estimated here from t, cmd and pos."""
 
 
 @dataclass(frozen=True)
@@ -203,7 +206,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     edge_neg = at_other_knob_zero(grid, d_neg) if ref_neg is None else float(ref_neg)
     h_pos, h_neg = plateau_heights(k, edge_pos, edge_neg)
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
-                                          np.asarray(s.pos_deg, float)) for s in order]))
+                                          np.asarray(s.pos_deg, float))
+                           if s.lag_s is None else s.lag_s for s in order]))
     lo, hi = BETA_RANGE
     beta_pos = [min(max(b, lo), hi)
                 for b in smooth_over_grid(grid, [f.backlash_gain for f in pos_fits])]
@@ -222,6 +226,38 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         lag_s=min(max(lag, 0.0), 1.0))
 
 
+@dataclass(frozen=True)
+class SweepPrefit:
+    """What the fit takes from one sweep's own signals alone, analysed once per sweep: the
+    settle-rule backlash and the drive's lag (together ~0.4 s of a paper sweep, which the
+    calibration spends in the identification worker while the next sweep plays)."""
+
+    backlash_pos_deg: float
+    backlash_neg_deg: float
+    lag_s: float
+
+
+def prefit_sweep(data: Conditioned) -> SweepPrefit:
+    """:class:`SweepPrefit` of one conditioned sweep.
+
+    The backlash is not the identification's own half-cycles': this pass splits the whole
+    recording at its reversals again (a first sweep's way down to -A counts, the first
+    half-cycle of a recording that starts at -A does not), so it is a second pass over every
+    half-cycle."""
+    b_pos, b_neg = settle_rule_backlash(data)
+    lag = estimate_lag_s(np.asarray(data.t_s, float), np.asarray(data.cmd_deg, float),
+                         np.asarray(data.pos_deg, float))
+    return SweepPrefit(b_pos, b_neg, lag)
+
+
+def with_prefit(point: Any) -> Any:
+    """``point`` (a grid point) with its :class:`SweepPrefit` (kept if it has one): a re-sweep
+    pooled into it later keeps the first sweep's signals, hence this analysis."""
+    if point.prefit is not None:
+        return point
+    return replace(point, prefit=prefit_sweep(point.result.data))
+
+
 def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
     """:class:`SweepCurrent` of one knob from the calibration's grid points."""
     out = []
@@ -231,10 +267,11 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
         d = p.result.data
         est = p.result.estimate
         # the backlash by the settle rule, whatever rule the product's paper B uses
-        b_pos, b_neg = settle_rule_backlash(d)
+        pre = with_prefit(p).prefit
         out.append(SweepCurrent(float(p.other_deg), d.t_s, d.cmd_deg, d.pos_deg,
                                 d.current_filtered_A, est("dead_zone_pos_deg"),
-                                est("dead_zone_neg_deg"), b_pos, b_neg))
+                                est("dead_zone_neg_deg"), pre.backlash_pos_deg,
+                                pre.backlash_neg_deg, pre.lag_s))
     return out
 
 

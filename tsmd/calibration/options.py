@@ -47,6 +47,10 @@ class IdentifyOptions:
     """"settle" (the paper's point a2): where the current joins the release level within the
     noise; "fraction": where it has made up ``backlash_fraction`` of its jump to that level."""
     backlash_fraction: float = 0.975
+    release_fit_half_deg: float = 4.0
+    """"fraction": the share's crossing is read off a quadratic fitted to the current over this
+    much knob travel either side of it (noise averaged; narrow enough for a quadratic to follow
+    the curve: 2.5-6 deg gave the same accuracy on lumped development units 1-8)."""
     min_level_deg: float = 3.0
     """A run of flat pieces shorter than this after a reversal is a pause in the transient (a
     turn of the filtered reversal, a speed change), not the release level, which lasts until

@@ -131,8 +131,8 @@ def test_fitted_omega_follows_the_units_backlash_gain_at_the_other_knobs_zero() 
 
 
 @pytest.mark.parametrize(("sign", "beta", "x0"), [(1, 0.35, 20.0), (-1, 0.3, -15.0),
-                                                   (1, 0.25, -40.0)])
-@pytest.mark.parametrize("ratio", [0.8, 0.93, 1.1])
+                                                   (1, 0.3, 0.0)])
+@pytest.mark.parametrize("ratio", [0.9, 0.93, 1.1])
 def test_release_line_moved_keeps_the_backlash_end_at_the_amplitude(
         sign: int, beta: float, x0: float, ratio: float) -> None:
     omega, height, edge, amplitude = 1.3, 5.0 * sign, 24.0 * sign, 89.0 * sign
@@ -147,6 +147,18 @@ def test_release_line_moved_keeps_the_backlash_end_at_the_amplitude(
 def test_release_line_is_never_shallower_than_the_loaded_line() -> None:
     beta, _ = release_through_amplitude(0.1, 5.0, 90.0, 0.8)
     assert BETA_RANGE[0] < beta <= BETA_RANGE[1]
+
+
+@pytest.mark.parametrize("sign", [1, -1])
+def test_moved_zero_load_point_stays_within_the_profiles_range(sign: int) -> None:
+    # a small backlash gain and a shallower product: the anchored line would need x0 far out
+    beta, x0 = release_through_amplitude(0.08, 10.0 * sign, 90.0 * sign, 0.8)
+    assert abs(x0) <= 90.0
+    assert BETA_RANGE[0] < beta <= BETA_RANGE[1]
+    tension_play_from_mapping(tension_play_to_mapping(dataclasses.replace(
+        fit_tension_play([synthetic_sweep(g) for g in (-90.0, 90.0)], DEVICE_KNOB),
+        zero_load_pos_deg=(x0,) * 2, zero_load_neg_deg=(-abs(x0),) * 2,
+        backlash_gain_pos=(beta,) * 2)))
 
 
 def test_release_ratio_is_one_without_the_sheets_release_slope_or_backlash_gain() -> None:

@@ -154,6 +154,8 @@ def unit_omega(sheet_omega: float, sheet_backlash_gain: float | None, unit_backl
     return min(max(float(w), lo), hi)
 
 
+FAR_ZERO_LOAD_DEG = 89.0
+"""A moved zero-load point stays within +-this (the profile keeps x0 within +-90 deg)."""
 RELEASE_RATIO_RANGE: tuple[float, float] = (0.7, 1.3)
 """Plausible release-path over backlash-end-locus slope ratios; outside, the sheet is refused."""
 
@@ -182,8 +184,10 @@ def release_through_amplitude(beta: float, zero_load_deg: float, amplitude_deg: 
     if ratio == 1.0:
         return beta, zero_load_deg
     lo, hi = BETA_RANGE
-    b = min(max(1.0 - (1.0 - beta) / ratio, lo + 0.01), hi)
     backlash = beta * (amplitude_deg - zero_load_deg)  # signed: negative on the negative side
+    # never shallower than the loaded line, and x0' within the profile's range (+-FAR_ZERO_LOAD)
+    floor = max(lo + 0.01, abs(backlash) / (abs(amplitude_deg) + FAR_ZERO_LOAD_DEG))
+    b = min(max(1.0 - (1.0 - beta) / ratio, floor), hi)
     return b, amplitude_deg - backlash / b
 
 

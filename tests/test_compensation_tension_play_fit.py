@@ -17,11 +17,18 @@ from tsmd.calibration.tension_play_fit import (
     fit_tension_play,
     friction_current_A,
     median_of_three,
+    release_slope_ratio,
+    release_through_amplitude,
     unit_omega,
 )
 from tsmd.compensation import CompensationError, build_compensator
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
+from tsmd.compensation.tension_play import (
+    BETA_RANGE,
+    release_line,
+    tension_play_from_mapping,
+    tension_play_to_mapping,
+)
 from tsmd.profile import (
     DeviceKnob,
     ProfileError,
@@ -121,6 +128,73 @@ def test_fitted_omega_follows_the_units_backlash_gain_at_the_other_knobs_zero() 
     beta_0 = 0.5 * (p.backlash_gain_pos[1] + p.backlash_gain_neg[1])
     assert p.omega == pytest.approx(1.5 * (1.0 - beta_0) / 0.8)
     assert beta_0 == pytest.approx(20.0 / (90.0 - 12.5), rel=0.03)
+
+
+@pytest.mark.parametrize(("sign", "beta", "x0"), [(1, 0.35, 20.0), (-1, 0.3, -15.0),
+                                                   (1, 0.3, 0.0)])
+@pytest.mark.parametrize("ratio", [0.9, 0.93, 1.1])
+def test_release_line_moved_keeps_the_backlash_end_at_the_amplitude(
+        sign: int, beta: float, x0: float, ratio: float) -> None:
+    omega, height, edge, amplitude = 1.3, 5.0 * sign, 24.0 * sign, 89.0 * sign
+    b2, x02 = release_through_amplitude(beta, x0, amplitude, ratio)
+    s1, c1 = release_line(omega, height, edge, beta, x0)
+    s2, c2 = release_line(omega, height, edge, b2, x02)
+    end = amplitude - beta * (amplitude - x0)
+    assert s2 == pytest.approx(ratio * s1)
+    assert s2 * end + c2 == pytest.approx(s1 * end + c1)
+
+
+def test_release_line_is_never_shallower_than_the_loaded_line() -> None:
+    beta, _ = release_through_amplitude(0.1, 5.0, 90.0, 0.8)
+    assert BETA_RANGE[0] < beta <= BETA_RANGE[1]
+
+
+@pytest.mark.parametrize("sign", [1, -1])
+def test_moved_zero_load_point_stays_within_the_profiles_range(sign: int) -> None:
+    # a small backlash gain and a shallower product: the anchored line would need x0 far out
+    beta, x0 = release_through_amplitude(0.08, 10.0 * sign, 90.0 * sign, 0.8)
+    assert abs(x0) <= 90.0
+    assert BETA_RANGE[0] < beta <= BETA_RANGE[1]
+    tension_play_from_mapping(tension_play_to_mapping(dataclasses.replace(
+        fit_tension_play([synthetic_sweep(g) for g in (-90.0, 90.0)], DEVICE_KNOB),
+        zero_load_pos_deg=(x0,) * 2, zero_load_neg_deg=(-abs(x0),) * 2,
+        backlash_gain_pos=(beta,) * 2)))
+
+
+def test_release_ratio_is_one_without_the_sheets_release_slope_or_backlash_gain() -> None:
+    assert release_slope_ratio(DEVICE_KNOB) == 1.0
+    assert release_slope_ratio(dataclasses.replace(DEVICE_KNOB, release_omega=2.0)) == 1.0
+    assert release_through_amplitude(0.3, 10.0, 90.0, 1.0) == (0.3, 10.0)
+
+
+def test_release_ratio_is_the_tracked_release_slope_over_the_backlash_end_locus() -> None:
+    knob = dataclasses.replace(DEVICE_KNOB, release_omega=2.0, reference_backlash_gain=0.3)
+    assert release_slope_ratio(knob) == pytest.approx(2.0 * 0.7 / 1.5)
+
+
+def test_implausible_release_ratio_is_refused_in_one_line() -> None:
+    knob = dataclasses.replace(DEVICE_KNOB, release_omega=5.0, reference_backlash_gain=0.3)
+    with pytest.raises(ValueError, match="release/locus slope ratio") as err:
+        release_slope_ratio(knob)
+    assert "\n" not in str(err.value)
+
+
+def test_fitted_release_line_has_the_products_ratio_and_the_units_backlash_end() -> None:
+    grid = (-90.0, 0.0, 90.0)
+    plain = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.2)
+    knob = dataclasses.replace(plain, release_omega=1.5 / 0.8 * 0.9)
+    p0 = fit_tension_play([synthetic_sweep(g) for g in grid], plain)
+    p = fit_tension_play([synthetic_sweep(g) for g in grid], knob)
+    assert p.omega == p0.omega  # the loaded line is the unit's either way
+    for i in range(len(grid)):
+        s0, c0 = release_line(p0.omega, p0.height_pos_deg, D_POS, p0.backlash_gain_pos[i],
+                              p0.zero_load_pos_deg[i])
+        s, c = release_line(p.omega, p.height_pos_deg, D_POS, p.backlash_gain_pos[i],
+                            p.zero_load_pos_deg[i])
+        amplitude = 90.0
+        end = amplitude - p0.backlash_gain_pos[i] * (amplitude - p0.zero_load_pos_deg[i])
+        assert s == pytest.approx(0.9 * s0)
+        assert s * end + c == pytest.approx(s0 * end + c0, abs=0.05)
 
 
 def test_unit_omega_stays_within_the_plausible_slopes() -> None:

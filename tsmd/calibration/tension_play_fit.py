@@ -18,6 +18,13 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   ``omega_unit = omega_sheet (1 - beta_unit) / (1 - beta_sheet)`` with ``beta_sheet`` the
   data-sheet unit's backlash gain from its own current (``reference_backlash_gain``, same
   estimator); without it the data sheet's omega;
+* the release line's slope: the locus of backlash ends has slope ``omega / (1 - beta)``, but
+  where a product's release path after the backlash is shallower or steeper than that locus (a
+  lumped catheter's is 7 % shallower; the current cannot see it: a released tendon's current is
+  friction only), the data sheet's tracked ``release_omega`` gives the product's ratio
+  ``release_omega (1 - beta_sheet) / omega_sheet`` (:func:`release_slope_ratio`); the unit's
+  release line then has that ratio times its own locus slope and still passes through its own
+  backlash end at the calibration amplitude (:func:`release_through_amplitude`);
 * the plateau heights ``H``: product constants, from the data sheet's reference points through
   the edges the current showed on the data-sheet unit (``reference_dead_zone_*_deg``), so that
   each unit's loaded line moves with its own edges (more slack: the tip reaches less at +-90).
@@ -150,6 +157,43 @@ def unit_omega(sheet_omega: float, sheet_backlash_gain: float | None, unit_backl
     return min(max(float(w), lo), hi)
 
 
+FAR_ZERO_LOAD_DEG = 89.0
+"""A moved zero-load point stays within +-this (the profile keeps x0 within +-90 deg)."""
+RELEASE_RATIO_RANGE: tuple[float, float] = (0.7, 1.3)
+"""Plausible release-path over backlash-end-locus slope ratios; outside, the sheet is refused."""
+
+
+def release_slope_ratio(device_knob: Any) -> float:
+    """The product's release-path slope over its backlash-end locus slope, from the data sheet:
+    ``release_omega (1 - reference_backlash_gain) / omega`` (tracked release slope against the
+    locus the current's backlash gain gives on the same unit); 1 without both keys."""
+    release = getattr(device_knob, "release_omega", None)
+    gain = getattr(device_knob, "reference_backlash_gain", None)
+    if release is None or gain is None:
+        return 1.0
+    ratio = float(release) * (1.0 - float(gain)) / float(device_knob.omega)
+    lo, hi = RELEASE_RATIO_RANGE
+    if not lo <= ratio <= hi:
+        raise ValueError(f"data sheet: release_omega {release} gives a release/locus slope ratio "
+                         f"{ratio:.2f} outside [{lo}, {hi}]")
+    return ratio
+
+
+def release_through_amplitude(beta: float, zero_load_deg: float, amplitude_deg: float,
+                              ratio: float) -> tuple[float, float]:
+    """(beta', x0') whose release line has ``ratio`` times the slope of (beta, x0)'s and passes
+    through the same backlash end at the amplitude: ``A - beta (A - x0) = A - beta' (A - x0')``.
+    The loaded line and the backlash identified at the amplitude are unchanged."""
+    if ratio == 1.0:
+        return beta, zero_load_deg
+    lo, hi = BETA_RANGE
+    backlash = beta * (amplitude_deg - zero_load_deg)  # signed: negative on the negative side
+    # never shallower than the loaded line, and x0' within the profile's range (+-FAR_ZERO_LOAD)
+    floor = max(lo + 0.01, abs(backlash) / (abs(amplitude_deg) + FAR_ZERO_LOAD_DEG))
+    b = min(max(1.0 - (1.0 - beta) / ratio, floor), hi)
+    return b, amplitude_deg - backlash / b
+
+
 def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list[float]:
     """Least-squares polynomial over the grid (degree min(2, n - 2), 0 for n <= 2)."""
     g = np.asarray(grid_deg, float)
@@ -216,14 +260,19 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     # the sheet measured its beta with the other knob at 0: compare the unit there
     beta_0 = 0.5 * (at_other_knob_zero(grid, beta_pos) + at_other_knob_zero(grid, beta_neg))
     omega = unit_omega(float(k.omega), getattr(k, "reference_backlash_gain", None), beta_0)
+    ratio = release_slope_ratio(k)
+    sides = []
+    for betas, fits in ((beta_pos, pos_fits), (beta_neg, neg_fits)):
+        x0s = smooth_over_grid(grid, [f.zero_load_deg for f in fits])
+        moved = [release_through_amplitude(b, x0, f.amplitude_deg, ratio)
+                 for b, x0, f in zip(betas, x0s, fits, strict=True)]
+        sides.append((tuple(m[0] for m in moved), tuple(m[1] for m in moved)))
     return TensionPlayParams(
         omega=omega, height_pos_deg=float(h_pos), height_neg_deg=float(h_neg),
         other_knob_deg=tuple(grid), dead_zone_pos_deg=tuple(d_pos),
-        dead_zone_neg_deg=tuple(d_neg),
-        backlash_gain_pos=tuple(beta_pos), backlash_gain_neg=tuple(beta_neg),
-        zero_load_pos_deg=tuple(smooth_over_grid(grid, [f.zero_load_deg for f in pos_fits])),
-        zero_load_neg_deg=tuple(smooth_over_grid(grid, [f.zero_load_deg for f in neg_fits])),
-        lag_s=min(max(lag, 0.0), 1.0))
+        dead_zone_neg_deg=tuple(d_neg), backlash_gain_pos=sides[0][0],
+        backlash_gain_neg=sides[1][0], zero_load_pos_deg=sides[0][1],
+        zero_load_neg_deg=sides[1][1], lag_s=min(max(lag, 0.0), 1.0))
 
 
 @dataclass(frozen=True)

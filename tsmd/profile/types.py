@@ -52,7 +52,9 @@ class DeviceKnob:
     limits: KnobLimits
     release_omega: float | None = None
     """Optional, measured on the data-sheet unit only (`tsmd datasheet`): tip/knob slope of the
-    release branches. No compensator uses it (it is that unit's, not the product's)."""
+    release branches. Method ours uses only its ratio to the locus of backlash ends that
+    ``reference_backlash_gain`` gives on the same unit (a product's shape constant), never the
+    slope itself."""
     reference_backlash_pos_deg: float | None = None
     """Optional: the data-sheet unit's tip backlash after the reversal at reference_pos
     (calibration compares its own backlash with it as a plausibility check)."""

@@ -18,7 +18,7 @@ from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
 from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
-from tsmd.gap.model import ParamSpec
+from tsmd.gap.fit import ParamSpec
 from tsmd.gap.report import finite_json, write_report
 from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (

@@ -189,10 +189,28 @@ def lag_share(series: Sequence[GapSeries],
     found = [loop_contrast(d["rate"].currents, d["rate"].levels)
              for d in by_config.values() if "rate" in d]
     loops = [lp for lp in found if lp is not None]
-    shrinks = [loop_shrink(loops[:i] + loops[i + 1:], loops[i], lag_design)
+    speeds = _level_speeds(series, "rate")
+    if len(loops) < 2 or len(speeds) < 2 or min(speeds) <= 0.0:
+        return None
+    design = lag_design(speeds)
+    shrinks = [loop_shrink(loops[:i] + loops[i + 1:], loops[i], design)
                for i in range(len(loops))]
     finite = [x for x in shrinks if np.isfinite(x)]
     return (float(np.mean(finite)), min(finite), max(finite)) if finite else None
+
+
+def _level_speeds(series: Sequence[GapSeries], test: str) -> list[float]:
+    """Median knob speed (deg/s) of each level of ``test``, from the recorded motion."""
+    speeds: dict[str, list[FloatArray]] = {}
+    for s in series:
+        if s.segment is None:
+            continue
+        dt = np.diff(s.t_s, prepend=s.t_s[0] - 1.0)
+        v = np.abs(np.diff(s.knob_deg, axis=0, prepend=s.knob_deg[:1])) / dt[:, None]
+        for i, seg in enumerate(s.segments):
+            if seg.test == test:
+                speeds.setdefault(seg.level, []).append(v[s.segment == i].max(axis=1))
+    return [float(np.median(np.concatenate(v))) for v in speeds.values()]
 
 
 def segments_present(series: Sequence[GapSeries]) -> bool:

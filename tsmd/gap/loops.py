@@ -30,6 +30,8 @@ class Loops:
     knob: FloatArray  # (K,) the knob angle of each point
     dirn: FloatArray  # (K,) +1 rising branch, -1 falling
     part: FloatArray  # (K,) which knob / channel the point belongs to
+    span_deg: float = 1.0
+    """Knob angle (deg) of ``knob`` = 1: the loops' amplitude."""
 
 
 def _branches(knob: FloatArray) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
@@ -60,6 +62,7 @@ def loop_contrast(windows: dict[tuple[str, int], list[Triple | None]],
     n_parts = len(full[keys[0]])
     ys: dict[tuple[str, int], list[FloatArray]] = {k: [] for k in keys}
     ds, ps, tips, xs = [], [], [], []
+    span_deg = 1.0
     for p in range(n_parts):
         sparse = min(keys, key=lambda k: len(full[k][p][0]))
         knob_ref = full[sparse][p][0]
@@ -78,13 +81,14 @@ def loop_contrast(windows: dict[tuple[str, int], list[Triple | None]],
             ys[k].append(np.concatenate([_sample(knob[m], resid[m], g) for m, (g, _) in pairs]))
             meas.append(np.concatenate([_sample(knob[m], measured[m], g) for m, (g, _) in pairs]))
         tips.append(np.mean(meas, axis=0))
+        span_deg = max(float(np.abs(knob_ref).max()), 1e-9)
         for grid, sign in grids:
-            xs.append(grid / max(float(np.abs(knob_ref).max()), 1e-9))
+            xs.append(grid / span_deg)
             ds.append(np.full(len(grid), sign))
             ps.append(np.full(len(grid), float(p)))
     y = np.array([[np.concatenate(ys[(lv, r)]) for r in (0, 1)] for lv in levels])
     return Loops(y, np.concatenate(tips), np.concatenate(xs), np.concatenate(ds),
-                 np.concatenate(ps))
+                 np.concatenate(ps), span_deg)
 
 
 def anova(loops: Sequence[Loops]) -> tuple[float, float, float, float]:
@@ -152,16 +156,52 @@ def _design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
     return np.column_stack(cols)
 
 
-def lag_design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
-    """A lag of the measured signal: its loop delayed along the knob, i.e. widened by the
-    slope times the branch direction, per knob; plus a branch offset (what the simulator's
-    fitted viscous term of the current already took of the lag)."""
-    g = _slope(lp, mean_loop)
-    cols = []
+LAGS_S: tuple[float, ...] = (0.03, 0.1, 0.3)
+"""Time constants (s) of the first-order lags whose speed contrasts span the lag model."""
+
+
+def smooth_along(lp: Loops, loop: FloatArray, length_deg: float) -> FloatArray:
+    """``loop`` through a first-order lag of ``length_deg`` of knob travel, run along each
+    part's closed path (falling branch from +A, then rising) until periodic: what a lag of
+    ``length_deg / speed`` seconds makes of the loop at a constant knob speed."""
+    out = loop.copy()
     for p in np.unique(lp.part):
-        z = (lp.part == p).astype(float)
-        cols += [z * g * lp.dirn, z * lp.dirn]
-    return np.column_stack(cols)
+        fall = np.flatnonzero((lp.part == p) & (lp.dirn < 0))
+        rise = np.flatnonzero((lp.part == p) & (lp.dirn > 0))
+        path = np.concatenate([fall[np.argsort(-lp.knob[fall])], rise[np.argsort(lp.knob[rise])]])
+        x = lp.knob[path] * lp.span_deg
+        step = np.abs(np.diff(x, append=x[0]))  # the last step closes the loop
+        alpha = np.exp(-np.roll(step, 1) / max(length_deg, 1e-9))
+        src = loop[path]
+        y = float(src[-1])
+        for _ in range(3):  # three laps: the start value is forgotten
+            ys = np.empty(len(path))
+            for k in range(len(path)):
+                y = alpha[k] * y + (1.0 - alpha[k]) * float(src[k])
+                ys[k] = y
+        out[path] = ys
+    return out
+
+
+def lag_design(speeds_deg_s: Sequence[float]) -> Callable[[Loops, FloatArray], FloatArray]:
+    """A lag of the measured signal, fitted on the loops of the levels run at
+    ``speeds_deg_s``: per knob and lag in :data:`LAGS_S`, the measured mean loop smoothed
+    along its path over the fastest level's travel in that time minus over the slowest's
+    (exact where the loop has sharp corners, unlike its first-order expansion, slope times
+    branch direction); plus a branch offset (what the simulator's fitted viscous term of the
+    current already took of the lag)."""
+    fast, slow = max(speeds_deg_s), min(speeds_deg_s)
+
+    def design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
+        cols = [smooth_along(lp, mean_loop, fast * tau) - smooth_along(lp, mean_loop, slow * tau)
+                for tau in LAGS_S]
+        out = []
+        for p in np.unique(lp.part):
+            z = (lp.part == p).astype(float)
+            out += [z * c for c in cols] + [z * lp.dirn]
+        return np.column_stack(out)
+
+    return design
 
 
 def loop_shrink(train: Sequence[Loops], held: Loops,

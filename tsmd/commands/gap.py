@@ -178,9 +178,12 @@ def _protocol(args: argparse.Namespace) -> int:
     if not 10.0 <= rate_hz <= 1000.0:
         raise GapError(f"--rate-hz {rate_hz:g}: the loop runs at 10-1000 Hz")
     out = Path(args.out if args.out.endswith(".csv") else f"{args.out}/protocol.csv")
-    out.parent.mkdir(parents=True, exist_ok=True)
     traj = protocol_trajectory(rate_hz, args.configuration.strip())
-    write_trajectory(out, traj)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        write_trajectory(out, traj)
+    except OSError as exc:
+        raise GapError(f"--out {out}: cannot write: {exc.strerror or exc}") from None
     print(f"protocol: {traj['t'][-1]:.0f} s at {rate_hz:g} Hz -> {out}; play it with "
           f"`tsmd replay --trajectory {out} --no-compensation --out RECORDING.csv` "
           "(loop.rate_hz the same)")

@@ -4,17 +4,20 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
 from numpy.typing import NDArray
 
+from tsmd import cli
 from tsmd.gap.contrast import contrast_scores, lag_share
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.errors import GapError
+from tsmd.gap.loops import Loops, smooth_along
 from tsmd.gap.protocol import Segment, decode_table, encode_table, protocol
 from tsmd.gap.signature import SignatureScore
-from tsmd.recording import Recording
+from tsmd.recording import Recording, read_trajectory
 
 RATE_HZ = 25.0
 Arr = NDArray[np.float64]
@@ -215,3 +218,36 @@ def test_a_segment_column_without_its_header_is_one_line() -> None:
 def test_a_malformed_segments_entry_is_one_line() -> None:
     with pytest.raises(GapError, match="entry 1"):
         decode_table("rate:slow:0:-1;rate:fast:x:-1", "p")
+
+
+def test_a_lag_along_the_loop_matches_the_same_lag_in_time() -> None:
+    """At constant knob speed a first-order lag of tau s is one of speed * tau deg of knob
+    travel, corners included (the lag model's basis relies on it)."""
+    amp_deg, speed_deg_s, rate_hz, tau_s = 40.0, 80.0, 50.0, 0.1
+    step = speed_deg_s / rate_hz
+    leg = np.arange(amp_deg, -amp_deg, -step)
+    knob = np.tile(np.concatenate([leg, -leg]), 4)  # +A -> -A -> +A, four laps
+    true = np.where(np.diff(knob, prepend=knob[0] + 1.0) < 0, -1.0, 1.0)  # square corners
+    alpha = np.exp(-1.0 / (rate_hz * tau_s))
+    lagged = true.copy()
+    for k in range(1, len(knob)):
+        lagged[k] = alpha * lagged[k - 1] + (1.0 - alpha) * true[k]
+    lap = slice(len(knob) - 2 * len(leg), len(knob))  # the last lap: periodic by now
+    x, y, y_true = knob[lap], lagged[lap], true[lap]
+    falling = np.arange(len(x)) < len(leg)
+    loops = Loops(np.zeros((2, 2, len(x))), y_true, x / amp_deg,
+                  np.where(falling, -1.0, 1.0), np.zeros(len(x)), amp_deg)
+    assert np.allclose(smooth_along(loops, y_true, speed_deg_s * tau_s), y, atol=1e-9)
+
+
+def test_the_protocol_command_writes_a_trajectory_replay_reads_with_its_labels(
+        tmp_path: Path) -> None:
+    out = tmp_path / "protocol.csv"
+    assert cli.main(["gap", "protocol", "--out", str(out), "--rate-hz", "50",
+                     "--configuration", "looped"]) == 0
+    traj = read_trajectory(out)
+    t, q, seg, table = protocol(50.0)
+    assert np.array_equal(traj["segment"], seg)
+    assert np.allclose(traj["q1"], q[:, 0]) and np.allclose(traj["t"], t)
+    assert decode_table(traj.metadata["segments"], "x") == table
+    assert traj.metadata["configuration"] == "looped"

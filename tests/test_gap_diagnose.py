@@ -16,7 +16,7 @@ from tsmd.commands import gap as gap_command
 from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
-from tsmd.gap.model import ParamSpec
+from tsmd.gap.fit import ParamSpec
 from tsmd.gap.report import write_report
 from tsmd.gap.result import GapConfig, GapResult
 from tsmd.recording import Recording, write_recording

@@ -14,7 +14,7 @@ from tsmd.gap import report
 from tsmd.gap.data import make_split, series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
-from tsmd.gap.model import ParamSpec
+from tsmd.gap.fit import ParamSpec
 from tsmd.gap.result import GapConfig
 from tsmd.recording import Recording, write_recording
 

@@ -10,7 +10,8 @@ from tsmd.gap.candidates import RateDependence, catalogue, play
 from tsmd.gap.data import make_split, parse_holdout, series_from_recording
 from tsmd.gap.diagnose import is_significant
 from tsmd.gap.errors import GapError
-from tsmd.gap.model import Evaluator, ParamSpec, View, build_views, fit_base
+from tsmd.gap.fit import ParamSpec, fit_base
+from tsmd.gap.model import Evaluator, View, build_views
 from tsmd.gap.result import GapConfig
 from tsmd.gap.simulate import eval_grid, fit_grid, lowpass, simulate, turning_points
 from tsmd.gap.stats import bootstrap_ratio_ci, ljung_box, noise_variance, ptpe

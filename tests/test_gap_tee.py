@@ -7,7 +7,7 @@ import pytest
 
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.diagnose import diagnose
-from tsmd.gap.model import ParamSpec
+from tsmd.gap.fit import ParamSpec
 from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import builtin_factory
 

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from tsmd.loop import LoopState
-from tsmd.recording import REQUIRED_COLUMNS, read_recording
-from tsmd.replay import LockstepRunner, ReplayError, run_trajectory
+from tsmd.recording import REQUIRED_COLUMNS, Recording, read_recording
+from tsmd.replay import LockstepRunner, ReplayError, carry_conditions, run_trajectory
 
 PERIOD_S = 0.004
 
@@ -161,3 +161,18 @@ def test_a_played_recording_has_contiguous_columns() -> None:
     t, q = sine(1.0)
     rec = run_trajectory(t, q)
     assert all(column.flags.c_contiguous for column in rec.columns.values())
+
+
+def test_a_replayed_trajectory_carries_its_segment_labels_and_condition_headers() -> None:
+    t, q = sine(1.0)
+    label = np.where((t >= 0.3) & (t < 0.6), 0.0, -1.0)
+    traj = Recording({"t": t, "q1": q[:, 0], "q2": q[:, 1], "segment": label},
+                     {"segments": "rate:slow:0:-1", "configuration": "looped", "note": "x"})
+    rec = run_trajectory(t, q)
+    carry_conditions(traj, rec)
+    # at 250 Hz the ticks between trajectory samples hold the label of the sample before
+    expected = np.where((rec["t"] >= 0.3 - 1e-9) & (rec["t"] < 0.6 - 1e-9), 0.0, -1.0)
+    assert np.array_equal(rec["segment"], expected)
+    assert rec.metadata["segments"] == "rate:slow:0:-1"
+    assert rec.metadata["configuration"] == "looped"
+    assert "note" not in rec.metadata

@@ -213,6 +213,20 @@ def parse_recording(text: str, source: str = "<recording>",
     return Recording(columns, metadata)
 
 
+def write_trajectory(path: str | os.PathLike[str], trajectory: Recording) -> None:
+    """Write a trajectory file (``t,q1,q2`` first, then any other columns, e.g. a label)."""
+    names = ["t", "q1", "q2"] + [c for c in trajectory.columns if c not in ("t", "q1", "q2")]
+    missing = [c for c in names[:3] if c not in trajectory.columns]
+    if missing:
+        raise RecordingError(f"trajectory has no column(s) {', '.join(missing)}")
+    with open(path, "w", newline="", encoding="utf-8") as stream:
+        write_metadata(stream, trajectory.metadata)
+        stream.write(",".join(names) + "\n")
+        for row in zip(*(np.asarray(trajectory.columns[c], dtype=float) for c in names),
+                       strict=True):
+            stream.write(",".join(_format(v) for v in row) + "\n")
+
+
 def read_trajectory(path: str | os.PathLike[str]) -> Recording:
     """A trajectory file for replay: columns ``t,q1,q2`` (deg), metadata lines allowed."""
     return read_recording(path, required=("t", "q1", "q2"))

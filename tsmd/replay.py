@@ -62,6 +62,26 @@ def rows_to_recording(rows: NDArray[np.float64], t_ticks: NDArray[np.float64],
     return Recording({"t": t_ticks[: len(table)].copy(), **columns}, metadata)
 
 
+CONDITION_KEYS: tuple[str, ...] = ("segments", "configuration", "sheath_shape", "catheter")
+"""Trajectory header keys describing the conditions of the run; a replay copies them into its
+recording (``tsmd gap`` reads them)."""
+
+
+def carry_conditions(trajectory: Recording, recording: Recording) -> None:
+    """Copy the trajectory's condition headers and, when it has one, its ``segment`` column
+    onto the recording's rows (the label of the last trajectory sample at or before each
+    row's time): a protocol played on the rig comes back labelled (in place)."""
+    for key in CONDITION_KEYS:
+        if trajectory.metadata.get(key, "").strip():
+            recording.metadata[key] = trajectory.metadata[key]
+    if "segment" not in trajectory.columns:
+        return
+    t_traj = trajectory["t"]
+    idx = np.searchsorted(t_traj, recording["t"] + 1e-9, side="right") - 1
+    label = trajectory["segment"][np.clip(idx, 0, len(t_traj) - 1)]
+    recording.columns["segment"] = np.where(idx >= 0, label, -1.0)
+
+
 class LockstepRunner:
     """The full stack on the in-process simulated rig, ticked in lockstep (deterministic).
 

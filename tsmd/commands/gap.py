@@ -2,6 +2,8 @@
 
 ``tsmd gap RECORDING...`` writes ``gap_report.md``, ``gap_report.json`` and PNG plots to
 ``--out``. ``tsmd gap selftest`` runs the blind self-test on data made by the built-in plant.
+``tsmd gap protocol --out FILE.csv`` writes the matched-condition protocol as a trajectory for
+``tsmd replay``, whose recording then carries the protocol's segment labels.
 """
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
 from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
-from tsmd.gap.model import ParamSpec
+from tsmd.gap.fit import ParamSpec
+from tsmd.gap.protocol import protocol_trajectory
 from tsmd.gap.report import finite_json, write_report
 from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (
@@ -29,14 +32,14 @@ from tsmd.gap.selftest import (
     run_selftest,
     selftest_markdown,
 )
-from tsmd.recording import Recording, read_recording
+from tsmd.recording import Recording, read_recording, write_trajectory
 from tsmd.tee import load_tee_acquisition
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("recordings", nargs="+", metavar="RECORDING",
                         help="recording CSV files (tsmd recording format; with --tee raw TEE "
-                             "CSVs), or the word 'selftest'")
+                             "CSVs), or the word 'selftest' or 'protocol'")
     parser.add_argument("--plant", default=BUILTIN_PLANT,
                         help="simulator plant 'module:factory' (default: the built-in plant)")
     parser.add_argument("--params", default=None,
@@ -66,7 +69,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seeds", default="0,1", help="selftest: noise/unit seeds")
     parser.add_argument("--cases", default=",".join(EFFECTS),
                         help=f"selftest: cases ({', '.join(EFFECTS)})")
-    parser.add_argument("--rate-hz", type=float, default=50.0, help="selftest: sample rate")
+    parser.add_argument("--rate-hz", type=float, default=None,
+                        help="selftest: sample rate (default 50); protocol: the loop rate the "
+                             "trajectory is made for (default 250)")
+    parser.add_argument("--configuration", default="",
+                        help="protocol: the set-up label written into the trajectory's header "
+                             "(e.g. straight, looped); the replay's recording carries it")
     parser.add_argument("--method", default="signature", choices=("signature", "candidates"),
                         help="effects by their condition signature on top of a structural "
                              "hysteresis layer (default; holds when the base physics differ), "
@@ -136,6 +144,8 @@ def _factory(spec: str, fixed: dict[str, Any]) -> Any:
 def main(args: argparse.Namespace) -> int:
     if args.recordings[0] == "selftest":
         return _selftest(args)
+    if args.recordings[0] == "protocol":
+        return _protocol(args)
     series = [_load_recording(p, args.tee) for p in args.recordings]
     names = [s.name for s in series]
     if len(set(names)) != len(names):
@@ -163,6 +173,23 @@ def main(args: argparse.Namespace) -> int:
     return 0
 
 
+def _protocol(args: argparse.Namespace) -> int:
+    rate_hz = 250.0 if args.rate_hz is None else args.rate_hz
+    if not 10.0 <= rate_hz <= 1000.0:
+        raise GapError(f"--rate-hz {rate_hz:g}: the loop runs at 10-1000 Hz")
+    out = Path(args.out if args.out.endswith(".csv") else f"{args.out}/protocol.csv")
+    traj = protocol_trajectory(rate_hz, args.configuration.strip())
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        write_trajectory(out, traj)
+    except OSError as exc:
+        raise GapError(f"--out {out}: cannot write: {exc.strerror or exc}") from None
+    print(f"protocol: {traj['t'][-1]:.0f} s at {rate_hz:g} Hz -> {out}; play it with "
+          f"`tsmd replay --trajectory {out} --no-compensation --out RECORDING.csv` "
+          "(loop.rate_hz the same)")
+    return 0
+
+
 def _selftest(args: argparse.Namespace) -> int:
     cases = [c.strip() for c in args.cases.split(",") if c.strip()]
     unknown = [c for c in cases if c not in EFFECTS]
@@ -178,15 +205,16 @@ def _selftest(args: argparse.Namespace) -> int:
         print(f"  {c.case:<11} {c.duration_s:5.0f} s seed {c.seed}: {c.verdict:<26} "
               f"top={c.top or 'none':<11} ({c.wall_s:.1f} s)", flush=True)
 
+    rate_hz = 50.0 if args.rate_hz is None else args.rate_hz
     if args.data_plant or args.sim_plant:
 
         data = parse_plant_spec(args.data_plant or "capstan-other")
         sim = parse_plant_spec(args.sim_plant or "capstan")
-        result = run_crosstest(data, sim, cases, sizes, seeds, args.rate_hz,
+        result = run_crosstest(data, sim, cases, sizes, seeds, rate_hz,
                                cross_config(sim.fit, args.method), progress=progress,
                                matched=not args.no_protocol)
     else:
-        result = run_selftest(cases, sizes, seeds, args.rate_hz,
+        result = run_selftest(cases, sizes, seeds, rate_hz,
                               GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method),
                               progress=progress)
     text = selftest_markdown(result)

@@ -26,12 +26,14 @@ from tsmd.daemon import Daemon
 from tsmd.errors import TsmdError
 from tsmd.profile import ProfileStore, load_profile
 from tsmd.recording import Recording, read_trajectory, write_recording
-from tsmd.replay import LiveTrajectoryRunner, run_trajectory
+from tsmd.replay import LiveTrajectoryRunner, carry_conditions, run_trajectory
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--trajectory", required=True, metavar="CSV",
-                        help="trajectory file with columns t,q1,q2 (s, deg)")
+                        help="trajectory file with columns t,q1,q2 (s, deg); a 'segment' "
+                             "column and the condition headers (segments, configuration, "
+                             "catheter) are carried into the recording")
     parser.add_argument("--out", required=True, metavar="CSV", help="recording to write")
     comp = parser.add_mutually_exclusive_group()
     comp.add_argument("--no-compensation", action="store_true",
@@ -85,6 +87,7 @@ def main(args: argparse.Namespace) -> int:
     else:
         recording = _run_live(config, profile, method, t_s, q_deg)
     recording.metadata["trajectory"] = Path(args.trajectory).name
+    carry_conditions(trajectory, recording)
     write_recording(args.out, recording)
     _print_summary(recording, args.out)
     return 0

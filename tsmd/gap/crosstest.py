@@ -27,7 +27,7 @@ from simrig.tracker import EmTracker
 from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
-from tsmd.gap.model import ParamSpec
+from tsmd.gap.fit import ParamSpec
 from tsmd.gap.protocol import Segment, encode_table, protocol
 from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (

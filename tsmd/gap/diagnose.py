@@ -19,20 +19,8 @@ from numpy.typing import NDArray
 
 from tsmd.gap.candidates import catalogue
 from tsmd.gap.data import GapSeries, Split, fit_windows, make_split
-from tsmd.gap.model import (
-    CHANNELS,
-    Active,
-    Candidate,
-    Evaluator,
-    Prediction,
-    View,
-    build_views,
-    fit_base,
-    fit_candidate,
-    get_param,
-    joint_refine,
-    polish_base,
-)
+from tsmd.gap.fit import fit_base, fit_candidate, get_param, joint_refine, polish_base
+from tsmd.gap.model import CHANNELS, Active, Candidate, Evaluator, Prediction, View, build_views
 from tsmd.gap.result import CandidateScore, GapConfig, GapResult
 from tsmd.gap.simulate import PlantFactory
 from tsmd.gap.stats import bootstrap_ratio_ci, noise_variance, pooled_ljung_box, ptpe, rmse

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.gap.errors import GapError
+from tsmd.recording import Recording
 
 FloatArray = NDArray[np.float64]
 
@@ -151,6 +152,17 @@ def protocol(rate_hz: float, design: ProtocolDesign | None = None) -> tuple[
     q = np.vstack(b.q)
     t = np.arange(len(q), dtype=float) * b.dt
     return t, q, np.concatenate(b.label), b.table
+
+
+def protocol_trajectory(rate_hz: float, configuration: str = "") -> Recording:
+    """The protocol as a trajectory file for ``tsmd replay``: ``t,q1,q2`` plus the ``segment``
+    column and the ``segments`` header, which the replay carries into its recording. Made at
+    the loop's rate, each tick plays one sample (the matched loops stay on one knob lattice)."""
+    t, q, seg, table = protocol(rate_hz)
+    meta = {"source": f"tsmd gap protocol ({rate_hz:g} Hz)", "segments": encode_table(table)}
+    if configuration:
+        meta["configuration"] = configuration
+    return Recording({"t": t, "q1": q[:, 0], "q2": q[:, 1], "segment": seg}, meta)
 
 
 def encode_table(table: list[Segment]) -> str:

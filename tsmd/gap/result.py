@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from tsmd.gap.model import ParamSpec
+from tsmd.gap.fit import ParamSpec
 from tsmd.gap.where import BinRow
 
 

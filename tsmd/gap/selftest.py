@@ -28,7 +28,7 @@ from simrig.plants.capstan import DEFAULT_KNOBS
 from simrig.tracker import EmTracker
 from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import diagnose
-from tsmd.gap.model import ParamSpec
+from tsmd.gap.fit import ParamSpec
 from tsmd.gap.result import GapConfig, GapResult
 from tsmd.gap.simulate import simulate
 from tsmd.recording import Recording

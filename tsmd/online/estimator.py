@@ -45,6 +45,9 @@ class EstimatorOptions:
     slope_window: int = 3
     """The slope a measurement uses comes from the median of this edge's last
     ``slope_window`` ramps, never from one ramp alone (see :meth:`EdgeTracker.update`)."""
+    shared_slope_ratio_max: float = 8.0
+    """A slope change both edges of the knob show (a sheath's friction) is followed up to this
+    ratio; beyond ``slope_ratio_max`` on one edge alone it is a stuck knob or a blocked tip."""
 
 
 def shrunk_ratio(ratio: float, tolerance: float) -> float:
@@ -75,6 +78,8 @@ class EdgeTracker:
     level_A: float | None = None
     slope_ref_A_per_deg: float | None = None
     residual_ref_deg: float = 0.0
+    knee_residual_ref_deg: float = math.nan
+    """The knee's offset from the profile's edge over the baseline (NaN: no knees seen)."""
     estimate_deg: float = 0.0
     applied_deg: float = 0.0
     accepted: list[float] = field(default_factory=list)
@@ -134,15 +139,26 @@ class EdgeTracker:
                 self.residual_ref_deg = median(
                     r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
                     for r, d in self._baseline)
+                knees = [r.side * (r.knee_deg - d) for r, d in self._baseline
+                         if math.isfinite(r.knee_deg)]
+                if len(knees) * 2 > len(self._baseline):
+                    self.knee_residual_ref_deg = median(knees)
                 events.append(("info", "online reference learned",
                                {**tag, "level_A": round(self.level_A, 4)}))
             return events
         assert self.level_A is not None and self.slope_ref_A_per_deg is not None
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
-        if not 1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max:
-            # A stuck knob, a blocked tip, or a stroke across a shape change: this ramp is
-            # refused and the suspects before it are void, but the ramps after it measure
-            # (freezing them delayed a slack change by two ramps per side).
+        self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
+        shared = 0.0 if partner is None else common_change(
+            self.slope_change, partner.slope_change, o.same_slope_tolerance)
+        shared_ok = (abs(shared) >= 2.0 * o.same_slope_tolerance
+                     and 1.0 / o.shared_slope_ratio_max <= ratio <= o.shared_slope_ratio_max)
+        if not (1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max or shared_ok):
+            # A stuck knob or a blocked tip (one tendon's ramp), or a stroke across a shape
+            # change: this ramp is refused and the suspects before it are void, but the ramps
+            # after it measure (freezing them delayed a slack change by two ramps per side). A
+            # steeper ramp on both tendons of the knob is the sheath's friction (a bend): it
+            # measures.
             self.suspects.clear()
             self.n_refused += 1
             events.append(("warning", "online ramp refused", {
@@ -152,24 +168,37 @@ class EdgeTracker:
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
-        # The crossing is taken on a line through the window's centre; its slope decides how
+        if (abs(shared) >= o.same_slope_tolerance and math.isfinite(ramp.knee_deg)
+                and math.isfinite(self.knee_residual_ref_deg)):
+            # The sheath's friction changed (both tendons' ramps steeper): the engagement's
+            # step changed with it, so no level crossing places the edge; the knee, seen in
+            # the stroke itself, does. Otherwise the crossing (its scatter is a third of the
+            # knee's: the knee is resolved to the samples' spacing at full speed, ~0.5 deg).
+            self._measured(ramp.side * (ramp.knee_deg - profile_edge_deg)
+                           - self.knee_residual_ref_deg, events)
+            return events
+        # The crossing is taken on a
+        # line through the window's centre; its slope decides how
         # far back the edge is (~15 deg of extrapolation: 10 % of slope is 1.5 deg). One
         # ramp's slope scatters by 25 % and more, and one edge's for a few ramps in a row
         # (fast random moves); a friction change of the sheath (curvature: 2-4 x) shows in
         # every ramp of both tendons from then on. So the slope in use moves by the change
         # both edges' last ramps agree on (beyond the tolerance only), and a ramp that
         # disagrees with it measures nothing.
-        self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         slope = self.slope_ref_A_per_deg * shrunk_ratio(
-            1.0 + (self.slope_change if partner is None else common_change(
-                self.slope_change, partner.slope_change, o.same_slope_tolerance)),
+            1.0 + (self.slope_change if partner is None else shared),
             o.same_slope_tolerance)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
             self.n_odd_slope += 1
             self.last_measurement_deg = math.nan
             return events
-        m = ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
-                         - self.residual_ref_deg)
+        self._measured(ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
+                                    - self.residual_ref_deg), events)
+        return events
+
+    def _measured(self, m: float, events: list[tuple[str, str, dict[str, Any]]]) -> None:
+        """One measurement of the offset: accepted, or a suspect (followed when confirmed)."""
+        o = self.options
         self.last_measurement_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()
@@ -181,7 +210,6 @@ class EdgeTracker:
                                                     <= o.confirm_spread_deg):
                 events += self.follow(median(self.suspects), "consecutive ramps agree")
         self._apply()
-        return events
 
     def agrees_with(self, other: EdgeTracker) -> bool:
         """Both edges of a knob have a suspect and they agree: the knob's shape changed (a

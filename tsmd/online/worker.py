@@ -194,11 +194,12 @@ class OnlineWorker:
         knob, side = stroke.knob, stroke.direction
         tracker = self.trackers[(knob, side)]
         stroke, edge = self._referred(stroke)
-        expected = edge + side * tracker.applied_deg
+        applied = edge + side * tracker.applied_deg
+        expected = applied
         if tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
             expected = relocated_edge_deg(stroke, expected, tracker.level_A,
                                           tracker.slope_ref_A_per_deg, self._knob_ramp[knob])
-        ramp = loaded_ramp(stroke, expected, self._knob_ramp[knob])
+        ramp = loaded_ramp(stroke, expected, self._knob_ramp[knob], knee_expected_deg=applied)
         if isinstance(ramp, Rejected):
             if ramp.stall:
                 tracker.freeze(ramp.reason)

@@ -227,3 +227,34 @@ def test_the_paper_compensator_under_the_limiter_is_shifted_too(profile: Any) ->
     worker.observe(worker_row(), True)
     assert edges_at(limited.inner.knobs[0], 0.0)[0] == pytest.approx(  # type: ignore[attr-defined]
         edges_at(worker.base_knobs[0], 0.0)[0] + 2.0)
+
+
+def test_a_sheath_bend_is_recovered(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    # at 100 s every edge moves 4 deg out and both tendons' ramps become 3.5 x steeper
+    feed(worker, rows(300.0, profile_edges(base, 4.0, at_s=100.0), friction=(100.0, 3.5),
+                      seed=6))
+    for knob in (0, 1):
+        for side in (0, 1):
+            assert worker.offsets()[knob][side] == pytest.approx(4.0, abs=1.0)
+
+
+def test_a_stalled_motor_after_a_sheath_bend_still_freezes(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    data = rows(300.0, profile_edges(base, 4.0, at_s=100.0), friction=(100.0, 3.5), seed=7)
+    feed(worker, data)
+    before = worker.offsets()[0]
+    stalled = rows(40.0, profile_edges(base, 9.0), friction=(0.0, 3.5), stall=(0, 0.0, 40.0),
+                   seed=8)
+    t0 = data[-1][0] + 0.004
+    feed(worker, [(r[0] + t0, *r[1:]) for r in stalled])
+    assert worker.offsets()[0] == before
+    assert worker.events[-1]["event"] != "online shape change followed"
+    assert any(e["event"] == "online estimate frozen" and e["t"] > t0 for e in worker.events)
+
+
+def test_an_edge_coupling_the_profile_does_not_hold_is_no_drift(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    # the current's edges sit 0.8 deg further out whenever the other knob is below -20 deg
+    feed(worker, rows(600.0, profile_edges(base, other_below=(-20.0, 0.8)), seed=9))
+    assert max(abs(v) for pair in worker.offsets() for v in pair) <= 0.4

@@ -45,6 +45,12 @@ class EstimatorOptions:
     slope_window: int = 3
     """The slope a measurement uses comes from the median of this edge's last
     ``slope_window`` ramps, never from one ramp alone (see :meth:`EdgeTracker.update`)."""
+    other_bin_deg: float = 30.0
+    """Width of the other knob's angle bins in which the current's own edge is learned
+    relative to the profile's (:meth:`EdgeTracker.bin_bias_deg`)."""
+    bin_min: int = 3
+    """Measurements a bin needs before its bias counts."""
+    bin_window: int = 7
     shared_slope_ratio_max: float = 8.0
     """A slope change both edges of the knob show (a sheath's friction) is followed up to this
     ratio; beyond ``slope_ratio_max`` on one edge alone it is a stuck knob or a blocked tip."""
@@ -93,6 +99,9 @@ class EdgeTracker:
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
+    bins: dict[int, list[float]] = field(default_factory=dict)
+    """Per bin of the other knob's angle: the last accepted measurements minus the estimate
+    then (where the current's edge sits in that bin relative to the profile's)."""
     _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
 
     @property
@@ -113,6 +122,22 @@ class EdgeTracker:
                               else ramps)
         self.frozen_reason = reason
         self.suspects.clear()
+
+    def _bin(self, other_deg: float) -> int:
+        return math.floor(other_deg / self.options.other_bin_deg) if math.isfinite(
+            other_deg) else 0
+
+    def bin_bias_deg(self, other_deg: float) -> float:
+        """How far the current's edge reads from the profile's in this bin of the other
+        knob's angle, beyond the estimate (0 until the bin has ``bin_min`` measurements).
+
+        The profile's coupling has three grid points; the current's edge can depend on the
+        other knob beyond them (lumped 101: phi1's positive edge 0.5-0.85 deg lower with phi2
+        at -41..-61 deg than at +31..+74 deg, before any change), which a single offset
+        mistakes for a change. Learned from the accepted ramps themselves, so a shape change
+        (every bin at once) still moves the estimate."""
+        values = self.bins.get(self._bin(other_deg), [])
+        return median(values) if len(values) >= self.options.bin_min else 0.0
 
     @property
     def slope_change(self) -> float:
@@ -139,6 +164,11 @@ class EdgeTracker:
                 self.residual_ref_deg = median(
                     r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
                     for r, d in self._baseline)
+                for r, d in self._baseline:
+                    key = self._bin(r.other_deg)
+                    self.bins[key] = [*self.bins.get(key, []), r.side * (
+                        r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
+                        - self.residual_ref_deg)]
                 knees = [r.side * (r.knee_deg - d) for r, d in self._baseline
                          if math.isfinite(r.knee_deg)]
                 if len(knees) * 2 > len(self._baseline):
@@ -175,7 +205,7 @@ class EdgeTracker:
             # the stroke itself, does. Otherwise the crossing (its scatter is a third of the
             # knee's: the knee is resolved to the samples' spacing at full speed, ~0.5 deg).
             self._measured(ramp.side * (ramp.knee_deg - profile_edge_deg)
-                           - self.knee_residual_ref_deg, events)
+                           - self.knee_residual_ref_deg, ramp.other_deg, events)
             return events
         # The crossing is taken on a
         # line through the window's centre; its slope decides how
@@ -193,15 +223,25 @@ class EdgeTracker:
             self.last_measurement_deg = math.nan
             return events
         self._measured(ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
-                                    - self.residual_ref_deg), events)
+                                    - self.residual_ref_deg), ramp.other_deg, events)
         return events
 
-    def _measured(self, m: float, events: list[tuple[str, str, dict[str, Any]]]) -> None:
-        """One measurement of the offset: accepted, or a suspect (followed when confirmed)."""
+    def _measured(self, raw_deg: float, other_deg: float,
+                  events: list[tuple[str, str, dict[str, Any]]]) -> None:
+        """One measurement of the offset (referred to its bin of the other knob's angle):
+        accepted, or a suspect (followed when confirmed)."""
         o = self.options
+        m = raw_deg - self.bin_bias_deg(other_deg)
         self.last_measurement_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()
+            key = self._bin(other_deg)
+            learned = len(self.bins.get(key, [])) >= o.bin_min
+            self.bins[key] = [*self.bins.get(key, []), raw_deg - self.estimate_deg][
+                -o.bin_window:]
+            if not learned:  # a bin still learning where the current's edge sits: it
+                return       # teaches the bin, not the estimate (a change beyond the gate
+                             # is a suspect as anywhere)
             self.accepted = [*self.accepted, m][-o.window:]
             self.estimate_deg = median(self.accepted)
         else:

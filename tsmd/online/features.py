@@ -215,13 +215,13 @@ def relocated_edge_deg(stroke: Stroke, expected_edge_deg: float, level_A: float,
 
 
 def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
-                options: RampOptions | None = None, knee_expected_deg: float | None = None
+                options: RampOptions | None = None, knee: float = math.nan
                 ) -> LoadedRamp | Rejected:
     """The loaded ramp of a stroke that leaves the dead zone beyond ``expected_edge_deg``.
 
     ``expected_edge_deg`` is the edge of the stroke's side (D_pos for a rising stroke, D_neg
-    for a falling one) where the ramp is expected to start (:func:`relocated_edge_deg`);
-    the knee is searched around ``knee_expected_deg`` (default: the same).
+    for a falling one) where the ramp is expected to start (the stroke's knee,
+    :func:`find_knee_deg`, or :func:`relocated_edge_deg`); ``knee`` is kept with the ramp.
     """
     o = options or RampOptions()
     side = stroke.direction
@@ -257,6 +257,4 @@ def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
     noise = float(np.sqrt(np.mean(r * r))) if r.size else math.nan
     return LoadedRamp(stroke.knob, side, float(x.mean()), a, b,
                       float(np.median(stroke.other_deg[sel])), float(stroke.t_s[sel][-1]),
-                      int(x.size), noise, find_knee_deg(
-                          stroke, expected_edge_deg if knee_expected_deg is None
-                          else knee_expected_deg, o))
+                      int(x.size), noise, knee)

@@ -11,6 +11,7 @@ simulation and tests, called synchronously every ``drain_every`` ticks.
 from __future__ import annotations
 
 import collections
+import math
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import replace
@@ -32,6 +33,7 @@ from tsmd.online.features import (
     RampOptions,
     Rejected,
     Stroke,
+    find_knee_deg,
     loaded_ramp,
     relocated_edge_deg,
 )
@@ -194,12 +196,14 @@ class OnlineWorker:
         knob, side = stroke.knob, stroke.direction
         tracker = self.trackers[(knob, side)]
         stroke, edge = self._referred(stroke)
-        applied = edge + side * tracker.applied_deg
-        expected = applied
-        if tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
+        expected = edge + side * tracker.applied_deg
+        knee = find_knee_deg(stroke, expected, self._knob_ramp[knob])
+        if math.isfinite(knee):  # the window starts past the engagement this stroke shows
+            expected = knee
+        elif tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
             expected = relocated_edge_deg(stroke, expected, tracker.level_A,
                                           tracker.slope_ref_A_per_deg, self._knob_ramp[knob])
-        ramp = loaded_ramp(stroke, expected, self._knob_ramp[knob], knee_expected_deg=applied)
+        ramp = loaded_ramp(stroke, expected, self._knob_ramp[knob], knee)
         if isinstance(ramp, Rejected):
             if ramp.stall:
                 tracker.freeze(ramp.reason)

@@ -244,6 +244,7 @@ def test_a_stalled_motor_after_a_sheath_bend_still_freezes(profile: Any) -> None
     data = rows(300.0, profile_edges(base, 4.0, at_s=100.0), friction=(100.0, 3.5), seed=7)
     feed(worker, data)
     before = worker.offsets()[0]
+    assert before == pytest.approx((4.0, 4.0), abs=1.0)  # the bend was followed
     stalled = rows(40.0, profile_edges(base, 9.0), friction=(0.0, 3.5), stall=(0, 0.0, 40.0),
                    seed=8)
     t0 = data[-1][0] + 0.004

@@ -95,6 +95,8 @@ class EdgeTracker:
     n_ramps: int = 0
     last_measurement_deg: float = math.nan
     recent_slopes: list[float] = field(default_factory=list)
+    recent_gaps: list[float] = field(default_factory=list)
+    """The last ramps' knee minus their crossing (reference slope), as offsets (deg)."""
     n_odd_slope: int = 0
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     n_refused: int = 0
@@ -138,6 +140,15 @@ class EdgeTracker:
         (every bin at once) still moves the estimate."""
         values = self.bins.get(self._bin(other_deg), [])
         return median(values) if len(values) >= self.options.bin_min else 0.0
+
+    @property
+    def engagement_changed(self) -> bool:
+        """The knee and the level crossing of the last ramps disagree by more than the gate:
+        the engagement's step or slope changed (a bend; capstan unit 2: the ramp only
+        1.2 x steeper, the crossing 11 deg inward, the knee 4-6 deg outward)."""
+        o = self.options
+        return (len(self.recent_gaps) >= min(2, o.slope_window)
+                and abs(median(self.recent_gaps)) > o.gate_deg)
 
     @property
     def slope_change(self) -> float:
@@ -198,15 +209,18 @@ class EdgeTracker:
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
-        if (abs(shared) >= o.same_slope_tolerance and math.isfinite(ramp.knee_deg)
-                and math.isfinite(self.knee_residual_ref_deg)):
-            # The sheath's friction changed (both tendons' ramps steeper): the engagement's
-            # step changed with it, so no level crossing places the edge; the knee, seen in
-            # the stroke itself, does. Otherwise the crossing (its scatter is a third of the
-            # knee's: the knee is resolved to the samples' spacing at full speed, ~0.5 deg).
-            self._measured(ramp.side * (ramp.knee_deg - profile_edge_deg)
-                           - self.knee_residual_ref_deg, ramp.other_deg, events)
-            return events
+        knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
+        if math.isfinite(knee_m):
+            crossing_m = ramp.side * (ramp.crossing_deg(self.level_A, self.slope_ref_A_per_deg)
+                                      - profile_edge_deg - self.residual_ref_deg)
+            self.recent_gaps = [*self.recent_gaps, knee_m - crossing_m][-o.slope_window:]
+            if abs(shared) >= o.same_slope_tolerance or self.engagement_changed:
+                # The sheath's friction changed: the engagement's step and the ramp with it,
+                # so no level crossing places the edge; the knee, seen in the stroke itself,
+                # does. Otherwise the crossing (its scatter is a third of the knee's: the
+                # knee is resolved to the samples' spacing at full speed, ~0.5 deg).
+                self._measured(knee_m, ramp.other_deg, events)
+                return events
         # The crossing is taken on a
         # line through the window's centre; its slope decides how
         # far back the edge is (~15 deg of extrapolation: 10 % of slope is 1.5 deg). One

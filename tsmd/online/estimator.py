@@ -96,6 +96,8 @@ class EdgeTracker:
     last_measurement_deg: float = math.nan
     recent_slopes: list[float] = field(default_factory=list)
     recent_gaps: list[float] = field(default_factory=list)
+    last_feature: str = ""
+    """What placed the last measurement: "knee" or "crossing"."""
     """The last ramps' knee minus their crossing (reference slope), as offsets (deg)."""
     n_odd_slope: int = 0
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
@@ -219,6 +221,7 @@ class EdgeTracker:
                 # so no level crossing places the edge; the knee, seen in the stroke itself,
                 # does. Otherwise the crossing (its scatter is a third of the knee's: the
                 # knee is resolved to the samples' spacing at full speed, ~0.5 deg).
+                self.last_feature = "knee"
                 self._measured(knee_m, ramp.other_deg, events)
                 return events
         # The crossing is taken on a
@@ -236,6 +239,7 @@ class EdgeTracker:
             self.n_odd_slope += 1
             self.last_measurement_deg = math.nan
             return events
+        self.last_feature = "crossing"
         self._measured(ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
                                     - self.residual_ref_deg), ramp.other_deg, events)
         return events
@@ -296,10 +300,14 @@ class EdgeTracker:
             self.applied_deg = max(-o.max_offset_deg, min(o.max_offset_deg, self.estimate_deg))
 
     def status(self) -> dict[str, Any]:
+        o = self.options
         state = ("learning" if self.learning else "frozen" if self.frozen_for > 0
                  else "tracking")
         return {"state": state, "offset_deg": round(self.applied_deg, 3),
                 "estimate_deg": round(self.estimate_deg, 3),
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
                 "odd_slope_ramps": self.n_odd_slope, "refused_ramps": self.n_refused,
+                "feature": self.last_feature or None,
+                "other_knob_bins_deg": {f"{k * o.other_bin_deg:g}": round(self.bin_bias_deg(
+                    (k + 0.5) * o.other_bin_deg), 3) for k in sorted(self.bins)},
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None}

@@ -259,3 +259,20 @@ def test_an_edge_coupling_the_profile_does_not_hold_is_no_drift(profile: Any) ->
     # the current's edges sit 0.8 deg further out whenever the other knob is below -20 deg
     feed(worker, rows(600.0, profile_edges(base, other_below=(-20.0, 0.8)), seed=9))
     assert max(abs(v) for pair in worker.offsets() for v in pair) <= 0.4
+
+
+def test_a_sheath_bend_raises_the_backlash_gain_as_the_current_slope(profile: Any) -> None:
+    worker, comp, base = make_worker(profile)
+    feed(worker, rows(300.0, profile_edges(base, 4.0, at_s=100.0), friction=(100.0, 1.6),
+                      seed=10))
+    f0, f1 = base[0].field, comp.knobs[0].field
+    beta = f0.column("backlash_gain_pos")
+    assert f1.at(0.0)[beta] == pytest.approx(1.6 * f0.at(0.0)[beta], rel=0.1)
+    assert comp.knobs[0].omega < base[0].omega  # the release slope omega / (1 - beta) stays
+
+
+def test_without_a_change_the_backlash_gain_stays(profile: Any) -> None:
+    worker, comp, base = make_worker(profile)
+    feed(worker, rows(300.0, profile_edges(base), noise_A=0.006, seed=11))
+    assert worker.gains == ((1.0, 1.0), (1.0, 1.0))
+    assert comp.knobs[0].omega == base[0].omega

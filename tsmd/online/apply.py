@@ -16,8 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from tsmd.calibration.tension_play_fit import unit_omega
 from tsmd.compensation.ours import MOVES_WITH_EDGE, OursKnob
 from tsmd.compensation.paper import PaperKnob
+from tsmd.compensation.tension_play import BETA_RANGE
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, KnobProfile, ReferencePoint, save_profile
 
@@ -31,18 +33,41 @@ class OnlineError(TsmdError):
     """Online estimates cannot be applied or saved as asked."""
 
 
-def shifted_knob(knob: Any, offset: tuple[float, float]) -> Any:
+def shifted_knob(knob: Any, offset: tuple[float, float],
+                 gain_ratio: tuple[float, float] = (1.0, 1.0)) -> Any:
     """A copy of a compensator knob (ours or the paper's) with its edges moved outward.
 
-    Ours: each tendon's zero-load point moves with its edge (the whole characteristic moves).
+    Ours: each tendon's zero-load point moves with its edge (the whole characteristic moves);
+    ``gain_ratio`` (pos, neg) multiplies each tendon's backlash gain beta (a sheath bend: the
+    backlash grows with the tension per knob degree, :attr:`EdgeTracker.gain_ratio`), and
+    omega follows the calibration's relation (the release slope ``omega / (1 - beta)`` is
+    the product's).
     """
     off_pos, off_neg = offset
     moves = {"dead_zone_pos_deg": off_pos, "dead_zone_neg_deg": -off_neg}
     if isinstance(knob, OursKnob):
         moves.update({MOVES_WITH_EDGE[edge]: move for edge, move in list(moves.items())})
-    elif not isinstance(knob, PaperKnob):
+        field = knob.field.shifted(moves)
+        if gain_ratio == (1.0, 1.0):
+            return replace(knob, field=field)
+        field = field.scaled({"backlash_gain_pos": gain_ratio[0],
+                              "backlash_gain_neg": gain_ratio[1]})
+        lo, hi = BETA_RANGE
+        columns = [field.column("backlash_gain_pos"), field.column("backlash_gain_neg")]
+        field.values[:, columns] = np.clip(field.values[:, columns], lo, hi)
+        field = type(field)(field.grid_deg.tolist(), field.values, field.method, field.columns)
+        omega = unit_omega(knob.omega, _beta_at_zero(knob.field), _beta_at_zero(field))
+        return replace(knob, field=field, omega=omega)
+    if not isinstance(knob, PaperKnob):
         raise OnlineError(f"online re-estimation cannot shift a {type(knob).__name__}")
     return replace(knob, field=knob.field.shifted(moves))
+
+
+def _beta_at_zero(field: Any) -> float:
+    """The mean backlash gain of both tendons with the other knob at 0 (as the calibration)."""
+    values = field.at(0.0)
+    return 0.5 * float(values[field.column("backlash_gain_pos")]
+                       + values[field.column("backlash_gain_neg")])
 
 
 def edges_at(knob: Any, other_deg: float) -> tuple[float, float]:

@@ -97,6 +97,8 @@ class EdgeTracker:
     recent_slopes: list[float] = field(default_factory=list)
     recent_gaps: list[float] = field(default_factory=list)
     last_feature: str = ""
+    shared_change: float = 0.0
+    """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
     """What placed the last measurement: "knee" or "crossing"."""
     """The last ramps' knee minus their crossing (reference slope), as offsets (deg)."""
     n_odd_slope: int = 0
@@ -153,6 +155,24 @@ class EdgeTracker:
                 and abs(median(self.recent_gaps)) > o.gate_deg)
 
     @property
+    def gain_ratio(self) -> float:
+        """How much this tendon's backlash gain beta changed: as its loaded current's slope,
+        as far as the other tendon confirms it, none within the slopes' scatter
+        (:func:`shrunk_ratio`).
+
+        The tension play's backlash after a reversal is the tendon's stretch given back,
+        ``B = c T_r``, with the tension ``T_r = k (x_r - x0)`` the current shows; so
+        ``beta = B / (x_r - x0) = c k``: with the compliance ``c`` unchanged by a bend, beta
+        follows the current's slope ``k`` (capstan units 1, 2, 101 after 60 deg: slope
+        1.2-1.4 x, the fresh calibrations' beta 1.17-1.28 x). The release itself is crossed too
+        fast under compensation to measure it (docs/online.md)."""
+        if self.learning:
+            return 1.0
+        o = self.options
+        return min(max(shrunk_ratio(1.0 + self.shared_change, o.same_slope_tolerance),
+                       1.0 / o.slope_ratio_max), o.slope_ratio_max)
+
+    @property
     def slope_change(self) -> float:
         """The median of the last ramps' slopes against the reference, minus 1 (0 while
         learning)."""
@@ -194,6 +214,7 @@ class EdgeTracker:
         self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         shared = 0.0 if partner is None else common_change(
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
+        self.shared_change = shared
         shared_ok = (abs(shared) >= 2.0 * o.same_slope_tolerance
                      and 1.0 / o.shared_slope_ratio_max <= ratio <= o.shared_slope_ratio_max)
         if not (1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max or shared_ok):
@@ -308,6 +329,7 @@ class EdgeTracker:
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
                 "odd_slope_ramps": self.n_odd_slope, "refused_ramps": self.n_refused,
                 "feature": self.last_feature or None,
+                "backlash_gain_ratio": round(self.gain_ratio, 3),
                 "other_knob_bins_deg": {f"{k * o.other_bin_deg:g}": round(self.bin_bias_deg(
                     (k + 0.5) * o.other_bin_deg), 3) for k in sorted(self.bins)},
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None}

@@ -60,7 +60,8 @@ class OnlineWorker:
     def __init__(self, compensator: Any, period_s: float, columns: Sequence[str], *,
                  estimator: EstimatorOptions | None = None, ramp: RampOptions | None = None,
                  handle_slip_deg: tuple[float, float] | None = None,
-                 rate_deg_s: float = 4.0, queue_len: int = 8192, drain_every: int = 0,
+                 rate_deg_s: float = 4.0, gain_rate_per_s: float = 0.1,
+                 queue_len: int = 8192, drain_every: int = 0,
                  on_event: EventSink | None = None,
                  fault_reason: Callable[[], str | None] | None = None) -> None:
         compensator = getattr(compensator, "inner", compensator)  # under a LimitedCompensator
@@ -83,6 +84,9 @@ class OnlineWorker:
         self.trackers = {(knob, side): EdgeTracker(knob, side, estimator or EstimatorOptions())
                          for knob in (0, 1) for side in (1, -1)}
         self.rate_deg_s = rate_deg_s
+        self.gain_rate_per_s = gain_rate_per_s
+        self.gains: Offsets = ONE_GAINS
+        """The backlash gain ratios published with the knobs (pos, neg per knob)."""
         self.queue: collections.deque[tuple[tuple[float, ...], bool]] = collections.deque(
             maxlen=queue_len)
         self.drain_every = drain_every
@@ -257,21 +261,26 @@ class OnlineWorker:
         return ((tr[(0, 1)].applied_deg, tr[(0, -1)].applied_deg),
                 (tr[(1, 1)].applied_deg, tr[(1, -1)].applied_deg))
 
+    def _gain_targets(self) -> Offsets:
+        if not self.enabled:
+            return ONE_GAINS
+        tr = self.trackers
+        return ((tr[(0, 1)].gain_ratio, tr[(0, -1)].gain_ratio),
+                (tr[(1, 1)].gain_ratio, tr[(1, -1)].gain_ratio))
+
     def _publish(self, t_s: float) -> None:
-        """Move the published offsets towards the targets at ``rate_deg_s`` (smoothly)."""
+        """Move the published offsets towards the targets at ``rate_deg_s`` and the backlash
+        gain ratios at ``gain_rate_per_s`` (smoothly)."""
         version, current, _ = self.published
-        targets = self._targets()
         dt = max(t_s - self._t_publish, 0.0)
         self._t_publish = t_s
-        step = self.rate_deg_s * dt
-        moved = tuple(tuple(c + max(-step, min(step, g - c)) for c, g in zip(cur, tgt,
-                                                                               strict=True))
-                      for cur, tgt in zip(current, targets, strict=True))
-        new: Offsets = ((moved[0][0], moved[0][1]), (moved[1][0], moved[1][1]))
-        if new == current:
+        new = _towards(current, self._targets(), self.rate_deg_s * dt)
+        gains = _towards(self.gains, self._gain_targets(), self.gain_rate_per_s * dt)
+        if new == current and gains == self.gains:
             return
-        knobs = (shifted_knob(self.base_knobs[0], new[0]),
-                 shifted_knob(self.base_knobs[1], new[1]))
+        knobs = (shifted_knob(self.base_knobs[0], new[0], gains[0]),
+                 shifted_knob(self.base_knobs[1], new[1], gains[1]))
+        self.gains = gains
         self.published = (version + 1, new, knobs)
 
     # --- control and reporting (any thread) --------------------------------------------------
@@ -282,6 +291,7 @@ class OnlineWorker:
             self.enabled = enabled
             if not enabled:
                 version = self.published[0]
+                self.gains = ONE_GAINS
                 self.published = (version + 1, ZERO_OFFSETS, self.base_knobs)
         self._emit("info", "online re-estimation", enabled=enabled)
 
@@ -294,6 +304,7 @@ class OnlineWorker:
         off = self.published[1]
         return {"enabled": self.enabled, "version": self.published[0],
                 "offsets_deg": [list(off[0]), list(off[1])],
+                "backlash_gain_ratios": [list(self.gains[0]), list(self.gains[1])],
                 "edges": {f"phi{k + 1}_{'pos' if s > 0 else 'neg'}": tr.status()
                           for (k, s), tr in self.trackers.items()},
                 "events": list(self.events)[-5:]}
@@ -307,3 +318,14 @@ class OnlineWorker:
         self.events.append({"level": level, "event": event, "t": self._t_last, **fields})
         if self.on_event is not None:
             self.on_event(level, event, **fields)
+
+
+ONE_GAINS: Offsets = ((1.0, 1.0), (1.0, 1.0))
+"""Backlash gain ratios (pos, neg) per knob that leave the profile's beta."""
+
+
+def _towards(current: Offsets, target: Offsets, step: float) -> Offsets:
+    """Each value moved towards its target by at most ``step``."""
+    (a, b), (c, d) = ((x + max(-step, min(step, g - x)) for x, g in zip(cur, tgt, strict=True))
+                      for cur, tgt in zip(current, target, strict=True))
+    return ((a, b), (c, d))

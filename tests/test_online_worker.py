@@ -276,3 +276,20 @@ def test_without_a_change_the_backlash_gain_stays(profile: Any) -> None:
     feed(worker, rows(300.0, profile_edges(base), noise_A=0.006, seed=11))
     assert worker.gains == ((1.0, 1.0), (1.0, 1.0))
     assert comp.knobs[0].omega == base[0].omega
+
+
+def test_a_saved_version_compensates_like_the_online_backlash_gains(profile: Any) -> None:
+    offsets, gains = ((3.0, 2.0), (1.0, -1.0)), ((1.3, 1.2), (1.0, 1.5))
+    live = build_compensator(profile, "ours", 0.004)
+    worker = OnlineWorker(live, 0.004, ROW_COLUMNS)
+    worker.published = (1, offsets, (shifted_knob(worker.base_knobs[0], offsets[0], gains[0]),
+                                     shifted_knob(worker.base_knobs[1], offsets[1], gains[1])))
+    worker.observe(worker_row(), True)
+    saved = build_compensator(profile_with_offsets(profile, offsets, gains=gains), "ours",
+                              0.004)
+    t = np.arange(0.0, 30.0, 0.004)
+    q = np.column_stack([50 * np.sin(2 * np.pi * 0.07 * t), 40 * np.sin(2 * np.pi * 0.05 * t)])
+    live.reset(q[0])
+    saved.reset(q[0])
+    worst = max(float(np.max(np.abs(live.command(row) - saved.command(row)))) for row in q)
+    assert worst < 1e-6

@@ -231,8 +231,8 @@ def test_the_paper_compensator_under_the_limiter_is_shifted_too(profile: Any) ->
 
 def test_a_sheath_bend_is_recovered(profile: Any) -> None:
     worker, _, base = make_worker(profile)
-    # at 100 s every edge moves 4 deg out and both tendons' ramps become 3.5 x steeper
-    feed(worker, rows(300.0, profile_edges(base, 4.0, at_s=100.0), friction=(100.0, 3.5),
+    # at 80 s every edge moves 4 deg out and both tendons' ramps become 3.5 x steeper
+    feed(worker, rows(220.0, profile_edges(base, 4.0, at_s=80.0), friction=(80.0, 3.5),
                       seed=6))
     for knob in (0, 1):
         for side in (0, 1):
@@ -241,7 +241,7 @@ def test_a_sheath_bend_is_recovered(profile: Any) -> None:
 
 def test_a_stalled_motor_after_a_sheath_bend_still_freezes(profile: Any) -> None:
     worker, _, base = make_worker(profile)
-    data = rows(300.0, profile_edges(base, 4.0, at_s=100.0), friction=(100.0, 3.5), seed=7)
+    data = rows(220.0, profile_edges(base, 4.0, at_s=80.0), friction=(80.0, 3.5), seed=7)
     feed(worker, data)
     before = worker.offsets()[0]
     assert before == pytest.approx((4.0, 4.0), abs=1.0)  # the bend was followed
@@ -263,7 +263,7 @@ def test_an_edge_coupling_the_profile_does_not_hold_is_no_drift(profile: Any) ->
 
 def test_a_sheath_bend_raises_the_backlash_gain_as_the_current_slope(profile: Any) -> None:
     worker, comp, base = make_worker(profile)
-    feed(worker, rows(300.0, profile_edges(base, 4.0, at_s=100.0), friction=(100.0, 1.6),
+    feed(worker, rows(220.0, profile_edges(base, 4.0, at_s=80.0), friction=(80.0, 1.6),
                       seed=10))
     f0, f1 = base[0].field, comp.knobs[0].field
     beta = f0.column("backlash_gain_pos")

@@ -60,7 +60,7 @@ class OnlineWorker:
     def __init__(self, compensator: Any, period_s: float, columns: Sequence[str], *,
                  estimator: EstimatorOptions | None = None, ramp: RampOptions | None = None,
                  handle_slip_deg: tuple[float, float] | None = None,
-                 rate_deg_s: float = 4.0, gain_rate_per_s: float = 0.1,
+                 rate_deg_s: float = 4.0, gain_rate_per_s: float = 0.5,
                  queue_len: int = 8192, drain_every: int = 0,
                  on_event: EventSink | None = None,
                  fault_reason: Callable[[], str | None] | None = None) -> None:
@@ -86,6 +86,7 @@ class OnlineWorker:
         self.rate_deg_s = rate_deg_s
         self.gain_rate_per_s = gain_rate_per_s
         self.gains: Offsets = ONE_GAINS
+        self._gains_moving: Offsets = ONE_GAINS
         """The backlash gain ratios published with the knobs (pos, neg per knob)."""
         self.queue: collections.deque[tuple[tuple[float, ...], bool]] = collections.deque(
             maxlen=queue_len)
@@ -275,13 +276,20 @@ class OnlineWorker:
         dt = max(t_s - self._t_publish, 0.0)
         self._t_publish = t_s
         new = _towards(current, self._targets(), self.rate_deg_s * dt)
-        gains = _towards(self.gains, self._gain_targets(), self.gain_rate_per_s * dt)
+        targets = self._gain_targets()
+        self._gains_moving = _towards(self._gains_moving, targets, self.gain_rate_per_s * dt)
+        gains = self._gains_moving
+        if (max(abs(a - b) for g, h in zip(gains, self.gains, strict=True)
+                for a, b in zip(g, h, strict=True)) < GAIN_STEP and gains != targets):
+            gains = self.gains  # rebuilding the knobs costs ~0.1 s: in steps of GAIN_STEP
         if new == current and gains == self.gains:
             return
-        knobs = (shifted_knob(self.base_knobs[0], new[0], gains[0]),
-                 shifted_knob(self.base_knobs[1], new[1], gains[1]))
+        old_knobs = self.published[2]
+        knobs = tuple(  # a knob whose values did not move is kept (a rebuild costs ~65 ms)
+            old_knobs[k] if (new[k], gains[k]) == (current[k], self.gains[k])
+            else shifted_knob(self.base_knobs[k], new[k], gains[k]) for k in (0, 1))
         self.gains = gains
-        self.published = (version + 1, new, knobs)
+        self.published = (version + 1, new, (knobs[0], knobs[1]))
 
     # --- control and reporting (any thread) --------------------------------------------------
 
@@ -291,7 +299,7 @@ class OnlineWorker:
             self.enabled = enabled
             if not enabled:
                 version = self.published[0]
-                self.gains = ONE_GAINS
+                self.gains = self._gains_moving = ONE_GAINS
                 self.published = (version + 1, ZERO_OFFSETS, self.base_knobs)
         self._emit("info", "online re-estimation", enabled=enabled)
 
@@ -322,6 +330,8 @@ class OnlineWorker:
 
 ONE_GAINS: Offsets = ((1.0, 1.0), (1.0, 1.0))
 """Backlash gain ratios (pos, neg) per knob that leave the profile's beta."""
+GAIN_STEP = 0.05
+"""The published backlash gain ratios move in steps of at least this (or to the target)."""
 
 
 def _towards(current: Offsets, target: Offsets, step: float) -> Offsets:

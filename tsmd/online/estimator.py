@@ -95,12 +95,12 @@ class EdgeTracker:
     n_ramps: int = 0
     last_measurement_deg: float = math.nan
     recent_slopes: list[float] = field(default_factory=list)
-    recent_gaps: list[float] = field(default_factory=list)
     last_feature: str = ""
+    """What placed the last measurement: "knee" or "crossing"."""
     shared_change: float = 0.0
     """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
-    """What placed the last measurement: "knee" or "crossing"."""
-    """The last ramps' knee minus their crossing (reference slope), as offsets (deg)."""
+    partner_change: float = 0.0
+    """The knob's other tendon's slope change at this tendon's last ramp."""
     n_odd_slope: int = 0
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     n_refused: int = 0
@@ -146,13 +146,18 @@ class EdgeTracker:
         return median(values) if len(values) >= self.options.bin_min else 0.0
 
     @property
-    def engagement_changed(self) -> bool:
-        """The knee and the level crossing of the last ramps disagree by more than the gate:
-        the engagement's step or slope changed (a bend; capstan unit 2: the ramp only
-        1.2 x steeper, the crossing 11 deg inward, the knee 4-6 deg outward)."""
-        o = self.options
-        return (len(self.recent_gaps) >= min(2, o.slope_window)
-                and abs(median(self.recent_gaps)) > o.gate_deg)
+    def knee_mode(self) -> bool:
+        """Both tendons' ramps of the knob changed slope the same way beyond the tolerance
+        (15 %, the medians of their last three ramps): the sheath's friction changed the
+        engagement, and the knee, not a level crossing, places the edge. A slack change
+        moves the engagement without changing it (lumped 101, +0.5 mm: slopes 0.85-1.07 x);
+        a bend changes it (capstan unit 2, 60 deg: both ramps 1.17-1.37 x, the crossing 11 deg
+        inward, the knee 4-6 deg outward). The knee is not used otherwise: on the lumped
+        plant's gradual toe it scatters by +-3 deg and read -5 deg after a +4.8 deg slack
+        change (tried, session 7)."""
+        tol = self.options.same_slope_tolerance
+        own, other = self.slope_change, self.partner_change
+        return own * other > 0.0 and min(abs(own), abs(other)) > tol
 
     @property
     def gain_ratio(self) -> float:
@@ -215,6 +220,7 @@ class EdgeTracker:
         shared = 0.0 if partner is None else common_change(
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
         self.shared_change = shared
+        self.partner_change = 0.0 if partner is None else partner.slope_change
         shared_ok = (abs(shared) >= 2.0 * o.same_slope_tolerance
                      and 1.0 / o.shared_slope_ratio_max <= ratio <= o.shared_slope_ratio_max)
         if not (1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max or shared_ok):
@@ -233,18 +239,14 @@ class EdgeTracker:
             self.frozen_for -= 1
             return events
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
-        if math.isfinite(knee_m):
-            crossing_m = ramp.side * (ramp.crossing_deg(self.level_A, self.slope_ref_A_per_deg)
-                                      - profile_edge_deg - self.residual_ref_deg)
-            self.recent_gaps = [*self.recent_gaps, knee_m - crossing_m][-o.slope_window:]
-            if abs(shared) >= o.same_slope_tolerance or self.engagement_changed:
-                # The sheath's friction changed: the engagement's step and the ramp with it,
-                # so no level crossing places the edge; the knee, seen in the stroke itself,
-                # does. Otherwise the crossing (its scatter is a third of the knee's: the
-                # knee is resolved to the samples' spacing at full speed, ~0.5 deg).
-                self.last_feature = "knee"
-                self._measured(knee_m, ramp.other_deg, events)
-                return events
+        if math.isfinite(knee_m) and self.knee_mode:
+            # The sheath's friction changed the engagement: no level crossing places the
+            # edge; the knee, seen in the stroke itself, does. Otherwise the crossing (the
+            # knee scatters three times as much: it is resolved to the samples' spacing at
+            # full speed, ~0.5 deg, and on the lumped plant's gradual toe by +-3 deg).
+            self.last_feature = "knee"
+            self._measured(knee_m, ramp.other_deg, events)
+            return events
         # The crossing is taken on a
         # line through the window's centre; its slope decides how
         # far back the edge is (~15 deg of extrapolation: 10 % of slope is 1.5 deg). One

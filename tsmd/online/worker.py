@@ -203,8 +203,8 @@ class OnlineWorker:
         stroke, edge = self._referred(stroke)
         expected = edge + side * tracker.applied_deg
         knee = find_knee_deg(stroke, expected, self._knob_ramp[knob])
-        if math.isfinite(knee):  # the window starts past the engagement this stroke shows
-            expected = knee
+        if math.isfinite(knee[0]) and tracker.knee_mode:
+            expected = knee[0]  # the window starts past the engagement this stroke shows
         elif tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
             expected = relocated_edge_deg(stroke, expected, tracker.level_A,
                                           tracker.slope_ref_A_per_deg, self._knob_ramp[knob])

@@ -145,6 +145,16 @@ class EdgeTracker:
         values = self.bins.get(self._bin(other_deg), [])
         return median(values) if len(values) >= self.options.bin_min else 0.0
 
+    def plausible(self, ramp: LoadedRamp | object) -> bool:
+        """A ramp whose slope is within ``slope_ratio_max`` of the reference (True while
+        learning); anything else (a rejected stroke) is not."""
+        if not isinstance(ramp, LoadedRamp):
+            return False
+        if self.slope_ref_A_per_deg is None:
+            return True
+        ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
+        return 1.0 / self.options.slope_ratio_max <= ratio <= self.options.slope_ratio_max
+
     @property
     def knee_mode(self) -> bool:
         """Both tendons' ramps of the knob changed slope the same way beyond the tolerance

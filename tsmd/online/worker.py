@@ -209,6 +209,11 @@ class OnlineWorker:
             expected = relocated_edge_deg(stroke, expected, tracker.level_A,
                                           tracker.slope_ref_A_per_deg, self._knob_ramp[knob])
         ramp = loaded_ramp(stroke, expected, self._knob_ramp[knob], knee)
+        if math.isfinite(knee[0]) and expected != knee[0] and not tracker.plausible(ramp):
+            # The reference ramp's relocation assumes an unchanged ramp: after a bend it can
+            # put the window inside the dead zone (a flat "ramp"); past the knee it is not.
+            at_knee = loaded_ramp(stroke, knee[0], self._knob_ramp[knob], knee)
+            ramp = at_knee if isinstance(at_knee, LoadedRamp) else ramp
         if isinstance(ramp, Rejected):
             if ramp.stall:
                 tracker.freeze(ramp.reason)

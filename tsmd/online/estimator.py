@@ -101,6 +101,10 @@ class EdgeTracker:
     """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
     partner_change: float = 0.0
     """The knob's other tendon's slope change at this tendon's last ramp."""
+    knee_slopes: list[float] = field(default_factory=list)
+    """The last slopes of ramps fitted past their own knee (after a bend: the loaded ramp
+    itself, not a window that starts on the engagement's step)."""
+    partner_knee_change: float = 0.0
     n_odd_slope: int = 0
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     n_refused: int = 0
@@ -179,13 +183,25 @@ class EdgeTracker:
         ``B = c T_r``, with the tension ``T_r = k (x_r - x0)`` the current shows; so
         ``beta = B / (x_r - x0) = c k``: with the compliance ``c`` unchanged by a bend, beta
         follows the current's slope ``k`` (capstan units 1, 2, 101 after 60 deg: slope
-        1.2-1.4 x, the fresh calibrations' beta 1.17-1.28 x). The release itself is crossed too
-        fast under compensation to measure it (docs/online.md)."""
-        if self.learning:
+        1.2-1.4 x past the knee, the fresh calibrations' beta 1.17-1.28 x). Only in knee mode
+        and only from ramps fitted past their knee (a window that starts on the engagement's
+        grown step reads 2.5-3 x). The release itself is crossed too fast under compensation
+        to measure it (docs/online.md)."""
+        if self.learning or not self.knee_mode:
             return 1.0
         o = self.options
-        return min(max(shrunk_ratio(1.0 + self.shared_change, o.same_slope_tolerance),
+        change = common_change(self.knee_slope_change, self.partner_knee_change,
+                               o.same_slope_tolerance)
+        return min(max(shrunk_ratio(1.0 + change, o.same_slope_tolerance),
                        1.0 / o.slope_ratio_max), o.slope_ratio_max)
+
+    @property
+    def knee_slope_change(self) -> float:
+        """The median slope of the last ramps fitted past their knee against the reference,
+        minus 1 (0 without such ramps)."""
+        if self.slope_ref_A_per_deg is None or not self.knee_slopes:
+            return 0.0
+        return median(self.knee_slopes) / self.slope_ref_A_per_deg - 1.0
 
     @property
     def slope_change(self) -> float:
@@ -231,6 +247,9 @@ class EdgeTracker:
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
         self.shared_change = shared
         self.partner_change = 0.0 if partner is None else partner.slope_change
+        if ramp.past_knee:
+            self.knee_slopes = [*self.knee_slopes, ramp.slope_A_per_deg][-o.slope_window:]
+        self.partner_knee_change = 0.0 if partner is None else partner.knee_slope_change
         shared_ok = (abs(shared) >= 2.0 * o.same_slope_tolerance
                      and 1.0 / o.shared_slope_ratio_max <= ratio <= o.shared_slope_ratio_max)
         if not (1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max or shared_ok):

@@ -91,6 +91,8 @@ class LoadedRamp:
     NaN when the stroke had too little of the dead zone or of the ramp around it."""
     knee_step_A: float = math.nan
     """The current's step up at the knee (the tendon engaging); for per-ramp diagnosis."""
+    past_knee: bool = False
+    """The window was placed past this stroke's own knee (not by the expected edge)."""
 
     def current_at(self, knob_deg: float) -> float:
         """The line's current at a knob angle."""
@@ -261,4 +263,5 @@ def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
     noise = float(np.sqrt(np.mean(r * r))) if r.size else math.nan
     return LoadedRamp(stroke.knob, side, float(x.mean()), a, b,
                       float(np.median(stroke.other_deg[sel])), float(stroke.t_s[sel][-1]),
-                      int(x.size), noise, knee[0], knee[1])
+                      int(x.size), noise, knee[0], knee[1],
+                      expected_edge_deg == knee[0])

@@ -165,3 +165,15 @@ def test_a_friction_change_on_both_edges_is_followed() -> None:
         neg.update(ramp_with_edge(EDGE_DEG + 3.0, slope=2.5 * SLOPE), EDGE_DEG, pos)
     assert pos.applied_deg == pytest.approx(3.0, abs=0.05)
     assert neg.applied_deg == pytest.approx(3.0, abs=0.05)
+
+
+def test_a_much_steeper_ramp_measures_on_both_edges_and_is_refused_on_one() -> None:
+    pos, neg = learned(), learned()
+    lone, usual = learned(), learned()
+    for _ in range(4):  # a bend (both tendons 4 x steeper) against a blocked tendon (one)
+        pos.update(ramp_with_edge(EDGE_DEG + 3.0, slope=4 * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_with_edge(EDGE_DEG + 3.0, slope=4 * SLOPE), EDGE_DEG, pos)
+        lone.update(ramp_with_edge(EDGE_DEG + 3.0, slope=4 * SLOPE), EDGE_DEG, usual)
+        usual.update(ramp_with_edge(EDGE_DEG), EDGE_DEG, lone)
+    assert pos.applied_deg == pytest.approx(3.0, abs=0.05)
+    assert lone.status()["refused_ramps"] == 4 and lone.applied_deg == 0.0

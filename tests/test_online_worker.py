@@ -227,3 +227,69 @@ def test_the_paper_compensator_under_the_limiter_is_shifted_too(profile: Any) ->
     worker.observe(worker_row(), True)
     assert edges_at(limited.inner.knobs[0], 0.0)[0] == pytest.approx(  # type: ignore[attr-defined]
         edges_at(worker.base_knobs[0], 0.0)[0] + 2.0)
+
+
+def test_a_sheath_bend_is_recovered(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    # at 80 s every edge moves 4 deg out and both tendons' ramps become 3.5 x steeper
+    feed(worker, rows(220.0, profile_edges(base, 4.0, at_s=80.0), friction=(80.0, 3.5),
+                      seed=6))
+    for knob in (0, 1):
+        for side in (0, 1):
+            assert worker.offsets()[knob][side] == pytest.approx(4.0, abs=1.0)
+
+
+def test_a_stalled_motor_after_a_sheath_bend_still_freezes(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    data = rows(220.0, profile_edges(base, 4.0, at_s=80.0), friction=(80.0, 3.5), seed=7)
+    feed(worker, data)
+    before = worker.offsets()[0]
+    assert before == pytest.approx((4.0, 4.0), abs=1.0)  # the bend was followed
+    stalled = rows(40.0, profile_edges(base, 9.0), friction=(0.0, 3.5), stall=(0, 0.0, 40.0),
+                   seed=8)
+    t0 = data[-1][0] + 0.004
+    feed(worker, [(r[0] + t0, *r[1:]) for r in stalled])
+    assert worker.offsets()[0] == before
+    assert worker.events[-1]["event"] != "online shape change followed"
+    assert any(e["event"] == "online estimate frozen" and e["t"] > t0 for e in worker.events)
+
+
+def test_an_edge_coupling_the_profile_does_not_hold_is_no_drift(profile: Any) -> None:
+    worker, _, base = make_worker(profile)
+    # the current's edges sit 0.8 deg further out whenever the other knob is below -20 deg
+    feed(worker, rows(600.0, profile_edges(base, other_below=(-20.0, 0.8)), seed=9))
+    assert max(abs(v) for pair in worker.offsets() for v in pair) <= 0.4
+
+
+def test_a_sheath_bend_raises_the_backlash_gain_as_the_current_slope(profile: Any) -> None:
+    worker, comp, base = make_worker(profile)
+    feed(worker, rows(220.0, profile_edges(base, 4.0, at_s=80.0), friction=(80.0, 1.6),
+                      seed=10))
+    f0, f1 = base[0].field, comp.knobs[0].field
+    beta = f0.column("backlash_gain_pos")
+    assert f1.at(0.0)[beta] == pytest.approx(1.6 * f0.at(0.0)[beta], rel=0.1)
+    assert comp.knobs[0].omega < base[0].omega  # the release slope omega / (1 - beta) stays
+
+
+def test_without_a_change_the_backlash_gain_stays(profile: Any) -> None:
+    worker, comp, base = make_worker(profile)
+    feed(worker, rows(300.0, profile_edges(base), noise_A=0.006, seed=11))
+    assert worker.gains == ((1.0, 1.0), (1.0, 1.0))
+    assert comp.knobs[0].omega == base[0].omega
+
+
+def test_a_saved_version_compensates_like_the_online_backlash_gains(profile: Any) -> None:
+    offsets, gains = ((3.0, 2.0), (1.0, -1.0)), ((1.3, 1.2), (1.0, 1.5))
+    live = build_compensator(profile, "ours", 0.004)
+    worker = OnlineWorker(live, 0.004, ROW_COLUMNS)
+    worker.published = (1, offsets, (shifted_knob(worker.base_knobs[0], offsets[0], gains[0]),
+                                     shifted_knob(worker.base_knobs[1], offsets[1], gains[1])))
+    worker.observe(worker_row(), True)
+    saved = build_compensator(profile_with_offsets(profile, offsets, gains=gains), "ours",
+                              0.004)
+    t = np.arange(0.0, 30.0, 0.004)
+    q = np.column_stack([50 * np.sin(2 * np.pi * 0.07 * t), 40 * np.sin(2 * np.pi * 0.05 * t)])
+    live.reset(q[0])
+    saved.reset(q[0])
+    worst = max(float(np.max(np.abs(live.command(row) - saved.command(row)))) for row in q)
+    assert worst < 1e-6

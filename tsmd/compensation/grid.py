@@ -80,3 +80,11 @@ class ParameterField:
         for name, offset in offsets_deg.items():
             values[:, self.column(name)] += offset
         return ParameterField(self.grid_deg.tolist(), values, self.method, self.columns)
+
+    def scaled(self, factors: Mapping[str, float]) -> ParameterField:
+        """A copy with each named parameter multiplied by ``factors[name]`` at every grid
+        point."""
+        values = self.values.copy()
+        for name, factor in factors.items():
+            values[:, self.column(name)] *= factor
+        return ParameterField(self.grid_deg.tolist(), values, self.method, self.columns)

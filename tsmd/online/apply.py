@@ -16,8 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from tsmd.calibration.tension_play_fit import unit_omega
 from tsmd.compensation.ours import MOVES_WITH_EDGE, OursKnob
 from tsmd.compensation.paper import PaperKnob
+from tsmd.compensation.tension_play import BETA_RANGE
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, KnobProfile, ReferencePoint, save_profile
 
@@ -31,18 +33,41 @@ class OnlineError(TsmdError):
     """Online estimates cannot be applied or saved as asked."""
 
 
-def shifted_knob(knob: Any, offset: tuple[float, float]) -> Any:
+def shifted_knob(knob: Any, offset: tuple[float, float],
+                 gain_ratio: tuple[float, float] = (1.0, 1.0)) -> Any:
     """A copy of a compensator knob (ours or the paper's) with its edges moved outward.
 
-    Ours: each tendon's zero-load point moves with its edge (the whole characteristic moves).
+    Ours: each tendon's zero-load point moves with its edge (the whole characteristic moves);
+    ``gain_ratio`` (pos, neg) multiplies each tendon's backlash gain beta (a sheath bend: the
+    backlash grows with the tension per knob degree, :attr:`EdgeTracker.gain_ratio`), and
+    omega follows the calibration's relation (the release slope ``omega / (1 - beta)`` is
+    the product's).
     """
     off_pos, off_neg = offset
     moves = {"dead_zone_pos_deg": off_pos, "dead_zone_neg_deg": -off_neg}
     if isinstance(knob, OursKnob):
         moves.update({MOVES_WITH_EDGE[edge]: move for edge, move in list(moves.items())})
-    elif not isinstance(knob, PaperKnob):
+        field = knob.field.shifted(moves)
+        if gain_ratio == (1.0, 1.0):
+            return replace(knob, field=field)
+        field = field.scaled({"backlash_gain_pos": gain_ratio[0],
+                              "backlash_gain_neg": gain_ratio[1]})
+        lo, hi = BETA_RANGE
+        columns = [field.column("backlash_gain_pos"), field.column("backlash_gain_neg")]
+        field.values[:, columns] = np.clip(field.values[:, columns], lo, hi)
+        field = type(field)(field.grid_deg.tolist(), field.values, field.method, field.columns)
+        omega = unit_omega(knob.omega, _beta_at_zero(knob.field), _beta_at_zero(field))
+        return replace(knob, field=field, omega=omega)
+    if not isinstance(knob, PaperKnob):
         raise OnlineError(f"online re-estimation cannot shift a {type(knob).__name__}")
     return replace(knob, field=knob.field.shifted(moves))
+
+
+def _beta_at_zero(field: Any) -> float:
+    """The mean backlash gain of both tendons with the other knob at 0 (as the calibration)."""
+    values = field.at(0.0)
+    return 0.5 * float(values[field.column("backlash_gain_pos")]
+                       + values[field.column("backlash_gain_neg")])
 
 
 def edges_at(knob: Any, other_deg: float) -> tuple[float, float]:
@@ -61,22 +86,37 @@ def apply_knobs(compensator: Any, knobs: tuple[Any, Any]) -> None:
         compensator.knobs = knobs
 
 
-def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str = ""
-                         ) -> CatheterProfile:
-    """The profile with its edges moved by ``offsets`` (same catheter, a new version).
+def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str = "",
+                         gains: Offsets = ((1.0, 1.0), (1.0, 1.0))) -> CatheterProfile:
+    """The profile with its edges moved by ``offsets`` and its tension play's backlash gains
+    multiplied by ``gains`` (same catheter, a new version; omega as :func:`shifted_knob`).
 
     The reference points move with the edges, so the plateau heights stay what the
     calibration gave (H from the reference point through D(0), design assumption 1).
     """
     knobs = []
-    for k, (off_pos, off_neg) in zip(profile.knobs, offsets, strict=True):
+    lo, hi = BETA_RANGE
+    for k, (off_pos, off_neg), (g_pos, g_neg) in zip(profile.knobs, offsets, gains,
+                                                     strict=True):
         ours = k.tension_play
         if ours is not None:
+            beta_pos = tuple(min(max(v * g_pos, lo), hi) for v in ours.backlash_gain_pos)
+            beta_neg = tuple(min(max(v * g_neg, lo), hi) for v in ours.backlash_gain_neg)
+            grid = ours.other_knob_deg
+
+            def at_zero(pos: tuple[float, ...], neg: tuple[float, ...],
+                        grid: tuple[float, ...] = grid) -> float:
+                return 0.5 * float(np.interp(0.0, grid, pos) + np.interp(0.0, grid, neg))
+
             ours = replace(
                 ours, dead_zone_pos_deg=tuple(v + off_pos for v in ours.dead_zone_pos_deg),
                 dead_zone_neg_deg=tuple(v - off_neg for v in ours.dead_zone_neg_deg),
                 zero_load_pos_deg=tuple(v + off_pos for v in ours.zero_load_pos_deg),
-                zero_load_neg_deg=tuple(v - off_neg for v in ours.zero_load_neg_deg))
+                zero_load_neg_deg=tuple(v - off_neg for v in ours.zero_load_neg_deg),
+                backlash_gain_pos=beta_pos, backlash_gain_neg=beta_neg,
+                omega=unit_omega(ours.omega, at_zero(ours.backlash_gain_pos,
+                                                     ours.backlash_gain_neg),
+                                 at_zero(beta_pos, beta_neg)))
         knobs.append(KnobProfile(
             k.omega, ReferencePoint(k.reference_pos.knob_deg + off_pos, k.reference_pos.tip_deg),
             ReferencePoint(k.reference_neg.knob_deg - off_neg, k.reference_neg.tip_deg),
@@ -85,9 +125,12 @@ def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str =
             tuple(float(v) - off_neg for v in k.dead_zone_neg_deg),
             k.backlash_pos_deg, k.backlash_neg_deg, ours))
     quality = dict(profile.quality)
-    for i, (off_pos, off_neg) in enumerate(offsets):
+    for i, ((off_pos, off_neg), (g_pos, g_neg)) in enumerate(zip(offsets, gains,
+                                                                  strict=True)):
         quality[f"phi{i + 1}_online_offset_pos_deg"] = float(off_pos)
         quality[f"phi{i + 1}_online_offset_neg_deg"] = float(off_neg)
+        quality[f"phi{i + 1}_online_backlash_gain_ratio_pos"] = float(g_pos)
+        quality[f"phi{i + 1}_online_backlash_gain_ratio_neg"] = float(g_neg)
     now = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
     source = (f"online re-estimation from motor current, {now}, on the calibration of "
               f"{profile.calibrated_at} ({profile.source})" + (f"; {note}" if note else ""))
@@ -96,18 +139,21 @@ def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str =
 
 
 def save_online_version(profile: CatheterProfile, offsets: Offsets,
-                        directory: str | os.PathLike[str], note: str = "") -> Path:
+                        directory: str | os.PathLike[str], note: str = "",
+                        gains: Offsets = ((1.0, 1.0), (1.0, 1.0))) -> Path:
     """Save the online estimates as ``<dir>/<catheter_id>.online-<UTC time>.yaml``.
 
     Never overwrites: not the calibrated ``<catheter_id>.yaml``, not an earlier version.
     """
     if not all(np.isfinite(v) for pair in offsets for v in pair):
         raise OnlineError(f"online offsets must be finite, got {offsets}")
+    if not all(np.isfinite(v) and v > 0 for pair in gains for v in pair):
+        raise OnlineError(f"online backlash gain ratios must be finite and > 0, got {gains}")
     stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
     path = Path(directory) / f"{profile.catheter_id}.online-{stamp}.yaml"
     n = 1
     while path.exists():
         n += 1
         path = Path(directory) / f"{profile.catheter_id}.online-{stamp}-{n}.yaml"
-    save_profile(profile_with_offsets(profile, offsets, note), path)
+    save_profile(profile_with_offsets(profile, offsets, note, gains), path)
     return path

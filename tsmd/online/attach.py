@@ -87,7 +87,8 @@ class OnlineAttachment:
                               "send online {\"enabled\": true} first")
         if profile is None:
             raise OnlineError("online_save: no catheter profile is loaded")
-        return save_online_version(profile, worker.offsets(), directory)
+        return save_online_version(profile, worker.offsets(), directory,
+                                   gains=worker.gains)
 
     def offsets_row(self) -> tuple[float, ...]:
         """The offsets in force, in :data:`tsmd.online.RECORDING_COLUMNS` order (0: none)."""

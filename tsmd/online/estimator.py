@@ -45,6 +45,15 @@ class EstimatorOptions:
     slope_window: int = 3
     """The slope a measurement uses comes from the median of this edge's last
     ``slope_window`` ramps, never from one ramp alone (see :meth:`EdgeTracker.update`)."""
+    other_bin_deg: float = 30.0
+    """Width of the other knob's angle bins in which the current's own edge is learned
+    relative to the profile's (:meth:`EdgeTracker.bin_bias_deg`)."""
+    bin_min: int = 3
+    """Measurements a bin needs before its bias counts."""
+    bin_window: int = 7
+    shared_slope_ratio_max: float = 8.0
+    """A slope change both edges of the knob show (a sheath's friction) is followed up to this
+    ratio; beyond ``slope_ratio_max`` on one edge alone it is a stuck knob or a blocked tip."""
 
 
 def shrunk_ratio(ratio: float, tolerance: float) -> float:
@@ -75,6 +84,8 @@ class EdgeTracker:
     level_A: float | None = None
     slope_ref_A_per_deg: float | None = None
     residual_ref_deg: float = 0.0
+    knee_residual_ref_deg: float = math.nan
+    """The knee's offset from the profile's edge over the baseline (NaN: no knees seen)."""
     estimate_deg: float = 0.0
     applied_deg: float = 0.0
     accepted: list[float] = field(default_factory=list)
@@ -84,10 +95,23 @@ class EdgeTracker:
     n_ramps: int = 0
     last_measurement_deg: float = math.nan
     recent_slopes: list[float] = field(default_factory=list)
+    last_feature: str = ""
+    """What placed the last measurement: "knee" or "crossing"."""
+    shared_change: float = 0.0
+    """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
+    partner_change: float = 0.0
+    """The knob's other tendon's slope change at this tendon's last ramp."""
+    knee_slopes: list[float] = field(default_factory=list)
+    """The last slopes of ramps fitted past their own knee (after a bend: the loaded ramp
+    itself, not a window that starts on the engagement's step)."""
+    partner_knee_change: float = 0.0
     n_odd_slope: int = 0
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
+    bins: dict[int, list[float]] = field(default_factory=dict)
+    """Per bin of the other knob's angle: the last accepted measurements minus the estimate
+    then (where the current's edge sits in that bin relative to the profile's)."""
     _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
 
     @property
@@ -108,6 +132,76 @@ class EdgeTracker:
                               else ramps)
         self.frozen_reason = reason
         self.suspects.clear()
+
+    def _bin(self, other_deg: float) -> int:
+        return math.floor(other_deg / self.options.other_bin_deg) if math.isfinite(
+            other_deg) else 0
+
+    def bin_bias_deg(self, other_deg: float) -> float:
+        """How far the current's edge reads from the profile's in this bin of the other
+        knob's angle, beyond the estimate (0 until the bin has ``bin_min`` measurements).
+
+        The profile's coupling has three grid points; the current's edge can depend on the
+        other knob beyond them (lumped 101: phi1's positive edge 0.5-0.85 deg lower with phi2
+        at -41..-61 deg than at +31..+74 deg, before any change), which a single offset
+        mistakes for a change. Learned from the accepted ramps themselves, so a shape change
+        (every bin at once) still moves the estimate."""
+        values = self.bins.get(self._bin(other_deg), [])
+        return median(values) if len(values) >= self.options.bin_min else 0.0
+
+    def plausible(self, ramp: LoadedRamp | object) -> bool:
+        """A ramp whose slope is within ``slope_ratio_max`` of the reference (True while
+        learning); anything else (a rejected stroke) is not."""
+        if not isinstance(ramp, LoadedRamp):
+            return False
+        if self.slope_ref_A_per_deg is None:
+            return True
+        ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
+        return 1.0 / self.options.slope_ratio_max <= ratio <= self.options.slope_ratio_max
+
+    @property
+    def knee_mode(self) -> bool:
+        """Both tendons' ramps of the knob changed slope the same way beyond the tolerance
+        (15 %, the medians of their last three ramps): the sheath's friction changed the
+        engagement, and the knee, not a level crossing, places the edge. A slack change
+        moves the engagement without changing it (lumped 101, +0.5 mm: slopes 0.85-1.07 x);
+        a bend changes it (capstan unit 2, 60 deg: both ramps 1.17-1.37 x, the crossing 11 deg
+        inward, the knee 4-6 deg outward). The knee is not used otherwise: on the lumped
+        plant's gradual toe it scatters by +-3 deg and read -5 deg after a +4.8 deg slack
+        change (tried, session 7)."""
+        tol = self.options.same_slope_tolerance
+        own, other = self.slope_change, self.partner_change
+        return own * other > 0.0 and min(abs(own), abs(other)) > tol
+
+    @property
+    def gain_ratio(self) -> float:
+        """How much this tendon's backlash gain beta changed: as its loaded current's slope,
+        as far as the other tendon confirms it, none within the slopes' scatter
+        (:func:`shrunk_ratio`).
+
+        The tension play's backlash after a reversal is the tendon's stretch given back,
+        ``B = c T_r``, with the tension ``T_r = k (x_r - x0)`` the current shows; so
+        ``beta = B / (x_r - x0) = c k``: with the compliance ``c`` unchanged by a bend, beta
+        follows the current's slope ``k`` (capstan units 1, 2, 101 after 60 deg: slope
+        1.2-1.4 x past the knee, the fresh calibrations' beta 1.17-1.28 x). Only in knee mode
+        and only from ramps fitted past their knee (a window that starts on the engagement's
+        grown step reads 2.5-3 x). The release itself is crossed too fast under compensation
+        to measure it (docs/online.md)."""
+        if self.learning or not self.knee_mode:
+            return 1.0
+        o = self.options
+        change = common_change(self.knee_slope_change, self.partner_knee_change,
+                               o.same_slope_tolerance)
+        return min(max(shrunk_ratio(1.0 + change, o.same_slope_tolerance),
+                       1.0 / o.slope_ratio_max), o.slope_ratio_max)
+
+    @property
+    def knee_slope_change(self) -> float:
+        """The median slope of the last ramps fitted past their knee against the reference,
+        minus 1 (0 without such ramps)."""
+        if self.slope_ref_A_per_deg is None or not self.knee_slopes:
+            return 0.0
+        return median(self.knee_slopes) / self.slope_ref_A_per_deg - 1.0
 
     @property
     def slope_change(self) -> float:
@@ -134,15 +228,36 @@ class EdgeTracker:
                 self.residual_ref_deg = median(
                     r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
                     for r, d in self._baseline)
+                for r, d in self._baseline:
+                    key = self._bin(r.other_deg)
+                    self.bins[key] = [*self.bins.get(key, []), r.side * (
+                        r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
+                        - self.residual_ref_deg)]
+                knees = [r.side * (r.knee_deg - d) for r, d in self._baseline
+                         if math.isfinite(r.knee_deg)]
+                if len(knees) * 2 > len(self._baseline):
+                    self.knee_residual_ref_deg = median(knees)
                 events.append(("info", "online reference learned",
                                {**tag, "level_A": round(self.level_A, 4)}))
             return events
         assert self.level_A is not None and self.slope_ref_A_per_deg is not None
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
-        if not 1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max:
-            # A stuck knob, a blocked tip, or a stroke across a shape change: this ramp is
-            # refused and the suspects before it are void, but the ramps after it measure
-            # (freezing them delayed a slack change by two ramps per side).
+        self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
+        shared = 0.0 if partner is None else common_change(
+            self.slope_change, partner.slope_change, o.same_slope_tolerance)
+        self.shared_change = shared
+        self.partner_change = 0.0 if partner is None else partner.slope_change
+        if ramp.past_knee:
+            self.knee_slopes = [*self.knee_slopes, ramp.slope_A_per_deg][-o.slope_window:]
+        self.partner_knee_change = 0.0 if partner is None else partner.knee_slope_change
+        shared_ok = (abs(shared) >= 2.0 * o.same_slope_tolerance
+                     and 1.0 / o.shared_slope_ratio_max <= ratio <= o.shared_slope_ratio_max)
+        if not (1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max or shared_ok):
+            # A stuck knob or a blocked tip (one tendon's ramp), or a stroke across a shape
+            # change: this ramp is refused and the suspects before it are void, but the ramps
+            # after it measure (freezing them delayed a slack change by two ramps per side). A
+            # steeper ramp on both tendons of the knob is the sheath's friction (a bend): it
+            # measures.
             self.suspects.clear()
             self.n_refused += 1
             events.append(("warning", "online ramp refused", {
@@ -152,27 +267,51 @@ class EdgeTracker:
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
-        # The crossing is taken on a line through the window's centre; its slope decides how
+        knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
+        if math.isfinite(knee_m) and self.knee_mode:
+            # The sheath's friction changed the engagement: no level crossing places the
+            # edge; the knee, seen in the stroke itself, does. Otherwise the crossing (the
+            # knee scatters three times as much: it is resolved to the samples' spacing at
+            # full speed, ~0.5 deg, and on the lumped plant's gradual toe by +-3 deg).
+            self.last_feature = "knee"
+            self._measured(knee_m, ramp.other_deg, events)
+            return events
+        # The crossing is taken on a
+        # line through the window's centre; its slope decides how
         # far back the edge is (~15 deg of extrapolation: 10 % of slope is 1.5 deg). One
         # ramp's slope scatters by 25 % and more, and one edge's for a few ramps in a row
         # (fast random moves); a friction change of the sheath (curvature: 2-4 x) shows in
         # every ramp of both tendons from then on. So the slope in use moves by the change
         # both edges' last ramps agree on (beyond the tolerance only), and a ramp that
         # disagrees with it measures nothing.
-        self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         slope = self.slope_ref_A_per_deg * shrunk_ratio(
-            1.0 + (self.slope_change if partner is None else common_change(
-                self.slope_change, partner.slope_change, o.same_slope_tolerance)),
+            1.0 + (self.slope_change if partner is None else shared),
             o.same_slope_tolerance)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
             self.n_odd_slope += 1
             self.last_measurement_deg = math.nan
             return events
-        m = ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
-                         - self.residual_ref_deg)
+        self.last_feature = "crossing"
+        self._measured(ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
+                                    - self.residual_ref_deg), ramp.other_deg, events)
+        return events
+
+    def _measured(self, raw_deg: float, other_deg: float,
+                  events: list[tuple[str, str, dict[str, Any]]]) -> None:
+        """One measurement of the offset (referred to its bin of the other knob's angle):
+        accepted, or a suspect (followed when confirmed)."""
+        o = self.options
+        m = raw_deg - self.bin_bias_deg(other_deg)
         self.last_measurement_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()
+            key = self._bin(other_deg)
+            learned = len(self.bins.get(key, [])) >= o.bin_min
+            self.bins[key] = [*self.bins.get(key, []), raw_deg - self.estimate_deg][
+                -o.bin_window:]
+            if not learned:  # a bin still learning where the current's edge sits: it
+                return       # teaches the bin, not the estimate (a change beyond the gate
+                             # is a suspect as anywhere)
             self.accepted = [*self.accepted, m][-o.window:]
             self.estimate_deg = median(self.accepted)
         else:
@@ -181,7 +320,6 @@ class EdgeTracker:
                                                     <= o.confirm_spread_deg):
                 events += self.follow(median(self.suspects), "consecutive ramps agree")
         self._apply()
-        return events
 
     def agrees_with(self, other: EdgeTracker) -> bool:
         """Both edges of a knob have a suspect and they agree: the knob's shape changed (a
@@ -214,10 +352,15 @@ class EdgeTracker:
             self.applied_deg = max(-o.max_offset_deg, min(o.max_offset_deg, self.estimate_deg))
 
     def status(self) -> dict[str, Any]:
+        o = self.options
         state = ("learning" if self.learning else "frozen" if self.frozen_for > 0
                  else "tracking")
         return {"state": state, "offset_deg": round(self.applied_deg, 3),
                 "estimate_deg": round(self.estimate_deg, 3),
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
                 "odd_slope_ramps": self.n_odd_slope, "refused_ramps": self.n_refused,
+                "feature": self.last_feature or None,
+                "backlash_gain_ratio": round(self.gain_ratio, 3),
+                "other_knob_bins_deg": {f"{k * o.other_bin_deg:g}": round(self.bin_bias_deg(
+                    (k + 0.5) * o.other_bin_deg), 3) for k in sorted(self.bins)},
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None}

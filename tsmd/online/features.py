@@ -59,6 +59,14 @@ class RampOptions:
     ``exp(-slip / handle_slip_deg)`` for it, so a restart near the edge does not bend the line."""
     restart_skip_deg: float = 1.0
     """Samples closer than this to a restart are left out (the stick itself)."""
+    knee_search_deg: float = 10.0
+    """The knee (where the current leaves the dead zone's flat level) is searched this far
+    either side of the expected edge ..."""
+    knee_plateau_deg: float = 6.0
+    """... with this much of the dead zone's flat current before the search range."""
+    knee_step_deg: float = 0.25
+    knee_min_side: int = 10
+    """Samples needed on each side of a knee candidate."""
 
 
 @dataclass(frozen=True)
@@ -78,6 +86,13 @@ class LoadedRamp:
     t_s: float
     n_samples: int
     noise_A: float
+    knee_deg: float = math.nan
+    """Knob angle where the current leaves the dead zone's flat level (:func:`find_knee_deg`);
+    NaN when the stroke had too little of the dead zone or of the ramp around it."""
+    knee_step_A: float = math.nan
+    """The current's step up at the knee (the tendon engaging); for per-ramp diagnosis."""
+    past_knee: bool = False
+    """The window was placed past this stroke's own knee (not by the expected edge)."""
 
     def current_at(self, knob_deg: float) -> float:
         """The line's current at a knob angle."""
@@ -122,6 +137,63 @@ def _window(u: Array, slip_deg: Array, start: float, width: float, o: RampOption
     return beyond & (u <= start + width)
 
 
+def _hinge_scan(x: Array, y: Array, stick: Array, lo: float, hi: float, o: RampOptions
+                ) -> tuple[float, float, Array]:
+    """(best knee in ``lo..hi``, the current's step up there, the residuals): flat, then a
+    step up and a line, plus the handle's stick term when it varies; NaN and no residuals
+    when no candidate fits."""
+    with_stick = float(stick.max() - stick.min()) > 0.05
+    best, best_step, best_sse, best_r = math.nan, math.nan, math.inf, np.zeros(0)
+    for e in np.arange(lo, hi + 1e-9, o.knee_step_deg):
+        out = x >= e
+        n_out = int(np.count_nonzero(out))
+        if n_out < o.knee_min_side or x.size - n_out < o.knee_min_side:
+            continue
+        columns = [~out, out, np.where(out, x - e, 0.0)]
+        if with_stick:
+            columns.append(stick)
+        a_mat = np.column_stack(columns).astype(float)
+        coef, *_ = np.linalg.lstsq(a_mat, y, rcond=None)
+        r = y - a_mat @ coef
+        sse = float(r @ r)
+        if coef[1] > coef[0] and sse < best_sse:  # the current steps up out of the dead zone
+            best, best_step, best_sse, best_r = float(e), float(coef[1] - coef[0]), sse, r
+    return best, best_step, best_r
+
+
+def find_knee_deg(stroke: Stroke, expected_edge_deg: float,
+                  options: RampOptions | None = None) -> tuple[float, float]:
+    """Where the current leaves the dead zone's flat level: the edge itself, seen in the stroke.
+
+    A hinge is fitted by least squares for each candidate knee within ``knee_search_deg`` of
+    the expected edge: flat inside, a step (the tendon engaging) and a line beyond, plus the
+    handle's fading stick. Unlike a level crossing of the loaded line, the knee does not move
+    when a sheath bend makes the engagement's step and the ramp steeper (capstan unit 1, 60 deg
+    bend: the step at the knee 40 -> 50 mA, the ramp 1.3 x; a level crossing read the edge
+    ~10 deg inward while the calibration's edge moved 4.8 deg outward). Returns (knee, the
+    current's step up at it); NaN without enough samples either side.
+    """
+    o = options or RampOptions()
+    side = stroke.direction
+    u = side * stroke.pos_deg
+    y = side * stroke.current_A
+    e0 = side * expected_edge_deg
+    lo, hi = e0 - o.knee_search_deg, e0 + o.knee_search_deg
+    sel = ((stroke.slip_deg >= o.restart_skip_deg) & (u >= lo - o.knee_plateau_deg)
+           & (u <= e0 + o.margin_deg + o.width_deg))
+    x, y, stick = u[sel], y[sel], np.exp(-stroke.slip_deg[sel] / o.handle_slip_deg)
+    if (np.count_nonzero(x < lo) < o.knee_min_side
+            or not (np.all(np.isfinite(x)) and np.all(np.isfinite(y)))):
+        return math.nan, math.nan  # too little of the dead zone's flat current before it
+    best, step, r = _hinge_scan(x, y, stick, lo, hi, o)
+    sigma = 1.4826 * float(np.median(np.abs(r - np.median(r)))) if r.size else 0.0
+    if sigma > 0:  # spikes: dropped, then the scan again
+        keep = np.abs(r) <= o.spike_sigma * sigma
+        if not keep.all():
+            best, step, _ = _hinge_scan(x[keep], y[keep], stick[keep], lo, hi, o)
+    return (side * best, step) if math.isfinite(best) else (math.nan, math.nan)
+
+
 def relocated_edge_deg(stroke: Stroke, expected_edge_deg: float, level_A: float,
                        slope_A_per_deg: float, options: RampOptions | None = None) -> float:
     """Where the edge is, from the reference ramp (level at the edge, slope), robustly.
@@ -148,11 +220,14 @@ def relocated_edge_deg(stroke: Stroke, expected_edge_deg: float, level_A: float,
 
 
 def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
-                options: RampOptions | None = None) -> LoadedRamp | Rejected:
+                options: RampOptions | None = None,
+                knee: tuple[float, float] = (math.nan, math.nan)) -> LoadedRamp | Rejected:
     """The loaded ramp of a stroke that leaves the dead zone beyond ``expected_edge_deg``.
 
     ``expected_edge_deg`` is the edge of the stroke's side (D_pos for a rising stroke, D_neg
-    for a falling one) where the ramp is expected to start (:func:`relocated_edge_deg`).
+    for a falling one) where the ramp is expected to start (the stroke's knee,
+    :func:`find_knee_deg`, or :func:`relocated_edge_deg`); ``knee`` (angle, step) is kept
+    with the ramp.
     """
     o = options or RampOptions()
     side = stroke.direction
@@ -188,4 +263,5 @@ def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
     noise = float(np.sqrt(np.mean(r * r))) if r.size else math.nan
     return LoadedRamp(stroke.knob, side, float(x.mean()), a, b,
                       float(np.median(stroke.other_deg[sel])), float(stroke.t_s[sel][-1]),
-                      int(x.size), noise)
+                      int(x.size), noise, knee[0], knee[1],
+                      expected_edge_deg == knee[0])

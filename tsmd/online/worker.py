@@ -11,6 +11,7 @@ simulation and tests, called synchronously every ``drain_every`` ticks.
 from __future__ import annotations
 
 import collections
+import math
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import replace
@@ -32,6 +33,7 @@ from tsmd.online.features import (
     RampOptions,
     Rejected,
     Stroke,
+    find_knee_deg,
     loaded_ramp,
     relocated_edge_deg,
 )
@@ -58,7 +60,8 @@ class OnlineWorker:
     def __init__(self, compensator: Any, period_s: float, columns: Sequence[str], *,
                  estimator: EstimatorOptions | None = None, ramp: RampOptions | None = None,
                  handle_slip_deg: tuple[float, float] | None = None,
-                 rate_deg_s: float = 4.0, queue_len: int = 8192, drain_every: int = 0,
+                 rate_deg_s: float = 4.0, gain_rate_per_s: float = 0.5,
+                 queue_len: int = 8192, drain_every: int = 0,
                  on_event: EventSink | None = None,
                  fault_reason: Callable[[], str | None] | None = None) -> None:
         compensator = getattr(compensator, "inner", compensator)  # under a LimitedCompensator
@@ -81,6 +84,10 @@ class OnlineWorker:
         self.trackers = {(knob, side): EdgeTracker(knob, side, estimator or EstimatorOptions())
                          for knob in (0, 1) for side in (1, -1)}
         self.rate_deg_s = rate_deg_s
+        self.gain_rate_per_s = gain_rate_per_s
+        self.gains: Offsets = ONE_GAINS
+        self._gains_moving: Offsets = ONE_GAINS
+        """The backlash gain ratios published with the knobs (pos, neg per knob)."""
         self.queue: collections.deque[tuple[tuple[float, ...], bool]] = collections.deque(
             maxlen=queue_len)
         self.drain_every = drain_every
@@ -195,10 +202,18 @@ class OnlineWorker:
         tracker = self.trackers[(knob, side)]
         stroke, edge = self._referred(stroke)
         expected = edge + side * tracker.applied_deg
-        if tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
+        knee = find_knee_deg(stroke, expected, self._knob_ramp[knob])
+        if math.isfinite(knee[0]) and tracker.knee_mode:
+            expected = knee[0]  # the window starts past the engagement this stroke shows
+        elif tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
             expected = relocated_edge_deg(stroke, expected, tracker.level_A,
                                           tracker.slope_ref_A_per_deg, self._knob_ramp[knob])
-        ramp = loaded_ramp(stroke, expected, self._knob_ramp[knob])
+        ramp = loaded_ramp(stroke, expected, self._knob_ramp[knob], knee)
+        if math.isfinite(knee[0]) and expected != knee[0] and not tracker.plausible(ramp):
+            # The reference ramp's relocation assumes an unchanged ramp: after a bend it can
+            # put the window inside the dead zone (a flat "ramp"); past the knee it is not.
+            at_knee = loaded_ramp(stroke, knee[0], self._knob_ramp[knob], knee)
+            ramp = at_knee if isinstance(at_knee, LoadedRamp) else ramp
         if isinstance(ramp, Rejected):
             if ramp.stall:
                 tracker.freeze(ramp.reason)
@@ -252,22 +267,34 @@ class OnlineWorker:
         return ((tr[(0, 1)].applied_deg, tr[(0, -1)].applied_deg),
                 (tr[(1, 1)].applied_deg, tr[(1, -1)].applied_deg))
 
+    def _gain_targets(self) -> Offsets:
+        if not self.enabled:
+            return ONE_GAINS
+        tr = self.trackers
+        return ((tr[(0, 1)].gain_ratio, tr[(0, -1)].gain_ratio),
+                (tr[(1, 1)].gain_ratio, tr[(1, -1)].gain_ratio))
+
     def _publish(self, t_s: float) -> None:
-        """Move the published offsets towards the targets at ``rate_deg_s`` (smoothly)."""
+        """Move the published offsets towards the targets at ``rate_deg_s`` and the backlash
+        gain ratios at ``gain_rate_per_s`` (smoothly)."""
         version, current, _ = self.published
-        targets = self._targets()
         dt = max(t_s - self._t_publish, 0.0)
         self._t_publish = t_s
-        step = self.rate_deg_s * dt
-        moved = tuple(tuple(c + max(-step, min(step, g - c)) for c, g in zip(cur, tgt,
-                                                                               strict=True))
-                      for cur, tgt in zip(current, targets, strict=True))
-        new: Offsets = ((moved[0][0], moved[0][1]), (moved[1][0], moved[1][1]))
-        if new == current:
+        new = _towards(current, self._targets(), self.rate_deg_s * dt)
+        targets = self._gain_targets()
+        self._gains_moving = _towards(self._gains_moving, targets, self.gain_rate_per_s * dt)
+        gains = self._gains_moving
+        if (max(abs(a - b) for g, h in zip(gains, self.gains, strict=True)
+                for a, b in zip(g, h, strict=True)) < GAIN_STEP and gains != targets):
+            gains = self.gains  # rebuilding the knobs costs ~0.1 s: in steps of GAIN_STEP
+        if new == current and gains == self.gains:
             return
-        knobs = (shifted_knob(self.base_knobs[0], new[0]),
-                 shifted_knob(self.base_knobs[1], new[1]))
-        self.published = (version + 1, new, knobs)
+        old_knobs = self.published[2]
+        knobs = tuple(  # a knob whose values did not move is kept (a rebuild costs ~65 ms)
+            old_knobs[k] if (new[k], gains[k]) == (current[k], self.gains[k])
+            else shifted_knob(self.base_knobs[k], new[k], gains[k]) for k in (0, 1))
+        self.gains = gains
+        self.published = (version + 1, new, (knobs[0], knobs[1]))
 
     # --- control and reporting (any thread) --------------------------------------------------
 
@@ -277,6 +304,7 @@ class OnlineWorker:
             self.enabled = enabled
             if not enabled:
                 version = self.published[0]
+                self.gains = self._gains_moving = ONE_GAINS
                 self.published = (version + 1, ZERO_OFFSETS, self.base_knobs)
         self._emit("info", "online re-estimation", enabled=enabled)
 
@@ -289,6 +317,7 @@ class OnlineWorker:
         off = self.published[1]
         return {"enabled": self.enabled, "version": self.published[0],
                 "offsets_deg": [list(off[0]), list(off[1])],
+                "backlash_gain_ratios": [list(self.gains[0]), list(self.gains[1])],
                 "edges": {f"phi{k + 1}_{'pos' if s > 0 else 'neg'}": tr.status()
                           for (k, s), tr in self.trackers.items()},
                 "events": list(self.events)[-5:]}
@@ -302,3 +331,16 @@ class OnlineWorker:
         self.events.append({"level": level, "event": event, "t": self._t_last, **fields})
         if self.on_event is not None:
             self.on_event(level, event, **fields)
+
+
+ONE_GAINS: Offsets = ((1.0, 1.0), (1.0, 1.0))
+"""Backlash gain ratios (pos, neg) per knob that leave the profile's beta."""
+GAIN_STEP = 0.05
+"""The published backlash gain ratios move in steps of at least this (or to the target)."""
+
+
+def _towards(current: Offsets, target: Offsets, step: float) -> Offsets:
+    """Each value moved towards its target by at most ``step``."""
+    (a, b), (c, d) = ((x + max(-step, min(step, g - x)) for x, g in zip(cur, tgt, strict=True))
+                      for cur, tgt in zip(current, target, strict=True))
+    return ((a, b), (c, d))

@@ -261,18 +261,16 @@ class OnlineWorker:
                        confidence=round(tracker.confidence, 2))
 
     def _targets(self) -> Offsets:
-        if not self.enabled:
-            return ZERO_OFFSETS
-        tr = self.trackers
-        return ((tr[(0, 1)].applied_deg, tr[(0, -1)].applied_deg),
-                (tr[(1, 1)].applied_deg, tr[(1, -1)].applied_deg))
+        return self._per_edge("applied_deg") if self.enabled else ZERO_OFFSETS
 
     def _gain_targets(self) -> Offsets:
-        if not self.enabled:
-            return ONE_GAINS
-        tr = self.trackers
-        return ((tr[(0, 1)].gain_ratio, tr[(0, -1)].gain_ratio),
-                (tr[(1, 1)].gain_ratio, tr[(1, -1)].gain_ratio))
+        return self._per_edge("gain_ratio") if self.enabled else ONE_GAINS
+
+    def _per_edge(self, name: str) -> Offsets:
+        """One tracker value per (knob, side), in the published offsets' layout."""
+        def value(knob: int, side: int) -> float:
+            return float(getattr(self.trackers[(knob, side)], name))
+        return ((value(0, 1), value(0, -1)), (value(1, 1), value(1, -1)))
 
     def _publish(self, t_s: float) -> None:
         """Move the published offsets towards the targets at ``rate_deg_s`` and the backlash

@@ -20,8 +20,10 @@ from numpy.typing import NDArray
 
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
-from tsmd.calibration.identify import identify_sweep
-from tsmd.calibration.signal import Conditioned
+from tsmd.calibration.identify import _resample_on_angle, identify_sweep, split_half_cycles
+from tsmd.calibration.options import IdentifyOptions
+from tsmd.calibration.pieces import RELEASE_LEVEL_WINDOW_DEG, loaded_current, smooth_value
+from tsmd.calibration.signal import Conditioned, lowpass
 from tsmd.calibration.tension_play_fit import fit_sweep_sides
 from tsmd.compensation.safety import KnobLimits
 from tsmd.config import TsmdConfig, default_sim_config
@@ -201,31 +203,46 @@ def _finite_or_none(value: float) -> float | None:
 
 
 def backlash_settle_fraction(data: Conditioned, tip_t_s: NDArray[np.float64],
-                             tip_deg: NDArray[np.float64]) -> float | None:
+                             tip_deg: NDArray[np.float64],
+                             options: IdentifyOptions | None = None) -> float | None:
     """How far the (filtered) current has come back when the tip starts to move after a
-    reversal at the sweep's ends, as a share of its swing from the reversal to its release
-    level; median over the reversals. The release level is the current's median over the
-    5-20 deg of knob travel after the tip has started back (the tendon releasing freely)."""
-    pos, cur = data.pos_deg, data.current_filtered_A
-    tip = np.interp(data.t_s, tip_t_s, tip_deg)
+    reversal at the sweep's ends, as a share of its swing from the loaded current to the
+    release level; median over the reversals.
+
+    Measured with the definitions the share is used with, or it does not transfer: the tip as
+    the scoring truth reads it (low-passed at the current's cutoff, then 1 deg back: on the raw
+    tracker the noise fired the threshold 1.5-2.5 deg early), and the current as the
+    calibration's fraction rule reads it (the identification's half-cycles on the angle grid,
+    :func:`~tsmd.calibration.pieces.loaded_current`, the release level over
+    ``RELEASE_LEVEL_WINDOW_DEG`` after the tip's release, the value there off the same
+    quadratic). The one sample at the position's turning point, used before, still carries
+    the motor's friction half-turned (docs/calibration.md, session 7)."""
+    opts = options if options is not None else IdentifyOptions()
+    step = opts.grid_step_deg
+    tip_f, _ = lowpass(np.asarray(tip_deg, dtype=float), 1.0 / float(np.median(np.diff(tip_t_s))))
+    tip = np.interp(data.t_s, tip_t_s, tip_f)
+    lo_deg, hi_deg = RELEASE_LEVEL_WINDOW_DEG
     shares = []
-    for a, b, direction in split_passes(pos):
-        if abs(pos[a]) < SWEEP_AMPLITUDE_DEG - 10.0:
+    for direction, a, b, after_reversal in split_half_cycles(data.cmd_deg, 10.0):
+        if not after_reversal or abs(data.pos_deg[a]) < SWEEP_AMPLITUDE_DEG - 10.0:
             continue
-        side = -direction  # +1 after the reversal at +90 deg
-        travel = side * (pos[a] - pos[a:b])
-        moved = np.flatnonzero(side * (tip[a] - tip[a:b]) > TIP_THRESHOLD_DEG)
-        if moved.size == 0:
+        pos = data.pos_deg[a:b]
+        grid, yg = _resample_on_angle(pos, direction * data.current_filtered_A[a:b], direction,
+                                      step)
+        _, tg = _resample_on_angle(pos, direction * tip[a:b], direction, step)
+        moved = np.flatnonzero(tg - tg[0] > TIP_THRESHOLD_DEG)
+        if grid.size < 6 or moved.size == 0:
             continue
         k = int(moved[0])
-        free = (travel > travel[k] + 5.0) & (travel < travel[k] + 20.0)
+        free = (grid > grid[k] + lo_deg) & (grid < grid[k] + hi_deg)
         if np.count_nonzero(free) < 5:
             continue
-        level = float(np.median(side * cur[a:b][free]))
-        swing = side * cur[a] - level
+        loaded = loaded_current(yg, step)
+        swing = float(np.median(yg[free])) - loaded
         if swing <= 0.0:
             continue
-        shares.append((side * cur[a] - side * cur[a + k]) / swing)
+        made_up = smooth_value(grid, yg, k, opts.release_fit_half_deg) - loaded
+        shares.append(min(made_up / swing, 1.0))
     return float(np.median(shares)) if shares else None
 
 

@@ -146,6 +146,24 @@ def smooth_crossing(grid: FloatArray, yg: FloatArray, k: int, target: float,
     return k
 
 
+def loaded_current(yg: FloatArray, step_deg: float) -> float:
+    """The fraction rule's loaded current: the mean over the first ``RELEASE_LOADED_DEG`` of
+    travel after the reversal on the angle grid (the motor's friction has turned by then; the
+    one sample at the position's turning point carries it half-turned)."""
+    return float(np.mean(yg[:max(1, round(RELEASE_LOADED_DEG / step_deg))]))
+
+
+def smooth_value(grid: FloatArray, yg: FloatArray, k: int, half_deg: float) -> float:
+    """The current at ``grid[k]`` read off a quadratic fitted over ``half_deg`` either side
+    (as :func:`smooth_crossing` reads it: a few mA of noise otherwise move a share by 1 %)."""
+    step = float(grid[1] - grid[0])
+    width = round(half_deg / step)
+    a, b = max(0, k - width), min(yg.size, k + width + 1)
+    if b - a < 6:
+        return float(yg[k])
+    return float(np.polyval(np.polyfit(grid[a:b] - grid[k], yg[a:b], 2), 0.0))
+
+
 def recovered_end(grid: FloatArray, yg: FloatArray, start_k: int, stop: int,
                   level: FloatArray, opts: IdentifyOptions) -> int:
     """Where the current has made up ``backlash_fraction`` of its jump from the loaded current
@@ -167,7 +185,7 @@ def recovered_end(grid: FloatArray, yg: FloatArray, start_k: int, stop: int,
     """
     step = float(grid[1] - grid[0])
     hold = max(2, round(opts.settle_hold_deg / step))
-    loaded = float(np.mean(yg[:max(1, round(RELEASE_LOADED_DEG / step))]))
+    loaded = loaded_current(yg, step)
 
     def first_hold(target: FloatArray | float, end: int) -> int | None:
         above = yg[:end] >= target

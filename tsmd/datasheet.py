@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
-from tsmd.calibration.identify import _resample_on_angle, identify_sweep, split_half_cycles
+from tsmd.calibration.identify import identify_sweep, resample_on_angle, split_half_cycles
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.pieces import RELEASE_LEVEL_WINDOW_DEG, loaded_current, smooth_value
 from tsmd.calibration.signal import Conditioned, lowpass
@@ -227,9 +227,9 @@ def backlash_settle_fraction(data: Conditioned, tip_t_s: NDArray[np.float64],
         if not after_reversal or abs(data.pos_deg[a]) < SWEEP_AMPLITUDE_DEG - 10.0:
             continue
         pos = data.pos_deg[a:b]
-        grid, yg = _resample_on_angle(pos, direction * data.current_filtered_A[a:b], direction,
+        grid, yg = resample_on_angle(pos, direction * data.current_filtered_A[a:b], direction,
                                       step)
-        _, tg = _resample_on_angle(pos, direction * tip[a:b], direction, step)
+        _, tg = resample_on_angle(pos, direction * tip[a:b], direction, step)
         moved = np.flatnonzero(tg - tg[0] > TIP_THRESHOLD_DEG)
         if grid.size < 6 or moved.size == 0:
             continue

@@ -165,7 +165,7 @@ def split_half_cycles(cmd_deg: FloatArray,
     return out
 
 
-def _resample_on_angle(x: FloatArray, y: FloatArray, direction: int,
+def resample_on_angle(x: FloatArray, y: FloatArray, direction: int,
                        step_deg: float) -> tuple[FloatArray, FloatArray]:
     """y on a uniform grid of the direction-signed angle ``direction * x`` (made monotonic)."""
     s = np.maximum.accumulate(direction * x)
@@ -189,7 +189,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     step = opts.grid_step_deg
     noise = max(data.filtered_noise_A, 1e-12)
 
-    grid, yg = _resample_on_angle(pos, y, direction, step)
+    grid, yg = resample_on_angle(pos, y, direction, step)
     min_size = max(2, round(2.0 / step))
     if grid.size < 3 * min_size:
         return HalfCycle(direction, start, stop, after_reversal,

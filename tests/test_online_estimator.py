@@ -177,3 +177,51 @@ def test_a_much_steeper_ramp_measures_on_both_edges_and_is_refused_on_one() -> N
         usual.update(ramp_with_edge(EDGE_DEG), EDGE_DEG, lone)
     assert pos.applied_deg == pytest.approx(3.0, abs=0.05)
     assert lone.status()["refused_ramps"] == 4 and lone.applied_deg == 0.0
+
+
+COUPLING_DEG = {-75.0: -0.6, -45.0: -0.3, -15.0: 0.0, 15.0: 0.2, 45.0: 0.7}
+"""Where the current's edge sits, per angle of the other knob (zero mean over the bins)."""
+
+
+def ramp_at_other(edge_deg: float, other_deg: float) -> LoadedRamp:
+    return LoadedRamp(0, 1, edge_deg + 10.0, LEVEL_A + SLOPE * 10.0, SLOPE, other_deg, 0.0,
+                      200, 0.003)
+
+
+def estimates_under_coupling(seed: int, shift_deg: float, shift_from: int,
+                             n_ramps: int) -> list[float]:
+    """The estimate after each ramp of a static other-knob coupling with noise; every bin
+    shifted by ``shift_deg`` from ramp ``shift_from`` on (within the gate: no confirmation)."""
+    tracker = EdgeTracker(0, 1, EstimatorOptions())
+    for _ in range(tracker.options.baseline_ramps):
+        tracker.update(ramp_at_other(EDGE_DEG, -15.0), EDGE_DEG)
+    rng = np.random.default_rng(seed)
+    others = list(COUPLING_DEG)
+    estimates = []
+    for i in range(n_ramps):
+        other = others[int(rng.integers(len(others)))]
+        shift = shift_deg if i >= shift_from else 0.0
+        edge = EDGE_DEG + COUPLING_DEG[other] + shift + 0.3 * rng.standard_normal()
+        tracker.update(ramp_at_other(edge, other), EDGE_DEG)
+        estimates.append(tracker.estimate_deg)
+    return estimates
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_static_other_knob_coupling_does_not_walk_the_estimate(seed: int) -> None:
+    estimates = estimates_under_coupling(seed, 0.0, 0, 1000)
+    block_means = [float(np.mean(estimates[i:i + 100])) for i in range(0, 1000, 100)]
+    assert max(abs(b) for b in block_means) <= 0.15
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_common_shift_within_the_gate_goes_to_the_estimate_not_the_bins(seed: int) -> None:
+    estimates = estimates_under_coupling(seed, 1.0, 300, 800)
+    assert float(np.mean(estimates[500:])) == pytest.approx(1.0, abs=0.15)
+
+
+def test_two_measurements_do_not_move_the_estimate_past_the_profile() -> None:
+    tracker = learned()
+    tracker.update(ramp_with_edge(EDGE_DEG + 0.1), EDGE_DEG)
+    tracker.update(ramp_with_edge(EDGE_DEG + 1.2), EDGE_DEG)
+    assert tracker.applied_deg == 0.0

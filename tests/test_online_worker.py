@@ -258,11 +258,15 @@ def test_a_stalled_motor_after_a_sheath_bend_still_freezes(profile: Any) -> None
     assert any(e["event"] == "online estimate frozen" and e["t"] > t0 for e in worker.events)
 
 
-def test_an_edge_coupling_the_profile_does_not_hold_is_no_drift(profile: Any) -> None:
+def test_an_edge_coupling_the_profile_does_not_hold_moves_no_offset_beyond_it(
+        profile: Any) -> None:
+    """The coupling's share common to the other knob's range may show in the offsets (the
+    bins are anchored to their visit-weighted mean, the reference is the baseline ramps'),
+    but a walk would carry them beyond the coupling itself."""
     worker, _, base = make_worker(profile)
-    # the current's edges sit 0.8 deg further out whenever the other knob is below -20 deg
-    feed(worker, rows(600.0, profile_edges(base, other_below=(-20.0, 0.8)), seed=9))
-    assert max(abs(v) for pair in worker.offsets() for v in pair) <= 0.4
+    coupling_deg = 0.8  # the current's edges sit further out with the other knob below -20 deg
+    feed(worker, rows(600.0, profile_edges(base, other_below=(-20.0, coupling_deg)), seed=9))
+    assert max(abs(v) for pair in worker.offsets() for v in pair) < coupling_deg
 
 
 def test_a_sheath_bend_raises_the_backlash_gain_as_the_current_slope(profile: Any) -> None:

@@ -87,6 +87,11 @@ class EdgeTracker:
     knee_residual_ref_deg: float = math.nan
     """The knee's offset from the profile's edge over the baseline (NaN: no knees seen)."""
     estimate_deg: float = 0.0
+    level_deg: float = 0.0
+    """The last level the tracker was sure of: the profile's (0) until a change is followed.
+    Until the window is full, the missing measurements count as this level (a prior), so two
+    ramps of a noisy edge cannot move the estimate on their own (lumped 102, no change: phi1
+    pos at 0.11 and 1.16 deg gave 0.64)."""
     applied_deg: float = 0.0
     accepted: list[float] = field(default_factory=list)
     suspects: list[float] = field(default_factory=list)
@@ -112,6 +117,8 @@ class EdgeTracker:
     bins: dict[int, list[float]] = field(default_factory=dict)
     """Per bin of the other knob's angle: the last accepted measurements minus the estimate
     then (where the current's edge sits in that bin relative to the profile's)."""
+    bin_visits: dict[int, int] = field(default_factory=dict)
+    """Per bin: how many measurements it has taken (its weight in the bins' common mean)."""
     _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
 
     @property
@@ -146,8 +153,29 @@ class EdgeTracker:
         at -41..-61 deg than at +31..+74 deg, before any change), which a single offset
         mistakes for a change. Learned from the accepted ramps themselves, so a shape change
         (every bin at once) still moves the estimate."""
-        values = self.bins.get(self._bin(other_deg), [])
-        return median(values) if len(values) >= self.options.bin_min else 0.0
+        own = self._bin_median(self._bin(other_deg))
+        return 0.0 if own is None else own - self._bins_mean_deg()
+
+    def _bin_median(self, key: int) -> float | None:
+        values = self.bins.get(key, [])
+        return median(values) if len(values) >= self.options.bin_min else None
+
+    def _bins_mean_deg(self) -> float:
+        """The learned bins' medians averaged, weighted by their visits: the part of the bins
+        they all share, which belongs to the estimate and is taken out of every bin.
+
+        Without it the estimate and the bins are not pinned against each other (a ramp's
+        measurement is its raw offset minus its bin's, the bin's is the raw offset minus the
+        estimate then): any split of a common offset between them is stable, so noise walked
+        the estimate (lumped 102, no change, 400 s: 0.62/0.70 deg)."""
+        learned = [(m, self.bin_visits.get(k, 0)) for k in self.bins
+                   if (m := self._bin_median(k)) is not None]
+        weight = sum(w for _, w in learned)
+        return sum(m * w for m, w in learned) / weight if weight > 0 else 0.0
+
+    def _teach_bin(self, key: int, value_deg: float) -> None:
+        self.bins[key] = [*self.bins.get(key, []), value_deg][-self.options.bin_window:]
+        self.bin_visits[key] = self.bin_visits.get(key, 0) + 1
 
     def plausible(self, ramp: LoadedRamp | object) -> bool:
         """A ramp whose slope is within ``slope_ratio_max`` of the reference (True while
@@ -229,10 +257,9 @@ class EdgeTracker:
                     r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
                     for r, d in self._baseline)
                 for r, d in self._baseline:
-                    key = self._bin(r.other_deg)
-                    self.bins[key] = [*self.bins.get(key, []), r.side * (
+                    self._teach_bin(self._bin(r.other_deg), r.side * (
                         r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
-                        - self.residual_ref_deg)]
+                        - self.residual_ref_deg))
                 knees = [r.side * (r.knee_deg - d) for r, d in self._baseline
                          if math.isfinite(r.knee_deg)]
                 if len(knees) * 2 > len(self._baseline):
@@ -307,13 +334,13 @@ class EdgeTracker:
             self.suspects.clear()
             key = self._bin(other_deg)
             learned = len(self.bins.get(key, [])) >= o.bin_min
-            self.bins[key] = [*self.bins.get(key, []), raw_deg - self.estimate_deg][
-                -o.bin_window:]
+            self._teach_bin(key, raw_deg - self.estimate_deg)
             if not learned:  # a bin still learning where the current's edge sits: it
                 return       # teaches the bin, not the estimate (a change beyond the gate
                              # is a suspect as anywhere)
             self.accepted = [*self.accepted, m][-o.window:]
-            self.estimate_deg = median(self.accepted)
+            self.estimate_deg = median(
+                [*self.accepted, *[self.level_deg] * (o.window - len(self.accepted))])
         else:
             self.suspects = [*self.suspects, m][-o.confirm:]
             if len(self.suspects) >= o.confirm and (max(self.suspects) - min(self.suspects)
@@ -342,7 +369,7 @@ class EdgeTracker:
                    {**tag, "from_deg": round(self.estimate_deg, 2), "to_deg": round(new_deg, 2),
                     "why": why})]
         self.accepted = kept or [new_deg]
-        self.estimate_deg = new_deg
+        self.estimate_deg = self.level_deg = new_deg
         self._apply()
         return events
 

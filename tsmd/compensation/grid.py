@@ -7,6 +7,7 @@ end values are held (no extrapolation): the grid already spans the knob's range.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -81,10 +82,12 @@ class ParameterField:
             values[:, self.column(name)] += offset
         return ParameterField(self.grid_deg.tolist(), values, self.method, self.columns)
 
-    def scaled(self, factors: Mapping[str, float]) -> ParameterField:
+    def scaled(self, factors: Mapping[str, float],
+               bounds: tuple[float, float] = (-math.inf, math.inf)) -> ParameterField:
         """A copy with each named parameter multiplied by ``factors[name]`` at every grid
-        point."""
+        point, the scaled values kept within ``bounds`` (the parameter's physical range)."""
         values = self.values.copy()
         for name, factor in factors.items():
-            values[:, self.column(name)] *= factor
+            col = self.column(name)
+            values[:, col] = np.clip(values[:, col] * factor, *bounds)
         return ParameterField(self.grid_deg.tolist(), values, self.method, self.columns)

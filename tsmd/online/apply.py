@@ -51,11 +51,7 @@ def shifted_knob(knob: Any, offset: tuple[float, float],
         if gain_ratio == (1.0, 1.0):
             return replace(knob, field=field)
         field = field.scaled({"backlash_gain_pos": gain_ratio[0],
-                              "backlash_gain_neg": gain_ratio[1]})
-        lo, hi = BETA_RANGE
-        columns = [field.column("backlash_gain_pos"), field.column("backlash_gain_neg")]
-        field.values[:, columns] = np.clip(field.values[:, columns], lo, hi)
-        field = type(field)(field.grid_deg.tolist(), field.values, field.method, field.columns)
+                              "backlash_gain_neg": gain_ratio[1]}, BETA_RANGE)
         omega = unit_omega(knob.omega, _beta_at_zero(knob.field), _beta_at_zero(field))
         return replace(knob, field=field, omega=omega)
     if not isinstance(knob, PaperKnob):

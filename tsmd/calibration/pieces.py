@@ -127,14 +127,12 @@ def smooth_crossing(grid: FloatArray, yg: FloatArray, k: int, target: float,
     the first sample above a share of the swing by degrees; a curve fitted over a few degrees
     averages that noise and leaves the trend.
     """
-    step = float(grid[1] - grid[0])
-    width = round(half_deg / step)
     for _ in range(4):
-        a, b = max(0, k - width), min(yg.size, k + width + 1)
-        if b - a < 6:
+        fit = _local_quadratic(grid, yg, k, half_deg)
+        if fit is None:
             return k
-        x = grid[a:b] - grid[k]
-        f = np.polyval(np.polyfit(x, yg[a:b], 2), x) - target
+        a, b, coef = fit
+        f = np.polyval(coef, grid[a:b] - grid[k]) - target
         ups = np.flatnonzero((f[:-1] < 0.0) & (f[1:] >= 0.0))
         if ups.size:
             k_new = a + int(ups[np.argmin(np.abs(ups + a - k))]) + 1
@@ -156,12 +154,19 @@ def loaded_current(yg: FloatArray, step_deg: float) -> float:
 def smooth_value(grid: FloatArray, yg: FloatArray, k: int, half_deg: float) -> float:
     """The current at ``grid[k]`` read off a quadratic fitted over ``half_deg`` either side
     (as :func:`smooth_crossing` reads it: a few mA of noise otherwise move a share by 1 %)."""
-    step = float(grid[1] - grid[0])
-    width = round(half_deg / step)
+    fit = _local_quadratic(grid, yg, k, half_deg)
+    return float(yg[k]) if fit is None else float(np.polyval(fit[2], 0.0))
+
+
+def _local_quadratic(grid: FloatArray, yg: FloatArray, k: int, half_deg: float
+                     ) -> tuple[int, int, FloatArray] | None:
+    """The samples ``a:b`` within ``half_deg`` of ``grid[k]`` and a quadratic fitted to them in
+    ``grid - grid[k]``; None when fewer than 6 samples are there."""
+    width = round(half_deg / float(grid[1] - grid[0]))
     a, b = max(0, k - width), min(yg.size, k + width + 1)
     if b - a < 6:
-        return float(yg[k])
-    return float(np.polyval(np.polyfit(grid[a:b] - grid[k], yg[a:b], 2), 0.0))
+        return None
+    return a, b, np.polyfit(grid[a:b] - grid[k], yg[a:b], 2)
 
 
 def recovered_end(grid: FloatArray, yg: FloatArray, start_k: int, stop: int,

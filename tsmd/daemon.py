@@ -47,7 +47,7 @@ from tsmd.profile import (
 from tsmd.replay import LiveTrajectoryRunner
 from tsmd.rt import FixedRateScheduler, RealtimeReport, apply_realtime, set_fifo
 from tsmd.service import CompensationChoice, Service
-from tsmd.stack import StackError, build_loop, make_compensator, open_sim
+from tsmd.stack import StackError, build_loop, make_compensator, make_standby, open_sim
 
 SIM_EXAMPLE_PROFILE = "profiles/example-sim.yaml"
 
@@ -219,7 +219,8 @@ class Daemon:
         tip_source = self.rig.tip_pair if self.rig is not None else None
         self.loop = build_loop(config, self.drives, compensator, MonotonicClock(),
                                compensation_label=label, tip_source=tip_source,
-                               recorder=self.recorder, on_event=self.events.emit)
+                               recorder=self.recorder, on_event=self.events.emit,
+                               standby=make_standby(profile, label, config))
         self.online = OnlineAttachment(config.online, self.loop, on_event=self.events.emit,
                                        handle_slip_deg=self._handle_slip_deg(config))
         if self.recorder is not None and config.online.enabled:

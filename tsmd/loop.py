@@ -15,8 +15,7 @@ from __future__ import annotations
 
 import collections
 import math
-from collections.abc import Callable
-from concurrent.futures import Future
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -25,12 +24,13 @@ from drivers.clock import Clock
 from drivers.drive import DriveError, FaultEvent, KnobDrives
 from tsmd.compensation import Compensator
 from tsmd.compensation.safety import KnobLimiter, KnobLimits
+from tsmd.loop_commands import LoopCommands
+from tsmd.loop_compensators import LoopCompensators
 from tsmd.loop_recorders import BackgroundRecorder, MemoryRecorder
-from tsmd.loop_supervision import remaining_fault_cause, silent_drive, tick_fault
+from tsmd.loop_supervision import tick_fault
 from tsmd.loop_types import (
     ROW,
     ROW_COLUMNS,
-    Array,
     LatestSetpoint,
     LoopCommand,
     LoopError,
@@ -52,8 +52,12 @@ _ENABLED = LoopState.ENABLED  # read several times a tick: a global, not an enum
 _pack_row = ROW.pack
 
 
-class ControlLoop:
-    """Fixed-period feed-forward control of the knob drives; see the module docstring."""
+class ControlLoop(LoopCommands):
+    """Fixed-period feed-forward control of the knob drives; see the module docstring.
+
+    ``standby``: compensators of other methods for the same catheter, which follow the motor
+    while not active (:mod:`tsmd.loop_compensators`).
+    """
 
     def __init__(self, drives: KnobDrives, compensator: Compensator, limiter: KnobLimiter,
                  period_s: float, clock: Clock, *,
@@ -62,7 +66,8 @@ class ControlLoop:
                  tip_source: Callable[[], Any] | None = None,
                  after_sync: Callable[[], None] | None = None,
                  recorder: TickRecorder | None = None,
-                 on_event: Callable[..., None] | None = None) -> None:
+                 on_event: Callable[..., None] | None = None,
+                 standby: Mapping[str, Compensator] | None = None) -> None:
         if drives.count != 2:
             raise ValueError(f"the loop drives two knobs, got {drives.count} drives")
         self.drives = drives
@@ -70,8 +75,7 @@ class ControlLoop:
         self.clock = clock
         self.stale_feedback_syncs = stale_feedback_syncs
         self.overrun_fault_streak = overrun_fault_streak
-        self._compensator = compensator
-        self._compensation_label = compensation_label
+        self._compensators = LoopCompensators(compensator, compensation_label, standby)
         self._limiter = limiter
         if limiter.dt_s != period_s:
             raise ValueError(f"the limiter steps {limiter.dt_s} s, the loop {period_s} s")
@@ -108,7 +112,7 @@ class ControlLoop:
 
     @property
     def compensation_label(self) -> str:
-        return self._compensation_label
+        return self._compensators.label
 
     @property
     def playing(self) -> bool:
@@ -189,7 +193,7 @@ class ControlLoop:
 
     def _command(self, pos: list[float]) -> tuple[Pair, Pair]:
         playback = self._playback
-        compensator: Compensator | None = self._compensator
+        compensator: Compensator | None = self._compensators.active
         if playback is not None:
             if playback.cancel is not None and playback.cancel.is_set():
                 self._end_playback("cancelled")
@@ -221,7 +225,9 @@ class ControlLoop:
         if not (_isfinite(c0) and _isfinite(c1)):
             self._fault(f"limiter gave {[c0, c1]} for q {list(q)}")
             return q, self._last_cmd
-        return q, (min(max(c0, lo[0]), hi[0]), min(max(c1, lo[1]), hi[1]))
+        c0, c1 = min(max(c0, lo[0]), hi[0]), min(max(c1, lo[1]), hi[1])
+        self._compensators.follow(q[0], q[1], c0, c1, active=compensator is None)
+        return q, (c0, c1)
 
     def _record(self, row: tuple[float, ...]) -> None:
         if self.recorder is not None:
@@ -240,8 +246,7 @@ class ControlLoop:
         self._playback = None
         self._play_q = []
         playback.error = error
-        self.setpoint.set(self._q)
-        self._compensator.reset(np.array(self._q))
+        self.setpoint.set(self._q)  # the compensator commanded or followed: no reset
         playback.done.set()
 
     # --- faults ----------------------------------------------------------------------------
@@ -273,149 +278,3 @@ class ControlLoop:
     def _emit(self, level: str, event: str, **fields: Any) -> None:
         if self._on_event is not None:
             self._on_event(level, event, **fields)
-
-    # --- commands (executed in the loop thread) --------------------------------------------
-
-    def post(self, name: str, **args: Any) -> Future[Any]:
-        """Queue a command for the loop thread; raises LoopError('busy') when the queue is full."""
-        command = LoopCommand(name, args)
-        if len(self.commands) >= self.max_pending_commands:
-            raise LoopError("busy", "the loop has too many pending commands")
-        self.commands.append(command)  # deque.append is atomic: no lock on the hot path
-        return command.future
-
-    def execute(self, name: str, **args: Any) -> Any:
-        """Run a command now, in the calling thread (only when no other thread ticks)."""
-        return getattr(self, f"_cmd_{name}")(**args)
-
-    def _run_commands(self) -> None:
-        commands = self.commands
-        while commands:
-            command = commands.popleft()
-            if not command.future.set_running_or_notify_cancel():
-                continue
-            try:
-                result = self.execute(command.name, **command.args)
-            except (LoopError, DriveError) as exc:
-                command.future.set_exception(exc)
-            except Exception as exc:  # a command must never kill the loop
-                command.future.set_exception(LoopError("internal", f"{command.name}: {exc}"))
-            else:
-                command.future.set_result(result)
-
-    def _hold_position(self) -> Array:
-        pos = np.array([f.position_deg for f in self.drives.feedback()], dtype=float)
-        if not np.all(np.isfinite(pos)):
-            raise LoopError("feedback", f"no valid position feedback ({pos.tolist()})")
-        return np.minimum(np.maximum(pos, self._min), self._max)
-
-    def _cmd_enable(self) -> str:
-        if self.state is LoopState.FAULT:
-            raise LoopError("fault", f"in FAULT ({self.fault_reason}); send reset first")
-        if self.state is LoopState.ENABLED:
-            return self.state.value
-        silent = silent_drive(self.drives)
-        if silent is not None:
-            raise LoopError("drive", f"{silent}; not enabling")
-        self.schedule_reset = True
-        try:
-            self.drives.enable()
-        except DriveError as exc:
-            self._emit("warning", "enable failed", reason=str(exc))
-            raise LoopError("drive", f"enable failed: {exc}") from None
-        self.drives.pump()
-        # Findings from while the drives were walked to OPERATION ENABLED (feedback late
-        # during the walk) are history: enable() succeeded, so they are logged, not faults.
-        for event in self.drives.poll_events():
-            self.last_events.append(event)
-            self._emit("warning", "drive event during enable", drive=event.drive,
-                       kind=event.kind.value, message=event.message)
-        pos = self._hold_position()
-        self._q = self._last_cmd = (float(pos[0]), float(pos[1]))
-        self._compensator.reset(pos)
-        self._limiter.reset(pos)
-        self.setpoint.set((float(pos[0]), float(pos[1])))
-        self.stats.overrun_streak = 0
-        self.state = LoopState.ENABLED
-        self._emit("info", "enabled", position_deg=pos.tolist())
-        return self.state.value
-
-    def _cmd_disable(self) -> str:
-        self.schedule_reset = True
-        self._end_playback("disabled")
-        self.drives.disable()
-        self.setpoint.clear()
-        if self.state is LoopState.ENABLED:
-            self.state = LoopState.DISABLED
-        self._emit("info", "disabled")
-        return self.state.value
-
-    def _cmd_stop(self) -> str:
-        """Quick stop; the loop goes to DISABLED (enable again to move)."""
-        self._end_playback("stopped")
-        self.drives.quick_stop()
-        self.setpoint.clear()
-        if self.state is LoopState.ENABLED:
-            self.state = LoopState.DISABLED
-        self._emit("warning", "quick stop")
-        return self.state.value
-
-    def _cmd_reset(self) -> str:
-        """Clear FAULT once its cause is gone; the loop is DISABLED afterwards."""
-        if self.state is not LoopState.FAULT:
-            return self.state.value
-        self.schedule_reset = True
-        self.drives.fault_reset()
-        self.drives.disable()
-        self.drives.pump()
-        cause = remaining_fault_cause(self.drives, self.stale_feedback_syncs)
-        if cause is not None:
-            raise LoopError("fault", f"cause still present: {cause}")
-        self.state = LoopState.DISABLED
-        self.fault_reason = None
-        self.stats.overrun_streak = 0
-        self._emit("info", "fault reset")
-        return self.state.value
-
-    def _cmd_home(self, drives: list[int] | None = None) -> Any:
-        """Find the knobs' zero reference (CiA 402 Homing Mode); only while DISABLED."""
-        if self.state is not LoopState.DISABLED:
-            raise LoopError("not_disabled", f"home: the loop is {self.state.value}; "
-                                            "disable first")
-        self.schedule_reset = True  # homing cycles the bus itself for seconds
-        return self.drives.home(drives)
-
-    def _cmd_set_compensator(self, compensator: Compensator, label: str) -> str:
-        compensator.reset(np.array(self._q))
-        self._compensator = compensator
-        self._compensation_label = label
-        self._emit("info", "compensation", method=label)
-        return label
-
-    def _cmd_play(self, playback: Playback) -> None:
-        if self.state is not LoopState.ENABLED:
-            raise LoopError("not_enabled", f"cannot play a trajectory in state {self.state.value}")
-        if self._playback is not None:
-            raise LoopError("busy", "a trajectory is already playing")
-        if playback.compensate:
-            self._compensator.reset(np.array(self._q))
-        self._play_q = np.asarray(playback.q_deg, dtype=float)[:, :2].tolist()
-        self._playback = playback
-
-    def _cmd_shutdown(self) -> str:
-        """Quick stop then disable: what SIGTERM does."""
-        self._end_playback("shutdown")
-        if self.state is LoopState.ENABLED:
-            try:
-                self.drives.quick_stop()
-            except DriveError as exc:
-                self._emit("error", "quick stop failed", reason=str(exc))
-        try:
-            self.drives.disable()
-        except DriveError as exc:
-            self._emit("error", "disable failed", reason=str(exc))
-        self.setpoint.clear()
-        if self.state is LoopState.ENABLED:
-            self.state = LoopState.DISABLED
-        self._emit("info", "shutdown: drives quick-stopped and disabled")
-        return self.state.value

@@ -22,7 +22,7 @@ from tsmd.online.apply import OnlineError
 from tsmd.online.attach import OnlineAttachment
 from tsmd.profile import ProfileError, ProfileStore, load_device_model
 from tsmd.rt import set_normal_scheduling
-from tsmd.stack import StackError, knob_limits, make_compensator
+from tsmd.stack import StackError, knob_limits, make_compensator, make_standby
 from tsmd.trajectory import TrajectoryRunner
 
 
@@ -203,7 +203,11 @@ class Service:
         except StackError as exc:
             raise ServiceError(str(exc), exc.code) from None
         label = choice.effective if profile is not None else "none"
-        self._wait("set_compensator", compensator=compensator, label=label)
+        # the same catheter: each new compensator continues from the one of its method that
+        # was active or followed the motor (switching on mid-motion keeps the branch)
+        self._wait("set_compensator", compensator=compensator, label=label,
+                   standby=make_standby(profile, label, self.config),
+                   keep_state=profile is self.profile)
         self.profile = profile
         self.choice = choice
         if self.online is not None:  # a new worker, on the new compensator's own values

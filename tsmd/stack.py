@@ -9,7 +9,7 @@ the compensator for the profile and method, the limiter last in the loop.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from drivers.clock import Clock
@@ -65,13 +65,32 @@ def make_compensator(profile: CatheterProfile | None, method: str,
                          "compensation") from None
 
 
+def make_standby(profile: CatheterProfile | None, active_method: str,
+                 config: TsmdConfig) -> dict[str, Compensator]:
+    """The compensators of the other methods this profile supports: the loop keeps them
+    following the motor, so switching to one mid-motion starts on the right branch."""
+    out: dict[str, Compensator] = {}
+    if profile is None:
+        return out
+    for method in METHODS:
+        if method in ("none", active_method):
+            continue
+        try:
+            out[method] = make_compensator(profile, method, config)
+        except StackError:
+            continue  # e.g. an older profile without the parameters of 'ours'
+    return out
+
+
 def build_loop(config: TsmdConfig, drives: KnobDrives, compensator: Compensator, clock: Clock,
                *, compensation_label: str,
                tip_source: Callable[[], Any] | None = None,
                after_sync: Callable[[], None] | None = None,
                recorder: TickRecorder | None = None,
-               on_event: Callable[..., None] | None = None) -> ControlLoop:
-    """The control loop of ``config`` on ``drives``, ticking on ``clock``."""
+               on_event: Callable[..., None] | None = None,
+               standby: Mapping[str, Compensator] | None = None) -> ControlLoop:
+    """The control loop of ``config`` on ``drives``, ticking on ``clock``; ``standby``
+    compensators (:func:`make_standby`) follow the motor while not active."""
     if compensation_label not in METHODS:
         raise StackError(f"compensation label {compensation_label!r} is not one of "
                          f"{list(METHODS)}", "compensation")
@@ -81,7 +100,7 @@ def build_loop(config: TsmdConfig, drives: KnobDrives, compensator: Compensator,
         stale_feedback_syncs=config.loop.stale_feedback_syncs,
         overrun_fault_streak=config.loop.overrun_fault_streak,
         compensation_label=compensation_label, tip_source=tip_source, after_sync=after_sync,
-        recorder=recorder, on_event=on_event)
+        recorder=recorder, on_event=on_event, standby=standby)
 
 
 def open_sim(config: TsmdConfig, seed: int, *, lockstep: bool, plant: Plant | None = None,

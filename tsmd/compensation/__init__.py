@@ -11,8 +11,9 @@ knobs' range.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -35,6 +36,7 @@ __all__ = [
     "METHODS",
     "CompensationError",
     "Compensator",
+    "FollowsMotor",
     "KnobLimiter",
     "KnobLimits",
     "LimitedCompensator",
@@ -58,6 +60,18 @@ class Compensator(Protocol):
         """The motor command (shape (2,), degrees) for this tick's desired angles."""
 
 
+@runtime_checkable
+class FollowsMotor(Protocol):
+    """A compensator that can stand by: it keeps its model on the branch the catheter is on
+    while something else commands the motor, so switching it on mid-motion needs no reset."""
+
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
+        """This tick the desired angles were ``q_deg`` and the motor was sent ``motor_deg``."""
+
+    def continue_from(self, other: Any) -> None:
+        """Take the state of ``other``, a compensator of the same kind for the same catheter."""
+
+
 class NoCompensation:
     """Sends the desired angles as they are (non-finite values hold the last command)."""
 
@@ -72,6 +86,13 @@ class NoCompensation:
         q = np.asarray(q_deg, dtype=float)
         self._last = np.where(np.isfinite(q), q, self._last)
         return self._last.copy()
+
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
+        motor = np.asarray(motor_deg, dtype=float)
+        self._last = np.where(np.isfinite(motor), motor, self._last)
+
+    def continue_from(self, other: NoCompensation) -> None:
+        self._last = other._last.copy()
 
 
 class LimitedCompensator:
@@ -101,6 +122,16 @@ class LimitedCompensator:
         raw = self.inner.command(q_deg)
         self.last_unlimited = np.asarray(raw, dtype=float).copy()
         return self.limiter.limit(raw)
+
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
+        if isinstance(self.inner, FollowsMotor):
+            self.inner.follow(q_deg, motor_deg)
+        self.limiter.limit(np.asarray(motor_deg, dtype=float))  # the limiter where the motor is
+
+    def continue_from(self, other: LimitedCompensator) -> None:
+        if isinstance(self.inner, FollowsMotor):
+            self.inner.continue_from(other.inner)
+        self.limiter = copy.deepcopy(other.limiter)
 
 
 def paper_compensator(profile: CatheterProfile) -> PaperCompensator:

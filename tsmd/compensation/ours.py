@@ -13,6 +13,7 @@ and lists, no numpy on scalars and no allocation beyond the output array.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from collections.abc import Sequence
@@ -30,6 +31,7 @@ from tsmd.compensation.tension_play import (
     branches,
     interp_linear,
     inverse_step,
+    model_step,
     rest_state,
 )
 
@@ -230,7 +232,36 @@ class OursCompensator:
         self._slot = slot + 1 if slot + 1 < n else 0
         return np.array((out[0] / n, out[1] / n))
 
-    def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
+        """The motor was sent ``motor_deg`` for ``q_deg`` by someone else (compensation off,
+        another method): the model follows the motor (branch, direction, held output), the
+        desired angle's trackers follow ``q_deg`` and the output filter holds the motor's
+        commands, so a switch to this compensator mid-motion continues from here."""
+        period = self.period_s
+        for i, kc in enumerate(self._k):
+            qi, x = float(q_deg[i]), float(motor_deg[i])
+            if qi - qi == 0.0:
+                self._watch(kc, qi)
+                self._motion(kc, qi)
+                kc.target = qi
+                kc.still_s = 0.0  # no dwell before this compensator has brought the tip to q
+            if x - x == 0.0:
+                kc.state = model_step(kc.state, x, self.knobs[i].at(float(motor_deg[1 - i])))
+                kc.out = x
+                kc.hold = 0
+                kc.lim_v, kc.lim_deg, kc.lim_target = (x - kc.lim_deg) / period, x, None
+                kc.window = [x] * self._n_avg  # the filter's output is the motor's command
+                kc.sum = x * self._n_avg
+
+    def continue_from(self, other: OursCompensator) -> None:
+        """Take ``other``'s state (same catheter; e.g. the one that followed the motor while
+        this one was being built), keep these parameters."""
+        self._k = copy.deepcopy(other._k)
+        self._slot = other._slot
+        self._set_constants()
+
+    def _watch(self, kc: _KnobCommand, q_raw: float) -> bool:
+        """Rest and dwell bookkeeping of the desired angle; True when a dwell is due."""
         kc.move_s += self.period_s
         if -REST_DEG < q_raw - kc.rest_q < REST_DEG:
             kc.stand_s += self.period_s
@@ -243,11 +274,13 @@ class OursCompensator:
             # the dwell counts once the sent command has arrived (the tip got there first)
             if abs(kc.sum / self._n_avg - kc.out) < _SETTLED_DEG:
                 kc.still_s += self.period_s
-            if kc.still_s >= DWELL_S and self._centre(kc, b):
-                return
-        else:
-            kc.still_q = q_raw
-            kc.still_s = 0.0
+            return kc.still_s >= DWELL_S
+        kc.still_q = q_raw
+        kc.still_s = 0.0
+        return False
+
+    def _motion(self, kc: _KnobCommand, q_raw: float) -> tuple[float, float, float]:
+        """The desired angle past the jitter deadband, its step and its velocity estimate."""
         q_prev = kc.q_prev
         qi = q_prev
         if (q_raw - q_prev) * kc.q_dir >= 0.0:
@@ -280,6 +313,12 @@ class OursCompensator:
             kc.held_s = 0.0
         elif kc.held_s > 1.5 * self.period_s:
             kc.v_raw = kc.accel = 0.0  # standing: the next move starts from rest
+        return qi, dq, v
+
+    def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
+        if self._watch(kc, q_raw) and self._centre(kc, b):
+            return
+        qi, dq, v = self._motion(kc, q_raw)
         lead = kc.ahead_s * v
         if lead < -_MAX_LEAD_DEG:
             lead = -_MAX_LEAD_DEG

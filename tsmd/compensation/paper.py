@@ -348,6 +348,17 @@ class PaperCompensator:
             out[i] = state.x_deg
         return out
 
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
+        """The motor was sent ``motor_deg`` by someone else: the model follows it."""
+        for i, knob in enumerate(self.knobs):
+            x, other = float(motor_deg[i]), float(q_deg[1 - i])
+            if math.isfinite(x) and math.isfinite(other):
+                self._states[i] = model_step(self._states[i], x, knob.params(other))[0]
+
+    def continue_from(self, other: PaperCompensator) -> None:
+        """Take ``other``'s model state (same catheter), keep these parameters."""
+        self._states = list(other._states)
+
     @property
     def states(self) -> tuple[ModelState, ...]:
         return tuple(self._states)

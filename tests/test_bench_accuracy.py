@@ -10,7 +10,8 @@ import pytest
 
 from tsmd import cli
 from tsmd.bench import accuracy, family_accuracy
-from tsmd.bench.accuracy import PERIOD_S, _conditioned, scenarios, tracking_errors
+from tsmd.bench.accuracy import tracking_errors
+from tsmd.bench.accuracy_scenarios import PERIOD_S, conditioned, scenarios
 
 
 def test_protocol_has_the_papers_scenarios() -> None:
@@ -57,8 +58,8 @@ def test_ptpe_and_rmse() -> None:
 
 def test_conditioned_start_adds_one_unscored_full_cycle_of_both_knobs() -> None:
     s = next(s for s in scenarios() if s.group == "2-DOF periodic")
-    _, plain, skip = _conditioned(s.t_s, s.q_deg, False)
-    t, cond, skip_c = _conditioned(s.t_s, s.q_deg, True)
+    _, plain, skip = conditioned(s.t_s, s.q_deg, False)
+    t, cond, skip_c = conditioned(s.t_s, s.q_deg, True)
     lead = cond[:skip_c - skip]
     assert np.allclose(cond[skip_c - skip:], plain)  # the scored part is unchanged
     assert np.allclose(cond[skip_c:], s.q_deg) and np.allclose(plain[skip:], s.q_deg)

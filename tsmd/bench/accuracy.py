@@ -30,10 +30,12 @@ from tsmd.bench.accuracy_report import (
     plot_runs,
     summarise,
 )
+from tsmd.bench.accuracy_scenarios import PERIOD_S, Scenario, conditioned, scenarios
 from tsmd.calibration import calibrate
 from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
 from tsmd.compensation import LimitedCompensator, build_compensator
-from tsmd.config import default_sim_config, resolve_data_path
+from tsmd.compensation.grid import CALIBRATION_GRID_DEG
+from tsmd.config import resolve_data_path
 from tsmd.datasheet import analysed_from, settle, tip_sweep
 from tsmd.errors import TsmdError
 from tsmd.profile import (
@@ -44,75 +46,6 @@ from tsmd.profile import (
     save_profile,
 )
 from tsmd.replay import LockstepRunner, run_trajectory
-
-PERIOD_S = default_sim_config().loop.period_s
-"""The bench runs on the packaged simulated rig: trajectories at that loop's own tick."""
-GRID_DEG = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
-
-@dataclass(frozen=True)
-class Scenario:
-    """One trajectory of the protocol; ``knobs`` are the knobs whose tracking is scored."""
-
-    group: str
-    name: str
-    t_s: NDArray[np.float64]
-    q_deg: NDArray[np.float64]
-    knobs: tuple[int, ...]
-
-
-CONDITIONING_HZ = 0.08
-
-
-def _conditioned(t: NDArray[np.float64], q: NDArray[np.float64], condition: bool
-                 ) -> tuple[NDArray[np.float64], NDArray[np.float64], int]:
-    """``settle``, optionally after one unscored +-90 deg cycle of both knobs at 0.08 Hz.
-
-    A fresh simulated plant is tension-free, a state a catheter that has been calibrated (the
-    paper's experiments follow the calibration on the same catheter) is never in. With
-    ``condition`` every run starts from the state one full cycle leaves.
-    """
-    tt, qq, skip = settle(t, q, PERIOD_S)
-    if not condition:
-        return tt, qq, skip
-    tc = np.arange(0.0, 1.0 / CONDITIONING_HZ, PERIOD_S)
-    cond = np.repeat((90.0 * np.sin(2 * math.pi * CONDITIONING_HZ * tc))[:, None], 2, axis=1)
-    full: NDArray[np.float64] = np.vstack([cond, qq]).astype(float)
-    t_full: NDArray[np.float64] = np.arange(len(full), dtype=float) * PERIOD_S
-    return t_full, full, skip + len(cond)
-
-
-def scenarios(quick: bool = False) -> list[Scenario]:
-    """The paper's scenarios (section "Scenarios"): 1-DOF with the other knob fixed, 2-DOF."""
-    f1 = 0.04
-    cycles = 1 if quick else 2
-    t = np.arange(0.0, cycles / f1, PERIOD_S)
-    fixed = (0.0, 60.0) if quick else (-60.0, -30.0, 0.0, 30.0, 60.0)
-    out: list[Scenario] = []
-    periodic = 60.0 * np.sin(2 * math.pi * f1 * t)
-    for knob in (0, 1):
-        for other in fixed:
-            q = np.zeros((t.size, 2))
-            q[:, knob] = periodic
-            q[:, 1 - knob] = other
-            out.append(Scenario("1-DOF periodic", f"phi{knob + 1}, other at {other:+.0f}",
-                                t, q, (knob,)))
-    t_np = np.arange(0.0, (0.5 if quick else 1.0) / 0.02, PERIOD_S)
-
-    def nonperiodic(tt: NDArray[np.float64], scale: float) -> NDArray[np.float64]:
-        return (30.0 * np.sin(2 * math.pi * 0.02 * scale * tt)
-                + 30.0 * np.sin(2 * math.pi * 0.02 * math.sqrt(3.0) * scale * tt))
-
-    for knob in (0, 1):
-        q = np.zeros((t_np.size, 2))
-        q[:, knob] = nonperiodic(t_np, 1.0)
-        out.append(Scenario("1-DOF non-periodic", f"phi{knob + 1}, other at +0", t_np, q,
-                            (knob,)))
-    q2 = np.column_stack([periodic, 60.0 * np.sin(2 * math.pi * 2 * f1 * t)])
-    out.append(Scenario("2-DOF periodic", "phi1 0.04 Hz, phi2 0.08 Hz", t, q2, (0, 1)))
-    q2n = np.column_stack([nonperiodic(t_np, 1.0), nonperiodic(t_np, 2.0)])
-    out.append(Scenario("2-DOF non-periodic", "phi1 0.02+0.035 Hz, phi2 twice", t_np, q2n,
-                        (0, 1)))
-    return out
 
 
 def tracking_errors(tip_deg: NDArray[np.float64], q_deg: NDArray[np.float64]
@@ -160,7 +93,7 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
     knobs = []
     for knob in (0, 1):
         sweeps = []
-        for other in GRID_DEG:
+        for other in CALIBRATION_GRID_DEG:
             tt, qq, skip = settle(*tip_sweep(knob, other, PERIOD_S), PERIOD_S)
             rec = _run(tt, qq, None, "none", seed, plant_factory())
             skip = analysed_from(skip, PERIOD_S)
@@ -176,7 +109,7 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
         dk = device.knobs[knob]
         ours = fit_tension_play(sweeps, dk)
         knobs.append(make_knob_profile(
-            dk, GRID_DEG, [s.dead_zone_pos_deg for s in sweeps],
+            dk, CALIBRATION_GRID_DEG, [s.dead_zone_pos_deg for s in sweeps],
             [s.dead_zone_neg_deg for s in sweeps], [s.backlash_pos_deg for s in sweeps],
             [s.backlash_neg_deg for s in sweeps], ours))
     return CatheterProfile(
@@ -210,7 +143,7 @@ class RunResult:
 
 def run_scenario(s: Scenario, method: str, seed: int, profile: Any,
                  plant_factory: Callable[[], Any], condition: bool = False) -> RunResult:
-    tt, qq, skip = _conditioned(s.t_s, s.q_deg, condition)
+    tt, qq, skip = conditioned(s.t_s, s.q_deg, condition)
     rec = _run(tt, qq, profile if method != "none" else None, method, seed, plant_factory())
     tip = np.column_stack([rec["tip1"], rec["tip2"]])[skip:]
     cmd = np.column_stack([rec["cmd1"], rec["cmd2"]])[skip:]

@@ -26,15 +26,9 @@ from numpy.typing import NDArray
 
 from simrig.family import PLANT_ROLE, PLANT_SPECS, family_member
 from simrig.plant import PlantLoadError, load_plant
-from tsmd.bench.accuracy import (
-    PERIOD_S,
-    Scenario,
-    calibrated_profile,
-    compute_time_us,
-    run_scenario,
-    scenarios,
-)
+from tsmd.bench.accuracy import calibrated_profile, compute_time_us, run_scenario
 from tsmd.bench.accuracy_report import plot_runs
+from tsmd.bench.accuracy_scenarios import PERIOD_S, Scenario, scenarios
 from tsmd.bench.realism import data_sheet
 from tsmd.config import resolve_data_path
 from tsmd.errors import TsmdError

@@ -16,11 +16,8 @@ import sys
 import tempfile
 import threading
 import time
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from drivers.clock import MonotonicClock
 from drivers.drive import DriveError, KnobDrives
@@ -31,6 +28,7 @@ from tsmd.api.server import ApiServer
 from tsmd.bus_events import BusEventLog
 from tsmd.compensation import Compensator
 from tsmd.config import TsmdConfig, drive_configs, resolve_data_path
+from tsmd.daemon_loop import LoopThread, RunSummary
 from tsmd.errors import DaemonError
 from tsmd.log import EventLog, get_logger
 from tsmd.loop import BackgroundRecorder, ControlLoop, LoopError
@@ -45,7 +43,7 @@ from tsmd.profile import (
     load_profile,
 )
 from tsmd.replay import LiveTrajectoryRunner
-from tsmd.rt import FixedRateScheduler, RealtimeReport, apply_realtime, set_fifo
+from tsmd.rt import FixedRateScheduler, RealtimeReport, set_fifo
 from tsmd.service import CompensationChoice, Service
 from tsmd.stack import StackError, build_loop, make_compensator, make_standby, open_sim
 
@@ -79,17 +77,6 @@ def resolve_socket_path(configured: str, explicit: str | None = None) -> tuple[P
     return fallback, f"cannot use {parent} for the socket; listening on {fallback} instead"
 
 
-@dataclass
-class RunSummary:
-    ticks: int
-    overruns: int
-    faults: int
-    lateness_p99_ms: float
-    lateness_max_ms: float
-    state: str
-    fault: str | None
-
-
 class Daemon:
     """Owns every part; :meth:`start`, then :meth:`wait`, then :meth:`stop` (idempotent)."""
 
@@ -118,14 +105,10 @@ class Daemon:
         self.service: Service | None = None
         self.online: OnlineAttachment | None = None
         self.server: ApiServer | None = None
-        self.scheduler: FixedRateScheduler | None = None
         self.recorder: BackgroundRecorder | None = None
         self.socket_path: Path | None = None
         self.notifier = Notifier()
-        self.rt_report: RealtimeReport | None = None
-        self._loop_stop = threading.Event()
-        self._loop_thread: threading.Thread | None = None
-        self._loop_error: BaseException | None = None
+        self.loop_thread: LoopThread | None = None
         self._stopped = False
         self.shutdown_requested = threading.Event()
 
@@ -253,55 +236,26 @@ class Daemon:
         out: dict[str, Any] = {"sim": self.sim}
         if self.server is not None:
             out["clients"] = self.server.client_count
-        if self.rt_report is not None:
-            out["realtime"] = {"fifo_priority": self.rt_report.fifo_priority,
-                               "cpu": self.rt_report.cpu,
-                               "memory_locked": self.rt_report.memory_locked}
+        report = self.rt_report
+        if report is not None:
+            out["realtime"] = {"fifo_priority": report.fifo_priority, "cpu": report.cpu,
+                               "memory_locked": report.memory_locked}
         return out
 
     def _start_loop_thread(self) -> None:
-        loop = self.loop
-        assert loop is not None
+        assert self.loop is not None
 
-        def on_tick_end(overran: bool) -> None:
-            loop.note_overrun(overran)
+        def on_death(exc: BaseException) -> None:
+            self.events.emit("critical", "loop thread died", error=repr(exc))
+            self.shutdown_requested.set()
 
-        def reanchor() -> bool:
-            if loop.schedule_reset:
-                loop.schedule_reset = False
-                return True
-            return False
-
-        self.scheduler = FixedRateScheduler(loop.period_s, loop.tick, on_tick_end=on_tick_end,
-                                            should_reanchor=reanchor)
-        started = threading.Event()
-        rt = self.config.loop.realtime
-
-        def run() -> None:
-            self.rt_report = apply_realtime(rt.priority, rt.cpu, rt.lock_memory)
-            started.set()
-            try:
-                assert self.scheduler is not None
-                self.scheduler.run(self._loop_stop)
-            except BaseException as exc:  # the loop died: make it visible, then stop
-                self._loop_error = exc
-                self.events.emit("critical", "loop thread died", error=repr(exc))
-                with contextlib.suppress(DriveError):
-                    loop.drives.quick_stop()
-                self.shutdown_requested.set()
-
-        self._loop_thread = threading.Thread(target=run, name="tsmd-loop", daemon=True)
-        self._loop_thread.start()
-        started.wait(5.0)
-        deadline = time.monotonic() + 5.0
-        while loop.latest_sample is None and time.monotonic() < deadline:
-            time.sleep(loop.period_s)  # READY means the loop is ticking
-        if loop.latest_sample is None:
-            raise DaemonError("the control loop did not start ticking", "loop")
+        self.loop_thread = LoopThread(self.loop, self.config.loop.realtime, on_death)
+        self.loop_thread.start()
         if self._helper_rt_warning is not None:
             self.log.warning("real-time setting not applied",
                              reason=f"helper threads: {self._helper_rt_warning}")
-        for warning in self.rt_report.warnings if self.rt_report else []:
+        report = self.loop_thread.rt_report
+        for warning in report.warnings if report else []:
             self.log.warning("real-time setting not applied", reason=warning)
 
     def _start_api(self) -> None:
@@ -357,7 +311,7 @@ class Daemon:
         self.notifier.stopping()
         loop = self.loop
         calibrating = self.service is not None and self.service.cancel_calibration("shutdown")
-        if loop is not None and self._loop_thread is not None and self._loop_thread.is_alive():
+        if loop is not None and self.loop_thread is not None and self.loop_thread.alive:
             try:
                 loop.post("shutdown").result(timeout=5.0)
             except (LoopError, DriveError, TimeoutError) as exc:
@@ -367,9 +321,8 @@ class Daemon:
                 while self.service is not None and self.service.calibrating \
                         and time.monotonic() < deadline:
                     time.sleep(0.05)
-        self._loop_stop.set()
-        if self._loop_thread is not None:
-            self._loop_thread.join(5.0)
+        if self.loop_thread is not None:
+            self.loop_thread.stop()
         if self.online is not None:
             self.online.detach()
         if self.server is not None:
@@ -393,15 +346,15 @@ class Daemon:
     @property
     def loop_error(self) -> BaseException | None:
         """What killed the loop thread, if it died (the process then exits non-zero)."""
-        return self._loop_error
+        return self.loop_thread.error if self.loop_thread is not None else None
+
+    @property
+    def scheduler(self) -> FixedRateScheduler | None:
+        return self.loop_thread.scheduler if self.loop_thread is not None else None
+
+    @property
+    def rt_report(self) -> RealtimeReport | None:
+        return self.loop_thread.rt_report if self.loop_thread is not None else None
 
     def summary(self) -> RunSummary | None:
-        loop = self.loop
-        if loop is None:
-            return None
-        late = self.scheduler.times.lateness() if self.scheduler is not None else np.zeros(0)
-        return RunSummary(
-            ticks=loop.stats.ticks, overruns=loop.stats.overruns, faults=loop.stats.faults,
-            lateness_p99_ms=float(np.percentile(late, 99) * 1e3) if late.size else 0.0,
-            lateness_max_ms=float(late.max() * 1e3) if late.size else 0.0,
-            state=loop.state.value, fault=loop.fault_reason)
+        return self.loop_thread.summary() if self.loop_thread is not None else None

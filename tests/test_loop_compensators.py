@@ -107,3 +107,38 @@ def test_paper_follows_the_motor_down_its_falling_branch() -> None:
         paper.follow(np.array([x, 0.0]), np.array([x, 0.0]))  # type: ignore[attr-defined]
     state = paper.states[0]  # type: ignore[attr-defined]
     assert (state.direction, state.x_deg) == (-1, pytest.approx(10.0))
+
+
+def demo_sine_rmse_after_load(late_every: int) -> tuple[float, float]:
+    """Ours on the demo's sine (a 50 Hz client on wall time) for 30 s; in the first 15 s every
+    ``late_every``-th tick comes late by two periods (the client's sine moves on, the rig and the
+    compensator advance one tick). Tip RMSE per knob over the last 10 s."""
+    profile = load_profile(resolve_data_path("profiles/example-sim.yaml"))
+    drives, rig = open_sim(CONFIG, 0, lockstep=True)
+    loop = build_loop(CONFIG, drives, make_compensator(profile, "ours", CONFIG), rig.clock,
+                      compensation_label="ours", tip_source=rig.tip_pair,
+                      after_sync=rig.exchange)
+    drives.boot()
+    loop.tick()
+    loop.execute("enable")
+    wall_s, k, errors = 0.0, 0, []
+    while wall_s < 30.0:
+        t_s = np.floor(wall_s * 50.0) / 50.0
+        loop.setpoint.set((60.0 * np.sin(2 * np.pi * 0.1 * t_s),
+                           30.0 * np.sin(4 * np.pi * 0.1 * t_s)))
+        sample = loop.tick()
+        if wall_s >= 20.0:
+            errors.append(np.subtract(sample.tip_deg, sample.q_deg))
+        k += 1
+        late = late_every > 0 and wall_s < 15.0 and k % late_every == 0
+        loop.note_overrun(late)
+        wall_s += PERIOD_S * (3 if late else 1)
+    rig.close()
+    rmse = np.sqrt(np.mean(np.square(errors), axis=0))
+    return float(rmse[0]), float(rmse[1])
+
+
+def test_late_ticks_leave_no_lasting_error_once_the_load_is_gone() -> None:
+    calm = demo_sine_rmse_after_load(0)
+    loaded = demo_sine_rmse_after_load(7)
+    assert loaded == pytest.approx(calm, abs=0.15)

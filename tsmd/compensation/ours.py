@@ -233,10 +233,8 @@ class OursCompensator:
         return np.array((out[0] / n, out[1] / n))
 
     def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
-        """The motor was sent ``motor_deg`` for ``q_deg`` by someone else (compensation off,
-        another method): the model follows the motor (branch, direction, held output), the
-        desired angle's trackers follow ``q_deg`` and the output filter holds the motor's
-        commands, so a switch to this compensator mid-motion continues from here."""
+        """Someone else sent the motor ``motor_deg`` for ``q_deg``: the model follows the motor,
+        the trackers ``q_deg``, the output filter holds the motor (a switch continues here)."""
         period = self.period_s
         for i, kc in enumerate(self._k):
             qi, x = float(q_deg[i]), float(motor_deg[i])
@@ -254,8 +252,7 @@ class OursCompensator:
                 kc.sum = x * self._n_avg
 
     def continue_from(self, other: OursCompensator) -> None:
-        """Take ``other``'s state (same catheter; e.g. the one that followed the motor while
-        this one was being built), keep these parameters."""
+        """Take ``other``'s state (same catheter), keep these parameters."""
         self._k = copy.deepcopy(other._k)
         self._slot = other._slot
         self._set_constants()

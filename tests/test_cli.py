@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from tsmd.cli import main
@@ -14,3 +16,23 @@ def test_help_lists_every_command(capsys: pytest.CaptureFixture[str]) -> None:
     out = capsys.readouterr().out
     for name in ("run", "sim", "calibrate", "replay", "gap", "bench"):
         assert name in out
+
+
+def test_every_command_has_help(capsys: pytest.CaptureFixture[str]) -> None:
+    for name in ("run", "sim", "calibrate", "datasheet", "replay", "gap", "bench"):
+        with pytest.raises(SystemExit) as exc:
+            main([name, "--help"])
+        assert exc.value.code == 0
+        assert capsys.readouterr().out.startswith(f"usage: tsmd {name}")
+
+
+def test_a_config_without_drives_is_one_line_naming_drives(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    config = tmp_path / "empty.yaml"
+    config.write_text("", encoding="utf-8")
+    code = main(["run", "--sim", "--no-demo", "--duration", "0.1", "--config", str(config),
+                 "--socket", str(tmp_path / "t.sock")])
+    lines = [line for line in capsys.readouterr().err.splitlines()
+             if not line.startswith("{")]  # the event log's JSON lines go to stderr too
+    assert code == 2
+    assert len(lines) == 1 and "drives: expected 2 drives" in lines[0]

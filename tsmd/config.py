@@ -322,7 +322,7 @@ def _validate(config: TsmdConfig) -> None:
                 f"limits.{name}: min_deg ({knob.min_deg}) must be below max_deg ({knob.max_deg})")
     if config.drives and len(config.drives) != 2:
         raise ConfigError(f"drives: expected 2 drives (phi1, phi2), got {len(config.drives)}")
-    drives = drive_configs(config)
+    drives = _parse_drives(config)
     for i, (drive, name) in enumerate(zip(drives, ("phi1", "phi2"), strict=False)):
         knob = getattr(config.limits, name)
         if knob.min_deg < drive.min_deg or knob.max_deg > drive.max_deg:
@@ -364,7 +364,16 @@ def default_sim_config() -> TsmdConfig:
 
 
 def drive_configs(config: TsmdConfig) -> list[DriveConfig]:
-    """The ``drives`` entries as ``drivers.units.DriveConfig`` objects, validated."""
+    """The two knob drives as ``drivers.units.DriveConfig`` objects (a configuration may leave
+    ``drives`` out, but nothing that runs drives can do without them)."""
+    out = _parse_drives(config)
+    if len(out) != 2:
+        raise ConfigError(f"drives: expected 2 drives (phi1, phi2), got {len(out)}: the "
+                          "configuration must list the knob drives (see docs/configuration.md)")
+    return out
+
+
+def _parse_drives(config: TsmdConfig) -> list[DriveConfig]:
     out = []
     for i, entry in enumerate(config.drives):
         try:

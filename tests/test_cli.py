@@ -36,3 +36,13 @@ def test_a_config_without_drives_is_one_line_naming_drives(
              if not line.startswith("{")]  # the event log's JSON lines go to stderr too
     assert code == 2
     assert len(lines) == 1 and "drives: expected 2 drives" in lines[0]
+
+
+def test_an_unknown_option_is_refused_with_the_commands_own_usage(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["calibrate", "--catheter", "x", "--out", "p.yaml"])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2
+    assert err.startswith("usage: tsmd calibrate")
+    assert "tsmd calibrate: error: unrecognized arguments: --out p.yaml" in err

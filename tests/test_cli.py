@@ -46,3 +46,10 @@ def test_an_unknown_option_is_refused_with_the_commands_own_usage(
     assert exc.value.code == 2
     assert err.startswith("usage: tsmd calibrate")
     assert "tsmd calibrate: error: unrecognized arguments: --out p.yaml" in err
+
+
+@pytest.mark.parametrize("duration", ["-1", "0", "nan", "inf"])
+def test_run_refuses_a_duration_that_is_not_a_positive_time(
+        duration: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "--sim", "--duration", duration]) == 2
+    assert "--duration must be a positive number of seconds" in capsys.readouterr().err

@@ -23,6 +23,7 @@ import numpy as np
 from tsmd.api.client import ApiClient, ApiClientError
 from tsmd.config import DEFAULT_CONFIG_PATH, TsmdConfig, default_sim_config, load_config
 from tsmd.daemon import Daemon
+from tsmd.errors import TsmdError
 from tsmd.log import configure_logging
 
 DEMO_SET_HZ = 50.0
@@ -130,6 +131,8 @@ class Demo:
 
 
 def main(args: argparse.Namespace) -> int:
+    if args.duration is not None and not 0.0 < args.duration < math.inf:
+        raise TsmdError(f"--duration must be a positive number of seconds, got {args.duration}")
     configure_logging(args.log_format)
     config = _config(args)
     daemon = Daemon(config, sim=args.sim, socket_path=args.socket, profile_path=args.profile,

@@ -4,6 +4,9 @@
 from __future__ import annotations
 
 from collections.abc import Iterator
+from concurrent.futures import Future
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -13,6 +16,7 @@ from tsmd.compensation import NoCompensation
 from tsmd.config import default_sim_config, resolve_data_path
 from tsmd.loop import ControlLoop
 from tsmd.profile import CatheterProfile, load_profile
+from tsmd.service import CompensationChoice, Service
 from tsmd.stack import build_loop, make_compensator, make_standby, open_sim
 
 CONFIG = default_sim_config()
@@ -35,7 +39,7 @@ def uncompensated_loop(sim_profile: CatheterProfile) -> Iterator[tuple[ControlLo
     drives, rig = open_sim(CONFIG, 0, lockstep=True)
     loop = build_loop(CONFIG, drives, NoCompensation(), rig.clock, compensation_label="none",
                       tip_source=rig.tip_pair, after_sync=rig.exchange,
-                      standby=make_standby(sim_profile, "none", CONFIG))
+                      standby=make_standby(sim_profile, "ours", "none", CONFIG))
     drives.boot()
     loop.tick()
     loop.execute("enable")
@@ -56,7 +60,7 @@ def test_switching_on_at_a_standstill_after_moving_without_compensation_brings_t
     play_phi1(loop, ramp(0.0, 60.0, 2.0) + ramp(60.0, 0.0, 2.0) + [0.0] * 250)
     assert loop.latest_sample is not None and loop.latest_sample.tip_deg[0] > 20.0
     loop.execute("set_compensator", compensator=make_compensator(sim_profile, "ours", CONFIG),
-                 label="ours", standby=make_standby(sim_profile, "ours", CONFIG),
+                 label="ours", standby=make_standby(sim_profile, "ours", "ours", CONFIG),
                  keep_state=True)
     play_phi1(loop, [0.0] * 500)
     # a compensator started at rest believes the tip is at q and leaves it at ~31 deg
@@ -69,11 +73,48 @@ def test_the_compensator_switched_on_knows_the_catheter_came_down(
     play_phi1(loop, ramp(0.0, 60.0, 2.0) + ramp(60.0, 20.0, 1.5))
     ours = make_compensator(sim_profile, "ours", CONFIG)
     loop.execute("set_compensator", compensator=ours, label="ours",
-                 standby=make_standby(sim_profile, "ours", CONFIG), keep_state=True)
+                 standby=make_standby(sim_profile, "ours", "ours", CONFIG), keep_state=True)
     state = ours._k[0].state  # type: ignore[attr-defined]
     assert state.direction == -1  # a rest start assumes the knob came up from home
     assert state.x_deg == pytest.approx(20.0, abs=0.5)  # where the motor is
     assert state.y_deg < 20.0 - 1.0  # the model's tip: down its falling branch, not at q
+
+
+class PostedNow:
+    """A lockstep loop whose posted commands run at once (no loop thread in these tests)."""
+
+    def __init__(self, loop: ControlLoop) -> None:
+        self._loop = loop
+
+    def post(self, name: str, **args: Any) -> Future[Any]:
+        future: Future[Any] = Future()
+        future.set_result(self._loop.execute(name, **args))
+        return future
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._loop, name)
+
+
+def test_the_api_switching_compensation_off_and_on_keeps_the_branch(
+        sim_profile: CatheterProfile, tmp_path: Path) -> None:
+    # what the README demo does: compensation off, knobs moved, compensation on
+    drives, rig = open_sim(CONFIG, 0, lockstep=True)
+    loop = build_loop(CONFIG, drives, make_compensator(sim_profile, "ours", CONFIG), rig.clock,
+                      compensation_label="ours", tip_source=rig.tip_pair,
+                      after_sync=rig.exchange)
+    drives.boot()
+    loop.tick()
+    loop.execute("enable")
+    service = Service(CONFIG, PostedNow(loop), sim_profile,  # type: ignore[arg-type]
+                      CompensationChoice(True, "ours"), profiles_dir=tmp_path)
+    try:
+        service.set_compensation(False, None)
+        play_phi1(loop, ramp(0.0, 60.0, 2.0) + ramp(60.0, 0.0, 2.0) + [0.0] * 250)
+        service.set_compensation(True, None)
+        play_phi1(loop, [0.0] * 500)
+    finally:
+        rig.close()
+    assert loop.latest_sample is not None and abs(loop.latest_sample.tip_deg[0]) < 3.0
 
 
 def test_switching_with_a_new_profile_starts_at_rest(

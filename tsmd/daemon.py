@@ -203,7 +203,7 @@ class Daemon:
         self.loop = build_loop(config, self.drives, compensator, MonotonicClock(),
                                compensation_label=label, tip_source=tip_source,
                                recorder=self.recorder, on_event=self.events.emit,
-                               standby=make_standby(profile, label, config))
+                               standby=make_standby(profile, choice.method, label, config))
         self.online = OnlineAttachment(config.online, self.loop, on_event=self.events.emit,
                                        handle_slip_deg=self._handle_slip_deg(config))
         if self.recorder is not None and config.online.enabled:

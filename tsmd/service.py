@@ -206,7 +206,7 @@ class Service:
         # the same catheter: each new compensator continues from the one of its method that
         # was active or followed the motor (switching on mid-motion keeps the branch)
         self._wait("set_compensator", compensator=compensator, label=label,
-                   standby=make_standby(profile, label, self.config),
+                   standby=make_standby(profile, choice.method, label, self.config),
                    keep_state=profile is self.profile)
         self.profile = profile
         self.choice = choice

@@ -55,8 +55,9 @@ _pack_row = ROW.pack
 class ControlLoop(LoopCommands):
     """Fixed-period feed-forward control of the knob drives; see the module docstring.
 
-    ``standby``: compensators of other methods for the same catheter, which follow the motor
-    while not active (:mod:`tsmd.loop_compensators`).
+    ``standby``: the compensator(s) that may be switched on mid-run for the same catheter,
+    which follow the motor while not active (:mod:`tsmd.loop_compensators`). The commands
+    executed between ticks are :class:`tsmd.loop_commands.LoopCommands`.
     """
 
     def __init__(self, drives: KnobDrives, compensator: Compensator, limiter: KnobLimiter,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -26,16 +28,18 @@ def test_every_command_has_help(capsys: pytest.CaptureFixture[str]) -> None:
         assert capsys.readouterr().out.startswith(f"usage: tsmd {name}")
 
 
-def test_a_config_without_drives_is_one_line_naming_drives(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_config_without_drives_is_one_line_naming_drives(tmp_path: Path) -> None:
     config = tmp_path / "empty.yaml"
     config.write_text("", encoding="utf-8")
-    code = main(["run", "--sim", "--no-demo", "--duration", "0.1", "--config", str(config),
-                 "--socket", str(tmp_path / "t.sock")])
-    lines = [line for line in capsys.readouterr().err.splitlines()
+    # a process of its own: `tsmd run` configures the process's logging
+    proc = subprocess.run([sys.executable, "-m", "tsmd", "run", "--sim", "--no-demo",
+                           "--duration", "0.1", "--config", str(config),
+                           "--socket", str(tmp_path / "t.sock")],
+                          capture_output=True, text=True, timeout=60)
+    lines = [line for line in proc.stderr.splitlines()
              if not line.startswith("{")]  # the event log's JSON lines go to stderr too
-    assert code == 2
-    assert len(lines) == 1 and "drives: expected 2 drives" in lines[0]
+    assert proc.returncode == 2
+    assert len(lines) == 1 and "drives: expected 2 drives" in lines[0], proc.stderr
 
 
 def test_an_unknown_option_is_refused_with_the_commands_own_usage(

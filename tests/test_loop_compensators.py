@@ -14,7 +14,7 @@ from support.profiles import make_profile
 
 from tsmd.compensation import NoCompensation
 from tsmd.config import default_sim_config, resolve_data_path
-from tsmd.loop import ControlLoop
+from tsmd.loop import ControlLoop, Playback
 from tsmd.profile import CatheterProfile, load_profile
 from tsmd.service import CompensationChoice, Service
 from tsmd.stack import build_loop, make_compensator, make_standby, open_sim
@@ -183,3 +183,25 @@ def test_late_ticks_leave_no_lasting_error_once_the_load_is_gone() -> None:
     calm = demo_sine_rmse_after_load(0)
     loaded = demo_sine_rmse_after_load(7)
     assert loaded == pytest.approx(calm, abs=0.15)
+
+
+def test_nothing_moves_after_an_uncompensated_trajectory_ends(
+        sim_profile: CatheterProfile) -> None:
+    # a calibration sweep ends held at its last knob angle, which is not where the tip is
+    drives, rig = open_sim(CONFIG, 0, lockstep=True)
+    loop = build_loop(CONFIG, drives, make_compensator(sim_profile, "ours", CONFIG), rig.clock,
+                      compensation_label="ours", tip_source=rig.tip_pair,
+                      after_sync=rig.exchange)
+    drives.boot()
+    loop.tick()
+    loop.execute("enable")
+    path = np.column_stack([ramp(0.0, 60.0, 2.0) + ramp(60.0, 0.0, 2.0), np.zeros(1000)])
+    playback = Playback(path, False, None)
+    loop.execute("play", playback=playback)
+    try:
+        while not playback.done.is_set():
+            loop.tick()
+        commands = [loop.tick().cmd_deg[0] for _ in range(250)]
+    finally:
+        rig.close()
+    assert max(abs(c) for c in commands) < 0.5

@@ -227,7 +227,7 @@ class ControlLoop(LoopCommands):
             self._fault(f"limiter gave {[c0, c1]} for q {list(q)}")
             return q, self._last_cmd
         c0, c1 = min(max(c0, lo[0]), hi[0]), min(max(c1, lo[1]), hi[1])
-        self._compensators.follow(q[0], q[1], c0, c1, active=compensator is None)
+        self._compensators.follow(q[0], q[1], c0, c1)
         return q, (c0, c1)
 
     def _record(self, row: tuple[float, ...]) -> None:
@@ -247,7 +247,11 @@ class ControlLoop(LoopCommands):
         self._playback = None
         self._play_q = []
         playback.error = error
-        self.setpoint.set(self._q)  # the compensator commanded or followed: no reset
+        self.setpoint.set(self._q)
+        # The held setpoint is the last desired angle; after an uncompensated sweep that is a
+        # knob angle, not where the tip is: at rest there, or the compensator would move the
+        # knobs on its own to bring the tip to it.
+        self._compensators.active.reset(np.array(self._q))
         playback.done.set()
 
     # --- faults ----------------------------------------------------------------------------

@@ -38,13 +38,9 @@ class LoopCompensators:
         for c in self.standby.values():
             c.reset(q_deg)
 
-    def follow(self, q0: float, q1: float, cmd0: float, cmd1: float, *, active: bool) -> None:
-        """The motor was sent (cmd0, cmd1) for the desired (q0, q1): the standing-by follow, and
-        the active one too when ``active`` (it did not command this tick: an uncompensated
-        trajectory)."""
+    def follow(self, q0: float, q1: float, cmd0: float, cmd1: float) -> None:
+        """The motor was sent (cmd0, cmd1) for the desired (q0, q1): those standing by follow."""
         followers = self._followers
-        if active and isinstance(self.active, FollowsMotor):
-            followers = (*followers, self.active)
         if not followers:
             return
         q, cmd = np.array((q0, q1)), np.array((cmd0, cmd1))

@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from tsmd import config as config_module
 from tsmd.compensation import METHODS
 from tsmd.config import (
     CompensationMethod,
@@ -169,3 +170,11 @@ def test_the_online_defaults_are_the_estimators_own() -> None:
     online, options = TsmdConfig().online, EstimatorOptions()
     assert (online.gate_deg, online.max_offset_deg, online.deadband_deg) == (
         options.gate_deg, options.max_offset_deg, options.deadband_deg)
+
+
+def test_a_missing_default_config_says_how_to_run_without_it(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    missing = tmp_path / "tsmd.yaml"
+    monkeypatch.setattr(config_module, "DEFAULT_CONFIG_PATH", missing)
+    with pytest.raises(ConfigError, match=r"pass --config FILE, or --sim"):
+        load_config(missing)

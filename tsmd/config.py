@@ -350,6 +350,9 @@ def parse_config(data: Any, source: str = "<config>") -> TsmdConfig:
 def load_config(path: str | Path = DEFAULT_CONFIG_PATH) -> TsmdConfig:
     """Read and validate a YAML configuration file."""
     p = Path(path)
+    if p == DEFAULT_CONFIG_PATH and not p.exists():  # a new user's first `tsmd run`
+        raise ConfigError(f"{p}: no such file (the default configuration): pass --config FILE, "
+                          "or --sim for the simulated rig")
     data = read_yaml(p, ConfigError)
     try:
         return parse_config(data, source=str(p))

@@ -3,9 +3,11 @@
 Switching compensation on mid-motion (the demo, an operator who first moves the knobs without
 it) must start on the branch of the hysteresis the catheter is on. A compensator built at the
 switch knows nothing of the motor's history, and a reset puts it at rest, which is wrong after
-any motion. So every compensator that is not active is fed, each enabled tick, what the motor
-was actually sent (:meth:`tsmd.compensation.FollowsMotor.follow`), and one switched in takes
-the state of the compensator of its own method that stood by (or was active) before.
+any motion. So the compensator standing by (``tsmd.stack.make_standby``: the configured
+method's, while compensation is off) is fed, each enabled tick, what the motor was actually
+sent (:meth:`tsmd.compensation.FollowsMotor.follow`), and one switched in takes the state of
+the compensator of its own method that stood by (or was active) before. ``enable`` and the end
+of a trajectory put them at rest: the loop's defined starts.
 """
 
 from __future__ import annotations

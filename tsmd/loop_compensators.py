@@ -6,8 +6,8 @@ switch knows nothing of the motor's history, and a reset puts it at rest, which 
 any motion. So the compensator standing by (``tsmd.stack.make_standby``: the configured
 method's, while compensation is off) is fed, each enabled tick, what the motor was actually
 sent (:meth:`tsmd.compensation.FollowsMotor.follow`), and one switched in takes the state of
-the compensator of its own method that stood by (or was active) before. ``enable`` and the end
-of a trajectory put them at rest: the loop's defined starts.
+the compensator of its own method that stood by (or was active) before. ``enable`` puts them all
+at rest, the end of a trajectory the active one (its held angle may be a knob angle).
 """
 
 from __future__ import annotations

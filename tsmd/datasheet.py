@@ -20,6 +20,7 @@ from numpy.typing import NDArray
 
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
+from tsmd.bench.tip_truth import TIP_THRESHOLD_DEG, tip_reading
 from tsmd.calibration.identify import identify_sweep, resample_on_angle, split_half_cycles
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.pieces import (
@@ -50,7 +51,6 @@ LOADED_FIT_DEG = (40.0, 85.0)
 """Knob range where the loaded branch is fitted for omega (mirrored for falling passes)."""
 RELEASED_FIT_DEG = (35.0, 65.0)
 """Knob range where the releasing branch is fitted for release_omega."""
-TIP_THRESHOLD_DEG = 1.0
 REFERENCE_BAND_DEG = 0.5
 """Samples within this of the knob's turning point give the reference tip angle."""
 
@@ -166,6 +166,9 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         raise DatasheetError(f"knob {knob + 1} does not sweep +-{SWEEP_AMPLITUDE_DEG:g} deg in "
                              f"the analysed rows (range {pos.min():.1f}..{pos.max():.1f} deg)")
     dz = measure_dead_zone_backlash(pos, tip, threshold_deg=TIP_THRESHOLD_DEG)
+    # B as the scoring truth reads it (the raw tip's 1 deg fires 1.5-2.5 deg early); D stays
+    # on the raw tip: the dead-zone offset is what the compensators were built against
+    tip_b = tip_reading(t, rec[f"cmd{knob + 1}"][start:], pos, tip)
     # where the calibration's current analysis puts the edges on the same sweep
     cur = identify_sweep(t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:])
     dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
@@ -200,8 +203,8 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         omega=float(np.median(loaded)), release_omega=float(np.median(released)),
         reference_pos=ReferencePoint(SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos > top]))),
         reference_neg=ReferencePoint(-SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos < -top]))),
-        reference_backlash_pos_deg=float(dz.backlash_pos_deg),
-        reference_backlash_neg_deg=float(dz.backlash_neg_deg),
+        reference_backlash_pos_deg=float(tip_b.backlash_pos_deg),
+        reference_backlash_neg_deg=float(tip_b.backlash_neg_deg),
         dead_zone_offset_deg=float(dz_offset),
         dead_zone_pos_deg=_finite_or_none(cur.estimate("dead_zone_pos_deg")),
         dead_zone_neg_deg=_finite_or_none(cur.estimate("dead_zone_neg_deg")), backlash_gain=gain,

@@ -20,9 +20,15 @@ from numpy.typing import NDArray
 
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
+from tsmd.bench.tip_truth import TIP_THRESHOLD_DEG, tip_reading
 from tsmd.calibration.identify import identify_sweep, resample_on_angle, split_half_cycles
 from tsmd.calibration.options import IdentifyOptions
-from tsmd.calibration.pieces import RELEASE_LEVEL_WINDOW_DEG, loaded_current, smooth_value
+from tsmd.calibration.pieces import (
+    RELEASE_LEVEL_WINDOW_DEG,
+    loaded_current,
+    release_slope_ratio,
+    smooth_value,
+)
 from tsmd.calibration.signal import Conditioned, lowpass
 from tsmd.calibration.tension_play_fit import fit_sweep_sides
 from tsmd.compensation.safety import KnobLimits
@@ -45,7 +51,6 @@ LOADED_FIT_DEG = (40.0, 85.0)
 """Knob range where the loaded branch is fitted for omega (mirrored for falling passes)."""
 RELEASED_FIT_DEG = (35.0, 65.0)
 """Knob range where the releasing branch is fitted for release_omega."""
-TIP_THRESHOLD_DEG = 1.0
 REFERENCE_BAND_DEG = 0.5
 """Samples within this of the knob's turning point give the reference tip angle."""
 
@@ -79,6 +84,8 @@ class KnobConstants:
     backlash_settle_fraction: float | None = None
     """Share of the current's swing after a reversal made up when the tip starts back
     (:func:`backlash_settle_fraction`; None: no reversal could be measured)."""
+    backlash_release_slope_ratio: float | None = None
+    """The current's release-to-loaded slope ratio there (:func:`backlash_release_slope_ratio`)."""
 
     def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
         """The data sheet's knob entry, rounded as a data sheet is printed."""
@@ -101,7 +108,10 @@ class KnobConstants:
             reference_backlash_gain=(None if self.backlash_gain is None
                                      else round(float(self.backlash_gain), 3)),
             backlash_settle_fraction=(None if self.backlash_settle_fraction is None
-                                      else round(float(self.backlash_settle_fraction), 3)))
+                                      else round(float(self.backlash_settle_fraction), 3)),
+            backlash_release_slope_ratio=(None if self.backlash_release_slope_ratio is None
+                                          else round(float(self.backlash_release_slope_ratio),
+                                                     4)))
 
 
 def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,
@@ -156,6 +166,9 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         raise DatasheetError(f"knob {knob + 1} does not sweep +-{SWEEP_AMPLITUDE_DEG:g} deg in "
                              f"the analysed rows (range {pos.min():.1f}..{pos.max():.1f} deg)")
     dz = measure_dead_zone_backlash(pos, tip, threshold_deg=TIP_THRESHOLD_DEG)
+    # B as the scoring truth reads it (the raw tip's 1 deg fires 1.5-2.5 deg early); D stays
+    # on the raw tip: the dead-zone offset is what the compensators were built against
+    tip_b = tip_reading(t, rec[f"cmd{knob + 1}"][start:], pos, tip)
     # where the calibration's current analysis puts the edges on the same sweep
     cur = identify_sweep(t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:])
     dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
@@ -190,12 +203,13 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         omega=float(np.median(loaded)), release_omega=float(np.median(released)),
         reference_pos=ReferencePoint(SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos > top]))),
         reference_neg=ReferencePoint(-SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos < -top]))),
-        reference_backlash_pos_deg=float(dz.backlash_pos_deg),
-        reference_backlash_neg_deg=float(dz.backlash_neg_deg),
+        reference_backlash_pos_deg=float(tip_b.backlash_pos_deg),
+        reference_backlash_neg_deg=float(tip_b.backlash_neg_deg),
         dead_zone_offset_deg=float(dz_offset),
         dead_zone_pos_deg=_finite_or_none(cur.estimate("dead_zone_pos_deg")),
         dead_zone_neg_deg=_finite_or_none(cur.estimate("dead_zone_neg_deg")), backlash_gain=gain,
-        backlash_settle_fraction=backlash_settle_fraction(cur.data, t, tip))
+        backlash_settle_fraction=backlash_settle_fraction(cur.data, t, tip),
+        backlash_release_slope_ratio=backlash_release_slope_ratio(cur.data, t, tip))
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -207,22 +221,40 @@ def backlash_settle_fraction(data: Conditioned, tip_t_s: NDArray[np.float64],
                              options: IdentifyOptions | None = None) -> float | None:
     """How far the (filtered) current has come back when the tip starts to move after a
     reversal at the sweep's ends, as a share of its swing from the loaded current to the
-    release level; median over the reversals.
+    release level; median over the reversals (:func:`release_reads`)."""
+    reads = release_reads(data, tip_t_s, tip_deg, options)
+    return float(np.median([share for share, _ in reads])) if reads else None
 
-    Measured with the definitions the share is used with, or it does not transfer: the tip as
-    the scoring truth reads it (low-passed at the current's cutoff, then 1 deg back: on the raw
+
+def backlash_release_slope_ratio(data: Conditioned, tip_t_s: NDArray[np.float64],
+                                 tip_deg: NDArray[np.float64],
+                                 options: IdentifyOptions | None = None) -> float | None:
+    """The current's release-to-loaded slope ratio after the tip's release
+    (:func:`tsmd.calibration.pieces.release_slope_ratio`), median over the reversals: the
+    anchor from which each calibrated unit's own ratio moves the share."""
+    ratios = [r for _, r in release_reads(data, tip_t_s, tip_deg, options) if math.isfinite(r)]
+    return float(np.median(ratios)) if ratios else None
+
+
+def release_reads(data: Conditioned, tip_t_s: NDArray[np.float64], tip_deg: NDArray[np.float64],
+                  options: IdentifyOptions | None = None) -> list[tuple[float, float]]:
+    """(share of the swing, release-to-loaded slope ratio) at the tip's release after each
+    reversal at the sweep's ends.
+
+    Measured with the definitions they are used with, or they do not transfer: the tip as the
+    scoring truth reads it (low-passed at the current's cutoff, then 1 deg back: on the raw
     tracker the noise fired the threshold 1.5-2.5 deg early), and the current as the
-    calibration's fraction rule reads it (the identification's half-cycles on the angle grid,
-    :func:`~tsmd.calibration.pieces.loaded_current`, the release level over
-    ``RELEASE_LEVEL_WINDOW_DEG`` after the tip's release, the value there off the same
-    quadratic). The one sample at the position's turning point, used before, still carries
-    the motor's friction half-turned (docs/calibration.md, session 7)."""
+    calibration's fraction rule reads it (the identification's half-cycles on the angle grid
+    without the last ``edge_margin_deg``, :func:`~tsmd.calibration.pieces.loaded_current`, the
+    release level over ``RELEASE_LEVEL_WINDOW_DEG`` after the tip's release, the value there
+    off the same quadratic). The one sample at the position's turning point, used before,
+    still carries the motor's friction half-turned (docs/calibration.md, session 7)."""
     opts = options if options is not None else IdentifyOptions()
     step = opts.grid_step_deg
     tip_f, _ = lowpass(np.asarray(tip_deg, dtype=float), 1.0 / float(np.median(np.diff(tip_t_s))))
     tip = np.interp(data.t_s, tip_t_s, tip_f)
     lo_deg, hi_deg = RELEASE_LEVEL_WINDOW_DEG
-    shares = []
+    reads = []
     for direction, a, b, after_reversal in split_half_cycles(data.cmd_deg, 10.0):
         if not after_reversal or abs(data.pos_deg[a]) < SWEEP_AMPLITUDE_DEG - 10.0:
             continue
@@ -242,8 +274,9 @@ def backlash_settle_fraction(data: Conditioned, tip_t_s: NDArray[np.float64],
         if swing <= 0.0:
             continue
         made_up = smooth_value(grid, yg, k, opts.release_fit_half_deg) - loaded
-        shares.append(min(made_up / swing, 1.0))
-    return float(np.median(shares)) if shares else None
+        cut = yg.size - round(opts.edge_margin_deg / step)
+        reads.append((min(made_up / swing, 1.0), release_slope_ratio(grid[:cut], yg[:cut], k)))
+    return reads
 
 
 def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 2000,

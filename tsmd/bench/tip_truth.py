@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simrig.analysis import SweepAnalysisError, measure_dead_zone_backlash
+from simrig.analysis import DeadZoneBacklash, SweepAnalysisError, measure_dead_zone_backlash
 from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.identify import split_half_cycles
 from tsmd.calibration.signal import lowpass
@@ -28,14 +28,22 @@ def tip_truth(point: GridPoint) -> dict[str, float]:
     t, pos, tip = rec["t"][m], rec[f"pos{k}"][m], rec[f"tip{k}"][m]
     if not np.isfinite(tip).all():
         return {}
-    rate = 1.0 / float(np.median(np.diff(t)))
-    tip_f, _ = lowpass(tip, rate)
-    knob = monotone_knob(rec[f"cmd{k}"][m], pos)
     try:
-        truth = measure_dead_zone_backlash(knob, tip_f, threshold_deg=TIP_THRESHOLD_DEG)
+        truth = tip_reading(t, rec[f"cmd{k}"][m], pos, tip)
     except SweepAnalysisError:
         return {}
     return dict(truth._asdict())
+
+
+def tip_reading(t_s: np.ndarray, cmd_deg: np.ndarray, pos_deg: np.ndarray,
+                tip_deg: np.ndarray) -> DeadZoneBacklash:
+    """D and B of one tracked sweep as the truth reads them: the tip low-passed at the
+    current's cutoff (zero phase; on the raw tracker 0.1 deg of noise fires the 1 deg threshold
+    1.5-2.5 deg early on a slowly starting tip), the knob made monotonic between reversals.
+    Raises :class:`simrig.analysis.SweepAnalysisError` where the sweep shows neither."""
+    tip_f, _ = lowpass(np.asarray(tip_deg, dtype=float), 1.0 / float(np.median(np.diff(t_s))))
+    knob = monotone_knob(np.asarray(cmd_deg, dtype=float), np.asarray(pos_deg, dtype=float))
+    return measure_dead_zone_backlash(knob, tip_f, threshold_deg=TIP_THRESHOLD_DEG)
 
 
 def monotone_knob(cmd_deg: np.ndarray, pos_deg: np.ndarray) -> np.ndarray:

@@ -43,6 +43,8 @@ from tsmd.calibration.pieces import (
     flat_pieces,
     knee_edge,
     linear_pieces,
+    release_slope_ratio,
+    share_end,
 )
 from tsmd.calibration.signal import Conditioned, FloatArray, condition
 
@@ -250,11 +252,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         slip = f"{where}: {dropped}" if dropped else None
 
     def index_at(k: int | None) -> int | None:
-        if k is None:
-            return None
-        target = direction * grid[min(k, grid.size - 1)]
-        hits = np.flatnonzero(direction * (pos - target) >= 0)
-        return start + int(hits[0]) if hits.size else stop - 1
+        return None if k is None else _index_at(pos, direction, grid, k, start)
 
     return HalfCycle(
         direction=direction, start=start, stop=stop, after_reversal=after_reversal,
@@ -264,6 +262,51 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         edge_index=index_at(edge_k) if math.isfinite(edge_deg) else None,
         backlash_deg=backlash_deg, edge_deg=edge_deg, plateau_A=direction * plateau,
         rise_A=rise, snr=snr, problems=tuple(problems), slip=slip)
+
+
+def _index_at(pos: FloatArray, direction: int, grid: FloatArray, k: int, start: int) -> int:
+    """The sample (into the sweep's arrays) where the knob reaches the grid's angle ``k``."""
+    target = direction * grid[min(k, grid.size - 1)]
+    hits = np.flatnonzero(direction * (pos - target) >= 0)
+    return start + int(hits[0]) if hits.size else start + pos.size - 1
+
+
+def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
+                        opts: IdentifyOptions) -> tuple[HalfCycle, ...]:
+    """The fraction rule's release ends moved to this unit's own share of the swing.
+
+    The share at which the tip lets go differs from unit to unit (lumped development units:
+    0.939-0.971 against one sheet's 0.957), and so does the release-to-loaded slope ratio that
+    follows the sheath's friction-wrap product; the sweep's mean ratio (one half-cycle's is
+    too noisy) moves the sheet's share by ``backlash_share_per_slope_ratio`` per unit of ratio
+    away from the sheet unit's. Without a reference ratio the halves are returned as they are.
+    """
+    ref = opts.backlash_reference_slope_ratio
+    if opts.backlash != "fraction" or ref is None:
+        return halves
+    step = opts.grid_step_deg
+    curves: dict[int, tuple[FloatArray, FloatArray, FloatArray, int]] = {}
+    for i, h in enumerate(halves):
+        if h.after_reversal and math.isfinite(h.backlash_deg):
+            pos = data.pos_deg[h.start:h.stop]
+            grid, yg = resample_on_angle(
+                pos, h.direction * data.current_filtered_A[h.start:h.stop], h.direction, step)
+            end = yg.size - round(opts.edge_margin_deg / step)
+            curves[i] = (pos, grid[:end], yg[:end], round(h.backlash_deg / step))
+    ratios = [release_slope_ratio(g, y, k) for _, g, y, k in curves.values()]
+    finite = [r for r in ratios if math.isfinite(r)]
+    if not finite:
+        return halves
+    share = opts.backlash_fraction + opts.backlash_share_per_slope_ratio * (
+        float(np.mean(finite)) - ref)
+    share = min(max(share, 0.5), 0.999)
+    out = list(halves)
+    for i, (pos, grid, yg, k) in curves.items():
+        k_new = share_end(grid, yg, min(k, yg.size - 1), share, opts.release_fit_half_deg)
+        h = halves[i]
+        out[i] = replace(h, backlash_deg=float(grid[k_new] - grid[0]),
+                         backlash_end_index=_index_at(pos, h.direction, grid, k_new, h.start))
+    return tuple(out)
 
 
 def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
@@ -298,7 +341,8 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
     if not stretches:
         raise CalibrationError(
             f"the command never moves more than {opts.min_reversal_deg:g} deg: nothing to identify")
-    halves = tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches)
+    halves = unit_share_backlash(
+        data, tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches), opts)
     check_signal(data, [(h.direction, h.start, h.stop, h.snr) for h in halves], opts.min_snr)
     check_slips([h.slip for h in halves if h.snr >= opts.min_snr])
     values: dict[str, list[float]] = {name: [] for name in PARAMETERS}

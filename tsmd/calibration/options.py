@@ -47,6 +47,12 @@ class IdentifyOptions:
     """"settle" (the paper's point a2): where the current joins the release level within the
     noise; "fraction": where it has made up ``backlash_fraction`` of its jump to that level."""
     backlash_fraction: float = 0.975
+    backlash_reference_slope_ratio: float | None = None
+    """"fraction" with a data sheet that measured it: the release-to-loaded slope ratio
+    (:func:`tsmd.calibration.pieces.release_slope_ratio`) on the sheet's unit, where the share
+    was ``backlash_fraction``; each sweep's own ratio then moves its share by
+    ``backlash_share_per_slope_ratio`` per unit of ratio (None: one share for every unit)."""
+    backlash_share_per_slope_ratio: float = 0.0
     release_fit_half_deg: float = 4.0
     """"fraction": the share's crossing is read off a quadratic fitted to the current over this
     much knob travel either side of it (noise averaged; narrow enough for a quadratic to follow
@@ -66,11 +72,26 @@ the current's noise hides the rest (a few mA against a swing of 0.2-0.5 A), so t
 (where the current joins its release level) already marks the tip's release there."""
 
 
-def for_product(options: IdentifyOptions, settle_fraction: float | None) -> IdentifyOptions:
+SHARE_PER_SLOPE_RATIO = -0.24
+"""How the share of the swing made up at the tip's release moves with the unit's release-to-
+loaded slope ratio (a larger ratio: less friction-wrap in the sheath, the tip lets go earlier
+in the current's approach). Fitted once on lumped development units 1-8 (fast sweeps, noise
+seeds 0 and 1, r = -0.7 over units and knobs; docs/calibration.md, session 8); the sheet's
+own unit gives the anchor."""
+
+
+def for_product(options: IdentifyOptions, settle_fraction: float | None,
+                slope_ratio: float | None = None) -> IdentifyOptions:
     """The identification for one knob of a product whose data sheet measured how far the
     current has come back when the tip starts to move: below :data:`SETTLED_FRACTION` the
-    backlash ends at that share of the current's swing ("fraction"), else as ``options`` say."""
+    backlash ends at that share of the current's swing ("fraction"), moved per sweep by the
+    unit's own slope ratio where the sheet gives its unit's (``slope_ratio``); else as
+    ``options`` say."""
     if settle_fraction is None or settle_fraction >= SETTLED_FRACTION \
             or options.backlash != "settle":
         return options
-    return replace(options, backlash="fraction", backlash_fraction=settle_fraction)
+    if slope_ratio is None:
+        return replace(options, backlash="fraction", backlash_fraction=settle_fraction)
+    return replace(options, backlash="fraction", backlash_fraction=settle_fraction,
+                   backlash_reference_slope_ratio=slope_ratio,
+                   backlash_share_per_slope_ratio=SHARE_PER_SLOPE_RATIO)

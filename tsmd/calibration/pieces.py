@@ -203,17 +203,46 @@ def recovered_end(grid: FloatArray, yg: FloatArray, start_k: int, stop: int,
     k = first_hold(line_target, stop)
     if k is None:
         return stop - 1
+    return share_end(grid, yg, k, opts.backlash_fraction, opts.release_fit_half_deg)
+
+
+def share_end(grid: FloatArray, yg: FloatArray, k: int, share: float, half_deg: float) -> int:
+    """From the end ``k``: where the current crosses ``share`` of its swing to the release
+    level (median over ``RELEASE_LEVEL_WINDOW_DEG`` after the end), read off the quadratic of
+    :func:`smooth_crossing`; the level and the end iterated up to ``RELEASE_LEVEL_ITERATIONS``
+    times."""
+    step = float(grid[1] - grid[0])
+    loaded = loaded_current(yg, step)
     lo_deg, hi_deg = RELEASE_LEVEL_WINDOW_DEG
     for _ in range(RELEASE_LEVEL_ITERATIONS):
         a, b = k + round(lo_deg / step), min(yg.size, k + round(hi_deg / step))
         if b - a < 5:
             break
-        target = loaded + opts.backlash_fraction * (float(np.median(yg[a:b])) - loaded)
-        k_new = smooth_crossing(grid, yg, k, target, opts.release_fit_half_deg)
+        target = loaded + share * (float(np.median(yg[a:b])) - loaded)
+        k_new = smooth_crossing(grid, yg, k, target, half_deg)
         if k_new == k:
             break
         k = k_new
     return k
+
+
+def release_slope_ratio(grid: FloatArray, yg: FloatArray, k: int) -> float:
+    """The current's slope over ``RELEASE_LEVEL_WINDOW_DEG`` after the release end ``k`` (the
+    tip moving back, the tendon paying out through the sheath's friction) over the loaded
+    ramp's slope (the last quarter of the travel: the tip pulled, the tendon drawn in against
+    it), NaN where either cannot be read.
+
+    Both slopes carry the bending section's stiffness, one divided by the sheath's friction
+    factor and one multiplied by it, so their ratio follows the unit's friction-wrap product,
+    which is what moves the share of the swing made up at the tip's release from unit to unit
+    (docs/calibration.md, session 8)."""
+    step = float(grid[1] - grid[0])
+    lo_deg, hi_deg = RELEASE_LEVEL_WINDOW_DEG
+    a, b = k + round(lo_deg / step), min(yg.size, k + round(hi_deg / step))
+    loaded = slope_per_deg(yg[int(0.75 * yg.size):], step)
+    if b - a < 5 or not loaded > 0.0:
+        return math.nan
+    return slope_per_deg(yg[a:b], step) / loaded
 
 
 def backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,

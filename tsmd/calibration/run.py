@@ -89,8 +89,9 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
                    ) -> tuple[IdentifyOptions, IdentifyOptions]:
     """Each knob's identification with its product's backlash rule from the data sheet."""
     base = options or IdentifyOptions()
-    return (for_product(base, device.knobs[0].backlash_settle_fraction),
-            for_product(base, device.knobs[1].backlash_settle_fraction))
+    k1, k2 = device.knobs[0], device.knobs[1]
+    return (for_product(base, k1.backlash_settle_fraction, k1.backlash_release_slope_ratio),
+            for_product(base, k2.backlash_settle_fraction, k2.backlash_release_slope_ratio))
 
 
 def identify_recording(rec: Recording, options: KnobOptions = None,

@@ -162,7 +162,9 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
                      0.01, 45.0, "deg"),
             optional(k.get("reference_backlash_gain"), "reference_backlash_gain", 0.0, 0.8, ""),
             optional(k.get("backlash_settle_fraction"), "backlash_settle_fraction", 0.5, 1.0,
-                     "")))
+                     ""),
+            optional(k.get("backlash_release_slope_ratio"), "backlash_release_slope_ratio",
+                     -1.0, 1.0, "")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -192,6 +194,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             knobs[name]["reference_backlash_gain"] = k.reference_backlash_gain
         if k.backlash_settle_fraction is not None:
             knobs[name]["backlash_settle_fraction"] = k.backlash_settle_fraction
+        if k.backlash_release_slope_ratio is not None:
+            knobs[name]["backlash_release_slope_ratio"] = k.backlash_release_slope_ratio
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

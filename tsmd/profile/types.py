@@ -79,6 +79,10 @@ class DeviceKnob:
     current has made up when the tip starts back (the end of the backlash). Per product: where
     it is below :data:`tsmd.calibration.options.SETTLED_FRACTION`, calibration ends the backlash
     at this share instead of where the current has settled (old sheets: the settle rule)."""
+    backlash_release_slope_ratio: float | None = None
+    """Optional: on the data-sheet unit, the current's slope just after the tip's release over
+    its loaded ramp's (:func:`tsmd.calibration.pieces.release_slope_ratio`): with it the share
+    above moves per unit with that unit's own ratio (old sheets: one share for every unit)."""
 
 
 @dataclass(frozen=True)

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tsmd.online.estimator import EdgeTracker, EstimatorOptions, shrunk_ratio
+from tsmd.online.estimator import EdgeTracker, EstimatorOptions
 from tsmd.online.features import LoadedRamp
+from tsmd.online.slopes import shrunk_ratio
 
 EDGE_DEG = 20.0
 LEVEL_A = 0.05

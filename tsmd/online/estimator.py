@@ -28,6 +28,7 @@ from statistics import median
 from typing import Any
 
 from tsmd.online.features import LoadedRamp
+from tsmd.online.slopes import common_change, shrunk_ratio
 
 
 @dataclass(frozen=True)
@@ -54,24 +55,6 @@ class EstimatorOptions:
     shared_slope_ratio_max: float = 8.0
     """A slope change both edges of the knob show (a sheath's friction) is followed up to this
     ratio; beyond ``slope_ratio_max`` on one edge alone it is a stuck knob or a blocked tip."""
-
-
-def shrunk_ratio(ratio: float, tolerance: float) -> float:
-    """A slope ratio whose change within ``tolerance`` counts as none (the slopes' scatter),
-    beyond twice the tolerance counts in full (a friction change), and in between grows
-    linearly: the slope used, and so the edge, never jumps at a threshold."""
-    change = abs(ratio - 1.0)
-    kept = change if change >= 2.0 * tolerance else 2.0 * max(change - tolerance, 0.0)
-    return 1.0 + math.copysign(kept, ratio - 1.0)
-
-
-def common_change(own: float, partner: float, tolerance: float) -> float:
-    """An edge's slope change as far as the knob's other edge confirms it (a sheath's friction
-    changes both tendons of a knob alike): none when the partner's goes the other way or
-    stays within ``tolerance``, the edge's own beyond twice the tolerance, linear between."""
-    if own * partner <= 0.0:
-        return 0.0
-    return own * min(max(abs(partner) / tolerance - 1.0, 0.0), 1.0)
 
 
 @dataclass
@@ -342,14 +325,9 @@ class EdgeTracker:
                 return events
             self._measured(knee_m, ramp.other_deg, events)
             return events
-        # The crossing is taken on a
-        # line through the window's centre; its slope decides how
-        # far back the edge is (~15 deg of extrapolation: 10 % of slope is 1.5 deg). One
-        # ramp's slope scatters by 25 % and more, and one edge's for a few ramps in a row
-        # (fast random moves); a friction change of the sheath (curvature: 2-4 x) shows in
-        # every ramp of both tendons from then on. So the slope in use moves by the change
-        # both edges' last ramps agree on (beyond the tolerance only), and a ramp that
-        # disagrees with it measures nothing.
+        # The crossing on a line through the window's centre (~15 deg back: 10 % of slope is
+        # 1.5 deg of edge) with the slope both edges' last ramps agree on; one ramp's slope
+        # scatters by 25 % and more, so a ramp that disagrees with it measures nothing.
         slope = self.slope_ref_A_per_deg * shrunk_ratio(
             1.0 + (self.slope_change if partner is None else shared),
             o.same_slope_tolerance)

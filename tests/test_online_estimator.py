@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tsmd.online.estimator import EdgeTracker, EstimatorOptions, shrunk_ratio
+from tsmd.online.estimator import EdgeTracker, EstimatorOptions
 from tsmd.online.features import LoadedRamp
+from tsmd.online.slopes import shrunk_ratio
 
 EDGE_DEG = 20.0
 LEVEL_A = 0.05
@@ -225,3 +226,44 @@ def test_two_measurements_do_not_move_the_estimate_past_the_profile() -> None:
     tracker.update(ramp_with_edge(EDGE_DEG + 0.1), EDGE_DEG)
     tracker.update(ramp_with_edge(EDGE_DEG + 1.2), EDGE_DEG)
     assert tracker.applied_deg == 0.0
+
+
+def ramp_with_knee(knee_deg: float, slope: float = SLOPE) -> LoadedRamp:
+    """A ramp whose stroke showed its knee at ``knee_deg`` (positive side); its crossing of
+    LEVEL_A stays at the calibrated edge (a bend's steeper engagement reads inward there)."""
+    return LoadedRamp(0, 1, EDGE_DEG + 10.0, LEVEL_A + slope * 10.0, slope, 0.0, 0.0, 200,
+                      0.003, knee_deg, 0.01)
+
+
+def learned_knob() -> tuple[EdgeTracker, EdgeTracker]:
+    """Both tendons of a knob past their baseline, knees at the calibrated edge."""
+    pos, neg = EdgeTracker(0, 1), EdgeTracker(0, -1)
+    for _ in range(pos.options.baseline_ramps):
+        pos.update(ramp_with_knee(EDGE_DEG), EDGE_DEG, neg)
+        neg.update(ramp_with_knee(EDGE_DEG), EDGE_DEG, pos)
+    return pos, neg
+
+
+def test_the_first_steeper_ramp_of_both_tendons_places_the_edge_by_its_knee() -> None:
+    pos, neg = learned_knob()  # a bend: both ramps 1.4 x steeper, knees 4 deg further out
+    neg.update(ramp_with_knee(EDGE_DEG + 4.2, 1.4 * SLOPE), EDGE_DEG, pos)
+    pos.update(ramp_with_knee(EDGE_DEG + 4.0, 1.4 * SLOPE), EDGE_DEG, neg)
+    neg.update(ramp_with_knee(EDGE_DEG + 4.2, 1.4 * SLOPE), EDGE_DEG, pos)
+    assert neg.knee_mode and neg.last_feature == "knee"  # the medians have not moved yet
+    assert neg.agrees_with(pos) and neg.suspects[-1] == pytest.approx(4.2)
+
+
+def test_one_steeper_ramp_of_one_tendon_alone_is_no_knee_mode() -> None:
+    pos, neg = learned_knob()
+    pos.update(ramp_with_knee(EDGE_DEG + 4.0, 1.4 * SLOPE), EDGE_DEG, neg)
+    neg.update(ramp_with_knee(EDGE_DEG, SLOPE), EDGE_DEG, pos)
+    assert not pos.knee_mode and not neg.knee_mode
+
+
+def test_a_knee_inward_while_the_ramps_got_steeper_measures_nothing() -> None:
+    pos, neg = learned_knob()  # the lumped plant's toe: steeper ramps, knees read inward
+    for _ in range(3):
+        pos.update(ramp_with_knee(EDGE_DEG - 4.0, 1.4 * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_with_knee(EDGE_DEG - 4.0, 1.4 * SLOPE), EDGE_DEG, pos)
+    assert neg.knee_mode and neg.suspects == [] and neg.applied_deg == 0.0
+    assert neg.status()["odd_knee_ramps"] == 3

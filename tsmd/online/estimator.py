@@ -28,6 +28,7 @@ from statistics import median
 from typing import Any
 
 from tsmd.online.features import LoadedRamp
+from tsmd.online.slopes import common_change, shrunk_ratio
 
 
 @dataclass(frozen=True)
@@ -54,24 +55,6 @@ class EstimatorOptions:
     shared_slope_ratio_max: float = 8.0
     """A slope change both edges of the knob show (a sheath's friction) is followed up to this
     ratio; beyond ``slope_ratio_max`` on one edge alone it is a stuck knob or a blocked tip."""
-
-
-def shrunk_ratio(ratio: float, tolerance: float) -> float:
-    """A slope ratio whose change within ``tolerance`` counts as none (the slopes' scatter),
-    beyond twice the tolerance counts in full (a friction change), and in between grows
-    linearly: the slope used, and so the edge, never jumps at a threshold."""
-    change = abs(ratio - 1.0)
-    kept = change if change >= 2.0 * tolerance else 2.0 * max(change - tolerance, 0.0)
-    return 1.0 + math.copysign(kept, ratio - 1.0)
-
-
-def common_change(own: float, partner: float, tolerance: float) -> float:
-    """An edge's slope change as far as the knob's other edge confirms it (a sheath's friction
-    changes both tendons of a knob alike): none when the partner's goes the other way or
-    stays within ``tolerance``, the edge's own beyond twice the tolerance, linear between."""
-    if own * partner <= 0.0:
-        return 0.0
-    return own * min(max(abs(partner) / tolerance - 1.0, 0.0), 1.0)
 
 
 @dataclass
@@ -106,12 +89,16 @@ class EdgeTracker:
     """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
     partner_change: float = 0.0
     """The knob's other tendon's slope change at this tendon's last ramp."""
+    partner_last_change: float = 0.0
+    """The knob's other tendon's last ramp's own slope change (:attr:`last_change`)."""
     knee_slopes: list[float] = field(default_factory=list)
     """The last slopes of ramps fitted past their own knee (after a bend: the loaded ramp
     itself, not a window that starts on the engagement's step)."""
     partner_knee_change: float = 0.0
     n_odd_slope: int = 0
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
+    n_odd_knee: int = 0
+    """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
     bins: dict[int, list[float]] = field(default_factory=dict)
@@ -197,9 +184,34 @@ class EdgeTracker:
         inward, the knee 4-6 deg outward). The knee is not used otherwise: on the lumped
         plant's gradual toe it scatters by +-3 deg and read -5 deg after a +4.8 deg slack
         change (tried, session 7)."""
+        return self.knee_direction != 0
+
+    @property
+    def knee_direction(self) -> int:
+        """+1 when both tendons' ramps got steeper (more friction: :attr:`knee_mode`), -1
+        flatter, 0 not in knee mode.
+
+        Besides the medians of three ramps, **the last ramp of each tendon alone** counts
+        when both changed the same way beyond twice the tolerance (30 %): a bend shows in
+        the first ramp of each tendon after it, and waiting for the medians cost two ramps
+        per edge (capstan unit 1 phi2: followed 134 s, not 112 s, after a bend at 80 s;
+        the RMSE window begins at 113 s). One ramp's slope scatters by 20-50 % now and then,
+        so one tendon alone, or a change within 30 %, does not count."""
         tol = self.options.same_slope_tolerance
         own, other = self.slope_change, self.partner_change
-        return own * other > 0.0 and min(abs(own), abs(other)) > tol
+        if own * other > 0.0 and min(abs(own), abs(other)) > tol:
+            return 1 if own > 0.0 else -1
+        own, other = self.last_change, self.partner_last_change
+        if own * other > 0.0 and min(abs(own), abs(other)) > 2.0 * tol:
+            return 1 if own > 0.0 else -1
+        return 0
+
+    @property
+    def last_change(self) -> float:
+        """The last ramp's slope against the reference, minus 1 (0 while learning)."""
+        if self.slope_ref_A_per_deg is None or not self.recent_slopes:
+            return 0.0
+        return self.recent_slopes[-1] / self.slope_ref_A_per_deg - 1.0
 
     @property
     def gain_ratio(self) -> float:
@@ -274,6 +286,7 @@ class EdgeTracker:
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
         self.shared_change = shared
         self.partner_change = 0.0 if partner is None else partner.slope_change
+        self.partner_last_change = 0.0 if partner is None else partner.last_change
         if ramp.past_knee:
             self.knee_slopes = [*self.knee_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         self.partner_knee_change = 0.0 if partner is None else partner.knee_slope_change
@@ -295,22 +308,26 @@ class EdgeTracker:
             self.frozen_for -= 1
             return events
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
-        if math.isfinite(knee_m) and self.knee_mode:
+        direction = self.knee_direction
+        if math.isfinite(knee_m) and direction != 0:
             # The sheath's friction changed the engagement: no level crossing places the
             # edge; the knee, seen in the stroke itself, does. Otherwise the crossing (the
             # knee scatters three times as much: it is resolved to the samples' spacing at
             # full speed, ~0.5 deg, and on the lumped plant's gradual toe by +-3 deg).
             self.last_feature = "knee"
+            if direction * (knee_m - self.estimate_deg) < -o.gate_deg:
+                # More friction (steeper ramps) widens the dead zone, less narrows it; a
+                # knee that says the opposite beyond the gate is the toe's shape, not the
+                # edge (lumped 104, 60 deg bend: ramps 1.15-1.22 x, knees 2.5-6.25 deg
+                # inward, followed: phi1 tracked worse than with online off).
+                self.n_odd_knee += 1
+                self.last_measurement_deg = math.nan
+                return events
             self._measured(knee_m, ramp.other_deg, events)
             return events
-        # The crossing is taken on a
-        # line through the window's centre; its slope decides how
-        # far back the edge is (~15 deg of extrapolation: 10 % of slope is 1.5 deg). One
-        # ramp's slope scatters by 25 % and more, and one edge's for a few ramps in a row
-        # (fast random moves); a friction change of the sheath (curvature: 2-4 x) shows in
-        # every ramp of both tendons from then on. So the slope in use moves by the change
-        # both edges' last ramps agree on (beyond the tolerance only), and a ramp that
-        # disagrees with it measures nothing.
+        # The crossing on a line through the window's centre (~15 deg back: 10 % of slope is
+        # 1.5 deg of edge) with the slope both edges' last ramps agree on; one ramp's slope
+        # scatters by 25 % and more, so a ramp that disagrees with it measures nothing.
         slope = self.slope_ref_A_per_deg * shrunk_ratio(
             1.0 + (self.slope_change if partner is None else shared),
             o.same_slope_tolerance)
@@ -385,7 +402,8 @@ class EdgeTracker:
         return {"state": state, "offset_deg": round(self.applied_deg, 3),
                 "estimate_deg": round(self.estimate_deg, 3),
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
-                "odd_slope_ramps": self.n_odd_slope, "refused_ramps": self.n_refused,
+                "odd_slope_ramps": self.n_odd_slope, "odd_knee_ramps": self.n_odd_knee,
+                "refused_ramps": self.n_refused,
                 "feature": self.last_feature or None,
                 "backlash_gain_ratio": round(self.gain_ratio, 3),
                 "other_knob_bins_deg": {f"{k * o.other_bin_deg:g}": round(self.bin_bias_deg(

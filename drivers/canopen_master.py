@@ -99,6 +99,8 @@ class CanOpenDrives(MasterHoming, KnobDrives):
             self._handlers[0x700 + d.node_id] = self._heartbeat_handler(d)
             self._handlers[0x080 + d.node_id] = self._emcy_handler(d)
             self._handlers[0x580 + d.node_id] = d.sdo.on_response
+        # before the notifier starts: its thread reports a failing bus through the lock at once
+        self._lock = threading.Lock()
         self._queue: collections.deque[can.Message] | None = None
         self._notifier: can.Notifier | None = None
         if receive == "notifier":
@@ -107,7 +109,6 @@ class CanOpenDrives(MasterHoming, KnobDrives):
                                           timeout=0.05)
         elif receive != "poll":
             raise DriveError(f"receive must be 'poll' or 'notifier', not {receive!r}")
-        self._lock = threading.Lock()
 
     @classmethod
     def open(cls, interface: str, channel: str, configs: Sequence[DriveConfig], period_s: float,

@@ -39,6 +39,7 @@ __all__ = [
     "KnobLimits",
     "LimitedCompensator",
     "NoCompensation",
+    "Previewing",
     "build_compensator",
 ]
 
@@ -56,6 +57,16 @@ class Compensator(Protocol):
 
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         """The motor command (shape (2,), degrees) for this tick's desired angles."""
+
+
+class Previewing(Protocol):
+    """A compensator that can use the desired angles still to come. The loop playing a
+    trajectory calls ``preview`` every tick before ``command``, with the whole table (rows of
+    two angles) and this tick's row; a compensator uses the plan only in the tick it was
+    given (a setpoint from a client has none)."""
+
+    def preview(self, plan_deg: Sequence[Sequence[float]], index: int) -> None:
+        """This tick's desired angles are ``plan_deg[index]``; the rows after it follow."""
 
 
 class NoCompensation:

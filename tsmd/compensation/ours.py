@@ -62,6 +62,8 @@ _SETTLED_DEG = 1e-3
 _PLATEAU_MARGIN_DEG = 1.0
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
+_JUMP_HORIZON_S = 1.0
+"""How far ahead a plan is read for a dead-zone crossing (the widest crossing takes < 0.5 s)."""
 
 
 @dataclass(frozen=True)
@@ -112,14 +114,16 @@ class OursKnob:
 class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
-    __slots__ = ("accel", "ahead_s", "held_s", "hold", "jump_deg", "lim_deg", "lim_target",
-                 "lim_v", "limits", "move_s", "omega", "out", "plateau_hi_deg", "plateau_lo_deg",
-                 "q_dir", "q_prev", "q_raw", "rest_q", "stand_s", "state", "still_q", "still_s",
-                 "sum", "target", "v", "v_raw", "window")
+    __slots__ = ("accel", "ahead_s", "ahead_ticks", "held_s", "hold", "jump_deg", "lim_deg",
+                 "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan_hold",
+                 "plan_out", "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw",
+                 "rest_q", "stand_s", "state", "still_q", "still_s", "sum", "target", "v",
+                 "v_raw", "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
         self.ahead_s = 0.0
+        self.ahead_ticks = 0
         self.jump_deg = 0.0
         self.omega = 1.0
         self.plateau_lo_deg = self.plateau_hi_deg = 0.0
@@ -137,6 +141,8 @@ class _KnobCommand:
         self.target = q_deg
         self.out = state.x_deg
         self.hold = 0
+        self.plan_hold = 0
+        self.plan_out = 0.0
         self.still_q = q_deg
         self.still_s = 0.0
         self.rest_q = q_deg
@@ -180,6 +186,9 @@ class OursCompensator:
         self._n_avg = max(1, round(smoothing_s / period_s))
         self._k = (_KnobCommand(self.limits[0]), _KnobCommand(self.limits[1]))
         self._slot = 0
+        self._plan: Sequence[Sequence[float]] = ()
+        self._plan_i = 0
+        self._plan_fresh = False
         self._set_constants()
         self.reset(np.zeros(2))
 
@@ -188,6 +197,7 @@ class OursCompensator:
         jump_deg = 5.0 * max(k.omega for k in self.knobs) * self.v_max * self.period_s
         for kc, knob in zip(self._k, self.knobs, strict=True):
             kc.ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
+            kc.ahead_ticks = round(kc.ahead_s / self.period_s)
             kc.jump_deg = jump_deg
             kc.omega = knob.omega
             kc.plateau_lo_deg = min(knob.height_pos_deg, knob.height_neg_deg)
@@ -209,16 +219,28 @@ class OursCompensator:
             self._k[i].reset(states[i], q[i], self._n_avg)
         self._slot = 0
 
+    def preview(self, plan_deg: Sequence[Sequence[float]], index: int) -> None:
+        """This tick's desired angles are ``plan_deg[index]`` and the ones after it follow
+        (the loop playing a trajectory says so every tick; without it the next command is
+        causal): a dead-zone crossing is then timed on the plan (:meth:`_planned_jump`)."""
+        self._plan = plan_deg
+        self._plan_i = index
+        self._plan_fresh = True
+
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         k0, k1 = self._k
         b0 = self.knobs[0].at(k1.state.x_deg)
         b1 = self.knobs[1].at(k0.state.x_deg)
         slot = self._slot
         period = self.period_s
+        planned = self._plan_fresh
+        self._plan_fresh = False
         out = []
-        for kc, qi, b in ((k0, float(q_deg[0]), b0), (k1, float(q_deg[1]), b1)):
+        for col, kc, qi, b in ((0, k0, float(q_deg[0]), b0), (1, k1, float(q_deg[1]), b1)):
             if qi - qi == 0.0:  # finite; otherwise the command stays where it is
-                self._track(kc, qi, b)
+                self._track(kc, qi, b, planned)
+                if planned:
+                    kc.out = self._planned_jump(kc, col, b)
             x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target, kc.out,
                                                      kc.limits, period)
             kc.lim_deg = x
@@ -230,7 +252,7 @@ class OursCompensator:
         self._slot = slot + 1 if slot + 1 < n else 0
         return np.array((out[0] / n, out[1] / n))
 
-    def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
+    def _track(self, kc: _KnobCommand, q_raw: float, b: Branches, planned: bool) -> None:
         kc.move_s += self.period_s
         if -REST_DEG < q_raw - kc.rest_q < REST_DEG:
             kc.stand_s += self.period_s
@@ -295,7 +317,7 @@ class OursCompensator:
         kc.target = target
         state = inverse_step(state, target, b)
         kc.state = state
-        kc.out = self._early_jump(kc, state, target, v, b)
+        kc.out = state.x_deg if planned else self._early_jump(kc, state, target, v, b)
 
     def _centre(self, kc: _KnobCommand, b: Branches) -> bool:
         """During a dwell: the knob to the middle of the play holding the model's output (the
@@ -312,6 +334,59 @@ class OursCompensator:
         kc.hold = 0
         kc.out = x
         return True
+
+    def _planned_jump(self, kc: _KnobCommand, col: int, b: Branches) -> float:
+        """The knob across the dead zone ahead at full speed, started so that the tip's error
+        when it reaches the plateau equals the error when it leaves it: the tip stands on the
+        plateau for the whole crossing whatever the knob does, so balancing the two is the
+        least peak error the velocity limit allows. Read from the plan, not predicted: a
+        causal prediction of a move from rest (tried, session 8) was no better than the
+        heuristic of :meth:`_early_jump`."""
+        x = kc.state.x_deg
+        if kc.plan_hold != 0:
+            if (x - kc.plan_out) * kc.plan_hold < 0.0:
+                return kc.plan_out  # the desired angle has not caught up with the jump yet
+            kc.plan_hold = 0
+        plan, period = self._plan, self.period_s
+        last = len(plan) - 1
+        k0 = self._plan_i + kc.ahead_ticks  # what the tip should show when this command acts
+        q_now = plan[k0 if k0 < last else last][col]
+        k = k0 + round(_JUMP_HORIZON_S / period)
+        q_far = plan[k if k < last else last][col]
+        if abs(q_far - q_now) < _JUMP_MIN_DEG:
+            return kc.out  # the plan stands (or hardly moves) for the next second
+        d = 1 if q_far > q_now else -1
+        flat = b.rising_flat if d > 0 else b.falling_flat
+        if flat is None or (q_now - flat.y_deg) * d >= 0.0:
+            return kc.out  # no dead zone ahead, or the desired angle is past its plateau
+        entry, exit_ = (flat.lo_deg, flat.hi_deg) if d > 0 else (flat.hi_deg, flat.lo_deg)
+        width = (exit_ - x) * d
+        to_entry = (entry - x) * d
+        if to_entry > 0.0:
+            width -= to_entry
+        else:
+            to_entry = 0.0
+        if width < _JUMP_MIN_DEG:
+            return kc.out  # past the dead zone (or all but through it)
+        v_max = self.v_max
+        # when the knob, sent now, reaches the plateau and leaves it (speeding up to v_max
+        # costs half the time the acceleration takes)
+        t_in = 0.5 * v_max / self.a_max + to_entry / v_max
+        t_out = t_in + width / v_max
+        if t_out > _JUMP_HORIZON_S:
+            return kc.out
+        k = k0 + round(t_in / period)
+        q_in = plan[k if k < last else last][col]
+        k = k0 + round(t_out / period)
+        q_out = plan[k if k < last else last][col]
+        if (q_in + q_out - 2.0 * flat.y_deg) * d < 0.0 or not q_in - q_in == q_out - q_out == 0.0:
+            return kc.out  # too early: the tip would wait on the plateau ahead of the plan
+        ahead = interp_linear(q_out, b.rising_deg if d > 0 else b.falling_deg, b.knots)
+        if (ahead - exit_) * d <= 0.0:
+            return kc.out  # the plan stops before the dead zone's far end: no jump
+        kc.plan_hold = d
+        kc.plan_out = ahead
+        return ahead
 
     def _early_jump(self, kc: _KnobCommand, state: PlayState, target: float, v: float,
                     b: Branches) -> float:

@@ -63,6 +63,11 @@ _PLATEAU_MARGIN_DEG = 1.0
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
 _JUMP_HORIZON_S = 1.0
+_TURN_SAMPLES = 8  # the plan read at this many points across a backlash crossing
+TURN_MIN_DEG = 1.0
+"""A planned turn is taken early only if it leaves at least this error (a third of what the
+causal reversal leaves on a triangle's turn): where the turn is slow both are small, and an
+early start moves the model's backlash error into the tip."""
 """How far ahead a plan is read for a dead-zone crossing (the widest crossing takes < 0.5 s)."""
 
 
@@ -116,9 +121,9 @@ class _KnobCommand:
 
     __slots__ = ("accel", "ahead_s", "ahead_ticks", "held_s", "hold", "jump_deg", "lim_deg",
                  "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan_hold",
-                 "plan_out", "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw",
-                 "rest_q", "stand_s", "state", "still_q", "still_s", "sum", "target", "v",
-                 "v_raw", "window")
+                 "plan_out", "plan_until", "plateau_hi_deg", "plateau_lo_deg", "q_dir",
+                 "q_prev", "q_raw", "rest_q", "stand_s", "state", "still_q", "still_s", "sum",
+                 "target", "v", "v_raw", "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
@@ -143,6 +148,7 @@ class _KnobCommand:
         self.hold = 0
         self.plan_hold = 0
         self.plan_out = 0.0
+        self.plan_until = 0
         self.still_q = q_deg
         self.still_s = 0.0
         self.rest_q = q_deg
@@ -344,13 +350,18 @@ class OursCompensator:
         heuristic of :meth:`_early_jump`."""
         x = kc.state.x_deg
         if kc.plan_hold != 0:
-            if (x - kc.plan_out) * kc.plan_hold < 0.0:
+            if (x - kc.plan_out) * kc.plan_hold < 0.0 and self._plan_i <= kc.plan_until:
                 return kc.plan_out  # the desired angle has not caught up with the jump yet
-            kc.plan_hold = 0
+            kc.plan_hold = 0  # caught up, or the plan's time for it is over (it turned again)
         plan, period = self._plan, self.period_s
         last = len(plan) - 1
         k0 = self._plan_i + kc.ahead_ticks  # what the tip should show when this command acts
         q_now = plan[k0 if k0 < last else last][col]
+        if q_now - q_now != 0.0:
+            return kc.out  # a plan that is not finite here is no plan
+        turn = self._planned_turn(kc, col, b, k0, q_now)
+        if turn is not None:
+            return turn
         k = k0 + round(_JUMP_HORIZON_S / period)
         q_far = plan[k if k < last else last][col]
         if abs(q_far - q_now) < _JUMP_MIN_DEG:
@@ -384,9 +395,54 @@ class OursCompensator:
         ahead = interp_linear(q_out, b.rising_deg if d > 0 else b.falling_deg, b.knots)
         if (ahead - exit_) * d <= 0.0:
             return kc.out  # the plan stops before the dead zone's far end: no jump
+        return self._hold(kc, d, ahead, t_out)
+
+    def _planned_turn(self, kc: _KnobCommand, col: int, b: Branches, k0: int, q_now: float
+                      ) -> float | None:
+        """The knob across the backlash before the plan turns back, or None. The tip holds
+        while the knob crosses: started so that the error at the turn's peak equals the error
+        when the crossing ends (a triangle's turn: a third of the crossing time early), the
+        least peak error; the knob then goes on to where the plan is at that end."""
+        state = kc.state
+        d = state.direction
+        ys = b.falling_deg if d > 0 else b.rising_deg  # the branch after the turn
+        x_end = interp_linear(q_now, ys, b.knots)
+        width = (state.x_deg - x_end) * d
+        if width < _JUMP_MIN_DEG:
+            return None  # no backlash to cross (or the knob is already across)
+        t_b = 0.5 * self.v_max / self.a_max + width / self.v_max
+        if t_b > _JUMP_HORIZON_S:
+            return None
+        plan = self._plan
+        last = len(plan) - 1
+        n = round(t_b / self.period_s)
+        k = k0 + n
+        q_end = plan[k if k < last else last][col]
+        if (q_end - q_now) * d >= 0.0:
+            return None  # the plan does not turn back within the crossing
+        peak = q_now
+        for j in range(1, _TURN_SAMPLES):
+            k = k0 + n * j // _TURN_SAMPLES
+            qj = plan[k if k < last else last][col]
+            if (qj - peak) * d > 0.0:
+                peak = qj
+        if (peak - q_now) * d > (q_now - q_end) * d or not q_end - q_end == peak - peak == 0.0:
+            return None  # too early: the tip would stop short of the peak by more
+        if (q_now - q_end) * d < TURN_MIN_DEG:
+            return None  # a slow turn: the causal reversal's error is as small
+        out = interp_linear(q_end, ys, b.knots)
+        if (out - x_end) * d > 0.0:
+            out = x_end
+        return self._hold(kc, -d, out, t_b)
+
+    def _hold(self, kc: _KnobCommand, d: int, out: float, until_s: float) -> float:
+        """Command ``out`` until the model's knob, following the plan, catches up with it, at
+        the latest ``until_s`` (+ 0.1 s) from now: a plan that turns again never leaves the
+        knob held."""
         kc.plan_hold = d
-        kc.plan_out = ahead
-        return ahead
+        kc.plan_out = out
+        kc.plan_until = self._plan_i + round((until_s + 0.1) / self.period_s)
+        return out
 
     def _early_jump(self, kc: _KnobCommand, state: PlayState, target: float, v: float,
                     b: Branches) -> float:

@@ -100,7 +100,7 @@ def test_a_plan_is_used_only_in_the_tick_it_was_given() -> None:
     comp = compensator()
     run_planned(comp, q[:400])
     comp.command(q[400])
-    assert comp._plan_fresh is False
+    assert comp._planner.fresh is False
 
 
 @given(random_params, st.lists(st.tuples(samples, samples, samples, samples), min_size=1,
@@ -144,5 +144,5 @@ def test_a_held_crossing_ends_when_the_plan_turns_again() -> None:
     q[1000:, 0] = q[999, 0]
     comp = compensator()
     cmd = run_planned(comp, q)
-    assert comp._k[0].plan_hold == 0
+    assert comp._k[0].plan.direction == 0
     assert cmd[-1, 0] == pytest.approx(comp._k[0].state.x_deg, abs=1e-6)

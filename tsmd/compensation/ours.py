@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
+from tsmd.compensation.planned import PlanHold, Planner
 from tsmd.compensation.safety import KnobLimits, step_floats
 from tsmd.compensation.tension_play import (
     Branches,
@@ -62,13 +63,6 @@ _SETTLED_DEG = 1e-3
 _PLATEAU_MARGIN_DEG = 1.0
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
-_JUMP_HORIZON_S = 1.0
-_TURN_SAMPLES = 8  # the plan read at this many points across a backlash crossing
-TURN_MIN_DEG = 1.0
-"""A planned turn is taken early only if it leaves at least this error (a third of what the
-causal reversal leaves on a triangle's turn): where the turn is slow both are small, and an
-early start moves the model's backlash error into the tip."""
-"""How far ahead a plan is read for a dead-zone crossing (the widest crossing takes < 0.5 s)."""
 
 
 @dataclass(frozen=True)
@@ -120,15 +114,16 @@ class _KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
     __slots__ = ("accel", "ahead_s", "ahead_ticks", "held_s", "hold", "jump_deg", "lim_deg",
-                 "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan_hold",
-                 "plan_out", "plan_until", "plateau_hi_deg", "plateau_lo_deg", "q_dir",
-                 "q_prev", "q_raw", "rest_q", "stand_s", "state", "still_q", "still_s", "sum",
-                 "target", "v", "v_raw", "window")
+                 "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan",
+                 "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "rest_q",
+                 "stand_s", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
+                 "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
         self.ahead_s = 0.0
         self.ahead_ticks = 0
+        self.plan = PlanHold()
         self.jump_deg = 0.0
         self.omega = 1.0
         self.plateau_lo_deg = self.plateau_hi_deg = 0.0
@@ -146,9 +141,7 @@ class _KnobCommand:
         self.target = q_deg
         self.out = state.x_deg
         self.hold = 0
-        self.plan_hold = 0
-        self.plan_out = 0.0
-        self.plan_until = 0
+        self.plan.direction = 0
         self.still_q = q_deg
         self.still_s = 0.0
         self.rest_q = q_deg
@@ -192,9 +185,7 @@ class OursCompensator:
         self._n_avg = max(1, round(smoothing_s / period_s))
         self._k = (_KnobCommand(self.limits[0]), _KnobCommand(self.limits[1]))
         self._slot = 0
-        self._plan: Sequence[Sequence[float]] = ()
-        self._plan_i = 0
-        self._plan_fresh = False
+        self._planner = Planner(period_s, self.v_max, self.a_max)
         self._set_constants()
         self.reset(np.zeros(2))
 
@@ -228,10 +219,9 @@ class OursCompensator:
     def preview(self, plan_deg: Sequence[Sequence[float]], index: int) -> None:
         """This tick's desired angles are ``plan_deg[index]`` and the ones after it follow
         (the loop playing a trajectory says so every tick; without it the next command is
-        causal): a dead-zone crossing is then timed on the plan (:meth:`_planned_jump`)."""
-        self._plan = plan_deg
-        self._plan_i = index
-        self._plan_fresh = True
+        causal): the dead-zone crossings and sharp turns are then timed on the plan
+        (:class:`tsmd.compensation.planned.Planner`)."""
+        self._planner.set(plan_deg, index)
 
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         k0, k1 = self._k
@@ -239,14 +229,14 @@ class OursCompensator:
         b1 = self.knobs[1].at(k0.state.x_deg)
         slot = self._slot
         period = self.period_s
-        planned = self._plan_fresh
-        self._plan_fresh = False
+        planner = self._planner
+        planned = planner.take()
         out = []
         for col, kc, qi, b in ((0, k0, float(q_deg[0]), b0), (1, k1, float(q_deg[1]), b1)):
             if qi - qi == 0.0:  # finite; otherwise the command stays where it is
                 self._track(kc, qi, b, planned)
                 if planned:
-                    kc.out = self._planned_jump(kc, col, b)
+                    kc.out = planner.command(kc.plan, kc.state, kc.out, kc.ahead_ticks, col, b)
             x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target, kc.out,
                                                      kc.limits, period)
             kc.lim_deg = x
@@ -340,109 +330,6 @@ class OursCompensator:
         kc.hold = 0
         kc.out = x
         return True
-
-    def _planned_jump(self, kc: _KnobCommand, col: int, b: Branches) -> float:
-        """The knob across the dead zone ahead at full speed, started so that the tip's error
-        when it reaches the plateau equals the error when it leaves it: the tip stands on the
-        plateau for the whole crossing whatever the knob does, so balancing the two is the
-        least peak error the velocity limit allows. Read from the plan, not predicted: a
-        causal prediction of a move from rest (tried, session 8) was no better than the
-        heuristic of :meth:`_early_jump`."""
-        x = kc.state.x_deg
-        if kc.plan_hold != 0:
-            if (x - kc.plan_out) * kc.plan_hold < 0.0 and self._plan_i <= kc.plan_until:
-                return kc.plan_out  # the desired angle has not caught up with the jump yet
-            kc.plan_hold = 0  # caught up, or the plan's time for it is over (it turned again)
-        plan, period = self._plan, self.period_s
-        last = len(plan) - 1
-        k0 = self._plan_i + kc.ahead_ticks  # what the tip should show when this command acts
-        q_now = plan[k0 if k0 < last else last][col]
-        if q_now - q_now != 0.0:
-            return kc.out  # a plan that is not finite here is no plan
-        turn = self._planned_turn(kc, col, b, k0, q_now)
-        if turn is not None:
-            return turn
-        k = k0 + round(_JUMP_HORIZON_S / period)
-        q_far = plan[k if k < last else last][col]
-        if abs(q_far - q_now) < _JUMP_MIN_DEG:
-            return kc.out  # the plan stands (or hardly moves) for the next second
-        d = 1 if q_far > q_now else -1
-        flat = b.rising_flat if d > 0 else b.falling_flat
-        if flat is None or (q_now - flat.y_deg) * d >= 0.0:
-            return kc.out  # no dead zone ahead, or the desired angle is past its plateau
-        entry, exit_ = (flat.lo_deg, flat.hi_deg) if d > 0 else (flat.hi_deg, flat.lo_deg)
-        width = (exit_ - x) * d
-        to_entry = (entry - x) * d
-        if to_entry > 0.0:
-            width -= to_entry
-        else:
-            to_entry = 0.0
-        if width < _JUMP_MIN_DEG:
-            return kc.out  # past the dead zone (or all but through it)
-        v_max = self.v_max
-        # when the knob, sent now, reaches the plateau and leaves it (speeding up to v_max
-        # costs half the time the acceleration takes)
-        t_in = 0.5 * v_max / self.a_max + to_entry / v_max
-        t_out = t_in + width / v_max
-        if t_out > _JUMP_HORIZON_S:
-            return kc.out
-        k = k0 + round(t_in / period)
-        q_in = plan[k if k < last else last][col]
-        k = k0 + round(t_out / period)
-        q_out = plan[k if k < last else last][col]
-        if (q_in + q_out - 2.0 * flat.y_deg) * d < 0.0 or not q_in - q_in == q_out - q_out == 0.0:
-            return kc.out  # too early: the tip would wait on the plateau ahead of the plan
-        ahead = interp_linear(q_out, b.rising_deg if d > 0 else b.falling_deg, b.knots)
-        if (ahead - exit_) * d <= 0.0:
-            return kc.out  # the plan stops before the dead zone's far end: no jump
-        return self._hold(kc, d, ahead, t_out)
-
-    def _planned_turn(self, kc: _KnobCommand, col: int, b: Branches, k0: int, q_now: float
-                      ) -> float | None:
-        """The knob across the backlash before the plan turns back, or None. The tip holds
-        while the knob crosses: started so that the error at the turn's peak equals the error
-        when the crossing ends (a triangle's turn: a third of the crossing time early), the
-        least peak error; the knob then goes on to where the plan is at that end."""
-        state = kc.state
-        d = state.direction
-        ys = b.falling_deg if d > 0 else b.rising_deg  # the branch after the turn
-        x_end = interp_linear(q_now, ys, b.knots)
-        width = (state.x_deg - x_end) * d
-        if width < _JUMP_MIN_DEG:
-            return None  # no backlash to cross (or the knob is already across)
-        t_b = 0.5 * self.v_max / self.a_max + width / self.v_max
-        if t_b > _JUMP_HORIZON_S:
-            return None
-        plan = self._plan
-        last = len(plan) - 1
-        n = round(t_b / self.period_s)
-        k = k0 + n
-        q_end = plan[k if k < last else last][col]
-        if (q_end - q_now) * d >= 0.0:
-            return None  # the plan does not turn back within the crossing
-        peak = q_now
-        for j in range(1, _TURN_SAMPLES):
-            k = k0 + n * j // _TURN_SAMPLES
-            qj = plan[k if k < last else last][col]
-            if (qj - peak) * d > 0.0:
-                peak = qj
-        if (peak - q_now) * d > (q_now - q_end) * d or not q_end - q_end == peak - peak == 0.0:
-            return None  # too early: the tip would stop short of the peak by more
-        if (q_now - q_end) * d < TURN_MIN_DEG:
-            return None  # a slow turn: the causal reversal's error is as small
-        out = interp_linear(q_end, ys, b.knots)
-        if (out - x_end) * d > 0.0:
-            out = x_end
-        return self._hold(kc, -d, out, t_b)
-
-    def _hold(self, kc: _KnobCommand, d: int, out: float, until_s: float) -> float:
-        """Command ``out`` until the model's knob, following the plan, catches up with it, at
-        the latest ``until_s`` (+ 0.1 s) from now: a plan that turns again never leaves the
-        knob held."""
-        kc.plan_hold = d
-        kc.plan_out = out
-        kc.plan_until = self._plan_i + round((until_s + 0.1) / self.period_s)
-        return out
 
     def _early_jump(self, kc: _KnobCommand, state: PlayState, target: float, v: float,
                     b: Branches) -> float:

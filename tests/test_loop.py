@@ -247,3 +247,29 @@ def test_latest_sample_is_the_last_tick_and_one_object_until_the_next() -> None:
     assert returned.tick == 1 and returned.pos_deg == (4.0, -2.0)
     loop.step()
     assert loop.latest_sample is not None and loop.latest_sample.tick == 2
+
+
+class Previewing(Offset):
+    """A toy compensator that also reads the plan."""
+
+    def __init__(self) -> None:
+        super().__init__(0.0)
+        self.previews: list[tuple[float, int]] = []
+
+    def preview(self, plan_deg: list[list[float]], index: int) -> None:
+        self.previews.append((plan_deg[index][0], index))
+
+
+def test_a_played_trajectory_is_previewed_every_tick_and_a_setpoint_never() -> None:
+    comp = Previewing()
+    loop, _drives = make_loop(comp)  # type: ignore[arg-type]
+    loop.tick()
+    loop.execute("enable")
+    loop.setpoint.set((1.0, 0.0))
+    loop.tick()
+    assert comp.previews == []
+    playback = Playback(np.column_stack([np.arange(5.0), np.zeros(5)]), compensate=True)
+    loop.execute("play", playback=playback)
+    while not playback.done.is_set():
+        loop.tick()
+    assert comp.previews == [(float(i), i) for i in range(5)]

@@ -203,6 +203,10 @@ class ControlLoop(LoopCommands):
                 q_raw = self._play_q[playback.index]
                 if not playback.compensate:
                     compensator = None  # the desired angles as they are
+                else:  # a compensator that can use what comes next sees the plan this tick
+                    preview = getattr(compensator, "preview", None)
+                    if preview is not None:
+                        preview(self._play_q, playback.index)
         else:
             q_raw = self.setpoint.get()
         if q_raw is None:

@@ -41,6 +41,7 @@ __all__ = [
     "KnobLimits",
     "LimitedCompensator",
     "NoCompensation",
+    "Previewing",
     "build_compensator",
 ]
 
@@ -70,6 +71,16 @@ class FollowsMotor(Protocol):
 
     def continue_from(self, other: Any) -> None:
         """Take the state of ``other``, a compensator of the same kind for the same catheter."""
+
+
+class Previewing(Protocol):
+    """A compensator that can use the desired angles still to come. The loop playing a
+    trajectory calls ``preview`` every tick before ``command``, with the whole table (rows of
+    two angles) and this tick's row; a compensator uses the plan only in the tick it was
+    given (a setpoint from a client has none)."""
+
+    def preview(self, plan_deg: Sequence[Sequence[float]], index: int) -> None:
+        """This tick's desired angles are ``plan_deg[index]``; the rows after it follow."""
 
 
 class NoCompensation:

@@ -23,6 +23,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
+from tsmd.compensation.ours_knob import (
+    KnobCommand,
+    motion,
+    watch,
+)
+from tsmd.compensation.planned import Planner
 from tsmd.compensation.safety import KnobLimits, step_floats
 from tsmd.compensation.tension_play import (
     Branches,
@@ -44,23 +50,8 @@ MOVES_WITH_EDGE: dict[str, str] = {"dead_zone_pos_deg": "zero_load_pos_deg",
                                    "dead_zone_neg_deg": "zero_load_neg_deg"}
 TABLE_STEP_DEG = 0.25
 """Resolution of the other knob's angle in the precomputed branches."""
-REVERSAL_DEADBAND_DEG = 0.1
-"""A desired angle that turns back by less than this is held: an exact inverse would make the
-motor cross the whole backlash for every jitter of the operator's input (error <= this)."""
-DWELL_S = 0.4
-"""A desired angle standing still (within :data:`REVERSAL_DEADBAND_DEG`) this long after the
-command arrived, off the plateaus, is a dwell:
-the knob moves to the middle of the play that holds the tip there (the tip does not move), so
-the next move, whichever way it goes, crosses half the play instead of all of it (a causal
-feed-forward cannot know the direction: the middle halves the worse case)."""
-REST_S = 0.4
-REST_DEG = 0.01
-"""A desired angle standing this long within this band is at rest: the next motion is a move
-from rest (point-to-point), which speeds up along a planned profile. A continuous motion's
-turning points stand within the reversal deadband for 0.2-1.2 s (the multisine): not rests."""
 MOVE_FROM_REST_S = 1.0
 """How long after leaving rest the look-ahead trusts the desired angle's acceleration fully."""
-_SETTLED_DEG = 1e-3
 _PLATEAU_MARGIN_DEG = 1.0
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
@@ -111,48 +102,6 @@ class OursKnob:
         return table[0 if i < 0 else (i if i < len(table) else len(table) - 1)]
 
 
-class _KnobCommand:
-    """One knob's command state (slots: the tick reads and writes these attributes only)."""
-
-    __slots__ = ("accel", "ahead_s", "held_s", "hold", "jump_deg", "lim_deg", "lim_target",
-                 "lim_v", "limits", "move_s", "omega", "out", "plateau_hi_deg", "plateau_lo_deg",
-                 "q_dir", "q_prev", "q_raw", "rest_q", "stand_s", "state", "still_q", "still_s",
-                 "sum", "target", "v", "v_raw", "window")
-
-    def __init__(self, limits: KnobLimits) -> None:
-        self.limits = limits
-        self.ahead_s = 0.0
-        self.jump_deg = 0.0
-        self.omega = 1.0
-        self.plateau_lo_deg = self.plateau_hi_deg = 0.0
-        self.reset(PlayState(0.0, 0.0, 1, 0.0), 0.0, 1)
-
-    def reset(self, state: PlayState, q_deg: float, n_avg: int) -> None:
-        self.state = state
-        self.q_prev = q_deg
-        self.q_dir = state.direction
-        self.v = 0.0
-        self.accel = 0.0
-        self.q_raw = q_deg
-        self.v_raw = 0.0
-        self.held_s = 0.0
-        self.target = q_deg
-        self.out = state.x_deg
-        self.hold = 0
-        self.still_q = q_deg
-        self.still_s = 0.0
-        self.rest_q = q_deg
-        self.stand_s = 0.0
-        self.move_s = math.inf
-        x = self.limits.clip(state.x_deg)
-        # the limiter's state as plain floats (safety.step_floats): no object per tick
-        self.lim_deg = x
-        self.lim_v = 0.0
-        self.lim_target: float | None = None
-        self.window = [x] * n_avg
-        self.sum = x * n_avg
-
-
 class OursCompensator:
     """Two knobs of the tension play, as a :class:`tsmd.compensation.Compensator`.
 
@@ -180,8 +129,9 @@ class OursCompensator:
         self.v_max = min(lim.max_velocity_deg_s for lim in limits)
         self.a_max = min(lim.max_accel_deg_s2 for lim in limits)
         self._n_avg = max(1, round(smoothing_s / period_s))
-        self._k = (_KnobCommand(self.limits[0]), _KnobCommand(self.limits[1]))
+        self._k = (KnobCommand(self.limits[0]), KnobCommand(self.limits[1]))
         self._slot = 0
+        self._planner = Planner(period_s, self.v_max, self.a_max)
         self._set_constants()
         self.reset(np.zeros(2))
 
@@ -190,6 +140,7 @@ class OursCompensator:
         jump_deg = 5.0 * max(k.omega for k in self.knobs) * self.v_max * self.period_s
         for kc, knob in zip(self._k, self.knobs, strict=True):
             kc.ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
+            kc.ahead_ticks = round(kc.ahead_s / self.period_s)
             kc.jump_deg = jump_deg
             kc.omega = knob.omega
             kc.plateau_lo_deg = min(knob.height_pos_deg, knob.height_neg_deg)
@@ -211,16 +162,27 @@ class OursCompensator:
             self._k[i].reset(states[i], q[i], self._n_avg)
         self._slot = 0
 
+    def preview(self, plan_deg: Sequence[Sequence[float]], index: int) -> None:
+        """This tick's desired angles are ``plan_deg[index]`` and the ones after it follow
+        (the loop playing a trajectory says so every tick; without it the next command is
+        causal): the dead-zone crossings and sharp turns are then timed on the plan
+        (:class:`tsmd.compensation.planned.Planner`)."""
+        self._planner.set(plan_deg, index)
+
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         k0, k1 = self._k
         b0 = self.knobs[0].at(k1.state.x_deg)
         b1 = self.knobs[1].at(k0.state.x_deg)
         slot = self._slot
         period = self.period_s
+        planner = self._planner
+        planned = planner.take()
         out = []
-        for kc, qi, b in ((k0, float(q_deg[0]), b0), (k1, float(q_deg[1]), b1)):
+        for col, kc, qi, b in ((0, k0, float(q_deg[0]), b0), (1, k1, float(q_deg[1]), b1)):
             if qi - qi == 0.0:  # finite; otherwise the command stays where it is
-                self._track(kc, qi, b)
+                self._track(kc, qi, b, planned)
+                if planned:
+                    kc.out = planner.command(kc.plan, kc.state, kc.out, kc.ahead_ticks, col, b)
             x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target, kc.out,
                                                      kc.limits, period)
             kc.lim_deg = x
@@ -239,14 +201,15 @@ class OursCompensator:
         for i, kc in enumerate(self._k):
             qi, x = float(q_deg[i]), float(motor_deg[i])
             if qi - qi == 0.0:
-                self._watch(kc, qi)
-                self._motion(kc, qi)
+                watch(kc, qi, period, self._n_avg)
+                motion(kc, qi, period)
                 kc.target = qi
                 kc.still_s = 0.0  # no dwell before this compensator has brought the tip to q
             if x - x == 0.0:
                 kc.state = model_step(kc.state, x, self.knobs[i].at(float(motor_deg[1 - i])))
                 kc.out = x
                 kc.hold = 0
+                kc.plan.direction = 0  # a planned crossing is this compensator's own
                 kc.lim_v, kc.lim_deg, kc.lim_target = (x - kc.lim_deg) / period, x, None
                 kc.window = [x] * self._n_avg  # the filter's output is the motor's command
                 kc.sum = x * self._n_avg
@@ -257,65 +220,10 @@ class OursCompensator:
         self._slot = other._slot
         self._set_constants()
 
-    def _watch(self, kc: _KnobCommand, q_raw: float) -> bool:
-        """Rest and dwell bookkeeping of the desired angle; True when a dwell is due."""
-        kc.move_s += self.period_s
-        if -REST_DEG < q_raw - kc.rest_q < REST_DEG:
-            kc.stand_s += self.period_s
-        else:
-            if kc.stand_s >= REST_S:
-                kc.move_s = 0.0  # a move from rest starts
-            kc.stand_s = 0.0
-            kc.rest_q = q_raw
-        if -REVERSAL_DEADBAND_DEG < q_raw - kc.still_q < REVERSAL_DEADBAND_DEG:
-            # the dwell counts once the sent command has arrived (the tip got there first)
-            if abs(kc.sum / self._n_avg - kc.out) < _SETTLED_DEG:
-                kc.still_s += self.period_s
-            return kc.still_s >= DWELL_S
-        kc.still_q = q_raw
-        kc.still_s = 0.0
-        return False
-
-    def _motion(self, kc: _KnobCommand, q_raw: float) -> tuple[float, float, float]:
-        """The desired angle past the jitter deadband, its step and its velocity estimate."""
-        q_prev = kc.q_prev
-        qi = q_prev
-        if (q_raw - q_prev) * kc.q_dir >= 0.0:
-            qi = q_raw
-        elif abs(q_raw - q_prev) >= REVERSAL_DEADBAND_DEG:  # a reversal, not jitter
-            qi = q_raw
-            kc.q_dir = -kc.q_dir
-        dq = qi - q_prev
-        kc.q_prev = qi
-        v = 0.7 * kc.v + 0.3 * dq / self.period_s
-        if abs(dq) > kc.jump_deg:  # a step, not a motion: nothing to predict from it
-            v = 0.0
-        kc.v = v
-        # The acceleration from the desired angle itself (the jitter deadband above releases a
-        # held input in one step, which is no acceleration of the operator's hand), only from a
-        # desired angle that changes every tick (a trajectory played in the loop). A client
-        # that sets 50 times a second holds each value for several ticks with its own timing
-        # jitter: the velocity of that staircase is readable, its acceleration is not (the
-        # daemon's demo: RMSE 11.4 / 6.8 deg with it, 3.0 / 3.0 without).
-        dq_raw = q_raw - kc.q_raw
-        kc.held_s += self.period_s
-        if dq_raw != 0.0:
-            kc.q_raw = q_raw
-            if abs(dq_raw) > kc.jump_deg or kc.held_s > 1.5 * self.period_s:
-                kc.v_raw = kc.accel = 0.0  # a step, a staircase, or a start after a pause
-            else:
-                v_raw = 0.7 * kc.v_raw + 0.3 * dq_raw / self.period_s
-                kc.accel = 0.8 * kc.accel + 0.2 * (v_raw - kc.v_raw) / self.period_s
-                kc.v_raw = v_raw
-            kc.held_s = 0.0
-        elif kc.held_s > 1.5 * self.period_s:
-            kc.v_raw = kc.accel = 0.0  # standing: the next move starts from rest
-        return qi, dq, v
-
-    def _track(self, kc: _KnobCommand, q_raw: float, b: Branches) -> None:
-        if self._watch(kc, q_raw) and self._centre(kc, b):
+    def _track(self, kc: KnobCommand, q_raw: float, b: Branches, planned: bool) -> None:
+        if watch(kc, q_raw, self.period_s, self._n_avg) and self._centre(kc, b):
             return
-        qi, dq, v = self._motion(kc, q_raw)
+        qi, dq, v = motion(kc, q_raw, self.period_s)
         lead = kc.ahead_s * v
         if lead < -_MAX_LEAD_DEG:
             lead = -_MAX_LEAD_DEG
@@ -331,9 +239,9 @@ class OursCompensator:
         kc.target = target
         state = inverse_step(state, target, b)
         kc.state = state
-        kc.out = self._early_jump(kc, state, target, v, b)
+        kc.out = state.x_deg if planned else self._early_jump(kc, state, target, v, b)
 
-    def _centre(self, kc: _KnobCommand, b: Branches) -> bool:
+    def _centre(self, kc: KnobCommand, b: Branches) -> bool:
         """During a dwell: the knob to the middle of the play holding the model's output (the
         other knob may move the branches: recomputed every tick). Not at rest on a plateau
         (both tendons slack, the catheter at home): there the knob is never moved on its own."""
@@ -349,7 +257,7 @@ class OursCompensator:
         kc.out = x
         return True
 
-    def _early_jump(self, kc: _KnobCommand, state: PlayState, target: float, v: float,
+    def _early_jump(self, kc: KnobCommand, state: PlayState, target: float, v: float,
                     b: Branches) -> float:
         x, d = state.x_deg, state.direction
         prev = kc.out

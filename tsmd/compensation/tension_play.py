@@ -129,6 +129,37 @@ def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
 # The model at one other-knob angle
 
 
+class Flat(NamedTuple):
+    """The widest flat part of a branch (the dead zone: both tendons slack, the tip stands at
+    ``y_deg`` while the knob crosses ``lo_deg``..``hi_deg``)."""
+
+    lo_deg: float
+    hi_deg: float
+    y_deg: float
+
+
+FLAT_SLOPE_FRACTION = 0.05
+"""A branch piece with a slope below this fraction of omega is flat (the envelopes' tilt is
+1e-6 omega; the shallowest real piece is the loaded line, omega)."""
+
+
+def widest_flat(knots: Sequence[float], ys: Sequence[float], omega: float) -> Flat | None:
+    """The widest run of adjacent flat pieces of one branch, or None if it has none."""
+    best: Flat | None = None
+    lo = -1
+    last = len(knots) - 2
+    for i in range(last + 1):
+        flat = ys[i + 1] - ys[i] < FLAT_SLOPE_FRACTION * omega * (knots[i + 1] - knots[i])
+        if flat and lo < 0:
+            lo = i
+        if lo >= 0 and (not flat or i == last):
+            hi = i + 1 if flat else i
+            if best is None or knots[hi] - knots[lo] > best.hi_deg - best.lo_deg:
+                best = Flat(knots[lo], knots[hi], 0.5 * (ys[lo] + ys[hi]))
+            lo = -1
+    return best
+
+
 @dataclass(frozen=True)
 class Branches:
     """Rising (lower) and falling (upper) branch of one knob, piecewise linear on ``knots``."""
@@ -136,6 +167,8 @@ class Branches:
     knots: tuple[float, ...]
     rising_deg: tuple[float, ...]
     falling_deg: tuple[float, ...]
+    rising_flat: Flat | None = None
+    falling_flat: Flat | None = None
 
     def rising(self, x_deg: float) -> float:
         return interp_linear(x_deg, self.knots, self.rising_deg)
@@ -212,7 +245,8 @@ def branches(omega: float, height_pos_deg: float, height_neg_deg: float, d_pos: 
         tilt = _FLAT_SLOPE * w * x
         lo.append(min(r, f) + tilt)
         hi.append(max(r, f) + tilt)
-    return Branches(tuple(xs), tuple(lo), tuple(hi))
+    return Branches(tuple(xs), tuple(lo), tuple(hi), widest_flat(xs, lo, w),
+                    widest_flat(xs, hi, w))
 
 
 class PlayState(NamedTuple):

@@ -21,7 +21,7 @@ from tsmd.gap.data import GapSeries, Split
 from tsmd.gap.layer import heldout_metrics, stack_views
 from tsmd.gap.model import CHANNELS, Evaluator, Prediction, View, build_views
 from tsmd.gap.result import CandidateScore, GapConfig, GapResult
-from tsmd.gap.signature import score_signatures
+from tsmd.gap.signature import SignatureScore, score_signatures
 from tsmd.gap.simulate import smooth_velocity
 
 
@@ -61,10 +61,7 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
                 s.share = s.raw_share = lag[0]
                 s.ci = lag[1:]
                 s.significant = s.significant and lag[0] >= cfg.min_share
-        # compliance last: a coupling or a current lag also moves its reversals' figure,
-        # and they are tested on matched contrasts that compliance leaves alone
-        sres.scores = sorted(kept + found, key=lambda s: (s.name == "compliance" and
-                                                          s.significant, -s.share))
+        sres.scores = rank_scores(kept + found)
     gap_present = sres.physics_excess > cfg.gap_floor * (sres.physics_excess + sres.noise_level)
     sig = [s for s in sres.scores if s.significant] if gap_present else []
     top = [sig[0].name] if sig else []
@@ -96,6 +93,13 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         candidates=cands, where_shares={}, where_bins={}, ljung_box_base={},
         timing_s={"signatures": time.perf_counter() - t0}, rows={"grid": len(d)},
         structure=structure)
+
+
+def rank_scores(scores: Sequence[SignatureScore]) -> list[SignatureScore]:
+    """By share, a significant compliance after every other score: a coupling or a current lag
+    also moves its reversals' figure, and they are tested on matched contrasts that a
+    compliance leaves alone (docs/gap.md)."""
+    return sorted(scores, key=lambda s: (s.name == "compliance" and s.significant, -s.share))
 
 
 def _residuals(series: Sequence[GapSeries], split: Split, ev: Evaluator,

@@ -3,16 +3,19 @@
 from __future__ import annotations
 
 import functools
+from pathlib import Path
 
 import numpy as np
 import pytest
 from numpy.typing import NDArray
 
+from tsmd import cli
 from tsmd.gap import compliance
 from tsmd.gap.crosstest import PRESETS, make_session
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.signature import SignatureScore
 from tsmd.gap.structure import rank_scores
+from tsmd.recording import Recording, write_recording
 
 Arr = NDArray[np.float64]
 RATE_HZ = 50.0
@@ -37,11 +40,16 @@ def test_lost_motion_is_the_play_whatever_the_releasing_gain(gain: float) -> Non
 
 
 @functools.cache
-def _protocol_series(unit: int, case: str, unit_variation: float = 0.1) -> list[GapSeries]:
+def _protocol_recordings(unit: int, case: str, unit_variation: float) -> list[Recording]:
     recs = make_session(PRESETS["capstan"], case, 4.0, RATE_HZ, unit,
                         unit_variation=unit_variation)
-    return [series_from_recording(r, f"{case}-{i}") for i, r in enumerate(recs)
-            if "segments" in r.metadata]
+    return [r for r in recs if "segments" in r.metadata]
+
+
+@functools.cache
+def _protocol_series(unit: int, case: str, unit_variation: float = 0.1) -> list[GapSeries]:
+    return [series_from_recording(r, f"{case}-{i}")
+            for i, r in enumerate(_protocol_recordings(unit, case, unit_variation))]
 
 
 @functools.cache
@@ -80,3 +88,32 @@ def test_a_significant_compliance_ranks_after_a_significant_matched_effect() -> 
 
     ranked = rank_scores([score("compliance", 0.95), score("coupling", 0.7)])
     assert [s.name for s in ranked] == ["coupling", "compliance"]
+
+
+def test_the_sheet_command_prints_the_figure_the_diagnosis_takes(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    paths = []
+    for i, rec in enumerate(_protocol_recordings(0, "none", 0.0)):
+        paths.append(str(tmp_path / f"ref{i}.csv"))
+        write_recording(paths[-1], rec)
+    assert cli.main(["gap", "sheet", *paths]) == 0
+    out = capsys.readouterr().out
+    ref = _sheet()
+    assert f"--compliance-sheet {ref[0]:.4g},{ref[1]:.4g}" in out
+
+
+@pytest.mark.parametrize("argv", [["sheet"], ["x.csv", "--compliance-sheet", "12"],
+                                  ["x.csv", "--compliance-sheet", "0,4"]])
+def test_a_bad_sheet_request_is_one_line(argv: list[str], tmp_path: Path,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    if argv[0] == "x.csv":
+        argv = [str(_written(tmp_path)), *argv[1:]]
+    code = cli.main(["gap", *argv, "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
+
+
+def _written(tmp_path: Path) -> Path:
+    path = tmp_path / "x.csv"
+    write_recording(path, _protocol_recordings(0, "none", 0.0)[0])
+    return path

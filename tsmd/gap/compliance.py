@@ -89,16 +89,22 @@ def _lost_motion(x: FloatArray, tip: FloatArray, a: int, b: int) -> tuple[float,
     travel = np.abs(x[b:end] - x[a])
     ahead = direction * tip[max(a - 2, 0):end]
     moved = (ahead - np.minimum.accumulate(ahead))[b - max(a - 2, 0):]  # back from its extreme
-    first = np.flatnonzero(moved >= DEPARTURE_DEG / 3.0)
     last = np.flatnonzero(moved >= DEPARTURE_DEG)
-    if first.size == 0 or last.size == 0 or first[0] == 0:
+    if last.size == 0:
         return None
-    rows = slice(int(first[0]), int(last[0]) + 1)
-    if last[0] - first[0] >= 2:
+    # the return's start: after the last row below a third of the threshold before it (a
+    # noise excursion within the lost motion does not start it; the running extreme of
+    # dozens of noisy samples spreads by several standard deviations)
+    below = np.flatnonzero(moved[:last[0]] < DEPARTURE_DEG / 3.0)
+    if below.size == 0:
+        return None
+    first = int(below[-1]) + 1
+    rows = slice(first, int(last[0]) + 1)
+    if last[0] - first >= 2:
         slope, icept = np.polyfit(travel[rows], moved[rows], 1)
-        lost = float(-icept / slope) if slope > 1e-6 else float(travel[first[0]])
+        lost = float(-icept / slope) if slope > 1e-6 else float(travel[first])
     else:
-        lost = float(travel[first[0]])
+        lost = float(travel[first])
     settled = np.flatnonzero(travel >= lost + SETTLE_DEG)
     if settled.size == 0 or lost <= 0.0:
         return None

@@ -152,6 +152,18 @@ def test_a_loop_that_is_wider_in_one_configuration_is_named_curvature() -> None:
     assert scores["curvature"].share > 0.5
 
 
+def test_a_loop_with_a_lower_gain_in_one_configuration_is_explained_as_curvature() -> None:
+    def flatter(t: Arr, q: Arr) -> Arr:
+        """The bent sheath's friction takes a tenth of the loaded branches' tip/knob slope."""
+        out = np.zeros((len(t), 4))
+        for j in range(2):
+            out[:, j] = -0.1 * q[:, j]
+        return out
+    scores = _scores(flatter, looped_only=True)
+    assert _named(scores) == {"curvature"}
+    assert scores["curvature"].share > 0.9
+
+
 def _creep(t: Arr, q: Arr) -> Arr:
     """Current relaxing in proportion to the time spent under load (slack creeping)."""
     dt = np.diff(t, prepend=t[0])

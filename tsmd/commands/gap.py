@@ -3,7 +3,9 @@
 ``tsmd gap RECORDING...`` writes ``gap_report.md``, ``gap_report.json`` and PNG plots to
 ``--out``. ``tsmd gap selftest`` runs the blind self-test on data made by the built-in plant.
 ``tsmd gap protocol --out FILE.csv`` writes the matched-condition protocol as a trajectory for
-``tsmd replay``, whose recording then carries the protocol's segment labels.
+``tsmd replay``, whose recording then carries the protocol's segment labels. ``tsmd gap sheet
+RECORDING...`` measures the data-sheet figure ``--compliance-sheet`` takes from the protocol
+recorded with a reference unit of the catheter model.
 """
 
 from __future__ import annotations
@@ -13,9 +15,11 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 
 from simrig.plant import load_plant
+from tsmd.gap.compliance import reference_deg_per_A
 from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
 from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
 from tsmd.gap.diagnose import diagnose
@@ -39,7 +43,8 @@ from tsmd.tee import load_tee_acquisition
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("recordings", nargs="+", metavar="RECORDING",
                         help="recording CSV files (tsmd recording format; with --tee raw TEE "
-                             "CSVs), or the word 'selftest' or 'protocol'")
+                             "CSVs), or the word 'selftest', 'protocol' or 'sheet' followed "
+                             "by the reference unit's protocol recordings")
     parser.add_argument("--plant", default=BUILTIN_PLANT,
                         help="simulator plant 'module:factory' (default: the built-in plant)")
     parser.add_argument("--params", default=None,
@@ -64,6 +69,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(default 2; 0 = off, faster)")
     parser.add_argument("--tee", action="store_true",
                         help="inputs are raw TEE acquisitions (converted by tsmd.tee)")
+    parser.add_argument("--compliance-sheet", default=None, metavar="DEG_PER_A,DEG_PER_A",
+                        help="the catheter model's data-sheet lost motion per ampere at a "
+                             "reversal, knob 1 and 2 (`tsmd gap sheet` on another unit's "
+                             "protocol recordings); with it and the protocol in the recordings "
+                             "tendon compliance can be named")
     parser.add_argument("--sizes", default="120,300",
                         help="selftest: recording lengths in s (comma-separated)")
     parser.add_argument("--seeds", default="0,1", help="selftest: noise/unit seeds")
@@ -146,6 +156,8 @@ def main(args: argparse.Namespace) -> int:
         return _selftest(args)
     if args.recordings[0] == "protocol":
         return _protocol(args)
+    if args.recordings[0] == "sheet":
+        return _sheet(args)
     series = [_load_recording(p, args.tee) for p in args.recordings]
     names = [s.name for s in series]
     if len(set(names)) != len(names):
@@ -162,7 +174,8 @@ def main(args: argparse.Namespace) -> int:
                        holdout=holdout if isinstance(holdout, float) else tuple(holdout),
                        block_s=args.block_s, fit_max_rows=max(args.fit_rows, 200),
                        joint_top=max(args.joint_top, 0), seed=args.seed,
-                       method=args.method)
+                       method=args.method,
+                       compliance_reference=_compliance_sheet(args.compliance_sheet))
     result = diagnose(series, _factory(args.plant, params), params, config)
     out = Path(args.out)
     md, js = write_report(result, out, ", ".join(names),
@@ -170,6 +183,33 @@ def main(args: argparse.Namespace) -> int:
     print(f"verdict: {result.verdict}")
     print(result.summary)
     print(f"report: {md}  data: {js}  ({result.timing_s['total']:.1f} s)")
+    return 0
+
+
+def _compliance_sheet(text: str | None) -> tuple[float, float] | None:
+    if text is None:
+        return None
+    try:
+        k1, k2 = (float(x) for x in text.split(","))
+    except ValueError:
+        raise GapError(f"--compliance-sheet {text!r}: expected two numbers, "
+                       "DEG_PER_A,DEG_PER_A") from None
+    if not (k1 > 0.0 and k2 > 0.0 and np.isfinite(k1) and np.isfinite(k2)):
+        raise GapError(f"--compliance-sheet {text!r}: both figures must be positive")
+    return k1, k2
+
+
+def _sheet(args: argparse.Namespace) -> int:
+    paths = args.recordings[1:]
+    if not paths:
+        raise GapError("tsmd gap sheet RECORDING...: give the reference unit's protocol "
+                       "recordings")
+    figure = reference_deg_per_A([_load_recording(p, args.tee) for p in paths])
+    if figure is None:
+        raise GapError("tsmd gap sheet: too few readable reversals at the protocol's 40 and "
+                       "60 deg in these recordings (do they carry the protocol's segments?)")
+    print(f"lost motion per ampere: knob 1 {figure[0]:.4g}, knob 2 {figure[1]:.4g} deg/A; "
+          f"diagnose other units with --compliance-sheet {figure[0]:.4g},{figure[1]:.4g}")
     return 0
 
 

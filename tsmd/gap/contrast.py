@@ -22,7 +22,15 @@ from scipy import stats
 
 from tsmd.gap.data import GapSeries
 from tsmd.gap.dwell import Drift, drift_shrink, drift_stat, dwell_slope
-from tsmd.gap.loops import Loops, Triple, anova, lag_design, loop_contrast, loop_shrink
+from tsmd.gap.loops import (
+    Loops,
+    Triple,
+    anova,
+    bend_design,
+    lag_design,
+    loop_contrast,
+    loop_shrink,
+)
 from tsmd.gap.signature import SIGNATURES, SignatureScore
 
 FloatArray = NDArray[np.float64]
@@ -83,7 +91,7 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
                 continue
             p = anova(loops)[3]
             # fitted on one motion's configuration contrast, scored on the other motion's
-            shrinks = [loop_shrink([loops[1 - i]], loops[i]) for i in range(2)]
+            shrinks = [loop_shrink([loops[1 - i]], loops[i], bend_design) for i in range(2)]
         elif test == "creep":
             drifts = [d for d in (_drift(t) for t in per_cfg) if d.diff.size]
             if not drifts:

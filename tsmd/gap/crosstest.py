@@ -11,6 +11,7 @@ matrix, false alarms on "none", and the held-out shrink of the named effect's ex
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from collections.abc import Callable, Sequence
@@ -24,6 +25,7 @@ from simrig.current_sensor import CurrentSensor
 from simrig.family import PLANT_SPECS, family_member
 from simrig.plant import load_plant
 from simrig.tracker import EmTracker
+from tsmd.gap.compliance import reference_deg_per_A
 from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
@@ -203,6 +205,22 @@ def _measure(plant: Any, t: FloatArray, q: FloatArray, rate_hz: float, lag_s: fl
     return {k: np.array(v, dtype=float) for k, v in cols.items()}
 
 
+_DATASHEETS: dict[str, tuple[float, float] | None] = {}
+
+
+def datasheet_reference(data: PlantSpec, rate_hz: float) -> tuple[float, float] | None:
+    """The data sheet of the data plant's catheter model: lost motion per ampere on the
+    protocol recorded with its nominal unit (unit 0, no scatter, never a scored unit; noise as
+    in the sessions). Measured once per plant and rate."""
+    key = f"{data.name or data.factory}@{rate_hz:g}"
+    if key not in _DATASHEETS:
+        recs = make_session(data, "none", 4.0, rate_hz, 0, unit_variation=0.0)
+        series = [series_from_recording(r, f"datasheet-{i}") for i, r in enumerate(recs)
+                  if "segments" in r.metadata]
+        _DATASHEETS[key] = reference_deg_per_A(series)
+    return _DATASHEETS[key]
+
+
 def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float, seed: int,
                    rate_hz: float = 50.0, config: GapConfig | None = None,
                    matched: bool = True) -> SelftestCase:
@@ -211,6 +229,8 @@ def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float
     series = [series_from_recording(r, f"{case}-{seed}-{r.metadata['configuration']}-{i}")
               for i, r in enumerate(recs)]
     cfg = config or GapConfig(fit_specs=sim.fit, seed=seed)
+    if matched and cfg.compliance_reference is None:
+        cfg = dataclasses.replace(cfg, compliance_reference=datasheet_reference(data, rate_hz))
 
     def factory(params: dict[str, Any]) -> Any:
         return sim.build(**params)

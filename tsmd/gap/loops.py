@@ -156,6 +156,14 @@ def _design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
     return np.column_stack(cols)
 
 
+def bend_design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
+    """:func:`_design` plus a gain per knob/channel (a residual growing with the knob angle):
+    a sheath shape changes the friction along it and with that the loaded branches' tip/knob
+    slope, which neither a shift nor a widening takes (the curvature test's model)."""
+    gains = [(lp.part == p) * lp.knob for p in np.unique(lp.part)]
+    return np.column_stack([_design(lp, mean_loop), *gains])
+
+
 LAGS_S: tuple[float, ...] = (0.03, 0.1, 0.3)
 """Time constants (s) of the first-order lags whose speed contrasts span the lag model."""
 

@@ -36,6 +36,11 @@ class GapConfig:
     """'signature': effects by their condition signature on top of a structural layer (robust
     to wrong base physics); 'candidates': the earlier candidate transforms around the plant."""
     sig_max_rows: int = 12000
+    compliance_reference: tuple[float, float] | None = None
+    """The catheter model's data sheet figure of lost motion per ampere (deg/A, knob 1, 2;
+    :func:`tsmd.gap.compliance.reference_deg_per_A` on the protocol recorded with another
+    unit). With it and the protocol, compliance is named from the reversals; without, it is
+    scored but not named."""
     final_max_rows: int = 20000
     """Held-out rows replayed for the how-far figures (all of them up to this many)."""
     n_surrogates: int = 30

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.gap.compliance import compliance_score
 from tsmd.gap.contrast import (
     DECIDES,
     UNMATCHED,
@@ -20,7 +21,7 @@ from tsmd.gap.data import GapSeries, Split
 from tsmd.gap.layer import heldout_metrics, stack_views
 from tsmd.gap.model import CHANNELS, Evaluator, Prediction, View, build_views
 from tsmd.gap.result import CandidateScore, GapConfig, GapResult
-from tsmd.gap.signature import score_signatures
+from tsmd.gap.signature import SignatureScore, score_signatures
 from tsmd.gap.simulate import smooth_velocity
 
 
@@ -45,6 +46,10 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         residuals = _residuals(series, split, ev, base_fit)
         found = contrast_scores(series, residuals, len(sres.scores), cfg.family_alpha,
                                 cfg.min_share)
+        if cfg.compliance_reference is not None:
+            stretch = compliance_score(series, cfg.compliance_reference, len(sres.scores),
+                                       cfg.family_alpha, cfg.min_share)
+            found += [stretch] if stretch is not None else []
         names = {c.name for c in found}
         kept = [s for s in sres.scores if s.name not in names]
         lag = lag_share(series, residuals)
@@ -56,7 +61,7 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
                 s.share = s.raw_share = lag[0]
                 s.ci = lag[1:]
                 s.significant = s.significant and lag[0] >= cfg.min_share
-        sres.scores = sorted(kept + found, key=lambda s: -s.share)
+        sres.scores = rank_scores(kept + found)
     gap_present = sres.physics_excess > cfg.gap_floor * (sres.physics_excess + sres.noise_level)
     sig = [s for s in sres.scores if s.significant] if gap_present else []
     top = [sig[0].name] if sig else []
@@ -90,6 +95,13 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         structure=structure)
 
 
+def rank_scores(scores: Sequence[SignatureScore]) -> list[SignatureScore]:
+    """By share, a significant compliance after every other score: a coupling or a current lag
+    also moves its reversals' figure, and they are tested on matched contrasts that a
+    compliance leaves alone (docs/gap.md)."""
+    return sorted(scores, key=lambda s: (s.name == "compliance" and s.significant, -s.share))
+
+
 def _residuals(series: Sequence[GapSeries], split: Split, ev: Evaluator,
                base_fit: Prediction) -> list[NDArray[np.float64]]:
     """Data minus the physics simulator on every row of the protocol recordings (others: 0)."""
@@ -107,7 +119,7 @@ def _residuals(series: Sequence[GapSeries], split: Split, ev: Evaluator,
 
 def _matched_score(score: Any) -> bool:
     """Whether a score came from the matched protocol (its share is of a matched contrast)."""
-    return score.name in DECIDES.values() or score.name == "sensor"
+    return score.name in DECIDES.values() or score.name in ("sensor", "compliance")
 
 
 def _structure_verdict(gap_present: bool, absorbed: float, layer_ratio: float,

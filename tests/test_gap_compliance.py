@@ -1,0 +1,119 @@
+"""Tendon compliance named from the protocol's reversals against the model's data sheet."""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+
+from tsmd import cli
+from tsmd.gap import compliance
+from tsmd.gap.crosstest import PRESETS, make_session
+from tsmd.gap.data import GapSeries, series_from_recording
+from tsmd.gap.signature import SignatureScore
+from tsmd.gap.structure import rank_scores
+from tsmd.recording import Recording, write_recording
+
+Arr = NDArray[np.float64]
+RATE_HZ = 50.0
+
+
+def _play(x: Arr, half_width: float) -> Arr:
+    out = np.empty(len(x))
+    y = float(x[0])
+    for k, xk in enumerate(x.tolist()):
+        y = min(max(y, xk - half_width), xk + half_width)
+        out[k] = y
+    return out
+
+
+@pytest.mark.parametrize("gain", [0.4, 1.0])
+def test_lost_motion_is_the_play_whatever_the_releasing_gain(gain: float) -> None:
+    x = np.concatenate([np.linspace(0.0, 40.0, 401), np.linspace(40.0, -40.0, 801)[1:]])
+    tip = gain * _play(x, 3.0)
+    found = compliance._lost_motion(x, tip, 400, 401)
+    assert found is not None
+    assert found[0] == pytest.approx(6.0, abs=0.15)
+
+
+@functools.cache
+def _protocol_recordings(unit: int, case: str, unit_variation: float) -> list[Recording]:
+    recs = make_session(PRESETS["capstan"], case, 4.0, RATE_HZ, unit,
+                        unit_variation=unit_variation)
+    return [r for r in recs if "segments" in r.metadata]
+
+
+@functools.cache
+def _protocol_series(unit: int, case: str, unit_variation: float = 0.1) -> list[GapSeries]:
+    return [series_from_recording(r, f"{case}-{i}")
+            for i, r in enumerate(_protocol_recordings(unit, case, unit_variation))]
+
+
+@functools.cache
+def _sheet() -> tuple[float, float]:
+    ref = compliance.reference_deg_per_A(_protocol_series(0, "none", 0.0))
+    assert ref is not None
+    return ref
+
+
+def test_doubled_tendon_compliance_is_named_against_the_data_sheet() -> None:
+    score = compliance.compliance_score(_protocol_series(5, "compliance"), _sheet(), 7)
+    assert score is not None and score.significant
+    assert score.share > 0.5
+
+
+def test_a_unit_without_the_effect_is_not_named() -> None:
+    score = compliance.compliance_score(_protocol_series(5, "none"), _sheet(), 7)
+    assert score is not None and not score.significant
+
+
+def test_a_current_sensor_lag_does_not_read_as_compliance() -> None:
+    score = compliance.compliance_score(_protocol_series(5, "sensor"), _sheet(), 7)
+    assert score is not None and not score.significant
+
+
+def test_recordings_without_the_protocol_give_no_figure() -> None:
+    plain = [GapSeries(s.name, s.t_s, s.knob_deg, s.current_A, s.tip_deg, s.knob_source)
+             for s in _protocol_series(5, "none")]
+    assert compliance.reference_deg_per_A(plain) is None
+    assert compliance.compliance_score(plain, _sheet(), 7) is None
+
+
+def test_a_significant_compliance_ranks_after_a_significant_matched_effect() -> None:
+    def score(name: str, share: float) -> SignatureScore:
+        return SignatureScore(name, name, "", share, (share, share), True, share, 0.0)
+
+    ranked = rank_scores([score("compliance", 0.95), score("coupling", 0.7)])
+    assert [s.name for s in ranked] == ["coupling", "compliance"]
+
+
+def test_the_sheet_command_prints_the_figure_the_diagnosis_takes(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    paths = []
+    for i, rec in enumerate(_protocol_recordings(0, "none", 0.0)):
+        paths.append(str(tmp_path / f"ref{i}.csv"))
+        write_recording(paths[-1], rec)
+    assert cli.main(["gap", "sheet", *paths]) == 0
+    out = capsys.readouterr().out
+    ref = _sheet()
+    assert f"--compliance-sheet {ref[0]:.4g},{ref[1]:.4g}" in out
+
+
+@pytest.mark.parametrize("argv", [["sheet"], ["x.csv", "--compliance-sheet", "12"],
+                                  ["x.csv", "--compliance-sheet", "0,4"]])
+def test_a_bad_sheet_request_is_one_line(argv: list[str], tmp_path: Path,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    if argv[0] == "x.csv":
+        argv = [str(_written(tmp_path)), *argv[1:]]
+    code = cli.main(["gap", *argv, "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
+
+
+def _written(tmp_path: Path) -> Path:
+    path = tmp_path / "x.csv"
+    write_recording(path, _protocol_recordings(0, "none", 0.0)[0])
+    return path

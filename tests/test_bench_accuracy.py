@@ -12,6 +12,9 @@ from tsmd import cli
 from tsmd.bench import accuracy, family_accuracy
 from tsmd.bench.accuracy import tracking_errors
 from tsmd.bench.accuracy_scenarios import PERIOD_S, conditioned, scenarios
+from tsmd.compensation.ours import OursCompensator
+from tsmd.config import resolve_data_path
+from tsmd.profile import load_profile
 
 
 def test_protocol_has_the_papers_scenarios() -> None:
@@ -88,3 +91,22 @@ def test_accuracy_without_family_options_stays_the_single_catheter_bench(
     monkeypatch.setattr(accuracy, "main", lambda ns: ran.append("accuracy") or 0)
     assert cli.main(["bench", "accuracy", "--quick"]) == 0
     assert ran == ["accuracy"]
+
+
+def test_planned_compute_time_includes_the_preview_of_every_tick(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    calls: list[int] = []
+    original = OursCompensator.preview
+
+    def counting(self: OursCompensator, plan_deg: object, index: int) -> None:
+        calls.append(index)
+        original(self, plan_deg, index)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(OursCompensator, "preview", counting)
+    profile = load_profile(resolve_data_path("profiles/example-sim.yaml"))
+    median_us, p99_us = accuracy.compute_time_us(profile, "ours", n_ticks=300, planned=True)
+    assert calls == list(range(300))
+    assert 0.0 < median_us <= p99_us
+    calls.clear()
+    accuracy.compute_time_us(profile, "ours", n_ticks=300)
+    assert calls == []

@@ -153,23 +153,28 @@ def run_scenario(s: Scenario, method: str, seed: int, profile: Any,
                      float(np.mean([e[1] for e in errs])), tt[skip:] - tt[skip], q, cmd, tip)
 
 
-def compute_time_us(profile: Any, method: str, n_ticks: int = 5000, clock: str = "wall"
-                    ) -> tuple[float, float]:
+def compute_time_us(profile: Any, method: str, n_ticks: int = 5000, clock: str = "wall",
+                    planned: bool = False) -> tuple[float, float]:
     """Median and p99 time of one ``command`` call for two knobs (microseconds).
 
     ``clock="wall"``: elapsed time, which on a shared machine includes being preempted;
     ``"cpu"``: this thread's CPU time (the cost of the computation itself), less the clock's
-    own cost (the median of empty readings).
+    own cost (the median of empty readings). ``planned``: the tick as the loop runs it while
+    playing a trajectory, ``preview`` (where the compensator has it) and ``command`` together.
     """
     read = {"wall": time.perf_counter_ns, "cpu": time.thread_time_ns}[clock]
     comp = build_compensator(profile if method != "none" else None, method, PERIOD_S)
     t = np.arange(n_ticks) * PERIOD_S
     q = np.column_stack([60 * np.sin(2 * math.pi * 0.04 * t), 60 * np.sin(2 * math.pi * 0.08 * t)])
     comp.reset(q[0])
+    plan = q.tolist()
+    preview = getattr(comp, "preview", None) if planned else None
     times = np.empty(n_ticks)
     empty = np.empty(n_ticks)
     for i, row in enumerate(q):
         t0 = read()
+        if preview is not None:
+            preview(plan, i)
         comp.command(row)
         t1 = read()
         times[i] = t1 - t0
@@ -333,6 +338,10 @@ def main(args: argparse.Namespace) -> int:
         med, p99 = compute_time_us(profile, method)
         cpu_med, cpu_p99 = compute_time_us(profile, method, clock="cpu")
         lines.append(f"| {method} | {med:.1f} | {p99:.1f} | {cpu_med:.1f} | {cpu_p99:.1f} |")
+    med, p99 = compute_time_us(profile, "ours", planned=True)
+    cpu_med, cpu_p99 = compute_time_us(profile, "ours", clock="cpu", planned=True)
+    lines.append(f"| ours, playing a trajectory (preview + command) | {med:.1f} | {p99:.1f} | "
+                 f"{cpu_med:.1f} | {cpu_p99:.1f} |")
     lines += ["", "Rate/position limiter (device limits) on the compensators' commands, "
               "same trajectories offline:", "",
               "| method | RMS deviation deg | max deviation deg | ticks limited |",

@@ -204,6 +204,11 @@ def main(args: argparse.Namespace) -> int:
         cpu_med, cpu_p99 = compute_time_us(profile, "ours", clock="cpu")
         lines.append(f"| {seed} | compute per tick, two knobs (ours) | wall median {med:.1f} us, "
                      f"p99 {p99:.1f} us; CPU median {cpu_med:.1f} us, p99 {cpu_p99:.1f} us |")
+        med, p99 = compute_time_us(profile, "ours", planned=True)
+        cpu_med, cpu_p99 = compute_time_us(profile, "ours", clock="cpu", planned=True)
+        lines.append(f"| {seed} | the same playing a trajectory (preview + command) | wall median "
+                     f"{med:.1f} us, p99 {p99:.1f} us; CPU median {cpu_med:.1f} us, "
+                     f"p99 {cpu_p99:.1f} us |")
     lines += ["", "Targets (ours): RMSE red. >= 90 % 1-DOF / 85 % 2-DOF, PTPE red. >= 75 "
               "/ 60 %, RMSE <= 0.6 x paper's.", ""]
     for label, idx in (("RMSE reduction", 3), ("PTPE reduction", 4)):

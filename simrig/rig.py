@@ -262,8 +262,9 @@ class SimRig:
         physics through the whole periods the clock has gone past.
 
         A SYNC first steps the periods before it under the old targets, then latches the new
-        RPDOs and steps its own period at once (the TPDO answers it, as in lockstep), so the
-        physics runs up to one period ahead of the clock, never more.
+        RPDOs and steps its own period at once (the TPDO answers it, as in lockstep). A SYNC
+        always steps one period, even an early one, but the count of where the physics is never
+        runs more than one period ahead of the clock, so early SYNCs do not eat later gaps.
         """
         now = self.clock.now_s()
         if self.physics_s is None:

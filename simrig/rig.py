@@ -3,12 +3,16 @@
 Lockstep (default): nothing runs by itself. Each :meth:`SimRig.exchange` reads every pending
 frame, advances the motors and the plant by one period on the rig's :class:`SimClock`, and sends
 the TPDOs due on the SYNC it saw, so a run is bit-for-bit repeatable for a given seed.
-Real time (``lockstep=False``): a thread serves the bus and steps the physics at each SYNC.
+Real time (``lockstep=False``): a thread serves the bus and keeps the physics on the wall clock,
+in whole periods: a SYNC steps one period with the targets it latches, and the periods no SYNC
+came for are stepped with the targets last latched (the drive holds them), so a late or missing
+SYNC does not slow the catheter down.
 """
 
 from __future__ import annotations
 
 import itertools
+import logging
 import os
 import threading
 from collections.abc import Mapping, Sequence
@@ -30,7 +34,11 @@ from simrig.plant import Plant, as_plant_step, load_plant
 from simrig.tracker import EmTracker
 
 DEFAULT_PLANT = "simrig.plants.capstan:make_tendon_sheath_plant"
+MAX_CATCH_UP_S = 0.25
+"""Longest gap the real-time rig steps through at once; the rest of a longer gap (the process
+stalled) is skipped and counted, not simulated in a CPU-burning burst."""
 _CHANNELS = itertools.count()
+_log = logging.getLogger(__name__)
 
 
 class CurrentMeasurement(Protocol):
@@ -60,16 +68,21 @@ class SimRig:
                  sensors: Sequence[CurrentMeasurement] | None = None,
                  current_sensor: Mapping[str, float] | None = None,
                  tracker: Any | None = None, tracker_noise_deg: float = 0.1,
-                 own_bus: bool = True) -> None:
+                 own_bus: bool = True, clock: Clock | None = None,
+                 max_catch_up_s: float = MAX_CATCH_UP_S) -> None:
         if len(drive_configs) != 2:
             raise ValueError(f"the rig drives two knobs, got {len(drive_configs)} drive configs")
+        if lockstep and clock is not None:
+            raise ValueError("a lockstep rig keeps its own simulated clock; clock is for real time")
         self.bus = bus
         self.plant = plant
         self.period_s = period_s
         self.seed = seed
         self.lockstep = lockstep
-        self.clock: Clock = SimClock() if lockstep else MonotonicClock()
-        self._sim_clock = self.clock if isinstance(self.clock, SimClock) else None
+        self.clock: Clock = SimClock() if lockstep else clock or MonotonicClock()
+        self._sim_clock = (self.clock if lockstep and isinstance(self.clock, SimClock)
+                           else None)
+        """The clock each lockstep step advances (a real-time rig only reads its clock)."""
         self._own_bus = own_bus
         self._send_owned = bus.send_owned if isinstance(bus, LockstepBus) else None
         self._take_frames = (bus.take_frames if isinstance(bus, LockstepBus) and bus.reads_frames
@@ -90,6 +103,12 @@ class SimRig:
         self._tip = np.zeros(2)
         self._torque = [0.0, 0.0]
         self.ticks = 0
+        self.max_catch_up_s = max_catch_up_s
+        self.physics_s: float | None = None
+        """Real time: the clock time the physics has been stepped to (None before serving)."""
+        self.stalls = 0
+        """Real time: gaps longer than ``max_catch_up_s``; ``stalled_s`` is the time skipped."""
+        self.stalled_s = 0.0
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self.error: BaseException | None = None
@@ -223,7 +242,7 @@ class SimRig:
 
     # -- real time -------------------------------------------------------------------------
     def start(self) -> None:
-        """Serve the bus from a thread (real-time mode): physics steps at each SYNC."""
+        """Serve the bus from a thread (real-time mode), the physics on the rig's clock."""
         if self.lockstep:
             raise RuntimeError("a lockstep rig is driven by exchange(), not a thread")
         self._stop.clear()
@@ -232,27 +251,58 @@ class SimRig:
 
     def _serve(self) -> None:
         try:
-            idle_after_s = 2.0 * self.period_s
-            last_step = self.clock.now_s()
+            wait_s = self.period_s / 4
             while not self._stop.is_set():
-                msg = self.bus.recv(self.period_s / 4)
-                now = self.clock.now_s()
-                if msg is not None:
-                    cid = msg.arbitration_id
-                    if cid == 0x080:
-                        for n in self.nodes:
-                            n.on_sync(now)
-                        self._advance(True)
-                        last_step = now
-                    elif not (msg.is_error_frame or msg.is_remote_frame
-                              or msg.is_extended_id):
-                        for n in self.nodes:
-                            n.on_frame(cid, msg.data, now)
-                if now - last_step > idle_after_s:  # no SYNC: keep heartbeats and timers going
-                    self._advance(False)
-                    last_step = now
+                self.serve(self.bus.recv(wait_s))
         except BaseException as exc:  # surfaced by stop()
             self.error = exc
+
+    def serve(self, msg: can.Message | None) -> None:
+        """One pass of the real-time server: handle ``msg`` (None: none came), then step the
+        physics through the whole periods the clock has gone past.
+
+        A SYNC first steps the periods before it under the old targets, then latches the new
+        RPDOs and steps its own period at once (the TPDO answers it, as in lockstep). A SYNC
+        always steps one period, even an early one, but the count of where the physics is never
+        runs more than one period ahead of the clock, so early SYNCs do not eat later gaps.
+        """
+        now = self.clock.now_s()
+        if self.physics_s is None:
+            self.physics_s = now
+        if msg is not None:
+            cid = msg.arbitration_id
+            if cid == 0x080:
+                self._catch_up(now)
+                for n in self.nodes:
+                    n.on_sync(now)
+                self._advance(True)
+                self.physics_s = min(self.physics_s + self.period_s, now + self.period_s)
+                return
+            if not (msg.is_error_frame or msg.is_remote_frame or msg.is_extended_id):
+                for n in self.nodes:
+                    n.on_frame(cid, msg.data, now)
+        self._catch_up(now)
+
+    def _catch_up(self, now_s: float) -> None:
+        """Step the periods between the physics and ``now_s`` that no SYNC stepped: each drive
+        keeps the target it latched last (CSP with no new target holds it)."""
+        period = self.period_s
+        physics_s = self.physics_s if self.physics_s is not None else now_s
+        steps = int((now_s - physics_s) / period)
+        if steps <= 0:
+            return
+        max_steps = max(1, int(self.max_catch_up_s / period))
+        if steps > max_steps:
+            skipped_s = (steps - max_steps) * period
+            self.stalls += 1
+            self.stalled_s += skipped_s
+            _log.warning("simulated rig stalled: %.3f s behind the clock, %.3f s of physics "
+                         "skipped", steps * period, skipped_s)
+            physics_s += skipped_s
+            steps = max_steps
+        for _ in range(steps):
+            self._advance(False)
+        self.physics_s = physics_s + steps * period
 
     def stop(self) -> None:
         self._stop.set()

@@ -99,6 +99,7 @@ def test_run_sim_with_duration_exits_0_with_a_summary(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     assert "ticks at 250 Hz" in proc.stdout
     assert "demo, compensation none" in proc.stdout
+    assert "simulated rig: " in proc.stdout
 
 
 def test_bad_config_is_refused_with_key_and_reason(tmp_path: Path) -> None:

@@ -163,6 +163,10 @@ def main(args: argparse.Namespace) -> int:
           f"{summary.overruns} overruns, lateness p99 {summary.lateness_p99_ms:.3f} ms "
           f"(max {summary.lateness_max_ms:.3f} ms), final state {summary.state}"
           + (f" ({summary.fault})" if summary.fault else ""))
+    rig = daemon.rig
+    if rig is not None:  # the simulated catheter keeps wall time: say so when it could not
+        print(f"  simulated rig: {rig.ticks} periods stepped, {rig.stalls} stalls"
+              + (f" ({rig.stalled_s:.3f} s of physics skipped)" if rig.stalls else ""))
     if demo is not None:
         for phase in demo.phases:
             rmse = phase.tip_rmse_deg()

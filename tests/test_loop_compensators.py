@@ -27,6 +27,19 @@ def ramp(a_deg: float, b_deg: float, duration_s: float) -> list[float]:
     return list(np.linspace(a_deg, b_deg, round(duration_s / PERIOD_S)))
 
 
+def enabled_sim_loop(compensator: Any, label: str, standby: Any = None
+                     ) -> tuple[ControlLoop, Any]:
+    """A lockstep loop on the sim rig (the packaged config's plant, seed 0), booted and
+    enabled; the caller closes the rig."""
+    drives, rig = open_sim(CONFIG, 0, lockstep=True)
+    loop = build_loop(CONFIG, drives, compensator, rig.clock, compensation_label=label,
+                      tip_source=rig.tip_pair, after_sync=rig.exchange, standby=standby)
+    drives.boot()
+    loop.tick()
+    loop.execute("enable")
+    return loop, rig
+
+
 @pytest.fixture(scope="module")
 def sim_profile() -> CatheterProfile:
     """The simulated catheter's own calibrated profile (what `tsmd run --sim` loads)."""
@@ -36,13 +49,8 @@ def sim_profile() -> CatheterProfile:
 @pytest.fixture
 def uncompensated_loop(sim_profile: CatheterProfile) -> Iterator[tuple[ControlLoop, object]]:
     """A lockstep loop on the simulated rig, compensation off, ours and paper standing by."""
-    drives, rig = open_sim(CONFIG, 0, lockstep=True)
-    loop = build_loop(CONFIG, drives, NoCompensation(), rig.clock, compensation_label="none",
-                      tip_source=rig.tip_pair, after_sync=rig.exchange,
-                      standby=make_standby(sim_profile, "ours", "none", CONFIG))
-    drives.boot()
-    loop.tick()
-    loop.execute("enable")
+    loop, rig = enabled_sim_loop(NoCompensation(), "none",
+                                 make_standby(sim_profile, "ours", "none", CONFIG))
     yield loop, rig
     rig.close()
 
@@ -98,13 +106,7 @@ class PostedNow:
 def test_the_api_switching_compensation_off_and_on_keeps_the_branch(
         sim_profile: CatheterProfile, tmp_path: Path) -> None:
     # what the README demo does: compensation off, knobs moved, compensation on
-    drives, rig = open_sim(CONFIG, 0, lockstep=True)
-    loop = build_loop(CONFIG, drives, make_compensator(sim_profile, "ours", CONFIG), rig.clock,
-                      compensation_label="ours", tip_source=rig.tip_pair,
-                      after_sync=rig.exchange)
-    drives.boot()
-    loop.tick()
-    loop.execute("enable")
+    loop, rig = enabled_sim_loop(make_compensator(sim_profile, "ours", CONFIG), "ours")
     service = Service(CONFIG, PostedNow(loop), sim_profile,  # type: ignore[arg-type]
                       CompensationChoice(True, "ours"), profiles_dir=tmp_path)
     try:
@@ -155,13 +157,7 @@ def demo_sine_rmse_after_load(late_every: int) -> tuple[float, float]:
     ``late_every``-th tick comes late by two periods (the client's sine moves on, the rig and the
     compensator advance one tick). Tip RMSE per knob over the last 10 s."""
     profile = load_profile(resolve_data_path("profiles/example-sim.yaml"))
-    drives, rig = open_sim(CONFIG, 0, lockstep=True)
-    loop = build_loop(CONFIG, drives, make_compensator(profile, "ours", CONFIG), rig.clock,
-                      compensation_label="ours", tip_source=rig.tip_pair,
-                      after_sync=rig.exchange)
-    drives.boot()
-    loop.tick()
-    loop.execute("enable")
+    loop, rig = enabled_sim_loop(make_compensator(profile, "ours", CONFIG), "ours")
     wall_s, k, errors = 0.0, 0, []
     while wall_s < 30.0:
         t_s = np.floor(wall_s * 50.0) / 50.0
@@ -188,13 +184,7 @@ def test_late_ticks_leave_no_lasting_error_once_the_load_is_gone() -> None:
 def test_nothing_moves_after_an_uncompensated_trajectory_ends(
         sim_profile: CatheterProfile) -> None:
     # a calibration sweep ends held at its last knob angle, which is not where the tip is
-    drives, rig = open_sim(CONFIG, 0, lockstep=True)
-    loop = build_loop(CONFIG, drives, make_compensator(sim_profile, "ours", CONFIG), rig.clock,
-                      compensation_label="ours", tip_source=rig.tip_pair,
-                      after_sync=rig.exchange)
-    drives.boot()
-    loop.tick()
-    loop.execute("enable")
+    loop, rig = enabled_sim_loop(make_compensator(sim_profile, "ours", CONFIG), "ours")
     path = np.column_stack([ramp(0.0, 60.0, 2.0) + ramp(60.0, 0.0, 2.0), np.zeros(1000)])
     playback = Playback(path, False, None)
     loop.execute("play", playback=playback)

@@ -328,10 +328,9 @@ def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 200
         t, q, skip = settle(*tip_sweep(knob, 0.0, period_s, RELEASE_READ_CYCLES), period_s)
         rec = run_trajectory(t, q, config=cfg, profile=None, method="none", seed=seed,
                              plant=plant_factory())
-        first = analysed_from(skip, period_s)
-        # the run is causal: its first ANALYSED_CYCLES are the short sweep's to the sample
-        out.append(knob_constants(rec, knob, first,
-                                  first + round(ANALYSED_CYCLES / SWEEP_HZ / period_s)))
+        # the run is causal: up to the short sweep's last sample it is the short sweep's
+        stop = skip + tip_sweep(knob, 0.0, period_s)[0].size
+        out.append(knob_constants(rec, knob, analysed_from(skip, period_s), stop))
     return out
 
 

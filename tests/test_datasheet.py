@@ -98,8 +98,8 @@ def test_plant_parameters_must_be_a_json_object(tmp_path: Path,
 
 
 def test_tip_measurements_skip_the_conditioning_cycle() -> None:
-    """Data-sheet sweeps analyse 2.25 cycles of +-90 deg after the plant has been through
-    every state once (its tension-free start is not the product's behaviour)."""
+    """A data-sheet sweep's whole-pass part is 2.25 cycles of +-90 deg after the plant has been
+    through every state once (its tension-free start is not the product's behaviour)."""
     assert CONDITIONING_CYCLES >= 1.0
     t, q = tip_sweep(1, 30.0, PERIOD_S)
     _, qq, skip = settle(t, q, PERIOD_S)

@@ -12,7 +12,14 @@ from support.profiles import DEVICE
 
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd.cli import main
-from tsmd.datasheet import CONDITIONING_CYCLES, analysed_from, knob_constants, settle, tip_sweep
+from tsmd.datasheet import (
+    CONDITIONING_CYCLES,
+    RELEASE_READ_CYCLES,
+    analysed_from,
+    knob_constants,
+    settle,
+    tip_sweep,
+)
 from tsmd.profile import DEFAULT_HANDLE_SLIP_DEG, load_device_model
 from tsmd.recording import Recording, read_recording, write_recording
 
@@ -91,8 +98,8 @@ def test_plant_parameters_must_be_a_json_object(tmp_path: Path,
 
 
 def test_tip_measurements_skip_the_conditioning_cycle() -> None:
-    """Data-sheet sweeps analyse 2.25 cycles of +-90 deg after the plant has been through
-    every state once (its tension-free start is not the product's behaviour)."""
+    """A data-sheet sweep's whole-pass part is 2.25 cycles of +-90 deg after the plant has been
+    through every state once (its tension-free start is not the product's behaviour)."""
     assert CONDITIONING_CYCLES >= 1.0
     t, q = tip_sweep(1, 30.0, PERIOD_S)
     _, qq, skip = settle(t, q, PERIOD_S)
@@ -151,3 +158,33 @@ def test_the_backlash_gain_uses_the_settle_rule_whatever_the_products_rule() -> 
         gains[name] = 0.5 * (sides[0].backlash_gain + sides[1].backlash_gain)
     assert abs(gains["product"] - gains["settle"]) > 0.01  # the two rules differ here
     assert c.backlash_gain == pytest.approx(gains["settle"], abs=0.005)
+
+
+def test_the_sheets_sweep_has_enough_reversals_for_its_release_reads() -> None:
+    """One reversal's release anchor scatters as much as the units' shares differ; the sheet
+    reads it over at least 40 reversals at +-90 deg per knob (docs/calibration.md, s8-acc2)."""
+    t, q = tip_sweep(0, 0.0, PERIOD_S, RELEASE_READ_CYCLES)
+    _, qq, skip = settle(t, q, PERIOD_S)
+    knob = qq[analysed_from(skip, PERIOD_S):, 0]
+    turns = np.flatnonzero(np.diff(np.sign(np.diff(knob))) != 0)
+    assert np.count_nonzero(np.abs(knob[turns + 1]) > 89.0) >= 40
+
+
+def test_release_reads_take_every_reversal_and_whole_pass_constants_the_first_cycles() -> None:
+    """``stop`` ends only the whole-pass constants (slopes, edges, gain: unchanged by a longer
+    sweep); the share and slope ratio are read at every reversal of the recording."""
+    from simrig.plants.lumped import make_lumped_plant
+
+    runner = LockstepPlantRunner(make_lumped_plant(), PERIOD_S, seed=0)
+    t, q, skip = settle(*tip_sweep(0, 0.0, PERIOD_S, 4.25), PERIOD_S)
+    rec = runner.run(t, q)
+    first = analysed_from(skip, PERIOD_S)
+    stop = first + round(2.25 / 0.04 / PERIOD_S)
+    long = knob_constants(rec, 0, first, stop)
+    short = knob_constants(Recording({k: v[:stop] for k, v in rec.columns.items()},
+                                     rec.metadata), 0, first)
+    assert short.release_reversals == 4 and long.release_reversals == 8
+    assert long.backlash_settle_fraction != short.backlash_settle_fraction
+    for name in ("omega", "release_omega", "dead_zone_pos_deg", "dead_zone_neg_deg",
+                 "backlash_gain", "dead_zone_offset_deg"):
+        assert getattr(long, name) == getattr(short, name)

@@ -6,11 +6,14 @@ adds the release slope, the backlash on the tip after the reversals at the refer
 how far beyond the current's dead-zone edge the tip leaves the plateau. All come from a +-90 deg,
 0.04 Hz sweep of each knob (other knob at 0 deg) with the tip tracked: on the simulator
 (:func:`measure_device_constants`) or on a tracked real unit's recordings (:func:`knob_constants`
-on each). The tip is used here only: this is the manufacturer's bench, not the robot.
+on each). The constants read once per reversal (release share, slope ratio, backlash) are read
+over ``RELEASE_READ_CYCLES``, the others over the first ``ANALYSED_CYCLES``. The tip is used here
+only: this is the manufacturer's bench, not the robot.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -42,6 +45,14 @@ from tsmd.stack import knob_limits
 SWEEP_HZ = 0.04
 SWEEP_AMPLITUDE_DEG = 90.0
 ANALYSED_CYCLES = 2.25
+"""Cycles whose whole passes give the slopes, reference points and dead-zone edges."""
+RELEASE_READ_CYCLES = 24.25
+"""Cycles read at their reversals (two per cycle at +-90 deg: 48) for the release share, the
+release-to-loaded slope ratio and the reference backlash. One reversal's share + 0.24 x ratio
+(the per-unit share's anchor) scatters by 0.009 (sd, lumped unit 0), more than the units'
+shares differ (0.008): over 4 reversals the anchor spread 0.966-0.980 over sheet seeds (about
+1 deg on every unit's B); over 48 its sd is 0.0015, a fifth of the units' (docs/calibration.md,
+session 8, s8-acc2). A product's sheet is measured once on a bench: its sweep may be long."""
 CONDITIONING_CYCLES = 1.0
 """Sweep cycles run before a tip measurement is analysed. The plant starts tension-free
 (virgin): its first release rests higher and its first engagement of the antagonist comes
@@ -86,6 +97,8 @@ class KnobConstants:
     (:func:`backlash_settle_fraction`; None: no reversal could be measured)."""
     backlash_release_slope_ratio: float | None = None
     """The current's release-to-loaded slope ratio there (:func:`backlash_release_slope_ratio`)."""
+    release_reversals: int = 0
+    """How many reversals gave the two above (:func:`release_reads`)."""
 
     def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
         """The data sheet's knob entry, rounded as a data sheet is printed."""
@@ -130,10 +143,10 @@ def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float
     return tt.astype(float), full, len(head)
 
 
-def tip_sweep(knob: int, other_deg: float, period_s: float
+def tip_sweep(knob: int, other_deg: float, period_s: float, cycles: float = ANALYSED_CYCLES
               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """A +-90 deg, 0.04 Hz sweep of ``knob`` (2.25 cycles after the conditioning cycles)."""
-    t = np.arange(0.0, (CONDITIONING_CYCLES + ANALYSED_CYCLES) / SWEEP_HZ, period_s)
+    """A +-90 deg, 0.04 Hz sweep of ``knob`` (``cycles`` after the conditioning cycles)."""
+    t = np.arange(0.0, (CONDITIONING_CYCLES + cycles) / SWEEP_HZ, period_s)
     q = np.zeros((t.size, 2))
     q[:, knob] = SWEEP_AMPLITUDE_DEG * np.sin(2 * math.pi * SWEEP_HZ * t)
     q[:, 1 - knob] = other_deg
@@ -151,8 +164,21 @@ def swept_knob(rec: Recording) -> int:
     return int(np.argmax(spans))
 
 
-def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
-    """The data-sheet constants of ``knob`` from a tracked sweep, analysed from row ``start``."""
+def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None = None
+                   ) -> KnobConstants:
+    """The data-sheet constants of ``knob`` from a tracked sweep, analysed from row ``start``:
+    the whole-pass constants up to row ``stop`` (None: the end), the reversal reads (release
+    share and slope ratio, reference backlash) over every reversal to the end."""
+    if stop is not None:
+        whole = knob_constants(Recording({k: v[:stop] for k, v in rec.columns.items()},
+                                         rec.metadata), knob, start)
+        ends = knob_constants(rec, knob, start)
+        return dataclasses.replace(
+            whole, reference_backlash_pos_deg=ends.reference_backlash_pos_deg,
+            reference_backlash_neg_deg=ends.reference_backlash_neg_deg,
+            backlash_settle_fraction=ends.backlash_settle_fraction,
+            backlash_release_slope_ratio=ends.backlash_release_slope_ratio,
+            release_reversals=ends.release_reversals)
     if not rec.has_tip:
         raise DatasheetError("the recording has no tip angles (tip1, tip2): a data sheet "
                              "needs a tracker on the tip")
@@ -199,6 +225,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
     if not loaded or not released:
         raise DatasheetError(f"knob {knob + 1}: no complete pass to fit the tip/knob slopes")
     top = SWEEP_AMPLITUDE_DEG - REFERENCE_BAND_DEG
+    reads = release_reads(cur.data, t, tip)
     return KnobConstants(
         omega=float(np.median(loaded)), release_omega=float(np.median(released)),
         reference_pos=ReferencePoint(SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos > top]))),
@@ -208,8 +235,8 @@ def knob_constants(rec: Recording, knob: int, start: int = 0) -> KnobConstants:
         dead_zone_offset_deg=float(dz_offset),
         dead_zone_pos_deg=_finite_or_none(cur.estimate("dead_zone_pos_deg")),
         dead_zone_neg_deg=_finite_or_none(cur.estimate("dead_zone_neg_deg")), backlash_gain=gain,
-        backlash_settle_fraction=backlash_settle_fraction(cur.data, t, tip),
-        backlash_release_slope_ratio=backlash_release_slope_ratio(cur.data, t, tip))
+        backlash_settle_fraction=median_share(reads),
+        backlash_release_slope_ratio=median_ratio(reads), release_reversals=len(reads))
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -222,8 +249,7 @@ def backlash_settle_fraction(data: Conditioned, tip_t_s: NDArray[np.float64],
     """How far the (filtered) current has come back when the tip starts to move after a
     reversal at the sweep's ends, as a share of its swing from the loaded current to the
     release level; median over the reversals (:func:`release_reads`)."""
-    reads = release_reads(data, tip_t_s, tip_deg, options)
-    return float(np.median([share for share, _ in reads])) if reads else None
+    return median_share(release_reads(data, tip_t_s, tip_deg, options))
 
 
 def backlash_release_slope_ratio(data: Conditioned, tip_t_s: NDArray[np.float64],
@@ -232,7 +258,17 @@ def backlash_release_slope_ratio(data: Conditioned, tip_t_s: NDArray[np.float64]
     """The current's release-to-loaded slope ratio after the tip's release
     (:func:`tsmd.calibration.pieces.release_slope_ratio`), median over the reversals: the
     anchor from which each calibrated unit's own ratio moves the share."""
-    ratios = [r for _, r in release_reads(data, tip_t_s, tip_deg, options) if math.isfinite(r)]
+    return median_ratio(release_reads(data, tip_t_s, tip_deg, options))
+
+
+def median_share(reads: Sequence[tuple[float, float]]) -> float | None:
+    """The sheet's release share: median over the reversals' reads (None: no reversal)."""
+    return float(np.median([share for share, _ in reads])) if reads else None
+
+
+def median_ratio(reads: Sequence[tuple[float, float]]) -> float | None:
+    """The sheet's slope ratio: median over the reversals' finite reads (None: none)."""
+    ratios = [r for _, r in reads if math.isfinite(r)]
     return float(np.median(ratios)) if ratios else None
 
 
@@ -282,15 +318,19 @@ def release_reads(data: Conditioned, tip_t_s: NDArray[np.float64], tip_deg: NDAr
 def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 2000,
                              config: TsmdConfig | None = None) -> list[KnobConstants]:
     """Both knobs' constants on the simulated rig: each knob swept through the full stack
-    (uncompensated, other knob at 0), analysed after ``CONDITIONING_CYCLES``."""
+    (uncompensated, other knob at 0) for ``RELEASE_READ_CYCLES``, analysed after
+    ``CONDITIONING_CYCLES`` (:func:`knob_constants`: the whole-pass constants on the first
+    ``ANALYSED_CYCLES``)."""
     cfg = config if config is not None else default_sim_config()
     period_s = cfg.loop.period_s
     out = []
     for knob in (0, 1):
-        t, q, skip = settle(*tip_sweep(knob, 0.0, period_s), period_s)
+        t, q, skip = settle(*tip_sweep(knob, 0.0, period_s, RELEASE_READ_CYCLES), period_s)
         rec = run_trajectory(t, q, config=cfg, profile=None, method="none", seed=seed,
                              plant=plant_factory())
-        out.append(knob_constants(rec, knob, analysed_from(skip, period_s)))
+        # the run is causal: up to the short sweep's last sample it is the short sweep's
+        stop = skip + tip_sweep(knob, 0.0, period_s)[0].size
+        out.append(knob_constants(rec, knob, analysed_from(skip, period_s), stop))
     return out
 
 

@@ -16,7 +16,9 @@ from simrig.plant import Plant, load_plant
 from tsmd import __version__
 from tsmd.config import DEFAULT_CONFIG_PATH, default_sim_config, load_config
 from tsmd.datasheet import (
+    ANALYSED_CYCLES,
     CONDITIONING_CYCLES,
+    RELEASE_READ_CYCLES,
     SWEEP_AMPLITUDE_DEG,
     SWEEP_HZ,
     DatasheetError,
@@ -76,6 +78,10 @@ def _from_recordings(paths: list[str]) -> list[KnobConstants]:
     return [by_knob[0], by_knob[1]]
 
 
+def _or_none(value: float | None, decimals: int) -> str:
+    return "none" if value is None else f"{value:.{decimals}f}"
+
+
 def main(args: argparse.Namespace) -> int:
     if args.params is not None and args.plant is None:
         raise DatasheetError("--params goes with --plant")
@@ -89,7 +95,8 @@ def main(args: argparse.Namespace) -> int:
 
         constants = measure_device_constants(factory, args.seed, config)
         source = (f"the simulated rig, plant {args.plant} with {json.dumps(params)}, seed "
-                  f"{args.seed}")
+                  f"{args.seed}, {RELEASE_READ_CYCLES:g} cycles per knob (whole passes: the "
+                  f"first {ANALYSED_CYCLES:g})")
     else:
         constants = _from_recordings(args.from_recording)
         config = load_config(args.config if args.config is not None else DEFAULT_CONFIG_PATH)
@@ -105,6 +112,9 @@ def main(args: argparse.Namespace) -> int:
         print(f"{name}: omega {c.omega:.2f}, release_omega {c.release_omega:.2f}, reference "
               f"tip {c.reference_pos.tip_deg:.2f}/{c.reference_neg.tip_deg:.2f} deg, backlash "
               f"{c.reference_backlash_pos_deg:.2f}/{c.reference_backlash_neg_deg:.2f} deg, "
-              f"dead-zone offset {c.dead_zone_offset_deg:.2f} deg")
+              f"dead-zone offset {c.dead_zone_offset_deg:.2f} deg, release share "
+              f"{_or_none(c.backlash_settle_fraction, 3)} and slope ratio "
+              f"{_or_none(c.backlash_release_slope_ratio, 4)} over {c.release_reversals} "
+              f"reversals")
     print(f"tsmd datasheet: wrote {args.out}")
     return 0

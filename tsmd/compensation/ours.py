@@ -154,8 +154,8 @@ class OursCompensator:
             kc.omega = knob.omega
             kc.plateau_lo_deg = min(knob.height_pos_deg, knob.height_neg_deg)
             kc.plateau_hi_deg = max(knob.height_pos_deg, knob.height_neg_deg)
-            kc.fresh_hi_deg = knob.height_neg_deg + knob.omega * knob.fresh_hold_deg
-            kc.fresh_lo_deg = knob.height_pos_deg - knob.omega * knob.fresh_hold_deg
+            kc.fresh_hi_deg = knob.height_neg_deg
+            kc.fresh_lo_deg = knob.height_pos_deg
 
     def replace_knobs(self, knobs: tuple[OursKnob, OursKnob]) -> None:
         """New parameters from the next tick on, state kept (online re-estimation)."""

@@ -56,6 +56,7 @@ class KnobCommand:
         self.first_side = 0
         """The side a fresh knob loaded first (+1, -1; 0: not yet)."""
         self.fresh_hi_deg = self.fresh_lo_deg = 0.0
+        """Where a fresh knob's first release has ended (the falling / rising plateau)."""
         self.reset(PlayState(0.0, 0.0, 1, 0.0), 0.0, 1)
 
     def reset(self, state: PlayState, q_deg: float, n_avg: int) -> None:

@@ -287,15 +287,17 @@ def fresh_branches(b: Branches, omega: float, d_pos: float, d_neg: float, h_pos:
                     widest_flat(xs, hi, omega))
 
 
-def fresh_state_ends(state: PlayState, first_side: int, hold_hi_deg: float,
-                     hold_lo_deg: float, margin_deg: float = 0.5) -> bool:
-    """True once a fresh knob's first release has handed over to the other tendon: after a
-    first positive loading the output went below the hold (or the peak, if lower), after a
-    negative one above it."""
+def fresh_state_ends(state: PlayState, first_side: int, h_pos: float, h_neg: float,
+                     margin_deg: float = 0.5) -> bool:
+    """True once a fresh knob's first release has handed over to the other tendon for good:
+    after a first positive loading the output went below the falling plateau ``h_neg`` (on the
+    negative loaded line, where the fresh and the conditioned branches agree), mirrored after a
+    negative one. Above it the conditioned model's falling branch is the release line, which
+    the tip on the loaded line is not on."""
     if first_side > 0 and state.direction < 0:
-        return state.y_deg < min(hold_hi_deg, state.held_deg) - margin_deg
+        return state.y_deg < h_neg - margin_deg
     if first_side < 0 and state.direction > 0:
-        return state.y_deg > max(hold_lo_deg, state.held_deg) + margin_deg
+        return state.y_deg > h_pos + margin_deg
     return False
 
 

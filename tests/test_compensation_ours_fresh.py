@@ -19,6 +19,9 @@ from tsmd.compensation.tension_play import (
     tension_play_from_mapping,
     tension_play_to_mapping,
 )
+from tsmd.config import load_config
+from tsmd.profile import load_profile
+from tsmd.stack import make_compensator
 
 PERIOD_S = 0.004
 LIMITS = KnobLimits(-90.0, 90.0, 120.0, 2000.0)
@@ -73,8 +76,9 @@ def test_without_a_fresh_hold_the_branches_are_the_conditioned_ones() -> None:
     assert fresh_branches(b, OMEGA, D_POS, D_NEG, H_POS, H_NEG, 0.0) is b
 
 
-def run(hold_deg: float, q: np.ndarray) -> np.ndarray:
-    comp = OursCompensator(ours_knobs([params(hold_deg)] * 2), PERIOD_S, (LIMITS, LIMITS))
+def run(hold_deg: float, q: np.ndarray, fresh_catheter: bool = True) -> np.ndarray:
+    comp = OursCompensator(ours_knobs([params(hold_deg)] * 2), PERIOD_S, (LIMITS, LIMITS),
+                           fresh_catheter=fresh_catheter)
     comp.reset(np.zeros(2))
     return np.array([comp.command(np.array([v, 0.0]))[0] for v in q])
 
@@ -89,6 +93,11 @@ def test_after_reset_the_first_release_crosses_the_fresh_hold() -> None:
     fresh, conditioned = run(10.0, q), run(0.0, q)
     # going down through the hold the fresh command is lower by up to the hold
     assert np.min(fresh - conditioned) < -8.0
+
+
+def test_a_catheter_not_said_to_be_fresh_starts_conditioned_whatever_the_profile() -> None:
+    q = cycles(1)
+    assert np.array_equal(run(10.0, q, fresh_catheter=False), run(0.0, q))
 
 
 def test_after_the_first_release_the_commands_are_the_conditioned_ones() -> None:
@@ -110,3 +119,13 @@ def test_a_negative_fresh_hold_is_refused_naming_the_key() -> None:
     m = tension_play_to_mapping(params(0.0)) | {"fresh_hold_deg": -1.0}
     with pytest.raises(ValueError, match="fresh_hold_deg"):
         tension_play_from_mapping(m)
+
+
+def test_the_configuration_tells_the_stack_that_the_catheter_is_fresh(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    path = tmp_path / "tsmd.yaml"
+    path.write_text("compensation: {method: ours, fresh_catheter: true}\n")
+    config = load_config(path)
+    assert config.compensation.fresh_catheter is True
+    profile = load_profile("profiles/example-sim.yaml")
+    comp = make_compensator(profile, "ours", config)
+    assert getattr(comp, "fresh_catheter", None) is True

@@ -124,7 +124,8 @@ class OursCompensator:
     """
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,
-                 limits: Sequence[KnobLimits] | None = None, smoothing_s: float = 0.1) -> None:
+                 limits: Sequence[KnobLimits] | None = None, smoothing_s: float = 0.1,
+                 fresh_catheter: bool = False) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be positive, got {period_s}")
         if limits is None:  # the simulated rig's drives, no position limit
@@ -132,6 +133,9 @@ class OursCompensator:
         if len(limits) != 2:
             raise ValueError(f"need limits for 2 knobs, got {len(limits)}")
         self.knobs = knobs
+        self.fresh_catheter = fresh_catheter
+        """The catheter was never loaded when reset (only the bench's fresh plant, or a new
+        catheter with a product profile): ``reset`` starts on the fresh branches."""
         self.period_s = period_s
         self.limits = (limits[0], limits[1])
         # jumps are planned with the slower knob's limits
@@ -163,11 +167,11 @@ class OursCompensator:
         self._set_constants()
 
     def reset(self, q_deg: NDArray[np.float64]) -> None:
-        """At rest at ``q_deg`` on a fresh catheter (straight, never loaded): a knob whose
-        profile knows the fresh hold (``fresh_hold_deg``) uses the fresh branches until its
-        first release has ended."""
+        """At rest at ``q_deg``. On a fresh catheter (``fresh_catheter``: straight, never
+        loaded) a knob whose profile knows the fresh hold (``fresh_hold_deg``) uses the fresh
+        branches until its first release has ended."""
         q = [float(v) if math.isfinite(v) else 0.0 for v in np.asarray(q_deg, dtype=float)]
-        fresh = [k.fresh_hold_deg > 0.0 for k in self.knobs]
+        fresh = [self.fresh_catheter and k.fresh_hold_deg > 0.0 for k in self.knobs]
         x = [0.0, 0.0]
         states = [PlayState(0.0, 0.0, 1, 0.0)] * 2
         for _ in range(3):  # each knob's branches depend on the other knob's command

@@ -36,7 +36,8 @@ def test_a_sweep_on_a_loaded_catheter_shows_almost_none(first_sweep_twice) -> No
 
 def test_only_the_knob_swept_first_gets_the_hold(first_sweep_twice) -> None:  # type: ignore[no-untyped-def]
     fresh, _ = first_sweep_twice
-    params = [dataclasses.make_dataclass("P", [("fresh_hold_deg", float)])(0.0) for _ in (0, 1)]
+    fields = [("fresh_hold_deg", float), ("fresh_edge_delay_deg", float)]
+    params = [dataclasses.make_dataclass("P", fields)(0.0, 0.0) for _ in (0, 1)]
     out = with_fresh_hold(params, [fresh])
     assert out[fresh.knob].fresh_hold_deg > 0.0
     assert out[1 - fresh.knob].fresh_hold_deg == 0.0

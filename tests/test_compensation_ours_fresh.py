@@ -48,7 +48,7 @@ def drive(b, path):  # type: ignore[no-untyped-def]
 
 
 def test_a_fresh_first_release_holds_where_the_other_loaded_line_is_hold_deg_inside() -> None:
-    b = fresh_branches(conditioned_branches(), OMEGA, D_POS, D_NEG, H_POS, H_NEG, 10.0)
+    b = fresh_branches(conditioned_branches(), OMEGA, D_POS, D_NEG, H_POS, H_NEG, 10.0, side=1)
     down = np.linspace(70.0, -60.0, 1301)
     y = drive(b, np.concatenate([np.linspace(0.0, 70.0, 701), down]))[701:]
     hold = H_NEG + OMEGA * 10.0
@@ -59,14 +59,14 @@ def test_a_fresh_first_release_holds_where_the_other_loaded_line_is_hold_deg_ins
 
 
 def test_a_fresh_release_from_below_the_hold_stays_at_its_peak() -> None:
-    b = fresh_branches(conditioned_branches(), OMEGA, D_POS, D_NEG, H_POS, H_NEG, 10.0)
+    b = fresh_branches(conditioned_branches(), OMEGA, D_POS, D_NEG, H_POS, H_NEG, 10.0, side=1)
     y = drive(b, np.concatenate([np.linspace(0.0, 28.0, 281), np.linspace(28.0, -5.0, 331)]))
     assert y[280] < H_NEG + OMEGA * 10.0
     assert np.allclose(y[281:], y[280], atol=1e-3)
 
 
 def test_a_fresh_negative_first_release_holds_mirrored() -> None:
-    b = fresh_branches(conditioned_branches(), OMEGA, D_POS, D_NEG, H_POS, H_NEG, 10.0)
+    b = fresh_branches(conditioned_branches(), OMEGA, D_POS, D_NEG, H_POS, H_NEG, 10.0, side=-1)
     y = drive(b, np.concatenate([np.linspace(0.0, -70.0, 701), np.linspace(-70.0, 5.0, 751)]))
     assert y[-1] == pytest.approx(H_POS - OMEGA * 10.0, abs=1e-3)
 
@@ -74,6 +74,19 @@ def test_a_fresh_negative_first_release_holds_mirrored() -> None:
 def test_without_a_fresh_hold_the_branches_are_the_conditioned_ones() -> None:
     b = conditioned_branches()
     assert fresh_branches(b, OMEGA, D_POS, D_NEG, H_POS, H_NEG, 0.0) is b
+
+
+def test_a_fresh_first_loading_leaves_straight_at_the_delayed_edge() -> None:
+    b = fresh_branches(conditioned_branches(), OMEGA, D_POS, D_NEG, H_POS, H_NEG, 10.0, 1.0)
+    x = np.linspace(0.0, 60.0, 601)
+    state = PlayState(0.0, 0.0, 1, 0.0)  # straight, at rest
+    y = []
+    for xi in x:
+        state = model_step(state, float(xi), b)
+        y.append(state.y_deg)
+    loaded = x > D_POS + 2.0
+    assert np.allclose(np.array(y)[loaded], OMEGA * (x[loaded] - D_POS - 1.0), atol=1e-3)
+    assert np.allclose(np.array(y)[x < D_POS + 1.0], 0.0, atol=1e-3)
 
 
 def run(hold_deg: float, q: np.ndarray, fresh_catheter: bool = True) -> np.ndarray:

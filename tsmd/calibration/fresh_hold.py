@@ -25,26 +25,40 @@ from tsmd.calibration.signal import Conditioned
 
 def fresh_hold_deg(data: Conditioned, options: IdentifyOptions | None = None) -> float:
     """The first release's edge minus the same side's median edge after it (0 if none)."""
+    return fresh_differences(data, options)[0]
+
+
+def fresh_differences(data: Conditioned, options: IdentifyOptions | None = None
+                      ) -> tuple[float, float]:
+    """(hold, edge delay) in knob degrees from a first sweep that starts fresh: the hold as in
+    :func:`fresh_hold_deg`; the edge delay: how much later the first loading's edge lies than
+    the same side's median edge on the later loadings (0 where not seen)."""
     opts = options or IdentifyOptions()
     halves = split_half_cycles(data.cmd_deg, opts.min_reversal_deg)
     if len(halves) < 3:
-        return 0.0
+        return 0.0, 0.0
     first_dir = halves[0][0]
-    edges = [analyse_half_cycle(data, d, a, b, after, opts).edge_deg
-             for d, a, b, after in halves[1:] if d == -first_dir]
-    later = [e for e in edges[1:] if math.isfinite(e)]
-    if not edges or not math.isfinite(edges[0]) or not later:
-        return 0.0
-    # after a positive first loading the negative edge lies higher (mirrored after a negative)
-    hold = first_dir * (edges[0] - float(np.median(later)))
-    return min(max(hold, 0.0), 90.0)
+    edges = [(d, analyse_half_cycle(data, d, a, b, after, opts).edge_deg)
+             for d, a, b, after in halves]
+    out = []
+    for side in (-first_dir, first_dir):
+        mine = [e for d, e in edges if d == side]  # that direction's edges, first one first
+        later = [e for e in mine[1:] if math.isfinite(e)]
+        if not mine or not math.isfinite(mine[0]) or not later:
+            out.append(0.0)
+            continue
+        # how much later the first edge of that direction lies (for the other side, the
+        # first release: the other tendon takes over later)
+        out.append(first_dir * (mine[0] - float(np.median(later))))
+    return min(max(out[0], 0.0), 90.0), min(max(out[1], -45.0), 45.0)
 
 
 def with_fresh_hold(params: Sequence[Any], points: Sequence[Any]) -> tuple[Any, ...]:
-    """``params`` (per knob) with the first sweep's knob's ``fresh_hold_deg``."""
+    """``params`` (per knob) with the first sweep's knob's ``fresh_hold_deg`` and
+    ``fresh_edge_delay_deg``."""
     if not points:
         return tuple(params)
     first = points[0]
-    hold = fresh_hold_deg(first.result.data)
-    return tuple(replace(p, fresh_hold_deg=hold) if k == first.knob else p
-                 for k, p in enumerate(params))
+    hold, delay = fresh_differences(first.result.data)
+    return tuple(replace(p, fresh_hold_deg=hold, fresh_edge_delay_deg=delay) if k == first.knob
+                 else p for k, p in enumerate(params))

@@ -73,8 +73,10 @@ class OursKnob:
     height_neg_deg: float
     lag_s: float = 0.0
     fresh_hold_deg: float = 0.0
+    fresh_edge_delay_deg: float | None = None
     _table: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
-    _fresh: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
+    _fresh: tuple[tuple[Branches, ...], ...] = dataclasses.field(init=False, repr=False,
+                                                                 compare=False)
     _lo: float = dataclasses.field(init=False, repr=False, compare=False)
     _step: float = dataclasses.field(init=False, repr=False, compare=False)
 
@@ -88,9 +90,11 @@ class OursKnob:
         rows = [[float(v) for v in self.field.at(lo + i * step)] for i in range(n)]
         w, h_pos, h_neg = self.omega, self.height_pos_deg, self.height_neg_deg
         table = tuple(branches(w, h_pos, h_neg, *r) for r in rows)
-        fresh = table if self.fresh_hold_deg <= 0.0 else tuple(
-            fresh_branches(b, w, r[0], r[1], h_pos, h_neg, self.fresh_hold_deg)
-            for b, r in zip(table, rows, strict=True))
+        # a fresh knob's tables by the side it loaded first: -1, none yet, +1
+        fresh = tuple(tuple(fresh_branches(b, w, r[0], r[1], h_pos, h_neg, self.fresh_hold_deg,
+                                           self.fresh_edge_delay_deg, side)
+                            for b, r in zip(table, rows, strict=True))
+                      for side in (-1, 0, 1)) if self.is_fresh_known else (table,) * 3
         object.__setattr__(self, "_table", table)
         object.__setattr__(self, "_fresh", fresh)
         object.__setattr__(self, "_lo", lo)
@@ -99,12 +103,20 @@ class OursKnob:
     @classmethod
     def from_params(cls, p: TensionPlayParams, interpolation: str = "pchip") -> OursKnob:
         return cls(ParameterField(p.other_knob_deg, p.columns(), interpolation, OURS_COLUMNS),
-                   p.omega, p.height_pos_deg, p.height_neg_deg, p.lag_s, p.fresh_hold_deg)
+                   p.omega, p.height_pos_deg, p.height_neg_deg, p.lag_s, p.fresh_hold_deg,
+                   # the profile's fresh numbers come together from one first sweep
+                   p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None)
 
-    def at(self, other_deg: float, fresh: bool = False) -> Branches:
+    @property
+    def is_fresh_known(self) -> bool:
+        """The profile says how a fresh catheter differs (else it is taken as conditioned)."""
+        return self.fresh_hold_deg > 0.0 or self.fresh_edge_delay_deg is not None
+
+    def at(self, other_deg: float, fresh: bool = False, side: int = 0) -> Branches:
         """The branches at the other knob's angle (nearest table row, clamped to the grid);
-        ``fresh``: those of a fresh catheter before its first release has ended."""
-        table = self._fresh if fresh else self._table
+        ``fresh``: those of a fresh catheter before its first release has ended, loaded first
+        on ``side`` (0: not yet)."""
+        table = self._fresh[side + 1] if fresh else self._table
         if other_deg != other_deg:  # NaN
             return table[0]
         i = int((other_deg - self._lo) / self._step + 0.5)
@@ -171,7 +183,7 @@ class OursCompensator:
         loaded) a knob whose profile knows the fresh hold (``fresh_hold_deg``) uses the fresh
         branches until its first release has ended."""
         q = [float(v) if math.isfinite(v) else 0.0 for v in np.asarray(q_deg, dtype=float)]
-        fresh = [self.fresh_catheter and k.fresh_hold_deg > 0.0 for k in self.knobs]
+        fresh = [self.fresh_catheter and k.is_fresh_known for k in self.knobs]
         x = [0.0, 0.0]
         states = [PlayState(0.0, 0.0, 1, 0.0)] * 2
         for _ in range(3):  # each knob's branches depend on the other knob's command
@@ -192,8 +204,8 @@ class OursCompensator:
 
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         k0, k1 = self._k
-        b0 = self.knobs[0].at(k1.state.x_deg, k0.fresh)
-        b1 = self.knobs[1].at(k0.state.x_deg, k1.fresh)
+        b0 = self.knobs[0].at(k1.state.x_deg, k0.fresh, k0.first_side)
+        b1 = self.knobs[1].at(k0.state.x_deg, k1.fresh, k1.first_side)
         slot = self._slot
         period = self.period_s
         planner = self._planner
@@ -229,8 +241,8 @@ class OursCompensator:
                 kc.target = qi
                 kc.still_s = 0.0  # no dwell before this compensator has brought the tip to q
             if x - x == 0.0:
-                kc.state = model_step(kc.state, x, self.knobs[i].at(float(motor_deg[1 - i]),
-                                                                    kc.fresh))
+                b = self.knobs[i].at(float(motor_deg[1 - i]), kc.fresh, kc.first_side)
+                kc.state = model_step(kc.state, x, b)
                 if kc.fresh:
                     _fresh_progress(kc)
                 kc.out = x

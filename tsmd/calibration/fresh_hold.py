@@ -22,6 +22,13 @@ from tsmd.calibration.identify import analyse_half_cycle, split_half_cycles
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.signal import Conditioned
 
+MIN_HOLD_DEG = 2.0
+"""A smaller hold is not a fresh release: the edges of one sweep repeat within 0.25-0.5 deg and
+the first move runs at another speed than the sweep. Without a fresh release seen, the first
+loading's edge delay is not taken either: on the capstan plant both come from the fresh
+tendons and come together; a plant whose first sweep shows no hold (the lumped plant: 0-0.5
+deg, with edge delays of 0.9-2.1 deg) starts like a conditioned one."""
+
 
 def fresh_hold_deg(data: Conditioned, options: IdentifyOptions | None = None) -> float:
     """The first release's edge minus the same side's median edge after it (0 if none)."""
@@ -50,7 +57,9 @@ def fresh_differences(data: Conditioned, options: IdentifyOptions | None = None
         # how much later the first edge of that direction lies (for the other side, the
         # first release: the other tendon takes over later)
         out.append(first_dir * (mine[0] - float(np.median(later))))
-    return min(max(out[0], 0.0), 90.0), min(max(out[1], -45.0), 45.0)
+    if out[0] < MIN_HOLD_DEG:
+        return 0.0, 0.0
+    return min(out[0], 90.0), min(max(out[1], -45.0), 45.0)
 
 
 def with_fresh_hold(params: Sequence[Any], points: Sequence[Any]) -> tuple[Any, ...]:

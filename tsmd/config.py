@@ -129,6 +129,9 @@ class ProfilesConfig:
 class CompensationConfig:
     method: CompensationMethod = "ours"
     enabled: bool = True
+    fresh_catheter: bool = False
+    """The catheter starts never loaded (straight, as made): ours' first release follows the
+    profile's fresh hold. False: it has been loaded before (calibrated), the usual case."""
 
 
 @dataclass(frozen=True)

@@ -58,7 +58,8 @@ def make_compensator(profile: CatheterProfile | None, method: str,
         method = "none"
     try:
         return build_compensator(profile, method, config.loop.period_s, knob_limits(config),
-                                 apply_limits=False)
+                                 apply_limits=False,
+                                 fresh_catheter=config.compensation.fresh_catheter)
     except (ValueError, TsmdError) as exc:
         raise StackError(f"cannot build the {method!r} compensator for "
                          f"{getattr(profile, 'catheter_id', '?')}: {exc}",

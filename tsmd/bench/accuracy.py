@@ -13,7 +13,7 @@ import argparse
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -35,7 +35,7 @@ from tsmd.calibration import calibrate
 from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
 from tsmd.compensation import LimitedCompensator, build_compensator
 from tsmd.compensation.grid import CALIBRATION_GRID_DEG
-from tsmd.config import resolve_data_path
+from tsmd.config import default_sim_config, resolve_data_path
 from tsmd.datasheet import analysed_from, settle, tip_sweep
 from tsmd.errors import TsmdError
 from tsmd.profile import (
@@ -63,8 +63,13 @@ def tracking_errors(tip_deg: NDArray[np.float64], q_deg: NDArray[np.float64]
 
 
 def _run(t: NDArray[np.float64], q: NDArray[np.float64], profile: Any, method: str, seed: int,
-         plant: Any) -> Any:
-    return run_trajectory(t, q, profile=profile, method=method, seed=seed, plant=plant)
+         plant: Any, fresh: bool = False) -> Any:
+    config = None
+    if fresh:  # the compensator is told that the plant starts never loaded
+        base = default_sim_config()
+        config = replace(base, compensation=replace(base.compensation, fresh_catheter=True))
+    return run_trajectory(t, q, config=config, profile=profile, method=method, seed=seed,
+                          plant=plant)
 
 
 def make_plant(coupling: float, unit_variation: float = 0.0, unit_seed: int = 0) -> Any:
@@ -144,7 +149,8 @@ class RunResult:
 def run_scenario(s: Scenario, method: str, seed: int, profile: Any,
                  plant_factory: Callable[[], Any], condition: bool = False) -> RunResult:
     tt, qq, skip = conditioned(s.t_s, s.q_deg, condition)
-    rec = _run(tt, qq, profile if method != "none" else None, method, seed, plant_factory())
+    rec = _run(tt, qq, profile if method != "none" else None, method, seed, plant_factory(),
+               not condition)
     tip = np.column_stack([rec["tip1"], rec["tip2"]])[skip:]
     cmd = np.column_stack([rec["cmd1"], rec["cmd2"]])[skip:]
     q = qq[skip:]

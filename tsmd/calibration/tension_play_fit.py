@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.calibration.fresh_hold import with_fresh_hold
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
 from tsmd.calibration.signal import Conditioned
@@ -325,8 +326,10 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
 
 
 def fit_from_points(points: Sequence[Any], device: Any) -> tuple[TensionPlayParams, ...]:
-    """Both knobs' parameters from the calibration's grid points and the data sheet."""
-    return tuple(fit_tension_play(sweeps_from_points(points, k), device.knobs[k]) for k in (0, 1))
+    """Both knobs' parameters from the calibration's grid points and the data sheet (the
+    first sweep's knob also with its fresh hold, :mod:`tsmd.calibration.fresh_hold`)."""
+    params = [fit_tension_play(sweeps_from_points(points, k), device.knobs[k]) for k in (0, 1)]
+    return with_fresh_hold(params, points)
 
 
 def with_tension_play(profile: Any, points: Sequence[Any], device: Any) -> Any:

@@ -157,7 +157,8 @@ def paper_compensator(profile: CatheterProfile) -> PaperCompensator:
 
 
 def ours_compensator(profile: CatheterProfile, period_s: float,
-                     limits: Sequence[KnobLimits] | None = None) -> OursCompensator:
+                     limits: Sequence[KnobLimits] | None = None,
+                     fresh_catheter: bool = False) -> OursCompensator:
     """The tension play's inverse from the profile's per-knob ``tension_play`` parameters."""
     params = [k.tension_play for k in profile.knobs]
     if params[0] is None or params[1] is None:
@@ -165,17 +166,18 @@ def ours_compensator(profile: CatheterProfile, period_s: float,
             f"profile {profile.catheter_id!r} has no parameters for method 'ours' (it was "
             "calibrated by an older tsmd): recalibrate it, or use method 'paper'")
     return OursCompensator(ours_knobs((params[0], params[1]), profile.interpolation),
-                           period_s, limits)
+                           period_s, limits, fresh_catheter=fresh_catheter)
 
 
 def build_compensator(profile: CatheterProfile | None, method: str, period_s: float,
                       limits: Sequence[KnobLimits] | None = None, *,
-                      apply_limits: bool = True) -> Compensator:
+                      apply_limits: bool = True, fresh_catheter: bool = False) -> Compensator:
     """The compensator for ``method`` ("none" | "paper" | "ours"), limited when ``limits``.
 
     ``apply_limits=False`` only informs the compensator of the motor's limits (ours plans its
     jumps and limits its own command with them): for a caller such as the control loop that
-    applies the limiter itself, last.
+    applies the limiter itself, last. ``fresh_catheter``: ours starts on a never-loaded
+    catheter's branches (:class:`OursCompensator`).
     """
     if method in RENAMED_METHODS:
         raise CompensationError(f"compensation method {method!r} is now called "
@@ -192,7 +194,7 @@ def build_compensator(profile: CatheterProfile | None, method: str, period_s: fl
     elif method == "paper":
         inner = paper_compensator(profile)
     else:
-        inner = ours_compensator(profile, period_s, limits)
+        inner = ours_compensator(profile, period_s, limits, fresh_catheter)
     if limits is None or not apply_limits:
         return inner
     return LimitedCompensator(inner, limits, period_s)

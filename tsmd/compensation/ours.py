@@ -35,6 +35,8 @@ from tsmd.compensation.tension_play import (
     PlayState,
     TensionPlayParams,
     branches,
+    fresh_branches,
+    fresh_state_ends,
     interp_linear,
     inverse_step,
     model_step,
@@ -70,7 +72,11 @@ class OursKnob:
     height_pos_deg: float
     height_neg_deg: float
     lag_s: float = 0.0
+    fresh_hold_deg: float = 0.0
+    fresh_edge_delay_deg: float | None = None
     _table: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
+    _fresh: tuple[tuple[Branches, ...], ...] = dataclasses.field(init=False, repr=False,
+                                                                 compare=False)
     _lo: float = dataclasses.field(init=False, repr=False, compare=False)
     _step: float = dataclasses.field(init=False, repr=False, compare=False)
 
@@ -81,21 +87,36 @@ class OursKnob:
         lo, hi = float(grid[0]), float(grid[-1])
         n = max(2, round((hi - lo) / TABLE_STEP_DEG) + 1)
         step = (hi - lo) / (n - 1)
-        table = tuple(branches(self.omega, self.height_pos_deg, self.height_neg_deg,
-                               *(float(v) for v in self.field.at(lo + i * step)))
-                      for i in range(n))
+        rows = [[float(v) for v in self.field.at(lo + i * step)] for i in range(n)]
+        w, h_pos, h_neg = self.omega, self.height_pos_deg, self.height_neg_deg
+        table = tuple(branches(w, h_pos, h_neg, *r) for r in rows)
+        # a fresh knob's tables by the side it loaded first: -1, none yet, +1
+        fresh = tuple(tuple(fresh_branches(b, w, r[0], r[1], h_pos, h_neg, self.fresh_hold_deg,
+                                           self.fresh_edge_delay_deg, side)
+                            for b, r in zip(table, rows, strict=True))
+                      for side in (-1, 0, 1)) if self.is_fresh_known else (table,) * 3
         object.__setattr__(self, "_table", table)
+        object.__setattr__(self, "_fresh", fresh)
         object.__setattr__(self, "_lo", lo)
         object.__setattr__(self, "_step", step)
 
     @classmethod
     def from_params(cls, p: TensionPlayParams, interpolation: str = "pchip") -> OursKnob:
         return cls(ParameterField(p.other_knob_deg, p.columns(), interpolation, OURS_COLUMNS),
-                   p.omega, p.height_pos_deg, p.height_neg_deg, p.lag_s)
+                   p.omega, p.height_pos_deg, p.height_neg_deg, p.lag_s, p.fresh_hold_deg,
+                   # the profile's fresh numbers come together from one first sweep
+                   p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None)
 
-    def at(self, other_deg: float) -> Branches:
-        """The branches at the other knob's angle (nearest table row, clamped to the grid)."""
-        table = self._table
+    @property
+    def is_fresh_known(self) -> bool:
+        """The profile says how a fresh catheter differs (else it is taken as conditioned)."""
+        return self.fresh_hold_deg > 0.0 or self.fresh_edge_delay_deg is not None
+
+    def at(self, other_deg: float, fresh: bool = False, side: int = 0) -> Branches:
+        """The branches at the other knob's angle (nearest table row, clamped to the grid);
+        ``fresh``: those of a fresh catheter before its first release has ended, loaded first
+        on ``side`` (0: not yet)."""
+        table = self._fresh[side + 1] if fresh else self._table
         if other_deg != other_deg:  # NaN
             return table[0]
         i = int((other_deg - self._lo) / self._step + 0.5)
@@ -115,7 +136,8 @@ class OursCompensator:
     """
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,
-                 limits: Sequence[KnobLimits] | None = None, smoothing_s: float = 0.1) -> None:
+                 limits: Sequence[KnobLimits] | None = None, smoothing_s: float = 0.1,
+                 fresh_catheter: bool = False) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be positive, got {period_s}")
         if limits is None:  # the simulated rig's drives, no position limit
@@ -123,6 +145,9 @@ class OursCompensator:
         if len(limits) != 2:
             raise ValueError(f"need limits for 2 knobs, got {len(limits)}")
         self.knobs = knobs
+        self.fresh_catheter = fresh_catheter
+        """The catheter was never loaded when reset (only the bench's fresh plant, or a new
+        catheter with a product profile): ``reset`` starts on the fresh branches."""
         self.period_s = period_s
         self.limits = (limits[0], limits[1])
         # jumps are planned with the slower knob's limits
@@ -145,6 +170,8 @@ class OursCompensator:
             kc.omega = knob.omega
             kc.plateau_lo_deg = min(knob.height_pos_deg, knob.height_neg_deg)
             kc.plateau_hi_deg = max(knob.height_pos_deg, knob.height_neg_deg)
+            kc.fresh_hi_deg = knob.height_neg_deg
+            kc.fresh_lo_deg = knob.height_pos_deg
 
     def replace_knobs(self, knobs: tuple[OursKnob, OursKnob]) -> None:
         """New parameters from the next tick on, state kept (online re-estimation)."""
@@ -152,14 +179,20 @@ class OursCompensator:
         self._set_constants()
 
     def reset(self, q_deg: NDArray[np.float64]) -> None:
+        """At rest at ``q_deg``. On a fresh catheter (``fresh_catheter``: straight, never
+        loaded) a knob whose profile knows the fresh hold (``fresh_hold_deg``) uses the fresh
+        branches until its first release has ended."""
         q = [float(v) if math.isfinite(v) else 0.0 for v in np.asarray(q_deg, dtype=float)]
+        fresh = [self.fresh_catheter and k.is_fresh_known for k in self.knobs]
         x = [0.0, 0.0]
         states = [PlayState(0.0, 0.0, 1, 0.0)] * 2
         for _ in range(3):  # each knob's branches depend on the other knob's command
-            states = [rest_state(q[i], self.knobs[i].at(x[1 - i])) for i in (0, 1)]
+            states = [rest_state(q[i], self.knobs[i].at(x[1 - i], fresh[i])) for i in (0, 1)]
             x = [s.x_deg for s in states]
         for i in (0, 1):
             self._k[i].reset(states[i], q[i], self._n_avg)
+            self._k[i].fresh = fresh[i]
+            self._k[i].first_side = 0
         self._slot = 0
 
     def preview(self, plan_deg: Sequence[Sequence[float]], index: int) -> None:
@@ -171,8 +204,8 @@ class OursCompensator:
 
     def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
         k0, k1 = self._k
-        b0 = self.knobs[0].at(k1.state.x_deg)
-        b1 = self.knobs[1].at(k0.state.x_deg)
+        b0 = self.knobs[0].at(k1.state.x_deg, k0.fresh, k0.first_side)
+        b1 = self.knobs[1].at(k0.state.x_deg, k1.fresh, k1.first_side)
         slot = self._slot
         period = self.period_s
         planner = self._planner
@@ -183,6 +216,8 @@ class OursCompensator:
                 self._track(kc, qi, b, planned)
                 if planned:
                     kc.out = planner.command(kc.plan, kc.state, kc.out, kc.ahead_ticks, col, b)
+                if kc.fresh:
+                    _fresh_progress(kc)
             x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target, kc.out,
                                                      kc.limits, period)
             kc.lim_deg = x
@@ -206,7 +241,10 @@ class OursCompensator:
                 kc.target = qi
                 kc.still_s = 0.0  # no dwell before this compensator has brought the tip to q
             if x - x == 0.0:
-                kc.state = model_step(kc.state, x, self.knobs[i].at(float(motor_deg[1 - i])))
+                b = self.knobs[i].at(float(motor_deg[1 - i]), kc.fresh, kc.first_side)
+                kc.state = model_step(kc.state, x, b)
+                if kc.fresh:
+                    _fresh_progress(kc)
                 kc.out = x
                 kc.hold = 0
                 kc.plan.direction = 0  # a planned crossing is this compensator's own
@@ -298,6 +336,18 @@ class OursCompensator:
             horizon_s = 0.5 * (jump / self.v_max + self.v_max / self.a_max)
         kc.hold = d
         return ahead
+
+
+def _fresh_progress(kc: KnobCommand) -> None:
+    """Which side a fresh knob loaded first, and whether its first release has ended."""
+    y = kc.state.y_deg
+    if kc.first_side == 0:
+        if y > kc.plateau_hi_deg + _PLATEAU_MARGIN_DEG:
+            kc.first_side = 1
+        elif y < kc.plateau_lo_deg - _PLATEAU_MARGIN_DEG:
+            kc.first_side = -1
+    elif fresh_state_ends(kc.state, kc.first_side, kc.fresh_hi_deg, kc.fresh_lo_deg):
+        kc.fresh = False
 
 
 def ours_knobs(params: Sequence[TensionPlayParams], interpolation: str = "pchip"

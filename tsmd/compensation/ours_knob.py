@@ -36,7 +36,8 @@ SETTLED_DEG = 1e-3
 class KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
-    __slots__ = ("accel", "ahead_s", "ahead_ticks", "held_s", "hold", "jump_deg", "lim_deg",
+    __slots__ = ("accel", "ahead_s", "ahead_ticks", "first_side", "fresh", "fresh_hi_deg",
+                 "fresh_lo_deg", "held_s", "hold", "jump_deg", "lim_deg",
                  "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan",
                  "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "rest_q",
                  "stand_s", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
@@ -50,6 +51,12 @@ class KnobCommand:
         self.jump_deg = 0.0
         self.omega = 1.0
         self.plateau_lo_deg = self.plateau_hi_deg = 0.0
+        self.fresh = False
+        """Still on a fresh catheter's branches (its first release has not ended)."""
+        self.first_side = 0
+        """The side a fresh knob loaded first (+1, -1; 0: not yet)."""
+        self.fresh_hi_deg = self.fresh_lo_deg = 0.0
+        """Where a fresh knob's first release has ended (the falling / rising plateau)."""
         self.reset(PlayState(0.0, 0.0, 1, 0.0), 0.0, 1)
 
     def reset(self, state: PlayState, q_deg: float, n_avg: int) -> None:

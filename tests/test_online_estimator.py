@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tsmd.online.estimator import EdgeTracker, EstimatorOptions
+from tsmd.online.estimator import EdgeTracker
+from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
 from tsmd.online.slopes import shrunk_ratio
 

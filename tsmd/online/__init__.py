@@ -12,7 +12,8 @@ from tsmd.online.apply import (
     save_online_version,
     shifted_knob,
 )
-from tsmd.online.estimator import EdgeTracker, EstimatorOptions
+from tsmd.online.estimator import EdgeTracker
+from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp, RampOptions, Rejected, Stroke, loaded_ramp
 from tsmd.online.segment import StrokeSegmenter
 from tsmd.online.worker import RECORDING_COLUMNS, OnlineWorker

@@ -17,7 +17,7 @@ from typing import Any, Protocol
 from tsmd.config import OnlineConfig
 from tsmd.loop import ROW_COLUMNS, TickRecorder
 from tsmd.online.apply import ZERO_OFFSETS, OnlineError, save_online_version
-from tsmd.online.estimator import EstimatorOptions
+from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.worker import OnlineWorker
 from tsmd.profile import CatheterProfile
 

@@ -27,7 +27,8 @@ from tsmd.online.apply import (
     edges_at,
     shifted_knob,
 )
-from tsmd.online.estimator import EdgeTracker, EstimatorOptions
+from tsmd.online.estimator import EdgeTracker
+from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import (
     LoadedRamp,
     RampOptions,

@@ -1,0 +1,36 @@
+"""The numbers of the edge estimator (:class:`tsmd.online.estimator.EdgeTracker`).
+
+Apart from the tracker so that the configuration and the worker can name them without the
+estimator's logic; docs/online.md ("Bounds, hysteresis, confidence, freezes") says what each
+one guards against.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class EstimatorOptions:
+    baseline_ramps: int = 3
+    window: int = 5
+    gate_deg: float = 1.5
+    confirm: int = 2
+    confirm_spread_deg: float = 2.0
+    max_offset_deg: float = 12.0
+    deadband_deg: float = 0.4
+    slope_ratio_max: float = 3.0
+    freeze_ramps: int = 2
+    same_slope_tolerance: float = 0.15
+    slope_window: int = 3
+    """The slope a measurement uses comes from the median of this edge's last
+    ``slope_window`` ramps, never from one ramp alone (see :meth:`EdgeTracker.update`)."""
+    other_bin_deg: float = 30.0
+    """Width of the other knob's angle bins in which the current's own edge is learned
+    relative to the profile's (:meth:`EdgeTracker.bin_bias_deg`)."""
+    bin_min: int = 3
+    """Measurements a bin needs before its bias counts."""
+    bin_window: int = 7
+    shared_slope_ratio_max: float = 8.0
+    """A slope change both edges of the knob show (a sheath's friction) is followed up to this
+    ratio; beyond ``slope_ratio_max`` on one edge alone it is a stuck knob or a blocked tip."""

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import numpy as np
 from support.branch_currents import knob_grid, noisy, steep_then_loaded_current, toe_current
 
-from tsmd.calibration.branch_fit import fit_edge
+from tsmd.calibration.branch_fit import KNEE_CHUNK, _knee, fit_edge
 from tsmd.calibration.estimate import estimate
 from tsmd.calibration.signal import remove_spikes
 
@@ -72,3 +73,18 @@ def test_the_uncertainty_of_the_edge_grows_with_the_noise() -> None:
         return estimate(edges, float("nan")).u95_deg
 
     assert u95(0.006) > 2.0 * u95(0.0005)
+
+
+def test_every_knee_candidate_is_a_least_squares_fit_across_chunks() -> None:
+    rng = np.random.default_rng(3)
+    x = np.linspace(0.0, 30.0, 200)
+    y = 0.02 * np.maximum(x - 8.0, 0.0) + rng.normal(0.0, 0.01, x.size)
+    e1 = np.linspace(1.0, 20.0, 2 * KNEE_CHUNK + 7)
+    e2 = e1 + 4.0
+    rss, coef = _knee(x, y, e1, e2)
+    for k in (0, KNEE_CHUNK, e1.size - 1):
+        basis = np.column_stack([np.ones_like(x), np.maximum(x - e1[k], 0.0),
+                                 np.maximum(x - e2[k], 0.0)])
+        want, res, *_ = np.linalg.lstsq(basis, y, rcond=None)
+        np.testing.assert_allclose(coef[k], want, rtol=1e-6, atol=1e-9)
+        np.testing.assert_allclose(rss[k], res[0], rtol=1e-6)

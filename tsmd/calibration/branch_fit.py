@@ -54,10 +54,26 @@ def _hinge(x: FloatArray, y: FloatArray, edges: FloatArray) -> tuple[FloatArray,
     return np.where(ok, rss, np.inf), level, slope
 
 
+KNEE_CHUNK = 128
+"""Candidate pairs fitted at once: the design matrix is (pairs, samples, 3), so a whole
+half-cycle's pairs at once held ~25 MiB; a chunk keeps it under 1.5 MiB with the same
+arithmetic per pair."""
+
+
 def _knee(x: FloatArray, y: FloatArray, e1: FloatArray,
           e2: FloatArray) -> tuple[FloatArray, FloatArray]:
     """For each candidate pair (e1, e2): residual sum of squares and coefficients
     (level, s1, s2 - s1)."""
+    rss = np.empty(e1.size)
+    coef = np.empty((e1.size, 3))
+    for a in range(0, e1.size, KNEE_CHUNK):
+        b = a + KNEE_CHUNK
+        rss[a:b], coef[a:b] = _knee_chunk(x, y, e1[a:b], e2[a:b])
+    return rss, coef
+
+
+def _knee_chunk(x: FloatArray, y: FloatArray, e1: FloatArray,
+                e2: FloatArray) -> tuple[FloatArray, FloatArray]:
     h1 = np.maximum(x[None, :] - e1[:, None], 0.0)
     h2 = np.maximum(x[None, :] - e2[:, None], 0.0)
     ones = np.ones_like(h1)

@@ -51,6 +51,11 @@ class EdgeTracker:
     ramps of a noisy edge cannot move the estimate on their own (lumped 102, no change: phi1
     pos at 0.11 and 1.16 deg gave 0.64)."""
     applied_deg: float = 0.0
+    zero_load_deg: float = 0.0
+    """How far the tendon's zero-load point x0 moved outward: with the edge while a level
+    crossing places it (a slack change moves the whole characteristic), not while the knee
+    does (a sheath bend: more friction moves the edge out and leaves x0, the fresh
+    calibrations of capstan units 1-4, 101-104: x0 within -2.5..+1.7 deg for edges +4.4..+6.8)."""
     accepted: list[float] = field(default_factory=list)
     suspects: list[float] = field(default_factory=list)
     frozen_for: int = 0
@@ -60,6 +65,12 @@ class EdgeTracker:
     recent_slopes: list[float] = field(default_factory=list)
     last_feature: str = ""
     """What placed the last measurement: "knee" or "crossing"."""
+    bend_suspect: bool = False
+    """The edge's first knee-placed measurement is beyond the gate the way the slopes changed
+    while both tendons' last ramps changed slope the same way beyond 30 %: a bend both tendons
+    show, which the worker follows at once on both edges
+    (:attr:`EstimatorOptions.follow_bend_at_once`). Later knees are confirmed as usual (one
+    knee scatters by +-1.5 deg: capstan unit 1 phi2 followed a lone 7.0 after 4.5)."""
     shared_change: float = 0.0
     """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
     partner_change: float = 0.0
@@ -232,6 +243,7 @@ class EdgeTracker:
         other edge of the same knob (its slopes confirm a friction change)."""
         o = self.options
         self.n_ramps += 1
+        self.bend_suspect = False
         events: list[tuple[str, str, dict[str, Any]]] = []
         tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
         if self.learning:
@@ -284,6 +296,7 @@ class EdgeTracker:
             return events
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
         direction = self.knee_direction
+        first_knee = self.last_feature != "knee"
         if math.isfinite(knee_m) and direction != 0:
             # The sheath's friction changed the engagement: no level crossing places the
             # edge; the knee, seen in the stroke itself, does. Otherwise the crossing (the
@@ -299,6 +312,11 @@ class EdgeTracker:
                 self.last_measurement_deg = math.nan
                 return events
             self._measured(knee_m, ramp.other_deg, events)
+            own, other = self.last_change, self.partner_last_change
+            self.bend_suspect = (first_knee and bool(self.suspects) and own * other > 0.0
+                                 and min(abs(own), abs(other)) > 2.0 * o.same_slope_tolerance
+                                 and direction * (self.suspects[-1] - self.estimate_deg)
+                                 > o.gate_deg)
             return events
         # The crossing on a line through the window's centre (~15 deg back: 10 % of slope is
         # 1.5 deg of edge) with the slope both edges' last ramps agree on; one ramp's slope
@@ -348,9 +366,13 @@ class EdgeTracker:
                 and other.frozen_for == 0
                 and abs(self.suspects[-1] - other.suspects[-1]) <= self.options.confirm_spread_deg)
 
-    def follow(self, new_deg: float, why: str) -> list[tuple[str, str, dict[str, Any]]]:
-        """Take a confirmed change (within the bound) as the estimate; events to report."""
+    def follow(self, new_deg: float, why: str, feature: str = ""
+               ) -> list[tuple[str, str, dict[str, Any]]]:
+        """Take a confirmed change (within the bound) as the estimate; events to report.
+        ``feature``: what placed it when not this edge's own last ramp (the other edge's
+        knee: a bend)."""
         o = self.options
+        self.last_feature = feature or self.last_feature
         tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
         kept = list(self.suspects)
         self.suspects.clear()
@@ -369,12 +391,15 @@ class EdgeTracker:
         o = self.options
         if abs(self.estimate_deg - self.applied_deg) > o.deadband_deg:
             self.applied_deg = max(-o.max_offset_deg, min(o.max_offset_deg, self.estimate_deg))
+        if self.last_feature != "knee" or not o.keep_zero_load_in_bend:
+            self.zero_load_deg = self.applied_deg
 
     def status(self) -> dict[str, Any]:
         o = self.options
         state = ("learning" if self.learning else "frozen" if self.frozen_for > 0
                  else "tracking")
         return {"state": state, "offset_deg": round(self.applied_deg, 3),
+                "zero_load_offset_deg": round(self.zero_load_deg, 3),
                 "estimate_deg": round(self.estimate_deg, 3),
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
                 "odd_slope_ramps": self.n_odd_slope, "odd_knee_ramps": self.n_odd_knee,

@@ -52,10 +52,9 @@ class EdgeTracker:
     pos at 0.11 and 1.16 deg gave 0.64)."""
     applied_deg: float = 0.0
     zero_load_deg: float = 0.0
-    """How far the tendon's zero-load point x0 moved outward: with the edge while a level
-    crossing places it (a slack change moves the whole characteristic), not while the knee
-    does (a sheath bend: more friction moves the edge out and leaves x0, the fresh
-    calibrations of capstan units 1-4, 101-104: x0 within -2.5..+1.7 deg for edges +4.4..+6.8)."""
+    """How far the tendon's zero-load point x0 moved outward: with the edge (a slack change
+    moves the whole characteristic), except for a knee-placed change when
+    :attr:`EstimatorOptions.keep_zero_load_in_bend` (a bend on the capstan plant)."""
     accepted: list[float] = field(default_factory=list)
     suspects: list[float] = field(default_factory=list)
     frozen_for: int = 0
@@ -66,11 +65,9 @@ class EdgeTracker:
     last_feature: str = ""
     """What placed the last measurement: "knee" or "crossing"."""
     bend_suspect: bool = False
-    """The edge's first knee-placed measurement is beyond the gate the way the slopes changed
-    while both tendons' last ramps changed slope the same way beyond 30 %: a bend both tendons
-    show, which the worker follows at once on both edges
-    (:attr:`EstimatorOptions.follow_bend_at_once`). Later knees are confirmed as usual (one
-    knee scatters by +-1.5 deg: capstan unit 1 phi2 followed a lone 7.0 after 4.5)."""
+    """The edge's first knee is a suspect beyond the gate the way the slopes changed, with both
+    tendons' last ramps > 30 % changed alike: a bend, followed at once on both edges when
+    :attr:`EstimatorOptions.follow_bend_at_once` (later lone knees scatter +-1.5 deg)."""
     shared_change: float = 0.0
     """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
     partner_change: float = 0.0
@@ -162,14 +159,11 @@ class EdgeTracker:
 
     @property
     def knee_mode(self) -> bool:
-        """Both tendons' ramps of the knob changed slope the same way beyond the tolerance
-        (15 %, the medians of their last three ramps): the sheath's friction changed the
-        engagement, and the knee, not a level crossing, places the edge. A slack change
-        moves the engagement without changing it (lumped 101, +0.5 mm: slopes 0.85-1.07 x);
-        a bend changes it (capstan unit 2, 60 deg: both ramps 1.17-1.37 x, the crossing 11 deg
-        inward, the knee 4-6 deg outward). The knee is not used otherwise: on the lumped
-        plant's gradual toe it scatters by +-3 deg and read -5 deg after a +4.8 deg slack
-        change (tried, session 7)."""
+        """Both tendons' ramps of the knob changed slope the same way (:attr:`knee_direction`):
+        the sheath's friction changed the engagement, and the knee, not a level crossing,
+        places the edge (capstan unit 2, 60 deg bend: ramps 1.17-1.37 x, the crossing 11 deg
+        inward, the knee 4-6 deg outward; a slack change leaves the slopes, lumped 101: 0.85-1.07
+        x). Not otherwise: on the lumped toe the knee scatters by +-3 deg (session 7)."""
         return self.knee_direction != 0
 
     @property

@@ -327,3 +327,11 @@ def test_switching_off_restores_the_profiles_zero_load_points(profile: Any) -> N
     worker.set_enabled(False)
     worker.observe(worker_row(), True)
     assert worker.zero_loads == ((0.0, 0.0), (0.0, 0.0)) and comp.knobs[0] is base[0]
+
+
+def test_the_status_reports_the_zero_load_points_in_force(profile: Any) -> None:
+    worker, _, _ = make_worker(profile)
+    worker.zero_loads = ((1.0, 0.5), (0.0, 0.0))
+    status = worker.status()
+    assert status["zero_load_offsets_deg"] == [[1.0, 0.5], [0.0, 0.0]]
+    assert status["edges"]["phi1_pos"]["zero_load_offset_deg"] == 0.0

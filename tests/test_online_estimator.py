@@ -236,9 +236,10 @@ def ramp_with_knee(knee_deg: float, slope: float = SLOPE) -> LoadedRamp:
                       0.003, knee_deg, 0.01)
 
 
-def learned_knob() -> tuple[EdgeTracker, EdgeTracker]:
+def learned_knob(options: EstimatorOptions | None = None) -> tuple[EdgeTracker, EdgeTracker]:
     """Both tendons of a knob past their baseline, knees at the calibrated edge."""
-    pos, neg = EdgeTracker(0, 1), EdgeTracker(0, -1)
+    o = options or EstimatorOptions()
+    pos, neg = EdgeTracker(0, 1, o), EdgeTracker(0, -1, o)
     for _ in range(pos.options.baseline_ramps):
         pos.update(ramp_with_knee(EDGE_DEG), EDGE_DEG, neg)
         neg.update(ramp_with_knee(EDGE_DEG), EDGE_DEG, pos)
@@ -268,3 +269,44 @@ def test_a_knee_inward_while_the_ramps_got_steeper_measures_nothing() -> None:
         neg.update(ramp_with_knee(EDGE_DEG - 4.0, 1.4 * SLOPE), EDGE_DEG, pos)
     assert neg.knee_mode and neg.suspects == [] and neg.applied_deg == 0.0
     assert neg.status()["odd_knee_ramps"] == 3
+
+
+def test_a_bend_followed_by_its_knee_leaves_the_zero_load_point_when_asked() -> None:
+    pos, neg = learned_knob(EstimatorOptions(keep_zero_load_in_bend=True))  # a bend: both
+    # ramps 1.4 x steeper, knees 4 deg further out
+    for _ in range(3):
+        pos.update(ramp_with_knee(EDGE_DEG + 4.0, 1.4 * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_with_knee(EDGE_DEG + 4.0, 1.4 * SLOPE), EDGE_DEG, pos)
+    assert neg.last_feature == "knee" and neg.applied_deg == pytest.approx(4.0)
+    assert neg.zero_load_deg == 0.0
+
+
+def test_a_slack_change_moves_the_zero_load_point_with_the_edge() -> None:
+    tracker = learned()
+    tracker.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
+    tracker.update(ramp_with_edge(EDGE_DEG + 4.2), EDGE_DEG)
+    assert tracker.last_feature == "crossing"
+    assert tracker.zero_load_deg == tracker.applied_deg == pytest.approx(4.1, abs=0.01)
+
+
+def test_by_default_a_bend_moves_the_zero_load_point_with_the_edge() -> None:
+    pos, neg = learned_knob()
+    for _ in range(3):
+        pos.update(ramp_with_knee(EDGE_DEG + 4.0, 1.4 * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_with_knee(EDGE_DEG + 4.0, 1.4 * SLOPE), EDGE_DEG, pos)
+    assert neg.last_feature == "knee" and neg.zero_load_deg == neg.applied_deg != 0.0
+
+
+def test_the_first_knee_of_a_bend_on_both_tendons_is_a_bend_suspect() -> None:
+    pos, neg = learned_knob()
+    neg.update(ramp_with_knee(EDGE_DEG, 1.4 * SLOPE), EDGE_DEG, pos)  # slope only, no knee mode
+    pos.update(ramp_with_knee(EDGE_DEG + 4.0, 1.4 * SLOPE), EDGE_DEG, neg)
+    assert pos.bend_suspect and pos.suspects == [pytest.approx(4.0)]
+
+
+def test_a_later_lone_knee_of_a_bend_is_no_bend_suspect() -> None:
+    pos, neg = learned_knob()
+    for knee in (4.0, 4.0, 4.0, 7.0):  # followed at 4, then one knee 3 deg further out
+        neg.update(ramp_with_knee(EDGE_DEG + knee, 1.4 * SLOPE), EDGE_DEG, pos)
+        pos.update(ramp_with_knee(EDGE_DEG + knee, 1.4 * SLOPE), EDGE_DEG, neg)
+    assert pos.applied_deg == pytest.approx(4.0) and not pos.bend_suspect

@@ -296,3 +296,42 @@ def test_a_saved_version_compensates_like_the_online_backlash_gains(profile: Any
     saved = build_compensator(profile_with_offsets(profile, offsets, gains=gains), "ours",
                               0.004)
     assert largest_command_difference_deg(live, saved) < 1e-6
+
+
+def test_a_knob_shifted_with_its_zero_load_points_kept_moves_only_the_edges(profile: Any) -> None:
+    knob = build_compensator(profile, "ours", 0.004).knobs[0]
+    f = knob.field
+    moved = shifted_knob(knob, (3.0, 2.0), zero_load=(0.0, 0.0)).field
+    for name, move in (("dead_zone_pos_deg", 3.0), ("dead_zone_neg_deg", -2.0),
+                       ("zero_load_pos_deg", 0.0), ("zero_load_neg_deg", 0.0)):
+        assert np.allclose(moved.values[:, f.column(name)],
+                           f.values[:, f.column(name)] + move)
+
+
+def test_a_saved_version_compensates_like_the_online_zero_load_points(profile: Any) -> None:
+    offsets, gains, zero = ((3.0, 2.0), (1.0, -1.0)), ((1.3, 1.2), (1.0, 1.5)), ((0.0, 0.5),
+                                                                                (1.0, 0.0))
+    live = build_compensator(profile, "ours", 0.004)
+    worker = OnlineWorker(live, 0.004, ROW_COLUMNS)
+    worker.published = (1, offsets, tuple(  # type: ignore[assignment]
+        shifted_knob(worker.base_knobs[k], offsets[k], gains[k], zero[k]) for k in (0, 1)))
+    worker.observe(worker_row(), True)
+    saved = build_compensator(profile_with_offsets(profile, offsets, gains=gains,
+                                                   zero_loads=zero), "ours", 0.004)
+    assert largest_command_difference_deg(live, saved) < 1e-6
+
+
+def test_switching_off_restores_the_profiles_zero_load_points(profile: Any) -> None:
+    worker, comp, base = make_worker(profile)
+    worker.zero_loads = ((1.0, 1.0), (0.0, 0.0))
+    worker.set_enabled(False)
+    worker.observe(worker_row(), True)
+    assert worker.zero_loads == ((0.0, 0.0), (0.0, 0.0)) and comp.knobs[0] is base[0]
+
+
+def test_the_status_reports_the_zero_load_points_in_force(profile: Any) -> None:
+    worker, _, _ = make_worker(profile)
+    worker.zero_loads = ((1.0, 0.5), (0.0, 0.0))
+    status = worker.status()
+    assert status["zero_load_offsets_deg"] == [[1.0, 0.5], [0.0, 0.0]]
+    assert status["edges"]["phi1_pos"]["zero_load_offset_deg"] == 0.0

@@ -34,19 +34,23 @@ class OnlineError(TsmdError):
 
 
 def shifted_knob(knob: Any, offset: tuple[float, float],
-                 gain_ratio: tuple[float, float] = (1.0, 1.0)) -> Any:
+                 gain_ratio: tuple[float, float] = (1.0, 1.0),
+                 zero_load: tuple[float, float] | None = None) -> Any:
     """A copy of a compensator knob (ours or the paper's) with its edges moved outward.
 
-    Ours: each tendon's zero-load point moves with its edge (the whole characteristic moves);
-    ``gain_ratio`` (pos, neg) multiplies each tendon's backlash gain beta (a sheath bend: the
-    backlash grows with the tension per knob degree, :attr:`EdgeTracker.gain_ratio`), and
-    omega follows the calibration's relation (the release slope ``omega / (1 - beta)`` is
-    the product's).
+    Ours: each tendon's zero-load point moves outward by ``zero_load`` (pos, neg; None: with
+    its edge, the whole characteristic moves as after a slack change; a sheath bend moves the
+    edge and keeps x0, :attr:`EdgeTracker.zero_load_deg`); ``gain_ratio`` (pos, neg)
+    multiplies each tendon's backlash gain beta (a sheath bend: the backlash grows with the
+    tension per knob degree, :attr:`EdgeTracker.gain_ratio`), and omega follows the
+    calibration's relation (the release slope ``omega / (1 - beta)`` is the product's).
     """
     off_pos, off_neg = offset
     moves = {"dead_zone_pos_deg": off_pos, "dead_zone_neg_deg": -off_neg}
     if isinstance(knob, OursKnob):
-        moves.update({MOVES_WITH_EDGE[edge]: move for edge, move in list(moves.items())})
+        x0_pos, x0_neg = offset if zero_load is None else zero_load
+        moves.update({MOVES_WITH_EDGE["dead_zone_pos_deg"]: x0_pos,
+                      MOVES_WITH_EDGE["dead_zone_neg_deg"]: -x0_neg})
         field = knob.field.shifted(moves)
         if gain_ratio == (1.0, 1.0):
             return replace(knob, field=field)
@@ -83,17 +87,20 @@ def apply_knobs(compensator: Any, knobs: tuple[Any, Any]) -> None:
 
 
 def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str = "",
-                         gains: Offsets = ((1.0, 1.0), (1.0, 1.0))) -> CatheterProfile:
-    """The profile with its edges moved by ``offsets`` and its tension play's backlash gains
-    multiplied by ``gains`` (same catheter, a new version; omega as :func:`shifted_knob`).
+                         gains: Offsets = ((1.0, 1.0), (1.0, 1.0)),
+                         zero_loads: Offsets | None = None) -> CatheterProfile:
+    """The profile with its edges moved by ``offsets``, its tension play's zero-load points
+    by ``zero_loads`` (None: with the edges) and its backlash gains multiplied by ``gains``
+    (same catheter, a new version; omega as :func:`shifted_knob`).
 
     The reference points move with the edges, so the plateau heights stay what the
     calibration gave (H from the reference point through D(0), design assumption 1).
     """
     knobs = []
     lo, hi = BETA_RANGE
-    for k, (off_pos, off_neg), (g_pos, g_neg) in zip(profile.knobs, offsets, gains,
-                                                     strict=True):
+    for k, (off_pos, off_neg), (g_pos, g_neg), (x0_pos, x0_neg) in zip(
+            profile.knobs, offsets, gains, offsets if zero_loads is None else zero_loads,
+            strict=True):
         ours = k.tension_play
         if ours is not None:
             beta_pos = tuple(min(max(v * g_pos, lo), hi) for v in ours.backlash_gain_pos)
@@ -107,8 +114,8 @@ def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str =
             ours = replace(
                 ours, dead_zone_pos_deg=tuple(v + off_pos for v in ours.dead_zone_pos_deg),
                 dead_zone_neg_deg=tuple(v - off_neg for v in ours.dead_zone_neg_deg),
-                zero_load_pos_deg=tuple(v + off_pos for v in ours.zero_load_pos_deg),
-                zero_load_neg_deg=tuple(v - off_neg for v in ours.zero_load_neg_deg),
+                zero_load_pos_deg=tuple(v + x0_pos for v in ours.zero_load_pos_deg),
+                zero_load_neg_deg=tuple(v - x0_neg for v in ours.zero_load_neg_deg),
                 backlash_gain_pos=beta_pos, backlash_gain_neg=beta_neg,
                 omega=unit_omega(ours.omega, at_zero(ours.backlash_gain_pos,
                                                      ours.backlash_gain_neg),
@@ -121,10 +128,12 @@ def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str =
             tuple(float(v) - off_neg for v in k.dead_zone_neg_deg),
             k.backlash_pos_deg, k.backlash_neg_deg, ours))
     quality = dict(profile.quality)
-    for i, ((off_pos, off_neg), (g_pos, g_neg)) in enumerate(zip(offsets, gains,
-                                                                  strict=True)):
+    for i, ((off_pos, off_neg), (g_pos, g_neg), (x0_pos, x0_neg)) in enumerate(zip(
+            offsets, gains, offsets if zero_loads is None else zero_loads, strict=True)):
         quality[f"phi{i + 1}_online_offset_pos_deg"] = float(off_pos)
         quality[f"phi{i + 1}_online_offset_neg_deg"] = float(off_neg)
+        quality[f"phi{i + 1}_online_zero_load_offset_pos_deg"] = float(x0_pos)
+        quality[f"phi{i + 1}_online_zero_load_offset_neg_deg"] = float(x0_neg)
         quality[f"phi{i + 1}_online_backlash_gain_ratio_pos"] = float(g_pos)
         quality[f"phi{i + 1}_online_backlash_gain_ratio_neg"] = float(g_neg)
     now = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
@@ -136,13 +145,14 @@ def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str =
 
 def save_online_version(profile: CatheterProfile, offsets: Offsets,
                         directory: str | os.PathLike[str], note: str = "",
-                        gains: Offsets = ((1.0, 1.0), (1.0, 1.0))) -> Path:
+                        gains: Offsets = ((1.0, 1.0), (1.0, 1.0)),
+                        zero_loads: Offsets | None = None) -> Path:
     """Save the online estimates as ``<dir>/<catheter_id>.online-<UTC time>.yaml``.
 
     Never overwrites: not the calibrated ``<catheter_id>.yaml``, not an earlier version.
     """
-    if not all(np.isfinite(v) for pair in offsets for v in pair):
-        raise OnlineError(f"online offsets must be finite, got {offsets}")
+    if not all(np.isfinite(v) for pair in (*offsets, *(zero_loads or ())) for v in pair):
+        raise OnlineError(f"online offsets must be finite, got {offsets}, {zero_loads}")
     if not all(np.isfinite(v) and v > 0 for pair in gains for v in pair):
         raise OnlineError(f"online backlash gain ratios must be finite and > 0, got {gains}")
     stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%S")
@@ -151,5 +161,5 @@ def save_online_version(profile: CatheterProfile, offsets: Offsets,
     while path.exists():
         n += 1
         path = Path(directory) / f"{profile.catheter_id}.online-{stamp}-{n}.yaml"
-    save_profile(profile_with_offsets(profile, offsets, note, gains), path)
+    save_profile(profile_with_offsets(profile, offsets, note, gains, zero_loads), path)
     return path

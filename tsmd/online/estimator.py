@@ -51,6 +51,10 @@ class EdgeTracker:
     ramps of a noisy edge cannot move the estimate on their own (lumped 102, no change: phi1
     pos at 0.11 and 1.16 deg gave 0.64)."""
     applied_deg: float = 0.0
+    zero_load_deg: float = 0.0
+    """How far the tendon's zero-load point x0 moved outward: with the edge (a slack change
+    moves the whole characteristic), except for a knee-placed change when
+    :attr:`EstimatorOptions.keep_zero_load_in_bend` (a bend on the capstan plant)."""
     accepted: list[float] = field(default_factory=list)
     suspects: list[float] = field(default_factory=list)
     frozen_for: int = 0
@@ -60,6 +64,10 @@ class EdgeTracker:
     recent_slopes: list[float] = field(default_factory=list)
     last_feature: str = ""
     """What placed the last measurement: "knee" or "crossing"."""
+    bend_suspect: bool = False
+    """The edge's first knee is a suspect beyond the gate the way the slopes changed, with both
+    tendons' last ramps > 30 % changed alike: a bend, followed at once on both edges when
+    :attr:`EstimatorOptions.follow_bend_at_once` (later lone knees scatter +-1.5 deg)."""
     shared_change: float = 0.0
     """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
     partner_change: float = 0.0
@@ -151,14 +159,11 @@ class EdgeTracker:
 
     @property
     def knee_mode(self) -> bool:
-        """Both tendons' ramps of the knob changed slope the same way beyond the tolerance
-        (15 %, the medians of their last three ramps): the sheath's friction changed the
-        engagement, and the knee, not a level crossing, places the edge. A slack change
-        moves the engagement without changing it (lumped 101, +0.5 mm: slopes 0.85-1.07 x);
-        a bend changes it (capstan unit 2, 60 deg: both ramps 1.17-1.37 x, the crossing 11 deg
-        inward, the knee 4-6 deg outward). The knee is not used otherwise: on the lumped
-        plant's gradual toe it scatters by +-3 deg and read -5 deg after a +4.8 deg slack
-        change (tried, session 7)."""
+        """Both tendons' ramps of the knob changed slope the same way (:attr:`knee_direction`):
+        the sheath's friction changed the engagement, and the knee, not a level crossing,
+        places the edge (capstan unit 2, 60 deg bend: ramps 1.17-1.37 x, the crossing 11 deg
+        inward, the knee 4-6 deg outward; a slack change leaves the slopes, lumped 101: 0.85-1.07
+        x). Not otherwise: on the lumped toe the knee scatters by +-3 deg (session 7)."""
         return self.knee_direction != 0
 
     @property
@@ -232,6 +237,7 @@ class EdgeTracker:
         other edge of the same knob (its slopes confirm a friction change)."""
         o = self.options
         self.n_ramps += 1
+        self.bend_suspect = False
         events: list[tuple[str, str, dict[str, Any]]] = []
         tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
         if self.learning:
@@ -284,6 +290,7 @@ class EdgeTracker:
             return events
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
         direction = self.knee_direction
+        first_knee = self.last_feature != "knee"
         if math.isfinite(knee_m) and direction != 0:
             # The sheath's friction changed the engagement: no level crossing places the
             # edge; the knee, seen in the stroke itself, does. Otherwise the crossing (the
@@ -299,6 +306,11 @@ class EdgeTracker:
                 self.last_measurement_deg = math.nan
                 return events
             self._measured(knee_m, ramp.other_deg, events)
+            own, other = self.last_change, self.partner_last_change
+            self.bend_suspect = (first_knee and bool(self.suspects) and own * other > 0.0
+                                 and min(abs(own), abs(other)) > 2.0 * o.same_slope_tolerance
+                                 and direction * (self.suspects[-1] - self.estimate_deg)
+                                 > o.gate_deg)
             return events
         # The crossing on a line through the window's centre (~15 deg back: 10 % of slope is
         # 1.5 deg of edge) with the slope both edges' last ramps agree on; one ramp's slope
@@ -348,9 +360,13 @@ class EdgeTracker:
                 and other.frozen_for == 0
                 and abs(self.suspects[-1] - other.suspects[-1]) <= self.options.confirm_spread_deg)
 
-    def follow(self, new_deg: float, why: str) -> list[tuple[str, str, dict[str, Any]]]:
-        """Take a confirmed change (within the bound) as the estimate; events to report."""
+    def follow(self, new_deg: float, why: str, feature: str = ""
+               ) -> list[tuple[str, str, dict[str, Any]]]:
+        """Take a confirmed change (within the bound) as the estimate; events to report.
+        ``feature``: what placed it when not this edge's own last ramp (the other edge's
+        knee: a bend)."""
         o = self.options
+        self.last_feature = feature or self.last_feature
         tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
         kept = list(self.suspects)
         self.suspects.clear()
@@ -369,12 +385,15 @@ class EdgeTracker:
         o = self.options
         if abs(self.estimate_deg - self.applied_deg) > o.deadband_deg:
             self.applied_deg = max(-o.max_offset_deg, min(o.max_offset_deg, self.estimate_deg))
+        if self.last_feature != "knee" or not o.keep_zero_load_in_bend:
+            self.zero_load_deg = self.applied_deg
 
     def status(self) -> dict[str, Any]:
         o = self.options
         state = ("learning" if self.learning else "frozen" if self.frozen_for > 0
                  else "tracking")
         return {"state": state, "offset_deg": round(self.applied_deg, 3),
+                "zero_load_offset_deg": round(self.zero_load_deg, 3),
                 "estimate_deg": round(self.estimate_deg, 3),
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
                 "odd_slope_ramps": self.n_odd_slope, "odd_knee_ramps": self.n_odd_knee,

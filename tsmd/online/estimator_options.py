@@ -34,3 +34,14 @@ class EstimatorOptions:
     shared_slope_ratio_max: float = 8.0
     """A slope change both edges of the knob show (a sheath's friction) is followed up to this
     ratio; beyond ``slope_ratio_max`` on one edge alone it is a stuck knob or a blocked tip."""
+    follow_bend_at_once: bool = False
+    """On: an edge's first knee beyond the gate while both tendons' last ramps changed slope
+    the same way by more than twice ``same_slope_tolerance`` is followed at once on both edges
+    of the knob (a bend widens both sides alike), not after a second suspect. Off by default:
+    it follows ~10 s sooner but one knee's scatter (+-1.5 deg) made capstan units 1-2 track
+    worse after a bend (docs/online.md, Session 9)."""
+    keep_zero_load_in_bend: bool = False
+    """On: a change the knee placed moves the edge, not the zero-load point (what a bend does
+    on the capstan plant). Off by default: with the knee's edges (~1 deg short of a fresh
+    calibration's) moving x0 with the edge tracks better, and the lumped plant's x0 moves
+    further than its edge (docs/online.md, Session 9)."""

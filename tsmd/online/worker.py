@@ -89,6 +89,8 @@ class OnlineWorker:
         self.gains: Offsets = ONE_GAINS
         self._gains_moving: Offsets = ONE_GAINS
         """The backlash gain ratios published with the knobs (pos, neg per knob)."""
+        self.zero_loads: Offsets = ZERO_OFFSETS
+        """The zero-load points' outward moves published with the knobs (pos, neg per knob)."""
         self.queue: collections.deque[tuple[tuple[float, ...], bool]] = collections.deque(
             maxlen=queue_len)
         self.drain_every = drain_every
@@ -244,10 +246,16 @@ class OnlineWorker:
         before = tracker.applied_deg
         other = self.trackers[(ramp.knob, -ramp.side)]
         events = tracker.update(ramp, d_pos if ramp.side > 0 else d_neg, other)
-        if tracker.agrees_with(other):
+        bend = (tracker.bend_suspect and tracker.options.follow_bend_at_once
+                and other.frozen_for == 0)
+        if bend or tracker.agrees_with(other):
             other_before = other.applied_deg
-            events += tracker.follow(tracker.suspects[-1], "both edges of the knob agree")
-            events += other.follow(other.suspects[-1], "both edges of the knob agree")
+            value = tracker.suspects[-1]
+            why = ("a bend on both tendons of the knob" if bend
+                   else "both edges of the knob agree")
+            events += tracker.follow(value, why)
+            events += other.follow(value if bend else other.suspects[-1], why,
+                                   "knee" if bend else "")
             if other.applied_deg != other_before:
                 self._emit("info", "online offset", knob=ramp.knob,
                            side="pos" if other.side > 0 else "neg",
@@ -263,6 +271,9 @@ class OnlineWorker:
 
     def _targets(self) -> Offsets:
         return self._per_edge("applied_deg") if self.enabled else ZERO_OFFSETS
+
+    def _zero_load_targets(self) -> Offsets:
+        return self._per_edge("zero_load_deg") if self.enabled else ZERO_OFFSETS
 
     def _gain_targets(self) -> Offsets:
         return self._per_edge("gain_ratio") if self.enabled else ONE_GAINS
@@ -280,19 +291,23 @@ class OnlineWorker:
         dt = max(t_s - self._t_publish, 0.0)
         self._t_publish = t_s
         new = _towards(current, self._targets(), self.rate_deg_s * dt)
+        zero_loads = _towards(self.zero_loads, self._zero_load_targets(), self.rate_deg_s * dt)
         targets = self._gain_targets()
         self._gains_moving = _towards(self._gains_moving, targets, self.gain_rate_per_s * dt)
         gains = self._gains_moving
         if (max(abs(a - b) for g, h in zip(gains, self.gains, strict=True)
                 for a, b in zip(g, h, strict=True)) < GAIN_STEP and gains != targets):
             gains = self.gains  # rebuilding the knobs costs ~0.1 s: in steps of GAIN_STEP
-        if new == current and gains == self.gains:
+        if new == current and gains == self.gains and zero_loads == self.zero_loads:
             return
         old_knobs = self.published[2]
         knobs = tuple(  # a knob whose values did not move is kept (a rebuild costs ~65 ms)
-            old_knobs[k] if (new[k], gains[k]) == (current[k], self.gains[k])
-            else shifted_knob(self.base_knobs[k], new[k], gains[k]) for k in (0, 1))
+            old_knobs[k] if (new[k], gains[k], zero_loads[k]) == (
+                current[k], self.gains[k], self.zero_loads[k])
+            else shifted_knob(self.base_knobs[k], new[k], gains[k], zero_loads[k])
+            for k in (0, 1))
         self.gains = gains
+        self.zero_loads = zero_loads
         self.published = (version + 1, new, (knobs[0], knobs[1]))
 
     # --- control and reporting (any thread) --------------------------------------------------
@@ -304,6 +319,7 @@ class OnlineWorker:
             if not enabled:
                 version = self.published[0]
                 self.gains = self._gains_moving = ONE_GAINS
+                self.zero_loads = ZERO_OFFSETS
                 self.published = (version + 1, ZERO_OFFSETS, self.base_knobs)
         self._emit("info", "online re-estimation", enabled=enabled)
 
@@ -317,6 +333,7 @@ class OnlineWorker:
         return {"enabled": self.enabled, "version": self.published[0],
                 "offsets_deg": [list(off[0]), list(off[1])],
                 "backlash_gain_ratios": [list(self.gains[0]), list(self.gains[1])],
+                "zero_load_offsets_deg": [list(self.zero_loads[0]), list(self.zero_loads[1])],
                 "edges": {f"phi{k + 1}_{'pos' if s > 0 else 'neg'}": tr.status()
                           for (k, s), tr in self.trackers.items()},
                 "events": list(self.events)[-5:]}

@@ -19,7 +19,8 @@ estimator sees only commanded and actual position and current. Per unit:
 
 The data sheet of the lumped family is measured once on its nominal unit (tracker on the tip,
 ``tsmd.datasheet``); capstan units use ``profiles/devices/sim-catheter.yaml``. Data sheets and
-calibrated profiles are cached in ``--cache`` (keyed by plant, unit and shape) so reruns are cheap.
+calibrated profiles are cached in ``--cache``, in a subdirectory keyed by the code that made them
+(:mod:`tsmd.bench.cache_key`), by plant, unit and shape, so reruns are cheap.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.bench.cache_key import keyed_cache
 from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.errors import TsmdError
 
@@ -319,7 +321,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="also run this long without a change, online on and off")
     parser.add_argument("--seed", type=int, default=0, help="noise and trajectory seed")
     parser.add_argument("--cache", default="/tmp/tsmd-bench-online",
-                        help="directory for the calibrated profiles")
+                        help="calibrated profiles go in a subdirectory per code version")
     parser.add_argument("--no-change", action="store_true", help="skip the shape-change runs")
 
 
@@ -329,6 +331,8 @@ def main(args: argparse.Namespace) -> int:
     except ValueError:
         raise TsmdError(f"--units {args.units!r}: expected integers like 0,1,2") from None
     shape_change(args.change)  # a bad --change is refused before anything runs
+    args.cache = str(keyed_cache(Path(args.cache)))
+    print(f"profiles cached in {args.cache}")
     device = device_for(args.plant, Path(args.cache))
     med, p99, top = hot_path_us()
     print(f"hot path (loop-side observe, two knobs): median {med:.2f} us, p99 {p99:.2f} us, "

@@ -32,11 +32,45 @@ def _play(x: Arr, half_width: float) -> Arr:
 
 @pytest.mark.parametrize("gain", [0.4, 1.0])
 def test_lost_motion_is_the_play_whatever_the_releasing_gain(gain: float) -> None:
-    x = np.concatenate([np.linspace(0.0, 40.0, 401), np.linspace(40.0, -40.0, 801)[1:]])
-    tip = gain * _play(x, 3.0)
-    found = compliance._lost_motion(x, tip, 400, 401)
-    assert found is not None
-    assert found[0] == pytest.approx(6.0, abs=0.15)
+    travel = compliance.TRAVEL_GRID_DEG
+    curve = gain * np.maximum(travel - 6.0, 0.0)
+    assert compliance._onset(curve) == pytest.approx(6.0, abs=0.05)
+
+
+def test_a_return_within_one_knob_sample_reads_within_that_sample() -> None:
+    # the knob moves 0.4 deg per sample and the tip returns 2 deg within one sample
+    x = np.arange(0.0, 40.0, 0.4)
+    tip = np.clip((x - 6.1) * 5.0, 0.0, None)
+    curve = np.interp(compliance.TRAVEL_GRID_DEG, x, tip)
+    assert 6.0 - 1e-9 <= compliance._onset(curve) <= 6.4
+
+
+def test_a_return_smaller_than_the_threshold_is_read_at_its_own_scale() -> None:
+    # a soft tendon at the loop amplitude leaves the tip barely out of its dead zone
+    travel = compliance.TRAVEL_GRID_DEG
+    curve = np.clip(travel - 9.0, 0.0, 0.9)
+    assert compliance._onset(curve) == pytest.approx(9.0, abs=0.05)
+
+
+def test_no_return_gives_no_lost_motion() -> None:
+    assert np.isnan(compliance._onset(np.full(len(compliance.TRAVEL_GRID_DEG), 0.1)))
+
+
+def test_the_null_spread_grows_with_the_repeats_scatter() -> None:
+    rng = np.random.default_rng(0)
+    travel = compliance.TRAVEL_GRID_DEG
+
+    def reversals(scatter_deg: float) -> compliance.Reversals:
+        onsets = 6.0 + scatter_deg * rng.standard_normal(8)
+        ret = np.array([np.maximum(travel - o, 0.0) for o in onsets])
+        cur = np.zeros_like(ret)
+        return compliance.Reversals(ret, cur, np.full(8, 0.05), np.full(8, 40.0),
+                                    np.zeros(8, dtype=np.int64))
+
+    rows = np.arange(8)
+    tight = compliance._jackknife_var(reversals(0.05), rows)[0]
+    loose = compliance._jackknife_var(reversals(0.5), rows)[0]
+    assert loose > 20.0 * tight
 
 
 @functools.cache

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from pathlib import Path
 
@@ -107,6 +108,18 @@ def test_a_unit_without_the_effect_is_not_named() -> None:
 def test_a_current_sensor_lag_does_not_read_as_compliance() -> None:
     score = compliance.compliance_score(_protocol_series(5, "sensor"), _sheet(), 7)
     assert score is not None and not score.significant
+
+
+def test_a_knob_whose_tip_never_returns_leaves_the_figure_to_the_other_knob() -> None:
+    # a soft tendon can leave one knob's tip inside its dead zone at the loop amplitude
+    flat = []
+    for s in _protocol_series(5, "compliance"):
+        tip = s.tip_deg.copy()
+        tip[:, 0] = 0.0
+        flat.append(dataclasses.replace(s, tip_deg=tip))
+    assert compliance.reference_deg_per_A(flat) is None
+    score = compliance.compliance_score(flat, _sheet(), 7)
+    assert score is not None and score.significant
 
 
 def test_recordings_without_the_protocol_give_no_figure() -> None:

@@ -223,14 +223,15 @@ def _contrast(r: Reversals, rows: NDArray[np.int64], with_var: bool = False,
     return Contrast(*(float(v) for v in total)) if found else None
 
 
-def _figures(series: Sequence[GapSeries]) -> list[tuple[Reversals, Contrast]] | None:
-    out = []
+def _figures(series: Sequence[GapSeries]) -> list[tuple[Reversals, Contrast] | None]:
+    """Per knob its reversals and load contrast; None for a knob without a readable one (a
+    soft tendon can leave the tip inside its dead zone at the loop amplitude)."""
+    out: list[tuple[Reversals, Contrast] | None] = []
     for knob in (0, 1):
         r = reversals(series, knob)
         c = _contrast(r, np.arange(len(r.at_deg)), with_var=True, min_per_group=MIN_PER_LEVEL)
-        if c is None or not (np.isfinite(c.slope) and c.slope > 0.0):
-            return None
-        out.append((r, c))
+        ok = c is not None and np.isfinite(c.slope) and c.slope > 0.0
+        out.append((r, c) if ok and c is not None else None)
     return out
 
 
@@ -238,7 +239,7 @@ def lost_motion_per_A(series: Sequence[GapSeries]) -> tuple[float, float] | None
     """The figure per knob (deg/A); None when a knob has no side with :data:`MIN_PER_LEVEL`
     readable reversals at both loads."""
     found = _figures(series)
-    if found is None:
+    if found[0] is None or found[1] is None:
         return None
     return found[0][1].slope, found[1][1].slope
 
@@ -251,20 +252,22 @@ the catheter model (the manufacturer's bench, or the nominal unit of a simulated
 def compliance_score(series: Sequence[GapSeries], reference: Sequence[float], n_tried: int,
                      family_alpha: float = 0.05, min_share: float = 0.05) -> SignatureScore | None:
     """Compliance named when the one-sided lower bound (level ``family_alpha / n_tried``; the
-    null's spread from the repeats at each load) of the figure's ratio to ``reference`` (geometric
-    mean over the knobs) exceeds 1 + :data:`TOLERANCE`. Share: the held-out shrink of the
-    load contrast's excess over the data sheet's, the figure fitted on one configuration
-    and scored on the other. The null's spread is the repeats' (jackknife) at each load.
-    None without enough readable reversals."""
-    found = _figures(series)
-    if found is None:
+    null's spread from the repeats at each load, a jackknife) of the figure's ratio to
+    ``reference`` (geometric mean over the knobs with a readable figure) exceeds
+    1 + :data:`TOLERANCE`. Share: the held-out shrink of the load contrast's excess over the
+    data sheet's, the figure fitted on one configuration and scored on the other. None when
+    no knob has enough readable reversals."""
+    per_knob = _figures(series)
+    found = [(f, ref) for f, ref in zip(per_knob, reference, strict=True) if f is not None]
+    if not found:
         return None
-    slopes = np.array([c.slope for _, c in found])
-    log_ratio = float(np.mean(np.log(slopes / np.asarray(reference))))
-    se = 0.5 * float(np.sqrt(sum(c.log_var for _, c in found)))
+    slopes = np.array([c.slope for (_, c), _ in found])
+    refs = np.array([ref for _, ref in found])
+    log_ratio = float(np.mean(np.log(slopes / refs)))
+    se = float(np.sqrt(sum(c.log_var for (_, c), _ in found))) / len(found)
     z_alpha = float(stats.norm.isf(family_alpha / max(n_tried, 1)))
     ratio, lower = float(np.exp(log_ratio)), float(np.exp(log_ratio - z_alpha * se))
-    share, lo, hi = _heldout_shrink([r for r, _ in found], reference)
+    share, lo, hi = _heldout_shrink([r for (r, _), _ in found], list(refs))
     z = (log_ratio - np.log1p(TOLERANCE)) / se if se > 0 else float("nan")
     title, _ = SIGNATURES["compliance"]
     significant = bool(lower > 1.0 + TOLERANCE and share >= min_share)

@@ -11,7 +11,7 @@ import pytest
 from numpy.typing import NDArray
 
 from tsmd import cli
-from tsmd.gap import compliance
+from tsmd.gap import compliance, crosstest
 from tsmd.gap.crosstest import PRESETS, make_session
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.signature import SignatureScore
@@ -164,3 +164,20 @@ def _written(tmp_path: Path) -> Path:
     path = tmp_path / "x.csv"
     write_recording(path, _protocol_recordings(0, "none", 0.0)[0])
     return path
+
+
+def test_a_data_sheet_measured_on_a_scattered_unit_differs_from_the_nominal_one() -> None:
+    nominal = crosstest.datasheet_reference(PRESETS["capstan"], RATE_HZ)
+    scattered = crosstest.datasheet_reference(PRESETS["capstan"], RATE_HZ, unit=201)
+    assert nominal is not None and scattered is not None
+    assert scattered != pytest.approx(nominal, rel=1e-3)
+    assert scattered == pytest.approx(nominal, rel=1.0 / 3.0)
+
+
+@pytest.mark.parametrize("unit", ["5", "-1"])
+def test_a_data_sheet_unit_that_is_scored_or_negative_is_one_line(
+        unit: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = cli.main(["gap", "selftest", "--data-plant", "capstan", "--sim-plant", "capstan",
+                     "--seeds", "5", "--sheet-unit", unit, "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "data-sheet unit" in err

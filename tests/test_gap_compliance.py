@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from pathlib import Path
 
@@ -10,7 +11,7 @@ import pytest
 from numpy.typing import NDArray
 
 from tsmd import cli
-from tsmd.gap import compliance
+from tsmd.gap import compliance, crosstest
 from tsmd.gap.crosstest import PRESETS, make_session
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.signature import SignatureScore
@@ -32,11 +33,45 @@ def _play(x: Arr, half_width: float) -> Arr:
 
 @pytest.mark.parametrize("gain", [0.4, 1.0])
 def test_lost_motion_is_the_play_whatever_the_releasing_gain(gain: float) -> None:
-    x = np.concatenate([np.linspace(0.0, 40.0, 401), np.linspace(40.0, -40.0, 801)[1:]])
-    tip = gain * _play(x, 3.0)
-    found = compliance._lost_motion(x, tip, 400, 401)
-    assert found is not None
-    assert found[0] == pytest.approx(6.0, abs=0.15)
+    travel = compliance.TRAVEL_GRID_DEG
+    curve = gain * np.maximum(travel - 6.0, 0.0)
+    assert compliance._onset(curve) == pytest.approx(6.0, abs=0.05)
+
+
+def test_a_return_within_one_knob_sample_reads_within_that_sample() -> None:
+    # the knob moves 0.4 deg per sample and the tip returns 2 deg within one sample
+    x = np.arange(0.0, 40.0, 0.4)
+    tip = np.clip((x - 6.1) * 5.0, 0.0, None)
+    curve = np.interp(compliance.TRAVEL_GRID_DEG, x, tip)
+    assert 6.0 - 1e-9 <= compliance._onset(curve) <= 6.4
+
+
+def test_a_return_smaller_than_the_threshold_is_read_at_its_own_scale() -> None:
+    # a soft tendon at the loop amplitude leaves the tip barely out of its dead zone
+    travel = compliance.TRAVEL_GRID_DEG
+    curve = np.clip(travel - 9.0, 0.0, 0.9)
+    assert compliance._onset(curve) == pytest.approx(9.0, abs=0.05)
+
+
+def test_no_return_gives_no_lost_motion() -> None:
+    assert np.isnan(compliance._onset(np.full(len(compliance.TRAVEL_GRID_DEG), 0.1)))
+
+
+def test_the_null_spread_grows_with_the_repeats_scatter() -> None:
+    rng = np.random.default_rng(0)
+    travel = compliance.TRAVEL_GRID_DEG
+
+    def reversals(scatter_deg: float) -> compliance.Reversals:
+        onsets = 6.0 + scatter_deg * rng.standard_normal(8)
+        ret = np.array([np.maximum(travel - o, 0.0) for o in onsets])
+        cur = np.zeros_like(ret)
+        return compliance.Reversals(ret, cur, np.full(8, 0.05), np.full(8, 40.0),
+                                    np.zeros(8, dtype=np.int64))
+
+    rows = np.arange(8)
+    tight = compliance._jackknife_var(reversals(0.05), rows)[0]
+    loose = compliance._jackknife_var(reversals(0.5), rows)[0]
+    assert loose > 20.0 * tight
 
 
 @functools.cache
@@ -73,6 +108,18 @@ def test_a_unit_without_the_effect_is_not_named() -> None:
 def test_a_current_sensor_lag_does_not_read_as_compliance() -> None:
     score = compliance.compliance_score(_protocol_series(5, "sensor"), _sheet(), 7)
     assert score is not None and not score.significant
+
+
+def test_a_knob_whose_tip_never_returns_leaves_the_figure_to_the_other_knob() -> None:
+    # a soft tendon can leave one knob's tip inside its dead zone at the loop amplitude
+    flat = []
+    for s in _protocol_series(5, "compliance"):
+        tip = s.tip_deg.copy()
+        tip[:, 0] = 0.0
+        flat.append(dataclasses.replace(s, tip_deg=tip))
+    assert compliance.reference_deg_per_A(flat) is None
+    score = compliance.compliance_score(flat, _sheet(), 7)
+    assert score is not None and score.significant
 
 
 def test_recordings_without_the_protocol_give_no_figure() -> None:
@@ -117,3 +164,20 @@ def _written(tmp_path: Path) -> Path:
     path = tmp_path / "x.csv"
     write_recording(path, _protocol_recordings(0, "none", 0.0)[0])
     return path
+
+
+def test_a_data_sheet_measured_on_a_scattered_unit_differs_from_the_nominal_one() -> None:
+    nominal = crosstest.datasheet_reference(PRESETS["capstan"], RATE_HZ)
+    scattered = crosstest.datasheet_reference(PRESETS["capstan"], RATE_HZ, unit=201)
+    assert nominal is not None and scattered is not None
+    assert scattered != pytest.approx(nominal, rel=1e-3)
+    assert scattered == pytest.approx(nominal, rel=1.0 / 3.0)
+
+
+@pytest.mark.parametrize("unit", ["5", "-1"])
+def test_a_data_sheet_unit_that_is_scored_or_negative_is_one_line(
+        unit: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = cli.main(["gap", "selftest", "--data-plant", "capstan", "--sim-plant", "capstan",
+                     "--seeds", "5", "--sheet-unit", unit, "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "data-sheet unit" in err

@@ -94,6 +94,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(preset capstan / capstan-other, or module:factory[@{json}])")
     parser.add_argument("--sim-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant used as the simulator")
+    parser.add_argument("--sheet-unit", type=int, default=0, metavar="N",
+                        help="selftest across plants: the unit of the data plant whose protocol "
+                             "gives the compliance data sheet (default 0, the nominal unit; "
+                             "never one of --seeds)")
     parser.add_argument("--no-protocol", action="store_true",
                         help="selftest across plants: sessions without the matched-condition "
                              "protocol recordings (the experiment motion only, as before)")
@@ -252,7 +256,7 @@ def _selftest(args: argparse.Namespace) -> int:
         sim = parse_plant_spec(args.sim_plant or "capstan")
         result = run_crosstest(data, sim, cases, sizes, seeds, rate_hz,
                                cross_config(sim.fit, args.method), progress=progress,
-                               matched=not args.no_protocol)
+                               matched=not args.no_protocol, sheet_unit=args.sheet_unit)
     else:
         result = run_selftest(cases, sizes, seeds, rate_hz,
                               GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method),

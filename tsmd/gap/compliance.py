@@ -6,9 +6,9 @@ the tip moves back, so this lost motion grows with the current's swing at the re
 amount per ampere that scales with the tendon's compliance. Slack and the joints' presliding
 add a part that does not grow with the load; it cancels in the contrast of two loads: the
 protocol's slow reversals at 40 deg (rate loops) against those at 60 deg (warm-up, dwells),
-both knobs together, in every configuration. Each load's lost motion and swing are medians
-over its repeats (one reversal carries the tracker noise, a dozen do not), and the repeats'
-spread is the null.
+both knobs together, in every configuration, each side of the knob on its own. Each load's lost
+motion is read from the mean of its repeats' return curves (the tracker noise averaged before a
+threshold is applied to it), and the null's spread is the repeats' own: a jackknife over them.
 
 Twice the compliance is, bit for bit, a catheter with half the tendon stiffness (docs/gap.md,
 Limits): nothing inside the data tells "this unit's tendon is softer" from "this model's tendons
@@ -20,6 +20,7 @@ another unit, :func:`reference_deg_per_A`); without one, compliance is not score
 from __future__ import annotations
 
 import itertools
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -36,7 +37,18 @@ MAX_SPEED_DEG_S = 45.0
 """Reversals at most this fast are read (the protocol's 20 and 40 deg/s): a fast reversal
 passes the lost motion in a few samples and adds the current's viscous part to its swing."""
 DEPARTURE_DEG = 1.5
-"""The tip's return read between a third of this and this (5-15x the tracker noise)."""
+"""The mean return curve read between a third of this and this (or of 0.6 of the curve's full
+return when that is smaller: a soft tendon at the loop amplitude leaves the tip barely out of
+its dead zone)."""
+MIN_RETURN_DEG = 0.3
+"""A mean return read below this is no return (the tracker noise of one reversal is 0.1 deg)."""
+TRAVEL_GRID_DEG = np.arange(0.0, 40.0, 0.05)
+"""Knob travel after a reversal on which the repeats' curves are averaged (finer than the
+knob's sample step: a return within one sample still reads between samples)."""
+REFERENCE_TRAVEL_DEG = 1.0
+"""The tip before its return: its mean over this much travel after the reversal."""
+SETTLE_WINDOW_DEG = 2.0
+"""The current after the lost motion: its mean over this much travel either side."""
 SETTLE_DEG = 10.0
 """The current after the lost motion is read this far further on the releasing branch: by
 then a sensor's lag of 0.1 s has caught up at the protocol's speeds (a lag is another effect)."""
@@ -55,18 +67,21 @@ LEVELS_DEG = (40.0, 60.0)
 constant part of the lost motion, slack and the joints' presliding, cancels)."""
 LEVEL_BAND_DEG = 2.0
 MIN_PER_LEVEL = 3
+"""Repeats at each load and side for a figure (the jackknife needs a few)."""
 CONDITION = "lost motion per ampere at the reversals against the data sheet"
 
 
 @dataclass(frozen=True)
 class Reversals:
-    """Per slow reversal of one knob: lost motion (deg), current swing (A), configuration."""
+    """Per slow reversal of one knob: the tip's return and the current against the knob travel
+    after it (on :data:`TRAVEL_GRID_DEG`, NaN beyond the motion), the current before it, the
+    knob angle of the reversal and the configuration."""
 
-    lost_deg: FloatArray
-    swing_A: FloatArray
-    config: NDArray[np.int64]
+    tip_return_deg: FloatArray
+    current_A: FloatArray
+    before_A: FloatArray
     at_deg: FloatArray
-    """The knob angle of the reversal."""
+    config: NDArray[np.int64]
 
 
 def _reversal_pairs(x: FloatArray) -> list[tuple[int, int]]:
@@ -77,117 +92,156 @@ def _reversal_pairs(x: FloatArray) -> list[tuple[int, int]]:
             if s[a] != s[b]]
 
 
-def _lost_motion(x: FloatArray, tip: FloatArray, a: int, b: int) -> tuple[float, int] | None:
-    """Knob travel after the reversal at row ``a`` before the tip moves back, and the row
-    :data:`SETTLE_DEG` of travel after it (None when the motion ends first). The tip's return
-    between a third of :data:`DEPARTURE_DEG` and all of it is a line extrapolated back to no
-    return, so neither the threshold nor the releasing branch's gain enters the figure."""
+def _after(x: FloatArray, a: int, b: int) -> tuple[FloatArray, int]:
+    """Knob travel from the reversal at row ``a`` over the motion that leaves it, and its end."""
     direction = np.sign(x[b] - x[a])
     steps = np.sign(np.round(np.diff(x[b:]), 9))
     against = np.flatnonzero(steps == -direction)
     end = b + 1 + (int(against[0]) if against.size else len(steps))
-    travel = np.abs(x[b:end] - x[a])
-    ahead = direction * tip[max(a - 2, 0):end]
-    moved = (ahead - np.minimum.accumulate(ahead))[b - max(a - 2, 0):]  # back from its extreme
-    last = np.flatnonzero(moved >= DEPARTURE_DEG)
-    if last.size == 0:
-        return None
-    # the return's start: after the last row below a third of the threshold before it (a
-    # noise excursion within the lost motion does not start it; the running extreme of
-    # dozens of noisy samples spreads by several standard deviations)
-    below = np.flatnonzero(moved[:last[0]] < DEPARTURE_DEG / 3.0)
-    if below.size == 0:
-        return None
-    first = int(below[-1]) + 1
-    rows = slice(first, int(last[0]) + 1)
-    if last[0] - first >= 2:
-        slope, icept = np.polyfit(travel[rows], moved[rows], 1)
-        lost = float(-icept / slope) if slope > 1e-6 else float(travel[first])
-    else:
-        lost = float(travel[first])
-    settled = np.flatnonzero(travel >= lost + SETTLE_DEG)
-    if settled.size == 0 or lost <= 0.0:
-        return None
-    return lost, b + int(settled[0])
+    return np.abs(x[a:end] - x[a]), end
 
 
 def reversals(series: Sequence[GapSeries], knob: int) -> Reversals:
-    """Every slow reversal of ``knob`` in the protocol recordings (the first of each recording
-    left out: it starts from the straight catheter)."""
+    """Every slow reversal of ``knob`` in the protocol recordings with the other knob at the
+    same angle (the first of each recording left out: it starts from the straight catheter)."""
     configs = sorted({s.config for s in series})
-    lost, swing, cfg, at = [], [], [], []
+    ret, cur_on, before, at, cfg = [], [], [], [], []
     for s in series:
         if s.segment is None:
             continue
-        x, tip, cur, t = s.knob_deg[:, knob], s.tip_deg[:, knob], s.current_A[:, knob], s.t_s
-        dt = float(np.median(np.diff(t)))
+        x, tip, cur = s.knob_deg[:, knob], s.tip_deg[:, knob], s.current_A[:, knob]
+        dt = float(np.median(np.diff(s.t_s)))
         pre = max(round(PRE_WINDOW_S / dt), 1)
-        half = max(round(0.25 * PRE_WINDOW_S / dt), 1)
         for a, b in _reversal_pairs(x)[1:]:
             speed = max(abs(x[a] - x[a - 1]), abs(x[b] - x[a])) / dt
-            other = s.knob_deg[a, 1 - knob]
-            if a < pre or speed > MAX_SPEED_DEG_S or abs(other - x[a]) > TOGETHER_DEG:
+            if (a < pre or speed > MAX_SPEED_DEG_S
+                    or abs(s.knob_deg[a, 1 - knob] - x[a]) > TOGETHER_DEG):
                 continue
-            found = _lost_motion(x, tip, a, b)
-            if found is None:
-                continue
-            i_rev = float(np.mean(cur[a - pre:a + 1]))
-            i_dep = float(np.mean(cur[found[1] - half:found[1] + half + 1]))
-            if abs(i_rev - i_dep) > 1e-4:
-                lost.append(found[0])
-                swing.append(abs(i_rev - i_dep))
-                cfg.append(configs.index(s.config))
-                at.append(float(x[a]))
-    return Reversals(np.array(lost, dtype=float), np.array(swing, dtype=float),
-                     np.array(cfg, dtype=np.int64), np.array(at, dtype=float))
+            travel, end = _after(x, a, b)
+            direction = np.sign(x[b] - x[a])
+            start = float(np.mean(tip[a:end][travel <= REFERENCE_TRAVEL_DEG]))
+            ret.append(np.interp(TRAVEL_GRID_DEG, travel, direction * (tip[a:end] - start),
+                                 right=np.nan))
+            cur_on.append(np.interp(TRAVEL_GRID_DEG, travel, cur[a:end], right=np.nan))
+            before.append(float(np.mean(cur[a - pre:a + 1])))
+            at.append(float(x[a]))
+            cfg.append(configs.index(s.config))
+    grid = len(TRAVEL_GRID_DEG)
+    return Reversals(np.array(ret, dtype=float).reshape(-1, grid),
+                     np.array(cur_on, dtype=float).reshape(-1, grid),
+                     np.array(before, dtype=float), np.array(at, dtype=float),
+                     np.array(cfg, dtype=np.int64))
 
 
-def _levels(r: Reversals) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-    """Reversals at the protocol's loop amplitude and at its dwell amplitude."""
-    amp = np.abs(r.at_deg)
-    return (np.abs(amp - LEVELS_DEG[0]) <= LEVEL_BAND_DEG,
-            np.abs(amp - LEVELS_DEG[1]) <= LEVEL_BAND_DEG)
+def _onset(curve: FloatArray) -> float:
+    """Knob travel before the mean return curve leaves zero: the line through its rise between
+    a third of the threshold and the threshold, extrapolated back to no return (neither the
+    threshold nor the releasing branch's gain enters); NaN without a readable return."""
+    top = float(np.nanmax(curve)) if np.isfinite(curve).any() else 0.0
+    high = min(DEPARTURE_DEG, 0.6 * top)
+    if high < MIN_RETURN_DEG:
+        return float("nan")
+    above = np.flatnonzero(curve >= high)
+    below = np.flatnonzero(curve[:above[0]] < high / 3.0)
+    if below.size == 0:
+        return float("nan")
+    rows = slice(int(below[-1]) + 1, int(above[0]) + 1)
+    if above[0] - below[-1] >= 3:
+        slope, icept = np.polyfit(TRAVEL_GRID_DEG[rows], curve[rows], 1)
+        if slope > 1e-6:
+            return float(-icept / slope)
+    return float(TRAVEL_GRID_DEG[rows.start])
 
 
-def _level_rows(r: Reversals) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    low, high = _levels(r)
-    return np.flatnonzero(low), np.flatnonzero(high)
+def _group(r: Reversals, rows: NDArray[np.int64]) -> tuple[float, float]:
+    """Lost motion (deg) of the repeats' mean return curve, and their mean current swing (A):
+    the current before the reversal minus the current :data:`SETTLE_DEG` of travel after the
+    lost motion (by then a sensor's lag of 0.1 s has caught up at the protocol's speeds)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # columns beyond every motion
+        lost = _onset(np.nanmean(r.tip_return_deg[rows], axis=0))
+        if not np.isfinite(lost):
+            return float("nan"), float("nan")
+        near = np.abs(TRAVEL_GRID_DEG - lost - SETTLE_DEG) <= SETTLE_WINDOW_DEG
+        after = np.nanmean(r.current_A[np.ix_(rows, np.flatnonzero(near))], axis=1)
+        swing = np.abs(r.before_A[rows] - after)
+        return lost, float(np.nanmean(swing)) if np.isfinite(swing).any() else float("nan")
 
 
-def _slope(r: Reversals, low: NDArray[np.int64], high: NDArray[np.int64]) -> float:
-    """Extra lost motion per extra ampere from the low to the high load (medians: a reversal
-    whose tip reading a noise spike ended early does not move it)."""
-    d_swing = np.median(r.swing_A[high]) - np.median(r.swing_A[low])
-    d_lost = np.median(r.lost_deg[high]) - np.median(r.lost_deg[low])
-    return float(d_lost / d_swing) if d_swing > 0 else float("nan")
+def _jackknife_var(r: Reversals, rows: NDArray[np.int64]) -> tuple[float, float]:
+    """Variance of :func:`_group`'s two figures from its repeats (leave one out)."""
+    n = len(rows)
+    loo = np.array([_group(r, np.delete(rows, i)) for i in range(n)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        dev = loo - np.nanmean(loo, axis=0)
+        var = (n - 1) / n * np.nansum(dev ** 2, axis=0)
+    return float(var[0]), float(var[1])
 
 
-def _median_var(x: FloatArray) -> float:
-    """Variance of a median from the spread between repeats (MAD, normal efficiency)."""
-    mad = 1.4826 * float(np.median(np.abs(x - np.median(x))))
-    return (1.2533 * mad) ** 2 / len(x)
+@dataclass(frozen=True)
+class Contrast:
+    """High load minus low load, summed over the knob's sides: lost motion (deg), current
+    swing (A) and their variances."""
+
+    lost_deg: float
+    swing_A: float
+    var_lost: float = 0.0
+    var_swing: float = 0.0
+
+    @property
+    def slope(self) -> float:
+        """Extra lost motion per extra ampere (deg/A)."""
+        return self.lost_deg / self.swing_A if self.swing_A > 0.0 else float("nan")
+
+    @property
+    def log_var(self) -> float:
+        """Variance of log(:attr:`slope`) by the delta method."""
+        return self.var_lost / self.lost_deg ** 2 + self.var_swing / self.swing_A ** 2
 
 
-def _log_slope_var(r: Reversals, low: NDArray[np.int64], high: NDArray[np.int64]) -> float:
-    """Variance of log(:func:`_slope`) by the delta method."""
-    d_swing = np.median(r.swing_A[high]) - np.median(r.swing_A[low])
-    d_lost = np.median(r.lost_deg[high]) - np.median(r.lost_deg[low])
-    v_lost = _median_var(r.lost_deg[high]) + _median_var(r.lost_deg[low])
-    v_swing = _median_var(r.swing_A[high]) + _median_var(r.swing_A[low])
-    return float(v_lost / d_lost ** 2 + v_swing / d_swing ** 2)
+def _contrast(r: Reversals, rows: NDArray[np.int64], with_var: bool = False,
+              min_per_group: int = 1) -> Contrast | None:
+    """The load contrast over ``rows``: per side of the knob (its two sides differ in slack
+    and in how far the loop leaves the dead zone), sides readable at both loads."""
+    amp = np.abs(r.at_deg[rows])
+    side = np.sign(r.at_deg[rows])
+    total = np.zeros(4)
+    found = False
+    for s in (1.0, -1.0):
+        groups = [rows[(np.abs(amp - level) <= LEVEL_BAND_DEG) & (side == s)]
+                  for level in LEVELS_DEG]
+        if min(len(g) for g in groups) < min_per_group:
+            continue
+        (lost_lo, swing_lo), (lost_hi, swing_hi) = (_group(r, g) for g in groups)
+        if not np.isfinite([lost_lo, swing_lo, lost_hi, swing_hi]).all():
+            continue
+        var = ([sum(v) for v in zip(*(_jackknife_var(r, g) for g in groups), strict=True)]
+               if with_var else [0.0, 0.0])
+        total += (lost_hi - lost_lo, swing_hi - swing_lo, *var)
+        found = True
+    return Contrast(*(float(v) for v in total)) if found else None
+
+
+def _figures(series: Sequence[GapSeries]) -> list[tuple[Reversals, Contrast] | None]:
+    """Per knob its reversals and load contrast; None for a knob without a readable one (a
+    soft tendon can leave the tip inside its dead zone at the loop amplitude)."""
+    out: list[tuple[Reversals, Contrast] | None] = []
+    for knob in (0, 1):
+        r = reversals(series, knob)
+        c = _contrast(r, np.arange(len(r.at_deg)), with_var=True, min_per_group=MIN_PER_LEVEL)
+        ok = c is not None and np.isfinite(c.slope) and c.slope > 0.0
+        out.append((r, c) if ok and c is not None else None)
+    return out
 
 
 def lost_motion_per_A(series: Sequence[GapSeries]) -> tuple[float, float] | None:
-    """The figure per knob (deg/A); None when a knob has fewer than
-    :data:`MIN_PER_LEVEL` readable reversals at either load."""
-    out = []
-    for knob in (0, 1):
-        r = reversals(series, knob)
-        low, high = _level_rows(r)
-        if min(len(low), len(high)) < MIN_PER_LEVEL:
-            return None
-        out.append(_slope(r, low, high))
-    return out[0], out[1]
+    """The figure per knob (deg/A); None when a knob has no side with :data:`MIN_PER_LEVEL`
+    readable reversals at both loads."""
+    found = _figures(series)
+    if found[0] is None or found[1] is None:
+        return None
+    return found[0][1].slope, found[1][1].slope
 
 
 reference_deg_per_A = lost_motion_per_A
@@ -198,23 +252,22 @@ the catheter model (the manufacturer's bench, or the nominal unit of a simulated
 def compliance_score(series: Sequence[GapSeries], reference: Sequence[float], n_tried: int,
                      family_alpha: float = 0.05, min_share: float = 0.05) -> SignatureScore | None:
     """Compliance named when the one-sided lower bound (level ``family_alpha / n_tried``; the
-    null's spread from the repeats at each load) of the figure's ratio to ``reference`` (geometric
-    mean over the knobs) exceeds 1 + :data:`TOLERANCE`. Share: the held-out shrink of the
-    load contrast's excess over the data sheet's, the figure fitted on one configuration
-    and scored on the other. None without enough readable reversals."""
-    per_knob = [reversals(series, k) for k in (0, 1)]
-    groups = [_level_rows(r) for r in per_knob]
-    if any(min(len(g[0]), len(g[1])) < MIN_PER_LEVEL for g in groups):
+    null's spread from the repeats at each load, a jackknife) of the figure's ratio to
+    ``reference`` (geometric mean over the knobs with a readable figure) exceeds
+    1 + :data:`TOLERANCE`. Share: the held-out shrink of the load contrast's excess over the
+    data sheet's, the figure fitted on one configuration and scored on the other. None when
+    no knob has enough readable reversals."""
+    per_knob = _figures(series)
+    found = [(f, ref) for f, ref in zip(per_knob, reference, strict=True) if f is not None]
+    if not found:
         return None
-    slopes = [_slope(r, low, high) for r, (low, high) in zip(per_knob, groups, strict=True)]
-    if not all(np.isfinite(x) and x > 0.0 for x in slopes):
-        return None
-    log_ratio = float(np.mean(np.log(np.asarray(slopes) / np.asarray(reference))))
-    se = 0.5 * float(np.sqrt(sum(_log_slope_var(r, *g)
-                                 for r, g in zip(per_knob, groups, strict=True))))
+    slopes = np.array([c.slope for (_, c), _ in found])
+    refs = np.array([ref for _, ref in found])
+    log_ratio = float(np.mean(np.log(slopes / refs)))
+    se = float(np.sqrt(sum(c.log_var for (_, c), _ in found))) / len(found)
     z_alpha = float(stats.norm.isf(family_alpha / max(n_tried, 1)))
     ratio, lower = float(np.exp(log_ratio)), float(np.exp(log_ratio - z_alpha * se))
-    share, lo, hi = _heldout_shrink(per_knob, groups, reference)
+    share, lo, hi = _heldout_shrink([r for (r, _), _ in found], list(refs))
     z = (log_ratio - np.log1p(TOLERANCE)) / se if se > 0 else float("nan")
     title, _ = SIGNATURES["compliance"]
     significant = bool(lower > 1.0 + TOLERANCE and share >= min_share)
@@ -224,27 +277,22 @@ def compliance_score(series: Sequence[GapSeries], reference: Sequence[float], n_
 
 
 def _heldout_shrink(per_knob: Sequence[Reversals],
-                    groups: Sequence[tuple[NDArray[np.int64], NDArray[np.int64]]],
                     reference: Sequence[float]) -> tuple[float, float, float]:
     """Mean, lowest and highest over held-out configurations of 1 - (the held-out load
-    contrast's lost motion minus the figure fitted on the other configurations' times its
+    contrast's lost motion minus the figure fitted on the other configurations times its
     current contrast)^2 / (the same with the data sheet's figure)^2, summed over the knobs;
     (0, nan, nan) with one configuration."""
-    n_cfg = max(int(r.config.max()) + 1 for r in per_knob)
+    n_cfg = max(int(r.config.max()) + 1 if len(r.config) else 0 for r in per_knob)
     shrinks = []
     for held in range(n_cfg):
         excess = resid = 0.0
-        for r, (low, high), ref in zip(per_knob, groups, reference, strict=True):
-            fit = (low[r.config[low] != held], high[r.config[high] != held])
-            test = (low[r.config[low] == held], high[r.config[high] == held])
-            if min(len(g) for g in (*fit, *test)) == 0:
+        for r, ref in zip(per_knob, reference, strict=True):
+            fit = _contrast(r, np.flatnonzero(r.config != held))
+            test = _contrast(r, np.flatnonzero(r.config == held))
+            if fit is None or test is None or not np.isfinite(fit.slope):
                 continue
-            slope = _slope(r, *fit)
-            d_lost = np.median(r.lost_deg[test[1]]) - np.median(r.lost_deg[test[0]])
-            d_swing = np.median(r.swing_A[test[1]]) - np.median(r.swing_A[test[0]])
-            if np.isfinite(slope):
-                excess += float((d_lost - ref * d_swing) ** 2)
-                resid += float((d_lost - slope * d_swing) ** 2)
+            excess += (test.lost_deg - ref * test.swing_A) ** 2
+            resid += (test.lost_deg - fit.slope * test.swing_A) ** 2
         if excess > 0.0:
             shrinks.append(1.0 - resid / excess)
     if not shrinks:

@@ -208,13 +208,16 @@ def _measure(plant: Any, t: FloatArray, q: FloatArray, rate_hz: float, lag_s: fl
 _DATASHEETS: dict[str, tuple[float, float] | None] = {}
 
 
-def datasheet_reference(data: PlantSpec, rate_hz: float) -> tuple[float, float] | None:
+def datasheet_reference(data: PlantSpec, rate_hz: float,
+                        unit: int = 0) -> tuple[float, float] | None:
     """The data sheet of the data plant's catheter model: lost motion per ampere on the
-    protocol recorded with its nominal unit (unit 0, no scatter, never a scored unit; noise as
-    in the sessions). Measured once per plant and rate."""
-    key = f"{data.name or data.factory}@{rate_hz:g}"
+    protocol recorded with one unit (noise as in the sessions): by default the nominal unit 0
+    (no scatter); another number is a scattered unit, as a real data sheet is measured on some
+    unit of the model. Never a scored unit. Measured once per plant, rate and unit."""
+    key = f"{data.name or data.factory}@{rate_hz:g}#{unit}"
     if key not in _DATASHEETS:
-        recs = make_session(data, "none", 4.0, rate_hz, 0, unit_variation=0.0)
+        recs = make_session(data, "none", 4.0, rate_hz, unit,
+                            unit_variation=0.0 if unit == 0 else 0.1)
         series = [series_from_recording(r, f"datasheet-{i}") for i, r in enumerate(recs)
                   if "segments" in r.metadata]
         _DATASHEETS[key] = reference_deg_per_A(series)
@@ -223,14 +226,15 @@ def datasheet_reference(data: PlantSpec, rate_hz: float) -> tuple[float, float] 
 
 def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float, seed: int,
                    rate_hz: float = 50.0, config: GapConfig | None = None,
-                   matched: bool = True) -> SelftestCase:
+                   matched: bool = True, sheet_unit: int = 0) -> SelftestCase:
     """Make one session and diagnose it blind with the other plant as the simulator."""
     recs = make_session(data, case, duration_s, rate_hz, seed, matched=matched)
     series = [series_from_recording(r, f"{case}-{seed}-{r.metadata['configuration']}-{i}")
               for i, r in enumerate(recs)]
     cfg = config or GapConfig(fit_specs=sim.fit, seed=seed)
     if matched and cfg.compliance_reference is None:
-        cfg = dataclasses.replace(cfg, compliance_reference=datasheet_reference(data, rate_hz))
+        cfg = dataclasses.replace(
+            cfg, compliance_reference=datasheet_reference(data, rate_hz, sheet_unit))
 
     def factory(params: dict[str, Any]) -> Any:
         return sim.build(**params)
@@ -258,12 +262,18 @@ def run_crosstest(data: PlantSpec, sim: PlantSpec, cases: Sequence[str],
                   sizes_s: Sequence[float], seeds: Sequence[int], rate_hz: float = 50.0,
                   config: GapConfig | None = None,
                   progress: Callable[[SelftestCase], None] | None = None,
-                  matched: bool = True) -> SelftestResult:
+                  matched: bool = True, sheet_unit: int = 0) -> SelftestResult:
+    if sheet_unit < 0:
+        raise GapError(f"data-sheet unit {sheet_unit}: a unit number is 0 or more")
+    if sheet_unit in seeds:
+        raise GapError(f"data-sheet unit {sheet_unit} is also scored: a data sheet is measured "
+                       "on another unit than those diagnosed")
     result = SelftestResult()
     for size in sizes_s:
         for seed in seeds:
             for case in cases:
-                c = run_cross_case(data, sim, case, size, seed, rate_hz, config, matched)
+                c = run_cross_case(data, sim, case, size, seed, rate_hz, config, matched,
+                                   sheet_unit)
                 result.cases.append(c)
                 if progress is not None:
                     progress(c)

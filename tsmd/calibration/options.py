@@ -72,12 +72,14 @@ the current's noise hides the rest (a few mA against a swing of 0.2-0.5 A), so t
 (where the current joins its release level) already marks the tip's release there."""
 
 
-SHARE_PER_SLOPE_RATIO = -0.24
+SHARE_PER_SLOPE_RATIO = -0.34
 """How the share of the swing made up at the tip's release moves with the unit's release-to-
 loaded slope ratio (a larger ratio: less friction-wrap in the sheath, the tip lets go earlier
-in the current's approach). Fitted once on lumped development units 1-8 (fast sweeps, noise
-seeds 0 and 1, r = -0.7 over units and knobs; docs/calibration.md, session 8); the sheet's
-own unit gives the anchor."""
+in the current's approach). Fitted on lumped development units 1-8 (fast sweeps, noise seeds 0
+and 1; half-cycles' share at the tip's release against their sweep's mean ratio, the ratio's
+slope read over :data:`tsmd.calibration.pieces.RELEASE_SLOPE_WINDOW_DEG`: -0.24 with the
+shorter window of session 8, whose noisier ratio attenuated the fit; docs/calibration.md,
+sessions 8 and 9); the sheet's own unit gives the anchor."""
 
 
 def for_product(options: IdentifyOptions, settle_fraction: float | None,

@@ -142,7 +142,8 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
     report = check_quality(points, limits, amplitude_deg,
                            omegas=tuple(k.omega for k in device.knobs))
     # Before refusing: a backlash far below the data sheet's often explains cycles that disagree.
-    cross_check_device(points, device, report)
+    cross_check_device(points, device, report,
+                       (limits or QualityLimits()).estimate.max_tip_error_deg)
     try:
         report.raise_if_bad()
     except CalibrationError as exc:

@@ -8,7 +8,6 @@ plant's noise-free tip with the plant package's own analysis, never read from it
 from __future__ import annotations
 
 import dataclasses
-
 import threading
 from pathlib import Path
 

@@ -229,8 +229,11 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
             problems.append(f"{where}: the current never becomes constant after the reversal")
         else:
             settle = found
-            # The backlash counts from the reversal (the model's X_ref).
-            backlash_deg = float(grid[settle] - grid[0])
+            # The backlash counts from the reversal (the model's X_ref); by the settle rule
+            # it ends where the data sheet's unit let go after its current settled.
+            lagged = min(settle + round(opts.backlash_settle_lag_deg / step), end - 1) \
+                if opts.backlash == "settle" else settle
+            backlash_deg = float(grid[lagged] - grid[0])
             swing = release_swing(grid[:end], yg[:end], settle)
 
     # The dead-zone edge: where the constant-current stretch ends and the current rises.
@@ -264,8 +267,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     return HalfCycle(
         direction=direction, start=start, stop=stop, after_reversal=after_reversal,
         peak_index=index_at(peak),
-        backlash_end_index=index_at(settle) if after_reversal and math.isfinite(backlash_deg)
-        else None,
+        backlash_end_index=index_at(round(backlash_deg / step))
+        if after_reversal and math.isfinite(backlash_deg) else None,
         edge_index=index_at(edge_k) if math.isfinite(edge_deg) else None,
         backlash_deg=backlash_deg, edge_deg=edge_deg, plateau_A=direction * plateau,
         rise_A=rise, snr=snr, problems=tuple(problems), slip=slip, release_swing_A=swing)
@@ -375,7 +378,7 @@ def settle_rule_backlash(data: Conditioned, options: IdentifyOptions | None = No
     fraction rule's earlier end (where the tip starts to move, on a Dahl-friction catheter)
     gives its backlash gain the curved start of the release, not its slope.
     """
-    opts = replace(options or IdentifyOptions(), backlash="settle")
+    opts = replace(options or IdentifyOptions(), backlash="settle", backlash_settle_lag_deg=0.0)
     values: dict[str, list[float]] = {"backlash_pos_deg": [], "backlash_neg_deg": []}
     for d, a, b, after in split_half_cycles(data.cmd_deg, opts.min_reversal_deg):
         if not after:

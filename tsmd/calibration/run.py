@@ -90,8 +90,10 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
     """Each knob's identification with its product's backlash rule from the data sheet."""
     base = options or IdentifyOptions()
     k1, k2 = device.knobs[0], device.knobs[1]
-    return (for_product(base, k1.backlash_settle_fraction, k1.backlash_release_slope_ratio),
-            for_product(base, k2.backlash_settle_fraction, k2.backlash_release_slope_ratio))
+    return (for_product(base, k1.backlash_settle_fraction, k1.backlash_release_slope_ratio,
+                        k1.backlash_settle_lag_deg),
+            for_product(base, k2.backlash_settle_fraction, k2.backlash_release_slope_ratio,
+                        k2.backlash_settle_lag_deg))
 
 
 def identify_recording(rec: Recording, options: KnobOptions = None,

@@ -166,7 +166,9 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional(k.get("backlash_release_slope_ratio"), "backlash_release_slope_ratio",
                      -1.0, 1.0, ""),
             optional(k.get("reference_release_swing_A"), "reference_release_swing_A", 0.0,
-                     100.0, "A")))
+                     100.0, "A"),
+            optional(k.get("backlash_settle_lag_deg"), "backlash_settle_lag_deg", -10.0, 10.0,
+                     "deg")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -200,6 +202,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             knobs[name]["backlash_release_slope_ratio"] = k.backlash_release_slope_ratio
         if k.reference_release_swing_A is not None:
             knobs[name]["reference_release_swing_A"] = k.reference_release_swing_A
+        if k.backlash_settle_lag_deg is not None:
+            knobs[name]["backlash_settle_lag_deg"] = k.backlash_settle_lag_deg
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

@@ -7,6 +7,7 @@ plant's noise-free tip with the plant package's own analysis, never read from it
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from pathlib import Path
 
@@ -368,17 +369,71 @@ def test_a_refusal_carries_the_data_sheet_warning_that_may_explain_it() -> None:
         finish("c", device, [GridPoint(k, 0.0, small) for k in (0, 1)])
 
 
-def test_backlash_near_the_data_sheets_gives_no_warning() -> None:
+def _with_swing(base: SweepResult, swing_A: float, backlash_deg: float) -> SweepResult:
+    """The result with every half-cycle's release swing and both backlashes set."""
+    halves = tuple(dataclasses.replace(h, release_swing_A=swing_A) for h in base.half_cycles)
+    return _with_backlash(SweepResult(base.data, halves, base.values), backlash_deg)
+
+
+def test_backlash_near_what_its_swing_implies_gives_no_warning() -> None:
     from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
 
     device = load_device_model(DEVICE)
-    sheet_b = device.knobs[1].reference_backlash_neg_deg
-    assert sheet_b is not None
-    near = _with_backlash(_identify(_sweep(SHORT_SWEEP)), 0.9 * sheet_b)
+    sheet = device.knobs[1]
+    assert sheet.reference_backlash_neg_deg is not None
+    assert sheet.reference_release_swing_A is not None
+    near = _with_swing(_identify(_sweep(SHORT_SWEEP)), sheet.reference_release_swing_A,
+                       0.9 * sheet.reference_backlash_neg_deg)
     report = QualityReport()
     cross_check_device([GridPoint(k, 0.0, near) for k in (0, 1)], device, report)
     assert report.warnings == []
     assert report.figures["phi2_backlash_neg_vs_datasheet"] == pytest.approx(0.9)
+
+
+def test_a_small_backlash_with_a_small_swing_is_seen_not_warned() -> None:
+    # lumped 103 phi2 and capstan development units 1, 2, 4-7: B right, 59-78 % of the sheet
+    # unit's, and their current swings less than the sheet unit's
+    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
+
+    device = load_device_model(DEVICE)
+    ref_b, ref_swing = (device.knobs[0].reference_backlash_pos_deg,
+                        device.knobs[0].reference_release_swing_A)
+    assert ref_b is not None and ref_swing is not None
+    small = _with_swing(_identify(_sweep(SHORT_SWEEP)), 0.55 * ref_swing, 0.6 * ref_b)
+    report = QualityReport()
+    cross_check_device([GridPoint(0, 0.0, small)], device, report)
+    assert report.warnings == []
+    assert report.figures["phi1_backlash_pos_vs_datasheet"] == pytest.approx(0.6)
+
+
+def test_a_backlash_short_of_what_a_large_swing_implies_is_warned() -> None:
+    # a routed handle: the guide pins add to the swing while the current settles early
+    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
+
+    device = load_device_model(DEVICE)
+    ref_b, ref_swing = (device.knobs[0].reference_backlash_pos_deg,
+                        device.knobs[0].reference_release_swing_A)
+    assert ref_b is not None and ref_swing is not None
+    routed = _with_swing(_identify(_sweep(SHORT_SWEEP)), 1.5 * ref_swing, 0.9 * ref_b)
+    report = QualityReport()
+    cross_check_device([GridPoint(0, 0.0, routed)], device, report)
+    assert len(report.warnings) == 2
+    assert "implies" in report.warnings[0] and "short on the tip" in report.warnings[0]
+
+
+def test_a_sheet_without_the_release_swing_keeps_the_fixed_share_check() -> None:
+    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
+
+    device = load_device_model(DEVICE)
+    old = dataclasses.replace(device, knobs=tuple(
+        dataclasses.replace(k, reference_release_swing_A=None) for k in device.knobs))
+    ref_b = device.knobs[0].reference_backlash_pos_deg
+    assert ref_b is not None
+    small = _with_swing(_identify(_sweep(SHORT_SWEEP)), 0.55 * 0.2, 0.6 * ref_b)
+    report = QualityReport()
+    cross_check_device([GridPoint(0, 0.0, small)], old, report)
+    assert len(report.warnings) == 2
+    assert "of the data sheet's reference backlash" in report.warnings[0]
 
 
 def _one_point_cross_check(plant_params: dict[str, object]):

@@ -94,3 +94,16 @@ def test_a_flatter_release_than_the_sheets_ends_the_backlash_later(sheet_ratio: 
                     backlash_share_per_slope_ratio=SHARE_PER_SLOPE_RATIO)
     shift = _backlash(moved) - _backlash(PLAIN)
     assert (shift > 1.0) if later else (shift < -1.0)
+
+
+def test_the_slope_ratio_stops_before_a_dead_zone_edge_inside_its_window() -> None:
+    # an edge 30 deg after the release end: past it the current is the loaded ramp, whose
+    # slope would be read as the release level's
+    grid = np.arange(0.0, 177.0, 0.25)
+    k = round(30.0 / 0.25)
+    curve = _release_curve(grid, 0.001) + LOADED_SLOPE_A_PER_DEG * np.maximum(grid - 60.0, 0.0)
+    stop = round(57.0 / 0.25)
+    release_level_only = 0.001 / (2.0 * LOADED_SLOPE_A_PER_DEG + 0.001)
+    assert release_slope_ratio(grid, curve, k, stop) == pytest.approx(release_level_only,
+                                                                      rel=0.05)
+    assert release_slope_ratio(grid, curve, k) > 2.0 * release_level_only

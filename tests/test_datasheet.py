@@ -128,6 +128,22 @@ def test_a_tracked_sweep_gives_the_current_edges_and_backlash_gain(sweep_files: 
         assert sheet.reference_dead_zone_pos_deg == pytest.approx(c.dead_zone_pos_deg, abs=0.01)
 
 
+def test_a_tracked_sweep_gives_a_settle_lag_and_release_swing_the_sheet_carries(
+        sweep_files: list[Path]) -> None:
+    """The tip lets go after the current has settled (0.6-1.0 deg of knob on the full stack's
+    capstan nominal, 2.9 deg on phi1 of this plant-only runner's 4 reversals: the lag belongs
+    to the rig it is measured on), and the current swings after each reversal: both read on
+    every reversal and carried by the sheet (docs/calibration.md, session 9)."""
+    limits = load_device_model(DEVICE).knobs[0].limits
+    for knob, path in enumerate(sweep_files):
+        c = knob_constants(read_recording(path), knob)
+        assert c.settle_lag_deg is not None and 0.0 < c.settle_lag_deg < 5.0
+        assert c.release_swing_A is not None and c.release_swing_A > 0.0
+        sheet = c.device_knob(limits)
+        assert sheet.backlash_settle_lag_deg == pytest.approx(c.settle_lag_deg, abs=0.01)
+        assert sheet.reference_release_swing_A == pytest.approx(c.release_swing_A, abs=1e-4)
+
+
 def test_the_backlash_gain_uses_the_settle_rule_whatever_the_products_rule() -> None:
     """On a product whose current has not settled when the tip starts back (lumped: settle
     fraction < 0.99), calibration ends the paper's B at that fraction; the tension play's

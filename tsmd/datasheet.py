@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -97,8 +98,16 @@ class KnobConstants:
     (:func:`backlash_settle_fraction`; None: no reversal could be measured)."""
     backlash_release_slope_ratio: float | None = None
     """The current's release-to-loaded slope ratio there (:func:`backlash_release_slope_ratio`)."""
+    release_swing_A: float | None = None
+    """The current's swing from the loaded current to the release level after a reversal
+    (:func:`tsmd.calibration.pieces.release_swing`, median over the reversals): another unit's
+    swing scales the backlash it should show (the "B cannot be seen" warning)."""
+    settle_lag_deg: float | None = None
+    """Knob travel from where the paper's settle rule ends the backlash to the tip's release
+    (1 deg moved back), median over the reversals: a product whose current settles before
+    the tip lets go ends every unit's backlash that much later."""
     release_reversals: int = 0
-    """How many reversals gave the two above (:func:`release_reads`)."""
+    """How many reversals gave the four above (:func:`release_reads`)."""
 
     def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
         """The data sheet's knob entry, rounded as a data sheet is printed."""
@@ -124,7 +133,11 @@ class KnobConstants:
                                       else round(float(self.backlash_settle_fraction), 3)),
             backlash_release_slope_ratio=(None if self.backlash_release_slope_ratio is None
                                           else round(float(self.backlash_release_slope_ratio),
-                                                     4)))
+                                                     4)),
+            reference_release_swing_A=(None if self.release_swing_A is None
+                                       else round(float(self.release_swing_A), 4)),
+            backlash_settle_lag_deg=(None if self.settle_lag_deg is None
+                                     else r(self.settle_lag_deg)))
 
 
 def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,
@@ -178,6 +191,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
             reference_backlash_neg_deg=ends.reference_backlash_neg_deg,
             backlash_settle_fraction=ends.backlash_settle_fraction,
             backlash_release_slope_ratio=ends.backlash_release_slope_ratio,
+            release_swing_A=ends.release_swing_A, settle_lag_deg=ends.settle_lag_deg,
             release_reversals=ends.release_reversals)
     if not rec.has_tip:
         raise DatasheetError("the recording has no tip angles (tip1, tip2): a data sheet "
@@ -225,7 +239,9 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
     if not loaded or not released:
         raise DatasheetError(f"knob {knob + 1}: no complete pass to fit the tip/knob slopes")
     top = SWEEP_AMPLITUDE_DEG - REFERENCE_BAND_DEG
-    reads = release_reads(cur.data, t, tip)
+    reads = release_reads(cur.data, t, tip, settle_deg={
+        h.start: h.backlash_deg for h in cur.half_cycles if h.after_reversal})
+    lags = [r.settle_lag_deg for r in reads if math.isfinite(r.settle_lag_deg)]
     return KnobConstants(
         omega=float(np.median(loaded)), release_omega=float(np.median(released)),
         reference_pos=ReferencePoint(SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos > top]))),
@@ -236,7 +252,9 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
         dead_zone_pos_deg=_finite_or_none(cur.estimate("dead_zone_pos_deg")),
         dead_zone_neg_deg=_finite_or_none(cur.estimate("dead_zone_neg_deg")), backlash_gain=gain,
         backlash_settle_fraction=median_share(reads),
-        backlash_release_slope_ratio=median_ratio(reads), release_reversals=len(reads))
+        backlash_release_slope_ratio=median_ratio(reads),
+        release_swing_A=float(np.median([r.swing_A for r in reads])) if reads else None,
+        settle_lag_deg=float(np.median(lags)) if lags else None, release_reversals=len(reads))
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -261,21 +279,32 @@ def backlash_release_slope_ratio(data: Conditioned, tip_t_s: NDArray[np.float64]
     return median_ratio(release_reads(data, tip_t_s, tip_deg, options))
 
 
-def median_share(reads: Sequence[tuple[float, float]]) -> float | None:
+class ReleaseRead(NamedTuple):
+    """What one reversal gives the sheet (:func:`release_reads`)."""
+
+    share: float
+    ratio: float
+    swing_A: float
+    settle_lag_deg: float = math.nan
+    """Knob travel from the settle rule's end to the tip's release."""
+
+
+def median_share(reads: Sequence[ReleaseRead]) -> float | None:
     """The sheet's release share: median over the reversals' reads (None: no reversal)."""
-    return float(np.median([share for share, _ in reads])) if reads else None
+    return float(np.median([r.share for r in reads])) if reads else None
 
 
-def median_ratio(reads: Sequence[tuple[float, float]]) -> float | None:
+def median_ratio(reads: Sequence[ReleaseRead]) -> float | None:
     """The sheet's slope ratio: median over the reversals' finite reads (None: none)."""
-    ratios = [r for _, r in reads if math.isfinite(r)]
+    ratios = [r.ratio for r in reads if math.isfinite(r.ratio)]
     return float(np.median(ratios)) if ratios else None
 
 
 def release_reads(data: Conditioned, tip_t_s: NDArray[np.float64], tip_deg: NDArray[np.float64],
-                  options: IdentifyOptions | None = None) -> list[tuple[float, float]]:
-    """(share of the swing, release-to-loaded slope ratio) at the tip's release after each
-    reversal at the sweep's ends.
+                  options: IdentifyOptions | None = None,
+                  settle_deg: Mapping[int, float] | None = None) -> list[ReleaseRead]:
+    """Share of the swing, release-to-loaded slope ratio and swing at the tip's release after
+    each reversal at the sweep's ends.
 
     Measured with the definitions they are used with, or they do not transfer: the tip as the
     scoring truth reads it (low-passed at the current's cutoff, then 1 deg back: on the raw
@@ -284,7 +313,9 @@ def release_reads(data: Conditioned, tip_t_s: NDArray[np.float64], tip_deg: NDAr
     without the last ``edge_margin_deg``, :func:`~tsmd.calibration.pieces.loaded_current`, the
     release level over ``RELEASE_LEVEL_WINDOW_DEG`` after the tip's release, the value there
     off the same quadratic). The one sample at the position's turning point, used before,
-    still carries the motor's friction half-turned (docs/calibration.md, session 7)."""
+    still carries the motor's friction half-turned (docs/calibration.md, session 7).
+    ``settle_deg``: the settle rule's backlash per half-cycle start (the sheet's own
+    identification), for the tip's lag behind it."""
     opts = options if options is not None else IdentifyOptions()
     step = opts.grid_step_deg
     tip_f, _ = lowpass(np.asarray(tip_deg, dtype=float), 1.0 / float(np.median(np.diff(tip_t_s))))
@@ -311,7 +342,10 @@ def release_reads(data: Conditioned, tip_t_s: NDArray[np.float64], tip_deg: NDAr
             continue
         made_up = smooth_value(grid, yg, k, opts.release_fit_half_deg) - loaded
         cut = yg.size - round(opts.edge_margin_deg / step)
-        reads.append((min(made_up / swing, 1.0), release_slope_ratio(grid[:cut], yg[:cut], k)))
+        settled = math.nan if settle_deg is None else settle_deg.get(a, math.nan)
+        reads.append(ReleaseRead(min(made_up / swing, 1.0),
+                                 release_slope_ratio(grid[:cut], yg[:cut], k), swing,
+                                 float(grid[k] - grid[0]) - settled))
     return reads
 
 

@@ -37,6 +37,7 @@ from tsmd.calibration.health import (
 )
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.pieces import (
+    EDGE_CLEARANCE_DEG,
     backlash_end,
     constant_phase,
     fitted_edge,
@@ -44,6 +45,7 @@ from tsmd.calibration.pieces import (
     knee_edge,
     linear_pieces,
     release_slope_ratio,
+    release_swing,
     share_end,
 )
 from tsmd.calibration.signal import Conditioned, FloatArray, condition
@@ -73,6 +75,9 @@ class HalfCycle:
     problems: tuple[str, ...] = ()
     slip: str | None = None
     """Where the loaded current dropped while the knob moved on, if it did."""
+    release_swing_A: float = math.nan
+    """After a reversal: the current's swing to its release level
+    (:func:`tsmd.calibration.pieces.release_swing`)."""
 
     @property
     def backlash_name(self) -> str:
@@ -208,6 +213,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     peak: int | None = None
     settle = 0
     backlash_deg = math.nan
+    swing = math.nan
     if after_reversal:
         # The small peak after the reversal (find_peaks); it belongs to the transient before the
         # constant phase (noise on the plateau has peaks too).
@@ -223,8 +229,12 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
             problems.append(f"{where}: the current never becomes constant after the reversal")
         else:
             settle = found
-            # The backlash counts from the reversal (the model's X_ref).
-            backlash_deg = float(grid[settle] - grid[0])
+            # The backlash counts from the reversal (the model's X_ref); by the settle rule
+            # it ends where the data sheet's unit let go after its current settled.
+            lagged = min(settle + round(opts.backlash_settle_lag_deg / step), end - 1) \
+                if opts.backlash == "settle" else settle
+            backlash_deg = float(grid[lagged] - grid[0])
+            swing = release_swing(grid[:end], yg[:end], settle)
 
     # The dead-zone edge: where the constant-current stretch ends and the current rises.
     edge_k: int | None = plateau_run[1] if plateau_run[1] < end else None
@@ -257,11 +267,11 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     return HalfCycle(
         direction=direction, start=start, stop=stop, after_reversal=after_reversal,
         peak_index=index_at(peak),
-        backlash_end_index=index_at(settle) if after_reversal and math.isfinite(backlash_deg)
-        else None,
+        backlash_end_index=index_at(round(backlash_deg / step))
+        if after_reversal and math.isfinite(backlash_deg) else None,
         edge_index=index_at(edge_k) if math.isfinite(edge_deg) else None,
         backlash_deg=backlash_deg, edge_deg=edge_deg, plateau_A=direction * plateau,
-        rise_A=rise, snr=snr, problems=tuple(problems), slip=slip)
+        rise_A=rise, snr=snr, problems=tuple(problems), slip=slip, release_swing_A=swing)
 
 
 def _index_at(pos: FloatArray, direction: int, grid: FloatArray, k: int, start: int) -> int:
@@ -286,6 +296,7 @@ def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
         return halves
     step = opts.grid_step_deg
     curves: dict[int, tuple[FloatArray, FloatArray, FloatArray, int]] = {}
+    stops: list[int | None] = []
     for i, h in enumerate(halves):
         if h.after_reversal and math.isfinite(h.backlash_deg):
             pos = data.pos_deg[h.start:h.stop]
@@ -293,7 +304,10 @@ def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
                 pos, h.direction * data.current_filtered_A[h.start:h.stop], h.direction, step)
             end = yg.size - round(opts.edge_margin_deg / step)
             curves[i] = (pos, grid[:end], yg[:end], round(h.backlash_deg / step))
-    ratios = [release_slope_ratio(g, y, k) for _, g, y, k in curves.values()]
+            stops.append(None if not math.isfinite(h.edge_deg) else int(
+                np.searchsorted(grid, h.direction * h.edge_deg)) - round(EDGE_CLEARANCE_DEG / step))
+    ratios = [release_slope_ratio(g, y, k, stop)
+              for (_, g, y, k), stop in zip(curves.values(), stops, strict=True)]
     finite = [r for r in ratios if math.isfinite(r)]
     if not finite:
         return halves
@@ -305,7 +319,8 @@ def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
         k_new = share_end(grid, yg, min(k, yg.size - 1), share, opts.release_fit_half_deg)
         h = halves[i]
         out[i] = replace(h, backlash_deg=float(grid[k_new] - grid[0]),
-                         backlash_end_index=_index_at(pos, h.direction, grid, k_new, h.start))
+                         backlash_end_index=_index_at(pos, h.direction, grid, k_new, h.start),
+                         release_swing_A=release_swing(grid, yg, k_new))
     return tuple(out)
 
 
@@ -363,7 +378,7 @@ def settle_rule_backlash(data: Conditioned, options: IdentifyOptions | None = No
     fraction rule's earlier end (where the tip starts to move, on a Dahl-friction catheter)
     gives its backlash gain the curved start of the release, not its slope.
     """
-    opts = replace(options or IdentifyOptions(), backlash="settle")
+    opts = replace(options or IdentifyOptions(), backlash="settle", backlash_settle_lag_deg=0.0)
     values: dict[str, list[float]] = {"backlash_pos_deg": [], "backlash_neg_deg": []}
     for d, a, b, after in split_half_cycles(data.cmd_deg, opts.min_reversal_deg):
         if not after:

@@ -53,6 +53,10 @@ class IdentifyOptions:
     was ``backlash_fraction``; each sweep's own ratio then moves its share by
     ``backlash_share_per_slope_ratio`` per unit of ratio (None: one share for every unit)."""
     backlash_share_per_slope_ratio: float = 0.0
+    backlash_settle_lag_deg: float = 0.0
+    """"settle" with a data sheet that measured it: how much further the knob turns, on the
+    sheet's unit, from where the current has settled to where the tip has moved back 1 deg
+    (``DeviceKnob.backlash_settle_lag_deg``); the backlash ends that far beyond the settle."""
     release_fit_half_deg: float = 4.0
     """"fraction": the share's crossing is read off a quadratic fitted to the current over this
     much knob travel either side of it (noise averaged; narrow enough for a quadratic to follow
@@ -72,24 +76,31 @@ the current's noise hides the rest (a few mA against a swing of 0.2-0.5 A), so t
 (where the current joins its release level) already marks the tip's release there."""
 
 
-SHARE_PER_SLOPE_RATIO = -0.24
+SHARE_PER_SLOPE_RATIO = -0.34
 """How the share of the swing made up at the tip's release moves with the unit's release-to-
 loaded slope ratio (a larger ratio: less friction-wrap in the sheath, the tip lets go earlier
-in the current's approach). Fitted once on lumped development units 1-8 (fast sweeps, noise
-seeds 0 and 1, r = -0.7 over units and knobs; docs/calibration.md, session 8); the sheet's
-own unit gives the anchor."""
+in the current's approach). Fitted on lumped development units 1-8 (fast sweeps, noise seeds 0
+and 1; half-cycles' share at the tip's release against their sweep's mean ratio, the ratio's
+slope read over :data:`tsmd.calibration.pieces.RELEASE_SLOPE_WINDOW_DEG`: -0.24 with the
+shorter window of session 8, whose noisier ratio attenuated the fit; docs/calibration.md,
+sessions 8 and 9); the sheet's own unit gives the anchor."""
 
 
 def for_product(options: IdentifyOptions, settle_fraction: float | None,
-                slope_ratio: float | None = None) -> IdentifyOptions:
+                slope_ratio: float | None = None,
+                settle_lag_deg: float | None = None) -> IdentifyOptions:
     """The identification for one knob of a product whose data sheet measured how far the
     current has come back when the tip starts to move: below :data:`SETTLED_FRACTION` the
     backlash ends at that share of the current's swing ("fraction"), moved per sweep by the
-    unit's own slope ratio where the sheet gives its unit's (``slope_ratio``); else as
-    ``options`` say."""
-    if settle_fraction is None or settle_fraction >= SETTLED_FRACTION \
-            or options.backlash != "settle":
+    unit's own slope ratio where the sheet gives its unit's (``slope_ratio``); else the
+    settle rule, ended ``settle_lag_deg`` beyond the settle where the sheet measured that lag;
+    else as ``options`` say."""
+    if options.backlash != "settle":
         return options
+    if settle_fraction is None or settle_fraction >= SETTLED_FRACTION:
+        if settle_lag_deg is None or settle_fraction is None:
+            return options
+        return replace(options, backlash_settle_lag_deg=settle_lag_deg)
     if slope_ratio is None:
         return replace(options, backlash="fraction", backlash_fraction=settle_fraction)
     return replace(options, backlash="fraction", backlash_fraction=settle_fraction,

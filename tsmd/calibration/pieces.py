@@ -22,6 +22,14 @@ RELEASE_LEVEL_WINDOW_DEG = (5.0, 20.0)
 """Knob travel after the backlash's end over which the release level is the current's median,
 as the data sheet defines it (fraction rule)."""
 RELEASE_LEVEL_ITERATIONS = 4
+RELEASE_SLOPE_WINDOW_DEG = (5.0, 40.0)
+"""Knob travel after the backlash's end over which the release level's slope is read for the
+slope ratio (:func:`release_slope_ratio`). Longer than the level's window: a slope read over
+15 deg scattered per half-cycle as much as the units differ (ratio sd 0.038, units 0.013), over
+35 deg by a quarter of that (0.010) (lumped development units 1-8, session 9). It ends before
+the dead-zone edge on the far side (at >= 100 deg of travel on a +-90 deg sweep)."""
+EDGE_CLEARANCE_DEG = 3.0
+"""The slope window stops this far before a dead-zone edge found in the half-cycle."""
 
 
 def slope_per_deg(y: FloatArray, step: float) -> float:
@@ -226,19 +234,36 @@ def share_end(grid: FloatArray, yg: FloatArray, k: int, share: float, half_deg: 
     return k
 
 
-def release_slope_ratio(grid: FloatArray, yg: FloatArray, k: int) -> float:
-    """The current's slope over ``RELEASE_LEVEL_WINDOW_DEG`` after the release end ``k`` (the
+def release_swing(grid: FloatArray, yg: FloatArray, k: int) -> float:
+    """The current's swing after a reversal: from the loaded current
+    (:func:`loaded_current`) to the release level (median over ``RELEASE_LEVEL_WINDOW_DEG``
+    after the release end ``k``), NaN where the level cannot be read. Over healthy units of
+    both plants the backlash grows with it (session 9), so it tells how much backlash a unit's
+    current should show."""
+    step = float(grid[1] - grid[0])
+    lo_deg, hi_deg = RELEASE_LEVEL_WINDOW_DEG
+    a, b = k + round(lo_deg / step), min(yg.size, k + round(hi_deg / step))
+    if b - a < 5:
+        return math.nan
+    return float(np.median(yg[a:b])) - loaded_current(yg, step)
+
+
+def release_slope_ratio(grid: FloatArray, yg: FloatArray, k: int,
+                        stop: int | None = None) -> float:
+    """The current's slope over ``RELEASE_SLOPE_WINDOW_DEG`` after the release end ``k`` (the
     tip moving back, the tendon paying out through the sheath's friction) over the loaded
     ramp's slope (the last quarter of the travel: the tip pulled, the tendon drawn in against
-    it), NaN where either cannot be read.
+    it), NaN where either cannot be read. ``stop``: the window ends there at the latest (a
+    dead-zone edge: beyond it the current is the loaded ramp, not the release level).
 
     Both slopes carry the bending section's stiffness, one divided by the sheath's friction
     factor and one multiplied by it, so their ratio follows the unit's friction-wrap product,
     which is what moves the share of the swing made up at the tip's release from unit to unit
-    (docs/calibration.md, session 8)."""
+    (docs/calibration.md, sessions 8 and 9)."""
     step = float(grid[1] - grid[0])
-    lo_deg, hi_deg = RELEASE_LEVEL_WINDOW_DEG
-    a, b = k + round(lo_deg / step), min(yg.size, k + round(hi_deg / step))
+    lo_deg, hi_deg = RELEASE_SLOPE_WINDOW_DEG
+    b = min(yg.size, k + round(hi_deg / step), yg.size if stop is None else stop)
+    a = k + round(lo_deg / step)
     loaded = slope_per_deg(yg[int(0.75 * yg.size):], step)
     if b - a < 5 or not loaded > 0.0:
         return math.nan

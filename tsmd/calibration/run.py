@@ -90,8 +90,10 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
     """Each knob's identification with its product's backlash rule from the data sheet."""
     base = options or IdentifyOptions()
     k1, k2 = device.knobs[0], device.knobs[1]
-    return (for_product(base, k1.backlash_settle_fraction, k1.backlash_release_slope_ratio),
-            for_product(base, k2.backlash_settle_fraction, k2.backlash_release_slope_ratio))
+    return (for_product(base, k1.backlash_settle_fraction, k1.backlash_release_slope_ratio,
+                        k1.backlash_settle_lag_deg),
+            for_product(base, k2.backlash_settle_fraction, k2.backlash_release_slope_ratio,
+                        k2.backlash_settle_lag_deg))
 
 
 def identify_recording(rec: Recording, options: KnobOptions = None,
@@ -142,7 +144,8 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
     report = check_quality(points, limits, amplitude_deg,
                            omegas=tuple(k.omega for k in device.knobs))
     # Before refusing: a backlash far below the data sheet's often explains cycles that disagree.
-    cross_check_device(points, device, report)
+    cross_check_device(points, device, report,
+                       (limits or QualityLimits()).estimate.max_tip_error_deg)
     try:
         report.raise_if_bad()
     except CalibrationError as exc:

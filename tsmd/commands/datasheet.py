@@ -114,7 +114,9 @@ def main(args: argparse.Namespace) -> int:
               f"{c.reference_backlash_pos_deg:.2f}/{c.reference_backlash_neg_deg:.2f} deg, "
               f"dead-zone offset {c.dead_zone_offset_deg:.2f} deg, release share "
               f"{_or_none(c.backlash_settle_fraction, 3)} and slope ratio "
-              f"{_or_none(c.backlash_release_slope_ratio, 4)} over {c.release_reversals} "
+              f"{_or_none(c.backlash_release_slope_ratio, 4)}, swing "
+              f"{_or_none(c.release_swing_A, 4)} A, settle lag {_or_none(c.settle_lag_deg, 2)} "
+              f"deg over {c.release_reversals} "
               f"reversals")
     print(f"tsmd datasheet: wrote {args.out}")
     return 0

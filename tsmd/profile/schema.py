@@ -164,7 +164,11 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional(k.get("backlash_settle_fraction"), "backlash_settle_fraction", 0.5, 1.0,
                      ""),
             optional(k.get("backlash_release_slope_ratio"), "backlash_release_slope_ratio",
-                     -1.0, 1.0, "")))
+                     -1.0, 1.0, ""),
+            optional(k.get("reference_release_swing_A"), "reference_release_swing_A", 0.0,
+                     100.0, "A"),
+            optional(k.get("backlash_settle_lag_deg"), "backlash_settle_lag_deg", -10.0, 10.0,
+                     "deg")))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -196,6 +200,10 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             knobs[name]["backlash_settle_fraction"] = k.backlash_settle_fraction
         if k.backlash_release_slope_ratio is not None:
             knobs[name]["backlash_release_slope_ratio"] = k.backlash_release_slope_ratio
+        if k.reference_release_swing_A is not None:
+            knobs[name]["reference_release_swing_A"] = k.reference_release_swing_A
+        if k.backlash_settle_lag_deg is not None:
+            knobs[name]["backlash_settle_lag_deg"] = k.backlash_settle_lag_deg
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

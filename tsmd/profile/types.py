@@ -83,6 +83,16 @@ class DeviceKnob:
     """Optional: on the data-sheet unit, the current's slope just after the tip's release over
     its loaded ramp's (:func:`tsmd.calibration.pieces.release_slope_ratio`): with it the share
     above moves per unit with that unit's own ratio (old sheets: one share for every unit)."""
+    reference_release_swing_A: float | None = None
+    """Optional, on the data-sheet unit: the motor current's swing after a reversal from the
+    loaded current to the release level (:func:`tsmd.calibration.pieces.release_swing`): with
+    it the reference backlashes scale to another unit's own swing for the check that B can be
+    seen in the current (old sheets: the reference backlashes as they are)."""
+    backlash_settle_lag_deg: float | None = None
+    """Optional, on the data-sheet unit: knob travel from where the paper's settle rule ends
+    the backlash to where the tip has moved back 1 deg (median over the reversals). Where the
+    settle rule is kept (``backlash_settle_fraction`` >= 0.99) calibration ends every unit's
+    backlash that much later (old sheets: at the settle)."""
 
 
 @dataclass(frozen=True)

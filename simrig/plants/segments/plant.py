@@ -62,13 +62,11 @@ class SegmentsPlant:
         toe[:, 0] = g("toe_mm") * 1e-3
         toe[:, 1:] = 1e-6  # inside the sheath: engages over 1 um, smooth for the solver
         self._toe = toe[:, None, :]
-        curvature_rad = math.radians(settings.sheath_curvature_deg)
-        wrap_rad = np.radians(g("sheath_wrap_deg")) + curvature_rad
-        self._mu_dpsi = (g("sheath_friction") * wrap_rad / n)[:, None, None]
+        self._slack_delta_m = np.zeros((2, 2))
+        self._set_curvature(settings.sheath_curvature_deg)
         self._drag_N = (g("sheath_drag_N") / n)[:, None, None]
         self._z_max = (g("presliding_mm") * 1e-3)[:, None, None]
         self._stick = g("stick_fraction")[:, None, None]
-        self._curvature_slack_m = settings.lumen_clearance_mm * 1e-3 * curvature_rad
         self._k_bend = g("bend_stiffness_Nm_per_rad")
         self._c_bend = g("bend_stiffening_per_rad2")
         self._m_hyst = g("bend_hysteresis_Nm")
@@ -103,6 +101,34 @@ class SegmentsPlant:
         self._tension0 = np.zeros((2, 2))
         self._settled = True
 
+    def reshape(self, sheath_curvature_deg: float | None = None,
+                slack_delta_mm: tuple[tuple[float, float], tuple[float, float]] | None = None
+                ) -> None:
+        """The catheter changes shape mid-run (``simrig.scenario.ShapeChangePlant``): the sheath
+        laid in a new curve, or every tendon's slack changed by ((+, -) knob 1, (+, -) knob 2)
+        mm from the unit's own. The tendons' and contacts' states are kept."""
+        if sheath_curvature_deg is not None:
+            if not (math.isfinite(sheath_curvature_deg) and sheath_curvature_deg >= 0.0):
+                raise ValueError(f"sheath_curvature_deg must be >= 0, got "
+                                 f"{sheath_curvature_deg!r}")
+            self._set_curvature(float(sheath_curvature_deg))
+        if slack_delta_mm is not None:
+            delta = np.asarray(slack_delta_mm, dtype=float)
+            if delta.shape != (2, 2) or not np.all(np.isfinite(delta)):
+                raise ValueError(f"slack_delta_mm must be ((+, -), (+, -)) in mm, got "
+                                 f"{slack_delta_mm!r}")
+            self._slack_delta_m = delta * 1e-3
+        self._settled = False
+
+    def _set_curvature(self, curvature_deg: float) -> None:
+        """A curved sheath adds its angle to every element's wrap and lets the tendon take the
+        inner side of its lumen (a shorter path: more slack)."""
+        curvature_rad = math.radians(curvature_deg)
+        wrap_rad = np.radians(_per_knob(self.knobs, "sheath_wrap_deg")) + curvature_rad
+        friction = _per_knob(self.knobs, "sheath_friction")
+        self._mu_dpsi = (friction * wrap_rad / self._n)[:, None, None]
+        self._curvature_slack_m = self.settings.lumen_clearance_mm * 1e-3 * curvature_rad
+
     def step(self, dt_s: float, knob_deg: NDArray[np.float64]) -> PlantStep:
         """Advance by ``dt_s`` with the knobs ending at ``knob_deg``."""
         q0, q1 = step_inputs(dt_s, knob_deg)
@@ -129,8 +155,8 @@ class SegmentsPlant:
 
     def _draw_in(self, knob_rad: Array) -> Array:
         """Pulley draw-in of each tendon minus its slack and the sheath's shortening (m)."""
-        p = _SIGN[None, :] * (self._r_m * knob_rad)[:, None] - self._slack_m
-        p -= self._curvature_slack_m
+        p = (_SIGN[None, :] * (self._r_m * knob_rad)[:, None] - self._slack_m
+             - self._slack_delta_m - self._curvature_slack_m)
         if self._shift or self._compress:
             other_theta = self._theta[::-1]
             other_tension = self._tension0.sum(axis=1)[::-1]

@@ -21,6 +21,7 @@ travel, so the loops do not depend on the tick (100 us to 4 ms) or on the knob s
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -85,6 +86,9 @@ class SegmentsPlant:
         left = np.concatenate([np.arange(n - 1), n + np.arange(n - 1)])
         self._off = (left, left + 1)
         self._last = np.array([n - 1, 2 * n - 1])
+        self._a = np.zeros((2, m, m))  # only the chain's entries are ever written
+        self._rhs = np.zeros((2, m))
+        self._stretch = np.empty((2, 2, n + 1))
         self.reset()
 
     def reset(self) -> None:
@@ -164,32 +168,34 @@ class SegmentsPlant:
             p -= (self._compress * other_tension)[:, None]
         return p
 
-    def _forces(self, p: Array) -> tuple[Array, Array, Array, Array]:
-        """Segment tensions and tangents, node friction capacity and the tip's residual."""
+    def _forces(self, p: Array) -> tuple[Array, Array, Array]:
+        """Segment tensions and tangent stiffnesses, and each node's friction capacity."""
         u = self._u
         n = self._n
-        stretch = np.empty((2, 2, n + 1))
+        stretch = self._stretch
         stretch[..., 0] = p - u[..., 0]
         stretch[..., 1:n] = u[..., :-1] - u[..., 1:]
         stretch[..., n] = u[..., -1] - _SIGN[None, :] * (self._rb_m * self._theta)[:, None]
         tension, tangent = laws.recruit(stretch, self._toe, self._k)
         capacity = self._mu_dpsi * 0.5 * (tension[..., :-1] + tension[..., 1:]) + self._drag_N
-        return tension, tangent, capacity, stretch
+        return tension, tangent, capacity
 
     def _piece(self, dt_s: float, knob_rad: Array) -> float:
         """One linearised implicit step to ``knob_rad``; returns the largest node travel (m)."""
         n, m = self._n, self._m
-        tension, tangent, capacity, _ = self._forces(self._draw_in(knob_rad))
+        tension, tangent, capacity = self._forces(self._draw_in(knob_rad))
         theta = self._theta
         r_nodes = tension[..., :-1] - tension[..., 1:] - capacity * self._z / self._z_max
         r_tip = (self._rb_m * (tension[:, 0, n] - tension[:, 1, n])
                  - self._k_bend * theta * (1.0 + self._c_bend * theta * theta)
                  - self._m_hyst * self._h)
-        rhs = np.concatenate([r_nodes.reshape(2, 2 * n), r_tip[:, None]], axis=1)
+        rhs = self._rhs
+        rhs[:, :2 * n] = r_nodes.reshape(2, 2 * n)
+        rhs[:, m - 1] = r_tip
         k_end = tangent[..., n]
         direction, dir_theta = self._dir, self._dir_theta
         for _ in range(3):
-            a = np.zeros((2, m, m))
+            a = self._a
             contact = capacity / self._z_max * laws.presliding_slope(
                 self._z, direction, self._z_max, self._stick)
             diag = tangent[..., :-1] + tangent[..., 1:] + contact + self._b_node / dt_s
@@ -204,7 +210,7 @@ class SegmentsPlant:
                     + self._m_hyst * laws.bouc_wen_slope(self._h, dir_theta, self._yield))
             a[:, m - 1, m - 1] = (self._rb_m ** 2 * k_end.sum(axis=1) + bend
                                   + _TIP_DAMPING_Nm_s_per_rad / dt_s)
-            dx = np.linalg.solve(a, rhs[..., None])[..., 0]
+            dx = cast(Array, np.linalg.solve(a, rhs[..., None])[..., 0])
             du = dx[:, :2 * n].reshape(2, 2, n)
             dtheta = dx[:, m - 1]
             new_dir = np.where(np.abs(du) > 1e-12, np.sign(du), direction)

@@ -27,7 +27,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.plant import PlantStep, step_inputs
-from simrig.plants.segments import laws
+from simrig.plants.segments.laws import (
+    bouc_wen_slope,
+    bouc_wen_update,
+    presliding_slope,
+    presliding_update,
+    recruit,
+)
 from simrig.plants.segments.params import SegmentsKnobParams, SegmentsPlantParams
 
 Array = NDArray[np.float64]
@@ -147,11 +153,11 @@ class SegmentsPlant:
             for i in range(1, pieces + 1):
                 knob = start + move * (i / pieces)
                 moved = self._piece(dt_piece, knob)
-            self._z_handle = laws.presliding_update(self._z_handle, move, self._handle_z_max,
+            self._z_handle = presliding_update(self._z_handle, move, self._handle_z_max,
                                                     self._handle_stick)
             self._knob_rad = target
             stretch0 = self._draw_in(target) - self._u[..., 0]
-            self._tension0 = laws.recruit(stretch0, self._toe[..., 0], self._k[..., 0])[0]
+            self._tension0 = recruit(stretch0, self._toe[..., 0], self._k[..., 0])[0]
             self._settled = moved < _SETTLED_M
         torque = (self._r_m * (self._tension0[:, 0] - self._tension0[:, 1])
                   + self._handle_Nm * self._z_handle / self._handle_z_max)
@@ -176,7 +182,7 @@ class SegmentsPlant:
         stretch[..., 0] = p - u[..., 0]
         stretch[..., 1:n] = u[..., :-1] - u[..., 1:]
         stretch[..., n] = u[..., -1] - _SIGN[None, :] * (self._rb_m * self._theta)[:, None]
-        tension, tangent = laws.recruit(stretch, self._toe, self._k)
+        tension, tangent = recruit(stretch, self._toe, self._k)
         capacity = self._mu_dpsi * 0.5 * (tension[..., :-1] + tension[..., 1:]) + self._drag_N
         return tension, tangent, capacity
 
@@ -196,7 +202,7 @@ class SegmentsPlant:
         direction, dir_theta = self._dir, self._dir_theta
         for _ in range(3):
             a = self._a
-            contact = capacity / self._z_max * laws.presliding_slope(
+            contact = capacity / self._z_max * presliding_slope(
                 self._z, direction, self._z_max, self._stick)
             diag = tangent[..., :-1] + tangent[..., 1:] + contact + self._b_node / dt_s
             a[:, self._diag[0], self._diag[1]] = diag.reshape(2, 2 * n)
@@ -207,7 +213,7 @@ class SegmentsPlant:
             a[:, self._last, m - 1] = cross
             a[:, m - 1, self._last] = cross
             bend = (self._k_bend * (1.0 + 3.0 * self._c_bend * theta * theta)
-                    + self._m_hyst * laws.bouc_wen_slope(self._h, dir_theta, self._yield))
+                    + self._m_hyst * bouc_wen_slope(self._h, dir_theta, self._yield))
             a[:, m - 1, m - 1] = (self._rb_m ** 2 * k_end.sum(axis=1) + bend
                                   + _TIP_DAMPING_Nm_s_per_rad / dt_s)
             dx = cast(Array, np.linalg.solve(a, rhs[..., None])[..., 0])
@@ -218,9 +224,9 @@ class SegmentsPlant:
             if np.array_equal(new_dir, direction) and np.array_equal(new_dir_theta, dir_theta):
                 break
             direction, dir_theta = new_dir, new_dir_theta
-        self._z = laws.presliding_update(self._z, du, self._z_max, self._stick)
+        self._z = presliding_update(self._z, du, self._z_max, self._stick)
         self._u = self._u + du
-        self._h = laws.bouc_wen_update(self._h, dtheta, self._yield)
+        self._h = bouc_wen_update(self._h, dtheta, self._yield)
         self._theta = theta + dtheta
         self._dir, self._dir_theta = direction, dir_theta
         return float(max(np.max(np.abs(du)), float(np.max(np.abs(dtheta))) * 1e-3))

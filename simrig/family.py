@@ -10,7 +10,8 @@ friction, current sensor) that live outside the plant.
 
 Unit 0 is the nominal unit (no scatter). Units 1-8 are the development set, units 101-108 the
 held-out set: tune on the first, report the second. The capstan plant is the development plant,
-the lumped plant is held out (``PLANT_ROLE``).
+the lumped plant is held out, the segments plant (session 9) was written blind and tsmd was run
+on it untuned (``PLANT_ROLE``).
 """
 
 from __future__ import annotations
@@ -26,13 +27,15 @@ from simrig.motor import MotorParams
 from simrig.plant import Plant, PlantLoadError, load_plant
 from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
+from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
 from simrig.rig import DEFAULT_CURRENT_SENSOR
 
 PLANT_SPECS: dict[str, str] = {
     "capstan": "simrig.plants.capstan:make_tendon_sheath_plant",
     "lumped": "simrig.plants.lumped:make_lumped_plant",
+    "segments": "simrig.plants.segments:make_segments_plant",
 }
-PLANT_ROLE = {"capstan": "development", "lumped": "held-out"}
+PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -78,10 +81,32 @@ SCATTER: dict[str, dict[str, float]] = {
         "handle_friction_Nm": 0.20,
         "handle_presliding_deg": 0.20,
     },
+    "segments": {
+        "pulley_radius_mm": 0.02,  # machined part
+        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # crimp geometry
+        "tendon_stiffness_N": 0.15,  # tendon lot (EA)
+        "free_length_m": 0.20,  # handle assembly
+        "sheath_length_m": 0.02,  # cut to length
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "sheath_wrap_deg": 0.10,  # lumen helix pitch
+        "sheath_drag_N": 0.20,  # lumen preload
+        "presliding_mm": 0.20,  # contact micro-geometry
+        "stick_fraction": 0.10,
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "bend_stiffness_Nm_per_rad": 0.15,  # polymer cover, links
+        "bend_stiffening_per_rad2": 0.20,
+        "bend_hysteresis_Nm": 0.20,  # link rubbing
+        "bend_yield_deg": 0.20,
+        "handle_friction_Nm": 0.20,  # knob bearing / brake setting
+        "handle_presliding_deg": 0.20,
+    },
 }
 """Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""
 
-_NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMPED_KNOBS}
+_NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMPED_KNOBS,
+                                        "segments": SEGMENTS_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -125,6 +150,8 @@ VARIANTS: dict[str, Variant] = {
                         "handle_friction_Nm": 1.5},
             "lumped": {"sheath_friction": 1.3, "sheath_drag_N": 1.5, "bend_friction_Nm": 1.5,
                        "handle_friction_Nm": 1.5},
+            "segments": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                         "bend_hysteresis_Nm": 1.5, "handle_friction_Nm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -140,7 +167,8 @@ VARIANTS: dict[str, Variant] = {
         factors={"capstan": {"tendon_stiffness_N": 0.5, "tendon_offset_mm": 1.0 / 1.4,
                              "sheath_friction": 1.0 / 1.4, "slack_pos_mm": 1.0 / 1.2,
                              "slack_neg_mm": 1.0 / 1.2},
-                 "lumped": {"tendon_stiffness_N": 0.4}},
+                 "lumped": {"tendon_stiffness_N": 0.4},
+                 "segments": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

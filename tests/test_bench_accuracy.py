@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from simrig.family import PLANT_SPECS
 from tsmd import cli
 from tsmd.bench import accuracy, family_accuracy
 from tsmd.bench.accuracy import tracking_errors
@@ -82,6 +83,14 @@ def test_accuracy_with_family_options_runs_the_family_bench_with_them(
     (ns,) = seen
     assert (ns.family, ns.units, ns.quick, ns.no_extra) == ("lumped", "101,103", True, True)
     assert ns.methods == "none,paper,ours" and ns.unit_seeds == "1,2,3"  # the family's defaults
+
+
+@pytest.mark.parametrize("plant", sorted(PLANT_SPECS))
+def test_accuracy_takes_every_family_plant(plant: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    seen: list[argparse.Namespace] = []
+    monkeypatch.setattr(family_accuracy, "main", lambda ns: seen.append(ns) or 0)
+    assert cli.main(["bench", "accuracy", "--family", plant, "--units", "101"]) == 0
+    assert seen[0].family == plant
 
 
 def test_accuracy_without_family_options_stays_the_single_catheter_bench(

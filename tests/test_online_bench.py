@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import argparse
+
 import numpy as np
 import pytest
 
-from tsmd.bench.online import mixed_motion, reversal_times, shape_change
+from simrig.family import PLANT_SPECS
+from simrig.scenario import ShapeChange
+from tsmd.bench.online import add_arguments, make_unit, mixed_motion, reversal_times, shape_change
 from tsmd.errors import TsmdError
 
 
@@ -51,3 +55,13 @@ def test_a_unit_whose_calibration_is_refused_is_one_line_and_the_bench_goes_on(
     assert online.main(parser.parse_args(["--units", "7,8", "--drift-s", "10"])) == 0
     lines = [ln for ln in capsys.readouterr().out.splitlines() if "refused" in ln]
     assert len(lines) == 4 and "| 7 |" in lines[0] and "| 8 |" in lines[1]
+
+
+@pytest.mark.parametrize("plant", sorted(PLANT_SPECS))
+def test_every_family_plant_is_a_choice_and_takes_both_shape_changes(plant: str) -> None:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    assert parser.parse_args(["--plant", plant]).plant == plant
+    for kind in ("slack:0.5", "curvature:90"):
+        unit = make_unit(plant, 101, [ShapeChange(0.0, shape_change(kind))])
+        assert np.all(np.isfinite(unit.step(0.004, np.array([10.0, -10.0])).tip_deg))

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.analysis import measure_dead_zone_backlash
+from simrig.family import PLANT_SPECS
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd import __version__
 from tsmd.bench.accuracy_report import (
@@ -248,7 +249,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     family = parser.add_argument_group(
         "the catheter family", "any of these runs `tsmd bench family` instead: each unit "
         "calibrated from its own current, one table per unit and the worst unit")
-    family.add_argument("--family", choices=("capstan", "lumped"), default=None,
+    family.add_argument("--family", choices=sorted(PLANT_SPECS), default=None,
                         help="score units of this family plant (simrig.family)")
     family.add_argument("--plant", default=None, help="plant factory module:factory")
     family.add_argument("--params", default=None, help="JSON keyword parameters of the plant")

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from simrig.family import PLANT_SPECS
 from tsmd.bench.cache_key import keyed_cache
 from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.errors import TsmdError
@@ -309,8 +310,9 @@ def hot_path_us(n: int = 20000) -> tuple[float, float, float]:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--plant", choices=("capstan", "lumped"), default="capstan",
-                        help="the family (capstan: development plant, lumped: held out)")
+    parser.add_argument("--plant", choices=sorted(PLANT_SPECS), default="capstan",
+                        help="the family (capstan: development plant, lumped: held out, "
+                        "segments: blind)")
     parser.add_argument("--units", default="0,1,2",
                         help="units of the family (0 nominal, 1-8 development, 101-108 held out)")
     parser.add_argument("--change", default="slack:0.5",

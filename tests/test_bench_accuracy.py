@@ -119,3 +119,41 @@ def test_planned_compute_time_includes_the_preview_of_every_tick(
     calls.clear()
     accuracy.compute_time_us(profile, "ours", n_ticks=300)
     assert calls == []
+
+
+def _refusing_unit_two(monkeypatch: pytest.MonkeyPatch) -> None:
+    profile = load_profile(resolve_data_path("profiles/example-sim.yaml"))
+
+    def unit_profile(unit: int, *_: object) -> object:
+        if unit == 2:
+            raise family_accuracy.CalibrationError("calibration refused (1 problem): x")
+        return profile
+
+    def run(s: object, method: str, *_: object) -> object:
+        rmse = {"none": 10.0, "paper": 4.0, "ours": 1.0}[method]
+        return argparse.Namespace(rmse_deg=rmse, ptpe_deg=2 * rmse)
+
+    monkeypatch.setattr(family_accuracy, "unit_profile", unit_profile)
+    monkeypatch.setattr(family_accuracy, "run_scenario", run)
+    monkeypatch.setattr(family_accuracy, "compute_time_us", lambda *a, **k: (1.0, 2.0))
+
+
+def test_family_bench_scores_the_other_units_when_one_calibration_is_refused(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    _refusing_unit_two(monkeypatch)
+    args = family_accuracy.namespace_from(argparse.Namespace(
+        unit_seeds="1,2,3", quick=True, no_extra=True))
+    assert family_accuracy.main(args) == 0
+    out = capsys.readouterr().out
+    assert "| 2 | no profile: calibration refused (1 problem): x |" in out
+    assert "| 3 | 1-DOF" in out
+    assert "for 1 of 3 units: [2]" in out
+
+
+def test_family_bench_fails_when_no_unit_could_be_scored(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    _refusing_unit_two(monkeypatch)
+    args = family_accuracy.namespace_from(argparse.Namespace(unit_seeds="2", quick=True,
+                                                             no_extra=True))
+    assert family_accuracy.main(args) == 1
+    assert "no unit was scored" in capsys.readouterr().out

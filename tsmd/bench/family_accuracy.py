@@ -30,6 +30,7 @@ from tsmd.bench.accuracy import calibrated_profile, compute_time_us, run_scenari
 from tsmd.bench.accuracy_report import plot_runs
 from tsmd.bench.accuracy_scenarios import PERIOD_S, Scenario, scenarios
 from tsmd.bench.realism import data_sheet
+from tsmd.calibration.errors import CalibrationError
 from tsmd.config import resolve_data_path
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, load_device_model, load_profile, save_profile
@@ -181,8 +182,16 @@ def main(args: argparse.Namespace) -> int:
         if args.unit_variation > 0:
             params.update(unit_variation=float(args.unit_variation), seed=seed)
         units.append((seed, plant_factory(args.plant, params)))
+    refused: list[int] = []
     for seed, make in units:
-        profile = unit_profile(seed, device, make, args.profiles)
+        try:
+            profile = unit_profile(seed, device, make, args.profiles)
+        except CalibrationError as exc:  # a finding about the unit: score the others
+            refused.append(seed)
+            line = f"| {seed} | no profile: {exc} |"
+            lines.append(line)
+            print(line, flush=True)
+            continue
         for s in scen:
             res = {m: run_scenario(s, m, 0, profile, make, not args.fresh) for m in methods}
             red = _pct(res["none"].rmse_deg, res["ours"].rmse_deg)
@@ -211,6 +220,11 @@ def main(args: argparse.Namespace) -> int:
                      f"p99 {cpu_p99:.1f} us |")
     lines += ["", "Targets (ours): RMSE red. >= 90 % 1-DOF / 85 % 2-DOF, PTPE red. >= 75 "
               "/ 60 %, RMSE <= 0.6 x paper's.", ""]
+    if refused:
+        lines.append(f"no profile (calibration refused or failed) for {len(refused)} of "
+                     f"{len(units)} units: {refused}")
+    if not rows:
+        return _emit([*lines, "no unit was scored"], args.report, 1)
     for label, idx in (("RMSE reduction", 3), ("PTPE reduction", 4)):
         worst = min(rows, key=lambda r: r[idx])
         lines.append(f"worst {label}: {worst[idx]:.1f} % (unit {worst[0]}, {worst[1]}: "
@@ -222,10 +236,15 @@ def main(args: argparse.Namespace) -> int:
               or r[4] < TARGET_PTPE_PCT[r[1].split()[0]] or r[5] > TARGET_RATIO_TO_PAPER]
     lines.append(f"rows missing a target: {len(misses)} of {len(rows)}")
     lines.append(f"wall time {time.perf_counter() - t0:.0f} s")
+    return _emit(lines, args.report, 0)
+
+
+def _emit(lines: list[str], report: Path | None, status: int) -> int:
+    """Print the table and its summary, and write them to ``report`` if given."""
     print("\n".join(lines))
-    if args.report is not None:
-        args.report.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return 0
+    if report is not None:
+        report.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return status
 
 
 if __name__ == "__main__":

@@ -182,7 +182,7 @@ def change_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, A
         fresh = calibrated(args.plant, unit, change, device, cache,
                            args.change.replace(":", "-"))
     except CalibrationRefusedError as exc:  # reported, compared with before the change only
-        fresh, refused = None, str(exc).split(":")[0]
+        fresh, refused = None, str(exc)
     else:
         refused = ""
     t, q = mixed_motion(args.change_at + args.after_s, args.seed)
@@ -353,7 +353,7 @@ def main(args: argparse.Namespace) -> int:
                 r = change_unit(u, args, device)
             except CalibrationRefusedError as exc:  # the unit's own calibration: next unit
                 print(f"| {u} | calibration before the change refused: "
-                      f"{str(exc).split(':')[0]} | | | | | | | |", flush=True)
+                      f"{exc} | | | | | | | |", flush=True)
                 continue
             for k, kn in enumerate(r["knobs"]):
                 ratio = kn["on"] / kn["fresh"]
@@ -388,7 +388,7 @@ def main(args: argparse.Namespace) -> int:
             try:
                 d = drift_unit(u, args, device)
             except CalibrationRefusedError as exc:
-                print(f"| {u} | calibration refused: {str(exc).split(':')[0]} | | | | | | |",
+                print(f"| {u} | calibration refused: {exc} | | | | | | |",
                       flush=True)
                 continue
             big = d["largest"]

@@ -108,6 +108,9 @@ class ControlLoop(LoopCommands):
         self._play_q: list[list[float]] = []
         """The playing trajectory as Python floats (converted once, not per tick)."""
         self._nan2 = (math.nan, math.nan)
+        self._t_prev_s: float | None = None
+        self.dt_s = period_s
+        """The time since the last tick (the period when it was on time), for the compensators."""
 
     # --- configuration read by the API -----------------------------------------------------
 
@@ -152,6 +155,7 @@ class ControlLoop(LoopCommands):
             self._run_commands()
         drives = self.drives
         t_s = self.clock.now_s()
+        self.dt_s = self._elapsed_s(t_s)
         drives.pump()
         events = drives.poll_events()
         feedback = drives.feedback()
@@ -192,6 +196,17 @@ class ControlLoop(LoopCommands):
         self.stats.ticks += 1
         self._latest = (self.stats.ticks, t_s, self.state, row, self.fault_reason)
 
+    def _elapsed_s(self, t_s: float) -> float:
+        """The time since the last tick began. Within a nanosecond of the period it is the
+        period (a lockstep clock adds the period each tick: its differences are the period to
+        the last bits only), and a clock that did not advance gives the period."""
+        prev, self._t_prev_s = self._t_prev_s, t_s
+        period = self.period_s
+        if prev is None:
+            return period
+        dt = t_s - prev
+        return dt if dt > 0.0 and abs(dt - period) > 1e-9 else period
+
     def _command(self, pos: list[float]) -> tuple[Pair, Pair]:
         playback = self._playback
         compensator: Compensator | None = self._compensators.active
@@ -221,17 +236,17 @@ class ControlLoop(LoopCommands):
         if compensator is None:
             c0, c1 = q
         else:
-            cmd = np.asarray(compensator.command(np.array(q)), dtype=float)
+            cmd = np.asarray(compensator.command(np.array(q), self.dt_s), dtype=float)
             if cmd.shape != (2,) or not (_isfinite(cmd[0]) and _isfinite(cmd[1])):
                 self._fault(f"compensator gave {cmd.tolist()} for q {list(q)}")
                 return q, self._last_cmd
             c0, c1 = cmd.tolist()
-        c0, c1 = self._limiter.limit_pair(c0, c1)
+        c0, c1 = self._limiter.limit_pair(c0, c1, self.dt_s)
         if not (_isfinite(c0) and _isfinite(c1)):
             self._fault(f"limiter gave {[c0, c1]} for q {list(q)}")
             return q, self._last_cmd
         c0, c1 = min(max(c0, lo[0]), hi[0]), min(max(c1, lo[1]), hi[1])
-        self._compensators.follow(q[0], q[1], c0, c1)
+        self._compensators.follow(q[0], q[1], c0, c1, self.dt_s)
         return q, (c0, c1)
 
     def _record(self, row: tuple[float, ...]) -> None:

@@ -7,11 +7,14 @@ import math
 
 import numpy as np
 import pytest
-from test_compensation_ours import LIMITS, PERIOD_S, params
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from test_compensation_ours import LIMITS, PERIOD_S, params, random_params, samples
 
 from tsmd.compensation.ours import OursCompensator, ours_knobs
 from tsmd.compensation.ours_knob import KnobCommand, motion
-from tsmd.compensation.safety import MAX_TICK_PERIODS, KnobLimiter, KnobLimits
+from tsmd.compensation.safety import MAX_TICK_PERIODS, KnobLimiter, KnobLimits, tick_time_s
+from tsmd.compensation.tension_play import TensionPlayParams
 
 
 def commands_at_times(q_of_t: object, late_every: int, duration_s: float,
@@ -90,3 +93,24 @@ def test_the_limiter_counts_a_late_tick_up_to_its_longest() -> None:
     x1 = limiter.limit(np.array([80.0, -80.0]), 10 * PERIOD_S)
     step = MAX_TICK_PERIODS * PERIOD_S * LIMITS.max_velocity_deg_s
     assert x1 - x0 == pytest.approx([step, -step])
+
+
+tick_times = st.one_of(st.floats(0.0, 12 * PERIOD_S), st.just(math.nan), st.just(math.inf),
+                       st.just(-PERIOD_S))
+
+
+@given(random_params, st.lists(st.tuples(samples, samples, tick_times), min_size=1, max_size=80))
+@settings(max_examples=50, deadline=None)
+def test_late_early_or_nonsense_tick_times_keep_the_command_finite_and_within_its_speed(
+        p: TensionPlayParams, rows: list[tuple[float, float, float]]) -> None:
+    comp = OursCompensator(ours_knobs((p, p)), PERIOD_S, (LIMITS, LIMITS))
+    comp.reset(np.zeros(2))
+    last = comp.command(np.zeros(2), PERIOD_S)
+    for q0, q1, dt in rows:
+        cmd = comp.command(np.array([q0, q1]), dt)
+        assert np.all(np.isfinite(cmd))
+        assert np.all(cmd >= LIMITS.min_deg - 1e-9) and np.all(cmd <= LIMITS.max_deg + 1e-9)
+        periods = max(1, round(tick_time_s(dt, PERIOD_S) / PERIOD_S))  # an early tick: one
+        step = LIMITS.max_velocity_deg_s * periods * PERIOD_S
+        assert np.all(np.abs(cmd - last) <= step * (1 + 1e-9) + 1e-9)
+        last = cmd

@@ -8,7 +8,7 @@ from support.drives import FakeDrives
 
 from drivers.clock import SimClock
 from drivers.drive import DriveState
-from tsmd.compensation.safety import KnobLimiter, KnobLimits
+from tsmd.compensation.safety import MAX_TICK_PERIODS, KnobLimiter, KnobLimits
 from tsmd.loop import ControlLoop, LoopError, LoopState, MemoryRecorder, Playback
 
 PERIOD_S = 0.004
@@ -302,3 +302,31 @@ def test_a_late_tick_lets_the_command_move_over_the_time_it_covers() -> None:
     loop.clock.advance(2 * PERIOD_S)
     loop.tick()
     assert drives.targets[-1][0] - before == pytest.approx(3 * PERIOD_S * 120.0)
+
+
+def test_a_tick_woken_late_and_the_next_on_time_count_two_periods_and_one() -> None:
+    comp = Offset(0.0)
+    loop, _ = make_loop(comp)
+    loop.tick()
+    loop.execute("enable")
+    loop.tick()
+    assert isinstance(loop.clock, SimClock)
+    loop.clock.advance(0.7 * PERIOD_S)  # this tick wakes 0.7 periods late, the next on time
+    loop.tick()
+    loop.clock.advance(0.3 * PERIOD_S)
+    loop.tick()
+    loop.tick()
+    assert comp.dts[-3:] == [pytest.approx(2 * PERIOD_S), PERIOD_S, PERIOD_S]
+
+
+def test_a_stall_counts_for_at_most_the_longest_tick() -> None:
+    comp = Offset(0.0)
+    loop, _ = make_loop(comp)
+    loop.tick()
+    loop.execute("enable")
+    loop.tick()
+    assert isinstance(loop.clock, SimClock)
+    loop.clock.advance(0.5)
+    loop.tick()
+    loop.tick()
+    assert comp.dts[-2:] == [pytest.approx(MAX_TICK_PERIODS * PERIOD_S), PERIOD_S]

@@ -23,7 +23,7 @@ import numpy as np
 from drivers.clock import Clock
 from drivers.drive import DriveError, FaultEvent, KnobDrives
 from tsmd.compensation import Compensator
-from tsmd.compensation.safety import KnobLimiter, KnobLimits
+from tsmd.compensation.safety import MAX_TICK_PERIODS, KnobLimiter, KnobLimits
 from tsmd.loop_commands import LoopCommands
 from tsmd.loop_compensators import LoopCompensators
 from tsmd.loop_recorders import BackgroundRecorder, MemoryRecorder
@@ -109,8 +109,10 @@ class ControlLoop(LoopCommands):
         """The playing trajectory as Python floats (converted once, not per tick)."""
         self._nan2 = (math.nan, math.nan)
         self._t_prev_s: float | None = None
+        self._carry_s = 0.0
         self.dt_s = period_s
-        """The time since the last tick (the period when it was on time), for the compensators."""
+        """The time this tick counts for, in whole periods (the period when it was on time):
+        what the compensators and the limiter are given."""
 
     # --- configuration read by the API -----------------------------------------------------
 
@@ -197,15 +199,24 @@ class ControlLoop(LoopCommands):
         self._latest = (self.stats.ticks, t_s, self.state, row, self.fault_reason)
 
     def _elapsed_s(self, t_s: float) -> float:
-        """The time since the last tick began. Within a nanosecond of the period it is the
-        period (a lockstep clock adds the period each tick: its differences are the period to
-        the last bits only), and a clock that did not advance gives the period."""
+        """The time since the last tick began, in whole periods (at least one, at most
+        :data:`MAX_TICK_PERIODS`), the remainder carried to the next tick: a tick woken late and
+        the next one woken on time are two periods and one, not 1.7 and 0.3 (the drives take a
+        target per SYNC, and ours steps its limits and average per period). On time, and in
+        lockstep, it is exactly the period; a clock that did not advance gives the period."""
         prev, self._t_prev_s = self._t_prev_s, t_s
         period = self.period_s
-        if prev is None:
+        if prev is None or not t_s - prev > 0.0:
             return period
-        dt = t_s - prev
-        return dt if dt > 0.0 and abs(dt - period) > 1e-9 else period
+        carry = self._carry_s + (t_s - prev)
+        n = int(carry / period + 0.5)
+        if n > MAX_TICK_PERIODS:  # a stall: what it missed is no motion time
+            self._carry_s = 0.0
+            return MAX_TICK_PERIODS * period
+        n = n if n > 1 else 1
+        carry -= n * period
+        self._carry_s = carry if carry > -period else -period
+        return period if n == 1 else n * period
 
     def _command(self, pos: list[float]) -> tuple[Pair, Pair]:
         playback = self._playback

@@ -34,7 +34,7 @@ def sine(n: int = 2500, amp: float = 60.0) -> np.ndarray:
 
 def run(comp: Compensator, q: np.ndarray) -> np.ndarray:
     comp.reset(q[0])
-    return np.array([comp.command(row) for row in q])
+    return np.array([comp.command(row, DT) for row in q])
 
 
 @pytest.mark.parametrize("method", ["none", "paper", "ours"])
@@ -53,8 +53,8 @@ def test_non_finite_setpoint_holds_the_last_command() -> None:
     for method in ("none", "paper"):
         comp = build_compensator(make_profile(), method, DT)
         comp.reset(np.zeros(2))
-        a = comp.command(np.array([10.0, 5.0]))
-        b = comp.command(np.array([math.nan, math.inf]))
+        a = comp.command(np.array([10.0, 5.0]), DT)
+        b = comp.command(np.array([math.nan, math.inf]), DT)
         assert np.array_equal(a, b), method
 
 
@@ -63,10 +63,10 @@ def test_non_finite_setpoint_keeps_ours_going_where_the_last_finite_one_led() ->
     held, repeated = (build_compensator(make_profile(), "ours", DT) for _ in range(2))
     for comp in (held, repeated):
         comp.reset(np.zeros(2))
-        comp.command(np.array([10.0, 5.0]))
+        comp.command(np.array([10.0, 5.0]), DT)
     for _ in range(200):
-        a = held.command(np.array([math.nan, math.inf]))
-        b = repeated.command(np.array([10.0, 5.0]))
+        a = held.command(np.array([math.nan, math.inf]), DT)
+        b = repeated.command(np.array([10.0, 5.0]), DT)
         assert np.array_equal(a, b)
 
 
@@ -88,7 +88,7 @@ def test_ours_without_its_parameters_is_refused_with_advice() -> None:
 def test_paper_compensation_adds_the_dead_zone_when_moving_out() -> None:
     comp = build_compensator(make_profile(d0=20.0), "paper", DT)
     comp.reset(np.zeros(2))
-    cmd = comp.command(np.array([13.0, 0.0]))
+    cmd = comp.command(np.array([13.0, 0.0]), DT)
     knob = make_profile().knobs[0]
     assert cmd[0] == pytest.approx(20.0 + (13.0 - knob.height_pos_deg) / knob.omega)
 
@@ -96,7 +96,7 @@ def test_paper_compensation_adds_the_dead_zone_when_moving_out() -> None:
 def test_paper_parameters_follow_the_other_knob() -> None:
     comp = build_compensator(make_profile(d0=20.0), "paper", DT)
     comp.reset(np.array([0.0, 90.0]))
-    cmd = comp.command(np.array([13.0, 90.0]))
+    cmd = comp.command(np.array([13.0, 90.0]), DT)
     knob = make_profile().knobs[0]
     assert cmd[0] == pytest.approx(17.0 + (13.0 - knob.height_pos_deg) / knob.omega)
 
@@ -227,8 +227,8 @@ def test_limits_given_without_apply_limits_are_not_applied_by_the_compensator() 
         limited = build_compensator(profile, method, DT, [LIMITS, LIMITS])
         free.reset(np.zeros(2))
         limited.reset(np.zeros(2))
-        step_free = abs(free.command(jump)[0])
-        step_limited = abs(limited.command(jump)[0])
+        step_free = abs(free.command(jump, DT)[0])
+        step_limited = abs(limited.command(jump, DT)[0])
         assert step_limited <= LIMITS.max_velocity_deg_s * DT + 1e-9
         assert step_free > step_limited
 

@@ -160,7 +160,7 @@ def compensator(p: TensionPlayParams | None = None) -> OursCompensator:
 
 def run(comp: OursCompensator, q: np.ndarray) -> np.ndarray:
     comp.reset(q[0] if np.all(np.isfinite(q[0])) else np.zeros(2))
-    return np.array([comp.command(row) for row in q])
+    return np.array([comp.command(row, PERIOD_S) for row in q])
 
 
 def assert_within_limits(cmd: np.ndarray, smoothing_s: float = 0.1) -> None:
@@ -312,7 +312,7 @@ def test_replaced_knobs_act_from_the_next_tick_and_keep_the_state() -> None:
     comp, kept = compensator(), compensator()
     for c in (comp, kept):
         c.reset(np.array([40.0, 0.0]))
-        c.command(np.array([40.0, 0.0]))
+        c.command(np.array([40.0, 0.0]), PERIOD_S)
     comp.replace_knobs(tuple(shifted(k, 3.0) for k in comp.knobs))  # type: ignore[arg-type]
     q = np.tile([40.0, 0.0], (300, 1))
     assert run_on(comp, q)[-1, 0] == pytest.approx(run_on(kept, q)[-1, 0] + 3.0, abs=1e-4)
@@ -320,7 +320,7 @@ def test_replaced_knobs_act_from_the_next_tick_and_keep_the_state() -> None:
 
 def run_on(comp: OursCompensator, q: np.ndarray) -> np.ndarray:
     """Commands for ``q`` from the compensator's present state (no reset)."""
-    return np.array([comp.command(row) for row in q])
+    return np.array([comp.command(row, PERIOD_S) for row in q])
 
 
 def _accelerating_ramp(hold_ticks: int) -> np.ndarray:

@@ -93,7 +93,7 @@ def run(hold_deg: float, q: np.ndarray, fresh_catheter: bool = True) -> np.ndarr
     comp = OursCompensator(ours_knobs([params(hold_deg)] * 2), PERIOD_S, (LIMITS, LIMITS),
                            fresh_catheter=fresh_catheter)
     comp.reset(np.zeros(2))
-    return np.array([comp.command(np.array([v, 0.0]))[0] for v in q])
+    return np.array([comp.command(np.array([v, 0.0]), PERIOD_S)[0] for v in q])
 
 
 def cycles(n: int) -> np.ndarray:

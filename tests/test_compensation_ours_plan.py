@@ -31,7 +31,7 @@ def run_planned(comp: OursCompensator, q: np.ndarray, plan: np.ndarray | None = 
     out = []
     for i, row in enumerate(q):
         comp.preview(rows, i)
-        out.append(comp.command(row))
+        out.append(comp.command(row, PERIOD_S))
     return np.array(out)
 
 
@@ -82,7 +82,7 @@ def test_a_planned_crossing_has_a_smaller_peak_error_than_a_causal_one() -> None
     planned = tip_of(run_planned(compensator(), q), -20.0) - q[:, 0]
     comp = compensator()
     comp.reset(q[0])
-    causal = tip_of(np.array([comp.command(row) for row in q]), -20.0) - q[:, 0]
+    causal = tip_of(np.array([comp.command(row, PERIOD_S) for row in q]), -20.0) - q[:, 0]
     assert np.ptp(planned[250:]) < np.ptp(causal[250:])
 
 
@@ -91,7 +91,7 @@ def test_a_plan_without_a_turn_or_a_dead_zone_ahead_changes_no_command() -> None
     q = np.column_stack([30.0 + 6.0 * t] * 2)  # up the loaded side only
     comp = compensator()
     comp.reset(q[0])
-    causal = np.array([comp.command(row) for row in q])
+    causal = np.array([comp.command(row, PERIOD_S) for row in q])
     assert np.array_equal(run_planned(compensator(), q), causal)
 
 
@@ -99,7 +99,7 @@ def test_a_plan_is_used_only_in_the_tick_it_was_given() -> None:
     q = move_across_the_dead_zone()
     comp = compensator()
     run_planned(comp, q[:400])
-    comp.command(q[400])
+    comp.command(q[400], PERIOD_S)
     assert comp._planner.fresh is False
 
 
@@ -131,7 +131,7 @@ def test_a_planned_turn_lowers_the_peak_error_around_a_sharp_turn() -> None:
     planned = tip_of(run_planned(compensator(), q), 0.0) - q[:, 0]
     comp = compensator()
     comp.reset(q[0])
-    causal = tip_of(np.array([comp.command(row) for row in q]), 0.0) - q[:, 0]
+    causal = tip_of(np.array([comp.command(row, PERIOD_S) for row in q]), 0.0) - q[:, 0]
     assert np.abs(planned[window]).max() < 0.5 * np.abs(causal[window]).max()
 
 

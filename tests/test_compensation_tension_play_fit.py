@@ -289,7 +289,7 @@ def test_former_method_name_tension_is_refused_naming_ours() -> None:
 def test_method_ours_builds_from_a_profile_with_the_section() -> None:
     comp = build_compensator(profile_with_tension_play(), "ours", PERIOD_S)
     comp.reset(np.zeros(2))
-    assert np.all(np.isfinite(comp.command(np.array([10.0, -10.0]))))
+    assert np.all(np.isfinite(comp.command(np.array([10.0, -10.0]), PERIOD_S)))
 
 
 def test_a_sweeps_lag_already_estimated_is_used_as_it_is() -> None:

@@ -8,7 +8,7 @@ from support.drives import FakeDrives
 
 from drivers.clock import SimClock
 from drivers.drive import DriveState
-from tsmd.compensation.safety import KnobLimiter, KnobLimits
+from tsmd.compensation.safety import MAX_TICK_PERIODS, KnobLimiter, KnobLimits
 from tsmd.loop import ControlLoop, LoopError, LoopState, MemoryRecorder, Playback
 
 PERIOD_S = 0.004
@@ -22,12 +22,14 @@ class Offset:
         self.offset_deg = offset_deg
         self.inputs: list[np.ndarray] = []
         self.resets: list[np.ndarray] = []
+        self.dts: list[float] = []
 
     def reset(self, q_deg: np.ndarray) -> None:
         self.resets.append(np.array(q_deg))
 
-    def command(self, q_deg: np.ndarray) -> np.ndarray:
+    def command(self, q_deg: np.ndarray, dt_s: float) -> np.ndarray:
         self.inputs.append(np.array(q_deg))
+        self.dts.append(dt_s)
         return np.asarray(q_deg) + self.offset_deg
 
 
@@ -273,3 +275,58 @@ def test_a_played_trajectory_is_previewed_every_tick_and_a_setpoint_never() -> N
     while not playback.done.is_set():
         loop.tick()
     assert comp.previews == [(float(i), i) for i in range(5)]
+
+
+def test_the_compensator_is_given_the_time_since_the_last_tick() -> None:
+    comp = Offset(0.0)
+    loop, _ = make_loop(comp)  # its clock advances one period after each SYNC
+    loop.tick()
+    loop.execute("enable")
+    loop.tick()
+    assert isinstance(loop.clock, SimClock)
+    loop.clock.advance(2 * PERIOD_S)  # two ticks missed
+    loop.tick()
+    loop.tick()
+    assert comp.dts[-3:] == [PERIOD_S, pytest.approx(3 * PERIOD_S), PERIOD_S]
+
+
+def test_a_late_tick_lets_the_command_move_over_the_time_it_covers() -> None:
+    loop, drives = make_loop(Offset(0.0))
+    loop.tick()
+    loop.execute("enable")
+    loop.setpoint.set((80.0, 0.0))
+    for _ in range(100):  # up to full speed
+        loop.tick()
+    before = drives.targets[-1][0]
+    assert isinstance(loop.clock, SimClock)
+    loop.clock.advance(2 * PERIOD_S)
+    loop.tick()
+    assert drives.targets[-1][0] - before == pytest.approx(3 * PERIOD_S * 120.0)
+
+
+def test_a_tick_woken_late_and_the_next_on_time_count_two_periods_and_one() -> None:
+    comp = Offset(0.0)
+    loop, _ = make_loop(comp)
+    loop.tick()
+    loop.execute("enable")
+    loop.tick()
+    assert isinstance(loop.clock, SimClock)
+    loop.clock.advance(0.7 * PERIOD_S)  # this tick wakes 0.7 periods late, the next on time
+    loop.tick()
+    loop.clock.advance(0.3 * PERIOD_S)
+    loop.tick()
+    loop.tick()
+    assert comp.dts[-3:] == [pytest.approx(2 * PERIOD_S), PERIOD_S, PERIOD_S]
+
+
+def test_a_stall_counts_for_at_most_the_longest_tick() -> None:
+    comp = Offset(0.0)
+    loop, _ = make_loop(comp)
+    loop.tick()
+    loop.execute("enable")
+    loop.tick()
+    assert isinstance(loop.clock, SimClock)
+    loop.clock.advance(0.5)
+    loop.tick()
+    loop.tick()
+    assert comp.dts[-2:] == [pytest.approx(MAX_TICK_PERIODS * PERIOD_S), PERIOD_S]

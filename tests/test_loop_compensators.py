@@ -136,18 +136,18 @@ def test_ours_after_following_the_motor_starts_where_the_motor_is() -> None:
     motor = 0.0
     for q in ramp(0.0, 50.0, 1.0):
         motor = q
-        followed.follow(np.array([q, 0.0]), np.array([motor, 0.0]))  # type: ignore[attr-defined]
+        followed.follow(np.array([q, 0.0]), np.array([motor, 0.0]), PERIOD_S)  # type: ignore[attr-defined]
     fresh.reset(np.array([50.0, 0.0]))
     v_max = CONFIG.limits.phi1.max_velocity_deg_s
-    first = followed.command(np.array([50.0, 0.0]))[0]
+    first = followed.command(np.array([50.0, 0.0]), PERIOD_S)[0]
     assert abs(first - motor) <= v_max * PERIOD_S + 1e-9
-    assert abs(fresh.command(np.array([50.0, 0.0]))[0] - motor) > v_max * PERIOD_S
+    assert abs(fresh.command(np.array([50.0, 0.0]), PERIOD_S)[0] - motor) > v_max * PERIOD_S
 
 
 def test_paper_follows_the_motor_down_its_falling_branch() -> None:
     paper = make_compensator(make_profile(), "paper", CONFIG)
     for x in ramp(0.0, 60.0, 1.0) + ramp(60.0, 10.0, 1.0):
-        paper.follow(np.array([x, 0.0]), np.array([x, 0.0]))  # type: ignore[attr-defined]
+        paper.follow(np.array([x, 0.0]), np.array([x, 0.0]), PERIOD_S)  # type: ignore[attr-defined]
     state = paper.states[0]  # type: ignore[attr-defined]
     assert (state.direction, state.x_deg) == (-1, pytest.approx(10.0))
 

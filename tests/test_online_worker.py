@@ -49,7 +49,8 @@ def largest_command_difference_deg(live: Any, saved: Any) -> float:
     q = np.column_stack([50 * np.sin(2 * np.pi * 0.07 * t), 40 * np.sin(2 * np.pi * 0.05 * t)])
     live.reset(q[0])
     saved.reset(q[0])
-    return max(float(np.max(np.abs(live.command(row) - saved.command(row)))) for row in q)
+    return max(float(np.max(np.abs(live.command(row, 0.004) - saved.command(row, 0.004))))
+               for row in q)
 
 def test_step_change_is_recovered_and_reaches_the_compensator(profile: Any) -> None:
     worker, comp, base = make_worker(profile)

@@ -23,7 +23,7 @@ import numpy as np
 from drivers.clock import Clock
 from drivers.drive import DriveError, FaultEvent, KnobDrives
 from tsmd.compensation import Compensator
-from tsmd.compensation.safety import KnobLimiter, KnobLimits
+from tsmd.compensation.safety import MAX_TICK_PERIODS, KnobLimiter, KnobLimits
 from tsmd.loop_commands import LoopCommands
 from tsmd.loop_compensators import LoopCompensators
 from tsmd.loop_recorders import BackgroundRecorder, MemoryRecorder
@@ -108,6 +108,11 @@ class ControlLoop(LoopCommands):
         self._play_q: list[list[float]] = []
         """The playing trajectory as Python floats (converted once, not per tick)."""
         self._nan2 = (math.nan, math.nan)
+        self._t_prev_s: float | None = None
+        self._carry_s = 0.0
+        self.dt_s = period_s
+        """The time this tick counts for, in whole periods (the period when it was on time):
+        what the compensators and the limiter are given."""
 
     # --- configuration read by the API -----------------------------------------------------
 
@@ -152,6 +157,7 @@ class ControlLoop(LoopCommands):
             self._run_commands()
         drives = self.drives
         t_s = self.clock.now_s()
+        self.dt_s = self._elapsed_s(t_s)
         drives.pump()
         events = drives.poll_events()
         feedback = drives.feedback()
@@ -192,6 +198,26 @@ class ControlLoop(LoopCommands):
         self.stats.ticks += 1
         self._latest = (self.stats.ticks, t_s, self.state, row, self.fault_reason)
 
+    def _elapsed_s(self, t_s: float) -> float:
+        """The time since the last tick began, in whole periods (at least one, at most
+        :data:`MAX_TICK_PERIODS`), the remainder carried to the next tick: a tick woken late and
+        the next one woken on time are two periods and one, not 1.7 and 0.3 (the drives take a
+        target per SYNC, and ours steps its limits and average per period). On time, and in
+        lockstep, it is exactly the period; a clock that did not advance gives the period."""
+        prev, self._t_prev_s = self._t_prev_s, t_s
+        period = self.period_s
+        if prev is None or not t_s - prev > 0.0:
+            return period
+        carry = self._carry_s + (t_s - prev)
+        n = int(carry / period + 0.5)
+        if n > MAX_TICK_PERIODS:  # a stall: what it missed is no motion time
+            self._carry_s = 0.0
+            return MAX_TICK_PERIODS * period
+        n = n if n > 1 else 1
+        carry -= n * period
+        self._carry_s = carry if carry > -period else -period
+        return period if n == 1 else n * period
+
     def _command(self, pos: list[float]) -> tuple[Pair, Pair]:
         playback = self._playback
         compensator: Compensator | None = self._compensators.active
@@ -221,17 +247,17 @@ class ControlLoop(LoopCommands):
         if compensator is None:
             c0, c1 = q
         else:
-            cmd = np.asarray(compensator.command(np.array(q)), dtype=float)
+            cmd = np.asarray(compensator.command(np.array(q), self.dt_s), dtype=float)
             if cmd.shape != (2,) or not (_isfinite(cmd[0]) and _isfinite(cmd[1])):
                 self._fault(f"compensator gave {cmd.tolist()} for q {list(q)}")
                 return q, self._last_cmd
             c0, c1 = cmd.tolist()
-        c0, c1 = self._limiter.limit_pair(c0, c1)
+        c0, c1 = self._limiter.limit_pair(c0, c1, self.dt_s)
         if not (_isfinite(c0) and _isfinite(c1)):
             self._fault(f"limiter gave {[c0, c1]} for q {list(q)}")
             return q, self._last_cmd
         c0, c1 = min(max(c0, lo[0]), hi[0]), min(max(c1, lo[1]), hi[1])
-        self._compensators.follow(q[0], q[1], c0, c1)
+        self._compensators.follow(q[0], q[1], c0, c1, self.dt_s)
         return q, (c0, c1)
 
     def _record(self, row: tuple[float, ...]) -> None:

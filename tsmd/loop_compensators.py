@@ -40,14 +40,15 @@ class LoopCompensators:
         for c in self.standby.values():
             c.reset(q_deg)
 
-    def follow(self, q0: float, q1: float, cmd0: float, cmd1: float) -> None:
-        """The motor was sent (cmd0, cmd1) for the desired (q0, q1): those standing by follow."""
+    def follow(self, q0: float, q1: float, cmd0: float, cmd1: float, dt_s: float) -> None:
+        """The motor was sent (cmd0, cmd1) for the desired (q0, q1), ``dt_s`` after the last
+        tick: those standing by follow."""
         followers = self._followers
         if not followers:
             return
         q, cmd = np.array((q0, q1)), np.array((cmd0, cmd1))
         for c in followers:
-            c.follow(q, cmd)
+            c.follow(q, cmd, dt_s)
 
     def switch(self, active: Compensator, label: str, standby: Mapping[str, Compensator],
                q_deg: np.ndarray, *, keep_state: bool) -> None:

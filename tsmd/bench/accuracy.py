@@ -182,7 +182,7 @@ def compute_time_us(profile: Any, method: str, n_ticks: int = 5000, clock: str =
         t0 = read()
         if preview is not None:
             preview(plan, i)
-        comp.command(row)
+        comp.command(row, PERIOD_S)
         t1 = read()
         times[i] = t1 - t0
         empty[i] = read() - t1
@@ -201,7 +201,7 @@ def limiter_cost(profile: Any, method: str, device: Any, scen: Sequence[Scenario
         _, qq, _ = settle(s.t_s, s.q_deg, PERIOD_S)
         lim.reset(qq[0])
         for row in qq:
-            out = lim.command(row)
+            out = lim.command(row, PERIOD_S)
             dev.append(np.abs(out - lim.last_unlimited))
     d = np.concatenate(dev)
     return {"rms_deg": float(np.sqrt(np.mean(d * d))), "max_deg": float(d.max()),

@@ -52,13 +52,16 @@ class CompensationError(TsmdError, ValueError):
 
 @runtime_checkable
 class Compensator(Protocol):
-    """Stateful map from desired knob angles to motor commands, called once per tick."""
+    """Stateful map from desired knob angles to motor commands, called once per tick with the
+    time since the last tick (a late tick on a loaded machine covers several periods: what
+    counts time, velocity estimates, limits, smoothing, counts it in seconds, not ticks)."""
 
     def reset(self, q_deg: NDArray[np.float64]) -> None:
         """Start from rest at desired angles ``q_deg`` (shape (2,))."""
 
-    def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The motor command (shape (2,), degrees) for this tick's desired angles."""
+    def command(self, q_deg: NDArray[np.float64], dt_s: float) -> NDArray[np.float64]:
+        """The motor command (shape (2,), degrees) for this tick's desired angles, ``dt_s``
+        seconds after the last tick (the period when ticks are on time)."""
 
 
 @runtime_checkable
@@ -66,8 +69,10 @@ class FollowsMotor(Protocol):
     """A compensator that can stand by: it keeps its model on the branch the catheter is on
     while something else commands the motor, so switching it on mid-motion needs no reset."""
 
-    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
-        """This tick the desired angles were ``q_deg`` and the motor was sent ``motor_deg``."""
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64],
+               dt_s: float) -> None:
+        """This tick (``dt_s`` after the last) the desired angles were ``q_deg`` and the motor
+        was sent ``motor_deg``."""
 
     def continue_from(self, other: Any) -> None:
         """Take the state of ``other``, a compensator of the same kind for the same catheter."""
@@ -93,12 +98,13 @@ class NoCompensation:
         q = np.asarray(q_deg, dtype=float)
         self._last = np.where(np.isfinite(q), q, 0.0)
 
-    def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+    def command(self, q_deg: NDArray[np.float64], dt_s: float) -> NDArray[np.float64]:
         q = np.asarray(q_deg, dtype=float)
         self._last = np.where(np.isfinite(q), q, self._last)
         return self._last.copy()
 
-    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64],
+               dt_s: float) -> None:
         motor = np.asarray(motor_deg, dtype=float)
         self._last = np.where(np.isfinite(motor), motor, self._last)
 
@@ -123,20 +129,21 @@ class LimitedCompensator:
     def reset(self, q_deg: NDArray[np.float64]) -> None:
         self.inner.reset(q_deg)
         q = np.asarray(q_deg, dtype=float)
-        start = self.inner.command(q)
+        start = self.inner.command(q, self.limiter.dt_s)
         self.inner.reset(q_deg)
         first = [lim.clip(float(x)) if np.isfinite(x) else 0.0
                  for x, lim in zip(start, self.limits, strict=True)]
         self.limiter.reset(np.array(first), hold=True)
 
-    def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-        raw = self.inner.command(q_deg)
+    def command(self, q_deg: NDArray[np.float64], dt_s: float) -> NDArray[np.float64]:
+        raw = self.inner.command(q_deg, dt_s)
         self.last_unlimited = np.asarray(raw, dtype=float).copy()
-        return self.limiter.limit(raw)
+        return self.limiter.limit(raw, dt_s)
 
-    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64],
+               dt_s: float) -> None:
         if isinstance(self.inner, FollowsMotor):
-            self.inner.follow(q_deg, motor_deg)
+            self.inner.follow(q_deg, motor_deg, dt_s)
         self.limiter.limit(np.asarray(motor_deg, dtype=float))  # the limiter where the motor is
 
     def continue_from(self, other: LimitedCompensator) -> None:

@@ -5,7 +5,10 @@ parameter comes from that catheter's calibration current (:mod:`tsmd.calibration
 tension_play_fit`). This module runs it once per tick for two knobs: each knob's branches
 follow the other knob's command (precomputed over that angle, so a tick only looks a row up);
 the desired angle is led by the drive's lag; a jump across the dead zone is started early; the
-command goes through the knob's limits and a short moving average (bounded jerk).
+command goes through the knob's limits and a short moving average (bounded jerk). Time is each
+tick's elapsed time as the loop measured it (``dt_s``): a late tick on a loaded machine moves
+the limits and the moving average on by the periods it covered, and the velocity estimates
+divide by it (:mod:`tsmd.compensation.ours_knob`).
 
 Per-tick cost matters (two knobs in well under the loop's budget): the tick uses plain floats
 and lists, no numpy on scalars and no allocation beyond the output array.
@@ -29,7 +32,7 @@ from tsmd.compensation.ours_knob import (
     watch,
 )
 from tsmd.compensation.planned import Planner
-from tsmd.compensation.safety import KnobLimits, step_floats
+from tsmd.compensation.safety import KnobLimits, step_floats, tick_time_s
 from tsmd.compensation.tension_play import (
     Branches,
     PlayState,
@@ -132,7 +135,9 @@ class OursCompensator:
     crossing error is centred instead of all lag); the command then goes through the knob's
     position/velocity/acceleration limits and a moving average over ``smoothing_s``: the average
     of a feasible motion stays feasible, and its acceleration changes by at most 2 a_max per
-    window, so the jerk is at most 2 a_max / ``smoothing_s``.
+    window, so the jerk is at most 2 a_max / ``smoothing_s``. A tick of ``dt_s`` = n periods
+    steps the limits and the average n periods (the knob's target moving evenly over the
+    periods missed), so limits and window hold in time, not in ticks.
     """
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,
@@ -162,11 +167,11 @@ class OursCompensator:
 
     def _set_constants(self) -> None:
         # faster than any knob can make the tip move (release slope <= 5 omega)
-        jump_deg = 5.0 * max(k.omega for k in self.knobs) * self.v_max * self.period_s
+        jump_deg_s = 5.0 * max(k.omega for k in self.knobs) * self.v_max
         for kc, knob in zip(self._k, self.knobs, strict=True):
             kc.ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
             kc.ahead_ticks = round(kc.ahead_s / self.period_s)
-            kc.jump_deg = jump_deg
+            kc.jump_deg_s = jump_deg_s
             kc.omega = knob.omega
             kc.plateau_lo_deg = min(knob.height_pos_deg, knob.height_neg_deg)
             kc.plateau_hi_deg = max(knob.height_pos_deg, knob.height_neg_deg)
@@ -202,42 +207,77 @@ class OursCompensator:
         (:class:`tsmd.compensation.planned.Planner`)."""
         self._planner.set(plan_deg, index)
 
-    def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+    def command(self, q_deg: NDArray[np.float64], dt_s: float) -> NDArray[np.float64]:
+        """The motor command for the desired angles ``q_deg``, ``dt_s`` after the last tick."""
         k0, k1 = self._k
         b0 = self.knobs[0].at(k1.state.x_deg, k0.fresh, k0.first_side)
         b1 = self.knobs[1].at(k0.state.x_deg, k1.fresh, k1.first_side)
-        slot = self._slot
         period = self.period_s
+        dt, n = self._elapsed(dt_s)
         planner = self._planner
         planned = planner.take()
         out = []
         for col, kc, qi, b in ((0, k0, float(q_deg[0]), b0), (1, k1, float(q_deg[1]), b1)):
             if qi - qi == 0.0:  # finite; otherwise the command stays where it is
-                self._track(kc, qi, b, planned)
+                self._track(kc, qi, b, planned, dt)
                 if planned:
                     kc.out = planner.command(kc.plan, kc.state, kc.out, kc.ahead_ticks, col, b)
                 if kc.fresh:
                     _fresh_progress(kc)
-            x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target, kc.out,
-                                                     kc.limits, period)
+            if n == 1:
+                x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target,
+                                                         kc.out, kc.limits, period)
+                kc.lim_deg = x
+                window = kc.window
+                kc.sum += x - window[self._slot]
+                window[self._slot] = x
+            else:
+                self._catch_up(kc, n)
+            out.append(kc.sum)
+        slot = self._slot + n
+        n_avg = self._n_avg
+        self._slot = slot if slot < n_avg else slot % n_avg
+        return np.array((out[0] / n_avg, out[1] / n_avg))
+
+    def _elapsed(self, dt_s: float) -> tuple[float, int]:
+        """This tick's time (seconds, :func:`tick_time_s`) and the whole periods it covers
+        (at least one)."""
+        period = self.period_s
+        if dt_s == period:
+            return period, 1
+        dt = tick_time_s(dt_s, period)
+        n = int(dt / period + 0.5)
+        return dt, n if n > 1 else 1
+
+    def _catch_up(self, kc: KnobCommand, n: int) -> None:
+        """``n`` periods of the limits and the average in one tick: the target moved evenly
+        from the last one to ``kc.out`` over them."""
+        period = self.period_s
+        start = kc.lim_target if kc.lim_target is not None else kc.out
+        goal = kc.out
+        window, n_avg = kc.window, self._n_avg
+        slot = self._slot
+        for j in range(1, n + 1):
+            target = goal if j == n or goal - goal != 0.0 else start + (goal - start) * j / n
+            x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target,
+                                                     target, kc.limits, period)
             kc.lim_deg = x
-            window = kc.window
             kc.sum += x - window[slot]
             window[slot] = x
-            out.append(kc.sum)
-        n = self._n_avg
-        self._slot = slot + 1 if slot + 1 < n else 0
-        return np.array((out[0] / n, out[1] / n))
+            slot = slot + 1 if slot + 1 < n_avg else 0
 
-    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
-        """Someone else sent the motor ``motor_deg`` for ``q_deg``: the model follows the motor,
-        the trackers ``q_deg``, the output filter holds the motor (a switch continues here)."""
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64],
+               dt_s: float) -> None:
+        """Someone else sent the motor ``motor_deg`` for ``q_deg``, ``dt_s`` after the last
+        tick: the model follows the motor, the trackers ``q_deg``, the output filter holds the
+        motor (a switch continues here)."""
         period = self.period_s
+        dt, _ = self._elapsed(dt_s)
         for i, kc in enumerate(self._k):
             qi, x = float(q_deg[i]), float(motor_deg[i])
             if qi - qi == 0.0:
-                watch(kc, qi, period, self._n_avg)
-                motion(kc, qi, period)
+                watch(kc, qi, dt, self._n_avg)
+                motion(kc, qi, dt, period)
                 kc.target = qi
                 kc.still_s = 0.0  # no dwell before this compensator has brought the tip to q
             if x - x == 0.0:
@@ -248,7 +288,7 @@ class OursCompensator:
                 kc.out = x
                 kc.hold = 0
                 kc.plan.direction = 0  # a planned crossing is this compensator's own
-                kc.lim_v, kc.lim_deg, kc.lim_target = (x - kc.lim_deg) / period, x, None
+                kc.lim_v, kc.lim_deg, kc.lim_target = (x - kc.lim_deg) / dt, x, None
                 kc.window = [x] * self._n_avg  # the filter's output is the motor's command
                 kc.sum = x * self._n_avg
 
@@ -258,10 +298,11 @@ class OursCompensator:
         self._slot = other._slot
         self._set_constants()
 
-    def _track(self, kc: KnobCommand, q_raw: float, b: Branches, planned: bool) -> None:
-        if watch(kc, q_raw, self.period_s, self._n_avg) and self._centre(kc, b):
+    def _track(self, kc: KnobCommand, q_raw: float, b: Branches, planned: bool,
+               dt_s: float) -> None:
+        if watch(kc, q_raw, dt_s, self._n_avg) and self._centre(kc, b):
             return
-        qi, dq, v = motion(kc, q_raw, self.period_s)
+        qi, dq, v = motion(kc, q_raw, dt_s, self.period_s)
         lead = kc.ahead_s * v
         if lead < -_MAX_LEAD_DEG:
             lead = -_MAX_LEAD_DEG

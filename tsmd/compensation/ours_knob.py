@@ -4,7 +4,9 @@ The tick (:mod:`tsmd.compensation.ours`) keeps each knob's state in a :class:`Kn
 plain floats; :func:`watch` and :func:`motion` read the desired angle into it: rest and dwell
 bookkeeping, the jitter deadband, the velocity and acceleration estimates. The compensator's
 tick and its standing by (``follow``) share them, so that a switch continues where the tick
-would have been.
+would have been. Time is the elapsed time of each tick (``dt_s``, what the loop measured), not a
+count of ticks: on a loaded machine a late tick carries two or three periods of the desired
+angle's motion, and read as one period it doubled or tripled the velocity estimate.
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ class KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
     __slots__ = ("accel", "ahead_s", "ahead_ticks", "first_side", "fresh", "fresh_hi_deg",
-                 "fresh_lo_deg", "held_s", "hold", "jump_deg", "lim_deg",
+                 "fresh_lo_deg", "held_s", "hold", "jump_deg_s", "lim_deg",
                  "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan",
                  "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "rest_q",
                  "stand_s", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
@@ -48,7 +50,8 @@ class KnobCommand:
         self.ahead_s = 0.0
         self.ahead_ticks = 0
         self.plan = PlanHold()
-        self.jump_deg = 0.0
+        self.jump_deg_s = 0.0
+        """A desired angle faster than this (deg/s) steps: nothing to predict from it."""
         self.omega = 1.0
         self.plateau_lo_deg = self.plateau_hi_deg = 0.0
         self.fresh = False
@@ -86,11 +89,12 @@ class KnobCommand:
         self.sum = x * n_avg
 
 
-def watch(kc: KnobCommand, q_raw: float, period_s: float, n_avg: int) -> bool:
-    """Rest and dwell bookkeeping of the desired angle; True when a dwell is due."""
-    kc.move_s += period_s
+def watch(kc: KnobCommand, q_raw: float, dt_s: float, n_avg: int) -> bool:
+    """Rest and dwell bookkeeping of the desired angle over ``dt_s`` (this tick's elapsed
+    time); True when a dwell is due."""
+    kc.move_s += dt_s
     if -REST_DEG < q_raw - kc.rest_q < REST_DEG:
-        kc.stand_s += period_s
+        kc.stand_s += dt_s
     else:
         if kc.stand_s >= REST_S:
             kc.move_s = 0.0  # a move from rest starts
@@ -99,15 +103,24 @@ def watch(kc: KnobCommand, q_raw: float, period_s: float, n_avg: int) -> bool:
     if -REVERSAL_DEADBAND_DEG < q_raw - kc.still_q < REVERSAL_DEADBAND_DEG:
         # the dwell counts once the sent command has arrived (the tip got there first)
         if abs(kc.sum / n_avg - kc.out) < SETTLED_DEG:
-            kc.still_s += period_s
+            kc.still_s += dt_s
         return kc.still_s >= DWELL_S
     kc.still_q = q_raw
     kc.still_s = 0.0
     return False
 
 
-def motion(kc: KnobCommand, q_raw: float, period_s: float) -> tuple[float, float, float]:
-    """The desired angle past the jitter deadband, its step and its velocity estimate."""
+def motion(kc: KnobCommand, q_raw: float, dt_s: float, period_s: float
+           ) -> tuple[float, float, float]:
+    """The desired angle past the jitter deadband, its step and its velocity estimate, over
+    this tick's elapsed time ``dt_s``. The estimates are first-order filters whose time
+    constants are set in periods (0.7 and 0.8 kept per period): a tick of n periods keeps
+    0.7^n, as n ticks of constant velocity would."""
+    if dt_s == period_s:
+        keep_v, gain_v, keep_a, gain_a = 0.7, 0.3, 0.8, 0.2
+    else:
+        keep_v, keep_a = 0.7 ** (dt_s / period_s), 0.8 ** (dt_s / period_s)
+        gain_v, gain_a = 1.0 - keep_v, 1.0 - keep_a
     q_prev = kc.q_prev
     qi = q_prev
     if (q_raw - q_prev) * kc.q_dir >= 0.0:
@@ -117,8 +130,9 @@ def motion(kc: KnobCommand, q_raw: float, period_s: float) -> tuple[float, float
         kc.q_dir = -kc.q_dir
     dq = qi - q_prev
     kc.q_prev = qi
-    v = 0.7 * kc.v + 0.3 * dq / period_s
-    if abs(dq) > kc.jump_deg:  # a step, not a motion: nothing to predict from it
+    v = keep_v * kc.v + gain_v * dq / dt_s
+    jump_deg = kc.jump_deg_s * dt_s
+    if abs(dq) > jump_deg:  # a step, not a motion: nothing to predict from it
         v = 0.0
     kc.v = v
     # The acceleration from the desired angle itself (the jitter deadband above releases a
@@ -126,16 +140,18 @@ def motion(kc: KnobCommand, q_raw: float, period_s: float) -> tuple[float, float
     # desired angle that changes every tick (a trajectory played in the loop). A client
     # that sets 50 times a second holds each value for several ticks with its own timing
     # jitter: the velocity of that staircase is readable, its acceleration is not (the
-    # daemon's demo: RMSE 11.4 / 6.8 deg with it, 3.0 / 3.0 without).
+    # daemon's demo: RMSE 11.4 / 6.8 deg with it, 3.0 / 3.0 without). "Every tick" is every
+    # period, in time: ticks late by a period or more let that client's staircase change at
+    # nearly every tick, and its acceleration then was noise up to the knob's limit again.
     dq_raw = q_raw - kc.q_raw
-    kc.held_s += period_s
+    kc.held_s += dt_s
     if dq_raw != 0.0:
         kc.q_raw = q_raw
-        if abs(dq_raw) > kc.jump_deg or kc.held_s > 1.5 * period_s:
+        if abs(dq_raw) > jump_deg or kc.held_s > 1.5 * period_s:
             kc.v_raw = kc.accel = 0.0  # a step, a staircase, or a start after a pause
         else:
-            v_raw = 0.7 * kc.v_raw + 0.3 * dq_raw / period_s
-            kc.accel = 0.8 * kc.accel + 0.2 * (v_raw - kc.v_raw) / period_s
+            v_raw = keep_v * kc.v_raw + gain_v * dq_raw / dt_s
+            kc.accel = keep_a * kc.accel + gain_a * (v_raw - kc.v_raw) / dt_s
             kc.v_raw = v_raw
         kc.held_s = 0.0
     elif kc.held_s > 1.5 * period_s:

@@ -337,7 +337,8 @@ class PaperCompensator:
         self._states = [rest_state(float(q[i]), k.params(float(q[1 - i])))
                         for i, k in enumerate(self.knobs)]
 
-    def command(self, q_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+    def command(self, q_deg: NDArray[np.float64], dt_s: float) -> NDArray[np.float64]:
+        """The inverse of the model at ``q_deg`` (static: the time ``dt_s`` plays no part)."""
         q = np.asarray(q_deg, dtype=float)
         out = np.empty(2)
         for i, knob in enumerate(self.knobs):
@@ -348,7 +349,8 @@ class PaperCompensator:
             out[i] = state.x_deg
         return out
 
-    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64]) -> None:
+    def follow(self, q_deg: NDArray[np.float64], motor_deg: NDArray[np.float64],
+               dt_s: float) -> None:
         """The motor was sent ``motor_deg`` by someone else: the model follows it."""
         for i, knob in enumerate(self.knobs):
             x, other = float(motor_deg[i]), float(q_deg[1 - i])

@@ -20,6 +20,11 @@ DEFAULT_MAX_VELOCITY_DEG_S = 120.0
 """Knob speed limit when the configuration does not say (the simulated rig's data sheet)."""
 DEFAULT_MAX_ACCEL_DEG_S2 = 2000.0
 """Knob acceleration limit when the configuration does not say."""
+MAX_TICK_PERIODS = 4
+"""A late tick is given the time it covers, up to this many periods: the drive held its last
+target meanwhile, and the next one may be as far as the limits allow over that time. Longer is
+a stall (a streak of overruns faults the loop), not motion time: one target step never covers
+more than this many periods of the velocity limit."""
 
 
 @dataclass(frozen=True)
@@ -124,15 +129,29 @@ class KnobLimiter:
         """Stand still at ``cmd_deg``; ``hold``: also take it as the last target (no jump)."""
         self._states = [(float(q), 0.0, float(q) if hold else None) for q in cmd_deg]
 
-    def limit(self, cmd_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.array(self.limit_pair(float(cmd_deg[0]), float(cmd_deg[1])))
+    def limit(self, cmd_deg: NDArray[np.float64], dt_s: float | None = None
+              ) -> NDArray[np.float64]:
+        """The limited command, ``dt_s`` after the last (default and on time: one period)."""
+        return np.array(self.limit_pair(float(cmd_deg[0]), float(cmd_deg[1]), dt_s))
 
-    def limit_pair(self, cmd0_deg: float, cmd1_deg: float) -> tuple[float, float]:
+    def limit_pair(self, cmd0_deg: float, cmd1_deg: float, dt_s: float | None = None
+                   ) -> tuple[float, float]:
         """:meth:`limit` on two floats (the control loop's hot path: no arrays)."""
-        dt = self.dt_s
+        dt = self.dt_s if dt_s is None else tick_time_s(dt_s, self.dt_s)
         lim0, lim1 = self.limits
         s0, s1 = self._states
         s0 = step_floats(s0[0], s0[1], s0[2], cmd0_deg, lim0, dt)
         s1 = step_floats(s1[0], s1[1], s1[2], cmd1_deg, lim1, dt)
         self._states = [s0, s1]
         return s0[0], s1[0]
+
+
+def tick_time_s(dt_s: float, period_s: float) -> float:
+    """The time a tick counts for: its elapsed ``dt_s``, at most :data:`MAX_TICK_PERIODS`
+    periods; one period if ``dt_s`` is not a positive number."""
+    if dt_s == period_s:
+        return period_s
+    if not dt_s > 0.0 or dt_s - dt_s != 0.0:
+        return period_s
+    longest = MAX_TICK_PERIODS * period_s
+    return dt_s if dt_s < longest else longest

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import subprocess
 import sys
 from pathlib import Path
@@ -9,6 +10,8 @@ from pathlib import Path
 import pytest
 
 from tsmd.cli import main
+from tsmd.commands import run as run_command
+from tsmd.config import default_sim_config
 
 
 def test_help_lists_every_command(capsys: pytest.CaptureFixture[str]) -> None:
@@ -57,3 +60,16 @@ def test_run_refuses_a_duration_that_is_not_a_positive_time(
         duration: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["run", "--sim", "--duration", duration]) == 2
     assert "--duration must be a positive number of seconds" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("priority", ["-1", "100"])
+def test_run_refuses_a_realtime_priority_outside_0_to_99(
+        priority: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "--sim", "--realtime-priority", priority]) == 2
+    assert "--realtime-priority must be 0-99" in capsys.readouterr().err
+
+
+def test_run_realtime_priority_overrides_the_configured_one() -> None:
+    args = argparse.Namespace(config=None, sim=True, realtime_priority=80)
+    assert default_sim_config().loop.realtime.priority == 0
+    assert run_command._config(args).loop.realtime.priority == 80

@@ -13,7 +13,7 @@ import signal
 import sys
 import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import FrameType
 from typing import Any
@@ -48,14 +48,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="home every drive that has a homing method before the loop starts "
                              "(drives[i].homing; a search moves the knobs)")
     parser.add_argument("--log-format", choices=("auto", "json", "console"), default="auto")
+    parser.add_argument("--realtime-priority", type=int, metavar="N",
+                        help="SCHED_FIFO priority of the loop thread, 1-99, or 0 for normal "
+                             "scheduling (overrides loop.realtime.priority; the packaged "
+                             "simulation config asks for 0, so that any user can run it)")
 
 
 def _config(args: argparse.Namespace) -> TsmdConfig:
     if args.config is not None:
-        return load_config(args.config)
-    if args.sim:
-        return default_sim_config()
-    return load_config(DEFAULT_CONFIG_PATH)
+        config = load_config(args.config)
+    elif args.sim:
+        config = default_sim_config()
+    else:
+        config = load_config(DEFAULT_CONFIG_PATH)
+    priority = getattr(args, "realtime_priority", None)
+    if priority is None:
+        return config
+    realtime = replace(config.loop.realtime, priority=priority)
+    return replace(config, loop=replace(config.loop, realtime=realtime))
 
 
 @dataclass
@@ -133,6 +143,8 @@ class Demo:
 def main(args: argparse.Namespace) -> int:
     if args.duration is not None and not 0.0 < args.duration < math.inf:
         raise TsmdError(f"--duration must be a positive number of seconds, got {args.duration}")
+    if args.realtime_priority is not None and not 0 <= args.realtime_priority <= 99:
+        raise TsmdError(f"--realtime-priority must be 0-99, got {args.realtime_priority}")
     configure_logging(args.log_format)
     config = _config(args)
     daemon = Daemon(config, sim=args.sim, socket_path=args.socket, profile_path=args.profile,

@@ -252,7 +252,10 @@ class ControlLoop(LoopCommands):
                 self._fault(f"compensator gave {cmd.tolist()} for q {list(q)}")
                 return q, self._last_cmd
             c0, c1 = cmd.tolist()
-        c0, c1 = self._limiter.limit_pair(c0, c1, self.dt_s)
+        # one SYNC, one period of the limits whatever the tick's lateness: a CSP drive moves to
+        # each target over its interpolation period (0x60C2), so a larger step would be a
+        # faster move than the velocity limit (the compensator still counts the elapsed time)
+        c0, c1 = self._limiter.limit_pair(c0, c1)
         if not (_isfinite(c0) and _isfinite(c1)):
             self._fault(f"limiter gave {[c0, c1]} for q {list(q)}")
             return q, self._last_cmd

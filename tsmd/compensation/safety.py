@@ -21,10 +21,10 @@ DEFAULT_MAX_VELOCITY_DEG_S = 120.0
 DEFAULT_MAX_ACCEL_DEG_S2 = 2000.0
 """Knob acceleration limit when the configuration does not say."""
 MAX_TICK_PERIODS = 4
-"""A late tick is given the time it covers, up to this many periods: the drive held its last
-target meanwhile, and the next one may be as far as the limits allow over that time. Longer is
-a stall (a streak of overruns faults the loop), not motion time: one target step never covers
-more than this many periods of the velocity limit."""
+"""A late tick is given the time it covers, up to this many periods, for what counts time
+(the compensator's estimates, timers and averages). Longer is a stall (a streak of overruns
+faults the loop), not motion time. The loop's own limiter still steps one period per SYNC: a
+CSP drive moves to each target over its interpolation period."""
 
 
 @dataclass(frozen=True)

@@ -17,24 +17,31 @@ from support.calibration import LockstepPlantRunner
 
 from simrig.analysis import measure_dead_zone_backlash
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
+from tsmd.bench.tip_truth import tip_truth
 from tsmd.calibration import (
     CalibrationCancelledError,
     CalibrationError,
     Protocol,
     QualityLimits,
     Sweep,
+    calibrate_from_recordings,
     fast_protocol,
     identify_recording,
     identify_sweep,
     paper_protocol,
     run_calibration,
 )
+from tsmd.calibration.assemble import GridPoint, QualityReport, check_quality, cross_check_device
+from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.calibration.identify import IdentifyOptions, SweepResult
 from tsmd.calibration.player import sweep_metadata
 from tsmd.calibration.protocol import sweep_run
-from tsmd.calibration.signal import lowpass
+from tsmd.calibration.run import _Identifier, finish, run_sweeps
+from tsmd.calibration.signal import condition, lowpass
+from tsmd.config import default_sim_config
 from tsmd.profile import ProfileStore, load_device_model
 from tsmd.recording import Recording, read_recording, write_recording
+from tsmd.replay import LockstepRunner
 
 PERIOD_S = 0.004
 DEVICE = Path(__file__).resolve().parent.parent / "profiles" / "devices" / "sim-catheter.yaml"
@@ -242,7 +249,6 @@ def test_a_small_calibration_builds_a_profile_that_saves_and_loads(small_cal,
 
 
 def test_logged_sweeps_give_the_same_profile_offline(small_cal, tmp_path: Path) -> None:
-    from tsmd.calibration import calibrate_from_recordings
 
     cal, _, _ = small_cal
     files = []
@@ -280,7 +286,6 @@ def test_a_cancelled_calibration_returns_the_knobs_to_zero_and_saves_nothing(
 
 
 def test_a_grid_without_the_zero_sweep_is_refused() -> None:
-    from tsmd.calibration.assemble import GridPoint, check_quality
 
     base = _identify(_sweep(SHORT_SWEEP))
     report = check_quality([GridPoint(k, o, base) for k in (0, 1) for o in (-30.0, 30.0)])
@@ -303,7 +308,6 @@ def test_the_knee_edge_lies_beyond_the_rise_and_nearer_the_tip(sweep_rec: Record
 
 
 def test_identification_in_a_worker_process_gives_the_same_values() -> None:
-    from tsmd.calibration.run import run_sweeps
 
     proto = Protocol("one", (SHORT_SWEEP,))
     here = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto)
@@ -313,7 +317,6 @@ def test_identification_in_a_worker_process_gives_the_same_values() -> None:
 
 
 def test_identification_in_a_worker_process_keeps_the_recording_that_was_played() -> None:
-    from tsmd.calibration.run import run_sweeps
 
     proto = Protocol("one", (SHORT_SWEEP,))
     here = run_sweeps(LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S), proto)
@@ -325,7 +328,6 @@ def test_identification_in_a_worker_process_keeps_the_recording_that_was_played(
 
 
 def test_conditioning_a_complete_sweep_keeps_its_arrays_without_a_copy() -> None:
-    from tsmd.calibration.signal import condition
 
     t = np.arange(500) * PERIOD_S
     cmd = 30.0 * np.sin(2 * np.pi * 0.5 * t)
@@ -342,7 +344,6 @@ def _with_backlash(base: SweepResult, backlash_deg: float) -> SweepResult:
 
 
 def test_backlash_far_below_the_data_sheets_is_a_warning_kept_in_the_figures() -> None:
-    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
 
     device = load_device_model(DEVICE)
     sheet_b = device.knobs[0].reference_backlash_pos_deg
@@ -356,8 +357,6 @@ def test_backlash_far_below_the_data_sheets_is_a_warning_kept_in_the_figures() -
 
 
 def test_a_refusal_carries_the_data_sheet_warning_that_may_explain_it() -> None:
-    from tsmd.calibration.assemble import GridPoint
-    from tsmd.calibration.run import finish
 
     device = load_device_model(DEVICE)
     sheet_b = device.knobs[0].reference_backlash_pos_deg
@@ -376,7 +375,6 @@ def _with_swing(base: SweepResult, swing_A: float, backlash_deg: float) -> Sweep
 
 
 def test_backlash_near_what_its_swing_implies_gives_no_warning() -> None:
-    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
 
     device = load_device_model(DEVICE)
     sheet = device.knobs[1]
@@ -390,39 +388,36 @@ def test_backlash_near_what_its_swing_implies_gives_no_warning() -> None:
     assert report.figures["phi2_backlash_neg_vs_datasheet"] == pytest.approx(0.9)
 
 
-def test_a_small_backlash_with_a_small_swing_is_seen_not_warned() -> None:
-    # lumped 103 phi2 and capstan development units 1, 2, 4-7: B right, 59-78 % of the sheet
-    # unit's, and their current swings less than the sheet unit's
-    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
-
+def _phi1_cross_check(swing_share: float, backlash_share: float) -> QualityReport:
+    """The data-sheet cross-check of a phi1 sweep whose release swing and backlash are these
+    shares of the sheet unit's."""
     device = load_device_model(DEVICE)
     ref_b, ref_swing = (device.knobs[0].reference_backlash_pos_deg,
                         device.knobs[0].reference_release_swing_A)
     assert ref_b is not None and ref_swing is not None
-    small = _with_swing(_identify(_sweep(SHORT_SWEEP)), 0.55 * ref_swing, 0.6 * ref_b)
+    point = _with_swing(_identify(_sweep(SHORT_SWEEP)), swing_share * ref_swing,
+                        backlash_share * ref_b)
     report = QualityReport()
-    cross_check_device([GridPoint(0, 0.0, small)], device, report)
+    cross_check_device([GridPoint(0, 0.0, point)], device, report)
+    return report
+
+
+def test_a_small_backlash_with_a_small_swing_is_seen_not_warned() -> None:
+    # lumped 103 phi2 and capstan development units 1, 2, 4-7: B right, 59-78 % of the sheet
+    # unit's, and their current swings less than the sheet unit's
+    report = _phi1_cross_check(swing_share=0.55, backlash_share=0.6)
     assert report.warnings == []
     assert report.figures["phi1_backlash_pos_vs_datasheet"] == pytest.approx(0.6)
 
 
 def test_a_backlash_short_of_what_a_large_swing_implies_is_warned() -> None:
     # a routed handle: the guide pins add to the swing while the current settles early
-    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
-
-    device = load_device_model(DEVICE)
-    ref_b, ref_swing = (device.knobs[0].reference_backlash_pos_deg,
-                        device.knobs[0].reference_release_swing_A)
-    assert ref_b is not None and ref_swing is not None
-    routed = _with_swing(_identify(_sweep(SHORT_SWEEP)), 1.5 * ref_swing, 0.9 * ref_b)
-    report = QualityReport()
-    cross_check_device([GridPoint(0, 0.0, routed)], device, report)
+    report = _phi1_cross_check(swing_share=1.5, backlash_share=0.9)
     assert len(report.warnings) == 2
     assert "implies" in report.warnings[0] and "short on the tip" in report.warnings[0]
 
 
 def test_a_sheet_without_the_release_swing_keeps_the_fixed_share_check() -> None:
-    from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
 
     device = load_device_model(DEVICE)
     old = dataclasses.replace(device, knobs=tuple(
@@ -441,10 +436,6 @@ def _one_point_cross_check(plant_params: dict[str, object]):
     against the straight-handle product's data sheet."""
     from dataclasses import replace
 
-    from tsmd.calibration.assemble import QualityReport, cross_check_device
-    from tsmd.calibration.run import run_sweeps
-    from tsmd.config import default_sim_config
-    from tsmd.replay import LockstepRunner
 
     config = default_sim_config()
     config = replace(config, sim=replace(config.sim, params=plant_params))
@@ -472,7 +463,6 @@ def test_a_routed_handle_makes_the_calibration_warn_that_its_backlash_is_implaus
 def test_the_nominal_straight_handle_shows_its_backlash_in_the_current() -> None:
     # The paper's class of handle: B from the current is the tip's within the issue's 2 deg
     # (tip measured on the tracked tip by the benchmark's function) and passes the cross-check.
-    from tsmd.bench.tip_truth import tip_truth
 
     report, ratios, points = _one_point_cross_check({})
     assert len(ratios) == 4
@@ -487,8 +477,6 @@ def test_the_nominal_straight_handle_shows_its_backlash_in_the_current() -> None
 def test_the_default_dead_zone_edge_is_where_the_tip_starts_to_move() -> None:
     # tsmd's default (knee) edge against the tracked tip, and the paper's rise edge beside it:
     # the current rises when the tendon engages, a few degrees before the tip moves.
-    from tsmd.bench.tip_truth import tip_truth
-    from tsmd.calibration.run import identify_recording
 
     _, _, points = _one_point_cross_check({})
     for p in points:
@@ -501,9 +489,6 @@ def test_the_default_dead_zone_edge_is_where_the_tip_starts_to_move() -> None:
 
 
 def test_a_refused_calibration_keeps_its_sweeps_for_examination() -> None:
-    from tsmd.calibration.assemble import GridPoint
-    from tsmd.calibration.errors import CalibrationRefusedError
-    from tsmd.calibration.run import finish
 
     base = _identify(_sweep(SHORT_SWEEP))
     points = [GridPoint(k, 30.0, base) for k in (0, 1)]  # no sweep at 0 deg: refused
@@ -515,7 +500,6 @@ def test_a_refused_calibration_keeps_its_sweeps_for_examination() -> None:
 def test_identification_worker_of_a_live_loop_runs_niced() -> None:
     import os
 
-    from tsmd.calibration.run import _Identifier
 
     identifier = _Identifier(None, isolate=True, live_loop=True)
     assert identifier.pool is not None
@@ -528,7 +512,6 @@ def test_identification_worker_of_a_live_loop_runs_niced() -> None:
 def test_identification_worker_in_lockstep_runs_at_the_callers_priority() -> None:
     import os
 
-    from tsmd.calibration.run import _Identifier
 
     identifier = _Identifier(None, isolate=True, live_loop=False)
     assert identifier.pool is not None

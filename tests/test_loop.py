@@ -277,13 +277,19 @@ def test_a_played_trajectory_is_previewed_every_tick_and_a_setpoint_never() -> N
     assert comp.previews == [(float(i), i) for i in range(5)]
 
 
-def test_the_compensator_is_given_the_time_since_the_last_tick() -> None:
+def _enabled_on_a_sim_clock() -> tuple[Offset, ControlLoop]:
+    """An enabled loop after one tick, on a SimClock that advances one period per SYNC."""
     comp = Offset(0.0)
-    loop, _ = make_loop(comp)  # its clock advances one period after each SYNC
+    loop, _ = make_loop(comp)
     loop.tick()
     loop.execute("enable")
     loop.tick()
     assert isinstance(loop.clock, SimClock)
+    return comp, loop
+
+
+def test_the_compensator_is_given_the_time_since_the_last_tick() -> None:
+    comp, loop = _enabled_on_a_sim_clock()
     loop.clock.advance(2 * PERIOD_S)  # two ticks missed
     loop.tick()
     loop.tick()
@@ -305,12 +311,7 @@ def test_a_late_tick_steps_the_drive_target_by_at_most_one_period_of_the_velocit
 
 
 def test_a_tick_woken_late_and_the_next_on_time_count_two_periods_and_one() -> None:
-    comp = Offset(0.0)
-    loop, _ = make_loop(comp)
-    loop.tick()
-    loop.execute("enable")
-    loop.tick()
-    assert isinstance(loop.clock, SimClock)
+    comp, loop = _enabled_on_a_sim_clock()
     loop.clock.advance(0.7 * PERIOD_S)  # this tick wakes 0.7 periods late, the next on time
     loop.tick()
     loop.clock.advance(0.3 * PERIOD_S)
@@ -320,12 +321,7 @@ def test_a_tick_woken_late_and_the_next_on_time_count_two_periods_and_one() -> N
 
 
 def test_a_stall_counts_for_at_most_the_longest_tick() -> None:
-    comp = Offset(0.0)
-    loop, _ = make_loop(comp)
-    loop.tick()
-    loop.execute("enable")
-    loop.tick()
-    assert isinstance(loop.clock, SimClock)
+    comp, loop = _enabled_on_a_sim_clock()
     loop.clock.advance(0.5)
     loop.tick()
     loop.tick()

@@ -10,8 +10,9 @@ friction, current sensor) that live outside the plant.
 
 Unit 0 is the nominal unit (no scatter). Units 1-8 are the development set, units 101-108 the
 held-out set: tune on the first, report the second. The capstan plant is the development plant,
-the lumped plant is held out, the segments plant (session 9) was written blind and tsmd was run
-on it untuned (``PLANT_ROLE``).
+the lumped plant is held out, the segments plant (written blind in session 9) is held out now,
+the coilpipe plant (session 10) was written blind and tsmd was run on it untuned
+(``PLANT_ROLE``).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ import numpy as np
 from simrig.motor import MotorParams
 from simrig.plant import Plant, PlantLoadError, load_plant
 from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
+from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
 from simrig.rig import DEFAULT_CURRENT_SENSOR
@@ -34,8 +36,10 @@ PLANT_SPECS: dict[str, str] = {
     "capstan": "simrig.plants.capstan:make_tendon_sheath_plant",
     "lumped": "simrig.plants.lumped:make_lumped_plant",
     "segments": "simrig.plants.segments:make_segments_plant",
+    "coilpipe": "simrig.plants.coilpipe:make_coilpipe_plant",  # last: the others' seeds hold
 }
-PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "blind"}
+PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
+              "coilpipe": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -102,11 +106,36 @@ SCATTER: dict[str, dict[str, float]] = {
         "handle_friction_Nm": 0.20,  # knob bearing / brake setting
         "handle_presliding_deg": 0.20,
     },
+    "coilpipe": {
+        "pulley_radius_mm": 0.02,  # machined drum
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # crimp and strand lay
+        "tendon_stiffness_N": 0.15,  # cable lot (EA)
+        "free_length_m": 0.20,  # handle assembly
+        "sheath_length_m": 0.02,  # cut to length
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "sheath_wrap_deg": 0.10,  # lumen helix pitch
+        "sheath_drag_N": 0.25,  # liner preload on the cable
+        "stribeck_ratio": 0.05,  # static/kinetic ratio of the liner (1.24-1.37 at 1.3)
+        "stribeck_speed_mm_s": 0.30,  # lubricant film: the least known of the friction constants
+        "viscous_N_s_per_mm": 0.30,  # lubricant amount and viscosity
+        "presliding_mm": 0.20,  # contact micro-geometry
+        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
+        "bend_creep_stiffness_Nm_per_rad": 0.25,  # polymer batch, moulding
+        "bend_creep_time_s": 0.30,
+        "handle_friction_Nm": 0.20,  # knob bearing / detent setting
+        "handle_presliding_deg": 0.20,
+        "gear_backlash_deg": 0.30,  # adapter tooth play (tolerance stack of two parts)
+        "gear_stiffness_Nm_per_deg": 0.20,  # adapter material and fit
+    },
 }
 """Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""
 
 _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMPED_KNOBS,
-                                        "segments": SEGMENTS_KNOBS}
+                                        "segments": SEGMENTS_KNOBS,
+                                        "coilpipe": COILPIPE_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -152,6 +181,8 @@ VARIANTS: dict[str, Variant] = {
                        "handle_friction_Nm": 1.5},
             "segments": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                          "bend_hysteresis_Nm": 1.5, "handle_friction_Nm": 1.5},
+            "coilpipe": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                         "viscous_N_s_per_mm": 1.5, "handle_friction_Nm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -168,7 +199,8 @@ VARIANTS: dict[str, Variant] = {
                              "sheath_friction": 1.0 / 1.4, "slack_pos_mm": 1.0 / 1.2,
                              "slack_neg_mm": 1.0 / 1.2},
                  "lumped": {"tendon_stiffness_N": 0.4},
-                 "segments": {"tendon_stiffness_N": 0.4}},
+                 "segments": {"tendon_stiffness_N": 0.4},
+                 "coilpipe": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

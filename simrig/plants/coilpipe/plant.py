@@ -177,11 +177,11 @@ class CoilPipePlant:
         """One implicit step to ``drive_mm``; halved (up to ``splits`` times) where Newton does
         not settle (a sudden stick-slip event inside a long step)."""
         sh = self.shared
-        # path shortening of each first segment: curved sheath, the other plane's bend
+        # a shorter path is more slack: the sheath laid in a curve, the other plane bent
         lost = self._curve_slack_mm + sh.coupling_mm_per_rad2 * np.square(self._tip_rad[::-1])
         offset = np.zeros(self._A.shape[0])
         offset[self._gear] = -drive_mm
-        offset[self._first] = self._slack - np.repeat(lost, 2)
+        offset[self._first] = self._slack + np.repeat(lost, 2)
         bend = np.where(self._bend_node, sh.bend_section_wrap_ratio
                         * np.abs(self._tip_rad)[np.minimum(self._knob, 1)], 0.0)
         mu_wrap = self._mu * (self._wrap0 + bend)

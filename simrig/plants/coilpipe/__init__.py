@@ -10,7 +10,6 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from simrig.plant import PlantLoadError
 from simrig.plants.coilpipe.params import (
     NOMINAL_KNOBS,
     CoilPipeKnobParams,
@@ -25,16 +24,21 @@ __all__ = ["NOMINAL_KNOBS", "CoilPipeKnobParams", "CoilPipeParamError", "CoilPip
            "CoilPipePlantParams", "make_coilpipe_plant"]
 
 
-def _knob(values: Mapping[str, Any] | CoilPipeKnobParams) -> CoilPipeKnobParams:
+def _knob(values: Mapping[str, Any] | CoilPipeKnobParams, index: int) -> CoilPipeKnobParams:
     if isinstance(values, CoilPipeKnobParams):
-        return values
-    if not isinstance(values, Mapping):
-        raise CoilPipeParamError(f"coilpipe knobs must be mappings of constants, got {values!r}")
-    known = {f.name for f in dataclasses.fields(CoilPipeKnobParams)}
-    unknown = sorted(set(values) - known)
-    if unknown:
-        raise CoilPipeParamError(f"unknown coilpipe knob parameter(s): {', '.join(unknown)}")
-    return CoilPipeKnobParams(**values)
+        knob = values
+    elif not isinstance(values, Mapping):
+        raise CoilPipeParamError(f"coilpipe knobs[{index}] must be a mapping of constants, "
+                                 f"got {values!r}")
+    else:
+        known = {f.name for f in dataclasses.fields(CoilPipeKnobParams)}
+        unknown = sorted(set(values) - known)
+        if unknown:
+            raise CoilPipeParamError(f"coilpipe knobs[{index}]: unknown parameter "
+                                     f"{', '.join(map(repr, unknown))}")
+        knob = CoilPipeKnobParams(**values)
+    check_knob(knob, index)
+    return knob
 
 
 def make_coilpipe_plant(knobs: Sequence[Mapping[str, Any] | CoilPipeKnobParams] | None = None,
@@ -44,15 +48,13 @@ def make_coilpipe_plant(knobs: Sequence[Mapping[str, Any] | CoilPipeKnobParams] 
     if knobs is None:
         pair = NOMINAL_KNOBS
     else:
-        if isinstance(knobs, (str, bytes)) or len(knobs) != 2:
-            raise PlantLoadError("coilpipe knobs must be a list of two mappings")
-        pair = (_knob(knobs[0]), _knob(knobs[1]))
+        if not isinstance(knobs, Sequence) or isinstance(knobs, (str, bytes)) or len(knobs) != 2:
+            raise CoilPipeParamError("coilpipe knobs must be a list of 2 mappings")
+        pair = (_knob(knobs[0], 0), _knob(knobs[1], 1))
     known = {f.name for f in dataclasses.fields(CoilPipePlantParams)}
     unknown = sorted(set(shared) - known)
     if unknown:
-        raise CoilPipeParamError(f"unknown coilpipe parameter(s): {', '.join(unknown)}")
+        raise CoilPipeParamError(f"unknown coilpipe parameter {', '.join(map(repr, unknown))}")
     plant_params = CoilPipePlantParams(**shared)
-    for k in pair:
-        check_knob(k)
     check_plant(plant_params)
     return CoilPipePlant(pair, plant_params)

@@ -15,8 +15,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+from simrig.plant import PlantLoadError
 
-class CoilPipeParamError(ValueError):
+
+class CoilPipeParamError(PlantLoadError):
     """A constant of the coil-pipe plant is outside its physical range."""
 
 
@@ -101,21 +103,20 @@ _POSITIVE = {"pulley_radius_mm", "tendon_offset_mm", "tendon_stiffness_N", "free
              "gear_stiffness_Nm_per_deg", "toe_mm"}
 
 
-def check_knob(p: CoilPipeKnobParams) -> None:
+def check_knob(p: CoilPipeKnobParams, index: int) -> None:
     """Refuse a knob's constants outside their physical range (one named line)."""
+    where = f"coilpipe knobs[{index}]."
     for f in fields(p):
         value = getattr(p, f.name)
         if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(
                 value):
-            raise CoilPipeParamError(f"coilpipe knob parameter {f.name} must be a finite number, "
-                                     f"got {value!r}")
+            raise CoilPipeParamError(f"{where}{f.name} must be a finite number, got {value!r}")
         if f.name in _POSITIVE and not value > 0:
-            raise CoilPipeParamError(f"coilpipe knob parameter {f.name} must be > 0, got {value}")
+            raise CoilPipeParamError(f"{where}{f.name} must be > 0, got {value}")
         if value < 0:
-            raise CoilPipeParamError(f"coilpipe knob parameter {f.name} must be >= 0, got {value}")
+            raise CoilPipeParamError(f"{where}{f.name} must be >= 0, got {value}")
     if p.stribeck_ratio < 1.0:
-        raise CoilPipeParamError(f"coilpipe knob parameter stribeck_ratio must be >= 1, got "
-                                 f"{p.stribeck_ratio}")
+        raise CoilPipeParamError(f"{where}stribeck_ratio must be >= 1, got {p.stribeck_ratio}")
 
 
 def check_plant(p: CoilPipePlantParams) -> None:

@@ -15,7 +15,9 @@ drive), implicit in every state, Newton on the force balance each step.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -87,8 +89,29 @@ class CoilPipePlant:
         self._w = np.array([blk - 1, 2 * blk - 1])
         self._section = section
         self._diag = np.arange(m) * (m + 1)
+        self._blk_sizes = (blk, eblk)
+        self._slack_delta_mm = np.zeros(4)
         self._set_constants(blk, eblk)
         self.reset()
+
+    def reshape(self, **changes: Any) -> None:
+        """The catheter changes shape mid-run (``simrig.scenario``): ``slack_delta_mm`` (per
+        knob, (positive, negative) tendon: more slack, e.g. a tendon settling) and
+        ``sheath_curvature_deg`` (the sheath laid in a curve). The state stays."""
+        unknown = sorted(set(changes) - {"slack_delta_mm", "sheath_curvature_deg"})
+        if unknown:
+            raise ValueError(f"coilpipe plant cannot change {', '.join(unknown)}")
+        if "slack_delta_mm" in changes:
+            delta = np.asarray(changes["slack_delta_mm"], dtype=float).reshape(4)
+            if not np.all(np.isfinite(delta)):
+                raise ValueError("coilpipe slack_delta_mm must be finite")
+            self._slack_delta_mm = self._slack_delta_mm + delta
+        if "sheath_curvature_deg" in changes:
+            curve = float(changes["sheath_curvature_deg"])
+            if not (math.isfinite(curve) and curve >= 0.0):
+                raise ValueError("coilpipe sheath_curvature_deg must be finite and >= 0")
+            self.shared = dataclasses.replace(self.shared, sheath_curvature_deg=curve)
+        self._set_constants(*self._blk_sizes)
 
     def _set_constants(self, blk: int, eblk: int) -> None:
         kn, sh, n, m = self.knobs, self.shared, self._n, self._m
@@ -122,7 +145,7 @@ class CoilPipePlant:
         self._gap = gap
         self._k_lin0 = k_lin
         self._slack = np.array([kn[0].slack_pos_mm, kn[0].slack_neg_mm,
-                                kn[1].slack_pos_mm, kn[1].slack_neg_mm])
+                                kn[1].slack_pos_mm, kn[1].slack_neg_mm]) + self._slack_delta_mm
         d = self._d_mm
         self._k_tip = _per_knob(kn, "bend_stiffness_Nm_per_rad") / (d * d * 1e-3)
         self._k_creep = _per_knob(kn, "bend_creep_stiffness_Nm_per_rad") / (d * d * 1e-3)

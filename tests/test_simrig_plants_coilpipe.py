@@ -39,8 +39,8 @@ def test_nominal_dead_zone_and_backlash_are_tens_of_knob_degrees(nominal: Any) -
 
 def test_nominal_slope_and_tip_range_are_the_papers(nominal: Any) -> None:
     q, tip, _ = nominal
-    assert np.all((1.15 < np.asarray(loaded_slope(q, tip, 40.0, 85.0)))
-                  & (np.asarray(loaded_slope(q, tip, 40.0, 85.0)) < 1.6))
+    slopes = np.asarray(loaded_slope(q, tip, 40.0, 85.0))
+    assert np.all((slopes > 1.15) & (slopes < 1.6))
     assert 60.0 < tip.max() < 95.0 and -95.0 < tip.min() < -60.0
 
 

@@ -114,7 +114,7 @@ class CoilPipePlant:
         self._set_constants(*self._blk_sizes)
 
     def _set_constants(self, blk: int, eblk: int) -> None:
-        kn, sh, n, m = self.knobs, self.shared, self._n, self._m
+        kn, sh, n = self.knobs, self.shared, self._n
         r = _per_knob(kn, "pulley_radius_mm")
         self._r_mm = r
         self._d_mm = _per_knob(kn, "tendon_offset_mm")
@@ -172,7 +172,6 @@ class CoilPipePlant:
         self._ratio = _per_knob(kn, "stribeck_ratio")[knob]
         self._vs = _per_knob(kn, "stribeck_speed_mm_s")[knob]
         self._curve_slack_mm = sh.lumen_clearance_mm * curve_rad
-        del m
 
     def reset(self) -> None:
         """Straight and unloaded: every coordinate, bristle and creep state at zero."""

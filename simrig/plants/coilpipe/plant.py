@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.plant import PlantStep, step_inputs
-from simrig.plants.coilpipe import laws
+from simrig.plants.coilpipe.laws import cable, lugre, stribeck
 from simrig.plants.coilpipe.params import CoilPipeKnobParams, CoilPipePlantParams
 
 Array = NDArray[np.float64]
@@ -213,7 +213,7 @@ class CoilPipePlant:
         k_lin[self._tip] = self._k_tip + k_creep
         bias = np.zeros_like(k_lin)
         bias[self._tip] = k_creep * self._w_creep
-        level = laws.stribeck(self._v, self._ratio, self._vs)
+        level = stribeck(self._v, self._ratio, self._vs)
         x_old = self._x
         x = x_old + self._v * dt_s  # first guess: the last step's speed again
         x[self._drum] = x_old[self._drum] + drive_mm - self._drive_mm
@@ -226,7 +226,7 @@ class CoilPipePlant:
             self._advance(0.5 * dt_s, drive_mm, splits - 1)
             return
         x, f = solved
-        self._z = laws.lugre(self._z, x - x_old, self._pre, level)[0]
+        self._z = lugre(self._z, x - x_old, self._pre, level)[0]
         w = x[self._w]
         self._w_creep = (self._w_creep + alpha * w) / (1.0 + alpha)
         self._v = (x - x_old) / dt_s
@@ -240,7 +240,7 @@ class CoilPipePlant:
         """Every element's force (N) and slope (N/mm) at ``x``."""
         e = self._A @ x - offset
         both = np.concatenate((e - self._gap, -e - self._gap))
-        t, dt = laws.cable(both, self._kk, self._toe2)
+        t, dt = cable(both, self._kk, self._toe2)
         n_el = e.size
         f = t[:n_el] - t[n_el:] + k_lin * e - bias
         df = dt[:n_el] + dt[n_el:] + k_lin
@@ -254,7 +254,7 @@ class CoilPipePlant:
         for _ in range(_MAX_NEWTON):
             f, df = self._forces(x, offset, k_lin, bias)
             d = x - x_old
-            z1, dz = laws.lugre(self._z, d, self._pre, level)
+            z1, dz = lugre(self._z, d, self._pre, level)
             # LuGre: the normal force grows with the local tension times the local wrap
             load = 0.5 * mu_wrap * (f[self._left] + f[self._right]) + self._drag
             residual = AT @ f + load * z1 + self._visc * (d / dt_s)

@@ -104,14 +104,16 @@ def test_a_curved_template_changes_the_commands() -> None:
 @given(random_params, st.floats(-150.0, 150.0))
 @settings(max_examples=300, deadline=None)
 def test_the_branches_are_exact_between_their_knots(p: TensionPlayParams, x: float) -> None:
-    """The piecewise-linear branches equal the bent lines' envelopes everywhere (every kink
-    the templates map to is a knot)."""
+    """The piecewise-linear branches equal the bent loaded lines' and the straight release
+    lines' envelopes everywhere (every kink the templates map to is a knot)."""
     assert p.shape_pos is not None and p.shape_neg is not None
     w, hp, hn = p.omega, p.height_pos_deg, p.height_neg_deg
     dp, dn, bp, bn = (p.dead_zone_pos_deg[0], p.dead_zone_neg_deg[0], p.backlash_gain_pos[0],
                       p.backlash_gain_neg[0])
-    rp = hp + w * p.shape_pos.at((x - bp * p.zero_load_pos_deg[0]) / (1 - bp) - dp)
-    rn = hn - w * p.shape_neg.at(-((x - bn * p.zero_load_neg_deg[0]) / (1 - bn) - dn))
+    off_p = p.shape_pos.shaped_deg[-1] - p.shape_pos.travel_deg[-1]
+    off_n = p.shape_neg.shaped_deg[-1] - p.shape_neg.travel_deg[-1]
+    rp = hp + w * ((x - bp * p.zero_load_pos_deg[0]) / (1 - bp) - dp + off_p)
+    rn = hn + w * ((x - bn * p.zero_load_neg_deg[0]) / (1 - bn) - dn - off_n)
     up = hp + w * p.shape_pos.at(max(x - dp, 0.0)) + min(rn - hp, 0.0)
     down = hn - w * p.shape_neg.at(max(dn - x, 0.0)) + max(rp - hn, 0.0)
     b = knob_branches(p)

@@ -8,9 +8,8 @@ can measure the shape once per product with a tracker (``tsmd datasheet``): the 
 beyond its plateau, in knob degrees at the sheet's omega, against the knob's travel beyond the
 dead-zone edge. Each unit keeps its own edges, backlash and omega from its calibration; the
 template only replaces the straight ``u`` by ``T(u)``: ``y = H + omega T(x - D)`` on the
-positive side, ``y = H - omega T(D - x)`` on the negative one, and the release line through
-the backlash ends (``tension_play.release_line``) is bent by the same ``T`` of its argument.
-Below the edge (``u < 0``, the release line's run down through the plateau) ``T(u) = u``.
+positive side, ``y = H - omega T(D - x)`` on the negative one; the release line stays straight
+and passes where the bent loaded line ends. Below the edge ``T(u) = u``.
 The branches built with it: :func:`tsmd.compensation.shaped_play.shaped_branches`.
 """
 
@@ -58,6 +57,12 @@ class LoadedShape:
     def is_straight(self) -> bool:
         """T(u) = u everywhere: the straight line, which the model then uses as before."""
         return all(a == b for a, b in zip(self.travel_deg, self.shaped_deg, strict=True))
+
+    @property
+    def far_offset_deg(self) -> float:
+        """T(u) - u at the last knot (the sheet's reference end): where the straight release
+        line through the loaded line's far end sits (0 when straight)."""
+        return self.shaped_deg[-1] - self.travel_deg[-1]
 
     def at(self, u_deg: float) -> float:
         """T(u)."""

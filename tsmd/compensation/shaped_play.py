@@ -39,13 +39,16 @@ def shaped_branches(omega: float, height_pos_deg: float, height_neg_deg: float, 
                     d_neg: float, beta_pos: float, beta_neg: float, x0_pos: float,
                     x0_neg: float, shape_pos: LoadedShape | None,
                     shape_neg: LoadedShape | None) -> Branches:
-    """``tension_play.branches`` with each side's lines bent by its template.
+    """``tension_play.branches`` with each side's loaded line bent by its template.
 
     rising  = H_pos + omega T_pos(max(x - D_pos, 0)) + min(R_neg(x) - H_pos, 0)
     falling = H_neg - omega T_neg(max(D_neg - x, 0)) + max(R_pos(x) - H_neg, 0)
-    R_pos(x) = H_pos + omega T_pos(a_pos(x)), a_pos(x) = (x - beta x0) / (1 - beta) - D_pos (the
-    straight release line's argument), R_neg mirrored; sampled at every knot the templates map
-    to, so the piecewise-linear result is exact.
+    The release lines R stay straight, as the data sheet's release slope ratio was measured
+    (``tension_play.release_line``), and pass where the bent loaded line ends at the
+    template's far end: R_pos(x) = H_pos + omega (a_pos(x) + T_pos(u_end) - u_end) with
+    a_pos(x) = (x - beta x0) / (1 - beta) - D_pos, R_neg mirrored. Bending them too moved
+    the tip's release on the blind plant by up to 9 deg (docs/model.md, session 10).
+    Sampled at every knot the templates map to, so the piecewise-linear result is exact.
     """
     w, h_pos, h_neg = omega, height_pos_deg, height_neg_deg
     sp = shape_pos if shape_pos is not None else _STRAIGHT
@@ -65,21 +68,21 @@ def shaped_branches(omega: float, height_pos_deg: float, height_neg_deg: float, 
     def x_neg(a: float) -> float:
         return (a + d_neg) * (1.0 - bn) + bn * x0_neg
 
+    off_pos, off_neg = sp.far_offset_deg, sn.far_offset_deg
+
     def rising(x: float) -> float:
         return (h_pos + w * sp.at(max(x - d_pos, 0.0))
-                + min(h_neg - w * sn.at(-a_neg(x)) - h_pos, 0.0))
+                + min(h_neg + w * (a_neg(x) - off_neg) - h_pos, 0.0))
 
     def falling(x: float) -> float:
         return (h_neg - w * sn.at(max(d_neg - x, 0.0))
-                + max(h_pos + w * sp.at(a_pos(x)) - h_neg, 0.0))
+                + max(h_pos + w * (a_pos(x) + off_pos) - h_neg, 0.0))
 
     kinks = {-_FAR_DEG, _FAR_DEG, d_pos, d_neg,
-             x_neg(-sn.inverse((h_neg - h_pos) / w)),  # R_neg meets the rising plateau
-             x_pos(sp.inverse((h_neg - h_pos) / w))}  # R_pos meets the falling plateau
+             x_neg((h_pos - h_neg) / w + off_neg),  # R_neg meets the rising plateau
+             x_pos((h_neg - h_pos) / w - off_pos)}  # R_pos meets the falling plateau
     kinks.update(d_pos + u for u in sp.travel_deg)
     kinks.update(d_neg - u for u in sn.travel_deg)
-    kinks.update(x_pos(u) for u in sp.travel_deg)
-    kinks.update(x_neg(-u) for u in sn.travel_deg)
     knots = sorted(k for k in kinks if -_FAR_DEG <= k <= _FAR_DEG)
     crossings = []
     for a, b in itertools.pairwise(knots):

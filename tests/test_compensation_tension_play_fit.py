@@ -22,6 +22,7 @@ from tsmd.calibration.tension_play_fit import (
     unit_omega,
 )
 from tsmd.compensation import CompensationError, build_compensator
+from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
     BETA_RANGE,
@@ -298,3 +299,24 @@ def test_a_sweeps_lag_already_estimated_is_used_as_it_is() -> None:
     sweeps = [synthetic_sweep(g) for g in (-90.0, 0.0, 90.0)]
     p = fit_tension_play([replace(s, lag_s=0.3) for s in sweeps], DEVICE_KNOB)
     assert p.lag_s == 0.3
+
+
+def test_a_sheets_template_puts_the_reference_point_on_the_bent_line() -> None:
+    shape = LoadedShape((0.0, 10.0, 65.0), (0.0, 13.0, 70.0))
+    knob = dataclasses.replace(DEVICE_KNOB, reference_dead_zone_pos_deg=25.0,
+                               reference_dead_zone_neg_deg=-25.0, loaded_shape_pos=shape,
+                               loaded_shape_neg=shape)
+    p = fit_tension_play([synthetic_sweep(g) for g in (-90.0, 90.0)], knob)
+    assert p.shape_pos == shape and p.shape_neg == shape
+    assert p.height_pos_deg == pytest.approx(100.0 - 1.5 * 70.0)
+    assert p.height_neg_deg == pytest.approx(-100.0 + 1.5 * 70.0)
+
+
+def test_a_straight_template_fits_exactly_as_no_template() -> None:
+    straight = LoadedShape((0.0, 65.0), (0.0, 65.0))
+    knob = dataclasses.replace(DEVICE_KNOB, reference_dead_zone_pos_deg=25.0,
+                               reference_dead_zone_neg_deg=-25.0)
+    sweeps = [synthetic_sweep(g) for g in (-90.0, 90.0)]
+    assert fit_tension_play(sweeps, dataclasses.replace(
+        knob, loaded_shape_pos=straight, loaded_shape_neg=straight)) == fit_tension_play(
+        sweeps, knob)

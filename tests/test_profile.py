@@ -277,3 +277,23 @@ def test_a_store_that_cannot_be_written_is_a_profile_error(tmp_path: Path) -> No
     blocker.write_text("")
     with pytest.raises(ProfileError, match="cannot save"):
         ProfileStore(blocker / "profiles").save(make_profile())
+
+
+def test_a_data_sheets_loaded_shape_is_read_and_written_back() -> None:
+    data = yaml.safe_load(DEVICE.read_text())
+    data["knobs"]["phi1"]["loaded_shape_neg"] = {"travel_deg": [0.0, 5.0, 60.0],
+                                                 "shaped_deg": [0.0, 6.5, 66.0]}
+    device = device_model_from_mapping(data)
+    shape = device.knobs[0].loaded_shape_neg
+    assert shape is not None and shape.at(5.0) == 6.5
+    assert device.knobs[0].loaded_shape_pos is None and device.knobs[1].loaded_shape_neg is None
+    assert device_model_from_mapping(device_model_to_mapping(device)) == device
+
+
+def test_a_non_monotone_loaded_shape_is_refused_naming_the_key() -> None:
+    data = yaml.safe_load(DEVICE.read_text())
+    data["knobs"]["phi2"]["loaded_shape_pos"] = {"travel_deg": [0.0, 5.0, 60.0],
+                                                 "shaped_deg": [0.0, 6.5, 6.0]}
+    with pytest.raises(ProfileError, match=r"knobs.phi2.loaded_shape_pos: slope") as err:
+        device_model_from_mapping(data)
+    assert "\n" not in str(err.value)

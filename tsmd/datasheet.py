@@ -35,8 +35,10 @@ from tsmd.calibration.pieces import (
 )
 from tsmd.calibration.signal import Conditioned, lowpass
 from tsmd.calibration.tension_play_fit import fit_sweep_sides
+from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.safety import KnobLimits
 from tsmd.config import TsmdConfig, default_sim_config
+from tsmd.datasheet_shape import measure_loaded_shape
 from tsmd.errors import TsmdError
 from tsmd.profile import DEFAULT_HANDLE_SLIP_DEG, DeviceKnob, DeviceModel, ReferencePoint
 from tsmd.recording import Recording
@@ -108,6 +110,9 @@ class KnobConstants:
     the tip lets go ends every unit's backlash that much later."""
     release_reversals: int = 0
     """How many reversals gave the four above (:func:`release_reads`)."""
+    loaded_shape_pos: LoadedShape | None = None
+    """The loaded branch's template per side (:mod:`tsmd.datasheet_shape`; None: not seen)."""
+    loaded_shape_neg: LoadedShape | None = None
 
     def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
         """The data sheet's knob entry, rounded as a data sheet is printed."""
@@ -137,7 +142,8 @@ class KnobConstants:
             reference_release_swing_A=(None if self.release_swing_A is None
                                        else round(float(self.release_swing_A), 4)),
             backlash_settle_lag_deg=(None if self.settle_lag_deg is None
-                                     else r(self.settle_lag_deg)))
+                                     else r(self.settle_lag_deg)),
+            loaded_shape_pos=self.loaded_shape_pos, loaded_shape_neg=self.loaded_shape_neg)
 
 
 def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,
@@ -242,8 +248,12 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
     reads = release_reads(cur.data, t, tip, settle_deg={
         h.start: h.backlash_deg for h in cur.half_cycles if h.after_reversal})
     lags = [r.settle_lag_deg for r in reads if math.isfinite(r.settle_lag_deg)]
+    omega = float(np.median(loaded))
+    # the template at the omega the sheet prints, from the current's edges as printed
+    shapes = [measure_loaded_shape(pos, tip, round(cur.estimate(f"dead_zone_{s}_deg"), 2),
+                                   round(omega, 2), side) for s, side in (("pos", 1), ("neg", -1))]
     return KnobConstants(
-        omega=float(np.median(loaded)), release_omega=float(np.median(released)),
+        omega=omega, release_omega=float(np.median(released)),
         reference_pos=ReferencePoint(SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos > top]))),
         reference_neg=ReferencePoint(-SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos < -top]))),
         reference_backlash_pos_deg=float(tip_b.backlash_pos_deg),
@@ -254,7 +264,8 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
         backlash_settle_fraction=median_share(reads),
         backlash_release_slope_ratio=median_ratio(reads),
         release_swing_A=float(np.median([r.swing_A for r in reads])) if reads else None,
-        settle_lag_deg=float(np.median(lags)) if lags else None, release_reversals=len(reads))
+        settle_lag_deg=float(np.median(lags)) if lags else None, release_reversals=len(reads),
+        loaded_shape_pos=shapes[0], loaded_shape_neg=shapes[1])
 
 
 def _finite_or_none(value: float) -> float | None:

@@ -53,6 +53,7 @@ from tsmd.calibration.fresh_hold import with_fresh_hold
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
 from tsmd.calibration.signal import Conditioned
+from tsmd.compensation.loaded_shape import curved, shaped_height
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.tension_play import BETA_RANGE, OMEGA_RANGE, TensionPlayParams
 
@@ -250,6 +251,15 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     edge_pos = at_other_knob_zero(grid, d_pos) if ref_pos is None else float(ref_pos)
     edge_neg = at_other_knob_zero(grid, d_neg) if ref_neg is None else float(ref_neg)
     h_pos, h_neg = plateau_heights(k, edge_pos, edge_neg)
+    # the product's loaded-branch template (data sheet) bends the line through the reference
+    shape_pos = curved(getattr(k, "loaded_shape_pos", None))
+    shape_neg = curved(getattr(k, "loaded_shape_neg", None))
+    if shape_pos is not None:
+        h_pos = shaped_height(k.reference_pos.knob_deg, k.reference_pos.tip_deg, edge_pos,
+                              float(k.omega), shape_pos)
+    if shape_neg is not None:
+        h_neg = shaped_height(k.reference_neg.knob_deg, k.reference_neg.tip_deg, edge_neg,
+                              float(k.omega), shape_neg)
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
                                           np.asarray(s.pos_deg, float))
                            if s.lag_s is None else s.lag_s for s in order]))
@@ -273,7 +283,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         other_knob_deg=tuple(grid), dead_zone_pos_deg=tuple(d_pos),
         dead_zone_neg_deg=tuple(d_neg), backlash_gain_pos=sides[0][0],
         backlash_gain_neg=sides[1][0], zero_load_pos_deg=sides[0][1],
-        zero_load_neg_deg=sides[1][1], lag_s=min(max(lag, 0.0), 1.0))
+        zero_load_neg_deg=sides[1][1], lag_s=min(max(lag, 0.0), 1.0), shape_pos=shape_pos,
+        shape_neg=shape_neg)
 
 
 @dataclass(frozen=True)

@@ -118,5 +118,10 @@ def main(args: argparse.Namespace) -> int:
               f"{_or_none(c.release_swing_A, 4)} A, settle lag {_or_none(c.settle_lag_deg, 2)} "
               f"deg over {c.release_reversals} "
               f"reversals")
+        for side, shape in (("+", c.loaded_shape_pos), ("-", c.loaded_shape_neg)):
+            if shape is not None:  # tip travel past the plateau over knob travel past the edge
+                print(f"  loaded shape {side}: T(u)/u " + " ".join(
+                    f"{u:g}:{t / u:.3f}" for u, t in zip(shape.travel_deg[1:],
+                                                         shape.shaped_deg[1:], strict=True)))
     print(f"tsmd datasheet: wrote {args.out}")
     return 0

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
+from tsmd.compensation.loaded_shape import LoadedShape, curved, steepest_slope
 from tsmd.compensation.ours_knob import (
     KnobCommand,
     motion,
@@ -33,11 +34,11 @@ from tsmd.compensation.ours_knob import (
 )
 from tsmd.compensation.planned import Planner
 from tsmd.compensation.safety import KnobLimits, step_floats, tick_time_s
+from tsmd.compensation.shaped_play import model_branches
 from tsmd.compensation.tension_play import (
     Branches,
     PlayState,
     TensionPlayParams,
-    branches,
     fresh_branches,
     fresh_state_ends,
     interp_linear,
@@ -77,6 +78,10 @@ class OursKnob:
     lag_s: float = 0.0
     fresh_hold_deg: float = 0.0
     fresh_edge_delay_deg: float | None = None
+    shape_pos: LoadedShape | None = None
+    """The product's loaded-branch template per side (None: straight); a fresh knob's first
+    loading and release (``fresh_branches``) stay straight."""
+    shape_neg: LoadedShape | None = None
     _table: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
     _fresh: tuple[tuple[Branches, ...], ...] = dataclasses.field(init=False, repr=False,
                                                                  compare=False)
@@ -92,7 +97,8 @@ class OursKnob:
         step = (hi - lo) / (n - 1)
         rows = [[float(v) for v in self.field.at(lo + i * step)] for i in range(n)]
         w, h_pos, h_neg = self.omega, self.height_pos_deg, self.height_neg_deg
-        table = tuple(branches(w, h_pos, h_neg, *r) for r in rows)
+        table = tuple(model_branches(w, h_pos, h_neg, r[0], r[1], r[2], r[3], r[4], r[5],
+                                     self.shape_pos, self.shape_neg) for r in rows)
         # a fresh knob's tables by the side it loaded first: -1, none yet, +1
         fresh = tuple(tuple(fresh_branches(b, w, r[0], r[1], h_pos, h_neg, self.fresh_hold_deg,
                                            self.fresh_edge_delay_deg, side)
@@ -108,7 +114,8 @@ class OursKnob:
         return cls(ParameterField(p.other_knob_deg, p.columns(), interpolation, OURS_COLUMNS),
                    p.omega, p.height_pos_deg, p.height_neg_deg, p.lag_s, p.fresh_hold_deg,
                    # the profile's fresh numbers come together from one first sweep
-                   p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None)
+                   p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None,
+                   curved(p.shape_pos), curved(p.shape_neg))
 
     @property
     def is_fresh_known(self) -> bool:
@@ -166,8 +173,9 @@ class OursCompensator:
         self.reset(np.zeros(2))
 
     def _set_constants(self) -> None:
-        # faster than any knob can make the tip move (release slope <= 5 omega)
-        jump_deg_s = 5.0 * max(k.omega for k in self.knobs) * self.v_max
+        # faster than any knob can make the tip move (release slope <= 5 omega T')
+        jump_deg_s = 5.0 * max(k.omega * steepest_slope(k.shape_pos, k.shape_neg)
+                               for k in self.knobs) * self.v_max
         for kc, knob in zip(self._k, self.knobs, strict=True):
             kc.ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
             kc.ahead_ticks = round(kc.ahead_s / self.period_s)

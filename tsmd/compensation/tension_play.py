@@ -30,6 +30,8 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.compensation.loaded_shape import LoadedShape, shape_from_mapping, shape_to_mapping
+
 BETA_RANGE: tuple[float, float] = (0.0, 0.8)
 """Backlash per knob degree of load: 0 = no backlash; 0.8 = release slope 5 omega."""
 OMEGA_RANGE: tuple[float, float] = (0.2, 5.0)
@@ -66,6 +68,8 @@ class TensionPlayParams:
     lag_s: float = 0.0
     fresh_hold_deg: float = 0.0
     fresh_edge_delay_deg: float = 0.0
+    shape_pos: LoadedShape | None = None
+    shape_neg: LoadedShape | None = None
 
     def columns(self) -> NDArray[np.float64]:
         """(n, 6): D_pos, D_neg, beta_pos, beta_neg, x0_pos, x0_neg per grid point."""
@@ -84,6 +88,7 @@ _SCALARS: dict[str, tuple[float, float]] = {
     "lag_s": (0.0, 1.0), "fresh_hold_deg": (0.0, 90.0), "fresh_edge_delay_deg": (-45.0, 45.0),
 }
 _OPTIONAL = {"lag_s", "fresh_hold_deg", "fresh_edge_delay_deg"}
+_SHAPES = {"loaded_shape_pos": "shape_pos", "loaded_shape_neg": "shape_neg"}
 
 
 def _number(value: Any, name: str, lo: float, hi: float) -> float:
@@ -107,11 +112,11 @@ def _numbers(values: Any, name: str, n: int | None, lo: float, hi: float) -> tup
 
 def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
     """Validate a profile's ``tension_play`` block (ValueError naming the key)."""
-    known = {"other_knob_deg", *_ROWS, *_SCALARS}
+    known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES}
     for key in m:
         if key not in known:
             raise ValueError(f"{key}: unknown key")
-    for key in known - _OPTIONAL:
+    for key in known - _OPTIONAL - set(_SHAPES):
         if key not in m:
             raise ValueError(f"{key}: missing key")
     grid = _numbers(m["other_knob_deg"], "other_knob_deg", None, -180.0, 180.0)
@@ -123,7 +128,8 @@ def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
         s["omega"], s["height_pos_deg"], s["height_neg_deg"], grid, r["dead_zone_pos_deg"],
         r["dead_zone_neg_deg"], r["backlash_gain_pos"], r["backlash_gain_neg"],
         r["zero_load_pos_deg"], r["zero_load_neg_deg"], s["lag_s"], s["fresh_hold_deg"],
-        s["fresh_edge_delay_deg"])
+        s["fresh_edge_delay_deg"],
+        *(shape_from_mapping(m[k], k) if m.get(k) is not None else None for k in _SHAPES))
 
 
 def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
@@ -131,6 +137,10 @@ def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
                            if not k.startswith("fresh_") or getattr(p, k) != 0.0}
     out["other_knob_deg"] = list(p.other_knob_deg)
     out.update({k: list(getattr(p, k)) for k in _ROWS})
+    for key, attr in _SHAPES.items():
+        shape = getattr(p, attr)
+        if shape is not None:
+            out[key] = shape_to_mapping(shape)
     return out
 
 

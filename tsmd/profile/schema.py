@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from tsmd.compensation.grid import INTERPOLATION_METHODS
+from tsmd.compensation.loaded_shape import LoadedShape, shape_from_mapping, shape_to_mapping
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
 from tsmd.profile.types import (
@@ -112,6 +113,18 @@ def _check_references(r: _Reader, key: str, pos: ReferencePoint, neg: ReferenceP
         raise r.fail(key, "reference_pos.tip_deg must be above reference_neg.tip_deg")
 
 
+_SHAPE_KEYS = ("loaded_shape_pos", "loaded_shape_neg")
+
+
+def _shape(r: _Reader, value: Any, where: str) -> LoadedShape | None:
+    if value is None:
+        return None
+    try:
+        return shape_from_mapping(value, where)
+    except ValueError as exc:
+        raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
+
+
 def device_model_from_mapping(data: Any, origin: str = "device model") -> DeviceModel:
     r = _Reader(origin)
     m = r.mapping(data, "top level")
@@ -168,7 +181,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional(k.get("reference_release_swing_A"), "reference_release_swing_A", 0.0,
                      100.0, "A"),
             optional(k.get("backlash_settle_lag_deg"), "backlash_settle_lag_deg", -10.0, 10.0,
-                     "deg")))
+                     "deg"), *(_shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS)))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -204,6 +217,10 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             knobs[name]["reference_release_swing_A"] = k.reference_release_swing_A
         if k.backlash_settle_lag_deg is not None:
             knobs[name]["backlash_settle_lag_deg"] = k.backlash_settle_lag_deg
+        for key in _SHAPE_KEYS:
+            shape = getattr(k, key)
+            if shape is not None:
+                knobs[name][key] = shape_to_mapping(shape)
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

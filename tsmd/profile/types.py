@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tsmd.compensation.grid import CALIBRATION_GRID_DEG
+from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import TensionPlayParams
@@ -93,6 +94,12 @@ class DeviceKnob:
     the backlash to where the tip has moved back 1 deg (median over the reversals). Where the
     settle rule is kept (``backlash_settle_fraction`` >= 0.99) calibration ends every unit's
     backlash that much later (old sheets: at the settle)."""
+    loaded_shape_pos: LoadedShape | None = None
+    """Optional, on the data-sheet unit: the loaded branch's shape (tip travel past the plateau
+    in knob degrees at ``omega`` against knob travel past the current's edge,
+    :mod:`tsmd.compensation.loaded_shape`); method ours bends each unit's loaded and release
+    lines by it (old sheets: straight lines)."""
+    loaded_shape_neg: LoadedShape | None = None
 
 
 @dataclass(frozen=True)

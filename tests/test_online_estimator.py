@@ -131,8 +131,9 @@ def test_one_ramp_with_an_odd_slope_measures_nothing() -> None:
 
 def test_slopes_within_their_scatter_leave_the_edge_at_the_reference_slopes() -> None:
     tracker = learned()
-    for ratio in (0.9, 0.87, 0.92, 0.88, 0.86, 0.9):  # persistently a little flatter
-        tracker.update(ramp_through(EDGE_DEG, ratio * SLOPE), EDGE_DEG)
+    tol = tracker.options.slope_in_use_tolerance
+    for share in (0.7, 0.9, 0.6, 0.8, 0.95, 0.7):  # persistently a little flatter
+        tracker.update(ramp_through(EDGE_DEG, (1.0 - share * tol) * SLOPE), EDGE_DEG)
     assert abs(tracker.last_measurement_deg) < 0.3
     assert tracker.applied_deg == 0.0
 
@@ -167,6 +168,40 @@ def test_a_friction_change_on_both_edges_is_followed() -> None:
         neg.update(ramp_with_edge(EDGE_DEG + 3.0, slope=2.5 * SLOPE), EDGE_DEG, pos)
     assert pos.applied_deg == pytest.approx(3.0, abs=0.05)
     assert neg.applied_deg == pytest.approx(3.0, abs=0.05)
+
+
+def _both_edges_18_percent_steeper(options: EstimatorOptions) -> tuple[EdgeTracker, EdgeTracker]:
+    """Both tendons' ramps 18 % steeper, their edges 3 deg further out (the lumped plant's
+    60 deg bend: ramps 1.04-1.21 x, the calibration's edges +2.75..+3.4 deg)."""
+    pos, neg = learned(options), learned(options)
+    for _ in range(6):
+        pos.update(ramp_with_edge(EDGE_DEG + 3.0, slope=1.18 * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_with_edge(EDGE_DEG + 3.0, slope=1.18 * SLOPE), EDGE_DEG, pos)
+    return pos, neg
+
+
+def test_a_small_friction_change_on_both_edges_is_followed_below_the_slope_tolerance() -> None:
+    pos, neg = _both_edges_18_percent_steeper(EstimatorOptions(slope_in_use_tolerance=0.05))
+    assert pos.applied_deg == pytest.approx(3.0, abs=0.05)
+    assert neg.applied_deg == pytest.approx(3.0, abs=0.05)
+
+
+def test_a_small_friction_change_within_the_slope_tolerance_measures_nothing() -> None:
+    pos, _ = _both_edges_18_percent_steeper(EstimatorOptions(slope_in_use_tolerance=0.15))
+    assert pos.applied_deg == 0.0 and pos.status()["odd_slope_ramps"] > 0
+
+
+def test_a_friction_change_without_knees_scales_the_backlash_gain_by_the_slope() -> None:
+    pos, _ = _both_edges_18_percent_steeper(
+        EstimatorOptions(slope_in_use_tolerance=0.05, gain_from_slope_in_use=True))
+    assert pos.knee_slopes == []
+    assert pos.gain_ratio == pytest.approx(1.18, abs=0.01)
+
+
+def test_without_gain_from_the_slope_in_use_the_backlash_gain_needs_knees() -> None:
+    pos, _ = _both_edges_18_percent_steeper(
+        EstimatorOptions(slope_in_use_tolerance=0.05, gain_from_slope_in_use=False))
+    assert pos.gain_ratio == 1.0
 
 
 def test_a_much_steeper_ramp_measures_on_both_edges_and_is_refused_on_one() -> None:

@@ -203,13 +203,21 @@ class EdgeTracker:
         ``B = c T_r``, with the tension ``T_r = k (x_r - x0)`` the current shows; so
         ``beta = B / (x_r - x0) = c k``: with the compliance ``c`` unchanged by a bend, beta
         follows the current's slope ``k`` (capstan units 1, 2, 101 after 60 deg: slope
-        1.2-1.4 x past the knee, the fresh calibrations' beta 1.17-1.28 x). Only in knee mode
-        and only from ramps fitted past their knee (a window that starts on the engagement's
-        grown step reads 2.5-3 x). The release itself is crossed too fast under compensation
-        to measure it (docs/online.md)."""
-        if self.learning or not self.knee_mode:
-            return 1.0
+        1.2-1.4 x past the knee, the fresh calibrations' beta 1.17-1.28 x). In knee mode
+        only from ramps fitted past their knee (a window that starts on the engagement's
+        grown step reads 2.5-3 x); without such ramps (the lumped plant has no knee) from the
+        slope in use when :attr:`EstimatorOptions.gain_from_slope_in_use`. The release
+        itself is crossed too fast under compensation to measure it (docs/online.md)."""
         o = self.options
+        if self.learning:
+            return 1.0
+        if not (self.knee_mode and self.knee_slopes):
+            if not o.gain_from_slope_in_use:
+                return 1.0
+            tol = o.slope_in_use_tolerance
+            change = common_change(self.slope_change, self.partner_change, tol)
+            return min(max(shrunk_ratio(1.0 + change, tol), 1.0 / o.slope_ratio_max),
+                       o.slope_ratio_max)
         change = common_change(self.knee_slope_change, self.partner_knee_change,
                                o.same_slope_tolerance)
         return min(max(shrunk_ratio(1.0 + change, o.same_slope_tolerance),
@@ -315,9 +323,10 @@ class EdgeTracker:
         # The crossing on a line through the window's centre (~15 deg back: 10 % of slope is
         # 1.5 deg of edge) with the slope both edges' last ramps agree on; one ramp's slope
         # scatters by 25 % and more, so a ramp that disagrees with it measures nothing.
-        slope = self.slope_ref_A_per_deg * shrunk_ratio(
-            1.0 + (self.slope_change if partner is None else shared),
-            o.same_slope_tolerance)
+        tol = o.slope_in_use_tolerance
+        change = self.slope_change if partner is None else common_change(
+            self.slope_change, partner.slope_change, tol)
+        slope = self.slope_ref_A_per_deg * shrunk_ratio(1.0 + change, tol)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
             self.n_odd_slope += 1
             self.last_measurement_deg = math.nan

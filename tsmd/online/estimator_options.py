@@ -22,6 +22,18 @@ class EstimatorOptions:
     slope_ratio_max: float = 3.0
     freeze_ramps: int = 2
     same_slope_tolerance: float = 0.15
+    slope_in_use_tolerance: float = 0.05
+    """The slope a crossing uses moves with the slope change both edges of the knob agree on:
+    none of it within this tolerance, in full beyond twice it (:func:`slopes.shrunk_ratio`).
+    0.15 until session 10: a 60 deg bend steepens the lumped plant's ramps 1.04-1.21 x and
+    moves its edges +2.75..+3.4 deg; with the change shrunk to none the crossing, 15 deg out,
+    read ~2 deg short and the ramps beyond 15 % measured nothing (lumped 1, 2: offsets
+    0-1.8 deg; docs/online.md, Session 10)."""
+    gain_from_slope_in_use: bool = True
+    """Where no ramp was fitted past its knee (outside knee mode, or a plant without a
+    knee), the backlash gain follows the slope in use (beta = compliance x the current's
+    slope; the lumped plant's bend: ramps 1.04-1.21 x, the fresh calibrations' beta
+    1.17-1.25 x). Off: the gain moves in knee mode only (until session 10)."""
     slope_window: int = 3
     """The slope a measurement uses comes from the median of this edge's last
     ``slope_window`` ramps, never from one ramp alone (see :meth:`EdgeTracker.update`)."""

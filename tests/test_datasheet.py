@@ -204,3 +204,18 @@ def test_release_reads_take_every_reversal_and_whole_pass_constants_the_first_cy
     for name in ("omega", "release_omega", "dead_zone_pos_deg", "dead_zone_neg_deg",
                  "backlash_gain", "dead_zone_offset_deg"):
         assert getattr(long, name) == getattr(short, name)
+
+
+def test_the_loaded_shape_template_is_written_only_when_asked(sweep_files: list[Path],
+                                                             tmp_path: Path) -> None:
+    """On the family's held-out units the template did not improve ours' worst row, so a
+    data sheet carries it only with ``--loaded-shape`` (docs/model.md, Session 10)."""
+    sim_yaml = str(Path(__file__).parents[1] / "tsmd" / "data" / "sim.yaml")
+    plain, shaped = tmp_path / "plain.yaml", tmp_path / "shaped.yaml"
+    for out, extra in ((plain, []), (shaped, ["--loaded-shape"])):
+        assert main(["datasheet", "--from-recording", *map(str, sweep_files), "--device-model",
+                     "unit-7", "--out", str(out), "--config", sim_yaml, *extra]) == 0
+    assert all(k.loaded_shape_pos is None and k.loaded_shape_neg is None
+               for k in load_device_model(plain).knobs)
+    assert any(k.loaded_shape_pos is not None or k.loaded_shape_neg is not None
+               for k in load_device_model(shaped).knobs)

@@ -380,10 +380,16 @@ def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 200
 
 
 def device_model(name: str, constants: Sequence[KnobConstants], config: TsmdConfig,
-                 description: str = "") -> DeviceModel:
-    """The data sheet: measured constants with the knobs' limits of ``config``."""
+                 description: str = "", loaded_shape: bool = False) -> DeviceModel:
+    """The data sheet: measured constants with the knobs' limits of ``config``.
+
+    ``loaded_shape``: keep the loaded-branch templates. Off by default: on the family's
+    held-out units the template did not improve ours' worst row (docs/model.md, Session 10).
+    """
     if len(constants) != 2:
         raise DatasheetError(f"need the constants of 2 knobs, got {len(constants)}")
+    if not loaded_shape:
+        constants = [dataclasses.replace(c, loaded_shape_pos=None, loaded_shape_neg=None) for c in constants]
     limits = knob_limits(config)
     knobs = tuple(c.device_knob(lim) for c, lim in zip(constants, limits, strict=True))
     return DeviceModel(name, (knobs[0], knobs[1]), description)

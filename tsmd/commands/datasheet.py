@@ -47,6 +47,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"configuration whose limits go into the data sheet (default: "
                              f"packaged sim config with --plant, else {DEFAULT_CONFIG_PATH})")
     parser.add_argument("--seed", type=int, default=2000, help="simulated rig's noise seed")
+    parser.add_argument("--loaded-shape", action="store_true",
+                        help="also write each knob's loaded-branch template (ours then bends its "
+                             "loaded lines by it; off by default, docs/model.md Session 10)")
 
 
 def _params(text: str | None) -> dict[str, Any]:
@@ -101,7 +104,8 @@ def main(args: argparse.Namespace) -> int:
         constants = _from_recordings(args.from_recording)
         config = load_config(args.config if args.config is not None else DEFAULT_CONFIG_PATH)
         source = "recordings " + ", ".join(Path(p).name for p in args.from_recording)
-    device = device_model(args.device_model, constants, config, args.description)
+    device = device_model(args.device_model, constants, config, args.description,
+                          loaded_shape=args.loaded_shape)
     comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "
                f"(tsmd datasheet) on {source}:\n"
                f"each knob swept +-{SWEEP_AMPLITUDE_DEG:g} deg at {SWEEP_HZ:g} Hz, other knob "

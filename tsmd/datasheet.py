@@ -29,7 +29,9 @@ from tsmd.calibration.identify import identify_sweep, resample_on_angle, split_h
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.pieces import (
     RELEASE_LEVEL_WINDOW_DEG,
+    line_share_at,
     loaded_current,
+    release_line,
     release_slope_ratio,
     smooth_value,
 )
@@ -106,8 +108,12 @@ class KnobConstants:
     """Knob travel from where the paper's settle rule ends the backlash to the tip's release
     (1 deg moved back), median over the reversals: a product whose current settles before
     the tip lets go ends every unit's backlash that much later."""
+    release_line_share: float | None = None
+    """The share of its gap to the release line at the same knob angle that the current has
+    closed at the tip's release (:func:`tsmd.calibration.pieces.line_share_at`), median over
+    the reversals."""
     release_reversals: int = 0
-    """How many reversals gave the four above (:func:`release_reads`)."""
+    """How many reversals gave the five above (:func:`release_reads`)."""
 
     def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
         """The data sheet's knob entry, rounded as a data sheet is printed."""
@@ -137,7 +143,9 @@ class KnobConstants:
             reference_release_swing_A=(None if self.release_swing_A is None
                                        else round(float(self.release_swing_A), 4)),
             backlash_settle_lag_deg=(None if self.settle_lag_deg is None
-                                     else r(self.settle_lag_deg)))
+                                     else r(self.settle_lag_deg)),
+            backlash_release_line_share=(None if self.release_line_share is None
+                                         else round(float(self.release_line_share), 4)))
 
 
 def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,
@@ -192,6 +200,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
             backlash_settle_fraction=ends.backlash_settle_fraction,
             backlash_release_slope_ratio=ends.backlash_release_slope_ratio,
             release_swing_A=ends.release_swing_A, settle_lag_deg=ends.settle_lag_deg,
+            release_line_share=ends.release_line_share,
             release_reversals=ends.release_reversals)
     if not rec.has_tip:
         raise DatasheetError("the recording has no tip angles (tip1, tip2): a data sheet "
@@ -242,6 +251,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
     reads = release_reads(cur.data, t, tip, settle_deg={
         h.start: h.backlash_deg for h in cur.half_cycles if h.after_reversal})
     lags = [r.settle_lag_deg for r in reads if math.isfinite(r.settle_lag_deg)]
+    line_shares = [r.line_share for r in reads if math.isfinite(r.line_share)]
     return KnobConstants(
         omega=float(np.median(loaded)), release_omega=float(np.median(released)),
         reference_pos=ReferencePoint(SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos > top]))),
@@ -254,7 +264,9 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
         backlash_settle_fraction=median_share(reads),
         backlash_release_slope_ratio=median_ratio(reads),
         release_swing_A=float(np.median([r.swing_A for r in reads])) if reads else None,
-        settle_lag_deg=float(np.median(lags)) if lags else None, release_reversals=len(reads))
+        settle_lag_deg=float(np.median(lags)) if lags else None,
+        release_line_share=float(np.median(line_shares)) if line_shares else None,
+        release_reversals=len(reads))
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -287,6 +299,8 @@ class ReleaseRead(NamedTuple):
     swing_A: float
     settle_lag_deg: float = math.nan
     """Knob travel from the settle rule's end to the tip's release."""
+    line_share: float = math.nan
+    """The share of the gap to the release line closed at the tip's release."""
 
 
 def median_share(reads: Sequence[ReleaseRead]) -> float | None:
@@ -343,9 +357,12 @@ def release_reads(data: Conditioned, tip_t_s: NDArray[np.float64], tip_deg: NDAr
         made_up = smooth_value(grid, yg, k, opts.release_fit_half_deg) - loaded
         cut = yg.size - round(opts.edge_margin_deg / step)
         settled = math.nan if settle_deg is None else settle_deg.get(a, math.nan)
-        reads.append(ReleaseRead(min(made_up / swing, 1.0),
-                                 release_slope_ratio(grid[:cut], yg[:cut], k), swing,
-                                 float(grid[k] - grid[0]) - settled))
+        line = release_line(grid[:cut], yg[:cut])
+        reads.append(ReleaseRead(
+            min(made_up / swing, 1.0), release_slope_ratio(grid[:cut], yg[:cut], k), swing,
+            float(grid[k] - grid[0]) - settled,
+            math.nan if line is None else line_share_at(grid, yg, k, line,
+                                                        opts.release_fit_half_deg)))
     return reads
 
 

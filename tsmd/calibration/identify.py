@@ -42,11 +42,11 @@ from tsmd.calibration.pieces import (
     constant_phase,
     fitted_edge,
     flat_pieces,
+    fraction_end,
     knee_edge,
     linear_pieces,
     release_slope_ratio,
     release_swing,
-    share_end,
 )
 from tsmd.calibration.signal import Conditioned, FloatArray, condition
 
@@ -222,8 +222,11 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         peaks, _ = find_peaks(transient, prominence=opts.peak_noise_k * noise)
         peak = int(peaks[0]) if peaks.size else None
         start_k = peak if peak is not None else 0
+        branch_stop = (plateau_run[1] - round(EDGE_CLEARANCE_DEG / step)
+                       if plateau_run[1] < end else None)
         found = (None if flat is None
-                 else backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts))
+                 else backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts,
+                                   branch_stop))
         if found is None:
             # No value rather than a guess: the quality checks then name this reason.
             problems.append(f"{where}: the current never becomes constant after the reversal")
@@ -315,8 +318,8 @@ def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
         float(np.mean(finite)) - ref)
     share = min(max(share, 0.5), 0.999)
     out = list(halves)
-    for i, (pos, grid, yg, k) in curves.items():
-        k_new = share_end(grid, yg, min(k, yg.size - 1), share, opts.release_fit_half_deg)
+    for j, (i, (pos, grid, yg, k)) in enumerate(curves.items()):
+        k_new = fraction_end(grid, yg, min(k, yg.size - 1), share, opts, stops[j])
         h = halves[i]
         out[i] = replace(h, backlash_deg=float(grid[k_new] - grid[0]),
                          backlash_end_index=_index_at(pos, h.direction, grid, k_new, h.start),

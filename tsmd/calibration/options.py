@@ -91,8 +91,11 @@ shorter window of session 8, whose noisier ratio attenuated the fit; docs/calibr
 sessions 8 and 9); the sheet's own unit gives the anchor."""
 
 
-LINE_SHARE_PER_SLOPE_RATIO = -0.34
-"""As :data:`SHARE_PER_SLOPE_RATIO` for the share of the gap to the release line."""
+LINE_SHARE_PER_SLOPE_RATIO = -0.5
+"""As :data:`SHARE_PER_SLOPE_RATIO` for the share of the gap to the release line: fitted on
+the half-cycles of the development units (lumped 1-8 seeds 0 and 1: -0.54; segments 1-4 seed 0:
+-0.59 with the 40-95 deg line; -0.48 and -0.54 with 40-80), the share at the tip's release
+against the sweep's mean ratio (session 10)."""
 
 
 def for_product(options: IdentifyOptions, settle_fraction: float | None,

@@ -33,11 +33,13 @@ slope ratio (:func:`release_slope_ratio`). Longer than the level's window: a slo
 the dead-zone edge on the far side (at >= 100 deg of travel on a +-90 deg sweep)."""
 EDGE_CLEARANCE_DEG = 3.0
 """The slope window stops this far before a dead-zone edge found in the half-cycle."""
-RELEASE_LINE_WINDOW_DEG = (40.0, 80.0)
+RELEASE_LINE_WINDOW_DEG = (40.0, 95.0)
 """Knob travel after the reversal over which the release branch is fitted as a line
 (:func:`release_line`): past the largest backlash of the family (31 deg) and its approach, short
-of the far dead-zone edge (>= 100 deg of travel on a +-90 deg sweep). Fixed relative to the
-reversal, so the level an end is tested against does not move with that end (session 10)."""
+of the far dead-zone edge (>= 100 deg of travel on a +-90 deg sweep; the line also stops
+``EDGE_CLEARANCE_DEG`` before an edge found). Fixed relative to the reversal, so the level an
+end is tested against does not move with that end. 40-95 deg gave the smallest scatter of B on
+the development units of lumped and segments (offline, session 10; 30-70, 35-80, 40-80 tried)."""
 RELEASE_LINE_MIN_DEG = 10.0
 """Less fitted travel than this (a short sweep, a near edge): no line, the median level."""
 

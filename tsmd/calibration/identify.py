@@ -98,6 +98,14 @@ class SweepResult:
     """Each parameter's value from every half-cycle that gave one, in time order."""
     resweeps: int = 0
     """How many re-sweeps were pooled into this result."""
+    own_half_cycles: int | None = None
+    """How many of ``half_cycles`` (the first) index ``data``; the re-sweeps' index their own
+    recordings (None: all of them)."""
+
+    @property
+    def data_half_cycles(self) -> tuple[HalfCycle, ...]:
+        """The half-cycles whose indices point into ``data`` (the first sweep's)."""
+        return self.half_cycles[:self.own_half_cycles]
 
     def estimate(self, name: str) -> float:
         """Median over the half-cycles (NaN when none gave a value)."""
@@ -114,7 +122,7 @@ class SweepResult:
         values = {name: self.values.get(name, ()) + other.values.get(name, ())
                   for name in PARAMETERS}
         return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
-                           self.resweeps + 1)
+                           self.resweeps + 1, len(self.data_half_cycles))
 
     @property
     def snr(self) -> float:

@@ -28,10 +28,10 @@ from tsmd.calibration import run as run_module
 from tsmd.calibration.assemble import GridPoint, check_quality
 from tsmd.calibration.estimate import estimate, point_estimates, pooled_sigma
 from tsmd.calibration.identify import PARAMETERS, HalfCycle, SweepResult
-from tsmd.calibration.report import _plot_currents
-from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.protocol import fast_protocol, paper_protocol
+from tsmd.calibration.report import _plot_currents
 from tsmd.calibration.resweep import uncertain_points
+from tsmd.calibration.signal import Conditioned
 from tsmd.profile import ProfileStore, load_device_model
 
 PERIOD_S = 0.004

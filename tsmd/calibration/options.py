@@ -93,8 +93,8 @@ sessions 8 and 9); the sheet's own unit gives the anchor."""
 
 LINE_SHARE_PER_SLOPE_RATIO = -0.5
 """As :data:`SHARE_PER_SLOPE_RATIO` for the share of the gap to the release line: fitted on
-the half-cycles of the development units (lumped 1-8 seeds 0 and 1: -0.54; segments 1-4 seed 0:
--0.59 with the 40-95 deg line; -0.48 and -0.54 with 40-80), the share at the tip's release
+the half-cycles of the development units (lumped 1-8 seeds 0 and 1: -0.54; segments 1-8 seed 0:
+-0.58, with the 40-95 deg line), the share at the tip's release
 against the sweep's mean ratio (session 10)."""
 
 

@@ -27,9 +27,11 @@ from tsmd.calibration import (
 from tsmd.calibration import run as run_module
 from tsmd.calibration.assemble import GridPoint, check_quality
 from tsmd.calibration.estimate import estimate, point_estimates, pooled_sigma
-from tsmd.calibration.identify import PARAMETERS, SweepResult
+from tsmd.calibration.identify import PARAMETERS, HalfCycle, SweepResult
 from tsmd.calibration.protocol import fast_protocol, paper_protocol
+from tsmd.calibration.report import _plot_currents
 from tsmd.calibration.resweep import uncertain_points
+from tsmd.calibration.signal import Conditioned
 from tsmd.profile import ProfileStore, load_device_model
 
 PERIOD_S = 0.004
@@ -166,3 +168,19 @@ def test_cancel_during_a_resweep_returns_the_knobs_and_leaves_the_old_profile(
     assert np.allclose(runner.trajectories[-1][-1], 0.0)
     assert (tmp_path / "cat-c.yaml").read_bytes() == before
     assert store.load("cat-c").calibrated_at == old.calibrated_at
+
+
+def test_the_report_plots_a_resweeps_half_cycles_only_on_their_own_recording(
+        tmp_path: Path) -> None:
+    # a re-sweep longer than the first sweep: its half-cycles index past the first's signals
+    matplotlib = pytest.importorskip("matplotlib")
+    matplotlib.use("Agg")
+    plt = pytest.importorskip("matplotlib.pyplot")
+    t = np.arange(100) * 0.01
+    data = Conditioned(t, t, t, t, t, 100.0, 1e-3, 1e-3, ())
+    first = SweepResult(data, (HalfCycle(1, 0, 100, True, backlash_end_index=50),), {})
+    again = SweepResult(data, (HalfCycle(1, 0, 300, True, backlash_end_index=250),), {})
+    merged = first.merged(again)
+    assert merged.data_half_cycles == first.half_cycles
+    _plot_currents(plt, [GridPoint(0, 0.0, merged)], tmp_path / "currents.png")
+    assert (tmp_path / "currents.png").exists()

@@ -144,6 +144,19 @@ def test_a_tracked_sweep_gives_a_settle_lag_and_release_swing_the_sheet_carries(
         assert sheet.reference_release_swing_A == pytest.approx(c.release_swing_A, abs=1e-4)
 
 
+def test_a_tracked_sweep_gives_the_line_share_the_sheet_carries(sweep_files: list[Path]) -> None:
+    """The share of the gap to the release line at the tip's release (session 10): the capstan
+    nominal's branch is flat and settled, so close to its settle fraction and to 1."""
+    limits = load_device_model(DEVICE).knobs[0].limits
+    for knob, path in enumerate(sweep_files):
+        c = knob_constants(read_recording(path), knob)
+        assert c.release_line_share is not None and 0.9 < c.release_line_share <= 1.05
+        assert c.release_line_share == pytest.approx(c.backlash_settle_fraction, abs=0.03)
+        sheet = c.device_knob(limits)
+        assert sheet.backlash_release_line_share == pytest.approx(c.release_line_share,
+                                                                  abs=1e-4)
+
+
 def test_the_backlash_gain_uses_the_settle_rule_whatever_the_products_rule() -> None:
     """On a product whose current has not settled when the tip starts back (lumped: settle
     fraction < 0.99), calibration ends the paper's B at that fraction; the tension play's

@@ -29,7 +29,9 @@ from tsmd.calibration.identify import identify_sweep, resample_on_angle, split_h
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.pieces import (
     RELEASE_LEVEL_WINDOW_DEG,
+    line_share_at,
     loaded_current,
+    release_line,
     release_slope_ratio,
     smooth_value,
 )
@@ -108,8 +110,12 @@ class KnobConstants:
     """Knob travel from where the paper's settle rule ends the backlash to the tip's release
     (1 deg moved back), median over the reversals: a product whose current settles before
     the tip lets go ends every unit's backlash that much later."""
+    release_line_share: float | None = None
+    """The share of its gap to the release line at the same knob angle that the current has
+    closed at the tip's release (:func:`tsmd.calibration.pieces.line_share_at`), median over
+    the reversals."""
     release_reversals: int = 0
-    """How many reversals gave the four above (:func:`release_reads`)."""
+    """How many reversals gave the five above (:func:`release_reads`)."""
     loaded_shape_pos: LoadedShape | None = None
     """The loaded branch's template per side (:mod:`tsmd.datasheet_shape`; None: not seen)."""
     loaded_shape_neg: LoadedShape | None = None
@@ -143,7 +149,9 @@ class KnobConstants:
                                        else round(float(self.release_swing_A), 4)),
             backlash_settle_lag_deg=(None if self.settle_lag_deg is None
                                      else r(self.settle_lag_deg)),
-            loaded_shape_pos=self.loaded_shape_pos, loaded_shape_neg=self.loaded_shape_neg)
+            loaded_shape_pos=self.loaded_shape_pos, loaded_shape_neg=self.loaded_shape_neg,
+            backlash_release_line_share=(None if self.release_line_share is None
+                                         else round(float(self.release_line_share), 4)))
 
 
 def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,
@@ -198,6 +206,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
             backlash_settle_fraction=ends.backlash_settle_fraction,
             backlash_release_slope_ratio=ends.backlash_release_slope_ratio,
             release_swing_A=ends.release_swing_A, settle_lag_deg=ends.settle_lag_deg,
+            release_line_share=ends.release_line_share,
             release_reversals=ends.release_reversals)
     if not rec.has_tip:
         raise DatasheetError("the recording has no tip angles (tip1, tip2): a data sheet "
@@ -252,6 +261,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
     # the template at the omega the sheet prints, from the current's edges as printed
     shapes = [measure_loaded_shape(pos, tip, round(cur.estimate(f"dead_zone_{s}_deg"), 2),
                                    round(omega, 2), side) for s, side in (("pos", 1), ("neg", -1))]
+    line_shares = [r.line_share for r in reads if math.isfinite(r.line_share)]
     return KnobConstants(
         omega=omega, release_omega=float(np.median(released)),
         reference_pos=ReferencePoint(SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos > top]))),
@@ -264,8 +274,9 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
         backlash_settle_fraction=median_share(reads),
         backlash_release_slope_ratio=median_ratio(reads),
         release_swing_A=float(np.median([r.swing_A for r in reads])) if reads else None,
-        settle_lag_deg=float(np.median(lags)) if lags else None, release_reversals=len(reads),
-        loaded_shape_pos=shapes[0], loaded_shape_neg=shapes[1])
+        settle_lag_deg=float(np.median(lags)) if lags else None,
+        release_line_share=float(np.median(line_shares)) if line_shares else None,
+        release_reversals=len(reads), loaded_shape_pos=shapes[0], loaded_shape_neg=shapes[1])
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -298,6 +309,8 @@ class ReleaseRead(NamedTuple):
     swing_A: float
     settle_lag_deg: float = math.nan
     """Knob travel from the settle rule's end to the tip's release."""
+    line_share: float = math.nan
+    """The share of the gap to the release line closed at the tip's release."""
 
 
 def median_share(reads: Sequence[ReleaseRead]) -> float | None:
@@ -354,9 +367,12 @@ def release_reads(data: Conditioned, tip_t_s: NDArray[np.float64], tip_deg: NDAr
         made_up = smooth_value(grid, yg, k, opts.release_fit_half_deg) - loaded
         cut = yg.size - round(opts.edge_margin_deg / step)
         settled = math.nan if settle_deg is None else settle_deg.get(a, math.nan)
-        reads.append(ReleaseRead(min(made_up / swing, 1.0),
-                                 release_slope_ratio(grid[:cut], yg[:cut], k), swing,
-                                 float(grid[k] - grid[0]) - settled))
+        line = release_line(grid[:cut], yg[:cut])
+        reads.append(ReleaseRead(
+            min(made_up / swing, 1.0), release_slope_ratio(grid[:cut], yg[:cut], k), swing,
+            float(grid[k] - grid[0]) - settled,
+            math.nan if line is None else line_share_at(grid, yg, k, line,
+                                                        opts.release_fit_half_deg)))
     return reads
 
 
@@ -389,7 +405,8 @@ def device_model(name: str, constants: Sequence[KnobConstants], config: TsmdConf
     if len(constants) != 2:
         raise DatasheetError(f"need the constants of 2 knobs, got {len(constants)}")
     if not loaded_shape:
-        constants = [dataclasses.replace(c, loaded_shape_pos=None, loaded_shape_neg=None) for c in constants]
+        constants = [dataclasses.replace(c, loaded_shape_pos=None, loaded_shape_neg=None)
+                     for c in constants]
     limits = knob_limits(config)
     knobs = tuple(c.device_knob(lim) for c, lim in zip(constants, limits, strict=True))
     return DeviceModel(name, (knobs[0], knobs[1]), description)

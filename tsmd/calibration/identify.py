@@ -42,11 +42,11 @@ from tsmd.calibration.pieces import (
     constant_phase,
     fitted_edge,
     flat_pieces,
+    fraction_end,
     knee_edge,
     linear_pieces,
     release_slope_ratio,
     release_swing,
-    share_end,
 )
 from tsmd.calibration.signal import Conditioned, FloatArray, condition
 
@@ -98,6 +98,14 @@ class SweepResult:
     """Each parameter's value from every half-cycle that gave one, in time order."""
     resweeps: int = 0
     """How many re-sweeps were pooled into this result."""
+    own_half_cycles: int | None = None
+    """How many of ``half_cycles`` (the first) index ``data``; the re-sweeps' index their own
+    recordings (None: all of them)."""
+
+    @property
+    def data_half_cycles(self) -> tuple[HalfCycle, ...]:
+        """The half-cycles whose indices point into ``data`` (the first sweep's)."""
+        return self.half_cycles[:self.own_half_cycles]
 
     def estimate(self, name: str) -> float:
         """Median over the half-cycles (NaN when none gave a value)."""
@@ -114,7 +122,7 @@ class SweepResult:
         values = {name: self.values.get(name, ()) + other.values.get(name, ())
                   for name in PARAMETERS}
         return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
-                           self.resweeps + 1)
+                           self.resweeps + 1, len(self.data_half_cycles))
 
     @property
     def snr(self) -> float:
@@ -222,8 +230,11 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         peaks, _ = find_peaks(transient, prominence=opts.peak_noise_k * noise)
         peak = int(peaks[0]) if peaks.size else None
         start_k = peak if peak is not None else 0
+        branch_stop = (plateau_run[1] - round(EDGE_CLEARANCE_DEG / step)
+                       if plateau_run[1] < end else None)
         found = (None if flat is None
-                 else backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts))
+                 else backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts,
+                                   branch_stop))
         if found is None:
             # No value rather than a guess: the quality checks then name this reason.
             problems.append(f"{where}: the current never becomes constant after the reversal")
@@ -315,8 +326,8 @@ def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
         float(np.mean(finite)) - ref)
     share = min(max(share, 0.5), 0.999)
     out = list(halves)
-    for i, (pos, grid, yg, k) in curves.items():
-        k_new = share_end(grid, yg, min(k, yg.size - 1), share, opts.release_fit_half_deg)
+    for j, (i, (pos, grid, yg, k)) in enumerate(curves.items()):
+        k_new = fraction_end(grid, yg, min(k, yg.size - 1), share, opts, stops[j])
         h = halves[i]
         out[i] = replace(h, backlash_deg=float(grid[k_new] - grid[0]),
                          backlash_end_index=_index_at(pos, h.direction, grid, k_new, h.start),

@@ -47,6 +47,11 @@ class IdentifyOptions:
     """"settle" (the paper's point a2): where the current joins the release level within the
     noise; "fraction": where it has made up ``backlash_fraction`` of its jump to that level."""
     backlash_fraction: float = 0.975
+    release_level: str = "median"
+    """"fraction": what the share is of. "median" (sheets before session 10): the swing to the
+    current's median over 5-20 deg after the end tested, iterated; "line": the gap to the
+    release branch fitted as a line once per half-cycle, at the same knob angle
+    (:func:`tsmd.calibration.pieces.line_share_end`), which a sloped branch cannot drag along."""
     backlash_reference_slope_ratio: float | None = None
     """"fraction" with a data sheet that measured it: the release-to-loaded slope ratio
     (:func:`tsmd.calibration.pieces.release_slope_ratio`) on the sheet's unit, where the share
@@ -86,17 +91,35 @@ shorter window of session 8, whose noisier ratio attenuated the fit; docs/calibr
 sessions 8 and 9); the sheet's own unit gives the anchor."""
 
 
+LINE_SHARE_PER_SLOPE_RATIO = -0.5
+"""As :data:`SHARE_PER_SLOPE_RATIO` for the share of the gap to the release line: fitted on
+the half-cycles of the development units (lumped 1-8 seeds 0 and 1: -0.54; segments 1-8 seed 0:
+-0.58, with the 40-95 deg line), the share at the tip's release
+against the sweep's mean ratio (session 10)."""
+
+
 def for_product(options: IdentifyOptions, settle_fraction: float | None,
                 slope_ratio: float | None = None,
-                settle_lag_deg: float | None = None) -> IdentifyOptions:
+                settle_lag_deg: float | None = None,
+                line_share: float | None = None) -> IdentifyOptions:
     """The identification for one knob of a product whose data sheet measured how far the
     current has come back when the tip starts to move: below :data:`SETTLED_FRACTION` the
     backlash ends at that share of the current's swing ("fraction"), moved per sweep by the
     unit's own slope ratio where the sheet gives its unit's (``slope_ratio``); else the
     settle rule, ended ``settle_lag_deg`` beyond the settle where the sheet measured that lag;
-    else as ``options`` say."""
+    else as ``options`` say. A sheet's ``line_share`` (the share of the gap to the release
+    line) replaces ``settle_fraction`` and its coefficient."""
     if options.backlash != "settle":
         return options
+    if line_share is not None:
+        if line_share >= SETTLED_FRACTION:
+            return for_product(options, line_share, None, settle_lag_deg)
+        line = replace(options, backlash="fraction", backlash_fraction=line_share,
+                       release_level="line")
+        if slope_ratio is None:
+            return line
+        return replace(line, backlash_reference_slope_ratio=slope_ratio,
+                       backlash_share_per_slope_ratio=LINE_SHARE_PER_SLOPE_RATIO)
     if settle_fraction is None or settle_fraction >= SETTLED_FRACTION:
         if settle_lag_deg is None or settle_fraction is None:
             return options

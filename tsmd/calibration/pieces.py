@@ -22,6 +22,9 @@ RELEASE_LEVEL_WINDOW_DEG = (5.0, 20.0)
 """Knob travel after the backlash's end over which the release level is the current's median,
 as the data sheet defines it (fraction rule)."""
 RELEASE_LEVEL_ITERATIONS = 4
+RELEASE_SMOOTH_START_DEG = 2.0
+""":func:`line_share_end` starts from the first point where the current's mean over this much
+travel either side is past the share (one noisy sample is not a crossing)."""
 RELEASE_SLOPE_WINDOW_DEG = (5.0, 40.0)
 """Knob travel after the backlash's end over which the release level's slope is read for the
 slope ratio (:func:`release_slope_ratio`). Longer than the level's window: a slope read over
@@ -30,6 +33,15 @@ slope ratio (:func:`release_slope_ratio`). Longer than the level's window: a slo
 the dead-zone edge on the far side (at >= 100 deg of travel on a +-90 deg sweep)."""
 EDGE_CLEARANCE_DEG = 3.0
 """The slope window stops this far before a dead-zone edge found in the half-cycle."""
+RELEASE_LINE_WINDOW_DEG = (40.0, 95.0)
+"""Knob travel after the reversal over which the release branch is fitted as a line
+(:func:`release_line`): past the largest backlash of the family (31 deg) and its approach, short
+of the far dead-zone edge (>= 100 deg of travel on a +-90 deg sweep; the line also stops
+``EDGE_CLEARANCE_DEG`` before an edge found). Fixed relative to the reversal, so the level an
+end is tested against does not move with that end. 40-95 deg gave the smallest scatter of B on
+the development units of lumped and segments (offline, session 10; 30-70, 35-80, 40-80 tried)."""
+RELEASE_LINE_MIN_DEG = 10.0
+"""Less fitted travel than this (a short sweep, a near edge): no line, the median level."""
 
 
 def slope_per_deg(y: FloatArray, step: float) -> float:
@@ -234,6 +246,68 @@ def share_end(grid: FloatArray, yg: FloatArray, k: int, share: float, half_deg: 
     return k
 
 
+def release_line(grid: FloatArray, yg: FloatArray, stop: int | None = None
+                 ) -> FloatArray | None:
+    """The release branch after a reversal as a line (slope, intercept in ``grid``'s units),
+    least squares over ``RELEASE_LINE_WINDOW_DEG`` of travel, ended at ``stop`` (a dead-zone
+    edge less its clearance) at the latest; None where less than ``RELEASE_LINE_MIN_DEG`` is left.
+
+    On a catheter whose current keeps climbing after the tip lets go (a release branch sloped by
+    0.5-0.8 % of the swing per deg, the segments plant) a level read after each candidate end
+    moves with that end, so every point of the branch passes for the share's crossing
+    (docs/calibration.md, "a blind plant's backlash"); a line read once does not."""
+    x = grid - grid[0]
+    last = x[-1] if stop is None else x[max(0, min(stop, x.size) - 1)]
+    lo_deg, hi_deg = RELEASE_LINE_WINDOW_DEG
+    sel = (x >= lo_deg) & (x <= min(hi_deg, last))
+    if np.count_nonzero(sel) * float(grid[1] - grid[0]) < RELEASE_LINE_MIN_DEG:
+        return None
+    return np.asarray(np.polyfit(grid[sel], yg[sel], 1), dtype=np.float64)
+
+
+def line_share_end(grid: FloatArray, yg: FloatArray, line: FloatArray, share: float,
+                   half_deg: float) -> int:
+    """The first point after the reversal where the current has closed ``share`` of its gap
+    from the loaded current to the release line at the same knob angle
+    (``y = loaded + share x (line - loaded)``), read off the quadratic of
+    :func:`smooth_crossing`.
+
+    On a flat branch this is the median level's end; on a sloped one the gap left beyond the
+    crossing, (1 - share) x swing, keeps the current above the target, so the crossing is
+    single and does not depend on where the search starts."""
+    step = float(grid[1] - grid[0])
+    loaded = loaded_current(yg, step)
+    z = yg - share * np.polyval(line, grid)
+    target = (1.0 - share) * loaded
+    width = max(1, round(RELEASE_SMOOTH_START_DEG / step))
+    mean = np.convolve(z, np.ones(2 * width + 1) / (2 * width + 1), mode="same")
+    above = np.flatnonzero(mean[width:z.size - width] >= target)
+    if above.size == 0:
+        return z.size - 1
+    return smooth_crossing(grid, z, width + int(above[0]), target, half_deg)
+
+
+def line_share_at(grid: FloatArray, yg: FloatArray, k: int, line: FloatArray,
+                  half_deg: float) -> float:
+    """The share of its gap to the release line that the current has closed at ``k`` (the
+    inverse of :func:`line_share_end`; the data sheet reads it at the tip's release)."""
+    loaded = loaded_current(yg, float(grid[1] - grid[0]))
+    gap = float(np.polyval(line, grid[k])) - loaded
+    return math.nan if gap <= 0.0 else (smooth_value(grid, yg, k, half_deg) - loaded) / gap
+
+
+def fraction_end(grid: FloatArray, yg: FloatArray, k: int, share: float,
+                 opts: IdentifyOptions, stop: int | None = None) -> int:
+    """The fraction rule's end at ``share``: against the release line
+    (:func:`line_share_end`) where ``opts.release_level`` says so and a line can be fitted
+    before ``stop``, else against the median level from the end ``k`` (:func:`share_end`)."""
+    if opts.release_level == "line":
+        line = release_line(grid, yg, stop)
+        if line is not None:
+            return line_share_end(grid, yg, line, share, opts.release_fit_half_deg)
+    return share_end(grid, yg, k, share, opts.release_fit_half_deg)
+
+
 def release_swing(grid: FloatArray, yg: FloatArray, k: int) -> float:
     """The current's swing after a reversal: from the loaded current
     (:func:`loaded_current`) to the release level (median over ``RELEASE_LEVEL_WINDOW_DEG``
@@ -272,7 +346,7 @@ def release_slope_ratio(grid: FloatArray, yg: FloatArray, k: int,
 
 def backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
                   pieces: list[tuple[int, int]], flat: list[bool], noise: float,
-                  opts: IdentifyOptions) -> int | None:
+                  opts: IdentifyOptions, stop: int | None = None) -> int | None:
     """Where the current becomes constant after the reversal (the paper's point a2).
 
     While the sheath unloads, the current falls steeply, then less and less steeply as the slip
@@ -282,6 +356,8 @@ def backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
     within ``peak_noise_k`` noise sigmas for ``settle_hold_deg``,
     refined to where the current's last ``backlash_tangent_deg`` before that, extended as a line,
     meets the level (the current approaches the level at a slant, so a band alone ends early).
+    ``stop``: where the release branch ends at the latest (the dead-zone edge less its
+    clearance), for the fraction rule's release line.
     """
     step = float(grid[1] - grid[0])
     min_points = max(3, round(opts.min_level_deg / step))
@@ -294,6 +370,10 @@ def backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
     a0, b0 = run
     level = np.polyfit(grid[a0:b0], yg[a0:b0], 1)
     if opts.backlash == "fraction":
+        line = release_line(grid, yg, stop) if opts.release_level == "line" else None
+        if line is not None:
+            return line_share_end(grid, yg, line, opts.backlash_fraction,
+                                  opts.release_fit_half_deg)
         return recovered_end(grid, yg, start_k, b0, level, opts)
     near = np.abs(yg[start_k:b0] - np.polyval(level, grid[start_k:b0])) <= opts.peak_noise_k * noise
     hold = max(2, round(opts.settle_hold_deg / step))

@@ -105,7 +105,7 @@ def _plot_currents(plt: object, points: list[GridPoint], path: Path) -> None:
                              squeeze=False, sharex=True)
     for ax, p in zip(axes.flat, points, strict=False):
         d = p.result.data
-        for h in p.result.half_cycles:
+        for h in p.result.data_half_cycles:  # a re-sweep's index its own recording
             sl = slice(h.start, h.stop)
             color = "tab:red" if h.direction > 0 else "tab:blue"
             ax.plot(d.pos_deg[sl], d.current_filtered_A[sl] * 1e3, color=color, lw=0.8)
@@ -161,7 +161,7 @@ def _plot_model(plt: object, cal: Calibration, knob: int, points: list[GridPoint
     except ValueError:
         return False
     d = r.data
-    start = min((h.start for h in r.half_cycles), default=0)
+    start = min((h.start for h in r.data_half_cycles), default=0)
     x = d.pos_deg[start:]
     state = initial_state(float(x[0]), params, direction=-1)
     model = []

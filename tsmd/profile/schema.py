@@ -181,7 +181,10 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional(k.get("reference_release_swing_A"), "reference_release_swing_A", 0.0,
                      100.0, "A"),
             optional(k.get("backlash_settle_lag_deg"), "backlash_settle_lag_deg", -10.0, 10.0,
-                     "deg"), *(_shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS)))
+                     "deg"),
+            backlash_release_line_share=optional(k.get("backlash_release_line_share"),
+                                                 "backlash_release_line_share", 0.5, 1.0, ""),
+            **{name: _shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS}))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
 
@@ -221,6 +224,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             shape = getattr(k, key)
             if shape is not None:
                 knobs[name][key] = shape_to_mapping(shape)
+        if k.backlash_release_line_share is not None:
+            knobs[name]["backlash_release_line_share"] = k.backlash_release_line_share
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

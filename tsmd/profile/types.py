@@ -100,6 +100,13 @@ class DeviceKnob:
     :mod:`tsmd.compensation.loaded_shape`); method ours bends each unit's loaded and release
     lines by it (old sheets: straight lines)."""
     loaded_shape_neg: LoadedShape | None = None
+    backlash_release_line_share: float | None = None
+    """Optional, on the data-sheet unit: the share of its gap to the release branch (a line
+    fitted over :data:`tsmd.calibration.pieces.RELEASE_LINE_WINDOW_DEG` of travel after the
+    reversal, taken at the same knob angle) that the current has closed when the tip has moved
+    back 1 deg (median over the reversals). Where given it replaces
+    ``backlash_settle_fraction``, whose level is read after the end and so moves with it on a
+    sloped release branch (session 10); old sheets keep that one."""
 
 
 @dataclass(frozen=True)

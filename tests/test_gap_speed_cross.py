@@ -3,6 +3,8 @@ side of the cross-plant self-test."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from support.gap import StandInPlant, make_recording
@@ -131,3 +133,13 @@ def test_a_case_the_data_plant_lacks_is_not_run(monkeypatch: pytest.MonkeyPatch)
     result = crosstest.run_crosstest(PRESETS["segments"], PRESETS["capstan"], ["creep"],
                                      [240.0], [101])
     assert result.cases == []
+
+
+def test_selftest_says_which_case_the_data_plant_cannot_make(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from tsmd import cli
+
+    code = cli.main(["gap", "selftest", "--data-plant", "segments", "--sim-plant", "capstan",
+                     "--cases", "creep", "--seeds", "101", "--out", str(tmp_path)])
+    assert code == 0
+    assert "creep: not run" in capsys.readouterr().out

@@ -131,6 +131,21 @@ def test_a_play_that_widens_with_speed_is_named_rate() -> None:
     assert scores["rate"].share > 0.5
 
 
+def test_a_rate_dependence_within_one_samples_tracker_noise_is_not_named() -> None:
+    def slight(t: Arr, q: Arr) -> Arr:
+        out = np.zeros((len(t), 4))
+        sp = _speed(t, q)
+        for j in range(2):
+            out[:, j] = _play(q[:, j], 0.002 * sp[:, j]) - q[:, j]
+        return out
+    series, residuals = _session(slight)
+    found = {s.name: s for s in contrast_scores(series, residuals, n_tried=6)}
+    assert found["rate"].significant  # enough repeats find it ...
+    sized = {s.name: s for s in contrast_scores(series, residuals, n_tried=6,
+                                                 tip_noise_deg=0.1)}
+    assert not sized["rate"].significant  # ... but it is smaller than one sample's noise
+
+
 def test_a_tip_that_follows_the_other_knob_is_named_coupling() -> None:
     def coupling(t: Arr, q: Arr) -> Arr:
         out = np.zeros((len(t), 4))

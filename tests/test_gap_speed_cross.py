@@ -3,6 +3,8 @@ side of the cross-plant self-test."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from support.gap import StandInPlant, make_recording
@@ -100,3 +102,44 @@ def test_a_session_records_the_matched_protocol_in_each_configuration() -> None:
     assert sorted(r.metadata["configuration"] for r in protocols) == ["looped", "straight"]
     series = series_from_recording(protocols[0], "p")
     assert series.segment is not None and len(series.segments) > 0
+
+
+def test_segments_preset_has_the_coupling_off_in_its_none_units_and_its_simulator() -> None:
+    segments = parse_plant_spec("segments")
+    assert segments.build_unit(101, 0.1).settings.coupling == 0.0
+    assert segments.build().settings.coupling == 0.0
+    coupled = segments.build_unit(101, 0.1, "coupling", **segments.case_effects("coupling"))
+    assert coupled.settings.coupling > 0.0
+
+
+def test_segments_compliance_case_halves_the_units_tendon_stiffness() -> None:
+    segments = PRESETS["segments"]
+    none = segments.build_unit(101, 0.1)
+    soft = segments.build_unit(101, 0.1, "compliance", **segments.case_effects("compliance"))
+    for k in (0, 1):
+        assert soft.knobs[k].tendon_stiffness_N == pytest.approx(
+            0.5 * none.knobs[k].tendon_stiffness_N)
+        assert soft.knobs[k].slack_pos_mm == none.knobs[k].slack_pos_mm
+
+
+def test_a_case_the_data_plant_lacks_is_not_run(monkeypatch: pytest.MonkeyPatch) -> None:
+    import tsmd.gap.crosstest as crosstest
+
+    def no_session(*_a: object, **_k: object) -> None:
+        raise AssertionError("a session was made for an effect the plant does not have")
+
+    monkeypatch.setattr(crosstest, "make_session", no_session)
+    assert not PRESETS["segments"].supports("creep")
+    result = crosstest.run_crosstest(PRESETS["segments"], PRESETS["capstan"], ["creep"],
+                                     [240.0], [101])
+    assert result.cases == []
+
+
+def test_selftest_says_which_case_the_data_plant_cannot_make(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from tsmd import cli
+
+    code = cli.main(["gap", "selftest", "--data-plant", "segments", "--sim-plant", "capstan",
+                     "--cases", "creep", "--seeds", "101", "--out", str(tmp_path)])
+    assert code == 0
+    assert "creep: not run" in capsys.readouterr().out

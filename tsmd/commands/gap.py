@@ -254,6 +254,10 @@ def _selftest(args: argparse.Namespace) -> int:
 
         data = parse_plant_spec(args.data_plant or "capstan-other")
         sim = parse_plant_spec(args.sim_plant or "capstan")
+        for case in cases:
+            if not data.supports(case):
+                print(f"  {case}: not run, the data plant {data.name or data.factory} has no "
+                      "such effect in its physics", flush=True)
         result = run_crosstest(data, sim, cases, sizes, seeds, rate_hz,
                                cross_config(sim.fit, args.method), progress=progress,
                                matched=not args.no_protocol, sheet_unit=args.sheet_unit)

@@ -118,12 +118,13 @@ def anova(loops: Sequence[Loops]) -> tuple[float, float, float, float]:
     return f, dfb, dfw, float(stats.f.sf(f, dfb, dfw))
 
 
-def _contrast(lp: Loops) -> FloatArray:
+def contrast_of(lp: Loops) -> FloatArray:
+    """The level means of the residual loops about their mean (levels x K)."""
     m = lp.y.mean(axis=1)
     return np.asarray(m - m.mean(axis=0))
 
 
-def _noise_ss(lp: Loops) -> float:
+def noise_ss(lp: Loops) -> float:
     """Expected sum of squares of the level contrasts from repeat noise alone."""
     n_lev, n_rep, k = lp.y.shape
     dev = lp.y - lp.y.mean(axis=1)[:, None, :]
@@ -217,17 +218,17 @@ def loop_shrink(train: Sequence[Loops], held: Loops,
     """Share of the held-out configuration's level contrast (above repeat noise) that an
     effect model fitted on the training configurations removes."""
     design = design or _design
-    c_ho = _contrast(held)
-    excess = float((c_ho**2).sum()) - _noise_ss(held)
-    if excess <= _noise_ss(held) or not train:  # no contrast above the repeats' noise
+    c_ho = contrast_of(held)
+    excess = float((c_ho**2).sum()) - noise_ss(held)
+    if excess <= noise_ss(held) or not train:  # no contrast above the repeats' noise
         return float("nan")
     coef = []
     for lp in train:
         a = design(lp, lp.tip)
-        c = _contrast(lp)
+        c = contrast_of(lp)
         coef.append(np.array([np.linalg.lstsq(a, c[lv], rcond=None)[0]
                               for lv in range(c.shape[0])]))
     beta = np.mean(coef, axis=0)
     a_ho = design(held, held.tip)
     resid = c_ho - beta @ a_ho.T
-    return min(1.0 - (float((resid**2).sum()) - _noise_ss(held)) / excess, 1.0)
+    return min(1.0 - (float((resid**2).sum()) - noise_ss(held)) / excess, 1.0)

@@ -279,7 +279,7 @@ class SelftestResult:
             else float("nan"),
             "median_current_rmse_shrink_when_correct": float(np.median(cur_shrink))
             if cur_shrink else float("nan"),
-            "median_wall_s": float(np.median([c.wall_s for c in self.cases])),
+            "median_wall_s": _median([c.wall_s for c in self.cases]),
             "median_excess_shrink_when_correct": _median(
                 [c.excess_shrink for c in effect_cases if c.correct]),
             "worst_excess_shrink_when_correct": _min(

@@ -45,7 +45,7 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         # mismatch, which the signatures of the same effects compete with
         residuals = _residuals(series, split, ev, base_fit)
         found = contrast_scores(series, residuals, len(sres.scores), cfg.family_alpha,
-                                cfg.min_share)
+                                cfg.min_share, float(np.sqrt(np.mean(noise_var[:2]))))
         if cfg.compliance_reference is not None:
             stretch = compliance_score(series, cfg.compliance_reference, len(sres.scores),
                                        cfg.family_alpha, cfg.min_share)

@@ -123,7 +123,8 @@ def main(args: argparse.Namespace) -> int:
               f"deg, line share {_or_none(c.release_line_share, 4)} over "
               f"{c.release_reversals} reversals")
         for side, shape in (("+", c.loaded_shape_pos), ("-", c.loaded_shape_neg)):
-            if args.loaded_shape and shape is not None:  # tip travel past the plateau over knob travel past the edge
+            # tip travel past the plateau over knob travel past the edge
+            if args.loaded_shape and shape is not None:
                 print(f"  loaded shape {side}: T(u)/u " + " ".join(
                     f"{u:g}:{t / u:.3f}" for u, t in zip(shape.travel_deg[1:],
                                                          shape.shaped_deg[1:], strict=True)))

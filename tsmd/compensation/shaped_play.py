@@ -7,16 +7,13 @@ the straight model's own function is used, so its commands stay bit for bit.
 
 from __future__ import annotations
 
-import itertools
-
 from tsmd.compensation.loaded_shape import LoadedShape, curved
 from tsmd.compensation.tension_play import (
     _FAR_DEG,
-    _FLAT_SLOPE,
     BETA_RANGE,
     Branches,
     branches,
-    widest_flat,
+    envelopes,
 )
 
 _STRAIGHT = LoadedShape((0.0, 1.0), (0.0, 1.0))
@@ -83,19 +80,4 @@ def shaped_branches(omega: float, height_pos_deg: float, height_neg_deg: float, 
              x_pos((h_neg - h_pos) / w - off_pos)}  # R_pos meets the falling plateau
     kinks.update(d_pos + u for u in sp.travel_deg)
     kinks.update(d_neg - u for u in sn.travel_deg)
-    knots = sorted(k for k in kinks if -_FAR_DEG <= k <= _FAR_DEG)
-    crossings = []
-    for a, b in itertools.pairwise(knots):
-        da, db = rising(a) - falling(a), rising(b) - falling(b)
-        if da * db < 0.0:
-            crossings.append(a + (b - a) * da / (da - db))
-    xs = sorted(set(knots + crossings))
-    xs = [x for i, x in enumerate(xs) if i == 0 or x - xs[i - 1] > 1e-9]
-    lo, hi = [], []
-    for x in xs:
-        r, f = rising(x), falling(x)
-        tilt = _FLAT_SLOPE * w * x
-        lo.append(min(r, f) + tilt)
-        hi.append(max(r, f) + tilt)
-    return Branches(tuple(xs), tuple(lo), tuple(hi), widest_flat(xs, lo, w),
-                    widest_flat(xs, hi, w))
+    return envelopes(kinks, rising, falling, w)

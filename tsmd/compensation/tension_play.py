@@ -23,7 +23,7 @@ from __future__ import annotations
 import itertools
 import math
 from bisect import bisect_right
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -247,10 +247,15 @@ def branches(omega: float, height_pos_deg: float, height_neg_deg: float, d_pos: 
     def falling(x: float) -> float:
         return h_neg + w * min(x - d_neg, 0.0) + max(s_pos * x + c_pos - h_neg, 0.0)
 
-    kinks = sorted({-_FAR_DEG, _FAR_DEG, d_pos, d_neg, (h_pos - c_neg) / s_neg,
-                    (h_neg - c_pos) / s_pos})
-    knots = [k for k in kinks if -_FAR_DEG <= k <= _FAR_DEG]
-    # where the two cross, the envelopes have a kink too
+    return envelopes({-_FAR_DEG, _FAR_DEG, d_pos, d_neg, (h_pos - c_neg) / s_neg,
+                      (h_neg - c_pos) / s_pos}, rising, falling, w)
+
+
+def envelopes(kinks: set[float], rising: Callable[[float], float],
+              falling: Callable[[float], float], omega: float) -> Branches:
+    """The lower and upper envelopes of two piecewise-linear branches, exact at their
+    ``kinks`` and where the branches cross (the envelopes have a kink there too)."""
+    knots = sorted(k for k in kinks if -_FAR_DEG <= k <= _FAR_DEG)
     crossings = []
     for a, b in itertools.pairwise(knots):
         da, db = rising(a) - falling(a), rising(b) - falling(b)
@@ -261,11 +266,11 @@ def branches(omega: float, height_pos_deg: float, height_neg_deg: float, d_pos: 
     lo, hi = [], []
     for x in xs:
         r, f = rising(x), falling(x)
-        tilt = _FLAT_SLOPE * w * x
+        tilt = _FLAT_SLOPE * omega * x
         lo.append(min(r, f) + tilt)
         hi.append(max(r, f) + tilt)
-    return Branches(tuple(xs), tuple(lo), tuple(hi), widest_flat(xs, lo, w),
-                    widest_flat(xs, hi, w))
+    return Branches(tuple(xs), tuple(lo), tuple(hi), widest_flat(xs, lo, omega),
+                    widest_flat(xs, hi, omega))
 
 
 def fresh_branches(b: Branches, omega: float, d_pos: float, d_neg: float, h_pos: float,

@@ -296,16 +296,23 @@ def line_share_at(grid: FloatArray, yg: FloatArray, k: int, line: FloatArray,
     return math.nan if gap <= 0.0 else (smooth_value(grid, yg, k, half_deg) - loaded) / gap
 
 
+def line_end(grid: FloatArray, yg: FloatArray, share: float, opts: IdentifyOptions,
+             stop: int | None = None) -> int | None:
+    """The end at ``share`` against the release line (:func:`line_share_end`) where
+    ``opts.release_level`` says so and a line can be fitted before ``stop``; else None."""
+    if opts.release_level != "line":
+        return None
+    line = release_line(grid, yg, stop)
+    return (None if line is None
+            else line_share_end(grid, yg, line, share, opts.release_fit_half_deg))
+
+
 def fraction_end(grid: FloatArray, yg: FloatArray, k: int, share: float,
                  opts: IdentifyOptions, stop: int | None = None) -> int:
-    """The fraction rule's end at ``share``: against the release line
-    (:func:`line_share_end`) where ``opts.release_level`` says so and a line can be fitted
-    before ``stop``, else against the median level from the end ``k`` (:func:`share_end`)."""
-    if opts.release_level == "line":
-        line = release_line(grid, yg, stop)
-        if line is not None:
-            return line_share_end(grid, yg, line, share, opts.release_fit_half_deg)
-    return share_end(grid, yg, k, share, opts.release_fit_half_deg)
+    """The fraction rule's end at ``share``: against the release line (:func:`line_end`),
+    else against the median level from the end ``k`` (:func:`share_end`)."""
+    end = line_end(grid, yg, share, opts, stop)
+    return share_end(grid, yg, k, share, opts.release_fit_half_deg) if end is None else end
 
 
 def release_swing(grid: FloatArray, yg: FloatArray, k: int) -> float:
@@ -370,11 +377,8 @@ def backlash_end(grid: FloatArray, yg: FloatArray, start_k: int,
     a0, b0 = run
     level = np.polyfit(grid[a0:b0], yg[a0:b0], 1)
     if opts.backlash == "fraction":
-        line = release_line(grid, yg, stop) if opts.release_level == "line" else None
-        if line is not None:
-            return line_share_end(grid, yg, line, opts.backlash_fraction,
-                                  opts.release_fit_half_deg)
-        return recovered_end(grid, yg, start_k, b0, level, opts)
+        end = line_end(grid, yg, opts.backlash_fraction, opts, stop)
+        return recovered_end(grid, yg, start_k, b0, level, opts) if end is None else end
     near = np.abs(yg[start_k:b0] - np.polyval(level, grid[start_k:b0])) <= opts.peak_noise_k * noise
     hold = max(2, round(opts.settle_hold_deg / step))
     stays = np.convolve(near.astype(float), np.ones(hold), mode="valid") >= hold

@@ -1,8 +1,8 @@
 """The tension play's branches with loaded lines bent by a per-product template.
 
-:func:`tsmd.compensation.tension_play.branches` with each side's loaded line and release line
-bent by its :class:`tsmd.compensation.loaded_shape.LoadedShape`; without a (curved) template
-the straight model's own function is used, so its commands stay bit for bit.
+:func:`tsmd.compensation.tension_play.branches` with each side's loaded line bent by its
+:class:`tsmd.compensation.loaded_shape.LoadedShape` (the release lines stay straight); without a
+(curved) template the straight model's own function is used, so its commands stay bit for bit.
 """
 
 from __future__ import annotations

@@ -211,17 +211,15 @@ class EdgeTracker:
         o = self.options
         if self.learning:
             return 1.0
-        if not (self.knee_mode and self.knee_slopes):
-            if not o.gain_from_slope_in_use:
-                return 1.0
-            tol = o.slope_in_use_tolerance
-            change = common_change(self.slope_change, self.partner_change, tol)
-            return min(max(shrunk_ratio(1.0 + change, tol), 1.0 / o.slope_ratio_max),
-                       o.slope_ratio_max)
-        change = common_change(self.knee_slope_change, self.partner_knee_change,
-                               o.same_slope_tolerance)
-        return min(max(shrunk_ratio(1.0 + change, o.same_slope_tolerance),
-                       1.0 / o.slope_ratio_max), o.slope_ratio_max)
+        if self.knee_mode and self.knee_slopes:
+            mine, theirs = self.knee_slope_change, self.partner_knee_change
+            tol = o.same_slope_tolerance
+        elif o.gain_from_slope_in_use:
+            mine, theirs, tol = self.slope_change, self.partner_change, o.slope_in_use_tolerance
+        else:
+            return 1.0
+        ratio = shrunk_ratio(1.0 + common_change(mine, theirs, tol), tol)
+        return min(max(ratio, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
 
     @property
     def knee_slope_change(self) -> float:

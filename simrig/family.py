@@ -11,8 +11,8 @@ friction, current sensor) that live outside the plant.
 Unit 0 is the nominal unit (no scatter). Units 1-8 are the development set, units 101-108 the
 held-out set: tune on the first, report the second. The capstan plant is the development plant,
 the lumped plant is held out, the segments plant (written blind in session 9) is held out now,
-the coilpipe plant (session 10) was written blind and tsmd was run on it untuned
-(``PLANT_ROLE``).
+the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11)
+was written blind and tsmd was run on it untuned (``PLANT_ROLE``).
 """
 
 from __future__ import annotations
@@ -30,16 +30,18 @@ from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
 from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
+from simrig.plants.stickslip import NOMINAL_KNOBS as STICKSLIP_KNOBS
 from simrig.rig import DEFAULT_CURRENT_SENSOR
 
 PLANT_SPECS: dict[str, str] = {
     "capstan": "simrig.plants.capstan:make_tendon_sheath_plant",
     "lumped": "simrig.plants.lumped:make_lumped_plant",
     "segments": "simrig.plants.segments:make_segments_plant",
-    "coilpipe": "simrig.plants.coilpipe:make_coilpipe_plant",  # last: the others' seeds hold
+    "coilpipe": "simrig.plants.coilpipe:make_coilpipe_plant",
+    "stickslip": "simrig.plants.stickslip:make_stickslip_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
-              "coilpipe": "blind"}
+              "coilpipe": "held-out", "stickslip": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -130,12 +132,39 @@ SCATTER: dict[str, dict[str, float]] = {
         "gear_backlash_deg": 0.30,  # adapter tooth play (tolerance stack of two parts)
         "gear_stiffness_Nm_per_deg": 0.20,  # adapter material and fit
     },
+    "stickslip": {
+        "pulley_radius_mm": 0.02,  # machined drum
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # crimp and braid lay
+        "tendon_stiffness_N": 0.15,  # braid lot (EA)
+        "creep_fast_share": 0.20,  # polymer lot and braid tension: relaxation scatters widely
+        "creep_fast_time_s": 0.30,
+        "creep_slow_share": 0.20,
+        "creep_slow_time_s": 0.30,
+        "free_length_pos_m": 0.20,  # handle assembly
+        "free_length_neg_m": 0.20,
+        "sheath_length_m": 0.02,  # cut to length
+        "sheath_wrap_deg": 0.10,  # lumen helix pitch
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "stiction_ratio": 0.05,  # one material pair
+        "sheath_drag_N": 0.20,  # liner preload
+        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
+        "bend_stiffening_per_rad2": 0.20,  # cover strain-hardening, polymer batch
+        "tip_mass_g": 0.10,  # transducer head and links
+        "tip_length_mm": 0.03,  # moulded links
+        "drive_stiffness_Nm_per_rad": 0.20,  # cable tension set at assembly, coupling fit
+        "handle_friction_Nm": 0.25,  # knob brake as left by the last user: the least controlled
+        "brake_stiction_ratio": 0.05,  # one pad material
+    },
 }
 """Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""
 
 _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMPED_KNOBS,
                                         "segments": SEGMENTS_KNOBS,
-                                        "coilpipe": COILPIPE_KNOBS}
+                                        "coilpipe": COILPIPE_KNOBS,
+                                        "stickslip": STICKSLIP_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -183,6 +212,8 @@ VARIANTS: dict[str, Variant] = {
                          "bend_hysteresis_Nm": 1.5, "handle_friction_Nm": 1.5},
             "coilpipe": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                          "viscous_N_s_per_mm": 1.5, "handle_friction_Nm": 1.5},
+            "stickslip": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                          "handle_friction_Nm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -200,7 +231,8 @@ VARIANTS: dict[str, Variant] = {
                              "slack_neg_mm": 1.0 / 1.2},
                  "lumped": {"tendon_stiffness_N": 0.4},
                  "segments": {"tendon_stiffness_N": 0.4},
-                 "coilpipe": {"tendon_stiffness_N": 0.4}},
+                 "coilpipe": {"tendon_stiffness_N": 0.4},
+                 "stickslip": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

@@ -5,8 +5,8 @@ out its antagonist; each tendon runs through the sheath over ``NODES_PER_TENDON`
 with Karnopp stick-slip friction (normal force from local tension x local wrap) into a
 pseudo-rigid-body tip of ``TIP_LINKS`` stiffening joints carrying the distal section's weight.
 Magnitudes: a TEE-probe-sized catheter (1 m shaft, 12 mm tip, 50 mm bending section), the paper's
-dead zone, backlash and slope (D, B tens of knob degrees, omega 1.32 +- 0.12), the TEE data's
-current level (~0.15 A at the drive).
+dead zone, backlash and slope (D, B tens of knob degrees, omega 1.32 +- 0.12), a drive current
+of the TEE data's order (0.15 A there, ~0.25 A at full bend here).
 """
 
 from __future__ import annotations
@@ -77,7 +77,8 @@ class StickSlipKnobParams:
     the tip stays in the dead zone (0.08 N: ~3 deg)."""
     bend_stiffness_Nm_per_rad: float = 0.012
     """Bending section stiffness (polymer cover over links, EI ~ 6e-4 N m^2 over 50 mm); with EA
-    it sets the loaded slope (1.3) and the tension (~20 N at full bend: ~0.15 A at the drive)."""
+    it sets the loaded slope (1.3-1.45) and the tension (~30 N at the drum at full bend: ~0.25 A
+    at the drive through the 50:1 gear)."""
     bend_stiffening_per_rad2: float = 0.2
     """Joint stiffening: k(phi) = k0 (1 + c phi^2), phi the joint angle (cover strain-hardening)."""
     tip_mass_g: float = 4.0

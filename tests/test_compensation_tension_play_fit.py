@@ -233,6 +233,29 @@ def test_one_sweeps_outlying_edge_is_removed_and_a_trend_kept() -> None:
     assert median_of_three([43.0, 35.0, 28.0, 21.0]) == [43.0, 35.0, 28.0, 21.0]
 
 
+def test_an_edge_confidently_off_its_neighbours_median_is_kept() -> None:
+    # a dead zone wider at both ends of the other knob's range (a V): the vertex is the
+    # catheter's when its deviation exceeds the calibration's uncertainties
+    assert median_of_three([25.1, 19.9, 25.9], [0.9, 0.7, 0.9]) == [25.1, 19.9, 25.9]
+
+
+def test_an_edge_off_its_neighbours_median_within_the_uncertainty_is_smoothed() -> None:
+    assert median_of_three([25.1, 24.3, 25.9], [0.9, 0.7, 0.9]) == [25.1, 25.1, 25.9]
+
+
+def test_the_fit_keeps_the_vertex_of_a_v_shaped_edge_given_its_uncertainty() -> None:
+    def sweeps(u95: float) -> list[SweepCurrent]:
+        out = []
+        for g in (-90.0, 0.0, 90.0):
+            s = synthetic_sweep(g)
+            d = D_POS + (5.0 if g else 0.0)
+            out.append(dataclasses.replace(s, dead_zone_pos_deg=d, dead_zone_u95_deg=(u95, u95)))
+        return out
+
+    assert fit_tension_play(sweeps(0.8), DEVICE_KNOB).dead_zone_pos_deg[1] == D_POS
+    assert fit_tension_play(sweeps(math.inf), DEVICE_KNOB).dead_zone_pos_deg[1] == D_POS + 5.0
+
+
 def test_one_sweep_is_not_a_grid() -> None:
     with pytest.raises(ValueError, match=">= 2 other-knob angles"):
         fit_tension_play([synthetic_sweep()], DEVICE_KNOB)

@@ -84,8 +84,6 @@ class SweepCurrent:
     """The drive's lag when already estimated; None: estimated here from t, cmd and pos."""
     dead_zone_u95_deg: tuple[float, float] = (math.inf, math.inf)
     """The calibration's 95 % uncertainty of (D_pos, D_neg); inf: unknown (always smoothed)."""
-    backlash_u95_deg: tuple[float, float] = (math.inf, math.inf)
-    """The same of the backlash (B_pos, B_neg); inf: unknown (beta and x0 always smoothed)."""
 
 
 @dataclass(frozen=True)
@@ -230,26 +228,6 @@ def median_of_three(values: Sequence[float], u95_deg: Sequence[float] | None = N
     return out
 
 
-def smoothed_loads(grid_deg: Sequence[float], fits: Sequence[SideFit],
-                   backlash_u95_deg: Sequence[float]) -> tuple[list[float], list[float]]:
-    """``beta`` and ``x0`` of one side over the grid, each smoothed (:func:`smooth_over_grid`)
-    where the smoothed pair's backlash at the calibration amplitude stays within that grid
-    point's 95 % uncertainty of B; elsewhere the point's own pair. A line through three grid
-    points cannot follow a backlash that differs at both ends of the other knob's range from
-    its middle: smoothed, the ends' would move the middle's, and with it ``omega``."""
-    lo, hi = BETA_RANGE
-    betas = smooth_over_grid(grid_deg, [f.backlash_gain for f in fits])
-    x0s = smooth_over_grid(grid_deg, [f.zero_load_deg for f in fits])
-    out_b, out_x = [], []
-    for b, x0, f, u in zip(betas, x0s, fits, backlash_u95_deg, strict=True):
-        moved = abs(abs(b * (f.amplitude_deg - x0)) - f.backlash_deg)
-        if moved > u:
-            b, x0 = f.backlash_gain, f.zero_load_deg
-        out_b.append(min(max(b, lo), hi))
-        out_x.append(x0)
-    return out_b, out_x
-
-
 def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> TensionPlayParams:
     """One knob's parameters from all its sweeps (ValueError naming the sweep that fails).
 
@@ -300,14 +278,18 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
                                           np.asarray(s.pos_deg, float))
                            if s.lag_s is None else s.lag_s for s in order]))
-    beta_pos, x0_pos = smoothed_loads(grid, pos_fits, [s.backlash_u95_deg[0] for s in order])
-    beta_neg, x0_neg = smoothed_loads(grid, neg_fits, [s.backlash_u95_deg[1] for s in order])
+    lo, hi = BETA_RANGE
+    beta_pos = [min(max(b, lo), hi)
+                for b in smooth_over_grid(grid, [f.backlash_gain for f in pos_fits])]
+    beta_neg = [min(max(b, lo), hi)
+                for b in smooth_over_grid(grid, [f.backlash_gain for f in neg_fits])]
     # the sheet measured its beta with the other knob at 0: compare the unit there
     beta_0 = 0.5 * (at_other_knob_zero(grid, beta_pos) + at_other_knob_zero(grid, beta_neg))
     omega = unit_omega(float(k.omega), getattr(k, "reference_backlash_gain", None), beta_0)
     ratio = release_slope_ratio(k)
     sides = []
-    for betas, x0s, fits in ((beta_pos, x0_pos, pos_fits), (beta_neg, x0_neg, neg_fits)):
+    for betas, fits in ((beta_pos, pos_fits), (beta_neg, neg_fits)):
+        x0s = smooth_over_grid(grid, [f.zero_load_deg for f in fits])
         moved = [release_through_amplitude(b, x0, f.amplitude_deg, ratio)
                  for b, x0, f in zip(betas, x0s, fits, strict=True)]
         sides.append((tuple(m[0] for m in moved), tuple(m[1] for m in moved)))
@@ -369,9 +351,7 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
                                 est("dead_zone_neg_deg"), pre.backlash_pos_deg,
                                 pre.backlash_neg_deg, pre.lag_s,
                                 (u["dead_zone_pos_deg"].u95_deg,
-                                 u["dead_zone_neg_deg"].u95_deg),
-                                (u["backlash_pos_deg"].u95_deg,
-                                 u["backlash_neg_deg"].u95_deg)))
+                                 u["dead_zone_neg_deg"].u95_deg)))
     return out
 
 

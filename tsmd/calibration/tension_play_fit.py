@@ -32,9 +32,10 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   and this unit's own edge at 0 deg.
 
 ``beta`` and ``x0`` scatter from sweep to sweep (``B_A`` by about 1 deg); over the grid they are
-smoothed by a least-squares polynomial in the other knob's angle (degree <= 2, at most n - 2),
-which keeps a trend the coupling gives and removes the scatter. The edges ``D``, which coupling
-can move steeply, get a running median of three instead. ``lag_s`` is the delay that maps
+smoothed by a least-squares polynomial in the other knob's angle (degree 2; on three grid points
+that passes through each), which keeps a trend the coupling gives and removes the scatter. The
+edges ``D``, which coupling can move steeply, get a running median of three instead (a value
+confidently off that median is kept). ``lag_s`` is the delay that maps
 commanded onto actual position. The tip is never used.
 """
 
@@ -200,10 +201,13 @@ def release_through_amplitude(beta: float, zero_load_deg: float, amplitude_deg: 
 
 
 def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list[float]:
-    """Least-squares polynomial over the grid (degree min(2, n - 2), 0 for n <= 2)."""
+    """Least-squares polynomial over the grid: degree 2 (a coupling that differs at both ends
+    of the other knob's range from its middle is at least quadratic; on three grid points a
+    line moved the middle's value by the ends', and with it ``omega``), fewer on fewer points
+    (n - 1: through every point)."""
     g = np.asarray(grid_deg, float)
     y = np.asarray(values, float)
-    degree = max(0, min(2, g.size - 2))
+    degree = max(0, min(2, g.size - 1))
     coef = np.polyfit(g, y, degree)
     return [float(v) for v in np.polyval(coef, g)]
 

@@ -11,6 +11,7 @@ from support.calibration import LockstepPlantRunner
 
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd.calibration import CalibrationError, Protocol, Sweep
+from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
 from tsmd.calibration.resweep import pooled
@@ -60,6 +61,14 @@ def test_tension_play_fit_analyses_a_point_without_a_prefit(isolated: SweepRuns)
     (sweep,) = sweeps_from_points([bare], 0)
     assert (sweep.backlash_pos_deg, sweep.backlash_neg_deg) == \
         settle_rule_backlash(bare.result.data)
+
+
+def test_tension_play_fit_takes_the_edges_uncertainty_the_calibration_gate_uses(
+        isolated: SweepRuns) -> None:
+    (sweep,) = sweeps_from_points([isolated.points[0]], 0)
+    (est,) = point_estimates([isolated.points[0].result])
+    assert sweep.dead_zone_u95_deg == (est["dead_zone_pos_deg"].u95_deg,
+                                       est["dead_zone_neg_deg"].u95_deg)
 
 
 def test_a_pooled_resweep_keeps_the_first_sweeps_prefit(isolated: SweepRuns) -> None:

@@ -19,6 +19,7 @@ from tsmd.calibration.tension_play_fit import (
     median_of_three,
     release_slope_ratio,
     release_through_amplitude,
+    smooth_over_grid,
     unit_omega,
 )
 from tsmd.compensation import CompensationError, build_compensator
@@ -231,6 +232,48 @@ def test_backlash_longer_than_the_loaded_run_is_refused() -> None:
 def test_one_sweeps_outlying_edge_is_removed_and_a_trend_kept() -> None:
     assert median_of_three([20.0, 20.2, 21.0, 20.1, 20.0]) == [20.0, 20.2, 20.2, 20.1, 20.0]
     assert median_of_three([43.0, 35.0, 28.0, 21.0]) == [43.0, 35.0, 28.0, 21.0]
+
+
+def test_an_edge_confidently_off_its_neighbours_median_is_kept() -> None:
+    # a dead zone wider at both ends of the other knob's range (a V): the vertex is the
+    # catheter's when its deviation exceeds the calibration's uncertainties
+    assert median_of_three([25.1, 19.9, 25.9], [0.9, 0.7, 0.9]) == [25.1, 19.9, 25.9]
+
+
+def test_an_edge_off_its_neighbours_median_within_the_uncertainty_is_smoothed() -> None:
+    assert median_of_three([25.1, 24.3, 25.9], [0.9, 0.7, 0.9]) == [25.1, 25.1, 25.9]
+
+
+def test_the_fit_keeps_the_vertex_of_a_v_shaped_edge_given_its_uncertainty() -> None:
+    def sweeps(u95: float) -> list[SweepCurrent]:
+        out = []
+        for g in (-90.0, 0.0, 90.0):
+            s = synthetic_sweep(g)
+            d = D_POS + (5.0 if g else 0.0)
+            out.append(dataclasses.replace(s, dead_zone_pos_deg=d, dead_zone_u95_deg=(u95, u95)))
+        return out
+
+    assert fit_tension_play(sweeps(0.8), DEVICE_KNOB).dead_zone_pos_deg[1] == D_POS
+    assert fit_tension_play(sweeps(math.inf), DEVICE_KNOB).dead_zone_pos_deg[1] == D_POS + 5.0
+
+
+def test_a_backlash_larger_at_both_ends_of_three_grid_points_leaves_the_middles_omega_alone(
+        ) -> None:
+    device = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.3)
+    v_shaped = fit_tension_play([synthetic_sweep(g, backlash_deg=40.0 if g else 20.0)
+                                 for g in (-90.0, 0.0, 90.0)], device)
+    flat = fit_tension_play([synthetic_sweep(g, backlash_deg=20.0)
+                             for g in (-90.0, 0.0, 90.0)], device)
+    assert v_shaped.omega == pytest.approx(flat.omega, rel=1e-6)
+
+
+def test_seven_grid_points_are_smoothed_by_a_parabola() -> None:
+    grid = [-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0]
+    noisy = [0.3 + 1e-5 * g * g + (0.01 if i == 3 else 0.0) for i, g in enumerate(grid)]
+    smooth = smooth_over_grid(grid, noisy)
+    assert abs(smooth[3] - noisy[3]) > 0.005
+    assert smooth_over_grid(grid, [0.3 + 1e-5 * g * g for g in grid]) == pytest.approx(
+        [0.3 + 1e-5 * g * g for g in grid])
 
 
 def test_one_sweep_is_not_a_grid() -> None:

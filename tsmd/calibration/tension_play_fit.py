@@ -32,9 +32,10 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   and this unit's own edge at 0 deg.
 
 ``beta`` and ``x0`` scatter from sweep to sweep (``B_A`` by about 1 deg); over the grid they are
-smoothed by a least-squares polynomial in the other knob's angle (degree <= 2, at most n - 2),
-which keeps a trend the coupling gives and removes the scatter. The edges ``D``, which coupling
-can move steeply, get a running median of three instead. ``lag_s`` is the delay that maps
+smoothed by a least-squares polynomial in the other knob's angle (degree 2; on three grid points
+that passes through each), which keeps a trend the coupling gives and removes the scatter. The
+edges ``D``, which coupling can move steeply, get a running median of three instead (a value
+confidently off that median is kept). ``lag_s`` is the delay that maps
 commanded onto actual position. The tip is never used.
 """
 
@@ -49,6 +50,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.fresh_hold import with_fresh_hold
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
@@ -81,6 +83,8 @@ class SweepCurrent:
     backlash_neg_deg: float
     lag_s: float | None = None
     """The drive's lag when already estimated; None: estimated here from t, cmd and pos."""
+    dead_zone_u95_deg: tuple[float, float] = (math.inf, math.inf)
+    """The calibration's 95 % uncertainty of (D_pos, D_neg); inf: unknown (always smoothed)."""
 
 
 @dataclass(frozen=True)
@@ -197,22 +201,35 @@ def release_through_amplitude(beta: float, zero_load_deg: float, amplitude_deg: 
 
 
 def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list[float]:
-    """Least-squares polynomial over the grid (degree min(2, n - 2), 0 for n <= 2)."""
+    """Least-squares polynomial over the grid: degree 2 (a coupling that differs at both ends
+    of the other knob's range from its middle is at least quadratic; on three grid points a
+    line moved the middle's value by the ends', and with it ``omega``), fewer on fewer points
+    (n - 1: through every point)."""
     g = np.asarray(grid_deg, float)
     y = np.asarray(values, float)
-    degree = max(0, min(2, g.size - 2))
+    degree = max(0, min(2, g.size - 1))
     coef = np.polyfit(g, y, degree)
     return [float(v) for v in np.polyval(coef, g)]
 
 
-def median_of_three(values: Sequence[float]) -> list[float]:
+def median_of_three(values: Sequence[float], u95_deg: Sequence[float] | None = None
+                    ) -> list[float]:
     """Each inner grid value replaced by the median of it and its neighbours: removes one
     sweep's outlier (an edge scatters by ~0.5 deg per sweep) and keeps any monotone trend the
-    coupling of the knobs gives exactly."""
+    coupling of the knobs gives exactly. With the calibration's 95 % uncertainties
+    (``u95_deg``), a value farther from that median than both uncertainties together is kept:
+    it is the catheter's, not scatter (a dead zone wider at both ends of the other knob's range
+    than at 0, a V, has its vertex at a grid point that the median would move onto a wing)."""
     v = [float(x) for x in values]
     if len(v) < 3:
         return v
-    return [v[0]] + [float(np.median(v[i - 1:i + 2])) for i in range(1, len(v) - 1)] + [v[-1]]
+    u = [math.inf] * len(v) if u95_deg is None else [float(x) for x in u95_deg]
+    out = list(v)
+    for i in range(1, len(v) - 1):
+        j = i - 1 + int(np.argsort(v[i - 1:i + 2], kind="stable")[1])
+        if not abs(v[i] - v[j]) > u[i] + u[j]:
+            out[i] = v[j]
+    return out
 
 
 def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> TensionPlayParams:
@@ -241,8 +258,10 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
             raise ValueError(f"{where}: {exc}") from None
         pos_fits.append(fit_pos)
         neg_fits.append(fit_neg)
-    d_pos = median_of_three([f.dead_zone_deg for f in pos_fits])
-    d_neg = median_of_three([f.dead_zone_deg for f in neg_fits])
+    d_pos = median_of_three([f.dead_zone_deg for f in pos_fits],
+                            [s.dead_zone_u95_deg[0] for s in order])
+    d_neg = median_of_three([f.dead_zone_deg for f in neg_fits],
+                            [s.dead_zone_u95_deg[1] for s in order])
     k = device_knob
     # H: with the data-sheet unit's own edges a product constant (the unit's loaded line moves
     # with its edges); without them the paper's assumption (the line through the reference point)
@@ -320,9 +339,11 @@ def with_prefit(point: Any) -> Any:
 
 
 def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
-    """:class:`SweepCurrent` of one knob from the calibration's grid points."""
+    """:class:`SweepCurrent` of one knob from the calibration's grid points (the edges'
+    uncertainties pooled over all of them, as the calibration's own gate does)."""
     out = []
-    for p in points:
+    uncertain = point_estimates([p.result for p in points])
+    for p, u in zip(points, uncertain, strict=True):
         if p.knob != knob:
             continue
         d = p.result.data
@@ -332,7 +353,9 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
         out.append(SweepCurrent(float(p.other_deg), d.t_s, d.cmd_deg, d.pos_deg,
                                 d.current_filtered_A, est("dead_zone_pos_deg"),
                                 est("dead_zone_neg_deg"), pre.backlash_pos_deg,
-                                pre.backlash_neg_deg, pre.lag_s))
+                                pre.backlash_neg_deg, pre.lag_s,
+                                (u["dead_zone_pos_deg"].u95_deg,
+                                 u["dead_zone_neg_deg"].u95_deg)))
     return out
 
 

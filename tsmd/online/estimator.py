@@ -222,6 +222,21 @@ class EdgeTracker:
         return min(max(ratio, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
 
     @property
+    def bend_weight(self) -> float:
+        """0..1: how far this tendon's change is a bend (the sheath's friction rose with the
+        edge's move) rather than slack (:class:`tsmd.online.bend.BendRelation` applies in that
+        share): 1 in knee mode with steeper ramps; otherwise the knob's common slope change,
+        none within ``slope_in_use_tolerance`` (a slack change leaves the slopes: lumped 101
+        0.85-1.07 x), in full beyond twice it (a 60 deg bend: 1.04-1.21 x on lumped)."""
+        if self.learning:
+            return 0.0
+        if self.knee_direction > 0 and self.knee_slopes:
+            return 1.0
+        tol = self.options.slope_in_use_tolerance
+        change = common_change(self.slope_change, self.partner_change, tol)
+        return min(max((change - tol) / tol, 0.0), 1.0) if tol > 0 else float(change > 0)
+
+    @property
     def knee_slope_change(self) -> float:
         """The median slope of the last ramps fitted past their knee against the reference,
         minus 1 (0 without such ramps)."""

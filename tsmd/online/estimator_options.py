@@ -52,6 +52,11 @@ class EstimatorOptions:
     of the knob (a bend widens both sides alike), not after a second suspect. Off by default:
     it follows ~10 s sooner but one knee's scatter (+-1.5 deg) made capstan units 1-2 track
     worse after a bend (docs/online.md, Session 9)."""
+    gain_from_bend: bool = True
+    """With a bend relation (:class:`tsmd.online.bend.BendRelation`), the backlash gain follows
+    the relation (its growth per degree of the release line's move, on the data sheet's unit)
+    instead of the loaded slope (which over-reads beta 1.29-1.43 x against the fresh
+    calibrations' 1.18-1.27 on capstan unit 1, session 9)."""
     keep_zero_load_in_bend: bool = False
     """On: a change the knee placed moves the edge, not the zero-load point (what a bend does
     on the capstan plant). Off by default: with the knee's edges (~1 deg short of a fresh

@@ -361,9 +361,9 @@ class EdgeTracker:
             key = self._bin(other_deg)
             learned = len(self.bins.get(key, [])) >= o.bin_min
             self._teach_bin(key, raw_deg - self.estimate_deg)
-            if not learned:  # a bin still learning where the current's edge sits: it
-                return       # teaches the bin, not the estimate (a change beyond the gate
-                             # is a suspect as anywhere)
+            if not (learned or o.learning_bins_count):  # a bin still learning where the
+                return  # current's edge sits: it teaches the bin, not the estimate (a change
+                        # beyond the gate is a suspect as anywhere)
             self.accepted = [*self.accepted, m][-o.window:]
             self.estimate_deg = median(
                 [*self.accepted, *[self.level_deg] * (o.window - len(self.accepted))])

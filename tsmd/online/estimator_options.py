@@ -43,6 +43,12 @@ class EstimatorOptions:
     bin_min: int = 3
     """Measurements a bin needs before its bias counts."""
     bin_window: int = 7
+    learning_bins_count: bool = False
+    """A measurement in a bin still learning counts for the estimate too (unreferred: the
+    bins' shared part is the estimate's). Off (until session 11) it only taught its bin: a
+    knob engaged at other-knob angles spread over several bins, one ramp per side every
+    ~20 s, then measured nothing for minutes (lumped 103 phi2 after a bend: 4 of 5 ramps of
+    the negative edge taught bins, the edge stayed at 0)."""
     shared_slope_ratio_max: float = 8.0
     """A slope change both edges of the knob show (a sheath's friction) is followed up to this
     ratio; beyond ``slope_ratio_max`` on one edge alone it is a stuck knob or a blocked tip."""

@@ -103,6 +103,9 @@ def bend_targets(bend: BendRelation, trackers: Mapping[tuple[int, int], Any],
     for (knob, side), tr in trackers.items():
         j = 0 if side > 0 else 1
         e, w, o = tr.applied_deg, tr.bend_weight, tr.options
+        if tr.last_feature == "knee" and not o.bend_in_knee_mode:
+            zero[knob][j], gain[knob][j] = tr.zero_load_deg, tr.gain_ratio
+            continue
         release = e * (1.0 + w * (r - 1.0))
         g = (min(max(1.0 + w * c * release, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
              if o.gain_from_bend else tr.gain_ratio)

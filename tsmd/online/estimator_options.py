@@ -63,6 +63,12 @@ class EstimatorOptions:
     the relation (its growth per degree of the release line's move, on the data sheet's unit)
     instead of the loaded slope (which over-reads beta 1.29-1.43 x against the fresh
     calibrations' 1.18-1.27 on capstan unit 1, session 9)."""
+    bend_in_knee_mode: bool = False
+    """With a bend relation: it also places the release line and beta of an edge the knee
+    placed. Off: a knee-placed edge keeps x0 moving with it and beta from its past-knee
+    slopes (what sessions 7-9 settled on for the capstan bend: the knee reads the edge
+    0.5-1.5 deg short, and with the relation on it capstan 1, 2 tracked worse after a 60 deg
+    bend, on / fresh mean 1.99 against 1.70; docs/online.md, Session 11)."""
     keep_zero_load_in_bend: bool = False
     """On: a change the knee placed moves the edge, not the zero-load point (what a bend does
     on the capstan plant). Off by default: with the knee's edges (~1 deg short of a fresh

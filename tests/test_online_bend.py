@@ -86,11 +86,12 @@ def test_an_edge_move_with_unchanged_slopes_is_no_bend() -> None:
     assert pos.bend_weight == 0.0
 
 
-def _targets(weight: float) -> tuple[Any, Any, Any]:
-    """Bend targets for every edge moved 3 deg with bend share ``weight`` on the example
-    profile's knobs, with (r, c) = (1.2, 0.06); and those knobs."""
+def _targets(weight: float, feature: str = "crossing") -> tuple[Any, Any, Any]:
+    """Bend targets for every edge moved 3 deg with bend share ``weight``, placed by
+    ``feature``, on the example profile's knobs, with (r, c) = (1.2, 0.06); and those knobs."""
     knobs = build_compensator(load_profile(PROFILE), "ours", 0.004).knobs
     trackers = {(k, s): SimpleNamespace(applied_deg=3.0, bend_weight=weight, gain_ratio=1.5,
+                                        zero_load_deg=2.5, last_feature=feature,
                                         options=EstimatorOptions())
                 for k in (0, 1) for s in (1, -1)}
     zero, gain = bend_targets(BendRelation(1.2, 0.06), trackers, knobs)
@@ -111,3 +112,8 @@ def test_a_change_that_is_no_bend_moves_the_zero_load_point_with_the_edge() -> N
     zero, gain, _ = _targets(0.0)
     assert [z for pair in zero for z in pair] == pytest.approx([3.0] * 4)
     assert gain == ((1.0, 1.0), (1.0, 1.0))
+
+
+def test_an_edge_the_knee_placed_keeps_its_trackers_zero_load_and_gain() -> None:
+    zero, gain, _ = _targets(1.0, feature="knee")
+    assert zero == ((2.5, 2.5), (2.5, 2.5)) and gain == ((1.5, 1.5), (1.5, 1.5))

@@ -72,6 +72,9 @@ class EdgeTracker:
     """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
     partner_change: float = 0.0
     """The knob's other tendon's slope change at this tendon's last ramp."""
+    knob_change: float = 0.0
+    """The knob's slope change: the median over both tendons' last ramps' slope ratios
+    (:attr:`EstimatorOptions.pooled_slope_change`)."""
     partner_last_change: float = 0.0
     """The knob's other tendon's last ramp's own slope change (:attr:`last_change`)."""
     knee_slopes: list[float] = field(default_factory=list)
@@ -215,11 +218,36 @@ class EdgeTracker:
             mine, theirs = self.knee_slope_change, self.partner_knee_change
             tol = o.same_slope_tolerance
         elif o.gain_from_slope_in_use:
-            mine, theirs, tol = self.slope_change, self.partner_change, o.slope_in_use_tolerance
+            tol = o.slope_in_use_tolerance
+            ratio = shrunk_ratio(1.0 + self._common_change(tol), tol)
+            return min(max(ratio, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
         else:
             return 1.0
         ratio = shrunk_ratio(1.0 + common_change(mine, theirs, tol), tol)
         return min(max(ratio, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
+
+    def _pooled_change(self, partner: EdgeTracker | None) -> float:
+        """The median of both tendons' last slope ratios, minus 1: six ramps, not three per
+        side against a three-ramp reference each (lumped 103 phi2 after a bend: sides +11 %
+        and +3.6 %, the negative side's reference at the top of its 1.36-1.56 scatter)."""
+        ratios = [x / self.slope_ref_A_per_deg for x in self.recent_slopes
+                  ] if self.slope_ref_A_per_deg else []
+        if partner is not None and partner.slope_ref_A_per_deg:
+            ratios += [x / partner.slope_ref_A_per_deg for x in partner.recent_slopes]
+        return median(ratios) - 1.0 if ratios else 0.0
+
+    def _common_change(self, tol: float) -> float:
+        """The slope change the knob's two tendons share (the slope in use's, the gain's).
+        Pooled: in full when both sides changed the same way and the smaller change is at
+        least a quarter of the larger, none below an eighth (one tendon's ramps alone run
+        19-27 % steep now and then: lumped 101, 1800 s), linearly between."""
+        own, partner = self.slope_change, self.partner_change
+        if not self.options.pooled_slope_change:
+            return common_change(own, partner, tol)
+        if own * partner <= 0.0:
+            return 0.0
+        agree = min(abs(own), abs(partner)) / max(abs(own), abs(partner))
+        return self.knob_change * min(max(8.0 * agree - 1.0, 0.0), 1.0)
 
     @property
     def bend_weight(self) -> float:
@@ -233,7 +261,7 @@ class EdgeTracker:
         if self.knee_direction > 0 and self.knee_slopes:
             return 1.0
         tol = self.options.slope_in_use_tolerance
-        change = common_change(self.slope_change, self.partner_change, tol)
+        change = self._common_change(tol)
         return min(max((change - tol) / tol, 0.0), 1.0) if tol > 0 else float(change > 0)
 
     @property
@@ -288,6 +316,7 @@ class EdgeTracker:
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
         self.shared_change = shared
         self.partner_change = 0.0 if partner is None else partner.slope_change
+        self.knob_change = self._pooled_change(partner)
         self.partner_last_change = 0.0 if partner is None else partner.last_change
         if ramp.past_knee:
             self.knee_slopes = [*self.knee_slopes, ramp.slope_A_per_deg][-o.slope_window:]
@@ -337,8 +366,7 @@ class EdgeTracker:
         # 1.5 deg of edge) with the slope both edges' last ramps agree on; one ramp's slope
         # scatters by 25 % and more, so a ramp that disagrees with it measures nothing.
         tol = o.slope_in_use_tolerance
-        change = self.slope_change if partner is None else common_change(
-            self.slope_change, partner.slope_change, tol)
+        change = self.slope_change if partner is None else self._common_change(tol)
         slope = self.slope_ref_A_per_deg * shrunk_ratio(1.0 + change, tol)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
             self.n_odd_slope += 1

@@ -29,6 +29,10 @@ class EstimatorOptions:
     moves its edges +2.75..+3.4 deg; with the change shrunk to none the crossing, 15 deg out,
     read ~2 deg short and the ramps beyond 15 % measured nothing (lumped 1, 2: offsets
     0-1.8 deg; docs/online.md, Session 10)."""
+    pooled_slope_change: bool = True
+    """The slope in use (and the gain from it, and the bend share) moves with the median of
+    both tendons' last ramps' slope ratios, not with one edge's change as far as the other's
+    confirms it (:func:`slopes.common_change`)."""
     gain_from_slope_in_use: bool = True
     """Where no ramp was fitted past its knee (outside knee mode, or a plant without a
     knee), the backlash gain follows the slope in use (beta = compliance x the current's

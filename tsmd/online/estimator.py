@@ -29,7 +29,7 @@ from typing import Any
 
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
-from tsmd.online.slopes import common_change, shrunk_ratio
+from tsmd.online.slopes import common_change, pooled_change, shrunk_ratio
 
 
 @dataclass
@@ -73,8 +73,7 @@ class EdgeTracker:
     partner_change: float = 0.0
     """The knob's other tendon's slope change at this tendon's last ramp."""
     knob_change: float = 0.0
-    """The knob's slope change: the median over both tendons' last ramps' slope ratios
-    (:attr:`EstimatorOptions.pooled_slope_change`)."""
+    """The knob's slope change over both tendons' last ramps (:func:`slopes.pooled_change`)."""
     partner_last_change: float = 0.0
     """The knob's other tendon's last ramp's own slope change (:attr:`last_change`)."""
     knee_slopes: list[float] = field(default_factory=list)
@@ -226,28 +225,19 @@ class EdgeTracker:
         ratio = shrunk_ratio(1.0 + common_change(mine, theirs, tol), tol)
         return min(max(ratio, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
 
-    def _pooled_change(self, partner: EdgeTracker | None) -> float:
-        """The median of both tendons' last slope ratios, minus 1: six ramps, not three per
-        side against a three-ramp reference each (lumped 103 phi2 after a bend: sides +11 %
-        and +3.6 %, the negative side's reference at the top of its 1.36-1.56 scatter)."""
+    def _pooled_ratios(self, partner: EdgeTracker | None) -> list[float]:
+        """Both tendons' last slopes, each against its own reference."""
         ratios = [x / self.slope_ref_A_per_deg for x in self.recent_slopes
                   ] if self.slope_ref_A_per_deg else []
         if partner is not None and partner.slope_ref_A_per_deg:
             ratios += [x / partner.slope_ref_A_per_deg for x in partner.recent_slopes]
-        return median(ratios) - 1.0 if ratios else 0.0
+        return ratios
 
     def _common_change(self, tol: float) -> float:
-        """The slope change the knob's two tendons share (the slope in use's, the gain's).
-        Pooled: in full when both sides changed the same way and the smaller change is at
-        least a quarter of the larger, none below an eighth (one tendon's ramps alone run
-        19-27 % steep now and then: lumped 101, 1800 s), linearly between."""
-        own, partner = self.slope_change, self.partner_change
-        if not self.options.pooled_slope_change:
-            return common_change(own, partner, tol)
-        if own * partner <= 0.0:
-            return 0.0
-        agree = min(abs(own), abs(partner)) / max(abs(own), abs(partner))
-        return self.knob_change * min(max(8.0 * agree - 1.0, 0.0), 1.0)
+        """The slope change the knob's two tendons share (the slope in use's, the gain's)."""
+        if self.options.pooled_slope_change:
+            return self.knob_change
+        return common_change(self.slope_change, self.partner_change, tol)
 
     @property
     def bend_weight(self) -> float:
@@ -316,7 +306,8 @@ class EdgeTracker:
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
         self.shared_change = shared
         self.partner_change = 0.0 if partner is None else partner.slope_change
-        self.knob_change = self._pooled_change(partner)
+        self.knob_change = pooled_change(self.slope_change, self.partner_change,
+                                         self._pooled_ratios(partner))
         self.partner_last_change = 0.0 if partner is None else partner.last_change
         if ramp.past_knee:
             self.knee_slopes = [*self.knee_slopes, ramp.slope_A_per_deg][-o.slope_window:]

@@ -17,7 +17,9 @@ estimator sees only commanded and actual position and current. Per unit:
   knobs) online on and off: each edge's largest offset against the calibration's uncertainty,
   and the tracking of both runs.
 
-The data sheet of the lumped family is measured once on its nominal unit (tracker on the tip,
+``--bend-relation unit0``: the worker gets the product's bend relation, measured on unit 0
+(:mod:`tsmd.bench.online_bend`). The data sheet of the lumped family is measured once on its
+nominal unit (tracker on the tip,
 ``tsmd.datasheet``); capstan units use ``profiles/devices/sim-catheter.yaml``. Data sheets and
 calibrated profiles are cached in ``--cache``, in a subdirectory keyed by the code that made them
 (:mod:`tsmd.bench.cache_key`), by plant, unit and shape, so reruns are cheap.

@@ -187,7 +187,8 @@ def test_a_small_friction_change_on_both_edges_is_followed_below_the_slope_toler
 
 
 def test_a_small_friction_change_within_the_slope_tolerance_measures_nothing() -> None:
-    pos, _ = _both_edges_18_percent_steeper(EstimatorOptions(slope_in_use_tolerance=0.15))
+    pos, _ = _both_edges_18_percent_steeper(EstimatorOptions(slope_in_use_tolerance=0.15,
+                                                             pooled_slope_change=False))
     assert pos.applied_deg == 0.0 and pos.status()["odd_slope_ramps"] > 0
 
 
@@ -345,3 +346,30 @@ def test_a_later_lone_knee_of_a_bend_is_no_bend_suspect() -> None:
         neg.update(ramp_with_knee(EDGE_DEG + knee, 1.4 * SLOPE), EDGE_DEG, pos)
         pos.update(ramp_with_knee(EDGE_DEG + knee, 1.4 * SLOPE), EDGE_DEG, neg)
     assert pos.applied_deg == pytest.approx(4.0) and not pos.bend_suspect
+
+
+def _sides_steeper(pos_ratio: float, neg_ratio: float, pooled: bool) -> tuple[EdgeTracker,
+                                                                               EdgeTracker]:
+    """Both edges' ramps steeper by the given ratios, their edges 3 deg further out."""
+    o = EstimatorOptions(pooled_slope_change=pooled)
+    pos, neg = learned(o), learned(o)
+    for _ in range(6):
+        pos.update(ramp_with_edge(EDGE_DEG + 3.0, slope=pos_ratio * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_with_edge(EDGE_DEG + 3.0, slope=neg_ratio * SLOPE), EDGE_DEG, pos)
+    return pos, neg
+
+
+def test_a_friction_change_read_unevenly_by_the_two_sides_is_followed_further_pooled(
+        ) -> None:
+    pooled = _sides_steeper(1.12, 1.04, pooled=True)  # lumped 103 phi2 after a bend
+    each = _sides_steeper(1.12, 1.04, pooled=False)
+    for a, b in zip(pooled, each, strict=True):
+        assert a.applied_deg > b.applied_deg + 0.4
+
+
+def test_one_steeper_side_with_a_barely_changed_partner_moves_no_slope_in_use() -> None:
+    pos, neg = learned(), learned()
+    for _ in range(6):
+        pos.update(ramp_through(EDGE_DEG, 1.25 * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_through(EDGE_DEG, 1.01 * SLOPE), EDGE_DEG, pos)
+    assert pos.applied_deg == 0.0 and neg.applied_deg == 0.0

@@ -17,7 +17,9 @@ estimator sees only commanded and actual position and current. Per unit:
   knobs) online on and off: each edge's largest offset against the calibration's uncertainty,
   and the tracking of both runs.
 
-The data sheet of the lumped family is measured once on its nominal unit (tracker on the tip,
+``--bend-relation unit0``: the worker gets the product's bend relation, measured on unit 0
+(:mod:`tsmd.bench.online_bend`). The data sheet of the lumped family is measured once on its
+nominal unit (tracker on the tip,
 ``tsmd.datasheet``); capstan units use ``profiles/devices/sim-catheter.yaml``. Data sheets and
 calibrated profiles are cached in ``--cache``, in a subdirectory keyed by the code that made them
 (:mod:`tsmd.bench.cache_key`), by plant, unit and shape, so reruns are cheap.
@@ -134,9 +136,10 @@ def calibrated(plant: str, unit: int, change: dict[str, Any] | None, device: Any
 
 
 def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int,
-        device: Any = None) -> tuple[Any, Any]:
+        device: Any = None, bend: Any = None) -> tuple[Any, Any]:
     """One lockstep run with our compensator; returns (recording, worker or None). The
-    worker takes each knob's handle slip from ``device``'s data sheet."""
+    worker takes each knob's handle slip from ``device``'s data sheet and the product's bend
+    relation ``bend`` (None: none)."""
     from tsmd.daemon import make_compensator
     from tsmd.loop import ROW_COLUMNS
     from tsmd.online import OnlineWorker
@@ -151,7 +154,7 @@ def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int,
                                                  device.knobs[1].handle_slip_deg)
             worker = OnlineWorker(comp, runner.loop.period_s, ROW_COLUMNS,
                                   handle_slip_deg=slip, drain_every=DRAIN_EVERY,
-                                  fault_reason=lambda: runner.loop.fault_reason)
+                                  fault_reason=lambda: runner.loop.fault_reason, bend=bend)
             runner.loop.observer = worker.observe
         rec = runner.run(t, q, compensate=True)
     return rec, worker
@@ -189,7 +192,7 @@ def change_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, A
     at = args.change_at
     t0 = time.perf_counter()
     rec_on, worker = run(before, make_unit(args.plant, unit, [ShapeChange(at, change)]),
-                         t, q, True, args.seed, device)
+                         t, q, True, args.seed, device, args.bend)
     rec_off, _ = run(before, make_unit(args.plant, unit, [ShapeChange(at, change)]),
                      t, q, False, args.seed)
     rec_fresh = None
@@ -265,7 +268,8 @@ def drift_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, An
     profile = calibrated(args.plant, unit, None, device, cache, "straight")
     t, q = drift_motion(args.drift_s, args.seed + 100)
     t0 = time.perf_counter()
-    rec_on, worker = run(profile, make_unit(args.plant, unit, []), t, q, True, args.seed, device)
+    rec_on, worker = run(profile, make_unit(args.plant, unit, []), t, q, True, args.seed, device,
+                         args.bend)
     wall_on = time.perf_counter() - t0
     rec_off, _ = run(profile, make_unit(args.plant, unit, []), t, q, False, args.seed)
     assert worker is not None
@@ -325,6 +329,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cache", default="/tmp/tsmd-bench-online",
                         help="calibrated profiles go in a subdirectory per code version")
     parser.add_argument("--no-change", action="store_true", help="skip the shape-change runs")
+    parser.add_argument("--bend-relation", choices=("unit0", "off"), default="off",
+                        help="unit0: the product's bend relation measured on unit 0 (release "
+                        "line and beta move with the edges); off: x0 moves with the edges")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -336,6 +343,14 @@ def main(args: argparse.Namespace) -> int:
     args.cache = str(keyed_cache(Path(args.cache)))
     print(f"profiles cached in {args.cache}")
     device = device_for(args.plant, Path(args.cache))
+    args.bend = None
+    if args.bend_relation == "unit0":
+        from tsmd.bench.online_bend import product_bend_relation
+
+        args.bend = product_bend_relation(args.plant, device, Path(args.cache))
+        print(f"bend relation (unit 0, bends 30/60/90 deg): release line "
+              f"{args.bend.release_per_edge:.3f} deg per edge deg, beta x (1 + "
+              f"{args.bend.gain_per_release_deg:.4f} per release deg)")
     med, p99, top = hot_path_us()
     print(f"hot path (loop-side observe, two knobs): median {med:.2f} us, p99 {p99:.2f} us, "
           f"max {top:.1f} us")

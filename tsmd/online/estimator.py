@@ -29,7 +29,7 @@ from typing import Any
 
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
-from tsmd.online.slopes import common_change, shrunk_ratio
+from tsmd.online.slopes import common_change, pooled_change, shrunk_ratio
 
 
 @dataclass
@@ -72,6 +72,8 @@ class EdgeTracker:
     """This tendon's slope change as far as the knob's other tendon confirms it (last ramp)."""
     partner_change: float = 0.0
     """The knob's other tendon's slope change at this tendon's last ramp."""
+    knob_change: float = 0.0
+    """The knob's slope change over both tendons' last ramps (:func:`slopes.pooled_change`)."""
     partner_last_change: float = 0.0
     """The knob's other tendon's last ramp's own slope change (:attr:`last_change`)."""
     knee_slopes: list[float] = field(default_factory=list)
@@ -215,11 +217,42 @@ class EdgeTracker:
             mine, theirs = self.knee_slope_change, self.partner_knee_change
             tol = o.same_slope_tolerance
         elif o.gain_from_slope_in_use:
-            mine, theirs, tol = self.slope_change, self.partner_change, o.slope_in_use_tolerance
+            tol = o.slope_in_use_tolerance
+            ratio = shrunk_ratio(1.0 + self._common_change(tol), tol)
+            return min(max(ratio, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
         else:
             return 1.0
         ratio = shrunk_ratio(1.0 + common_change(mine, theirs, tol), tol)
         return min(max(ratio, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
+
+    def _pooled_ratios(self, partner: EdgeTracker | None) -> list[float]:
+        """Both tendons' last slopes, each against its own reference."""
+        ratios = [x / self.slope_ref_A_per_deg for x in self.recent_slopes
+                  ] if self.slope_ref_A_per_deg else []
+        if partner is not None and partner.slope_ref_A_per_deg:
+            ratios += [x / partner.slope_ref_A_per_deg for x in partner.recent_slopes]
+        return ratios
+
+    def _common_change(self, tol: float) -> float:
+        """The slope change the knob's two tendons share (the slope in use's, the gain's)."""
+        if self.options.pooled_slope_change:
+            return self.knob_change
+        return common_change(self.slope_change, self.partner_change, tol)
+
+    @property
+    def bend_weight(self) -> float:
+        """0..1: how far this tendon's change is a bend (the sheath's friction rose with the
+        edge's move) rather than slack (:class:`tsmd.online.bend.BendRelation` applies in that
+        share): 1 in knee mode with steeper ramps; otherwise the knob's common slope change,
+        none within ``slope_in_use_tolerance`` (a slack change leaves the slopes: lumped 101
+        0.85-1.07 x), in full beyond twice it (a 60 deg bend: 1.04-1.21 x on lumped)."""
+        if self.learning:
+            return 0.0
+        if self.knee_direction > 0 and self.knee_slopes:
+            return 1.0
+        tol = self.options.slope_in_use_tolerance
+        change = self._common_change(tol)
+        return min(max((change - tol) / tol, 0.0), 1.0) if tol > 0 else float(change > 0)
 
     @property
     def knee_slope_change(self) -> float:
@@ -273,6 +306,8 @@ class EdgeTracker:
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
         self.shared_change = shared
         self.partner_change = 0.0 if partner is None else partner.slope_change
+        self.knob_change = pooled_change(self.slope_change, self.partner_change,
+                                         self._pooled_ratios(partner))
         self.partner_last_change = 0.0 if partner is None else partner.last_change
         if ramp.past_knee:
             self.knee_slopes = [*self.knee_slopes, ramp.slope_A_per_deg][-o.slope_window:]
@@ -322,8 +357,7 @@ class EdgeTracker:
         # 1.5 deg of edge) with the slope both edges' last ramps agree on; one ramp's slope
         # scatters by 25 % and more, so a ramp that disagrees with it measures nothing.
         tol = o.slope_in_use_tolerance
-        change = self.slope_change if partner is None else common_change(
-            self.slope_change, partner.slope_change, tol)
+        change = self.slope_change if partner is None else self._common_change(tol)
         slope = self.slope_ref_A_per_deg * shrunk_ratio(1.0 + change, tol)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
             self.n_odd_slope += 1
@@ -346,9 +380,9 @@ class EdgeTracker:
             key = self._bin(other_deg)
             learned = len(self.bins.get(key, [])) >= o.bin_min
             self._teach_bin(key, raw_deg - self.estimate_deg)
-            if not learned:  # a bin still learning where the current's edge sits: it
-                return       # teaches the bin, not the estimate (a change beyond the gate
-                             # is a suspect as anywhere)
+            if not (learned or o.learning_bins_count):  # a bin still learning where the
+                return  # current's edge sits: it teaches the bin, not the estimate (a change
+                        # beyond the gate is a suspect as anywhere)
             self.accepted = [*self.accepted, m][-o.window:]
             self.estimate_deg = median(
                 [*self.accepted, *[self.level_deg] * (o.window - len(self.accepted))])

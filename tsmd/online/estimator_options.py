@@ -29,6 +29,10 @@ class EstimatorOptions:
     moves its edges +2.75..+3.4 deg; with the change shrunk to none the crossing, 15 deg out,
     read ~2 deg short and the ramps beyond 15 % measured nothing (lumped 1, 2: offsets
     0-1.8 deg; docs/online.md, Session 10)."""
+    pooled_slope_change: bool = True
+    """The slope in use (and the gain from it, and the bend share) moves with the median of
+    both tendons' last ramps' slope ratios, not with one edge's change as far as the other's
+    confirms it (:func:`slopes.common_change`)."""
     gain_from_slope_in_use: bool = True
     """Where no ramp was fitted past its knee (outside knee mode, or a plant without a
     knee), the backlash gain follows the slope in use (beta = compliance x the current's
@@ -43,6 +47,12 @@ class EstimatorOptions:
     bin_min: int = 3
     """Measurements a bin needs before its bias counts."""
     bin_window: int = 7
+    learning_bins_count: bool = False
+    """A measurement in a bin still learning counts for the estimate too (unreferred: the
+    bins' shared part is the estimate's). Off (until session 11) it only taught its bin: a
+    knob engaged at other-knob angles spread over several bins, one ramp per side every
+    ~20 s, then measured nothing for minutes (lumped 103 phi2 after a bend: 4 of 5 ramps of
+    the negative edge taught bins, the edge stayed at 0)."""
     shared_slope_ratio_max: float = 8.0
     """A slope change both edges of the knob show (a sheath's friction) is followed up to this
     ratio; beyond ``slope_ratio_max`` on one edge alone it is a stuck knob or a blocked tip."""
@@ -52,6 +62,17 @@ class EstimatorOptions:
     of the knob (a bend widens both sides alike), not after a second suspect. Off by default:
     it follows ~10 s sooner but one knee's scatter (+-1.5 deg) made capstan units 1-2 track
     worse after a bend (docs/online.md, Session 9)."""
+    gain_from_bend: bool = True
+    """With a bend relation (:class:`tsmd.online.bend.BendRelation`), the backlash gain follows
+    the relation (its growth per degree of the release line's move, on the data sheet's unit)
+    instead of the loaded slope (which over-reads beta 1.29-1.43 x against the fresh
+    calibrations' 1.18-1.27 on capstan unit 1, session 9)."""
+    bend_in_knee_mode: bool = False
+    """With a bend relation: it also places the release line and beta of an edge the knee
+    placed. Off: a knee-placed edge keeps x0 moving with it and beta from its past-knee
+    slopes (what sessions 7-9 settled on for the capstan bend: the knee reads the edge
+    0.5-1.5 deg short, and with the relation on it capstan 1, 2 tracked worse after a 60 deg
+    bend, on / fresh mean 1.99 against 1.70; docs/online.md, Session 11)."""
     keep_zero_load_in_bend: bool = False
     """On: a change the knee placed moves the edge, not the zero-load point (what a bend does
     on the capstan plant). Off by default: with the knee's edges (~1 deg short of a fresh

@@ -4,6 +4,7 @@ knob's other tendon confirms it (a sheath's friction changes both tendons of a k
 from __future__ import annotations
 
 import math
+from statistics import median
 
 
 def shrunk_ratio(ratio: float, tolerance: float) -> float:
@@ -22,3 +23,16 @@ def common_change(own: float, partner: float, tolerance: float) -> float:
     if own * partner <= 0.0:
         return 0.0
     return own * min(max(abs(partner) / tolerance - 1.0, 0.0), 1.0)
+
+
+def pooled_change(own: float, partner: float, ratios: list[float]) -> float:
+    """The knob's slope change from both tendons' last slope ``ratios`` (their median, minus
+    1): in full when the two sides' own changes ``own`` and ``partner`` go the same way and
+    the smaller is at least a quarter of the larger, none below an eighth (one tendon's ramps
+    alone run 19-27 % steep now and then: lumped 101, 1800 s), linearly between. Six ramps,
+    not each side's three against its own three-ramp reference (lumped 103 phi2 after a bend:
+    +11 % and +3.6 %, the second reference at the top of its 1.36-1.56 scatter)."""
+    if own * partner <= 0.0 or not ratios:
+        return 0.0
+    agree = min(abs(own), abs(partner)) / max(abs(own), abs(partner))
+    return (median(ratios) - 1.0) * min(max(8.0 * agree - 1.0, 0.0), 1.0)

@@ -27,6 +27,7 @@ from tsmd.online.apply import (
     edges_at,
     shifted_knob,
 )
+from tsmd.online.bend import BendRelation, bend_targets
 from tsmd.online.estimator import EdgeTracker
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import (
@@ -55,7 +56,10 @@ class OnlineWorker:
     (:attr:`tsmd.profile.DeviceKnob.handle_slip_deg`); None keeps ``ramp``'s.
     ``fault_reason``: the loop's fault (``lambda: loop.fault_reason``); when the loop leaves
     ENABLED with a fault the freeze is a warning, otherwise (stop, disable, not yet enabled)
-    the estimate pauses silently.
+    the estimate pauses silently. ``bend``: the product's bend relation (data sheet's unit);
+    with it each tendon's release line (not x0) moves with its edge as the relation says, in
+    the share its slopes call a bend (:attr:`EdgeTracker.bend_weight`); None: x0 moves with
+    the edge (a slack change's parametrisation).
     """
 
     def __init__(self, compensator: Any, period_s: float, columns: Sequence[str], *,
@@ -64,7 +68,8 @@ class OnlineWorker:
                  rate_deg_s: float = 4.0, gain_rate_per_s: float = 0.5,
                  queue_len: int = 8192, drain_every: int = 0,
                  on_event: EventSink | None = None,
-                 fault_reason: Callable[[], str | None] | None = None) -> None:
+                 fault_reason: Callable[[], str | None] | None = None,
+                 bend: BendRelation | None = None) -> None:
         compensator = getattr(compensator, "inner", compensator)  # under a LimitedCompensator
         knobs = getattr(compensator, "knobs", None)
         if knobs is None or len(knobs) != 2:
@@ -82,6 +87,7 @@ class OnlineWorker:
         self._knob_ramp = tuple(replace(self.ramp_options, handle_slip_deg=float(x))
                                 for x in slip)
         self.fault_reason = fault_reason
+        self.bend = bend
         self.trackers = {(knob, side): EdgeTracker(knob, side, estimator or EstimatorOptions())
                          for knob in (0, 1) for side in (1, -1)}
         self.rate_deg_s = rate_deg_s
@@ -273,10 +279,20 @@ class OnlineWorker:
         return self._per_edge("applied_deg") if self.enabled else ZERO_OFFSETS
 
     def _zero_load_targets(self) -> Offsets:
-        return self._per_edge("zero_load_deg") if self.enabled else ZERO_OFFSETS
+        if not self.enabled:
+            return ZERO_OFFSETS
+        return self._per_edge("zero_load_deg") if self.bend is None else self._bend_targets()[0]
 
     def _gain_targets(self) -> Offsets:
-        return self._per_edge("gain_ratio") if self.enabled else ONE_GAINS
+        if not self.enabled:
+            return ONE_GAINS
+        if self.bend is None or not self.trackers[(0, 1)].options.gain_from_bend:
+            return self._per_edge("gain_ratio")
+        return self._bend_targets()[1]
+
+    def _bend_targets(self) -> tuple[Offsets, Offsets]:
+        assert self.bend is not None
+        return bend_targets(self.bend, self.trackers, self.base_knobs)
 
     def _per_edge(self, name: str) -> Offsets:
         """One tracker value per (knob, side), in the published offsets' layout."""

@@ -17,6 +17,7 @@ from tsmd.gap.errors import GapError
 from tsmd.gap.loops import Loops, smooth_along
 from tsmd.gap.protocol import Segment, decode_table, encode_table, protocol
 from tsmd.gap.signature import SignatureScore
+from tsmd.gap.structure import rank_scores
 from tsmd.recording import Recording, read_trajectory
 
 RATE_HZ = 25.0
@@ -201,6 +202,45 @@ def test_a_tracker_drifting_in_time_alone_is_not_creep() -> None:
     assert "drift" not in _named(_scores(tracker))
 
 
+def test_a_tip_springing_back_in_the_unloaded_dwells_is_not_creep() -> None:
+    """A viscoelastic tip cover relaxes back while the knob rests at 0 (the coilpipe plant):
+    the tip drifts in the unloaded dwells, the tension does not creep."""
+    def spring_back(t: Arr, q: Arr) -> Arr:
+        out = np.zeros((len(t), 4))
+        rest = np.all(np.abs(q) < 0.5, axis=1)
+        out[:, :2] = np.where(rest, -0.05 * t, 0.0)[:, None]
+        return out
+    assert "drift" not in _named(_scores(spring_back))
+
+
+def test_creep_within_one_samples_current_noise_is_not_named() -> None:
+    def faint(t: Arr, q: Arr) -> Arr:
+        return 0.15 * _creep(t, q)
+    series, residuals = _session(faint)
+    scores = {s.name: s for s in contrast_scores(series, residuals, n_tried=6,
+                                                 current_noise_A=0.004)}
+    assert scores["drift"].z > 2.5  # found, but about 3 mA over a dwell
+    assert not scores["drift"].significant
+
+
+def _dead_zone(x: Arr, width: Arr) -> Arr:
+    return np.sign(x) * np.maximum(np.abs(x) - width, 0.0)
+
+
+def test_a_dead_zone_widening_with_the_other_knob_is_explained_as_coupling() -> None:
+    """The other plane's bend shortens the tendon path: more slack on both sides of this knob
+    (the coilpipe plant's coupling), which neither a shift nor a backlash widening takes."""
+    def wider_dead_zone(t: Arr, q: Arr) -> Arr:
+        out = np.zeros((len(t), 4))
+        for j in range(2):
+            extra = 3.0 * (q[:, 1 - j] / 50.0) ** 2
+            out[:, j] = 0.8 * (_dead_zone(q[:, j], 6.0 + extra) - _dead_zone(q[:, j], 6.0))
+        return out
+    scores = _scores(wider_dead_zone)
+    assert _named(scores) == {"coupling"}
+    assert scores["coupling"].share > 0.8
+
+
 def _lagged_current(t: Arr, q: Arr) -> Arr:
     """A current sensor lagging by 0.1 s: its reading minus the true current."""
     true = _simulated(t, q)[:, 2]
@@ -278,3 +318,13 @@ def test_the_protocol_command_writes_a_trajectory_replay_reads_with_its_labels(
     assert np.allclose(traj["q1"], q[:, 0]) and np.allclose(traj["t"], t)
     assert decode_table(traj.metadata["segments"], "x") == table
     assert traj.metadata["configuration"] == "looped"
+
+
+def test_of_two_significant_loop_contrasts_the_larger_ranks_first() -> None:
+    def score(name: str, share: float, size_deg: float = float("nan")) -> SignatureScore:
+        return SignatureScore(name, name, "", share, (share, share), True, share, 0.0,
+                              size_deg=size_deg)
+
+    ranked = rank_scores([score("rate", 0.97, 0.3), score("sensor", 0.95),
+                          score("coupling", 0.90, 0.8)])
+    assert [s.name for s in ranked] == ["coupling", "sensor", "rate"]

@@ -122,6 +122,27 @@ def test_segments_compliance_case_halves_the_units_tendon_stiffness() -> None:
         assert soft.knobs[k].slack_pos_mm == none.knobs[k].slack_pos_mm
 
 
+def test_coilpipe_preset_has_the_path_coupling_off_in_its_none_units_and_its_simulator() -> None:
+    coilpipe = parse_plant_spec("coilpipe")
+    assert coilpipe.build_unit(101, 0.1).shared.coupling_mm_per_rad2 == 0.0
+    assert coilpipe.build().shared.coupling_mm_per_rad2 == 0.0
+    coupled = coilpipe.build_unit(101, 0.1, "coupling", **coilpipe.case_effects("coupling"))
+    assert coupled.shared.coupling_mm_per_rad2 > 0.0
+
+
+def test_coilpipe_rate_and_creep_cases_scale_the_units_own_constants() -> None:
+    coilpipe = PRESETS["coilpipe"]
+    none = coilpipe.build_unit(102, 0.1)
+    fast = coilpipe.build_unit(102, 0.1, "rate", **coilpipe.case_effects("rate"))
+    slow = coilpipe.build_unit(102, 0.1, "creep", **coilpipe.case_effects("creep"))
+    for k in (0, 1):
+        assert fast.knobs[k].viscous_N_s_per_mm == pytest.approx(
+            8.0 * none.knobs[k].viscous_N_s_per_mm)
+        assert slow.knobs[k].bend_creep_time_s == pytest.approx(
+            2.0 * none.knobs[k].bend_creep_time_s)
+        assert fast.knobs[k].bend_creep_time_s == none.knobs[k].bend_creep_time_s
+
+
 def test_a_case_the_data_plant_lacks_is_not_run(monkeypatch: pytest.MonkeyPatch) -> None:
     import tsmd.gap.crosstest as crosstest
 

@@ -112,6 +112,30 @@ def test_replay_steps_the_plant_once_per_row() -> None:
     assert tip[-1, 0] == pytest.approx(1.3 * 50)
 
 
+class _StiffPlant(StandInPlant):
+    """Fails on a step longer than 0.05 s, as an implicit plant may on thinned replay rows."""
+
+    def step(self, dt_s: float, knob_deg: np.ndarray) -> object:
+        if dt_s > 0.05:
+            raise FloatingPointError("step did not converge")
+        return super().step(dt_s, knob_deg)
+
+
+def test_a_step_the_plant_cannot_take_is_replayed_in_parts() -> None:
+    t = np.concatenate([np.arange(0, 5, 0.02), 5.0 + np.arange(1, 6) * 0.2])
+    knob = np.column_stack([np.linspace(0, 60, len(t)), np.zeros(len(t))])
+    tip, _ = simulate(_StiffPlant(slack_deg=10, play_deg=0), t, knob)
+    assert np.all(np.isfinite(tip))
+    assert tip[-1, 0] == pytest.approx(1.3 * 50)
+
+
+def test_a_plant_failing_even_in_parts_stops_with_one_line() -> None:
+    t = np.arange(0, 10, 1.0)
+    knob = np.column_stack([np.linspace(0, 60, len(t)), np.zeros(len(t))])
+    with pytest.raises(GapError, match="simulator plant failed at t = 0.000 s"):
+        simulate(_StiffPlant(slack_deg=10, play_deg=0), t, knob)
+
+
 def test_eval_grid_keeps_every_held_out_row() -> None:
     ho = np.zeros(1000, dtype=bool)
     ho[300:420] = True

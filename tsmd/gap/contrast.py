@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from scipy import stats
 
 from tsmd.gap.data import GapSeries
-from tsmd.gap.dwell import Drift, drift_shrink, drift_stat, dwell_slope
+from tsmd.gap.dwell import CREEP_CHANNELS, Drift, drift_shrink, drift_size, drift_stat, dwell_slope
 from tsmd.gap.loops import (
     Loops,
     Triple,
@@ -42,6 +42,9 @@ DECIDES: dict[str, str] = {"rate": "rate", "coupling": "coupling", "creep": "dri
 """Protocol test -> the signature it replaces when the recordings carry it (curvature: the
 rate and coupling tests' loops compared across configurations)."""
 
+LOOP_TESTS: frozenset[str] = frozenset({"rate", "coupling", "curvature"})
+"""The tests that compare residual loops (their contrast has a size in degrees)."""
+
 UNMATCHED: frozenset[str] = frozenset({"compliance"})
 """Signatures the protocol has no matched contrast for. Their null (the load shifted in time)
 breaks the link between the condition and the knob history, which the base mismatch shares:
@@ -52,7 +55,7 @@ they are still scored and shown, but not named."""
 CONDITIONS: dict[str, str] = {
     "rate": "the same loops at two speeds (matched segments)",
     "coupling": "the same loop with the other knob held at -, 0, + (matched segments)",
-    "creep": "tip and current drift in loaded against unloaded dwells",
+    "creep": "current drift in loaded against unloaded dwells",
     "curvature": "the same loops in two sheath configurations (matched segments)",
 }
 
@@ -75,14 +78,17 @@ class TestData:
 def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray],
                     n_tried: int, family_alpha: float = 0.05,
                     min_share: float = 0.05,
-                    tip_noise_deg: float | None = None) -> list[SignatureScore]:
+                    tip_noise_deg: float | None = None,
+                    current_noise_A: float | None = None) -> list[SignatureScore]:
     """Score every protocol test found in ``series`` (``residuals``: (n, 4) data minus the
     physics simulator, per series). Significant: p below ``family_alpha / n_tried``, at
     least ``min_share`` of a held-out configuration's contrast reproduced and, for the loop
     tests when ``tip_noise_deg`` (one sample's tracker noise) is given, a contrast larger than
     that noise (:func:`excess_rms`): a difference inside the noise of every single sample is
     found by enough repeats but is no cause of the gap (the blind plant's own rate dependence,
-    about 0.05 deg, was named rate against the capstan simulator: docs/gap.md, session 10)."""
+    about 0.05 deg, was named rate against the capstan simulator: docs/gap.md, session 10).
+    Creep likewise, when ``current_noise_A`` is given: the currents' drift over a loaded dwell
+    (:func:`tsmd.gap.dwell.drift_size`) at least one sample's current noise (session 11)."""
     by_config: dict[str, dict[str, TestData]] = {}
     for s, res in zip(series, residuals, strict=True):
         if s.segment is not None:
@@ -107,7 +113,7 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
             _, _, p = drift_stat(drifts)
             shrinks = [drift_shrink(drifts[:i] + drifts[i + 1:], drifts[i])
                        for i in range(len(drifts))]
-            size = float("nan")  # slopes, not loops: no size against one sample's noise
+            size = drift_size(drifts)
         else:
             found = [loop_contrast(t.loops, t.levels) for t in per_cfg]
             loops = [lp for lp in found if lp is not None]
@@ -121,12 +127,16 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
         share = float(np.mean(finite)) if finite else 0.0
         lo_hi = (min(finite), max(finite)) if finite else (float("nan"), float("nan"))
         title, _ = SIGNATURES[name]
-        material = not (np.isfinite(size) and tip_noise_deg is not None) or size >= tip_noise_deg
+        noise = current_noise_A if test == "creep" else tip_noise_deg
+        material = not (np.isfinite(size) and noise is not None) or size >= noise
         sig = bool(p < crit and finite and share >= min_share and material)
         condition = CONDITIONS[test]
-        if np.isfinite(size):
+        if np.isfinite(size) and test == "creep":
+            condition += f"; {1e3 * size:.1f} mA over a loaded dwell above the slopes' noise"
+        elif np.isfinite(size):
             condition += f"; contrast {size:.3f} deg above the repeats' noise"
-        out.append(SignatureScore(name, title, condition, share, lo_hi, sig, share, 0.0, _z(p)))
+        out.append(SignatureScore(name, title, condition, share, lo_hi, sig, share, 0.0, _z(p),
+                                  size if test in LOOP_TESTS else float("nan")))
     return out
 
 
@@ -193,23 +203,25 @@ def _collect(s: GapSeries, res: FloatArray, tests: dict[str, TestData]) -> None:
 
 
 def _drift(data: TestData) -> Drift:
-    """Loaded-minus-unloaded dwell slopes per repeat and channel."""
-    diffs, vars_ = [], []
+    """Loaded-minus-unloaded dwell slopes per repeat and current channel."""
+    diffs, vars_, spans = [], [], []
     for rep in sorted({r for _, r in data.dwells}):
         loaded, unloaded = data.dwells.get(("loaded", rep)), data.dwells.get(("unloaded", rep))
         if loaded is None or unloaded is None:
             continue
         (tl, yl), (tu, yu) = loaded, unloaded
         row_d, row_v = [], []
-        for ch in range(yl.shape[1]):
+        for ch in CREEP_CHANNELS:
             sl, vl = dwell_slope(tl, yl[:, ch])
             su, vu = dwell_slope(tu, yu[:, ch])
             row_d.append(sl - su)
             row_v.append(vl + vu)
         diffs.append(row_d)
         vars_.append(row_v)
+        spans.append(float(tl[-1] - tl[0]))
     return Drift(np.array(diffs, dtype=float).reshape(len(diffs), -1),
-                 np.array(vars_, dtype=float).reshape(len(vars_), -1))
+                 np.array(vars_, dtype=float).reshape(len(vars_), -1),
+                 np.array(spans, dtype=float))
 
 
 def lag_share(series: Sequence[GapSeries],

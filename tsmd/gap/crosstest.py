@@ -96,6 +96,31 @@ SEGMENTS_KNOB_EFFECTS: dict[str, dict[str, float]] = {"compliance": {"tendon_sti
 ``tendon_compliance`` 1.0 is exactly that, docs/gap.md). Tip moved 6.42 deg (unit 1)."""
 
 
+COILPIPE_BASE: dict[str, Any] = {"coupling_mm_per_rad2": 0.0}
+"""The coilpipe plant shortens a tendon's path with the other plane's bend by default (0.25
+mm/rad^2); its "none" units and its simulator have that off. What stays on is base physics: the
+shaft's compression under all four tensions (a load coupling of both knobs), LuGre friction
+with Stribeck and viscous terms (a rate dependence of its own) and the tip's relaxing stiffness
+(2 s: a creep of its own); docs/gap.md "Session 11"."""
+
+COILPIPE_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"coupling_mm_per_rad2": 0.55},
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The self-test effects in the coilpipe plant's own keywords, sized like the others before any
+diagnosis (tip RMSE effect on minus off, unit 1, noise-free, 120 s of the experiment motion at
+50 Hz): path coupling 0.55 mm/rad^2 1.51 deg, a 120 deg bend 5.14 deg."""
+
+COILPIPE_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "rate": {"viscous_N_s_per_mm": 8.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+    "creep": {"bend_creep_time_s": 2.0},
+}
+"""Coilpipe effects without a keyword, as factors on the unit's knob constants (same sizing):
+lumen viscosity x8 1.56 deg, tendon EA halved 4.47 deg, the tip cover relaxing twice as slowly
+(2 -> 4 s, its one creep branch) 0.58 deg."""
+
+
 @dataclass(frozen=True)
 class PlantSpec:
     """A plant as ``module:factory`` + fixed keyword parameters + what to fit as a simulator.
@@ -153,6 +178,9 @@ PRESETS: dict[str, PlantSpec] = {
     "segments": PlantSpec(PLANT_SPECS["segments"], dict(SEGMENTS_BASE), (), "segments",
                           family="segments", effects=SEGMENTS_EFFECTS,
                           knob_effects=SEGMENTS_KNOB_EFFECTS),
+    "coilpipe": PlantSpec(PLANT_SPECS["coilpipe"], dict(COILPIPE_BASE), (), "coilpipe",
+                          family="coilpipe", effects=COILPIPE_EFFECTS,
+                          knob_effects=COILPIPE_KNOB_EFFECTS),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

@@ -1,7 +1,11 @@
 """Creep from dwells: the residual's slope with the tendon loaded minus unloaded.
 
 A drifting tracker or a slow base mismatch drifts in both dwells and cancels in the difference;
-creep under tension drifts only in the loaded one.
+creep under tension drifts only in the loaded one. Creep under tension is read on the motor
+currents (the tension the held knob needs relaxes as the tendon creeps): at a held knob the tip
+also moves for reasons of the bending section, e.g. a viscoelastic cover that creeps on under
+load and springs back slowly in the unloaded dwell (the coilpipe plant, docs/gap.md "Session
+11"), which is no creep of the tendon and larger in the unloaded dwell than in the loaded one.
 """
 
 from __future__ import annotations
@@ -22,6 +26,11 @@ class Drift:
 
     diff: FloatArray  # (pairs, channels) loaded minus unloaded slope
     var: FloatArray
+    span_s: FloatArray  # (pairs,) how long each loaded dwell is compared
+
+
+CREEP_CHANNELS: tuple[int, int] = (2, 3)
+"""The residual's channels the creep test reads: the two motor currents (see the module)."""
 
 
 def dwell_slope(t: FloatArray, y: FloatArray) -> tuple[float, float]:
@@ -42,6 +51,18 @@ def drift_stat(drifts: Sequence[Drift]) -> tuple[float, float, float]:
     chi = sum(float((d.diff[u] ** 2 / d.var[u]).sum()) for d, u in zip(drifts, used, strict=True))
     dof = float(sum(int(u.sum()) for u in used))
     return chi, dof, float(stats.chi2.sf(chi, dof)) if dof else 1.0
+
+
+def drift_size(drifts: Sequence[Drift]) -> float:
+    """How far creep moves a channel over one loaded dwell beyond the slopes' noise: the RMS
+    loaded-minus-unloaded slope less its variance, times the dwell's compared length (the
+    channels' unit, here A)."""
+    diff = np.concatenate([d.diff.ravel() for d in drifts]) if drifts else np.zeros(0)
+    if not diff.size:
+        return float("nan")
+    var = np.concatenate([d.var.ravel() for d in drifts])
+    span = float(np.median(np.concatenate([d.span_s for d in drifts])))
+    return float(np.sqrt(max(float(np.mean(diff**2 - var)), 0.0)) * span)
 
 
 def drift_shrink(train: Sequence[Drift], held: Drift) -> float:

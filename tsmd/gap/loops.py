@@ -146,13 +146,16 @@ def _slope(lp: Loops, mean_loop: FloatArray) -> FloatArray:
 
 def _design(lp: Loops, mean_loop: FloatArray) -> FloatArray:
     """Effect-model regressors per point: shift along the knob (slope), widening (slope x
-    branch, also growing with the bend), a branch offset and an offset, per knob/channel."""
+    branch, also growing with the bend), a dead zone widening (slope x side: both sides'
+    loaded branches move outwards, as more slack makes them; since session 11), a branch
+    offset and an offset, per knob/channel."""
     g = _slope(lp, mean_loop)
     load = np.abs(lp.knob)
+    side = np.sign(lp.knob)
     cols = []
     for p in np.unique(lp.part):
         z = (lp.part == p).astype(float)
-        cols += [z * g, z * g * lp.dirn, z * g * lp.dirn * load, z * lp.dirn,
+        cols += [z * g, z * g * lp.dirn, z * g * lp.dirn * load, z * g * side, z * lp.dirn,
                  z * lp.dirn * load, z]
     return np.column_stack(cols)
 

@@ -135,6 +135,8 @@ class SignatureScore:
     """Mean share its surrogates remove."""
     z: float = float("nan")
     """How many surrogate standard deviations the true condition's gain lies above theirs."""
+    size_deg: float = float("nan")
+    """A matched loop test's contrast above the repeats' noise (deg; NaN for the others)."""
 
 
 @dataclass

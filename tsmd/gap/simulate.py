@@ -7,6 +7,7 @@ Python call per row, so rows the fit does not score are thinned (see :func:`eval
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from typing import Any
 
@@ -15,25 +16,66 @@ from numpy.typing import NDArray
 from scipy import signal
 
 from simrig.plant import Plant, as_plant_step
+from tsmd.gap.errors import GapError
 
 PlantFactory = Callable[[dict[str, Any]], Plant]
 """Builds a fresh plant from the base parameters being fitted (the others are fixed)."""
 
 
+SUBSTEPS = 16
+"""A step an implicit plant (coilpipe) does not converge on is taken again in this many equal
+parts of time and knob travel, from the plant's state before it."""
+_PLANT_FAILURES = (ArithmeticError, np.linalg.LinAlgError)
+
+
 def simulate(plant: Plant, t_s: NDArray[np.float64],
              knob_deg: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Step ``plant`` through the knob angles at times ``t_s``; return tip (N,2), torque (N,2)."""
+    """Step ``plant`` through the knob angles at times ``t_s``; return tip (N,2), torque (N,2).
+
+    A plant that fails on a step (thinned replay rows are longer steps than the recording's)
+    is replayed again keeping a copy of its state before every step, and a failing step is
+    retried in parts; only if that fails too does the replay stop, with one line
+    (:class:`GapError`). Plants that never fail pay nothing for this."""
+    knob = np.asarray(knob_deg, dtype=float)
+    try:
+        return _replay(plant, t_s, knob, guarded=False)
+    except _PLANT_FAILURES:
+        return _replay(plant, t_s, knob, guarded=True)
+
+
+def _replay(plant: Plant, t_s: NDArray[np.float64], knob: NDArray[np.float64],
+            guarded: bool) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     n = len(t_s)
     tip = np.empty((n, 2))
     torque = np.empty((n, 2))
     plant.reset()
     dt = np.diff(t_s, prepend=t_s[0] - (t_s[1] - t_s[0] if n > 1 else 0.01))
-    step = plant.step
     for k in range(n):
-        out = as_plant_step(step(float(dt[k]), knob_deg[k]))
+        saved = copy.deepcopy(plant) if guarded else None
+        try:
+            out = as_plant_step(plant.step(float(dt[k]), knob[k]))
+        except _PLANT_FAILURES:
+            if saved is None:
+                raise
+            plant = saved
+            out = _in_parts(plant, float(dt[k]), knob[max(k - 1, 0)], knob[k], float(t_s[k]))
         tip[k] = out.tip_deg
         torque[k] = out.knob_torque_Nm
     return tip, torque
+
+
+def _in_parts(plant: Plant, dt_s: float, start_deg: NDArray[np.float64],
+              end_deg: NDArray[np.float64], t_s: float) -> Any:
+    """One replay step taken in :data:`SUBSTEPS` equal parts of time and knob travel."""
+    out = None
+    try:
+        for i in range(1, SUBSTEPS + 1):
+            knob = start_deg + (end_deg - start_deg) * (i / SUBSTEPS)
+            out = as_plant_step(plant.step(dt_s / SUBSTEPS, knob))
+    except _PLANT_FAILURES as exc:
+        raise GapError(f"the simulator plant failed at t = {t_s:.3f} s, even in "
+                       f"{SUBSTEPS} parts: {exc}") from None
+    return out
 
 
 def turning_points(x: NDArray[np.float64], min_travel: float) -> NDArray[np.int64]:

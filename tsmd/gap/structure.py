@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 from tsmd.gap.compliance import compliance_score
 from tsmd.gap.contrast import (
     DECIDES,
+    LOOP_TESTS,
     UNMATCHED,
     contrast_scores,
     lag_share,
@@ -45,7 +46,8 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         # mismatch, which the signatures of the same effects compete with
         residuals = _residuals(series, split, ev, base_fit)
         found = contrast_scores(series, residuals, len(sres.scores), cfg.family_alpha,
-                                cfg.min_share, float(np.sqrt(np.mean(noise_var[:2]))))
+                                cfg.min_share, float(np.sqrt(np.mean(noise_var[:2]))),
+                                float(np.sqrt(np.mean(noise_var[2:]))))
         if cfg.compliance_reference is not None:
             stretch = compliance_score(series, cfg.compliance_reference, len(sres.scores),
                                        cfg.family_alpha, cfg.min_share)
@@ -98,8 +100,18 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
 def rank_scores(scores: Sequence[SignatureScore]) -> list[SignatureScore]:
     """By share, a significant compliance after every other score: a coupling or a current lag
     also moves its reversals' figure, and they are tested on matched contrasts that a
-    compliance leaves alone (docs/gap.md)."""
-    return sorted(scores, key=lambda s: (s.name == "compliance" and s.significant, -s.share))
+    compliance leaves alone (docs/gap.md). Significant matched loop tests take their places
+    among themselves by the size of their contrast: a share says how well the effect model
+    reproduces a contrast, not how large it is, and a catheter whose base has a small effect
+    of its own (the coilpipe plant's rate dependence, 0.3 deg) reproduces it as well as the
+    large one added (session 11)."""
+    ordered = sorted(scores, key=lambda s: (s.name == "compliance" and s.significant, -s.share))
+    loops = [i for i, s in enumerate(ordered)
+             if s.significant and s.name in LOOP_TESTS and np.isfinite(s.size_deg)]
+    by_size = sorted((ordered[i] for i in loops), key=lambda s: -s.size_deg)
+    for i, s in zip(loops, by_size, strict=True):
+        ordered[i] = s
+    return ordered
 
 
 def _residuals(series: Sequence[GapSeries], split: Split, ev: Evaluator,

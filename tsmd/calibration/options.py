@@ -101,17 +101,19 @@ against the sweep's mean ratio (session 10)."""
 def for_product(options: IdentifyOptions, settle_fraction: float | None,
                 slope_ratio: float | None = None,
                 settle_lag_deg: float | None = None,
-                line_share: float | None = None) -> IdentifyOptions:
+                line_share: float | None = None,
+                rule: str | None = None) -> IdentifyOptions:
     """The identification for one knob of a product whose data sheet measured how far the
     current has come back when the tip starts to move: below :data:`SETTLED_FRACTION` the
     backlash ends at that share of the current's swing ("fraction"), moved per sweep by the
     unit's own slope ratio where the sheet gives its unit's (``slope_ratio``); else the
     settle rule, ended ``settle_lag_deg`` beyond the settle where the sheet measured that lag;
     else as ``options`` say. A sheet's ``line_share`` (the share of the gap to the release
-    line) replaces ``settle_fraction`` and its coefficient."""
+    line) replaces ``settle_fraction`` and its coefficient, unless the sheet's ``rule`` is
+    "swing" (``DeviceKnob.backlash_release_rule``: the product keeps the share of the swing)."""
     if options.backlash != "settle":
         return options
-    if line_share is not None:
+    if line_share is not None and rule != "swing":
         if line_share >= SETTLED_FRACTION:
             return for_product(options, line_share, None, settle_lag_deg)
         line = replace(options, backlash="fraction", backlash_fraction=line_share,

@@ -4,7 +4,6 @@ names it, calibration follows it, and a sheet without it keeps the rule its shar
 from __future__ import annotations
 
 import dataclasses
-import math
 from pathlib import Path
 
 import pytest
@@ -88,11 +87,11 @@ def test_each_knob_gets_the_rule_that_reproduced_the_tip_better() -> None:
     assert [k.backlash_release_rule for k in chosen.knobs] == ["swing", "line"]
 
 
-def test_a_tie_in_count_goes_to_the_smaller_mean_error_then_to_line() -> None:
+def test_a_tie_in_count_keeps_line_whatever_the_mean_errors() -> None:
     scores = [scored("line", 0, 50, mean=1.2), scored("swing", 0, 50, mean=0.9),
-              scored("line", 1, 50), scored("swing", 1, 50)]
+              scored("line", 1, 50), scored("swing", 1, 49, mean=0.5)]
     chosen = choose_rules(sheet(), scores)
-    assert [k.backlash_release_rule for k in chosen.knobs] == ["swing", "line"]
+    assert [k.backlash_release_rule for k in chosen.knobs] == ["line", "line"]
 
 
 def test_a_knob_without_a_line_share_cannot_be_given_the_line_rule() -> None:
@@ -101,11 +100,6 @@ def test_a_knob_without_a_line_share_cannot_be_given_the_line_rule() -> None:
     assert [k.backlash_release_rule for k in chosen.knobs] == ["swing", "swing"]
     assert all(k.backlash_release_rule is None
                for k in with_rule(sheet(line_share=None), "line").knobs)
-
-
-def test_a_failed_calibration_scores_below_any_that_placed_values() -> None:
-    refused = RuleScore("line", 0, 0, 56, math.nan, math.nan, 0, 2)
-    assert scored("swing", 0, 0, mean=20.0).key() < refused.key()
 
 
 def test_bad_rule_seeds_are_one_line_before_anything_is_measured(

@@ -28,7 +28,7 @@ from tsmd.bench.calibration_family import (
 from tsmd.bench.tip_truth import tip_truth
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.config import TsmdConfig
-from tsmd.profile import DeviceModel
+from tsmd.profile import DeviceKnob, DeviceModel
 from tsmd.profile.types import RELEASE_RULES
 
 RULE_NOISE_SEEDS = (0, 1)
@@ -61,14 +61,20 @@ class RuleScore:
 
 
 def with_rule(device: DeviceModel, rule: str) -> DeviceModel:
-    """The sheet with ``rule`` on every knob that can use it (line: where a line share is)."""
+    """The sheet with ``rule`` on every knob that can use it (line, local: where the knob has
+    that share)."""
     if rule not in RELEASE_RULES:
         raise ValueError(f"unknown backlash rule {rule!r}")
-    knobs = tuple(
-        dataclasses.replace(k, backlash_release_rule=(
-            rule if rule == "swing" or k.backlash_release_line_share is not None else None))
-        for k in device.knobs)
+    knobs = tuple(dataclasses.replace(k, backlash_release_rule=rule if usable(k, rule) else None)
+                  for k in device.knobs)
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+
+def usable(knob: DeviceKnob, rule: str) -> bool:
+    """Whether the knob's sheet has the share ``rule`` needs."""
+    share = {"line": knob.backlash_release_line_share,
+             "local": knob.backlash_release_local_share}.get(rule, 1.0)
+    return share is not None
 
 
 def knob_errors(errors: Sequence[float], knob: int) -> np.ndarray:
@@ -100,13 +106,12 @@ def rule_scores(config: TsmdConfig, device: DeviceModel,
 
 
 def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceModel:
-    """Each knob gets the rule that placed more values within the target; a tie keeps
-    "line" (the rule of a sheet with a line share and no choice, chosen on the development
-    units of lumped and segments), and "line" needs the knob's line share."""
+    """Each knob gets the rule that placed the most values within the target; a tie keeps
+    the earlier of :data:`RELEASE_RULES` ("line": the rule of a sheet with a line share and no
+    choice, chosen on the development units of lumped and segments); a rule needs its share."""
     knobs = []
     for knob, k in enumerate(device.knobs):
-        mine = [s for s in scores if s.knob == knob
-                and (s.rule == "swing" or k.backlash_release_line_share is not None)]
+        mine = [s for s in scores if s.knob == knob and usable(k, s.rule)]
         if not mine:
             knobs.append(k)
             continue

@@ -160,7 +160,8 @@ def main(args: argparse.Namespace) -> int:
               f"{_or_none(c.backlash_settle_fraction, 3)} and slope ratio "
               f"{_or_none(c.backlash_release_slope_ratio, 4)}, swing "
               f"{_or_none(c.release_swing_A, 4)} A, settle lag {_or_none(c.settle_lag_deg, 2)} "
-              f"deg, line share {_or_none(c.release_line_share, 4)} over "
+              f"deg, line share {_or_none(c.release_line_share, 4)}, local share "
+              f"{_or_none(c.release_local_share, 4)} over "
               f"{c.release_reversals} reversals")
         for side, shape in (("+", c.loaded_shape_pos), ("-", c.loaded_shape_neg)):
             # tip travel past the plateau over knob travel past the edge

@@ -53,6 +53,15 @@ def test_a_sheet_without_the_choice_keeps_the_rule_its_shares_imply() -> None:
     assert device_options(None, with_line) != device_options(None, without_line)
 
 
+def test_a_sheet_naming_local_ends_the_backlash_against_the_branch_just_beyond() -> None:
+    device = sheet(rule="local")
+    device = dataclasses.replace(device, knobs=tuple(
+        dataclasses.replace(k, backlash_release_local_share=0.99) for k in device.knobs))
+    opts = device_options(None, device)[1]
+    assert (opts.backlash, opts.release_level, opts.backlash_fraction) == (
+        "fraction", "local", 0.99)
+
+
 def test_swing_with_a_settled_share_keeps_the_settle_rule() -> None:
     opts = for_product(IdentifyOptions(), 0.995, settle_lag_deg=0.5, line_share=LINE_SHARE,
                        rule="swing")
@@ -67,8 +76,9 @@ def test_the_rule_survives_the_sheets_yaml() -> None:
 
 
 @pytest.mark.parametrize(("rule", "line_share", "message"), [
-    ("median", LINE_SHARE, "not one of line, swing"),
+    ("median", LINE_SHARE, "not one of line, swing, local"),
     ("line", None, "needs backlash_release_line_share"),
+    ("local", LINE_SHARE, "needs backlash_release_local_share"),
 ])
 def test_a_bad_rule_in_the_sheet_is_one_line_naming_the_key(
         rule: str, line_share: float | None, message: str) -> None:

@@ -30,8 +30,9 @@ def sheet(line_share: float | None = LINE_SHARE, rule: str | None = None) -> Dev
     return dataclasses.replace(base, knobs=(knobs[0], knobs[1]))
 
 
-def scored(rule: str, knob: int, within: int, mean: float = 1.0) -> RuleScore:
-    return RuleScore(rule, knob, within, 56, mean, 3.0, 2, 2)
+def scored(rule: str, knob: int, within: int, mean: float = 1.0, accepted: int = 2
+           ) -> RuleScore:
+    return RuleScore(rule, knob, within, 56, mean, 3.0, accepted, 2)
 
 
 def test_a_sheet_naming_swing_ends_the_backlash_at_the_share_of_the_swing() -> None:
@@ -102,6 +103,13 @@ def test_a_tie_in_count_keeps_line_whatever_the_mean_errors() -> None:
               scored("line", 1, 50), scored("swing", 1, 49, mean=0.5)]
     chosen = choose_rules(sheet(), scores)
     assert [k.backlash_release_rule for k in chosen.knobs] == ["line", "line"]
+
+
+def test_a_tie_in_count_goes_to_the_rule_whose_runs_were_accepted() -> None:
+    scores = [scored("line", 0, 50, accepted=1), scored("swing", 0, 50, accepted=2),
+              scored("line", 1, 50), scored("swing", 1, 50)]
+    chosen = choose_rules(sheet(), scores)
+    assert [k.backlash_release_rule for k in chosen.knobs] == ["swing", "line"]
 
 
 def test_a_knob_without_a_line_share_cannot_be_given_the_line_rule() -> None:

@@ -15,6 +15,8 @@ from tsmd.calibration.pieces import (
     fraction_end,
     line_share_at,
     line_share_end,
+    local_share_at,
+    local_share_end,
     release_line,
     share_end,
 )
@@ -131,3 +133,20 @@ def test_the_line_share_survives_the_sheets_yaml() -> None:
     assert sheet.knobs[0].backlash_release_line_share == 0.9437
     assert sheet.knobs[1].backlash_release_line_share is None
     assert device_model_to_mapping(sheet)["knobs"]["phi1"]["backlash_release_line_share"] == 0.9437
+
+
+def shelf_then_ramp(x_deg: np.ndarray) -> np.ndarray:
+    """A release that levels off on a shelf 14 deg after the reversal and ramps on from 30 to
+    60 deg (the coilpipe plant's shape), direction-signed: loaded -1 A, final level 0 A."""
+    fall = 0.85 * (1.0 - np.exp(-x_deg / 3.5))
+    ramp = 0.15 * np.clip((x_deg - 30.0) / 30.0, 0.0, 1.0)
+    return np.asarray(-1.0 + fall + ramp, dtype=float)
+
+
+def test_the_local_rule_ends_on_the_shelf_not_on_the_later_ramp() -> None:
+    grid = np.arange(0.0, 100.0, 0.25)
+    y = shelf_then_ramp(grid)
+    release = round(14.0 / 0.25)
+    share = local_share_at(grid, y, release, 4.0)
+    assert local_share_end(grid, y, share, 4.0) == pytest.approx(release, abs=4)
+

@@ -31,6 +31,7 @@ from tsmd.calibration.pieces import (
     RELEASE_LEVEL_WINDOW_DEG,
     line_share_at,
     loaded_current,
+    local_share_at,
     release_line,
     release_slope_ratio,
     smooth_value,
@@ -114,6 +115,8 @@ class KnobConstants:
     """The share of its gap to the release line at the same knob angle that the current has
     closed at the tip's release (:func:`tsmd.calibration.pieces.line_share_at`), median over
     the reversals."""
+    release_local_share: float | None = None
+    """The same against the branch just beyond (:func:`~tsmd.calibration.pieces.local_share_at`)."""
     release_reversals: int = 0
     """How many reversals gave the five above (:func:`release_reads`)."""
     loaded_shape_pos: LoadedShape | None = None
@@ -151,7 +154,9 @@ class KnobConstants:
                                      else r(self.settle_lag_deg)),
             loaded_shape_pos=self.loaded_shape_pos, loaded_shape_neg=self.loaded_shape_neg,
             backlash_release_line_share=(None if self.release_line_share is None
-                                         else round(float(self.release_line_share), 4)))
+                                         else round(float(self.release_line_share), 4)),
+            backlash_release_local_share=(None if self.release_local_share is None
+                                          else round(float(self.release_local_share), 4)))
 
 
 def settle(t_s: NDArray[np.float64], q_deg: NDArray[np.float64], period_s: float,
@@ -207,6 +212,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
             backlash_release_slope_ratio=ends.backlash_release_slope_ratio,
             release_swing_A=ends.release_swing_A, settle_lag_deg=ends.settle_lag_deg,
             release_line_share=ends.release_line_share,
+            release_local_share=ends.release_local_share,
             release_reversals=ends.release_reversals)
     if not rec.has_tip:
         raise DatasheetError("the recording has no tip angles (tip1, tip2): a data sheet "
@@ -262,6 +268,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
     shapes = [measure_loaded_shape(pos, tip, round(cur.estimate(f"dead_zone_{s}_deg"), 2),
                                    round(omega, 2), side) for s, side in (("pos", 1), ("neg", -1))]
     line_shares = [r.line_share for r in reads if math.isfinite(r.line_share)]
+    local_shares = [r.local_share for r in reads if math.isfinite(r.local_share)]
     return KnobConstants(
         omega=omega, release_omega=float(np.median(released)),
         reference_pos=ReferencePoint(SWEEP_AMPLITUDE_DEG, float(np.median(tip[pos > top]))),
@@ -276,6 +283,7 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
         release_swing_A=float(np.median([r.swing_A for r in reads])) if reads else None,
         settle_lag_deg=float(np.median(lags)) if lags else None,
         release_line_share=float(np.median(line_shares)) if line_shares else None,
+        release_local_share=float(np.median(local_shares)) if local_shares else None,
         release_reversals=len(reads), loaded_shape_pos=shapes[0], loaded_shape_neg=shapes[1])
 
 
@@ -311,6 +319,8 @@ class ReleaseRead(NamedTuple):
     """Knob travel from the settle rule's end to the tip's release."""
     line_share: float = math.nan
     """The share of the gap to the release line closed at the tip's release."""
+    local_share: float = math.nan
+    """The share of the gap to the branch just beyond the tip's release closed there."""
 
 
 def median_share(reads: Sequence[ReleaseRead]) -> float | None:
@@ -372,7 +382,8 @@ def release_reads(data: Conditioned, tip_t_s: NDArray[np.float64], tip_deg: NDAr
             min(made_up / swing, 1.0), release_slope_ratio(grid[:cut], yg[:cut], k), swing,
             float(grid[k] - grid[0]) - settled,
             math.nan if line is None else line_share_at(grid, yg, k, line,
-                                                        opts.release_fit_half_deg)))
+                                                        opts.release_fit_half_deg),
+            local_share_at(grid[:cut], yg[:cut], k, opts.release_fit_half_deg)))
     return reads
 
 

@@ -51,7 +51,10 @@ class IdentifyOptions:
     """"fraction": what the share is of. "median" (sheets before session 10): the swing to the
     current's median over 5-20 deg after the end tested, iterated; "line": the gap to the
     release branch fitted as a line once per half-cycle, at the same knob angle
-    (:func:`tsmd.calibration.pieces.line_share_end`), which a sloped branch cannot drag along."""
+    (:func:`tsmd.calibration.pieces.line_share_end`), which a sloped branch cannot drag along;
+    "local": the gap to a line fitted over the 5-20 deg just beyond each candidate end, the
+    first candidate that has closed the share (:func:`tsmd.calibration.pieces.local_share_end`,
+    session 11: a shelf that ramps on later)."""
     backlash_reference_slope_ratio: float | None = None
     """"fraction" with a data sheet that measured it: the release-to-loaded slope ratio
     (:func:`tsmd.calibration.pieces.release_slope_ratio`) on the sheet's unit, where the share
@@ -101,17 +104,24 @@ against the sweep's mean ratio (session 10)."""
 def for_product(options: IdentifyOptions, settle_fraction: float | None,
                 slope_ratio: float | None = None,
                 settle_lag_deg: float | None = None,
-                line_share: float | None = None) -> IdentifyOptions:
+                line_share: float | None = None,
+                rule: str | None = None,
+                local_share: float | None = None) -> IdentifyOptions:
     """The identification for one knob of a product whose data sheet measured how far the
     current has come back when the tip starts to move: below :data:`SETTLED_FRACTION` the
     backlash ends at that share of the current's swing ("fraction"), moved per sweep by the
     unit's own slope ratio where the sheet gives its unit's (``slope_ratio``); else the
     settle rule, ended ``settle_lag_deg`` beyond the settle where the sheet measured that lag;
     else as ``options`` say. A sheet's ``line_share`` (the share of the gap to the release
-    line) replaces ``settle_fraction`` and its coefficient."""
+    line) replaces ``settle_fraction`` and its coefficient, unless the sheet's ``rule`` is
+    "swing" (``DeviceKnob.backlash_release_rule``: the product keeps the share of the swing)
+    or "local" (the share ``local_share`` of the gap to the branch just beyond the end)."""
     if options.backlash != "settle":
         return options
-    if line_share is not None:
+    if rule == "local" and local_share is not None:
+        return replace(options, backlash="fraction", backlash_fraction=local_share,
+                       release_level="local")
+    if line_share is not None and rule != "swing":
         if line_share >= SETTLED_FRACTION:
             return for_product(options, line_share, None, settle_lag_deg)
         line = replace(options, backlash="fraction", backlash_fraction=line_share,

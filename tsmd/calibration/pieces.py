@@ -296,10 +296,57 @@ def line_share_at(grid: FloatArray, yg: FloatArray, k: int, line: FloatArray,
     return math.nan if gap <= 0.0 else (smooth_value(grid, yg, k, half_deg) - loaded) / gap
 
 
+def local_line(grid: FloatArray, yg: FloatArray, k: int) -> float | None:
+    """The release branch just after ``k``: a line fitted over ``RELEASE_LEVEL_WINDOW_DEG``
+    past it, read back at ``grid[k]`` (None: the window runs off the half-cycle)."""
+    step = float(grid[1] - grid[0])
+    a, b = k + round(RELEASE_LEVEL_WINDOW_DEG[0] / step), k + round(
+        RELEASE_LEVEL_WINDOW_DEG[1] / step)
+    if b > yg.size:
+        return None
+    return float(np.polyval(np.polyfit(grid[a:b], yg[a:b], 1), grid[k]))
+
+
+def local_share_at(grid: FloatArray, yg: FloatArray, k: int, half_deg: float) -> float:
+    """The share of its gap to :func:`local_line` that the current has closed at ``k`` (the
+    data sheet reads it at the tip's release)."""
+    loaded = loaded_current(yg, float(grid[1] - grid[0]))
+    branch = local_line(grid, yg, k)
+    if branch is None or branch <= loaded:
+        return math.nan
+    return (smooth_value(grid, yg, k, half_deg) - loaded) / (branch - loaded)
+
+
+def local_share_end(grid: FloatArray, yg: FloatArray, share: float, half_deg: float) -> int:
+    """The first point after the reversal where the current (mean over +-2 deg) has closed
+    ``share`` of its gap to the branch just beyond it (:func:`local_line`), refined off the
+    quadratic of :func:`smooth_crossing`.
+
+    The first such point, not an iteration from a guess: where the current levels off on a
+    shelf and only later ramps on (the coilpipe plant: the tip lets go where the shelf begins,
+    the ramp to the final level ends 40 deg later) the median level and the 40-95 deg line
+    both sit on the ramp's level, and an iteration started on the ramp stays there."""
+    step = float(grid[1] - grid[0])
+    loaded = loaded_current(yg, step)
+    width = max(1, round(RELEASE_SMOOTH_START_DEG / step))
+    mean = np.convolve(yg, np.ones(2 * width + 1) / (2 * width + 1), mode="same")
+    for k in range(width, yg.size - width):
+        branch = local_line(grid, yg, k)
+        if branch is None:
+            break
+        target = loaded + share * (branch - loaded)
+        if mean[k] >= target:
+            return smooth_crossing(grid, yg, k, target, half_deg)
+    return yg.size - 1
+
+
 def line_end(grid: FloatArray, yg: FloatArray, share: float, opts: IdentifyOptions,
              stop: int | None = None) -> int | None:
-    """The end at ``share`` against the release line (:func:`line_share_end`) where
-    ``opts.release_level`` says so and a line can be fitted before ``stop``; else None."""
+    """The end at ``share`` against the release line (:func:`line_share_end`) or the branch
+    just beyond (:func:`local_share_end`) where ``opts.release_level`` says so and a line can
+    be fitted before ``stop``; else None."""
+    if opts.release_level == "local":
+        return local_share_end(grid[:stop], yg[:stop], share, opts.release_fit_half_deg)
     if opts.release_level != "line":
         return None
     line = release_line(grid, yg, stop)

@@ -91,9 +91,11 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
     base = options or IdentifyOptions()
     k1, k2 = device.knobs[0], device.knobs[1]
     return (for_product(base, k1.backlash_settle_fraction, k1.backlash_release_slope_ratio,
-                        k1.backlash_settle_lag_deg, k1.backlash_release_line_share),
+                        k1.backlash_settle_lag_deg, k1.backlash_release_line_share,
+                        k1.backlash_release_rule, k1.backlash_release_local_share),
             for_product(base, k2.backlash_settle_fraction, k2.backlash_release_slope_ratio,
-                        k2.backlash_settle_lag_deg, k2.backlash_release_line_share))
+                        k2.backlash_settle_lag_deg, k2.backlash_release_line_share,
+                        k2.backlash_release_rule, k2.backlash_release_local_share))
 
 
 def identify_recording(rec: Recording, options: KnobOptions = None,

@@ -8,13 +8,15 @@ per knob (the recording format of docs/recording-format.md, with tip columns).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import time
 from pathlib import Path
 from typing import Any
 
 from simrig.plant import Plant, load_plant
 from tsmd import __version__
-from tsmd.config import DEFAULT_CONFIG_PATH, default_sim_config, load_config
+from tsmd.config import DEFAULT_CONFIG_PATH, TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import (
     ANALYSED_CYCLES,
     CONDITIONING_CYCLES,
@@ -28,7 +30,8 @@ from tsmd.datasheet import (
     measure_device_constants,
     swept_knob,
 )
-from tsmd.profile import save_device_model
+from tsmd.datasheet_rule import RULE_NOISE_SEEDS, choose_rules, rule_scores
+from tsmd.profile import DeviceModel, save_device_model
 from tsmd.recording import read_recording
 
 
@@ -50,6 +53,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--loaded-shape", action="store_true",
                         help="also write each knob's loaded-branch template (ours then bends its "
                              "loaded lines by it; off by default, docs/model.md Session 10)")
+    parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
+                        metavar="LIST",
+                        help="with --plant: noise seeds of the unit's fast calibrations under "
+                             "each backlash rule; the better rule per knob goes into the sheet "
+                             "(docs/calibration.md, session 11; 'none': no choice, the sheet "
+                             "keeps the rule its shares imply)")
 
 
 def _params(text: str | None) -> dict[str, Any]:
@@ -81,6 +90,34 @@ def _from_recordings(paths: list[str]) -> list[KnobConstants]:
     return [by_knob[0], by_knob[1]]
 
 
+def _rule_seeds(text: str) -> list[int]:
+    if text.strip().lower() == "none":
+        return []
+    try:
+        seeds = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise DatasheetError(f"--rule-seeds: not a comma-separated list of integers or "
+                             f"'none': {text!r}") from None
+    if not seeds:
+        raise DatasheetError("--rule-seeds: give at least one seed, or 'none'")
+    return seeds
+
+
+def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
+                 params: dict[str, Any], seeds: list[int]) -> DeviceModel:
+    """The sheet with each knob's backlash rule, chosen on its own unit's calibrations."""
+    unit = config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=params))
+    t0 = time.monotonic()
+    scores = rule_scores(unit, device, seeds)
+    chosen = choose_rules(device, scores)
+    for knob, name in enumerate(("phi1", "phi2")):
+        mine = "; ".join(s.text() for s in scores if s.knob == knob)
+        print(f"{name} backlash rule on the sheet's unit, fast protocol, noise seeds "
+              f"{','.join(map(str, seeds))}: {mine} -> {chosen.knobs[knob].backlash_release_rule}")
+    print(f"  rule choice: {time.monotonic() - t0:.0f} s")
+    return chosen
+
+
 def _or_none(value: float | None, decimals: int) -> str:
     return "none" if value is None else f"{value:.{decimals}f}"
 
@@ -88,6 +125,7 @@ def _or_none(value: float | None, decimals: int) -> str:
 def main(args: argparse.Namespace) -> int:
     if args.params is not None and args.plant is None:
         raise DatasheetError("--params goes with --plant")
+    seeds = _rule_seeds(args.rule_seeds)
     if args.plant is not None:
         config = load_config(args.config) if args.config is not None else default_sim_config()
         params = _params(args.params)
@@ -106,6 +144,8 @@ def main(args: argparse.Namespace) -> int:
         source = "recordings " + ", ".join(Path(p).name for p in args.from_recording)
     device = device_model(args.device_model, constants, config, args.description,
                           loaded_shape=args.loaded_shape)
+    if args.plant is not None and seeds:
+        device = _choose_rule(device, config, args.plant, params, seeds)
     comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "
                f"(tsmd datasheet) on {source}:\n"
                f"each knob swept +-{SWEEP_AMPLITUDE_DEG:g} deg at {SWEEP_HZ:g} Hz, other knob "
@@ -120,7 +160,8 @@ def main(args: argparse.Namespace) -> int:
               f"{_or_none(c.backlash_settle_fraction, 3)} and slope ratio "
               f"{_or_none(c.backlash_release_slope_ratio, 4)}, swing "
               f"{_or_none(c.release_swing_A, 4)} A, settle lag {_or_none(c.settle_lag_deg, 2)} "
-              f"deg, line share {_or_none(c.release_line_share, 4)} over "
+              f"deg, line share {_or_none(c.release_line_share, 4)}, local share "
+              f"{_or_none(c.release_local_share, 4)} over "
               f"{c.release_reversals} reversals")
         for side, shape in (("+", c.loaded_shape_pos), ("-", c.loaded_shape_neg)):
             # tip travel past the plateau over knob travel past the edge

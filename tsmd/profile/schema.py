@@ -23,6 +23,7 @@ from tsmd.profile.types import (
     KNOB_NAMES,
     OMEGA_RANGE,
     PROFILE_SCHEMA_VERSION,
+    RELEASE_RULES,
     CatheterProfile,
     DeviceKnob,
     DeviceModel,
@@ -125,6 +126,21 @@ def _shape(r: _Reader, value: Any, where: str) -> LoadedShape | None:
         raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
 
 
+def _release_rule(r: _Reader, k: Mapping[str, Any], key: str) -> str | None:
+    value = k.get("backlash_release_rule")
+    if value is None:
+        return None
+    rule = r.text(value, f"{key}.backlash_release_rule")
+    if rule not in RELEASE_RULES:
+        raise r.fail(f"{key}.backlash_release_rule",
+                     f"{rule!r} is not one of {', '.join(RELEASE_RULES)}")
+    for needs, share in (("line", "backlash_release_line_share"),
+                         ("local", "backlash_release_local_share")):
+        if rule == needs and k.get(share) is None:
+            raise r.fail(f"{key}.backlash_release_rule", f"'{needs}' needs {share}")
+    return rule
+
+
 def device_model_from_mapping(data: Any, origin: str = "device model") -> DeviceModel:
     r = _Reader(origin)
     m = r.mapping(data, "top level")
@@ -184,6 +200,9 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
                      "deg"),
             backlash_release_line_share=optional(k.get("backlash_release_line_share"),
                                                  "backlash_release_line_share", 0.5, 1.0, ""),
+            backlash_release_local_share=optional(k.get("backlash_release_local_share"),
+                                                  "backlash_release_local_share", 0.5, 1.5, ""),
+            backlash_release_rule=_release_rule(r, k, key),
             **{name: _shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS}))
     desc = m.get("description", "")
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
@@ -226,6 +245,10 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
                 knobs[name][key] = shape_to_mapping(shape)
         if k.backlash_release_line_share is not None:
             knobs[name]["backlash_release_line_share"] = k.backlash_release_line_share
+        if k.backlash_release_local_share is not None:
+            knobs[name]["backlash_release_local_share"] = k.backlash_release_local_share
+        if k.backlash_release_rule is not None:
+            knobs[name]["backlash_release_rule"] = k.backlash_release_rule
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

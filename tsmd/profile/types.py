@@ -18,6 +18,8 @@ from tsmd.errors import TsmdError
 
 PROFILE_SCHEMA_VERSION = 1
 DEVICE_SCHEMA_VERSION = 1
+RELEASE_RULES = ("line", "swing", "local")
+"""The backlash rules a data sheet can name (``DeviceKnob.backlash_release_rule``)."""
 KNOB_NAMES: tuple[str, str] = ("phi1", "phi2")
 ANGLE_RANGE_DEG = 360.0
 """Every angle in a profile (knob or tip) must lie within +-ANGLE_RANGE_DEG: a larger value is
@@ -107,6 +109,20 @@ class DeviceKnob:
     back 1 deg (median over the reversals). Where given it replaces
     ``backlash_settle_fraction``, whose level is read after the end and so moves with it on a
     sloped release branch (session 10); old sheets keep that one."""
+    backlash_release_local_share: float | None = None
+    """Optional, on the data-sheet unit: the share of its gap to the release branch just beyond
+    the tip's release (a line over 5-20 deg past it, read back there:
+    :func:`tsmd.calibration.pieces.local_share_at`) closed at the tip's release, median over
+    the reversals; used where ``backlash_release_rule`` is "local"."""
+    backlash_release_rule: str | None = None
+    """Optional, the product's choice among the fraction rules (one of
+    :data:`RELEASE_RULES`): "line" ends the backlash at ``backlash_release_line_share`` of the
+    gap to the release line, "swing" at ``backlash_settle_fraction`` of the swing to the
+    release level (or the settle rule where that share is settled), "local" at
+    ``backlash_release_local_share`` of the gap to the branch just beyond. ``tsmd datasheet`` picks
+    the one whose calibration of the sheet's own unit best reproduces its tracked tip (session
+    11); without it a sheet keeps the rule its fields imply (line where the line share is
+    given)."""
 
 
 @dataclass(frozen=True)

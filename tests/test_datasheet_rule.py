@@ -1,0 +1,130 @@
+"""The product's backlash rule in the data sheet (tsmd.datasheet_rule, session 11): the sheet
+names it, calibration follows it, and a sheet without it keeps the rule its shares imply."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import pytest
+from support.profiles import DEVICE
+
+from tsmd.calibration.options import IdentifyOptions, for_product
+from tsmd.calibration.run import device_options
+from tsmd.cli import main
+from tsmd.datasheet_rule import RuleScore, choose_rules, with_rule
+from tsmd.profile import DeviceModel, ProfileError, load_device_model
+from tsmd.profile.schema import device_model_from_mapping, device_model_to_mapping
+
+LINE_SHARE = 0.94
+SWING_SHARE = 0.95
+
+
+def sheet(line_share: float | None = LINE_SHARE, rule: str | None = None) -> DeviceModel:
+    """The packaged sheet with fraction-rule shares on both knobs."""
+    base = load_device_model(DEVICE)
+    knobs = tuple(dataclasses.replace(k, backlash_settle_fraction=SWING_SHARE,
+                                      backlash_release_slope_ratio=0.1,
+                                      backlash_release_line_share=line_share,
+                                      backlash_release_rule=rule) for k in base.knobs)
+    return dataclasses.replace(base, knobs=(knobs[0], knobs[1]))
+
+
+def scored(rule: str, knob: int, within: int, mean: float = 1.0, accepted: int = 2
+           ) -> RuleScore:
+    return RuleScore(rule, knob, within, 56, mean, 3.0, accepted, 2)
+
+
+def test_a_sheet_naming_swing_ends_the_backlash_at_the_share_of_the_swing() -> None:
+    opts = device_options(None, sheet(rule="swing"))[0]
+    assert (opts.backlash, opts.release_level, opts.backlash_fraction) == (
+        "fraction", "median", SWING_SHARE)
+
+
+def test_a_sheet_naming_line_ends_the_backlash_against_the_release_line() -> None:
+    opts = device_options(None, sheet(rule="line"))[0]
+    assert (opts.backlash, opts.release_level, opts.backlash_fraction) == (
+        "fraction", "line", LINE_SHARE)
+
+
+def test_a_sheet_without_the_choice_keeps_the_rule_its_shares_imply() -> None:
+    with_line, without_line = sheet(), sheet(line_share=None)
+    assert device_options(None, with_line) == device_options(None, sheet(rule="line"))
+    assert device_options(None, without_line) == device_options(None, sheet(None, "swing"))
+    assert device_options(None, with_line) != device_options(None, without_line)
+
+
+def test_a_sheet_naming_local_ends_the_backlash_against_the_branch_just_beyond() -> None:
+    device = sheet(rule="local")
+    device = dataclasses.replace(device, knobs=tuple(
+        dataclasses.replace(k, backlash_release_local_share=0.99) for k in device.knobs))
+    opts = device_options(None, device)[1]
+    assert (opts.backlash, opts.release_level, opts.backlash_fraction) == (
+        "fraction", "local", 0.99)
+
+
+def test_swing_with_a_settled_share_keeps_the_settle_rule() -> None:
+    opts = for_product(IdentifyOptions(), 0.995, settle_lag_deg=0.5, line_share=LINE_SHARE,
+                       rule="swing")
+    assert (opts.backlash, opts.backlash_settle_lag_deg) == ("settle", 0.5)
+
+
+def test_the_rule_survives_the_sheets_yaml() -> None:
+    mapping = device_model_to_mapping(sheet(rule="swing"))
+    assert mapping["knobs"]["phi2"]["backlash_release_rule"] == "swing"
+    assert device_model_from_mapping(mapping).knobs[1].backlash_release_rule == "swing"
+    assert "backlash_release_rule" not in device_model_to_mapping(sheet())["knobs"]["phi1"]
+
+
+@pytest.mark.parametrize(("rule", "line_share", "message"), [
+    ("median", LINE_SHARE, "not one of line, swing, local"),
+    ("line", None, "needs backlash_release_line_share"),
+    ("local", LINE_SHARE, "needs backlash_release_local_share"),
+])
+def test_a_bad_rule_in_the_sheet_is_one_line_naming_the_key(
+        rule: str, line_share: float | None, message: str) -> None:
+    mapping = device_model_to_mapping(sheet(line_share=line_share))
+    mapping["knobs"]["phi1"]["backlash_release_rule"] = rule
+    with pytest.raises(ProfileError, match=message) as err:
+        device_model_from_mapping(mapping)
+    assert "phi1.backlash_release_rule" in str(err.value)
+    assert "\n" not in str(err.value)
+
+
+def test_each_knob_gets_the_rule_that_reproduced_the_tip_better() -> None:
+    scores = [scored("line", 0, 50), scored("swing", 0, 54),
+              scored("line", 1, 55), scored("swing", 1, 52)]
+    chosen = choose_rules(sheet(), scores)
+    assert [k.backlash_release_rule for k in chosen.knobs] == ["swing", "line"]
+
+
+def test_a_tie_in_count_keeps_line_whatever_the_mean_errors() -> None:
+    scores = [scored("line", 0, 50, mean=1.2), scored("swing", 0, 50, mean=0.9),
+              scored("line", 1, 50), scored("swing", 1, 49, mean=0.5)]
+    chosen = choose_rules(sheet(), scores)
+    assert [k.backlash_release_rule for k in chosen.knobs] == ["line", "line"]
+
+
+def test_a_tie_in_count_goes_to_the_rule_whose_runs_were_accepted() -> None:
+    scores = [scored("line", 0, 50, accepted=1), scored("swing", 0, 50, accepted=2),
+              scored("line", 1, 50), scored("swing", 1, 50)]
+    chosen = choose_rules(sheet(), scores)
+    assert [k.backlash_release_rule for k in chosen.knobs] == ["swing", "line"]
+
+
+def test_a_knob_without_a_line_share_cannot_be_given_the_line_rule() -> None:
+    scores = [scored("line", k, 56) for k in (0, 1)] + [scored("swing", k, 10) for k in (0, 1)]
+    chosen = choose_rules(sheet(line_share=None), scores)
+    assert [k.backlash_release_rule for k in chosen.knobs] == ["swing", "swing"]
+    assert all(k.backlash_release_rule is None
+               for k in with_rule(sheet(line_share=None), "line").knobs)
+
+
+def test_bad_rule_seeds_are_one_line_before_anything_is_measured(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["datasheet", "--plant", "simrig.plants.capstan:make_tendon_sheath_plant",
+                 "--device-model", "x", "--out", str(tmp_path / "d.yaml"),
+                 "--rule-seeds", "one"])
+    assert code == 2
+    assert "--rule-seeds" in capsys.readouterr().err
+    assert not (tmp_path / "d.yaml").exists()

@@ -38,9 +38,18 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.family import PLANT_SPECS
+from simrig.scenario import ShapeChange
 from tsmd.bench.cache_key import keyed_cache
+from tsmd.bench.online_bend import product_bend_relation
+from tsmd.bench.online_units import calibrated, device_for, make_unit, shape_change
 from tsmd.calibration.errors import CalibrationRefusedError
+from tsmd.compensation import build_compensator
+from tsmd.daemon import make_compensator
 from tsmd.errors import TsmdError
+from tsmd.loop import ROW_COLUMNS
+from tsmd.online import OnlineWorker
+from tsmd.profile import load_profile
+from tsmd.replay import LockstepRunner
 
 Array = NDArray[np.float64]
 PERIOD_S = 0.004
@@ -63,88 +72,11 @@ def mixed_motion(duration_s: float, seed: int) -> tuple[Array, Array]:
     return t, np.column_stack([q1 * ramp, q2 * ramp])
 
 
-def shape_change(kind: str) -> dict[str, Any]:
-    """``slack:MM`` (every tendon's slack grows by MM) or ``curvature:DEG`` (sheath bend)."""
-    name, _, value = kind.partition(":")
-    try:
-        x = float(value)
-    except ValueError:
-        raise TsmdError(f"--change {kind!r}: expected slack:MM or curvature:DEG") from None
-    if name == "slack":
-        return {"slack_delta_mm": ((x, x), (x, x))}
-    if name == "curvature":
-        return {"sheath_curvature_deg": x}
-    raise TsmdError(f"--change {kind!r}: expected slack:MM or curvature:DEG")
-
-
-def make_unit(plant: str, unit: int, changes: list[Any]) -> Any:
-    """Unit ``unit`` of ``plant``'s family (0 = nominal), with shape changes
-    ``[ShapeChange, ...]``."""
-    from simrig.family import family_member
-    from simrig.scenario import ShapeChangePlant
-
-    return ShapeChangePlant(family_member(plant, unit).build(), changes)
-
-
-def device_for(plant: str, cache: Path) -> Any:
-    """The data sheet of ``plant``'s family: the product's for capstan, measured on the nominal
-    lumped unit (cached) for lumped."""
-    from simrig.family import family_member
-    from tsmd.datasheet import device_model, measure_device_constants
-    from tsmd.profile import load_device_model, save_device_model
-
-    base = Path(__file__).resolve().parents[2] / "profiles" / "devices" / "sim-catheter.yaml"
-    if plant == "capstan":
-        return load_device_model(base)
-    path = cache / f"device-{plant}.yaml"
-    if path.exists():
-        return load_device_model(path)
-    from tsmd.config import default_sim_config
-
-    t0 = time.perf_counter()
-    device = device_model(f"family-{plant}", measure_device_constants(
-        family_member(plant, 0).build), default_sim_config(),
-        description=load_device_model(base).description)
-    cache.mkdir(parents=True, exist_ok=True)
-    save_device_model(device, path)
-    print(f"  data sheet of {plant} measured in {time.perf_counter() - t0:.0f} s wall",
-          flush=True)
-    return device
-
-
-def calibrated(plant: str, unit: int, change: dict[str, Any] | None, device: Any,
-               cache: Path, label: str) -> Any:
-    """The unit's profile from ``tsmd.calibration`` (fast protocol), cached."""
-    from simrig.scenario import ShapeChange
-    from tsmd.calibration import calibrate, fast_protocol
-    from tsmd.profile import load_profile, save_profile
-    from tsmd.replay import LockstepRunner
-
-    path = cache / f"{plant}-unit{unit}-{label}.yaml"
-    if path.exists():
-        return load_profile(path)
-    sim = make_unit(plant, unit, [ShapeChange(0.0, change)] if change else [])
-    t0 = time.perf_counter()
-    with LockstepRunner(None, None, "none", 3000 + unit, sim) as runner:
-        profile = calibrate(runner, f"{plant}-unit{unit}-{label}", device,
-                            protocol=fast_protocol())
-    cache.mkdir(parents=True, exist_ok=True)
-    save_profile(profile, path)
-    print(f"  calibrated {plant} unit {unit} ({label}) in {time.perf_counter() - t0:.0f} s wall",
-          flush=True)
-    return profile
-
-
 def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int,
         device: Any = None, bend: Any = None) -> tuple[Any, Any]:
     """One lockstep run with our compensator; returns (recording, worker or None). The
     worker takes each knob's handle slip from ``device``'s data sheet and the product's bend
     relation ``bend`` (None: none)."""
-    from tsmd.daemon import make_compensator
-    from tsmd.loop import ROW_COLUMNS
-    from tsmd.online import OnlineWorker
-    from tsmd.replay import LockstepRunner
-
     with LockstepRunner(None, profile, "ours", seed, plant) as runner:
         comp = make_compensator(profile, "ours", runner.config)
         runner.loop.execute("set_compensator", compensator=comp, label="ours")
@@ -176,7 +108,6 @@ def rmse(rec: Any, knob: int, t0: float, t1: float = math.inf) -> float:
 
 
 def change_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, Any]:
-    from simrig.scenario import ShapeChange
 
     change = shape_change(args.change)
     cache = Path(args.cache)
@@ -285,11 +216,6 @@ def drift_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, An
 def hot_path_us(n: int = 20000) -> tuple[float, float, float]:
     """Median, p99 and max wall time of the loop-side ``observe`` for two knobs, with the
     worker draining on its own thread every 50 ms (as in the daemon)."""
-    from tsmd.compensation import build_compensator
-    from tsmd.loop import ROW_COLUMNS
-    from tsmd.online import OnlineWorker
-    from tsmd.profile import load_profile
-
     profile = load_profile(Path(__file__).resolve().parents[2] / "profiles" / "example-sim.yaml")
     comp = build_compensator(profile, "ours", PERIOD_S)
     worker = OnlineWorker(comp, PERIOD_S, ROW_COLUMNS)
@@ -345,8 +271,6 @@ def main(args: argparse.Namespace) -> int:
     device = device_for(args.plant, Path(args.cache))
     args.bend = None
     if args.bend_relation == "unit0":
-        from tsmd.bench.online_bend import product_bend_relation
-
         args.bend = product_bend_relation(args.plant, device, Path(args.cache))
         print(f"bend relation (unit 0, bends 30/60/90 deg): release line "
               f"{args.bend.release_per_edge:.3f} deg per edge deg, beta x (1 + "

@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from tsmd.bench.online_units import calibrated, shape_change
 from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.online.bend import BendRelation, measure_bend_relation
 
@@ -20,8 +21,6 @@ SHEET_UNIT = 0
 def product_bend_relation(plant: str, device: Any, cache: Path) -> BendRelation:
     """The relation from unit 0's cached calibrations (made when missing); a bend whose
     calibration is refused is left out."""
-    from tsmd.bench.online import calibrated, shape_change
-
     straight = calibrated(plant, SHEET_UNIT, None, device, cache, "straight")
     bent = []
     for deg in BENDS_DEG:

@@ -13,7 +13,7 @@ import yaml
 from support.profiles import DEVICE
 
 from tsmd.calibration.options import SETTLED_FRACTION, IdentifyOptions, for_product
-from tsmd.calibration.pieces import recovered_end
+from tsmd.calibration.release import recovered_end
 from tsmd.calibration.run import device_options
 from tsmd.calibration.signal import Conditioned
 from tsmd.datasheet import backlash_settle_fraction

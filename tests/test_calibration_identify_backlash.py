@@ -1,4 +1,4 @@
-"""Specification of the backlash rule (``pieces.backlash_end``) on synthetic currents.
+"""Specification of the backlash rule (``release.backlash_end``) on synthetic currents.
 
 The currents are closed forms written here, not the plant and not the detector's code. Per
 half-cycle, with ``u`` the knob travel since the reversal and ``x`` the direction-signed knob

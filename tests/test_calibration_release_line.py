@@ -11,7 +11,7 @@ from scipy.optimize import brentq
 
 from tsmd.calibration.identify import analyse_half_cycle, split_half_cycles
 from tsmd.calibration.options import IdentifyOptions, for_product
-from tsmd.calibration.pieces import (
+from tsmd.calibration.release import (
     fraction_end,
     line_share_at,
     line_share_end,

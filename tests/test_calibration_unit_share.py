@@ -16,7 +16,7 @@ from tsmd.calibration.identify import (
     unit_share_backlash,
 )
 from tsmd.calibration.options import SHARE_PER_SLOPE_RATIO, IdentifyOptions, for_product
-from tsmd.calibration.pieces import release_slope_ratio
+from tsmd.calibration.release import release_slope_ratio
 from tsmd.calibration.signal import Conditioned
 
 LOADED_SLOPE_A_PER_DEG = 0.02

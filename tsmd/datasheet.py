@@ -27,14 +27,14 @@ from simrig.plant import Plant
 from tsmd.bench.tip_truth import TIP_THRESHOLD_DEG, tip_reading
 from tsmd.calibration.identify import identify_sweep, resample_on_angle, split_half_cycles
 from tsmd.calibration.options import IdentifyOptions
-from tsmd.calibration.pieces import (
+from tsmd.calibration.pieces import smooth_value
+from tsmd.calibration.release import (
     RELEASE_LEVEL_WINDOW_DEG,
     line_share_at,
     loaded_current,
     local_share_at,
     release_line,
     release_slope_ratio,
-    smooth_value,
 )
 from tsmd.calibration.signal import Conditioned, lowpass
 from tsmd.calibration.tension_play_fit import fit_sweep_sides
@@ -105,7 +105,7 @@ class KnobConstants:
     """The current's release-to-loaded slope ratio there (:func:`backlash_release_slope_ratio`)."""
     release_swing_A: float | None = None
     """The current's swing from the loaded current to the release level after a reversal
-    (:func:`tsmd.calibration.pieces.release_swing`, median over the reversals): another unit's
+    (:func:`tsmd.calibration.release.release_swing`, median over the reversals): another unit's
     swing scales the backlash it should show (the "B cannot be seen" warning)."""
     settle_lag_deg: float | None = None
     """Knob travel from where the paper's settle rule ends the backlash to the tip's release
@@ -113,10 +113,11 @@ class KnobConstants:
     the tip lets go ends every unit's backlash that much later."""
     release_line_share: float | None = None
     """The share of its gap to the release line at the same knob angle that the current has
-    closed at the tip's release (:func:`tsmd.calibration.pieces.line_share_at`), median over
+    closed at the tip's release (:func:`tsmd.calibration.release.line_share_at`), median over
     the reversals."""
     release_local_share: float | None = None
-    """The same against the branch just beyond (:func:`~tsmd.calibration.pieces.local_share_at`)."""
+    """The same against the branch just beyond
+    (:func:`~tsmd.calibration.release.local_share_at`)."""
     release_reversals: int = 0
     """How many reversals gave the five above (:func:`release_reads`)."""
     loaded_shape_pos: LoadedShape | None = None
@@ -304,7 +305,7 @@ def backlash_release_slope_ratio(data: Conditioned, tip_t_s: NDArray[np.float64]
                                  tip_deg: NDArray[np.float64],
                                  options: IdentifyOptions | None = None) -> float | None:
     """The current's release-to-loaded slope ratio after the tip's release
-    (:func:`tsmd.calibration.pieces.release_slope_ratio`), median over the reversals: the
+    (:func:`tsmd.calibration.release.release_slope_ratio`), median over the reversals: the
     anchor from which each calibrated unit's own ratio moves the share."""
     return median_ratio(release_reads(data, tip_t_s, tip_deg, options))
 
@@ -344,7 +345,7 @@ def release_reads(data: Conditioned, tip_t_s: NDArray[np.float64], tip_deg: NDAr
     scoring truth reads it (low-passed at the current's cutoff, then 1 deg back: on the raw
     tracker the noise fired the threshold 1.5-2.5 deg early), and the current as the
     calibration's fraction rule reads it (the identification's half-cycles on the angle grid
-    without the last ``edge_margin_deg``, :func:`~tsmd.calibration.pieces.loaded_current`, the
+    without the last ``edge_margin_deg``, :func:`~tsmd.calibration.release.loaded_current`, the
     release level over ``RELEASE_LEVEL_WINDOW_DEG`` after the tip's release, the value there
     off the same quadratic). The one sample at the position's turning point, used before,
     still carries the motor's friction half-turned (docs/calibration.md, session 7).

@@ -37,14 +37,16 @@ from tsmd.calibration.health import (
 )
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.pieces import (
-    EDGE_CLEARANCE_DEG,
-    backlash_end,
     constant_phase,
     fitted_edge,
     flat_pieces,
-    fraction_end,
     knee_edge,
     linear_pieces,
+)
+from tsmd.calibration.release import (
+    EDGE_CLEARANCE_DEG,
+    backlash_end,
+    fraction_end,
     release_slope_ratio,
     release_swing,
 )
@@ -77,7 +79,7 @@ class HalfCycle:
     """Where the loaded current dropped while the knob moved on, if it did."""
     release_swing_A: float = math.nan
     """After a reversal: the current's swing to its release level
-    (:func:`tsmd.calibration.pieces.release_swing`)."""
+    (:func:`tsmd.calibration.release.release_swing`)."""
 
     @property
     def backlash_name(self) -> str:

@@ -51,13 +51,13 @@ class IdentifyOptions:
     """"fraction": what the share is of. "median" (sheets before session 10): the swing to the
     current's median over 5-20 deg after the end tested, iterated; "line": the gap to the
     release branch fitted as a line once per half-cycle, at the same knob angle
-    (:func:`tsmd.calibration.pieces.line_share_end`), which a sloped branch cannot drag along;
+    (:func:`tsmd.calibration.release.line_share_end`), which a sloped branch cannot drag along;
     "local": the gap to a line fitted over the 5-20 deg just beyond each candidate end, the
-    first candidate that has closed the share (:func:`tsmd.calibration.pieces.local_share_end`,
+    first candidate that has closed the share (:func:`tsmd.calibration.release.local_share_end`,
     session 11: a shelf that ramps on later)."""
     backlash_reference_slope_ratio: float | None = None
     """"fraction" with a data sheet that measured it: the release-to-loaded slope ratio
-    (:func:`tsmd.calibration.pieces.release_slope_ratio`) on the sheet's unit, where the share
+    (:func:`tsmd.calibration.release.release_slope_ratio`) on the sheet's unit, where the share
     was ``backlash_fraction``; each sweep's own ratio then moves its share by
     ``backlash_share_per_slope_ratio`` per unit of ratio (None: one share for every unit)."""
     backlash_share_per_slope_ratio: float = 0.0
@@ -89,7 +89,7 @@ SHARE_PER_SLOPE_RATIO = -0.34
 loaded slope ratio (a larger ratio: less friction-wrap in the sheath, the tip lets go earlier
 in the current's approach). Fitted on lumped development units 1-8 (fast sweeps, noise seeds 0
 and 1; half-cycles' share at the tip's release against their sweep's mean ratio, the ratio's
-slope read over :data:`tsmd.calibration.pieces.RELEASE_SLOPE_WINDOW_DEG`: -0.24 with the
+slope read over :data:`tsmd.calibration.release.RELEASE_SLOPE_WINDOW_DEG`: -0.24 with the
 shorter window of session 8, whose noisier ratio attenuated the fit; docs/calibration.md,
 sessions 8 and 9); the sheet's own unit gives the anchor."""
 

@@ -84,11 +84,11 @@ class DeviceKnob:
     at this share instead of where the current has settled (old sheets: the settle rule)."""
     backlash_release_slope_ratio: float | None = None
     """Optional: on the data-sheet unit, the current's slope just after the tip's release over
-    its loaded ramp's (:func:`tsmd.calibration.pieces.release_slope_ratio`): with it the share
+    its loaded ramp's (:func:`tsmd.calibration.release.release_slope_ratio`): with it the share
     above moves per unit with that unit's own ratio (old sheets: one share for every unit)."""
     reference_release_swing_A: float | None = None
     """Optional, on the data-sheet unit: the motor current's swing after a reversal from the
-    loaded current to the release level (:func:`tsmd.calibration.pieces.release_swing`): with
+    loaded current to the release level (:func:`tsmd.calibration.release.release_swing`): with
     it the reference backlashes scale to another unit's own swing for the check that B can be
     seen in the current (old sheets: the reference backlashes as they are)."""
     backlash_settle_lag_deg: float | None = None
@@ -104,7 +104,7 @@ class DeviceKnob:
     loaded_shape_neg: LoadedShape | None = None
     backlash_release_line_share: float | None = None
     """Optional, on the data-sheet unit: the share of its gap to the release branch (a line
-    fitted over :data:`tsmd.calibration.pieces.RELEASE_LINE_WINDOW_DEG` of travel after the
+    fitted over :data:`tsmd.calibration.release.RELEASE_LINE_WINDOW_DEG` of travel after the
     reversal, taken at the same knob angle) that the current has closed when the tip has moved
     back 1 deg (median over the reversals). Where given it replaces
     ``backlash_settle_fraction``, whose level is read after the end and so moves with it on a
@@ -112,7 +112,7 @@ class DeviceKnob:
     backlash_release_local_share: float | None = None
     """Optional, on the data-sheet unit: the share of its gap to the release branch just beyond
     the tip's release (a line over 5-20 deg past it, read back there:
-    :func:`tsmd.calibration.pieces.local_share_at`) closed at the tip's release, median over
+    :func:`tsmd.calibration.release.local_share_at`) closed at the tip's release, median over
     the reversals; used where ``backlash_release_rule`` is "local"."""
     backlash_release_rule: str | None = None
     """Optional, the product's choice among the fraction rules (one of

@@ -1,13 +1,15 @@
 """The product's backlash rule, chosen on the data sheet's own unit.
 
-Two fraction rules end the backlash from the current: the share of the gap to the release line
-("line", session 10) and the share of the swing to the release level ("swing", before). On the
+Three fraction rules end the backlash from the current (:mod:`tsmd.calibration.release`): the
+share of the gap to the release line ("line", session 10), of the swing to the release level
+("swing", before) and of the gap to the branch just beyond ("local", session 11). On the
 sheet's own +-90 deg sweeps they tie, while the calibration grid's other amplitudes and
 other-knob angles separate them per product (coilpipe unit 0: 64 against 103 of 112 values
-within 2 deg; docs/calibration.md, session 10 lead). So the manufacturer, who tracks the tip of
-this unit anyway, calibrates it with the fast protocol under each rule (current only, as every
-unit is calibrated) and writes the rule whose D and B come closest to the tip into the sheet:
-a per-product constant measured where the other ones are.
+within 2 deg; docs/calibration.md, session 10 lead), and no one of them holds on every plant.
+So the manufacturer, who tracks the tip of this unit anyway, calibrates it with the fast
+protocol under each rule (current only, as every unit is calibrated) and writes the rule whose
+D and B come closest to the tip into the sheet: a per-product constant measured where the
+other ones are.
 """
 
 from __future__ import annotations

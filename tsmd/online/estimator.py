@@ -29,6 +29,7 @@ from typing import Any
 
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
+from tsmd.online.other_knob import OtherKnobBins
 from tsmd.online.slopes import common_change, pooled_change, shrunk_ratio
 
 
@@ -86,12 +87,13 @@ class EdgeTracker:
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
-    bins: dict[int, list[float]] = field(default_factory=dict)
-    """Per bin of the other knob's angle: the last accepted measurements minus the estimate
-    then (where the current's edge sits in that bin relative to the profile's)."""
-    bin_visits: dict[int, int] = field(default_factory=dict)
-    """Per bin: how many measurements it has taken (its weight in the bins' common mean)."""
+    bins: OtherKnobBins = field(init=False)
+    """Where the edge reads against the other knob's angle (:mod:`tsmd.online.other_knob`)."""
     _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        o = self.options
+        self.bins = OtherKnobBins(o.other_bin_deg, o.bin_min, o.bin_window)
 
     @property
     def learning(self) -> bool:
@@ -111,43 +113,6 @@ class EdgeTracker:
                               else ramps)
         self.frozen_reason = reason
         self.suspects.clear()
-
-    def _bin(self, other_deg: float) -> int:
-        return math.floor(other_deg / self.options.other_bin_deg) if math.isfinite(
-            other_deg) else 0
-
-    def bin_bias_deg(self, other_deg: float) -> float:
-        """How far the current's edge reads from the profile's in this bin of the other
-        knob's angle, beyond the estimate (0 until the bin has ``bin_min`` measurements).
-
-        The profile's coupling has three grid points; the current's edge can depend on the
-        other knob beyond them (lumped 101: phi1's positive edge 0.5-0.85 deg lower with phi2
-        at -41..-61 deg than at +31..+74 deg, before any change), which a single offset
-        mistakes for a change. Learned from the accepted ramps themselves, so a shape change
-        (every bin at once) still moves the estimate."""
-        own = self._bin_median(self._bin(other_deg))
-        return 0.0 if own is None else own - self._bins_mean_deg()
-
-    def _bin_median(self, key: int) -> float | None:
-        values = self.bins.get(key, [])
-        return median(values) if len(values) >= self.options.bin_min else None
-
-    def _bins_mean_deg(self) -> float:
-        """The learned bins' medians averaged, weighted by their visits: the part of the bins
-        they all share, which belongs to the estimate and is taken out of every bin.
-
-        Without it the estimate and the bins are not pinned against each other (a ramp's
-        measurement is its raw offset minus its bin's, the bin's is the raw offset minus the
-        estimate then): any split of a common offset between them is stable, so noise walked
-        the estimate (lumped 102, no change, 400 s: 0.62/0.70 deg)."""
-        learned = [(m, self.bin_visits.get(k, 0)) for k in self.bins
-                   if (m := self._bin_median(k)) is not None]
-        weight = sum(w for _, w in learned)
-        return sum(m * w for m, w in learned) / weight if weight > 0 else 0.0
-
-    def _teach_bin(self, key: int, value_deg: float) -> None:
-        self.bins[key] = [*self.bins.get(key, []), value_deg][-self.options.bin_window:]
-        self.bin_visits[key] = self.bin_visits.get(key, 0) + 1
 
     def plausible(self, ramp: LoadedRamp | object) -> bool:
         """A ramp whose slope is within ``slope_ratio_max`` of the reference (True while
@@ -289,7 +254,7 @@ class EdgeTracker:
                     r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
                     for r, d in self._baseline)
                 for r, d in self._baseline:
-                    self._teach_bin(self._bin(r.other_deg), r.side * (
+                    self.bins.teach(self.bins.key(r.other_deg), r.side * (
                         r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
                         - self.residual_ref_deg))
                 knees = [r.side * (r.knee_deg - d) for r, d in self._baseline
@@ -373,13 +338,13 @@ class EdgeTracker:
         """One measurement of the offset (referred to its bin of the other knob's angle):
         accepted, or a suspect (followed when confirmed)."""
         o = self.options
-        m = raw_deg - self.bin_bias_deg(other_deg)
+        m = raw_deg - self.bins.bias_deg(other_deg)
         self.last_measurement_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()
-            key = self._bin(other_deg)
-            learned = len(self.bins.get(key, [])) >= o.bin_min
-            self._teach_bin(key, raw_deg - self.estimate_deg)
+            key = self.bins.key(other_deg)
+            learned = self.bins.learned(key)
+            self.bins.teach(key, raw_deg - self.estimate_deg)
             if not (learned or o.learning_bins_count):  # a bin still learning where the
                 return  # current's edge sits: it teaches the bin, not the estimate (a change
                         # beyond the gate is a suspect as anywhere)
@@ -430,7 +395,6 @@ class EdgeTracker:
             self.zero_load_deg = self.applied_deg
 
     def status(self) -> dict[str, Any]:
-        o = self.options
         state = ("learning" if self.learning else "frozen" if self.frozen_for > 0
                  else "tracking")
         return {"state": state, "offset_deg": round(self.applied_deg, 3),
@@ -441,6 +405,5 @@ class EdgeTracker:
                 "refused_ramps": self.n_refused,
                 "feature": self.last_feature or None,
                 "backlash_gain_ratio": round(self.gain_ratio, 3),
-                "other_knob_bins_deg": {f"{k * o.other_bin_deg:g}": round(self.bin_bias_deg(
-                    (k + 0.5) * o.other_bin_deg), 3) for k in sorted(self.bins)},
+                "other_knob_bins_deg": self.bins.biases_deg(),
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None}

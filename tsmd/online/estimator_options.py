@@ -43,7 +43,7 @@ class EstimatorOptions:
     ``slope_window`` ramps, never from one ramp alone (see :meth:`EdgeTracker.update`)."""
     other_bin_deg: float = 30.0
     """Width of the other knob's angle bins in which the current's own edge is learned
-    relative to the profile's (:meth:`EdgeTracker.bin_bias_deg`)."""
+    relative to the profile's (:meth:`tsmd.online.other_knob.OtherKnobBins.bias_deg`)."""
     bin_min: int = 3
     """Measurements a bin needs before its bias counts."""
     bin_window: int = 7

@@ -115,6 +115,12 @@ def _check_references(r: _Reader, key: str, pos: ReferencePoint, neg: ReferenceP
 
 
 _SHAPE_KEYS = ("loaded_shape_pos", "loaded_shape_neg")
+_BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
+                  "backlash_release_slope_ratio", "reference_release_swing_A",
+                  "backlash_settle_lag_deg")
+"""Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
+_RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
+                      "backlash_release_rule")
 
 
 def _shape(r: _Reader, value: Any, where: str) -> LoadedShape | None:
@@ -229,26 +235,16 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         knobs[name]["handle_slip_deg"] = k.handle_slip_deg
-        if k.reference_backlash_gain is not None:
-            knobs[name]["reference_backlash_gain"] = k.reference_backlash_gain
-        if k.backlash_settle_fraction is not None:
-            knobs[name]["backlash_settle_fraction"] = k.backlash_settle_fraction
-        if k.backlash_release_slope_ratio is not None:
-            knobs[name]["backlash_release_slope_ratio"] = k.backlash_release_slope_ratio
-        if k.reference_release_swing_A is not None:
-            knobs[name]["reference_release_swing_A"] = k.reference_release_swing_A
-        if k.backlash_settle_lag_deg is not None:
-            knobs[name]["backlash_settle_lag_deg"] = k.backlash_settle_lag_deg
+        for key in _BACKLASH_KEYS:
+            if getattr(k, key) is not None:
+                knobs[name][key] = getattr(k, key)
         for key in _SHAPE_KEYS:
             shape = getattr(k, key)
             if shape is not None:
                 knobs[name][key] = shape_to_mapping(shape)
-        if k.backlash_release_line_share is not None:
-            knobs[name]["backlash_release_line_share"] = k.backlash_release_line_share
-        if k.backlash_release_local_share is not None:
-            knobs[name]["backlash_release_local_share"] = k.backlash_release_local_share
-        if k.backlash_release_rule is not None:
-            knobs[name]["backlash_release_rule"] = k.backlash_release_rule
+        for key in _RELEASE_RULE_KEYS:
+            if getattr(k, key) is not None:
+                knobs[name][key] = getattr(k, key)
     return {"schema_version": device.schema_version, "device_model": device.device_model,
             "description": device.description, "knobs": knobs}
 

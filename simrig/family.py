@@ -11,8 +11,9 @@ friction, current sensor) that live outside the plant.
 Unit 0 is the nominal unit (no scatter). Units 1-8 are the development set, units 101-108 the
 held-out set: tune on the first, report the second. The capstan plant is the development plant,
 the lumped plant is held out, the segments plant (written blind in session 9) is held out now,
-the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11)
-was written blind and tsmd was run on it untuned (``PLANT_ROLE``).
+the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11,
+written blind) is held out now, the twistshaft plant (session 12) was written blind and tsmd was
+run on it untuned (``PLANT_ROLE``).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
 from simrig.plants.stickslip import NOMINAL_KNOBS as STICKSLIP_KNOBS
+from simrig.plants.twistshaft import NOMINAL_KNOBS as TWISTSHAFT_KNOBS
 from simrig.rig import DEFAULT_CURRENT_SENSOR
 
 PLANT_SPECS: dict[str, str] = {
@@ -38,10 +40,11 @@ PLANT_SPECS: dict[str, str] = {
     "lumped": "simrig.plants.lumped:make_lumped_plant",
     "segments": "simrig.plants.segments:make_segments_plant",
     "coilpipe": "simrig.plants.coilpipe:make_coilpipe_plant",
-    "stickslip": "simrig.plants.stickslip:make_stickslip_plant",  # last: the others' seeds hold
+    "stickslip": "simrig.plants.stickslip:make_stickslip_plant",
+    "twistshaft": "simrig.plants.twistshaft:make_twistshaft_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
-              "coilpipe": "held-out", "stickslip": "blind"}
+              "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -158,13 +161,35 @@ SCATTER: dict[str, dict[str, float]] = {
         "handle_friction_Nm": 0.25,  # knob brake as left by the last user: the least controlled
         "brake_stiction_ratio": 0.05,  # one pad material
     },
+    "twistshaft": {
+        "pulley_radius_mm": 0.02,  # machined drum
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "lumen_angle_error_deg": 0.50,  # angular tolerance of the extrusion die (1-3 deg)
+        "lumen_helix_deg": 0.30,  # extrusion twist: the least controlled geometry
+        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # braid lay and crimp
+        "tendon_stiffness_N": 0.15,  # braid lot (EA)
+        "free_length_m": 0.20,  # handle assembly
+        "sheath_length_m": 0.02,  # cut to length
+        "bend_length_mm": 0.05,  # moulded links
+        "sheath_wrap_deg": 0.10,  # lumen path in the shaft
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "friction_exponent": 0.05,  # one material pair (0.67-0.9 over materials)
+        "contact_load_N": 0.25,  # surface roughness of the liner
+        "sheath_drag_N": 0.20,  # lumen preload
+        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
+        "handle_friction_Nm": 0.20,  # knob bearing / O-ring
+        "handle_presliding_deg": 0.20,
+    },
 }
 """Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""
 
 _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMPED_KNOBS,
                                         "segments": SEGMENTS_KNOBS,
                                         "coilpipe": COILPIPE_KNOBS,
-                                        "stickslip": STICKSLIP_KNOBS}
+                                        "stickslip": STICKSLIP_KNOBS,
+                                        "twistshaft": TWISTSHAFT_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -214,6 +239,8 @@ VARIANTS: dict[str, Variant] = {
                          "viscous_N_s_per_mm": 1.5, "handle_friction_Nm": 1.5},
             "stickslip": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                           "handle_friction_Nm": 1.5},
+            "twistshaft": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                           "handle_friction_Nm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -232,7 +259,8 @@ VARIANTS: dict[str, Variant] = {
                  "lumped": {"tendon_stiffness_N": 0.4},
                  "segments": {"tendon_stiffness_N": 0.4},
                  "coilpipe": {"tendon_stiffness_N": 0.4},
-                 "stickslip": {"tendon_stiffness_N": 0.4}},
+                 "stickslip": {"tendon_stiffness_N": 0.4},
+                 "twistshaft": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

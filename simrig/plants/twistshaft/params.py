@@ -19,12 +19,12 @@ class TwistKnobParams:
     tendon_offset_mm: float = 5.0
     """Lumen distance from the neutral axis: a 12-14 mm TEE tip carries its lumens at 4-6 mm
     (5.0 from 4.5 for the realism checks' loaded slope, 1.2-1.6)."""
-    lumen_angle_error_deg: float = 2.0
+    lumen_angle_error_deg: float = 1.5
     """Angular misplacement of this lumen pair off its plane (multi-lumen extrusion tolerance,
     1-3 deg): the other plane's bending lengthens or shortens these tendons' paths."""
-    lumen_helix_deg: float = 1.5
-    """Helix angle of the lumens (extrusion twist of 1-3 deg): tension along a helix twists the
-    shaft."""
+    lumen_helix_deg: float = 0.75
+    """Helix angle of the lumens in the steerable section (extrusion twist, link stacking:
+    0.5-3 deg): tension along a helix twists the section."""
     slack_pos_mm: float = 4.0
     """Tendon length left free when crimped on the drum: 4 mm is 29 knob deg of dead zone on
     8 mm (the paper's catheters and the TEE data: D of tens of knob degrees; 4.0 from 3.0 for
@@ -72,22 +72,25 @@ class TwistKnobParams:
 class ShaftParams:
     """The shaft shared by both knobs: its torsion, and the warm-up in the patient."""
 
-    torsion_stiffness_Nm_per_rad: float = 0.10
-    """GJ/L of a 1 m TEE shaft (braided polymer tube, GJ ~ 0.1 N m2)."""
-    torsion_friction_Nm: float = 0.0015
-    """Rotational friction of the shaft against the oesophagus wall and bite guard."""
+    torsion_stiffness_Nm_per_rad: float = 0.015
+    """Torsional stiffness of the catheter between handle and tip planes, set by its softest
+    part, the steerable section (thin Pebax over links, GJ ~ 1e-3 N m2 over 60 mm; the braided
+    1 m shaft, GJ ~ 0.3 N m2, adds little): ~2.5 deg of twist at full load."""
+    torsion_friction_Nm: float = 0.0002
+    """Rotational friction of the tip section against the oesophagus wall: holds ~0.8 deg of
+    twist when the load goes."""
     start_temperature_C: float = 24.0
     """The catheter starts at room temperature (inserted at reset)."""
     body_temperature_C: float = 37.0
     warm_time_s: float = 60.0
     """Time constant of the shaft's warm-up in the patient (polymer wall of ~1 mm in contact with
     tissue: tens of seconds to minutes)."""
-    bend_softening_per_C: float = 0.008
-    """Relative fall of the tip cover's modulus per deg C (Pebax 35-55D: -0.5 to -1.2 %/C between
-    room and body temperature)."""
-    liner_softening_per_C: float = 0.008
-    """Relative fall of the lumen liner's modulus per deg C (PTFE/polyolefin near their room-
-    temperature transitions): a softer liner has a larger real contact area."""
+    bend_softening_per_C: float = 0.015
+    """Relative fall of the tip cover's modulus per deg C (soft Pebax grades, 25-40D: -1 to -2 %/C
+    between room and body temperature): -20 % once warm."""
+    liner_softening_per_C: float = 0.003
+    """Relative fall of the lumen liner's modulus per deg C (PTFE: a fifth of the cover's): a
+    softer liner has a larger real contact area."""
     sheath_curvature_deg: float = 0.0
     """Extra curvature of the sheath (the curved-sheath variant): adds to every lumen's wrap."""
 

@@ -23,13 +23,13 @@ exponential).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import fields
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
-from simrig.plant import PlantStep, step_inputs
+from simrig.plant import PlantLoadError, PlantStep, step_inputs
 from simrig.plants.twistshaft.params import (
     ShaftParams,
     TwistKnobParams,
@@ -65,7 +65,8 @@ class TwistShaftPlant:
                 self._tendons.append(LumenTendon(
                     kp_N_mm=p.tendon_stiffness_N / (proximal_m * 1e3),
                     kd_N_mm=p.tendon_stiffness_N / (distal_m * 1e3), toe_mm=p.toe_mm,
-                    slack_mm=slack, wrap_rad=wrap_rad(p.sheath_wrap_deg, shaft.sheath_curvature_deg),
+                    slack_mm=slack,
+                    wrap_rad=wrap_rad(p.sheath_wrap_deg, shaft.sheath_curvature_deg),
                     mu=p.sheath_friction, n=p.friction_exponent, load_N=p.contact_load_N,
                     drag_N=p.sheath_drag_N))
                 beta = plane + err + (0.0 if sign > 0 else math.pi)
@@ -162,14 +163,26 @@ class TwistShaftPlant:
 def make_twistshaft_plant(knobs: Sequence[dict[str, float] | TwistKnobParams] | None = None,
                           **shaft: float) -> TwistShaftPlant:
     """The plant from per-knob constants (``knobs=[{...}, {...}]``) and shaft keywords
-    (``ShaftParams`` fields, e.g. ``sheath_curvature_deg``, ``warm_time_s``)."""
+    (``ShaftParams`` fields, e.g. ``sheath_curvature_deg``, ``warm_time_s``); a bad constant is
+    refused in one line naming it (:class:`simrig.plant.PlantLoadError`)."""
+    entries = list(knobs) if knobs is not None else list(NOMINAL_KNOBS)
+    if len(entries) != 2:
+        raise PlantLoadError(f"twistshaft: knobs must list 2 knobs, got {len(entries)}")
     built: list[TwistKnobParams] = []
-    for k, entry in enumerate(knobs if knobs is not None else NOMINAL_KNOBS):
-        if isinstance(entry, TwistKnobParams):
-            built.append(entry)
-            continue
-        try:
-            built.append(TwistKnobParams(**entry))
-        except TypeError as exc:
-            raise TypeError(f"twistshaft knob {k}: {exc}") from None
-    return TwistShaftPlant(built, ShaftParams(**shaft))
+    try:
+        for k, entry in enumerate(entries):
+            if isinstance(entry, TwistKnobParams):
+                built.append(entry)
+            elif isinstance(entry, Mapping):
+                unknown = sorted(set(entry) - {f.name for f in fields(TwistKnobParams)})
+                if unknown:
+                    raise ValueError(f"twistshaft knob {k}: unknown constant {unknown[0]!r}")
+                built.append(TwistKnobParams(**entry))
+            else:
+                raise ValueError(f"twistshaft knob {k}: a mapping of constants, got {entry!r}")
+        unknown = sorted(set(shaft) - {f.name for f in fields(ShaftParams)})
+        if unknown:
+            raise ValueError(f"twistshaft: unknown shaft constant {unknown[0]!r}")
+        return TwistShaftPlant(built, ShaftParams(**shaft))
+    except ValueError as exc:
+        raise PlantLoadError(str(exc)) from None

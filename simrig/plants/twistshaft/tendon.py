@@ -18,8 +18,21 @@ import math
 class LumenTendon:
     """Quasi-static state of one tendon: where its contact is (``x_mm``, drawn towards the drum)."""
 
-    __slots__ = ("kp_N_mm", "kd_N_mm", "toe_mm", "slack_mm", "wrap_rad", "mu", "n", "load_N",
-                 "drag_N", "x_mm", "_x_trial", "tp_N", "td_N")
+    __slots__ = (
+        "_x_trial",
+        "drag_N",
+        "kd_N_mm",
+        "kp_N_mm",
+        "load_N",
+        "mu",
+        "n",
+        "slack_mm",
+        "td_N",
+        "toe_mm",
+        "tp_N",
+        "wrap_rad",
+        "x_mm",
+    )
 
     def __init__(self, *, kp_N_mm: float, kd_N_mm: float, toe_mm: float, slack_mm: float,
                  wrap_rad: float, mu: float, n: float, load_N: float, drag_N: float) -> None:

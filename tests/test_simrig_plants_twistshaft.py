@@ -138,3 +138,15 @@ def test_the_lumen_friction_coefficient_falls_with_load_only_below_exponent_one(
         return t._capacity(tension_N, tension_N, 0.5)[0] / (2 * tension_N)
     assert share(0.67, 20.0) < 0.8 * share(0.67, 0.5)
     assert share(1.0, 20.0) == pytest.approx(share(1.0, 0.5))
+
+
+def test_reshaping_mid_run_widens_the_dead_zone_and_refuses_bad_changes() -> None:
+    before = _sweep(make_twistshaft_plant(), 0.004, cycles=2.25)
+    plant = make_twistshaft_plant()
+    plant.reshape(slack_delta_mm=((0.5, 0.5), (0.5, 0.5)), sheath_curvature_deg=30.0)
+    after = _sweep(plant, 0.004, cycles=2.25)
+    d_before = measure_dead_zone_backlash(before[0], before[1][:, 0]).dead_zone_pos_deg
+    d_after = measure_dead_zone_backlash(after[0], after[1][:, 0]).dead_zone_pos_deg
+    assert d_after > d_before + 2.0  # 0.5 mm on the 8 mm drum is 3.6 knob deg
+    with pytest.raises(ValueError, match="slack_delta_mm"):
+        plant.reshape(slack_delta_mm=((0.5,), (0.5, 0.5)))

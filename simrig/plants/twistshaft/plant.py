@@ -22,6 +22,7 @@ exponential).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import fields
@@ -84,6 +85,27 @@ class TwistShaftPlant:
         self.bend_rad = [0.0, 0.0]
         self.twist_rad = 0.0
         self._handle_anchor_deg = [0.0, 0.0]
+
+    def reshape(self, slack_delta_mm: Sequence[Sequence[float]] | None = None,
+                sheath_curvature_deg: float | None = None) -> None:
+        """Change the catheter mid-run (``simrig.scenario``): tendon slack grows by
+        ``((knob1 +, knob1 -), (knob2 +, knob2 -))`` mm, or the sheath takes a new curvature;
+        the contacts, bend, twist and temperature stay where they are."""
+        if slack_delta_mm is not None:
+            deltas = [float(d) for pair in slack_delta_mm for d in pair]
+            if len(deltas) != 4 or not all(math.isfinite(d) for d in deltas):
+                raise ValueError(f"slack_delta_mm must be 2 pairs of finite mm, got "
+                                 f"{slack_delta_mm!r}")
+            for t, d in zip(self._tendons, deltas, strict=True):
+                t.slack_mm += d
+        if sheath_curvature_deg is not None:
+            if not (math.isfinite(sheath_curvature_deg) and sheath_curvature_deg >= 0.0):
+                raise ValueError(f"sheath_curvature_deg must be finite and >= 0, got "
+                                 f"{sheath_curvature_deg!r}")
+            self.shaft = dataclasses.replace(self.shaft, sheath_curvature_deg=sheath_curvature_deg)
+            for i, t in enumerate(self._tendons):
+                t.wrap_rad = wrap_rad(self.knobs[self._geom[i][0]].sheath_wrap_deg,
+                                      sheath_curvature_deg)
 
     def _thermal(self) -> tuple[float, float]:
         """Tip stiffness factor and liner friction factor at the present temperature."""

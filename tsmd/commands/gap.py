@@ -91,7 +91,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "or the earlier candidate transforms around the plant")
     parser.add_argument("--data-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant that makes the 'real' data "
-                             "(preset capstan, capstan-other, lumped, segments, coilpipe, "
+                             "(preset capstan, capstan-other, lumped, segments, coilpipe, stickslip, "
                              "or module:factory[@{json}])")
     parser.add_argument("--sim-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant used as the simulator")

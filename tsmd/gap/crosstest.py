@@ -121,6 +121,26 @@ lumen viscosity x8 1.56 deg, tendon EA halved 4.47 deg, the tip cover relaxing t
 (2 -> 4 s, its one creep branch) 0.58 deg."""
 
 
+STICKSLIP_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 120.0}}
+"""The stickslip plant's one effect keyword: a 120 deg sheath bend moves its tip by 1.99 deg (tip
+RMSE effect on minus off, unit 1, noise-free, 120 s of the experiment motion at 50 Hz; the
+other plants' 5-12 deg). Its knobs' coupling (each tendon rubs round the whole bent section) is
+base physics with no constant of its own: that case is not run on it (as segments' creep)."""
+
+STICKSLIP_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "rate": {"creep_fast_share": 5.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+    "creep": {"creep_slow_share": 1.5},
+}
+"""Stickslip effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion): its only rate-dependent physics is the tendons' relaxation, so rate is the fast
+(0.5 s) Maxwell branch five times as stiff, 1.11 deg (x3: 0.65; the protocol's 20 against 80
+deg/s loops then differ by 0.36 / 0.16 deg RMS, the nominal unit's own 0.16 / 0.09); creep the
+slow (12 s) branch 1.5 times as stiff, 0.38 deg (the other plants' creep 0.35-0.42 deg); the
+tendon EA halved, 3.73 deg. "None" is the nominal physics as written: relaxing tendons,
+stick-slip, the brake and the bend's coupling are its base (docs/gap.md "Session 12")."""
+
+
 @dataclass(frozen=True)
 class PlantSpec:
     """A plant as ``module:factory`` + fixed keyword parameters + what to fit as a simulator.
@@ -181,6 +201,8 @@ PRESETS: dict[str, PlantSpec] = {
     "coilpipe": PlantSpec(PLANT_SPECS["coilpipe"], dict(COILPIPE_BASE), (), "coilpipe",
                           family="coilpipe", effects=COILPIPE_EFFECTS,
                           knob_effects=COILPIPE_KNOB_EFFECTS),
+    "stickslip": PlantSpec(PLANT_SPECS["stickslip"], {}, (), "stickslip", family="stickslip",
+                           effects=STICKSLIP_EFFECTS, knob_effects=STICKSLIP_KNOB_EFFECTS),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

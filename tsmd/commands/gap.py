@@ -91,7 +91,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "or the earlier candidate transforms around the plant")
     parser.add_argument("--data-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant that makes the 'real' data "
-                             "(preset capstan, capstan-other, lumped, segments, coilpipe, stickslip, "
+                             "(preset capstan, capstan-other, lumped, segments, coilpipe, "
+                             "stickslip, "
                              "or module:factory[@{json}])")
     parser.add_argument("--sim-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant used as the simulator")
@@ -99,6 +100,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="selftest across plants: the unit of the data plant whose protocol "
                              "gives the compliance data sheet (default 0, the nominal unit; "
                              "never one of --seeds)")
+    parser.add_argument("--no-reference", action="store_true",
+                        help="selftest across plants: no model reference (what the data plant's "
+                             "model has always, from the data sheet's unit); every rate, "
+                             "coupling and creep contrast is then named, as before session 12")
     parser.add_argument("--no-protocol", action="store_true",
                         help="selftest across plants: sessions without the matched-condition "
                              "protocol recordings (the experiment motion only, as before)")
@@ -261,7 +266,8 @@ def _selftest(args: argparse.Namespace) -> int:
                       "such effect in its physics", flush=True)
         result = run_crosstest(data, sim, cases, sizes, seeds, rate_hz,
                                cross_config(sim.fit, args.method), progress=progress,
-                               matched=not args.no_protocol, sheet_unit=args.sheet_unit)
+                               matched=not args.no_protocol, sheet_unit=args.sheet_unit,
+                               reference=not args.no_reference)
     else:
         result = run_selftest(cases, sizes, seeds, rate_hz,
                               GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method),

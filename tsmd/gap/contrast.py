@@ -204,10 +204,10 @@ def product_reference(series: Sequence[GapSeries]) -> ProductReference:
               if d.diff.size]
     if not drifts:
         return ProductReference(loops)
-    same = [d for d in drifts if d.diff.shape == drifts[0].diff.shape]
+    pairs = [d for d in drifts if d.diff.shape == drifts[0].diff.shape]
     # per dwell pair: the pairs load the tendons in turn (+ then -), their slopes differ
-    diff = np.mean([d.diff for d in same], axis=0)
-    var = np.mean([d.var for d in same], axis=0) / len(same)
+    diff = np.mean([d.diff for d in pairs], axis=0)
+    var = np.mean([d.var for d in pairs], axis=0) / len(pairs)
     return ProductReference(loops, (diff, var))
 
 

@@ -181,3 +181,19 @@ def test_a_data_sheet_unit_that_is_scored_or_negative_is_one_line(
                      "--seeds", "5", "--sheet-unit", unit, "--out", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "data-sheet unit" in err
+
+
+@pytest.mark.parametrize("kind", ["no-segments", "missing"])
+def test_a_model_reference_without_the_protocol_is_one_line(
+        kind: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    data = _written(tmp_path)
+    ref = tmp_path / "ref.csv"
+    if kind == "no-segments":
+        rec = _protocol_recordings(0, "none", 0.0)[0]
+        cols = {k: v for k, v in rec.columns.items() if k != "segment"}
+        meta = {k: v for k, v in rec.metadata.items() if k != "segments"}
+        write_recording(ref, Recording(cols, meta))
+    code = cli.main(["gap", str(data), "--model-reference", str(ref),
+                     "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err

@@ -11,11 +11,12 @@ import pytest
 from numpy.typing import NDArray
 
 from tsmd import cli
-from tsmd.gap.contrast import contrast_scores, lag_share
+from tsmd.gap.contrast import collect_tests, contrast_scores, lag_share, product_reference
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.errors import GapError
-from tsmd.gap.loops import Loops, smooth_along
+from tsmd.gap.loops import Loops, loop_contrast, noise_ss, smooth_along
 from tsmd.gap.protocol import Segment, decode_table, encode_table, protocol
+from tsmd.gap.reference import beyond_reference, measured_windows
 from tsmd.gap.signature import SignatureScore
 from tsmd.gap.structure import rank_scores
 from tsmd.recording import Recording, read_trajectory
@@ -328,3 +329,57 @@ def test_of_two_significant_loop_contrasts_the_larger_ranks_first() -> None:
     ranked = rank_scores([score("rate", 0.97, 0.3), score("sensor", 0.95),
                           score("coupling", 0.90, 0.8)])
     assert [s.name for s in ranked] == ["coupling", "sensor", "rate"]
+
+
+def _widening(gain: float) -> Effect:
+    """A play that widens with speed by ``gain`` deg per deg/s (rate dependence)."""
+    def rate(t: Arr, q: Arr) -> Arr:
+        out = np.zeros((len(t), 4))
+        sp = _speed(t, q)
+        for j in range(2):
+            out[:, j] = _play(q[:, j], gain * sp[:, j]) - q[:, j]
+        return out
+    return rate
+
+
+def _against_model(unit: Effect, model: Effect) -> dict[str, SignatureScore]:
+    """Scores of a unit with ``unit`` against a model whose reference unit has ``model``."""
+    reference = product_reference(_session(model, seed=7)[0])
+    series, residuals = _session(unit)
+    return {s.name: s for s in contrast_scores(series, residuals, n_tried=6, tip_noise_deg=0.1,
+                                               current_noise_A=0.004, reference=reference)}
+
+
+def test_a_rate_dependence_the_model_has_always_is_not_named_against_its_reference() -> None:
+    assert "rate" in _named(_scores(_widening(0.02)))
+    assert "rate" not in _named(_against_model(_widening(0.02), _widening(0.02)))
+
+
+def test_a_unit_with_more_rate_dependence_than_its_model_is_named_rate() -> None:
+    scores = _against_model(_widening(0.06), _widening(0.02))
+    assert _named(scores) == {"rate"}
+    assert scores["rate"].share > 0.5
+
+
+def test_creep_the_model_has_always_is_not_named_against_its_reference() -> None:
+    assert "drift" not in _named(_against_model(_creep, _creep))
+
+
+def test_more_creep_than_the_model_has_is_named_drift() -> None:
+    def more(t: Arr, q: Arr) -> Arr:
+        return 3.0 * _creep(t, q)
+    assert _named(_against_model(more, _creep)) == {"drift"}
+
+
+def test_a_subtracted_reference_counts_its_own_repeat_noise() -> None:
+    reference = product_reference(_session(_widening(0.02), seed=7)[0])
+    assert reference.loops["rate"].noise_per_point > 0.0
+    series, residuals = _session(_widening(0.02))
+    meas = collect_tests(series, [measured_windows(s) for s in series])
+    res = collect_tests(series, residuals)
+    data = res["straight"]["rate"]
+    plain = loop_contrast(data.loops, data.levels)
+    own = loop_contrast(meas["straight"]["rate"].loops, data.levels)
+    assert plain is not None and own is not None
+    beyond = beyond_reference(plain, own, data.levels, reference.loops["rate"])
+    assert noise_ss(beyond) > noise_ss(plain)

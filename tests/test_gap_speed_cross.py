@@ -143,6 +143,18 @@ def test_coilpipe_rate_and_creep_cases_scale_the_units_own_constants() -> None:
         assert fast.knobs[k].bend_creep_time_s == none.knobs[k].bend_creep_time_s
 
 
+def test_stickslip_cases_scale_the_units_own_relaxation_and_coupling_is_not_run() -> None:
+    stickslip = PRESETS["stickslip"]
+    none = stickslip.build_unit(102, 0.1)
+    fast = stickslip.build_unit(102, 0.1, "rate", **stickslip.case_effects("rate"))
+    slow = stickslip.build_unit(102, 0.1, "creep", **stickslip.case_effects("creep"))
+    for k in (0, 1):
+        assert fast.knobs[k].creep_fast_share == pytest.approx(5.0 * none.knobs[k].creep_fast_share)
+        assert slow.knobs[k].creep_slow_share == pytest.approx(1.5 * none.knobs[k].creep_slow_share)
+        assert fast.knobs[k].creep_slow_share == none.knobs[k].creep_slow_share
+    assert not stickslip.supports("coupling")
+
+
 def test_a_case_the_data_plant_lacks_is_not_run(monkeypatch: pytest.MonkeyPatch) -> None:
     import tsmd.gap.crosstest as crosstest
 

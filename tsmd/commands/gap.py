@@ -20,12 +20,14 @@ import yaml
 
 from simrig.plant import load_plant
 from tsmd.gap.compliance import reference_deg_per_A
+from tsmd.gap.contrast import product_reference
 from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
 from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.fit import ParamSpec
 from tsmd.gap.protocol import protocol_trajectory
+from tsmd.gap.reference import ProductReference
 from tsmd.gap.report import finite_json, write_report
 from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (
@@ -74,6 +76,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "reversal, knob 1 and 2 (`tsmd gap sheet` on another unit's "
                              "protocol recordings); with it and the protocol in the recordings "
                              "tendon compliance can be named")
+    parser.add_argument("--model-reference", default=None, metavar="REC,REC...",
+                        help="the protocol recorded on a reference unit of the catheter model "
+                             "(the data sheet's unit): what the model has always (its own "
+                             "rate, coupling and creep contrasts); effects are then named only "
+                             "for what a unit has beyond it")
     parser.add_argument("--sizes", default="120,300",
                         help="selftest: recording lengths in s (comma-separated)")
     parser.add_argument("--seeds", default="0,1", help="selftest: noise/unit seeds")
@@ -92,6 +99,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--data-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant that makes the 'real' data "
                              "(preset capstan, capstan-other, lumped, segments, coilpipe, "
+                             "stickslip, "
                              "or module:factory[@{json}])")
     parser.add_argument("--sim-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant used as the simulator")
@@ -99,6 +107,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="selftest across plants: the unit of the data plant whose protocol "
                              "gives the compliance data sheet (default 0, the nominal unit; "
                              "never one of --seeds)")
+    parser.add_argument("--no-reference", action="store_true",
+                        help="selftest across plants: no model reference (what the data plant's "
+                             "model has always, from the data sheet's unit); every rate, "
+                             "coupling and creep contrast is then named, as before session 12")
     parser.add_argument("--no-protocol", action="store_true",
                         help="selftest across plants: sessions without the matched-condition "
                              "protocol recordings (the experiment motion only, as before)")
@@ -180,7 +192,8 @@ def main(args: argparse.Namespace) -> int:
                        block_s=args.block_s, fit_max_rows=max(args.fit_rows, 200),
                        joint_top=max(args.joint_top, 0), seed=args.seed,
                        method=args.method,
-                       compliance_reference=_compliance_sheet(args.compliance_sheet))
+                       compliance_reference=_compliance_sheet(args.compliance_sheet),
+                       product_reference=_model_reference(args.model_reference, args.tee))
     result = diagnose(series, _factory(args.plant, params), params, config)
     out = Path(args.out)
     md, js = write_report(result, out, ", ".join(names),
@@ -202,6 +215,19 @@ def _compliance_sheet(text: str | None) -> tuple[float, float] | None:
     if not (k1 > 0.0 and k2 > 0.0 and np.isfinite(k1) and np.isfinite(k2)):
         raise GapError(f"--compliance-sheet {text!r}: both figures must be positive")
     return k1, k2
+
+
+def _model_reference(text: str | None, tee: bool) -> ProductReference | None:
+    if text is None:
+        return None
+    paths = [p.strip() for p in text.split(",") if p.strip()]
+    if not paths:
+        raise GapError("--model-reference: give the reference unit's protocol recordings")
+    reference = product_reference([_load_recording(p, tee) for p in paths])
+    if not reference.loops and reference.creep is None:
+        raise GapError(f"--model-reference {text!r}: no protocol segments (rate, coupling or "
+                       "creep) in these recordings")
+    return reference
 
 
 def _sheet(args: argparse.Namespace) -> int:
@@ -261,7 +287,8 @@ def _selftest(args: argparse.Namespace) -> int:
                       "such effect in its physics", flush=True)
         result = run_crosstest(data, sim, cases, sizes, seeds, rate_hz,
                                cross_config(sim.fit, args.method), progress=progress,
-                               matched=not args.no_protocol, sheet_unit=args.sheet_unit)
+                               matched=not args.no_protocol, sheet_unit=args.sheet_unit,
+                               reference=not args.no_reference)
     else:
         result = run_selftest(cases, sizes, seeds, rate_hz,
                               GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method),

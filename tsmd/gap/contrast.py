@@ -33,6 +33,14 @@ from tsmd.gap.loops import (
     loop_shrink,
     noise_ss,
 )
+from tsmd.gap.reference import (
+    REFERENCED,
+    LoopReference,
+    ProductReference,
+    beyond_reference,
+    drift_beyond_reference,
+    measured_windows,
+)
 from tsmd.gap.signature import SIGNATURES, SignatureScore
 
 FloatArray = NDArray[np.float64]
@@ -79,7 +87,8 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
                     n_tried: int, family_alpha: float = 0.05,
                     min_share: float = 0.05,
                     tip_noise_deg: float | None = None,
-                    current_noise_A: float | None = None) -> list[SignatureScore]:
+                    current_noise_A: float | None = None,
+                    reference: ProductReference | None = None) -> list[SignatureScore]:
     """Score every protocol test found in ``series`` (``residuals``: (n, 4) data minus the
     physics simulator, per series). Significant: p below ``family_alpha / n_tried``, at
     least ``min_share`` of a held-out configuration's contrast reproduced and, for the loop
@@ -88,15 +97,15 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
     found by enough repeats but is no cause of the gap (the blind plant's own rate dependence,
     about 0.05 deg, was named rate against the capstan simulator: docs/gap.md, session 10).
     Creep likewise, when ``current_noise_A`` is given: the currents' drift over a loaded dwell
-    (:func:`tsmd.gap.dwell.drift_size`) at least one sample's current noise (session 11)."""
-    by_config: dict[str, dict[str, TestData]] = {}
-    for s, res in zip(series, residuals, strict=True):
-        if s.segment is not None:
-            _collect(s, res, by_config.setdefault(s.config, {}))
+    (:func:`tsmd.gap.dwell.drift_size`) at least one sample's current noise (session 11).
+    With the model's ``reference`` (session 12) the rate, coupling and creep tests compare
+    what this unit has beyond its model's own contrasts (:mod:`tsmd.gap.reference`)."""
+    by_config = collect_tests(series, residuals)
+    meas_config = (collect_tests(series, [measured_windows(s) for s in series])
+                   if reference is not None else {})
     out = []
     crit = family_alpha / max(n_tried, 1)
     for test, name in DECIDES.items():
-        per_cfg = [d[test] for d in by_config.values() if test in d]
         if test == "curvature":
             loops = [lp for lp in (_across_configs([d[t] for d in by_config.values() if t in d])
                                    for t in ("rate", "coupling")) if lp is not None]
@@ -107,7 +116,8 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
             shrinks = [loop_shrink([loops[1 - i]], loops[i], bend_design) for i in range(2)]
             size = excess_rms(loops)
         elif test == "creep":
-            drifts = [d for d in (_drift(t) for t in per_cfg) if d.diff.size]
+            drifts = [d for d in (_drift_beyond(by_config, meas_config, c, reference)
+                                  for c in by_config if test in by_config[c]) if d.diff.size]
             if not drifts:
                 continue
             _, _, p = drift_stat(drifts)
@@ -115,7 +125,9 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
                        for i in range(len(drifts))]
             size = drift_size(drifts)
         else:
-            found = [loop_contrast(t.loops, t.levels) for t in per_cfg]
+            ref = reference.loops.get(test) if reference is not None else None
+            found = [_loops_beyond(by_config[c][test], meas_config.get(c, {}).get(test), ref)
+                     for c in by_config if test in by_config[c]]
             loops = [lp for lp in found if lp is not None]
             if not loops:
                 continue
@@ -138,6 +150,65 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
         out.append(SignatureScore(name, title, condition, share, lo_hi, sig, share, 0.0, _z(p),
                                   size if test in LOOP_TESTS else float("nan")))
     return out
+
+
+def collect_tests(series: Sequence[GapSeries],
+                  residuals: Sequence[FloatArray]) -> dict[str, dict[str, TestData]]:
+    """Every protocol window of ``series`` filed by configuration and test."""
+    by_config: dict[str, dict[str, TestData]] = {}
+    for s, res in zip(series, residuals, strict=True):
+        if s.segment is not None:
+            _collect(s, res, by_config.setdefault(s.config, {}))
+    return by_config
+
+
+def _loops_beyond(res: TestData, meas: TestData | None, ref: LoopReference | None
+                  ) -> Loops | None:
+    """One configuration's residual loops of a test, less the model's own contrast."""
+    lp = loop_contrast(res.loops, res.levels)
+    if lp is None or meas is None or ref is None:
+        return lp
+    mp = loop_contrast(meas.loops, meas.levels)
+    return beyond_reference(lp, mp, res.levels, ref) if mp is not None else lp
+
+
+def _drift_beyond(by_config: dict[str, dict[str, TestData]],
+                  meas_config: dict[str, dict[str, TestData]], config: str,
+                  reference: ProductReference | None) -> Drift:
+    drift = _drift(by_config[config]["creep"])
+    meas = meas_config.get(config, {}).get("creep")
+    if reference is None or meas is None:
+        return drift
+    return drift_beyond_reference(drift, _drift(meas), reference.creep)
+
+
+def product_reference(series: Sequence[GapSeries]) -> ProductReference:
+    """What the model has always, from the protocol recorded on the data sheet's unit (any
+    configurations): each referenced loop test's level contrast of the measured signals, mean
+    over configurations, and the currents' loaded-minus-unloaded dwell slopes."""
+    by_config = collect_tests(series, [measured_windows(s) for s in series])
+    loops: dict[str, LoopReference] = {}
+    for test in REFERENCED:
+        found = [(loop_contrast(d[test].loops, d[test].levels), d[test].levels)
+                 for d in by_config.values() if test in d]
+        usable = [(lp, lv) for lp, lv in found if lp is not None]
+        if not usable:
+            continue
+        first, levels = usable[0]
+        same = [lp for lp, lv in usable if lp.y.shape == first.y.shape and lv == levels]
+        value = np.mean([contrast_of(lp) for lp in same], axis=0)
+        noise = float(np.mean([noise_ss(lp) for lp in same])) / first.y.shape[2] / len(same)
+        loops[test] = LoopReference(tuple(levels), value, first.knob * first.span_deg,
+                                    first.dirn, first.part, noise)
+    drifts = [d for d in (_drift(c["creep"]) for c in by_config.values() if "creep" in c)
+              if d.diff.size]
+    if not drifts:
+        return ProductReference(loops)
+    pairs = [d for d in drifts if d.diff.shape == drifts[0].diff.shape]
+    # per dwell pair: the pairs load the tendons in turn (+ then -), their slopes differ
+    diff = np.mean([d.diff for d in pairs], axis=0)
+    var = np.mean([d.var for d in pairs], axis=0) / len(pairs)
+    return ProductReference(loops, (diff, var))
 
 
 def excess_rms(loops: Sequence[Loops]) -> float:
@@ -229,10 +300,7 @@ def lag_share(series: Sequence[GapSeries],
     """Share of the rate test's current contrast (fast against slow loops) that a lag of the
     current explains, fitted on one configuration and scored on the other (mean, lowest,
     highest over the held-out configurations); None without such a contrast."""
-    by_config: dict[str, dict[str, TestData]] = {}
-    for s, res in zip(series, residuals, strict=True):
-        if s.segment is not None:
-            _collect(s, res, by_config.setdefault(s.config, {}))
+    by_config = collect_tests(series, residuals)
     found = [loop_contrast(d["rate"].currents, d["rate"].levels)
              for d in by_config.values() if "rate" in d]
     loops = [lp for lp in found if lp is not None]

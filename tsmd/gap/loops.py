@@ -32,6 +32,8 @@ class Loops:
     part: FloatArray  # (K,) which knob / channel the point belongs to
     span_deg: float = 1.0
     """Knob angle (deg) of ``knob`` = 1: the loops' amplitude."""
+    ref_noise_ss: float = 0.0
+    """Noise a subtracted reference contrast brings (:mod:`tsmd.gap.reference`)."""
 
 
 def _branches(knob: FloatArray) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
@@ -129,7 +131,7 @@ def noise_ss(lp: Loops) -> float:
     n_lev, n_rep, k = lp.y.shape
     dev = lp.y - lp.y.mean(axis=1)[:, None, :]
     var = float((dev**2).sum()) / max(n_lev * (n_rep - 1) * k, 1)
-    return (n_lev - 1) * k * var / n_rep
+    return (n_lev - 1) * k * var / n_rep + lp.ref_noise_ss
 
 
 def _slope(lp: Loops, mean_loop: FloatArray) -> FloatArray:

@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from tsmd.gap.fit import ParamSpec
+from tsmd.gap.reference import ProductReference
 from tsmd.gap.where import BinRow
 
 
@@ -41,6 +42,10 @@ class GapConfig:
     :func:`tsmd.gap.compliance.reference_deg_per_A` on the protocol recorded with another
     unit). With it and the protocol, compliance is named from the reversals; without, it is
     scored but not named."""
+    product_reference: ProductReference | None = None
+    """What the catheter model has always (its own rate, coupling and creep contrasts), from
+    the protocol recorded on the data sheet's unit (:func:`tsmd.gap.contrast.product_reference`):
+    with it those tests name only what a unit has beyond its model."""
     final_max_rows: int = 20000
     """Held-out rows replayed for the how-far figures (all of them up to this many)."""
     n_surrogates: int = 30

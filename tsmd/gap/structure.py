@@ -47,7 +47,7 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         residuals = _residuals(series, split, ev, base_fit)
         found = contrast_scores(series, residuals, len(sres.scores), cfg.family_alpha,
                                 cfg.min_share, float(np.sqrt(np.mean(noise_var[:2]))),
-                                float(np.sqrt(np.mean(noise_var[2:]))))
+                                float(np.sqrt(np.mean(noise_var[2:]))), cfg.product_reference)
         if cfg.compliance_reference is not None:
             stretch = compliance_score(series, cfg.compliance_reference, len(sres.scores),
                                        cfg.family_alpha, cfg.min_share)

@@ -1,0 +1,107 @@
+"""What a catheter model has always: its own rate dependence, coupling and creep, measured once.
+
+A catheter's base physics may carry an effect of the catalogue by itself (the coilpipe plant's
+relaxing tip and Stribeck friction give 0.3 deg of rate contrast on every unit, docs/gap.md
+"Session 11"). A diagnosis that names every contrast names that on every unit of the model. The
+protocol recorded on the data sheet's unit (with the tracker, as the compliance data sheet is)
+gives the model's own contrasts of the *measured* signals, independent of any simulator; a unit
+is then compared with it: the residual's contrast plus the simulator's own contrast (the
+measured minus the residual's, on the same rows) minus the reference's is what this unit has
+beyond its model. A unit scatters around its model's reference; the loop tests' size rule (one
+sample's tracker noise, from the data) is the allowance, with the reference's own repeat noise
+counted as noise.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import NDArray
+
+from tsmd.gap.data import GapSeries
+from tsmd.gap.dwell import Drift
+from tsmd.gap.loops import Loops, contrast_of
+
+FloatArray = NDArray[np.float64]
+
+REFERENCED: tuple[str, ...] = ("rate", "coupling")
+"""Loop tests compared with the model's reference. Curvature is not: its levels are the
+session's own configurations, which a reference unit recorded elsewhere does not share."""
+
+
+@dataclass(frozen=True)
+class LoopReference:
+    """One loop test's level contrast on the reference unit, per point of its loops."""
+
+    levels: tuple[str, ...]
+    value: FloatArray  # (levels, K) contrast of the measured signal, mean over configurations
+    knob_deg: FloatArray  # (K,)
+    dirn: FloatArray  # (K,)
+    part: FloatArray  # (K,)
+    noise_per_point: float
+    """Expected squared contrast per point from the reference's repeat noise alone."""
+
+    def at(self, lp: Loops, levels: Sequence[str]) -> FloatArray | None:
+        """The reference contrast at ``lp``'s points (levels in ``levels``' order), or None
+        when the levels differ."""
+        if sorted(levels) != sorted(self.levels):
+            return None
+        x = lp.knob * lp.span_deg
+        out = np.zeros((len(levels), len(x)))
+        for p in np.unique(lp.part):
+            for d in (-1.0, 1.0):
+                mine = (lp.part == p) & (lp.dirn == d)
+                ref = (self.part == p) & (self.dirn == d)
+                if not mine.any():
+                    continue
+                if ref.sum() < 2:
+                    return None
+                order = np.argsort(self.knob_deg[ref])
+                for i, lv in enumerate(levels):
+                    row = self.value[self.levels.index(lv)][ref][order]
+                    out[i, mine] = np.interp(x[mine], self.knob_deg[ref][order], row)
+        return out
+
+
+@dataclass(frozen=True)
+class ProductReference:
+    """The model's own contrasts (its 'always'), from the protocol on the data sheet's unit."""
+
+    loops: dict[str, LoopReference]
+    creep: tuple[FloatArray, FloatArray] | None = None
+    """Per dwell pair and current, the loaded-minus-unloaded slope (A/s) and its variance,
+    mean over configurations."""
+
+
+def measured_windows(s: GapSeries) -> FloatArray:
+    """A series' measured channels laid out as a residual (tip 1, tip 2, current 1, 2)."""
+    return np.column_stack([s.tip_deg, s.current_A])
+
+
+def beyond_reference(res: Loops, meas: Loops, levels: Sequence[str],
+                     ref: LoopReference | None) -> Loops:
+    """The residual loops less the model's own contrast: ``res`` plus the simulator's own
+    contrast (``meas`` - ``res``, the same rows) minus the reference's. Unchanged without a
+    reference or when the levels do not match."""
+    if ref is None:
+        return res
+    own = ref.at(res, levels)
+    if own is None or meas.y.shape != res.y.shape:
+        return res
+    sim = contrast_of(meas) - contrast_of(res)
+    y = res.y + (sim - own)[:, None, :]
+    return replace(res, y=y, ref_noise_ss=res.y.shape[2] * ref.noise_per_point)
+
+
+def drift_beyond_reference(res: Drift, meas: Drift,
+                           creep: tuple[FloatArray, FloatArray] | None) -> Drift:
+    """The residual's dwell slopes less the model's own: the measured slopes minus the
+    reference's, pair by pair, their variances added. Unchanged without a reference or when
+    the dwells differ."""
+    if creep is None or not (meas.diff.shape == res.diff.shape == creep[0].shape):
+        return res
+    own, own_var = creep
+    return Drift(meas.diff - own, res.var + own_var, res.span_s)
+

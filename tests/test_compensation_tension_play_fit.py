@@ -388,22 +388,6 @@ def test_a_settle_rule_sheet_gain_scales_omega_by_the_units_settle_rule_gain() -
     assert rule.omega == pytest.approx(settle.omega)
 
 
-def test_a_product_rule_sheet_gain_scales_omega_by_the_plays_own_gain() -> None:
-    grid = (-90.0, 0.0, 90.0)
-    knob = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.2,
-                               reference_rule_backlash_gain=0.1)
-    p = fit_tension_play(_with_settle_backlash(
-        [synthetic_sweep(g, backlash_deg=15.0) for g in grid], 25.0), knob)
-    beta_0 = 0.5 * (p.backlash_gain_pos[1] + p.backlash_gain_neg[1])
-    assert p.omega == pytest.approx(unit_omega(1.5, 0.1, beta_0))
-
-
-def test_the_release_ratio_takes_the_product_rule_gain_where_the_sheet_has_it() -> None:
-    knob = dataclasses.replace(DEVICE_KNOB, release_omega=2.0, reference_backlash_gain=0.3,
-                               reference_rule_backlash_gain=0.2)
-    assert release_slope_ratio(knob) == pytest.approx(2.0 * 0.8 / 1.5)
-
-
 def test_a_non_finite_settle_backlash_leaves_omega_to_the_plays_gain() -> None:
     grid = (-90.0, 0.0, 90.0)
     knob = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.2)

@@ -128,19 +128,3 @@ def test_bad_rule_seeds_are_one_line_before_anything_is_measured(
     assert code == 2
     assert "--rule-seeds" in capsys.readouterr().err
     assert not (tmp_path / "d.yaml").exists()
-
-
-def test_the_chosen_rules_backlash_gain_goes_into_the_sheet() -> None:
-    scores = [dataclasses.replace(scored("line", k, 50), backlash_gain=0.21) for k in (0, 1)]
-    scores += [dataclasses.replace(scored("swing", k, 54), backlash_gain=0.33) for k in (0, 1)]
-    chosen = choose_rules(sheet(), scores)
-    assert [k.reference_rule_backlash_gain for k in chosen.knobs] == [0.33, 0.33]
-
-
-def test_the_product_rule_gain_survives_the_sheets_yaml() -> None:
-    base = sheet(rule="line")
-    device = dataclasses.replace(base, knobs=tuple(
-        dataclasses.replace(k, reference_rule_backlash_gain=0.123) for k in base.knobs))
-    mapping = device_model_to_mapping(device)
-    assert mapping["knobs"]["phi1"]["reference_rule_backlash_gain"] == 0.123
-    assert device_model_from_mapping(mapping) == device

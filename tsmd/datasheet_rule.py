@@ -18,7 +18,6 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -30,7 +29,6 @@ from tsmd.bench.calibration_family import (
 )
 from tsmd.bench.tip_truth import tip_truth
 from tsmd.calibration.protocol import fast_protocol
-from tsmd.calibration.tension_play_fit import fit_sweep_sides, sweeps_from_points
 from tsmd.config import TsmdConfig
 from tsmd.profile import DeviceKnob, DeviceModel
 from tsmd.profile.types import RELEASE_RULES
@@ -51,9 +49,6 @@ class RuleScore:
     max_deg: float
     accepted: int
     runs: int
-    backlash_gain: float | None = None
-    """The unit's backlash gain at the other knob's 0 with B by this rule (mean over the runs):
-    the sheet's ``reference_rule_backlash_gain`` where this rule is chosen."""
 
     def key(self) -> tuple[int, int]:
         """Better first: more values within the target, then more runs accepted (a refused
@@ -85,23 +80,6 @@ def usable(knob: DeviceKnob, rule: str) -> bool:
     return share is not None
 
 
-def rule_backlash_gain(points: Sequence[Any], knob: int) -> float | None:
-    """The backlash gain of ``knob`` with the other knob at 0 (mean of both sides), with B as
-    the points were identified (the rule a unit's tension play is fitted on, same estimator as
-    every unit's); None without such a point or a load ramp to fit."""
-    mine = [p for p in points if p.knob == knob]
-    zero = [s for s in (sweeps_from_points(mine, knob) if mine else []) if s.other_knob_deg == 0]
-    if not zero:
-        return None
-    s = zero[0]
-    try:
-        sides = fit_sweep_sides(s.pos_deg, s.current_A, s.dead_zone_pos_deg, s.dead_zone_neg_deg,
-                                s.backlash_pos_deg, s.backlash_neg_deg)
-    except ValueError:
-        return None
-    return 0.5 * (sides[0].backlash_gain + sides[1].backlash_gain)
-
-
 def knob_errors(errors: Sequence[float], knob: int) -> np.ndarray:
     """One knob's share of :func:`score`'s values (knob 0's parameters first)."""
     n = len(errors) // 2
@@ -122,14 +100,11 @@ def rule_scores(config: TsmdConfig, device: DeviceModel,
         for knob in (0, 1):
             e = np.concatenate([knob_errors(r.errors, knob) for r in runs])
             finite = e[np.isfinite(e)]
-            gains = [g for g in (rule_backlash_gain(r.points, knob) for r in runs)
-                     if g is not None]
             out.append(RuleScore(
                 rule, knob, int(np.sum(finite <= TARGET_DEG)), e.size,
                 float(np.mean(finite)) if finite.size else math.nan,
                 float(np.max(finite)) if finite.size else math.nan,
-                sum(r.accepted for r in runs), len(runs),
-                float(np.mean(gains)) if gains else None))
+                sum(r.accepted for r in runs), len(runs)))
     return out
 
 
@@ -145,8 +120,6 @@ def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceMode
             knobs.append(k)
             continue
         best = min(mine, key=lambda s: (s.key(), RELEASE_RULES.index(s.rule)))
-        gain = None if best.backlash_gain is None else round(best.backlash_gain, 3)
-        knobs.append(dataclasses.replace(k, backlash_release_rule=best.rule,
-                                         reference_rule_backlash_gain=gain))
+        knobs.append(dataclasses.replace(k, backlash_release_rule=best.rule))
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 

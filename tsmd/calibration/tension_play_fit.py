@@ -16,10 +16,9 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   loaded slope is the release (kinematic) slope times ``1 - beta``. The release slope is a
   product constant (pulley over moment arm), hence
   ``omega_unit = omega_sheet (1 - beta_unit) / (1 - beta_sheet)`` with ``beta_sheet`` the
-  data-sheet unit's backlash gain from its own current, both read with the same rule's B: the
-  product's rule where the sheet gives ``reference_rule_backlash_gain``, else the settle rule
-  (``reference_backlash_gain``, older sheets: the unit's ``beta`` for omega alone is then read
-  from the settle rule's B); without either the data sheet's omega;
+  data-sheet unit's backlash gain from its own current (``reference_backlash_gain``, read with
+  the settle rule's B) and ``beta_unit`` read the same way (the same load ramps, the settle
+  rule's B), whatever B the play itself is fitted on; without it the data sheet's omega;
 * the release line's slope: the locus of backlash ends has slope ``omega / (1 - beta)``, but
   where a product's release path after the backlash is shallower or steeper than that locus (a
   lumped catheter's is 7 % shallower; the current cannot see it: a released tendon's current is
@@ -175,22 +174,12 @@ RELEASE_RATIO_RANGE: tuple[float, float] = (0.7, 1.3)
 """Plausible release-path over backlash-end-locus slope ratios; outside, the sheet is refused."""
 
 
-def sheet_gain(device_knob: Any) -> float | None:
-    """The data-sheet unit's backlash gain: read with the product's rule where the sheet gives
-    it (as every unit's play is fitted), else with the settle rule; None without either."""
-    rule_gain = getattr(device_knob, "reference_rule_backlash_gain", None)
-    if rule_gain is not None:
-        return float(rule_gain)
-    gain = getattr(device_knob, "reference_backlash_gain", None)
-    return None if gain is None else float(gain)
-
-
 def release_slope_ratio(device_knob: Any) -> float:
     """The product's release-path slope over its backlash-end locus slope, from the data sheet:
-    ``release_omega (1 - gain) / omega`` (tracked release slope against the locus the current's
-    backlash gain, :func:`sheet_gain`, gives on the same unit); 1 without both keys."""
+    ``release_omega (1 - reference_backlash_gain) / omega`` (tracked release slope against the
+    locus the current's backlash gain gives on the same unit); 1 without both keys."""
     release = getattr(device_knob, "release_omega", None)
-    gain = sheet_gain(device_knob)
+    gain = getattr(device_knob, "reference_backlash_gain", None)
     if release is None or gain is None:
         return 1.0
     ratio = float(release) * (1.0 - float(gain)) / float(device_knob.omega)
@@ -303,8 +292,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                 for b in smooth_over_grid(grid, [f.backlash_gain for f in pos_fits])]
     beta_neg = [min(max(b, lo), hi)
                 for b in smooth_over_grid(grid, [f.backlash_gain for f in neg_fits])]
-    omega = unit_omega(float(k.omega), sheet_gain(k),
-                       omega_gain(grid, order, pos_fits, neg_fits, k, (beta_pos, beta_neg)))
+    omega = unit_omega(float(k.omega), getattr(k, "reference_backlash_gain", None),
+                       settle_rule_gain(grid, order, pos_fits, neg_fits, (beta_pos, beta_neg)))
     ratio = release_slope_ratio(k)
     sides = []
     for betas, fits in ((beta_pos, pos_fits), (beta_neg, neg_fits)):
@@ -321,16 +310,17 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         shape_neg=shape_neg)
 
 
-def omega_gain(grid: Sequence[float], sweeps: Sequence[SweepCurrent],
-               pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit], device_knob: Any,
-               betas: tuple[Sequence[float], Sequence[float]]) -> float:
-    """This unit's backlash gain at the other knob's 0 (mean of both sides), read with the
-    rule the sheet's gain was read with: the play's ``betas`` where the sheet gives its
-    product-rule gain, else (an older sheet's settle-rule gain) the same estimator on the
-    settle rule's B over the same load ramps, where the sweeps carry it (finite)."""
-    if (getattr(device_knob, "reference_rule_backlash_gain", None) is None
-            and all(s.settle_backlash_deg is not None
-                    and all(math.isfinite(b) for b in s.settle_backlash_deg) for s in sweeps)):
+def settle_rule_gain(grid: Sequence[float], sweeps: Sequence[SweepCurrent],
+                     pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit],
+                     betas: tuple[Sequence[float], Sequence[float]]) -> float:
+    """This unit's backlash gain at the other knob's 0 (mean of both sides) as the data sheet's
+    ``reference_backlash_gain`` is read: the settle rule's B over the same load ramps, smoothed
+    as the play's ``betas`` (which it is where the sweeps carry no other, or a non-finite, B).
+    A gain read with another rule than the sheet's would move omega by the rules' difference,
+    not the unit's stretch (session 12: variant (c), a product-rule gain on both sides, lost
+    on segments what it won on coilpipe)."""
+    if all(s.settle_backlash_deg is not None
+           and all(math.isfinite(b) for b in s.settle_backlash_deg) for s in sweeps):
         lo, hi = BETA_RANGE
         settle = [[min(max((s.settle_backlash_deg or (0.0, 0.0))[i]
                            / abs(f.amplitude_deg - f.zero_load_deg), lo), hi)

@@ -123,11 +123,6 @@ class DeviceKnob:
     the one whose calibration of the sheet's own unit best reproduces its tracked tip (session
     11); without it a sheet keeps the rule its fields imply (line where the line share is
     given)."""
-    reference_rule_backlash_gain: float | None = None
-    """Optional: the data-sheet unit's backlash gain as ``reference_backlash_gain`` but with B
-    by the product's own rule (``backlash_release_rule``, else the rule the fields imply), the
-    B every unit's tension play is fitted on: method ours then scales omega by the unit's gain
-    read the same way (session 12; older sheets: the settle rule's gains on both sides)."""
 
 
 @dataclass(frozen=True)

@@ -53,14 +53,21 @@ def test_identification_in_this_process_leaves_the_prefit_to_the_fit() -> None:
 def test_tension_play_fit_takes_the_prefit_already_found(isolated: SweepRuns) -> None:
     marked = replace(isolated.points[0], prefit=SweepPrefit(11.0, 12.0, 0.25))
     (sweep,) = sweeps_from_points([marked], 0)
-    assert (sweep.backlash_pos_deg, sweep.backlash_neg_deg, sweep.lag_s) == (11.0, 12.0, 0.25)
+    assert (sweep.settle_backlash_deg, sweep.lag_s) == ((11.0, 12.0), 0.25)
+
+
+def test_tension_play_fit_takes_the_backlash_of_the_profiles_rule(isolated: SweepRuns) -> None:
+    marked = replace(isolated.points[0], prefit=SweepPrefit(11.0, 12.0, 0.25))
+    (sweep,) = sweeps_from_points([marked], 0)
+    est = marked.result.estimate
+    assert (sweep.backlash_pos_deg, sweep.backlash_neg_deg) == \
+        (est("backlash_pos_deg"), est("backlash_neg_deg"))
 
 
 def test_tension_play_fit_analyses_a_point_without_a_prefit(isolated: SweepRuns) -> None:
     bare = replace(isolated.points[0], prefit=None)
     (sweep,) = sweeps_from_points([bare], 0)
-    assert (sweep.backlash_pos_deg, sweep.backlash_neg_deg) == \
-        settle_rule_backlash(bare.result.data)
+    assert sweep.settle_backlash_deg == settle_rule_backlash(bare.result.data)
 
 
 def test_tension_play_fit_takes_the_edges_uncertainty_the_calibration_gate_uses(

@@ -363,3 +363,35 @@ def test_a_straight_template_fits_exactly_as_no_template() -> None:
     assert fit_tension_play(sweeps, dataclasses.replace(
         knob, loaded_shape_pos=straight, loaded_shape_neg=straight)) == fit_tension_play(
         sweeps, knob)
+
+
+def _with_settle_backlash(sweeps: list[SweepCurrent], settle_deg: float) -> list[SweepCurrent]:
+    return [dataclasses.replace(s, settle_backlash_deg=(settle_deg, settle_deg)) for s in sweeps]
+
+
+def test_the_play_is_fitted_on_the_profiles_backlash_not_the_settle_rules() -> None:
+    grid = (-90.0, 0.0, 90.0)
+    knob = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.2)
+    rule = fit_tension_play(_with_settle_backlash(
+        [synthetic_sweep(g, backlash_deg=15.0) for g in grid], 25.0), knob)
+    settle = fit_tension_play([synthetic_sweep(g, backlash_deg=25.0) for g in grid], knob)
+    assert rule.backlash_gain_pos[1] == pytest.approx(15.0 / (90.0 - X0_POS), rel=0.02)
+    assert rule.backlash_gain_pos[1] < settle.backlash_gain_pos[1]
+
+
+def test_a_settle_rule_sheet_gain_scales_omega_by_the_units_settle_rule_gain() -> None:
+    grid = (-90.0, 0.0, 90.0)
+    knob = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.2)
+    rule = fit_tension_play(_with_settle_backlash(
+        [synthetic_sweep(g, backlash_deg=15.0) for g in grid], 25.0), knob)
+    settle = fit_tension_play([synthetic_sweep(g, backlash_deg=25.0) for g in grid], knob)
+    assert rule.omega == pytest.approx(settle.omega)
+
+
+def test_a_non_finite_settle_backlash_leaves_omega_to_the_plays_gain() -> None:
+    grid = (-90.0, 0.0, 90.0)
+    knob = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.2)
+    sweeps = [synthetic_sweep(g, backlash_deg=15.0) for g in grid]
+    p = fit_tension_play(_with_settle_backlash(sweeps, math.nan), knob)
+    assert p == fit_tension_play(sweeps, knob)
+    assert math.isfinite(p.omega)

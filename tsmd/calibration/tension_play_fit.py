@@ -3,10 +3,10 @@
 Per sweep (one knob swept +-A, the other held at a grid angle) and side:
 
 * the dead-zone edge ``D``: what the current analysis (:mod:`tsmd.calibration.identify`) found
-  (no data-sheet offset: that was one unit's); the backlash at the amplitude ``B_A``: the same
-  analysis by the paper's settle rule (``settle_rule_backlash``), whatever rule the product's
-  calibration uses for the paper's B: the straight release line starts where the release has
-  settled (a fraction rule ends B where the tip starts to move, inside the curved start);
+  (no data-sheet offset: that was one unit's); the backlash at the amplitude ``B_A``: the
+  profile's B, by the rule the product's data sheet chose (session 12: the settle rule's B,
+  used before whatever the product's rule, read 1.5-2.3x the tip's backlash on a coilpipe unit
+  whose sheet chose the local rule, and ours lost to the paper's there);
 * the zero-tension point ``x0``: the loaded current ramp (from 10 deg past ``D`` to 5 deg before
   the turn) fitted by a line and extrapolated to the current that moves the knob the same way
   through the dead zone, where no tendon is loaded (friction and any sensor offset cancel);
@@ -16,8 +16,9 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   loaded slope is the release (kinematic) slope times ``1 - beta``. The release slope is a
   product constant (pulley over moment arm), hence
   ``omega_unit = omega_sheet (1 - beta_unit) / (1 - beta_sheet)`` with ``beta_sheet`` the
-  data-sheet unit's backlash gain from its own current (``reference_backlash_gain``, same
-  estimator); without it the data sheet's omega;
+  data-sheet unit's backlash gain from its own current (``reference_backlash_gain``, read with
+  the settle rule's B) and ``beta_unit`` read the same way (the same load ramps, the settle
+  rule's B), whatever B the play itself is fitted on; without it the data sheet's omega;
 * the release line's slope: the locus of backlash ends has slope ``omega / (1 - beta)``, but
   where a product's release path after the backlash is shallower or steeper than that locus (a
   lumped catheter's is 7 % shallower; the current cannot see it: a released tendon's current is
@@ -85,6 +86,10 @@ class SweepCurrent:
     """The drive's lag when already estimated; None: estimated here from t, cmd and pos."""
     dead_zone_u95_deg: tuple[float, float] = (math.inf, math.inf)
     """The calibration's 95 % uncertainty of (D_pos, D_neg); inf: unknown (always smoothed)."""
+    settle_backlash_deg: tuple[float, float] | None = None
+    """The settle rule's (B_pos, B_neg) where the B above is another rule's: a sheet whose gain
+    was read with the settle rule scales omega by a unit gain read the same way. None: the B
+    above is the settle rule's."""
 
 
 @dataclass(frozen=True)
@@ -287,9 +292,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                 for b in smooth_over_grid(grid, [f.backlash_gain for f in pos_fits])]
     beta_neg = [min(max(b, lo), hi)
                 for b in smooth_over_grid(grid, [f.backlash_gain for f in neg_fits])]
-    # the sheet measured its beta with the other knob at 0: compare the unit there
-    beta_0 = 0.5 * (at_other_knob_zero(grid, beta_pos) + at_other_knob_zero(grid, beta_neg))
-    omega = unit_omega(float(k.omega), getattr(k, "reference_backlash_gain", None), beta_0)
+    omega = unit_omega(float(k.omega), getattr(k, "reference_backlash_gain", None),
+                       settle_rule_gain(grid, order, pos_fits, neg_fits, (beta_pos, beta_neg)))
     ratio = release_slope_ratio(k)
     sides = []
     for betas, fits in ((beta_pos, pos_fits), (beta_neg, neg_fits)):
@@ -304,6 +308,28 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         backlash_gain_neg=sides[1][0], zero_load_pos_deg=sides[0][1],
         zero_load_neg_deg=sides[1][1], lag_s=min(max(lag, 0.0), 1.0), shape_pos=shape_pos,
         shape_neg=shape_neg)
+
+
+def settle_rule_gain(grid: Sequence[float], sweeps: Sequence[SweepCurrent],
+                     pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit],
+                     betas: tuple[Sequence[float], Sequence[float]]) -> float:
+    """This unit's backlash gain at the other knob's 0 (mean of both sides) as the data sheet's
+    ``reference_backlash_gain`` is read: the settle rule's B over the same load ramps, smoothed
+    as the play's ``betas`` (which it is where the sweeps carry no other, or a non-finite, B).
+    A gain read with another rule than the sheet's would move omega by the rules' difference,
+    not the unit's stretch (session 12: variant (c), a product-rule gain on both sides, lost
+    on segments what it won on coilpipe)."""
+    if all(s.settle_backlash_deg is not None
+           and all(math.isfinite(b) for b in s.settle_backlash_deg) for s in sweeps):
+        lo, hi = BETA_RANGE
+        settle = [[min(max((s.settle_backlash_deg or (0.0, 0.0))[i]
+                           / abs(f.amplitude_deg - f.zero_load_deg), lo), hi)
+                   for s, f in zip(sweeps, fits, strict=True)]
+                  for i, fits in enumerate((pos_fits, neg_fits))]
+        betas = ([min(max(b, lo), hi) for b in smooth_over_grid(grid, settle[0])],
+                 [min(max(b, lo), hi) for b in smooth_over_grid(grid, settle[1])])
+    # the sheet measured its gain with the other knob at 0: compare the unit there
+    return 0.5 * (at_other_knob_zero(grid, betas[0]) + at_other_knob_zero(grid, betas[1]))
 
 
 @dataclass(frozen=True)
@@ -348,14 +374,15 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
             continue
         d = p.result.data
         est = p.result.estimate
-        # the backlash by the settle rule, whatever rule the product's paper B uses
+        # the play on the profile's B (the product's rule); the settle rule's for omega's gain
         pre = with_prefit(p).prefit
         out.append(SweepCurrent(float(p.other_deg), d.t_s, d.cmd_deg, d.pos_deg,
                                 d.current_filtered_A, est("dead_zone_pos_deg"),
-                                est("dead_zone_neg_deg"), pre.backlash_pos_deg,
-                                pre.backlash_neg_deg, pre.lag_s,
+                                est("dead_zone_neg_deg"), est("backlash_pos_deg"),
+                                est("backlash_neg_deg"), pre.lag_s,
                                 (u["dead_zone_pos_deg"].u95_deg,
-                                 u["dead_zone_neg_deg"].u95_deg)))
+                                 u["dead_zone_neg_deg"].u95_deg),
+                                (pre.backlash_pos_deg, pre.backlash_neg_deg)))
     return out
 
 

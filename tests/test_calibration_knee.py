@@ -73,6 +73,6 @@ def test_a_half_cycle_too_short_for_the_branch_has_no_knee() -> None:
     assert resolvable_end(short, yg, 100) == 100
 
 
-def test_the_knee_is_on_by_default_and_can_be_switched_off() -> None:
-    assert IdentifyOptions().backlash_knee
-    assert not replace(IdentifyOptions(), backlash_knee=False).backlash_knee
+def test_the_knee_is_off_by_default_and_can_be_switched_on() -> None:
+    assert not IdentifyOptions().backlash_knee
+    assert replace(IdentifyOptions(), backlash_knee=True).backlash_knee

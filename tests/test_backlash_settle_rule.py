@@ -16,7 +16,7 @@ from tsmd.calibration.options import SETTLED_FRACTION, IdentifyOptions, for_prod
 from tsmd.calibration.release import recovered_end
 from tsmd.calibration.run import device_options
 from tsmd.calibration.signal import Conditioned
-from tsmd.datasheet import backlash_settle_fraction
+from tsmd.datasheet_release import backlash_settle_fraction
 from tsmd.profile import ProfileError, device_model_to_mapping, load_device_model
 
 

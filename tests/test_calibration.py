@@ -17,7 +17,6 @@ from support.calibration import LockstepPlantRunner
 
 from simrig.analysis import measure_dead_zone_backlash
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
-from tsmd.bench.tip_truth import tip_truth
 from tsmd.calibration import (
     CalibrationCancelledError,
     CalibrationError,
@@ -42,6 +41,7 @@ from tsmd.config import default_sim_config
 from tsmd.profile import ProfileStore, load_device_model
 from tsmd.recording import Recording, read_recording, write_recording
 from tsmd.replay import LockstepRunner
+from tsmd.tip_truth import tip_truth
 
 PERIOD_S = 0.004
 DEVICE = Path(__file__).resolve().parent.parent / "profiles" / "devices" / "sim-catheter.yaml"

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import math
 
-from tsmd.bench.calibration_family import CatheterRun, ProtocolRun, family_table, score
+from tsmd.bench.calibration_family import CatheterRun, family_table
 from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.identify import PARAMETERS, SweepResult
+from tsmd.tracked_calibration import ProtocolRun, score
 
 GRID = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)
 TRUE = {"dead_zone_pos_deg": 20.0, "dead_zone_neg_deg": -20.0, "backlash_pos_deg": 25.0,

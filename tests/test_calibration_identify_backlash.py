@@ -153,7 +153,7 @@ def test_the_bench_tip_truth_ignores_drive_wobbles_at_speed_changes() -> None:
     # 0.02 deg twice per stroke, as the drive did at the two-speed protocol's speed changes:
     # cut there, the tip analysis took the pieces after the steps for passes and gave B < 1 deg.
     from simrig.analysis import measure_dead_zone_backlash
-    from tsmd.bench.tip_truth import monotone_knob
+    from tsmd.tip_truth import monotone_knob
 
     t = np.arange(0.0, 2 * PERIOD_S, 1.0 / RATE_HZ)
     cmd, direction, travel = _half_cycle_phase(t)

@@ -28,6 +28,16 @@ def test_drivers_imports_neither_tsmd_nor_simrig_and_simrig_does_not_import_tsmd
     assert wrong == []
 
 
+def test_no_module_outside_tsmd_bench_imports_tsmd_bench() -> None:
+    """The daemon (data sheet included) runs without the benchmarks: they sit on top of it."""
+    graph = import_graph()
+    wrong = sorted(f"{module} imports {target}" for module, targets in graph.items()
+                   if module.startswith("tsmd.") and not module.startswith("tsmd.bench")
+                   and module != "tsmd.commands.bench"
+                   for target in targets if target.startswith("tsmd.bench"))
+    assert wrong == []
+
+
 def test_the_graph_covers_every_package() -> None:
     graph = import_graph()
     assert {m.split(".")[0] for m in graph} == set(PACKAGES)

@@ -21,17 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tsmd.bench.calibration_family import (
-    TARGET_DEG,
-    play_protocol,
-    score,
-    truth_sweeps,
-)
-from tsmd.bench.tip_truth import tip_truth
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.config import TsmdConfig
 from tsmd.profile import DeviceKnob, DeviceModel
 from tsmd.profile.types import RELEASE_RULES
+from tsmd.tip_truth import tip_truth
+from tsmd.tracked_calibration import TARGET_DEG, play_protocol, score, truth_sweeps
 
 RULE_NOISE_SEEDS = (0, 1)
 """Noise seeds of the sheet unit's calibrations per rule: one run per seed and rule."""

@@ -32,7 +32,6 @@ from simrig.analysis import _rising_pass_measures
 from tsmd.bench.calibration_family import family_table, run_catheter_summary
 from tsmd.bench.calibration_faults import fault_table
 from tsmd.bench.calibration_time import main_time
-from tsmd.bench.tip_truth import TIP_THRESHOLD_DEG
 from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.identify import PARAMETERS, IdentifyOptions, split_half_cycles
@@ -42,6 +41,7 @@ from tsmd.config import resolve_data_path
 from tsmd.errors import TsmdError
 from tsmd.profile import load_device_model
 from tsmd.tee import DEFAULT_STEPS_PER_KNOB_DEG, default_tee_dir, load_tee_acquisition
+from tsmd.tip_truth import TIP_THRESHOLD_DEG
 
 DEFAULT_PLANT = "simrig.plants.capstan:make_tendon_sheath_plant"
 DEFAULT_DEVICE = "profiles/devices/sim-catheter.yaml"

@@ -15,10 +15,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.plant import Plant, PlantStep, as_plant_step
-from tsmd.bench.calibration_family import play_protocol, unit_config
+from tsmd.bench.calibration_family import unit_config
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.config import default_sim_config
 from tsmd.profile import DeviceModel
+from tsmd.tracked_calibration import play_protocol
 
 
 class _Sensor:

@@ -35,6 +35,7 @@ from tsmd.calibration.health import (
     check_slips,
     find_slip,
 )
+from tsmd.calibration.knee import resolvable_end
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.pieces import (
     constant_phase,
@@ -237,6 +238,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         found = (None if flat is None
                  else backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts,
                                    branch_stop))
+        if found is not None and opts.backlash == "fraction" and opts.backlash_knee:
+            found = resolvable_end(grid[:end], yg[:end], found, branch_stop)
         if found is None:
             # No value rather than a guess: the quality checks then name this reason.
             problems.append(f"{where}: the current never becomes constant after the reversal")
@@ -330,6 +333,8 @@ def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
     out = list(halves)
     for j, (i, (pos, grid, yg, k)) in enumerate(curves.items()):
         k_new = fraction_end(grid, yg, min(k, yg.size - 1), share, opts, stops[j])
+        if opts.backlash_knee:
+            k_new = resolvable_end(grid, yg, k_new, stops[j])
         h = halves[i]
         out[i] = replace(h, backlash_deg=float(grid[k_new] - grid[0]),
                          backlash_end_index=_index_at(pos, h.direction, grid, k_new, h.start),

@@ -65,6 +65,13 @@ class IdentifyOptions:
     """"settle" with a data sheet that measured it: how much further the knob turns, on the
     sheet's unit, from where the current has settled to where the tip has moved back 1 deg
     (``DeviceKnob.backlash_settle_lag_deg``); the backlash ends that far beyond the settle."""
+    backlash_knee: bool = False
+    """"fraction": an end beyond the current's knee (where its approach has slowed to the
+    release branch's creep, below its scatter per deg) is moved back to the knee
+    (:func:`tsmd.calibration.knee.resolvable_end`, session 12). Off by default: it placed every
+    value of held-out stickslip and coilpipe but moved lumped's ends before the tip's release
+    (0/8 accepted, 291/448; docs/calibration.md, session 12), so it is not a rule for every
+    product; False: the rule's end as is."""
     release_fit_half_deg: float = 4.0
     """"fraction": the share's crossing is read off a quadratic fitted to the current over this
     much knob travel either side of it (noise averaged; narrow enough for a quadratic to follow

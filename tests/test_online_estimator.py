@@ -403,3 +403,16 @@ def test_an_inward_crossing_on_a_ramp_of_the_usual_slope_is_still_followed() -> 
     for _ in range(2):
         tracker.update(ramp_with_edge(EDGE_DEG - 3.0), EDGE_DEG)
     assert tracker.applied_deg == pytest.approx(-3.0, abs=0.05)
+
+
+def test_an_inward_crossing_after_the_knobs_ramps_got_steeper_measures_nothing() -> None:
+    tracker, partner = (learned(EstimatorOptions(refuse_inward_on_steeper=True)),
+                        learned(EstimatorOptions(refuse_inward_on_steeper=True)))
+    for _ in range(3):  # both tendons 20 % steeper at the same edge: the slope in use follows
+        partner.update(steeper_at_the_same_edge(1.2), EDGE_DEG, tracker)
+        tracker.update(steeper_at_the_same_edge(1.2), EDGE_DEG, partner)
+    inward = LoadedRamp(0, 1, EDGE_DEG + 12.0, LEVEL_A + 1.2 * SLOPE * 15.0, 1.2 * SLOPE, 0.0,
+                        0.0, 200, 0.003)  # the same line 3 deg further in
+    for _ in range(2):
+        tracker.update(inward, EDGE_DEG, partner)
+    assert tracker.applied_deg == 0.0 and tracker.status()["odd_crossing_ramps"] == 2

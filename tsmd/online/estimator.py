@@ -86,7 +86,7 @@ class EdgeTracker:
     n_odd_knee: int = 0
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_odd_crossing: int = 0
-    """Crossings inward beyond the gate on a ramp steeper than the slope in use: none taken."""
+    """Crossings inward beyond the gate while the friction rose: no measurement taken."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
     bins: OtherKnobBins = field(init=False)
@@ -333,13 +333,13 @@ class EdgeTracker:
         self.last_feature = "crossing"
         raw = ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
                            - self.residual_ref_deg)
-        if (o.refuse_inward_on_steeper and ramp.slope_A_per_deg / slope - 1.0 > tol
-                and raw - self.estimate_deg < -o.gate_deg):
-            # Its crossing, taken ~15 deg out with a shallower slope than its own, reads
-            # inward by about 15 deg x the difference, and more friction widens the dead
-            # zone, never narrows it (stickslip 101 phi2 after a bend: ramps 13-14 % steeper
-            # than the slope in use, crossings -1.9/-2.8 deg, followed inward; the fresh
-            # calibration's edges moved -0.4..0).
+        rose = change > tol or ramp.slope_A_per_deg / slope - 1.0 > tol
+        if o.refuse_inward_on_steeper and rose and raw - self.estimate_deg < -o.gate_deg:
+            # More friction along the tendon (the knob's ramps, or this one, steeper beyond
+            # the tolerance) widens the dead zone, never narrows it; an inward crossing then
+            # is the ramp's shape or a slope in use that lags (stickslip 101 phi2 after a
+            # bend: ramps 13-19 % steeper, crossings -1.0..-2.8 deg, followed inward; the
+            # fresh calibration's edges moved -0.4..0).
             self.n_odd_crossing += 1
             self.last_measurement_deg = math.nan
             return events

@@ -373,3 +373,46 @@ def test_one_steeper_side_with_a_barely_changed_partner_moves_no_slope_in_use() 
         pos.update(ramp_through(EDGE_DEG, 1.25 * SLOPE), EDGE_DEG, neg)
         neg.update(ramp_through(EDGE_DEG, 1.01 * SLOPE), EDGE_DEG, pos)
     assert pos.applied_deg == 0.0 and neg.applied_deg == 0.0
+
+
+def steeper_at_the_same_edge(ratio: float) -> LoadedRamp:
+    """A ramp ``ratio`` x the reference slope whose own line still meets LEVEL_A at EDGE_DEG,
+    with its window centre 15 deg out (as the worker's)."""
+    slope = ratio * SLOPE
+    return LoadedRamp(0, 1, EDGE_DEG + 15.0, LEVEL_A + slope * 15.0, slope, 0.0, 0.0, 200,
+                      0.003)
+
+
+def test_an_inward_crossing_on_a_steeper_ramp_measures_nothing() -> None:
+    tracker, partner = learned(EstimatorOptions(refuse_inward_on_steeper=True)), learned()
+    for _ in range(2):  # 13 % steeper, the knob's other tendon not yet: the slope in use
+        tracker.update(steeper_at_the_same_edge(1.13), EDGE_DEG, partner)  # stays, ~2 deg in
+    assert tracker.applied_deg == 0.0 and tracker.suspects == []
+    assert tracker.status()["odd_crossing_ramps"] == 2
+
+
+def test_without_the_rule_a_steeper_ramp_moves_the_edge_inward() -> None:
+    tracker, partner = learned(), learned()
+    for _ in range(2):
+        tracker.update(steeper_at_the_same_edge(1.13), EDGE_DEG, partner)
+    assert tracker.applied_deg < -1.5
+
+
+def test_an_inward_crossing_on_a_ramp_of_the_usual_slope_is_still_followed() -> None:
+    tracker = learned(EstimatorOptions(refuse_inward_on_steeper=True))
+    for _ in range(2):
+        tracker.update(ramp_with_edge(EDGE_DEG - 3.0), EDGE_DEG)
+    assert tracker.applied_deg == pytest.approx(-3.0, abs=0.05)
+
+
+def test_an_inward_crossing_after_the_knobs_ramps_got_steeper_measures_nothing() -> None:
+    tracker, partner = (learned(EstimatorOptions(refuse_inward_on_steeper=True)),
+                        learned(EstimatorOptions(refuse_inward_on_steeper=True)))
+    for _ in range(3):  # both tendons 20 % steeper at the same edge: the slope in use follows
+        partner.update(steeper_at_the_same_edge(1.2), EDGE_DEG, tracker)
+        tracker.update(steeper_at_the_same_edge(1.2), EDGE_DEG, partner)
+    inward = LoadedRamp(0, 1, EDGE_DEG + 12.0, LEVEL_A + 1.2 * SLOPE * 15.0, 1.2 * SLOPE, 0.0,
+                        0.0, 200, 0.003)  # the same line 3 deg further in
+    for _ in range(2):
+        tracker.update(inward, EDGE_DEG, partner)
+    assert tracker.applied_deg == 0.0 and tracker.status()["odd_crossing_ramps"] == 2

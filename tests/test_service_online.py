@@ -16,6 +16,7 @@ from tsmd.config import TsmdConfig, default_sim_config, resolve_data_path
 from tsmd.daemon import SIM_EXAMPLE_PROFILE, Daemon
 from tsmd.online import RECORDING_COLUMNS
 from tsmd.online.apply import edges_at
+from tsmd.online.bend import BendRelation
 from tsmd.online.worker import OnlineWorker
 from tsmd.profile import device_model_to_mapping, load_device_model, load_profile
 from tsmd.recording import REQUIRED_COLUMNS, read_recording
@@ -278,6 +279,32 @@ def test_the_worker_takes_the_handle_slip_from_the_data_sheet(tmp_path: Path) ->
         assert [r.handle_slip_deg for r in ramps] == [4.5, 2.0]
     finally:
         daemon.stop()
+
+
+def test_the_worker_takes_the_bend_relation_from_the_data_sheet(tmp_path: Path) -> None:
+    config = sim_config(tmp_path, online=True)
+    assert config.profiles.device_model is not None
+    sheet = device_model_to_mapping(load_device_model(resolve_data_path(
+        config.profiles.device_model)))
+    sheet["bend_relation"] = {"release_per_edge": 0.61, "gain_per_release_deg": 0.064}
+    (tmp_path / "sheet.yaml").write_text(yaml.safe_dump(sheet))
+    config = dataclasses.replace(config, profiles=dataclasses.replace(
+        config.profiles, device_model=str(tmp_path / "sheet.yaml")))
+    daemon = Daemon(config, sim=True, socket_path=str(tmp_path / "d.sock"))
+    daemon.start()
+    try:
+        worker = running_worker(daemon)
+        assert worker.bend == BendRelation(0.61, 0.064)
+        assert worker.status()["bend_relation"] == {"release_per_edge": 0.61,
+                                                     "gain_per_release_deg": 0.064}
+    finally:
+        daemon.stop()
+
+
+def test_a_data_sheet_without_a_bend_relation_gives_the_worker_none(
+        start_daemon: Callable[..., Daemon]) -> None:
+    worker = running_worker(start_daemon(True))
+    assert worker.bend is None and worker.status()["bend_relation"] is None
 
 
 def test_the_worker_reads_the_loops_fault_reason(start_daemon: Callable[..., Daemon]) -> None:

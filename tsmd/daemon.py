@@ -35,8 +35,10 @@ from tsmd.loop import BackgroundRecorder, ControlLoop, LoopError
 from tsmd.notify import Notifier, watchdog_interval_s
 from tsmd.online import RECORDING_COLUMNS
 from tsmd.online.attach import OnlineAttachment
+from tsmd.online.bend import sheet_bend_relation
 from tsmd.profile import (
     CatheterProfile,
+    DeviceModel,
     ProfileError,
     ProfileStore,
     load_device_model,
@@ -204,8 +206,12 @@ class Daemon:
                                compensation_label=label, tip_source=tip_source,
                                recorder=self.recorder, on_event=self.events.emit,
                                standby=make_standby(profile, choice.method, label, config))
-        self.online = OnlineAttachment(config.online, self.loop, on_event=self.events.emit,
-                                       handle_slip_deg=self._handle_slip_deg(config))
+        sheet = self._online_sheet(config)
+        self.online = OnlineAttachment(
+            config.online, self.loop, on_event=self.events.emit,
+            handle_slip_deg=None if sheet is None else (sheet.knobs[0].handle_slip_deg,
+                                                        sheet.knobs[1].handle_slip_deg),
+            bend=sheet_bend_relation(sheet))
         if self.recorder is not None and config.online.enabled:
             self.loop.recorder = self.online.recording(self.recorder)
         self.online.attach(compensator)
@@ -215,18 +221,18 @@ class Daemon:
             runner_factory=self._live_runner, extra_status=self._extra_status,
             online=self.online)
 
-    def _handle_slip_deg(self, config: TsmdConfig) -> tuple[float, float] | None:
-        """The data sheet's handle slip per knob for online re-estimation (None: its default)."""
+    def _online_sheet(self, config: TsmdConfig) -> DeviceModel | None:
+        """The data sheet online re-estimation reads its handle slip per knob and the
+        product's bend relation from (None: the estimator's defaults, no relation)."""
         path = config.profiles.device_model
         if path is None:
             return None
         try:
-            knobs = load_device_model(resolve_data_path(path)).knobs
+            return load_device_model(resolve_data_path(path))
         except ProfileError as exc:
-            self.events.emit("warning", "online: data sheet unreadable, default handle slip",
-                             reason=str(exc))
+            self.events.emit("warning", "online: data sheet unreadable, default handle slip "
+                             "and no bend relation", reason=str(exc))
             return None
-        return knobs[0].handle_slip_deg, knobs[1].handle_slip_deg
 
     def _live_runner(self) -> LiveTrajectoryRunner:
         assert self.loop is not None

@@ -17,10 +17,12 @@ estimator sees only commanded and actual position and current. Per unit:
   knobs) online on and off: each edge's largest offset against the calibration's uncertainty,
   and the tracking of both runs.
 
-``--bend-relation unit0``: the worker gets the product's bend relation, measured on unit 0
-(:mod:`tsmd.bench.online_bend`). The data sheet of the lumped family is measured once on its
-nominal unit (tracker on the tip,
-``tsmd.datasheet``); capstan units use ``profiles/devices/sim-catheter.yaml``. Data sheets and
+``--bend-relation sheet``: the worker gets the product's bend relation from the data sheet, as
+the daemon's does; a sheet without one gets it measured on unit 0 as ``tsmd datasheet
+--bend-relation`` would (:mod:`tsmd.bench.online_bend`; ``unit0``, session 11's name, is the
+same). ``--sheet FILE``: the product's data sheet to use instead. The data sheet of the lumped
+family is measured once on its nominal unit (tracker on the tip, ``tsmd.datasheet``); capstan
+units use ``profiles/devices/sim-catheter.yaml``. Data sheets and
 calibrated profiles are cached in ``--cache``, in a subdirectory keyed by the code that made them
 (:mod:`tsmd.bench.cache_key`), by plant, unit and shape, so reruns are cheap.
 """
@@ -48,7 +50,8 @@ from tsmd.daemon import make_compensator
 from tsmd.errors import TsmdError
 from tsmd.loop import ROW_COLUMNS
 from tsmd.online import OnlineWorker
-from tsmd.profile import load_profile
+from tsmd.online.bend import sheet_bend_relation
+from tsmd.profile import load_device_model, load_profile
 from tsmd.replay import LockstepRunner
 
 Array = NDArray[np.float64]
@@ -255,8 +258,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cache", default="/tmp/tsmd-bench-online",
                         help="calibrated profiles go in a subdirectory per code version")
     parser.add_argument("--no-change", action="store_true", help="skip the shape-change runs")
-    parser.add_argument("--bend-relation", choices=("unit0", "off"), default="off",
-                        help="unit0: the product's bend relation measured on unit 0 (release "
+    parser.add_argument("--sheet", metavar="FILE",
+                        help="the product's data sheet (default: capstan's built-in one, "
+                             "other plants' measured on unit 0 and cached)")
+    parser.add_argument("--bend-relation", choices=("sheet", "unit0", "off"), default="off",
+                        help="sheet (or unit0): the data sheet's bend relation, measured on "
+                             "unit 0 when the sheet has none (release "
                         "line and beta move with the edges); off: x0 moves with the edges")
 
 
@@ -268,11 +275,14 @@ def main(args: argparse.Namespace) -> int:
     shape_change(args.change)  # a bad --change is refused before anything runs
     args.cache = str(keyed_cache(Path(args.cache)))
     print(f"profiles cached in {args.cache}")
-    device = device_for(args.plant, Path(args.cache))
+    device = (device_for(args.plant, Path(args.cache)) if args.sheet is None
+              else load_device_model(args.sheet))
     args.bend = None
-    if args.bend_relation == "unit0":
+    if args.bend_relation != "off":
         args.bend = product_bend_relation(args.plant, device, Path(args.cache))
-        print(f"bend relation (unit 0, bends 30/60/90 deg): release line "
+        source = ("the data sheet" if sheet_bend_relation(device) is not None
+                  else "unit 0, bends 30/60/90 deg")
+        print(f"bend relation ({source}): release line "
               f"{args.bend.release_per_edge:.3f} deg per edge deg, beta x (1 + "
               f"{args.bend.gain_per_release_deg:.4f} per release deg)")
     med, p99, top = hot_path_us()

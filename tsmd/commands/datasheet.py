@@ -11,6 +11,7 @@ import argparse
 import dataclasses
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +31,9 @@ from tsmd.datasheet import (
     measure_device_constants,
     swept_knob,
 )
+from tsmd.datasheet_bend import BENDS_DEG, bend_relation, rig_calibration
 from tsmd.datasheet_rule import RULE_NOISE_SEEDS, choose_rules, rule_scores
+from tsmd.online.bend import with_bend_relation
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.recording import read_recording
 
@@ -59,6 +62,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "each backlash rule; the better rule per knob goes into the sheet "
                              "(docs/calibration.md, session 11; 'none': no choice, the sheet "
                              "keeps the rule its shares imply)")
+    parser.add_argument("--bend-relation", action="store_true",
+                        help="with --plant: also calibrate the unit straight and with its sheath "
+                             "bent 30/60/90 deg and write the product's bend relation for online "
+                             "re-estimation (four fast calibrations, minutes; docs/online.md)")
 
 
 def _params(text: str | None) -> dict[str, Any]:
@@ -118,6 +125,17 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
     return chosen
 
 
+def _with_bend(device: DeviceModel, config: TsmdConfig,
+               factory: Callable[[], Plant]) -> DeviceModel:
+    """The sheet with the product's bend relation, from its unit calibrated straight and bent."""
+    t0 = time.monotonic()
+    bend = bend_relation(rig_calibration(factory, device, config))
+    print(f"bend relation on the sheet's unit (straight and {'/'.join(f'{b:g}' for b in BENDS_DEG)}"
+          f" deg): release line {bend.release_per_edge:.3f} deg per edge deg, beta x (1 + "
+          f"{bend.gain_per_release_deg:.4f} per release deg); {time.monotonic() - t0:.0f} s")
+    return with_bend_relation(device, bend)
+
+
 def _or_none(value: float | None, decimals: int) -> str:
     return "none" if value is None else f"{value:.{decimals}f}"
 
@@ -125,6 +143,9 @@ def _or_none(value: float | None, decimals: int) -> str:
 def main(args: argparse.Namespace) -> int:
     if args.params is not None and args.plant is None:
         raise DatasheetError("--params goes with --plant")
+    if args.bend_relation and args.plant is None:
+        raise DatasheetError("--bend-relation goes with --plant (the unit is calibrated bent on "
+                             "the simulated rig)")
     seeds = _rule_seeds(args.rule_seeds)
     if args.plant is not None:
         config = load_config(args.config) if args.config is not None else default_sim_config()
@@ -146,6 +167,8 @@ def main(args: argparse.Namespace) -> int:
                           loaded_shape=args.loaded_shape)
     if args.plant is not None and seeds:
         device = _choose_rule(device, config, args.plant, params, seeds)
+    if args.plant is not None and args.bend_relation:
+        device = _with_bend(device, config, factory)
     comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "
                f"(tsmd datasheet) on {source}:\n"
                f"each knob swept +-{SWEEP_AMPLITUDE_DEG:g} deg at {SWEEP_HZ:g} Hz, other knob "

@@ -17,6 +17,7 @@ from typing import Any, Protocol
 from tsmd.config import OnlineConfig
 from tsmd.loop import ROW_COLUMNS, TickRecorder
 from tsmd.online.apply import ZERO_OFFSETS, OnlineError, save_online_version
+from tsmd.online.bend import BendRelation
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.worker import OnlineWorker
 from tsmd.profile import CatheterProfile
@@ -34,16 +35,19 @@ class OnlineAttachment:
     """Owns the loop's online worker; ``wanted`` survives compensator changes.
 
     ``on_event(level, event, **fields)`` receives the worker's events (the daemon's log).
-    ``handle_slip_deg`` per knob comes from the data sheet (None: the estimator's default).
+    ``handle_slip_deg`` per knob comes from the data sheet (None: the estimator's default),
+    and so does the product's ``bend`` relation (None: the sheet has none).
     """
 
     def __init__(self, config: OnlineConfig, loop: Observed,
                  on_event: Callable[..., None] | None = None,
-                 handle_slip_deg: tuple[float, float] | None = None) -> None:
+                 handle_slip_deg: tuple[float, float] | None = None,
+                 bend: BendRelation | None = None) -> None:
         self.config = config
         self.loop = loop
         self.on_event = on_event
         self.handle_slip_deg = handle_slip_deg
+        self.bend = bend
         self.wanted = config.enabled
         self.worker: OnlineWorker | None = None
         self._compensator: Any = None
@@ -121,7 +125,8 @@ class OnlineAttachment:
                 estimator=EstimatorOptions(gate_deg=c.gate_deg, max_offset_deg=c.max_offset_deg,
                                            deadband_deg=c.deadband_deg),
                 rate_deg_s=c.rate_deg_s, on_event=self.on_event,
-                handle_slip_deg=self.handle_slip_deg, fault_reason=self._fault_reason)
+                handle_slip_deg=self.handle_slip_deg, fault_reason=self._fault_reason,
+                bend=self.bend)
         except OnlineError as exc:
             self._why_not = str(exc)
             if self.on_event is not None:

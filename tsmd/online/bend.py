@@ -12,6 +12,7 @@ an edge and the loaded ramps say the friction rose (a bend, not a slack change).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -19,6 +20,8 @@ from statistics import median
 from typing import Any
 
 from tsmd.online.apply import Offsets, OnlineError
+from tsmd.profile import DeviceModel
+from tsmd.profile.types import BEND_GAIN_PER_RELEASE_RANGE, BEND_RELEASE_PER_EDGE_RANGE
 
 MIN_EDGE_MOVE_DEG = 0.5
 """A bend that moved an edge less than this says nothing about the relation (calibration
@@ -37,10 +40,27 @@ class BendRelation:
     gain_per_release_deg: float
 
     def __post_init__(self) -> None:
-        if not (0.2 <= self.release_per_edge <= 5.0 and math.isfinite(
-                self.gain_per_release_deg) and abs(self.gain_per_release_deg) <= 0.5):
+        lo, hi = BEND_RELEASE_PER_EDGE_RANGE
+        g_lo, g_hi = BEND_GAIN_PER_RELEASE_RANGE
+        if not (lo <= self.release_per_edge <= hi and math.isfinite(self.gain_per_release_deg)
+                and g_lo <= self.gain_per_release_deg <= g_hi):
             raise OnlineError(f"implausible bend relation: release {self.release_per_edge} "
                               f"per edge deg, gain {self.gain_per_release_deg} per deg")
+
+
+def sheet_bend_relation(device: DeviceModel | None) -> BendRelation | None:
+    """The data sheet's bend relation (None: the sheet has none, and a bend moves x0 with the
+    edge as a slack change does)."""
+    if device is None or device.bend_release_per_edge is None:
+        return None
+    assert device.bend_gain_per_release_deg is not None  # the schema reads both or neither
+    return BendRelation(device.bend_release_per_edge, device.bend_gain_per_release_deg)
+
+
+def with_bend_relation(device: DeviceModel, bend: BendRelation) -> DeviceModel:
+    """``device`` carrying ``bend`` (rounded as a data sheet is written)."""
+    return dataclasses.replace(device, bend_release_per_edge=round(bend.release_per_edge, 3),
+                               bend_gain_per_release_deg=round(bend.gain_per_release_deg, 4))
 
 
 def release_line_deg(edge_deg: float, zero_load_deg: float, gain: float) -> float:
@@ -125,4 +145,4 @@ def bend_targets(bend: BendRelation, trackers: Mapping[tuple[int, int], Any],
 
 
 __all__ = ["BendRelation", "bend_targets", "measure_bend_relation", "release_line_deg",
-           "tendon_values", "zero_load_move_deg"]
+           "sheet_bend_relation", "tendon_values", "with_bend_relation", "zero_load_move_deg"]

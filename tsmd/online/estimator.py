@@ -85,6 +85,8 @@ class EdgeTracker:
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     n_odd_knee: int = 0
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
+    n_odd_crossing: int = 0
+    """Crossings inward beyond the gate while the friction rose: no measurement taken."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
     bins: OtherKnobBins = field(init=False)
@@ -329,8 +331,19 @@ class EdgeTracker:
             self.last_measurement_deg = math.nan
             return events
         self.last_feature = "crossing"
-        self._measured(ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
-                                    - self.residual_ref_deg), ramp.other_deg, events)
+        raw = ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
+                           - self.residual_ref_deg)
+        rose = change > tol or ramp.slope_A_per_deg / slope - 1.0 > tol
+        if o.refuse_inward_on_steeper and rose and raw - self.estimate_deg < -o.gate_deg:
+            # More friction along the tendon (the knob's ramps, or this one, steeper beyond
+            # the tolerance) widens the dead zone, never narrows it; an inward crossing then
+            # is the ramp's shape or a slope in use that lags (stickslip 101 phi2 after a
+            # bend: ramps 13-19 % steeper, crossings -1.0..-2.8 deg, followed inward; the
+            # fresh calibration's edges moved -0.4..0).
+            self.n_odd_crossing += 1
+            self.last_measurement_deg = math.nan
+            return events
+        self._measured(raw, ramp.other_deg, events)
         return events
 
     def _measured(self, raw_deg: float, other_deg: float,
@@ -402,7 +415,7 @@ class EdgeTracker:
                 "estimate_deg": round(self.estimate_deg, 3),
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
                 "odd_slope_ramps": self.n_odd_slope, "odd_knee_ramps": self.n_odd_knee,
-                "refused_ramps": self.n_refused,
+                "odd_crossing_ramps": self.n_odd_crossing, "refused_ramps": self.n_refused,
                 "feature": self.last_feature or None,
                 "backlash_gain_ratio": round(self.gain_ratio, 3),
                 "other_knob_bins_deg": self.bins.biases_deg(),

@@ -29,6 +29,10 @@ class EstimatorOptions:
     moves its edges +2.75..+3.4 deg; with the change shrunk to none the crossing, 15 deg out,
     read ~2 deg short and the ramps beyond 15 % measured nothing (lumped 1, 2: offsets
     0-1.8 deg; docs/online.md, Session 10)."""
+    refuse_inward_on_steeper: bool = False
+    """A crossing inward beyond the gate while the friction rose (the knob's slope change, or
+    this ramp's slope against the slope in use, beyond ``slope_in_use_tolerance``) measures
+    nothing, as the knee does in knee mode (session 12, stickslip 101 phi2; docs/online.md)."""
     pooled_slope_change: bool = True
     """The slope in use (and the gain from it, and the bend share) moves with the median of
     both tendons' last ramps' slope ratios, not with one edge's change as far as the other's

@@ -350,6 +350,9 @@ class OnlineWorker:
                 "offsets_deg": [list(off[0]), list(off[1])],
                 "backlash_gain_ratios": [list(self.gains[0]), list(self.gains[1])],
                 "zero_load_offsets_deg": [list(self.zero_loads[0]), list(self.zero_loads[1])],
+                "bend_relation": None if self.bend is None else {
+                    "release_per_edge": self.bend.release_per_edge,
+                    "gain_per_release_deg": self.bend.gain_per_release_deg},
                 "edges": {f"phi{k + 1}_{'pos' if s > 0 else 'neg'}": tr.status()
                           for (k, s), tr in self.trackers.items()},
                 "events": list(self.events)[-5:]}

@@ -17,6 +17,8 @@ from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
+    BEND_GAIN_PER_RELEASE_RANGE,
+    BEND_RELEASE_PER_EDGE_RANGE,
     DEFAULT_HANDLE_SLIP_DEG,
     DEVICE_SCHEMA_VERSION,
     ID_PATTERN,
@@ -211,7 +213,20 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_release_rule=_release_rule(r, k, key),
             **{name: _shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS}))
     desc = m.get("description", "")
-    return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version)
+    bend = _bend_relation(r, m.get("bend_relation"))
+    return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version, *bend)
+
+
+def _bend_relation(r: _Reader, raw: Any) -> tuple[float | None, float | None]:
+    """The sheet's optional bend relation (both numbers or the key absent)."""
+    if raw is None:
+        return None, None
+    m = r.mapping(raw, "bend_relation")
+    return (r.number(r.get(m, "release_per_edge", "bend_relation."),
+                     "bend_relation.release_per_edge", *BEND_RELEASE_PER_EDGE_RANGE, ""),
+            r.number(r.get(m, "gain_per_release_deg", "bend_relation."),
+                     "bend_relation.gain_per_release_deg", *BEND_GAIN_PER_RELEASE_RANGE,
+                     "per deg"))
 
 
 def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
@@ -245,8 +260,13 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         for key in _RELEASE_RULE_KEYS:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
-    return {"schema_version": device.schema_version, "device_model": device.device_model,
-            "description": device.description, "knobs": knobs}
+    out: dict[str, Any] = {"schema_version": device.schema_version,
+                           "device_model": device.device_model,
+                           "description": device.description, "knobs": knobs}
+    if device.bend_release_per_edge is not None:
+        out["bend_relation"] = {"release_per_edge": device.bend_release_per_edge,
+                                "gain_per_release_deg": device.bend_gain_per_release_deg}
+    return out
 
 
 def _ref_map(p: ReferencePoint) -> dict[str, float]:

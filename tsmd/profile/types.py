@@ -27,6 +27,11 @@ almost certainly in the wrong unit (radians are caught by the omega and range ch
 OMEGA_RANGE: tuple[float, float] = (0.2, 5.0)
 """Plausible tip-per-knob slopes; outside this the value is a unit or sign mistake."""
 ID_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,63}$")
+BEND_RELEASE_PER_EDGE_RANGE: tuple[float, float] = (0.2, 5.0)
+"""Plausible release-line moves per degree of dead-zone edge move in a sheath bend (measured:
+0.55-1.26 on the simulated products, docs/online.md session 11)."""
+BEND_GAIN_PER_RELEASE_RANGE: tuple[float, float] = (-0.5, 0.5)
+"""Plausible relative backlash-gain growth per degree of release-line move (measured ~0.06)."""
 
 
 class ProfileError(TsmdError, ValueError):
@@ -133,6 +138,14 @@ class DeviceModel:
     knobs: tuple[DeviceKnob, DeviceKnob]
     description: str = ""
     schema_version: int = DEVICE_SCHEMA_VERSION
+    bend_release_per_edge: float | None = None
+    """Optional, measured on the data-sheet unit (`tsmd datasheet --bend-relation`, calibrated
+    straight and bent): how far a tendon's release line moves per degree its dead-zone edge
+    moves in a sheath bend. With ``bend_gain_per_release_deg`` it is the product's bend
+    relation, which online re-estimation applies (a sheet without it: none)."""
+    bend_gain_per_release_deg: float | None = None
+    """Optional, with the field above: the backlash gain's relative growth per degree of
+    release-line move in a bend."""
 
     @property
     def limits(self) -> tuple[KnobLimits, KnobLimits]:

@@ -1,0 +1,69 @@
+"""The product's bend relation, measured on the data sheet's unit (`tsmd datasheet
+--bend-relation`).
+
+Online re-estimation sees a tendon's dead-zone edge in the current under compensated motion, not
+its release line (docs/online.md, session 10). How far a sheath bend moves the release line per
+degree of edge move, and how much beta grows with it, is a property of the product's
+construction (one number per product over units and bend angles, session 11), so the
+manufacturer measures it where the other constants are measured: the sheet's unit calibrated
+from current (fast protocol, the sheet's own rule) straight and with its sheath bent 30, 60 and
+90 deg (:func:`tsmd.online.bend.measure_bend_relation`). Four calibrations: optional, since it
+adds minutes to the sheet.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from simrig.plant import Plant, PlantLoadError
+from simrig.scenario import ShapeChange, ShapeChangePlant
+from tsmd.calibration import fast_protocol
+from tsmd.calibration.errors import CalibrationRefusedError
+from tsmd.calibration.run import calibrate
+from tsmd.config import TsmdConfig
+from tsmd.errors import TsmdError
+from tsmd.online.bend import BendRelation, measure_bend_relation
+from tsmd.profile import CatheterProfile, DeviceModel
+from tsmd.replay import LockstepRunner
+
+BENDS_DEG = (30.0, 60.0, 90.0)
+"""Sheath bends the sheet's unit is calibrated at besides straight (session 11's set)."""
+BEND_SEED = 3000
+"""Noise seed of the sheet unit's calibrations (the bench's seed for unit 0)."""
+
+CalibrateBent = Callable[[float], CatheterProfile]
+"""A unit's calibration with its sheath bent by the given angle (0: straight)."""
+
+
+def bend_relation(calibrate_bent: CalibrateBent,
+                  bends_deg: Sequence[float] = BENDS_DEG) -> BendRelation:
+    """The relation from one unit calibrated straight and at ``bends_deg``; a bend whose
+    calibration is refused is left out (an OnlineError in one line when none is left)."""
+    straight = calibrate_bent(0.0)
+    bent = []
+    for deg in bends_deg:
+        try:
+            bent.append(calibrate_bent(deg))
+        except CalibrationRefusedError:
+            continue
+    return measure_bend_relation(straight, bent)
+
+
+def rig_calibration(factory: Callable[[], Plant], device: DeviceModel, config: TsmdConfig,
+                    seed: int = BEND_SEED) -> CalibrateBent:
+    """Calibrations of the simulated rig's plant under ``device``'s sheet, bent on demand."""
+
+    def run(bend_deg: float) -> CatheterProfile:
+        changes = [ShapeChange(0.0, {"sheath_curvature_deg": bend_deg})] if bend_deg else []
+        try:
+            plant = ShapeChangePlant(factory(), changes)
+        except PlantLoadError as exc:
+            raise TsmdError(f"--bend-relation: {exc}") from None
+        with LockstepRunner(config, None, "none", seed, plant) as runner:
+            return calibrate(runner, f"{device.device_model}-bend-{bend_deg:g}", device,
+                             protocol=fast_protocol())
+
+    return run
+
+
+__all__ = ["BENDS_DEG", "BEND_SEED", "CalibrateBent", "bend_relation", "rig_calibration"]

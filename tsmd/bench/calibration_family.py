@@ -75,6 +75,8 @@ class ProtocolRun:
     ticks: int
     errors: list[float] = field(default_factory=list)
     """|identified - tip| for the 56 values (NaN where either is missing)."""
+    errors_lines: list[float] = field(default_factory=list)
+    """The same against the line truth (:data:`tsmd.bench.tip_truth.TRUTHS`)."""
 
     @property
     def within(self) -> int:
@@ -138,15 +140,24 @@ def profile_values(points: Sequence[GridPoint], knob: int, name: str,
     return np.asarray(PchipInterpolator(x, y, extrapolate=True)(np.asarray(at_deg)), float)
 
 
-def score(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]]) -> None:
-    """Fill ``run.errors``: the 56 values against the tip's truth."""
-    run.errors = []
+def errors_against(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]]
+                   ) -> list[float]:
+    """The 56 values' |identified - tip| against one truth."""
+    out = []
     for knob in (0, 1):
         grid = sorted(o for k, o in truth if k == knob)
         for name in PARAMETERS:
             found = profile_values(run.points, knob, name, grid)
             for other, value in zip(grid, found, strict=True):
-                run.errors.append(abs(value - truth[(knob, other)].get(name, math.nan)))
+                out.append(abs(value - truth[(knob, other)].get(name, math.nan)))
+    return out
+
+
+def score(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]],
+          truth_lines: dict[tuple[int, float], dict[str, float]] | None = None) -> None:
+    """Fill ``run.errors`` (and ``run.errors_lines`` when the line truth is given)."""
+    run.errors = errors_against(run, truth)
+    run.errors_lines = errors_against(run, truth_lines) if truth_lines is not None else []
 
 
 def truth_sweeps(config: TsmdConfig) -> list[GridPoint]:
@@ -200,8 +211,9 @@ def run_catheter(plant: str, params: dict[str, Any], unit_key: str, unit: int, n
     full = paper is not None and len(paper.points) == len(paper_protocol().sweeps)
     truth_points = paper.points if full and paper else truth_sweeps(cfg)
     truth = {(p.knob, p.other_deg): tip_truth(p) for p in truth_points}
+    truth_lines = {(p.knob, p.other_deg): tip_truth(p, "lines") for p in truth_points}
     for run in runs.values():
-        score(run, truth)
+        score(run, truth, truth_lines)
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     return CatheterRun(plant, unit, noise_seed,
                        {k: v for k, v in runs.items() if k in protocols}, rss)
@@ -238,10 +250,24 @@ def family_table(results: Sequence[CatheterRun], protocol: str) -> str:
         f"{len(worst.errors)} within {TARGET_DEG:g} deg, max {worst.max_error:.2f} deg"
         + ("" if worst.accepted else f", refused: {worst.reason[:200]}"),
     ]
+    lines += line_truth_summary(rows)
     refused = [(c, r) for c, r in rows if not r.accepted]
     lines += [f"- refused: unit {c.unit} seed {c.noise_seed}: {r.reason[:300]}"
               for c, r in refused]
     return "\n".join(lines)
+
+
+def line_truth_summary(rows: Sequence[tuple[CatheterRun, ProtocolRun]]) -> list[str]:
+    """The family's figures again against the line truth (where the runs carry it)."""
+    scored = [(c, r) for c, r in rows if r.errors_lines]
+    if not scored:
+        return []
+    values = np.concatenate([np.asarray(r.errors_lines, float) for _, r in scored])
+    good = sum(int(np.sum(np.asarray(r.errors_lines) <= TARGET_DEG)) >= 0.95 * len(r.errors_lines)
+               for _, r in scored)
+    return [f"- against the line truth (corners of the paper's lines on the tip): "
+            f"{int(np.sum(values <= TARGET_DEG))} of {values.size} within {TARGET_DEG:g} deg, "
+            f"runs >= 95 %: {good} of {len(scored)}, max {np.nanmax(values):.2f} deg"]
 
 
 def run_catheter_summary(plant: str, params: dict[str, Any], unit_key: str, unit: int,

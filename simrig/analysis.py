@@ -22,6 +22,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import minimize
 
 FloatArray = NDArray[np.float64]
 
@@ -159,3 +160,81 @@ def releasing_slope(
     q = np.asarray(knob_deg, dtype=np.float64)
     y = np.asarray(tip_deg, dtype=np.float64)
     return loaded_slope(q[::-1], y[::-1], lo_deg, hi_deg)
+
+
+def _binned(q: FloatArray, y: FloatArray, width_deg: float) -> tuple[FloatArray, FloatArray]:
+    """Median tip per knob bin of a monotone pass (the fit's cost independent of the rate)."""
+    edges = np.arange(q[0], q[-1] + width_deg, width_deg)
+    idx = np.clip(np.searchsorted(edges, q, side="right") - 1, 0, edges.size - 1)
+    keep = np.unique(idx)
+    qb = np.array([np.median(q[idx == k]) for k in keep])
+    yb = np.array([np.median(y[idx == k]) for k in keep])
+    return qb, yb
+
+
+def _hinge_fit(q: FloatArray, y: FloatArray, knots: FloatArray) -> tuple[float, FloatArray]:
+    """Least squares of a continuous piecewise line: flat before the first knot (the held
+    tip of the paper's backlash), a free slope after each knot. (sum of squares, coefficients)"""
+    basis = np.column_stack([np.ones_like(q)] + [np.maximum(q - k, 0.0) for k in knots])
+    coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
+    r = y - basis @ coef
+    return float(r @ r), coef
+
+
+def _rising_pass_lines(q: FloatArray, tip: FloatArray, thr: float) -> tuple[float, float]:
+    """(backlash, dead zone edge) of a rising pass as the corners of the paper's lines."""
+    b_thr, d_thr = _rising_pass_measures(q, tip, thr)
+    if not (np.isfinite(b_thr) and np.isfinite(d_thr)):
+        return float("nan"), float("nan")
+    qb, yb = _binned(q, tip, 0.5)
+    q0, q1 = float(qb[0]), float(qb[-1])
+    lo, hi = q0 + 0.25, q1 - 0.25
+
+    def cost(k: FloatArray) -> float:
+        if not lo < k[0] < k[1] < k[2] < hi:
+            return np.inf
+        return _hinge_fit(qb, yb, k)[0]
+
+    b0, d0 = q[0] + b_thr, d_thr
+    if not lo < b0 < d0 < hi:
+        return float("nan"), float("nan")
+    # the plateau's start is not read by the threshold: try a few and polish the best
+    starts = [np.array([b0, b0 + f * (d0 - b0), d0]) for f in (0.2, 0.4, 0.6, 0.8)]
+    best = min(starts, key=cost)
+    fit = minimize(cost, best, method="Nelder-Mead",
+                   options={"xatol": 0.05, "fatol": 1e-9, "maxiter": 600})
+    k = fit.x if np.isfinite(fit.fun) else best
+    _, coef = _hinge_fit(qb, yb, k)
+    release, plateau, loaded = coef[1], coef[1] + coef[2], coef[1] + coef[2] + coef[3]
+    # the lines must be the paper's: a release, a plateau flatter than both, a loaded branch
+    if not (release > 0.0 and loaded > 0.0 and abs(plateau) < 0.5 * min(release, loaded)):
+        return float("nan"), float("nan")
+    return float(k[0] - q[0]), float(k[2])
+
+
+def measure_by_lines(knob_deg: ArrayLike, tip_deg: ArrayLike,
+                     threshold_deg: float = 1.0) -> DeadZoneBacklash:
+    """``D_pos, D_neg, B_pos, B_neg`` (knob degrees) as the corners of the paper's lines.
+
+    Each pass is fitted with one continuous piecewise line: the tip held after the reversal
+    (flat), the release line, the dead-zone plateau (its own slope, so a tip that creeps along
+    the plateau does not move the edge) and the loaded line. B is the knob travel from the
+    reversal to the held line's corner with the release line, D the plateau's corner with the
+    loaded line. The threshold reading (:func:`measure_dead_zone_backlash`) only seeds the fit.
+    A pass whose fitted lines are not these (no plateau flatter than both branches) counts as
+    NaN; each value is the median over passes.
+    """
+    q = np.asarray(knob_deg, dtype=np.float64)
+    y = np.asarray(tip_deg, dtype=np.float64)
+    measure_dead_zone_backlash(q, y, threshold_deg)  # the same input checks, one message each
+    up: list[tuple[float, float]] = []
+    down: list[tuple[float, float]] = []
+    for a, b, direction in split_passes(q):
+        if direction > 0:
+            up.append(_rising_pass_lines(q[a:b], y[a:b], threshold_deg))
+        else:
+            bl, dz = _rising_pass_lines(-q[a:b], -y[a:b], threshold_deg)
+            down.append((bl, -dz))
+    b_neg, d_pos = np.nanmedian(np.array(up), axis=0) if _finite(up) else (np.nan, np.nan)
+    b_pos, d_neg = np.nanmedian(np.array(down), axis=0) if _finite(down) else (np.nan, np.nan)
+    return DeadZoneBacklash(float(d_pos), float(d_neg), float(b_pos), float(b_neg))

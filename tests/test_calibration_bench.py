@@ -43,3 +43,12 @@ def test_the_table_names_the_worst_unit_and_every_refusal() -> None:
     assert "accepted: 1 of 2 runs (50%)" in table
     assert "worst: unit 2 noise seed 0: 0/56 within 2 deg, max 2.50 deg" in table
     assert "refused: unit 2 seed 0: refused: test" in table
+
+
+def test_the_table_scores_the_runs_against_the_line_truth_too() -> None:
+    run = _run(0.0)
+    lines_truth = {key: {n: v + 3.0 for n, v in vals.items()} for key, vals in _truth().items()}
+    score(run, _truth(), lines_truth)
+    table = family_table([CatheterRun("p", 1, 0, {"fast": run}, 100.0)], "fast")
+    assert run.within == 56
+    assert "line truth (corners of the paper's lines on the tip): 0 of 56 within 2 deg" in table

@@ -8,6 +8,7 @@ import pytest
 from simrig.analysis import (
     SweepAnalysisError,
     loaded_slope,
+    measure_by_lines,
     measure_dead_zone_backlash,
     split_passes,
 )
@@ -92,3 +93,57 @@ def test_bad_input_is_refused_clearly(
 ) -> None:
     with pytest.raises(SweepAnalysisError, match=message):
         measure_dead_zone_backlash(knob, tip, threshold_deg=threshold)
+
+
+def paper_lines_sweep(backlash_deg: float, dead_deg: float, release: float, loaded: float,
+                      plateau_creep_deg: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Two +-90 deg cycles whose passes are the paper's lines, symmetric in the two directions:
+    held for ``backlash_deg``, a release line of slope ``release`` down to a plateau that ends at
+    ``+-dead_deg``, across which the tip creeps by ``plateau_creep_deg``, then the loaded line."""
+    top = loaded * (90.0 - dead_deg)
+    plateau_start = 90.0 - backlash_deg - top / release  # knob where the release reaches 0
+
+    def rising(q: np.ndarray) -> np.ndarray:  # from the reversal at -90 (mirror of falling)
+        return -falling(-q)
+
+    def falling(q: np.ndarray) -> np.ndarray:
+        creep = plateau_creep_deg * (plateau_start - q) / (plateau_start + dead_deg)
+        return np.select(
+            [q >= 90.0 - backlash_deg, q >= plateau_start, q >= -dead_deg],
+            [np.full_like(q, top), top - release * (90.0 - backlash_deg - q), -creep],
+            -plateau_creep_deg + (top - plateau_creep_deg) / (90.0 - dead_deg) * (q + dead_deg))
+
+    down, up = np.linspace(90.0, -90.0, 3600), np.linspace(-90.0, 90.0, 3600)
+    q = np.r_[np.linspace(0.0, 90.0, 900)[:-1], down, up[1:], down[1:], up[1:]]
+    y = np.r_[np.linspace(0.0, top, 900)[:-1], falling(down), rising(up[1:]),
+              falling(down[1:]), rising(up[1:])]
+    return q, y
+
+
+def test_lines_read_the_corners_of_the_paper_lines_where_release_and_load_differ() -> None:
+    q, tip = paper_lines_sweep(backlash_deg=16.0, dead_deg=18.0, release=1.6, loaded=1.1)
+    m = measure_by_lines(q, tip)
+    assert m.dead_zone_pos_deg == pytest.approx(18.0, abs=0.3)
+    assert m.dead_zone_neg_deg == pytest.approx(-18.0, abs=0.3)
+    assert m.backlash_pos_deg == pytest.approx(16.0, abs=0.3)
+    assert m.backlash_neg_deg == pytest.approx(16.0, abs=0.3)
+
+
+def test_a_tip_creeping_along_the_plateau_moves_the_threshold_edge_but_not_the_lines() -> None:
+    q, tip = paper_lines_sweep(backlash_deg=16.0, dead_deg=18.0, release=1.6, loaded=1.1,
+                               plateau_creep_deg=2.5)
+    by_threshold = measure_dead_zone_backlash(q, tip, threshold_deg=1.0)
+    by_lines = measure_by_lines(q, tip)
+    assert abs(by_threshold.dead_zone_pos_deg - 18.0) > 3.0
+    assert by_lines.dead_zone_pos_deg == pytest.approx(18.0, abs=0.3)
+
+
+def test_lines_give_nan_where_the_tip_shows_no_plateau() -> None:
+    q = 90.0 * np.sin(np.linspace(0.0, 4.0 * np.pi, 4000))
+    m = measure_by_lines(q, 1.2 * q)
+    assert np.isnan(m.dead_zone_pos_deg) and np.isnan(m.backlash_pos_deg)
+
+
+def test_lines_refuse_the_inputs_the_threshold_reading_refuses() -> None:
+    with pytest.raises(SweepAnalysisError, match="finite"):
+        measure_by_lines(np.array([0.0, 1.0, np.nan]), np.zeros(3))

@@ -8,7 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from simrig.analysis import DeadZoneBacklash, SweepAnalysisError, measure_dead_zone_backlash
+from simrig.analysis import (
+    DeadZoneBacklash,
+    SweepAnalysisError,
+    measure_by_lines,
+    measure_dead_zone_backlash,
+)
 from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.identify import split_half_cycles
 from tsmd.calibration.signal import lowpass
@@ -16,9 +21,15 @@ from tsmd.calibration.signal import lowpass
 TIP_THRESHOLD_DEG = 1.0
 """How far the tip must move off its plateau for an edge or a backlash end (deg)."""
 
+TRUTHS = {"threshold": measure_dead_zone_backlash, "lines": measure_by_lines}
+"""The two readings of the tip: where it has moved 1 deg, and the corners of the paper's lines
+(fitted over whole branches; the plateau with its own slope). They differ by up to ~3 deg on a
+curved branch, so a score names its truth."""
 
-def tip_truth(point: GridPoint) -> dict[str, float]:
-    """D and B measured on the tracked tip of the sweep (the plant package's analysis)."""
+
+def tip_truth(point: GridPoint, by: str = "threshold") -> dict[str, float]:
+    """D and B measured on the tracked tip of the sweep (the plant package's analysis), read
+    ``by`` one of :data:`TRUTHS`."""
     rec = point.recording
     if rec is None:
         return {}
@@ -29,21 +40,21 @@ def tip_truth(point: GridPoint) -> dict[str, float]:
     if not np.isfinite(tip).all():
         return {}
     try:
-        truth = tip_reading(t, rec[f"cmd{k}"][m], pos, tip)
+        truth = tip_reading(t, rec[f"cmd{k}"][m], pos, tip, by)
     except SweepAnalysisError:
         return {}
     return dict(truth._asdict())
 
 
 def tip_reading(t_s: np.ndarray, cmd_deg: np.ndarray, pos_deg: np.ndarray,
-                tip_deg: np.ndarray) -> DeadZoneBacklash:
+                tip_deg: np.ndarray, by: str = "threshold") -> DeadZoneBacklash:
     """D and B of one tracked sweep as the truth reads them: the tip low-passed at the
     current's cutoff (zero phase; on the raw tracker 0.1 deg of noise fires the 1 deg threshold
     1.5-2.5 deg early on a slowly starting tip), the knob made monotonic between reversals.
     Raises :class:`simrig.analysis.SweepAnalysisError` where the sweep shows neither."""
     tip_f, _ = lowpass(np.asarray(tip_deg, dtype=float), 1.0 / float(np.median(np.diff(t_s))))
     knob = monotone_knob(np.asarray(cmd_deg, dtype=float), np.asarray(pos_deg, dtype=float))
-    return measure_dead_zone_backlash(knob, tip_f, threshold_deg=TIP_THRESHOLD_DEG)
+    return TRUTHS[by](knob, tip_f, threshold_deg=TIP_THRESHOLD_DEG)
 
 
 def monotone_knob(cmd_deg: np.ndarray, pos_deg: np.ndarray) -> np.ndarray:

@@ -68,6 +68,8 @@ class ProtocolRun:
     ticks: int
     errors: list[float] = field(default_factory=list)
     """|identified - tip| for the 56 values (NaN where either is missing)."""
+    errors_lines: list[float] = field(default_factory=list)
+    """The same against the line truth (:data:`tsmd.tip_truth.TRUTHS`)."""
 
     @property
     def within(self) -> int:
@@ -124,15 +126,24 @@ def profile_values(points: Sequence[GridPoint], knob: int, name: str,
     return np.asarray(PchipInterpolator(x, y, extrapolate=True)(np.asarray(at_deg)), float)
 
 
-def score(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]]) -> None:
-    """Fill ``run.errors``: the 56 values against the tip's truth."""
-    run.errors = []
+def errors_against(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]]
+                   ) -> list[float]:
+    """The 56 values' |identified - tip| against one truth."""
+    out = []
     for knob in (0, 1):
         grid = sorted(o for k, o in truth if k == knob)
         for name in PARAMETERS:
             found = profile_values(run.points, knob, name, grid)
             for other, value in zip(grid, found, strict=True):
-                run.errors.append(abs(value - truth[(knob, other)].get(name, math.nan)))
+                out.append(abs(value - truth[(knob, other)].get(name, math.nan)))
+    return out
+
+
+def score(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]],
+          truth_lines: dict[tuple[int, float], dict[str, float]] | None = None) -> None:
+    """Fill ``run.errors`` (and ``run.errors_lines`` when the line truth is given)."""
+    run.errors = errors_against(run, truth)
+    run.errors_lines = errors_against(run, truth_lines) if truth_lines is not None else []
 
 
 def truth_sweeps(config: TsmdConfig) -> list[GridPoint]:

@@ -65,8 +65,9 @@ def run_catheter(plant: str, params: dict[str, Any], unit_key: str, unit: int, n
     full = paper is not None and len(paper.points) == len(paper_protocol().sweeps)
     truth_points = paper.points if full and paper else truth_sweeps(cfg)
     truth = {(p.knob, p.other_deg): tip_truth(p) for p in truth_points}
+    truth_lines = {(p.knob, p.other_deg): tip_truth(p, "lines") for p in truth_points}
     for run in runs.values():
-        score(run, truth)
+        score(run, truth, truth_lines)
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     return CatheterRun(plant, unit, noise_seed,
                        {k: v for k, v in runs.items() if k in protocols}, rss)
@@ -103,10 +104,24 @@ def family_table(results: Sequence[CatheterRun], protocol: str) -> str:
         f"{len(worst.errors)} within {TARGET_DEG:g} deg, max {worst.max_error:.2f} deg"
         + ("" if worst.accepted else f", refused: {worst.reason[:200]}"),
     ]
+    lines += line_truth_summary(rows)
     refused = [(c, r) for c, r in rows if not r.accepted]
     lines += [f"- refused: unit {c.unit} seed {c.noise_seed}: {r.reason[:300]}"
               for c, r in refused]
     return "\n".join(lines)
+
+
+def line_truth_summary(rows: Sequence[tuple[CatheterRun, ProtocolRun]]) -> list[str]:
+    """The family's figures again against the line truth (where the runs carry it)."""
+    scored = [(c, r) for c, r in rows if r.errors_lines]
+    if not scored:
+        return []
+    values = np.concatenate([np.asarray(r.errors_lines, float) for _, r in scored])
+    good = sum(int(np.sum(np.asarray(r.errors_lines) <= TARGET_DEG)) >= 0.95 * len(r.errors_lines)
+               for _, r in scored)
+    return [f"- against the line truth (corners of the paper's lines on the tip): "
+            f"{int(np.sum(values <= TARGET_DEG))} of {values.size} within {TARGET_DEG:g} deg, "
+            f"runs >= 95 %: {good} of {len(scored)}, max {np.nanmax(values):.2f} deg"]
 
 
 def run_catheter_summary(plant: str, params: dict[str, Any], unit_key: str, unit: int,

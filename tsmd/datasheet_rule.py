@@ -9,7 +9,9 @@ within 2 deg; docs/calibration.md, session 10 lead), and no one of them holds on
 So the manufacturer, who tracks the tip of this unit anyway, calibrates it with the fast
 protocol under each rule (current only, as every unit is calibrated) and writes the rule whose
 D and B come closest to the tip into the sheet: a per-product constant measured where the
-other ones are.
+other ones are. The knee (:mod:`tsmd.calibration.knee`) is chosen the same way, after the
+rule: the chosen rules calibrated once more with it on, kept per knob only where that placed
+more of the unit's values (lumped unit 0 loses with it, stickslip and coilpipe gain).
 """
 
 from __future__ import annotations
@@ -81,26 +83,61 @@ def knob_errors(errors: Sequence[float], knob: int) -> np.ndarray:
     return np.asarray(errors[knob * n:(knob + 1) * n], dtype=float)
 
 
-def rule_scores(config: TsmdConfig, device: DeviceModel,
-                noise_seeds: Sequence[int] = RULE_NOISE_SEEDS) -> list[RuleScore]:
-    """The fast protocol on the sheet's unit (``config.sim``) under each rule, scored per knob
-    against the tip on the paper's grid as the family bench scores (truth: the plant alone)."""
-    truth = {(p.knob, p.other_deg): tip_truth(p) for p in truth_sweeps(config)}
+Truth = dict[tuple[int, float], dict[str, float]]
+
+
+def sheet_truth(config: TsmdConfig) -> Truth:
+    """The sheet unit's tracked D and B on the paper's grid (the plant alone)."""
+    return {(p.knob, p.other_deg): tip_truth(p) for p in truth_sweeps(config)}
+
+
+def scored(config: TsmdConfig, candidate: DeviceModel, label: str, truth: Truth,
+           noise_seeds: Sequence[int]) -> list[RuleScore]:
+    """The fast protocol on the sheet's unit with ``candidate``, scored per knob against the
+    tip on the paper's grid as the family bench scores."""
+    runs = [play_protocol(config, candidate, fast_protocol(), seed) for seed in noise_seeds]
+    for run in runs:
+        score(run, truth)
     out = []
-    for rule in RELEASE_RULES:
-        candidate = with_rule(device, rule)
-        runs = [play_protocol(config, candidate, fast_protocol(), seed) for seed in noise_seeds]
-        for run in runs:
-            score(run, truth)
-        for knob in (0, 1):
-            e = np.concatenate([knob_errors(r.errors, knob) for r in runs])
-            finite = e[np.isfinite(e)]
-            out.append(RuleScore(
-                rule, knob, int(np.sum(finite <= TARGET_DEG)), e.size,
-                float(np.mean(finite)) if finite.size else math.nan,
-                float(np.max(finite)) if finite.size else math.nan,
-                sum(r.accepted for r in runs), len(runs)))
+    for knob in (0, 1):
+        e = np.concatenate([knob_errors(r.errors, knob) for r in runs])
+        finite = e[np.isfinite(e)]
+        out.append(RuleScore(
+            label, knob, int(np.sum(finite <= TARGET_DEG)), e.size,
+            float(np.mean(finite)) if finite.size else math.nan,
+            float(np.max(finite)) if finite.size else math.nan,
+            sum(r.accepted for r in runs), len(runs)))
     return out
+
+
+def rule_scores(config: TsmdConfig, device: DeviceModel,
+                noise_seeds: Sequence[int] = RULE_NOISE_SEEDS,
+                truth: Truth | None = None) -> list[RuleScore]:
+    """Each rule on the sheet's unit (``config.sim``), scored per knob."""
+    truth = sheet_truth(config) if truth is None else truth
+    return [one for rule in RELEASE_RULES
+            for one in scored(config, with_rule(device, rule), rule, truth, noise_seeds)]
+
+
+def with_knee(device: DeviceModel, on: tuple[bool, bool]) -> DeviceModel:
+    """The sheet with the knee on where ``on`` says (per knob)."""
+    knobs = tuple(dataclasses.replace(k, backlash_knee=True if o else None)
+                  for k, o in zip(device.knobs, on, strict=True))
+    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+
+def choose_knee(config: TsmdConfig, chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
+                truth: Truth, noise_seeds: Sequence[int] = RULE_NOISE_SEEDS
+                ) -> tuple[DeviceModel, list[RuleScore]]:
+    """The chosen rules once more with the knee on; each knob keeps it only where that placed
+    more values (then: more runs accepted) than its rule without it. (sheet, the knee's scores)"""
+    knee = scored(config, with_knee(chosen, (True, True)), "knee", truth, noise_seeds)
+    on = []
+    for knob, k in enumerate(chosen.knobs):
+        plain = [s for s in rule_scores_ if s.knob == knob and s.rule == k.backlash_release_rule]
+        with_it = knee[knob]
+        on.append(bool(plain) and with_it.key() < plain[0].key())
+    return with_knee(chosen, (on[0], on[1])), knee
 
 
 def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceModel:

@@ -89,13 +89,14 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
                    ) -> tuple[IdentifyOptions, IdentifyOptions]:
     """Each knob's identification with its product's backlash rule from the data sheet."""
     base = options or IdentifyOptions()
-    k1, k2 = device.knobs[0], device.knobs[1]
-    return (for_product(base, k1.backlash_settle_fraction, k1.backlash_release_slope_ratio,
-                        k1.backlash_settle_lag_deg, k1.backlash_release_line_share,
-                        k1.backlash_release_rule, k1.backlash_release_local_share),
-            for_product(base, k2.backlash_settle_fraction, k2.backlash_release_slope_ratio,
-                        k2.backlash_settle_lag_deg, k2.backlash_release_line_share,
-                        k2.backlash_release_rule, k2.backlash_release_local_share))
+    chosen = []
+    for k in device.knobs:
+        one = for_product(base, k.backlash_settle_fraction, k.backlash_release_slope_ratio,
+                          k.backlash_settle_lag_deg, k.backlash_release_line_share,
+                          k.backlash_release_rule, k.backlash_release_local_share)
+        # the product's knee (tsmd datasheet) where the sheet turns it on
+        chosen.append(replace(one, backlash_knee=True) if k.backlash_knee else one)
+    return chosen[0], chosen[1]
 
 
 def identify_recording(rec: Recording, options: KnobOptions = None,

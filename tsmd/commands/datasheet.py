@@ -32,7 +32,13 @@ from tsmd.datasheet import (
     swept_knob,
 )
 from tsmd.datasheet_bend import BENDS_DEG, bend_relation, rig_calibration
-from tsmd.datasheet_rule import RULE_NOISE_SEEDS, choose_rules, rule_scores
+from tsmd.datasheet_rule import (
+    RULE_NOISE_SEEDS,
+    choose_knee,
+    choose_rules,
+    rule_scores,
+    sheet_truth,
+)
 from tsmd.online.bend import with_bend_relation
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.recording import read_recording
@@ -115,12 +121,15 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
     """The sheet with each knob's backlash rule, chosen on its own unit's calibrations."""
     unit = config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=params))
     t0 = time.monotonic()
-    scores = rule_scores(unit, device, seeds)
-    chosen = choose_rules(device, scores)
+    truth = sheet_truth(unit)
+    scores = rule_scores(unit, device, seeds, truth)
+    chosen, knee = choose_knee(unit, choose_rules(device, scores), scores, truth, seeds)
     for knob, name in enumerate(("phi1", "phi2")):
         mine = "; ".join(s.text() for s in scores if s.knob == knob)
+        k = chosen.knobs[knob]
         print(f"{name} backlash rule on the sheet's unit, fast protocol, noise seeds "
-              f"{','.join(map(str, seeds))}: {mine} -> {chosen.knobs[knob].backlash_release_rule}")
+              f"{','.join(map(str, seeds))}: {mine}; with the knee: {knee[knob].text()} -> "
+              f"{k.backlash_release_rule}, knee {'on' if k.backlash_knee else 'off'}")
     print(f"  rule choice: {time.monotonic() - t0:.0f} s")
     return chosen
 

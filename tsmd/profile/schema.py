@@ -122,7 +122,7 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
                   "backlash_settle_lag_deg")
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
-                      "backlash_release_rule")
+                      "backlash_release_rule", "backlash_knee")
 
 
 def _shape(r: _Reader, value: Any, where: str) -> LoadedShape | None:
@@ -147,6 +147,12 @@ def _release_rule(r: _Reader, k: Mapping[str, Any], key: str) -> str | None:
         if rule == needs and k.get(share) is None:
             raise r.fail(f"{key}.backlash_release_rule", f"'{needs}' needs {share}")
     return rule
+
+
+def _knee(r: _Reader, value: Any, where: str) -> bool | None:
+    if value is None or isinstance(value, bool):
+        return value
+    raise r.fail(where, f"must be true or false, got {value!r}")
 
 
 def device_model_from_mapping(data: Any, origin: str = "device model") -> DeviceModel:
@@ -211,6 +217,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_release_local_share=optional(k.get("backlash_release_local_share"),
                                                   "backlash_release_local_share", 0.5, 1.5, ""),
             backlash_release_rule=_release_rule(r, k, key),
+            backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
             **{name: _shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS}))
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))

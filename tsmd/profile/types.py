@@ -128,6 +128,13 @@ class DeviceKnob:
     the one whose calibration of the sheet's own unit best reproduces its tracked tip (session
     11); without it a sheet keeps the rule its fields imply (line where the line share is
     given)."""
+    backlash_knee: bool | None = None
+    """Optional, the product's choice of the knee (:mod:`tsmd.calibration.knee`): a fraction
+    rule's backlash end beyond the point where the current's rise falls below its own scatter
+    moves back to that point. It places the end where the current creeps slowly after the
+    release (stickslip, coilpipe) and too early where the current slows gradually (lumped), so
+    ``tsmd datasheet`` turns it on only where it calibrates the sheet's own unit closer to its
+    tracked tip (session 12). None or False: off."""
 
 
 @dataclass(frozen=True)

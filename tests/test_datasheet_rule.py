@@ -12,7 +12,7 @@ from support.profiles import DEVICE
 from tsmd.calibration.options import IdentifyOptions, for_product
 from tsmd.calibration.run import device_options
 from tsmd.cli import main
-from tsmd.datasheet_rule import RuleScore, choose_rules, with_rule
+from tsmd.datasheet_rule import RuleScore, choose_rules, knee_choice, with_rule
 from tsmd.profile import DeviceModel, ProfileError, load_device_model
 from tsmd.profile.schema import device_model_from_mapping, device_model_to_mapping
 
@@ -128,3 +128,38 @@ def test_bad_rule_seeds_are_one_line_before_anything_is_measured(
     assert code == 2
     assert "--rule-seeds" in capsys.readouterr().err
     assert not (tmp_path / "d.yaml").exists()
+
+
+def test_the_knee_is_kept_only_on_the_knob_where_it_placed_more_values() -> None:
+    rules = [scored("line", 0, 50), scored("line", 1, 55)]
+    knee = [scored("knee", 0, 56), scored("knee", 1, 55)]
+    chosen = knee_choice(sheet(rule="line"), rules, knee)
+    assert [k.backlash_knee for k in chosen.knobs] == [True, None]
+
+
+def test_the_knee_that_costs_an_accepted_run_stays_off() -> None:
+    rules = [scored("line", 0, 50), scored("line", 1, 50)]
+    knee = [scored("knee", 0, 50, accepted=1), scored("knee", 1, 49)]
+    chosen = knee_choice(sheet(rule="line"), rules, knee)
+    assert [k.backlash_knee for k in chosen.knobs] == [None, None]
+
+
+def test_a_sheet_with_the_knee_turns_it_on_for_that_knob_only() -> None:
+    base = sheet(rule="line")
+    knobs = (dataclasses.replace(base.knobs[0], backlash_knee=True), base.knobs[1])
+    phi1, phi2 = device_options(None, dataclasses.replace(base, knobs=knobs))
+    assert phi1.backlash_knee and phi1.backlash == "fraction"
+    assert not phi2.backlash_knee
+
+
+def test_the_knee_survives_the_sheets_yaml_and_a_bad_value_is_one_line() -> None:
+    base = sheet(rule="line")
+    knobs = (base.knobs[0], dataclasses.replace(base.knobs[1], backlash_knee=True))
+    mapping = device_model_to_mapping(dataclasses.replace(base, knobs=knobs))
+    assert mapping["knobs"]["phi2"]["backlash_knee"] is True
+    assert "backlash_knee" not in mapping["knobs"]["phi1"]
+    assert device_model_from_mapping(mapping).knobs[1].backlash_knee is True
+    mapping["knobs"]["phi2"]["backlash_knee"] = "yes"
+    with pytest.raises(ProfileError, match="phi2.backlash_knee: must be true or false") as err:
+        device_model_from_mapping(mapping)
+    assert "\n" not in str(err.value)

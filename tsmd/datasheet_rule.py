@@ -129,15 +129,22 @@ def with_knee(device: DeviceModel, on: tuple[bool, bool]) -> DeviceModel:
 def choose_knee(config: TsmdConfig, chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
                 truth: Truth, noise_seeds: Sequence[int] = RULE_NOISE_SEEDS
                 ) -> tuple[DeviceModel, list[RuleScore]]:
-    """The chosen rules once more with the knee on; each knob keeps it only where that placed
-    more values (then: more runs accepted) than its rule without it. (sheet, the knee's scores)"""
+    """The chosen rules once more with the knee on, kept where it helps (:func:`knee_choice`).
+    (sheet, the knee's scores)"""
     knee = scored(config, with_knee(chosen, (True, True)), "knee", truth, noise_seeds)
+    return knee_choice(chosen, rule_scores_, knee), knee
+
+
+def knee_choice(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
+                knee_scores: Sequence[RuleScore]) -> DeviceModel:
+    """Each knob keeps the knee only where it placed more values (then: more runs accepted)
+    than the knob's rule without it; a tie keeps it off."""
     on = []
     for knob, k in enumerate(chosen.knobs):
         plain = [s for s in rule_scores_ if s.knob == knob and s.rule == k.backlash_release_rule]
-        with_it = knee[knob]
-        on.append(bool(plain) and with_it.key() < plain[0].key())
-    return with_knee(chosen, (on[0], on[1])), knee
+        knee = [s for s in knee_scores if s.knob == knob]
+        on.append(bool(plain and knee) and knee[0].key() < plain[0].key())
+    return with_knee(chosen, (on[0], on[1]))
 
 
 def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceModel:

@@ -130,11 +130,18 @@ def test_bad_rule_seeds_are_one_line_before_anything_is_measured(
     assert not (tmp_path / "d.yaml").exists()
 
 
-def test_the_knee_is_kept_only_on_the_knob_where_it_placed_more_values() -> None:
+def test_the_knee_is_dropped_only_on_the_knob_where_it_placed_fewer_values() -> None:
     rules = [scored("line", 0, 50), scored("line", 1, 55)]
-    knee = [scored("knee", 0, 56), scored("knee", 1, 55)]
+    knee = [scored("knee", 0, 56), scored("knee", 1, 54)]
     chosen = knee_choice(sheet(rule="line"), rules, knee)
     assert [k.backlash_knee for k in chosen.knobs] == [True, None]
+
+
+def test_a_tie_keeps_the_knee() -> None:
+    rules = [scored("line", 0, 56), scored("line", 1, 56)]
+    knee = [scored("knee", 0, 56, mean=1.5), scored("knee", 1, 56)]
+    chosen = knee_choice(sheet(rule="line"), rules, knee)
+    assert [k.backlash_knee for k in chosen.knobs] == [True, True]
 
 
 def test_the_knee_that_costs_an_accepted_run_stays_off() -> None:

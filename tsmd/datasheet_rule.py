@@ -10,8 +10,8 @@ So the manufacturer, who tracks the tip of this unit anyway, calibrates it with 
 protocol under each rule (current only, as every unit is calibrated) and writes the rule whose
 D and B come closest to the tip into the sheet: a per-product constant measured where the
 other ones are. The knee (:mod:`tsmd.calibration.knee`) is chosen the same way, after the
-rule: the chosen rules calibrated once more with it on, kept per knob only where that placed
-more of the unit's values (lumped unit 0 loses with it, stickslip and coilpipe gain).
+rule: the chosen rules calibrated once more with it on, kept per knob unless that placed fewer
+of the unit's values (lumped unit 0 loses with it).
 """
 
 from __future__ import annotations
@@ -137,13 +137,17 @@ def choose_knee(config: TsmdConfig, chosen: DeviceModel, rule_scores_: Sequence[
 
 def knee_choice(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
                 knee_scores: Sequence[RuleScore]) -> DeviceModel:
-    """Each knob keeps the knee only where it placed more values (then: more runs accepted)
-    than the knob's rule without it; a tie keeps it off."""
+    """Each knob keeps the knee unless it placed fewer values (then: fewer runs accepted) than
+    the knob's rule without it. A tie keeps it: the knee only stops a rule from reading B where
+    the current no longer says anything, and a unit that the rule alone already places fully
+    cannot show that (stickslip unit 0: 56/56 either way, while held-out units of that product
+    were refused without it); the products it harms show it on their own unit (lumped unit 0:
+    31 and 45 of 56 with it, 56/56 without)."""
     on = []
     for knob, k in enumerate(chosen.knobs):
         plain = [s for s in rule_scores_ if s.knob == knob and s.rule == k.backlash_release_rule]
         knee = [s for s in knee_scores if s.knob == knob]
-        on.append(bool(plain and knee) and knee[0].key() < plain[0].key())
+        on.append(bool(plain and knee) and knee[0].key() <= plain[0].key())
     return with_knee(chosen, (on[0], on[1]))
 
 

@@ -18,6 +18,7 @@ the stretch before the first reversal is ignored).
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -114,13 +115,23 @@ def measure_dead_zone_backlash(
         raise SweepAnalysisError(f"threshold_deg must be > 0, got {threshold_deg!r}")
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(y))):
         raise SweepAnalysisError("knob_deg and tip_deg must be finite (drop NaN samples first)")
+    return _over_passes(q, y, threshold_deg, _rising_pass_measures)
+
+
+PassReading = Callable[[FloatArray, FloatArray, float], tuple[float, float]]
+"""(backlash, dead zone edge) of one rising pass (a falling one is read mirrored)."""
+
+
+def _over_passes(q: FloatArray, y: FloatArray, threshold_deg: float,
+                 per_pass: PassReading) -> DeadZoneBacklash:
+    """Each pass read by ``per_pass`` (falling ones mirrored), the median over passes."""
     up: list[tuple[float, float]] = []
     down: list[tuple[float, float]] = []
     for a, b, direction in split_passes(q):
         if direction > 0:
-            up.append(_rising_pass_measures(q[a:b], y[a:b], threshold_deg))
+            up.append(per_pass(q[a:b], y[a:b], threshold_deg))
         else:
-            bl, dz = _rising_pass_measures(-q[a:b], -y[a:b], threshold_deg)
+            bl, dz = per_pass(-q[a:b], -y[a:b], threshold_deg)
             down.append((bl, -dz))
     if not up or not down:
         raise SweepAnalysisError("need at least one complete rising and one falling pass")
@@ -227,14 +238,4 @@ def measure_by_lines(knob_deg: ArrayLike, tip_deg: ArrayLike,
     q = np.asarray(knob_deg, dtype=np.float64)
     y = np.asarray(tip_deg, dtype=np.float64)
     measure_dead_zone_backlash(q, y, threshold_deg)  # the same input checks, one message each
-    up: list[tuple[float, float]] = []
-    down: list[tuple[float, float]] = []
-    for a, b, direction in split_passes(q):
-        if direction > 0:
-            up.append(_rising_pass_lines(q[a:b], y[a:b], threshold_deg))
-        else:
-            bl, dz = _rising_pass_lines(-q[a:b], -y[a:b], threshold_deg)
-            down.append((bl, -dz))
-    b_neg, d_pos = np.nanmedian(np.array(up), axis=0) if _finite(up) else (np.nan, np.nan)
-    b_pos, d_neg = np.nanmedian(np.array(down), axis=0) if _finite(down) else (np.nan, np.nan)
-    return DeadZoneBacklash(float(d_pos), float(d_neg), float(b_pos), float(b_neg))
+    return _over_passes(q, y, threshold_deg, _rising_pass_lines)

@@ -287,11 +287,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
                                           np.asarray(s.pos_deg, float))
                            if s.lag_s is None else s.lag_s for s in order]))
-    lo, hi = BETA_RANGE
-    beta_pos = [min(max(b, lo), hi)
-                for b in smooth_over_grid(grid, [f.backlash_gain for f in pos_fits])]
-    beta_neg = [min(max(b, lo), hi)
-                for b in smooth_over_grid(grid, [f.backlash_gain for f in neg_fits])]
+    beta_pos = smoothed_gains(grid, [f.backlash_gain for f in pos_fits])
+    beta_neg = smoothed_gains(grid, [f.backlash_gain for f in neg_fits])
     omega = unit_omega(float(k.omega), getattr(k, "reference_backlash_gain", None),
                        settle_rule_gain(grid, order, pos_fits, neg_fits, (beta_pos, beta_neg)))
     ratio = release_slope_ratio(k)
@@ -310,6 +307,17 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         shape_neg=shape_neg)
 
 
+def clamped_gain(beta: float) -> float:
+    """A backlash gain held inside :data:`BETA_RANGE`."""
+    lo, hi = BETA_RANGE
+    return min(max(beta, lo), hi)
+
+
+def smoothed_gains(grid: Sequence[float], gains: Sequence[float]) -> list[float]:
+    """Backlash gains smoothed over the other knob's grid, held inside :data:`BETA_RANGE`."""
+    return [clamped_gain(b) for b in smooth_over_grid(grid, gains)]
+
+
 def settle_rule_gain(grid: Sequence[float], sweeps: Sequence[SweepCurrent],
                      pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit],
                      betas: tuple[Sequence[float], Sequence[float]]) -> float:
@@ -319,15 +327,12 @@ def settle_rule_gain(grid: Sequence[float], sweeps: Sequence[SweepCurrent],
     A gain read with another rule than the sheet's would move omega by the rules' difference,
     not the unit's stretch (session 12: variant (c), a product-rule gain on both sides, lost
     on segments what it won on coilpipe)."""
-    if all(s.settle_backlash_deg is not None
-           and all(math.isfinite(b) for b in s.settle_backlash_deg) for s in sweeps):
-        lo, hi = BETA_RANGE
-        settle = [[min(max((s.settle_backlash_deg or (0.0, 0.0))[i]
-                           / abs(f.amplitude_deg - f.zero_load_deg), lo), hi)
-                   for s, f in zip(sweeps, fits, strict=True)]
-                  for i, fits in enumerate((pos_fits, neg_fits))]
-        betas = ([min(max(b, lo), hi) for b in smooth_over_grid(grid, settle[0])],
-                 [min(max(b, lo), hi) for b in smooth_over_grid(grid, settle[1])])
+    settle = [s.settle_backlash_deg for s in sweeps if s.settle_backlash_deg is not None]
+    if len(settle) == len(sweeps) and np.isfinite(settle).all():
+        pos, neg = ([clamped_gain(b[i] / abs(f.amplitude_deg - f.zero_load_deg))
+                     for b, f in zip(settle, fits, strict=True)]
+                    for i, fits in enumerate((pos_fits, neg_fits)))
+        betas = (smoothed_gains(grid, pos), smoothed_gains(grid, neg))
     # the sheet measured its gain with the other knob at 0: compare the unit there
     return 0.5 * (at_other_knob_zero(grid, betas[0]) + at_other_knob_zero(grid, betas[1]))
 

@@ -7,6 +7,7 @@ import shutil
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 import yaml
@@ -262,18 +263,27 @@ def test_a_recording_with_online_off_keeps_the_required_columns_only(
     assert tuple(read_recording(path).columns) == REQUIRED_COLUMNS
 
 
-def test_the_worker_takes_the_handle_slip_from_the_data_sheet(tmp_path: Path) -> None:
+def daemon_with_sheet(tmp_path: Path, edit: Callable[[dict[str, Any]], None]) -> Daemon:
+    """A started sim daemon with online on whose data sheet is the packaged one after ``edit``."""
     config = sim_config(tmp_path, online=True)
     assert config.profiles.device_model is not None
     sheet = device_model_to_mapping(load_device_model(resolve_data_path(
         config.profiles.device_model)))
-    sheet["knobs"]["phi1"]["handle_slip_deg"] = 4.5
-    sheet["knobs"]["phi2"]["handle_slip_deg"] = 2.0
+    edit(sheet)
     (tmp_path / "sheet.yaml").write_text(yaml.safe_dump(sheet))
     config = dataclasses.replace(config, profiles=dataclasses.replace(
         config.profiles, device_model=str(tmp_path / "sheet.yaml")))
     daemon = Daemon(config, sim=True, socket_path=str(tmp_path / "d.sock"))
     daemon.start()
+    return daemon
+
+
+def test_the_worker_takes_the_handle_slip_from_the_data_sheet(tmp_path: Path) -> None:
+    def slips(sheet: dict[str, Any]) -> None:
+        sheet["knobs"]["phi1"]["handle_slip_deg"] = 4.5
+        sheet["knobs"]["phi2"]["handle_slip_deg"] = 2.0
+
+    daemon = daemon_with_sheet(tmp_path, slips)
     try:
         ramps = running_worker(daemon)._knob_ramp
         assert [r.handle_slip_deg for r in ramps] == [4.5, 2.0]
@@ -282,16 +292,10 @@ def test_the_worker_takes_the_handle_slip_from_the_data_sheet(tmp_path: Path) ->
 
 
 def test_the_worker_takes_the_bend_relation_from_the_data_sheet(tmp_path: Path) -> None:
-    config = sim_config(tmp_path, online=True)
-    assert config.profiles.device_model is not None
-    sheet = device_model_to_mapping(load_device_model(resolve_data_path(
-        config.profiles.device_model)))
-    sheet["bend_relation"] = {"release_per_edge": 0.61, "gain_per_release_deg": 0.064}
-    (tmp_path / "sheet.yaml").write_text(yaml.safe_dump(sheet))
-    config = dataclasses.replace(config, profiles=dataclasses.replace(
-        config.profiles, device_model=str(tmp_path / "sheet.yaml")))
-    daemon = Daemon(config, sim=True, socket_path=str(tmp_path / "d.sock"))
-    daemon.start()
+    def relation(sheet: dict[str, Any]) -> None:
+        sheet["bend_relation"] = {"release_per_edge": 0.61, "gain_per_release_deg": 0.064}
+
+    daemon = daemon_with_sheet(tmp_path, relation)
     try:
         worker = running_worker(daemon)
         assert worker.bend == BendRelation(0.61, 0.064)

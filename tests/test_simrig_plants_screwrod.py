@@ -132,3 +132,11 @@ def test_bad_constants_are_refused_in_one_line(params: dict[str, object], messag
 def test_an_unknown_shape_change_is_refused() -> None:
     with pytest.raises(PlantLoadError, match="cannot reshape"):
         make_screwrod_plant().reshape(twist_deg=3.0)
+
+
+def test_closed_links_stop_the_tip_near_its_bend_limit() -> None:
+    plant = make_screwrod_plant()
+    tips, torques = _ramp(plant, 1, 180.0, rate_deg_s=60.0)
+    limit = plant.knobs[1].p.bend_limit_deg
+    assert limit < tips[-1] < limit + 8.0
+    assert torques[-1] > 3.0 * torques[len(torques) // 2]

@@ -69,6 +69,12 @@ class ScrewRodKnobParams:
     bend_stiffness_Nm_per_rad: float = 0.01
     """EI / length of the bending section (EI 5e-4 N m^2: soft Pebax and braid over 7 mm;
     set from 0.02 with the tendon's EA, same reason)."""
+    bend_limit_deg: float = 86.0
+    """Bend at which the section's link rims close (steerable TEE/ICE sections stop at
+    90-120 deg); beyond it the closed links take the moment."""
+    link_stiffness_Nm_per_rad: float = 1.0
+    """Stiffness of the closed links (rim contact of moulded polymer links: ~100 x the open
+    section), so that the tip stays within about 90 deg at 180 knob deg."""
 
     def slack_m(self, sign: int) -> float:
         return (self.slack_pos_mm if sign > 0 else self.slack_neg_mm) * 1e-3

@@ -129,6 +129,13 @@ class _Knob:
                 + p.handle_friction_Nm * self.thread_z)
 
 
+def _section(p: ScrewRodKnobParams, gap_m: float | None, wall_N_per_m: float
+             ) -> BendingSection:
+    return BendingSection(p.bend_length_mm * 1e-3, p.bend_stiffness_Nm_per_rad,
+                          math.radians(p.bend_limit_deg), p.link_stiffness_Nm_per_rad,
+                          gap_m, wall_N_per_m)
+
+
 class ScrewRodPlant:
     """Two knobs on lead-screw collars, UHMWPE tendons, a rod tip that meets a wall
     (anteriorly, knob 1 positive)."""
@@ -137,11 +144,9 @@ class ScrewRodPlant:
                  wall_gap_mm: float, wall_stiffness_N_per_mm: float,
                  sheath_curvature_deg: float) -> None:
         wall = wall_params(wall_gap_mm, wall_stiffness_N_per_mm)
-        sections = (BendingSection(knobs[0].bend_length_mm * 1e-3,
-                                   knobs[0].bend_stiffness_Nm_per_rad,
-                                   wall.wall_gap_mm * 1e-3, wall.wall_stiffness_N_per_mm * 1e3),
-                    BendingSection(knobs[1].bend_length_mm * 1e-3,
-                                   knobs[1].bend_stiffness_Nm_per_rad))
+        sections = (_section(knobs[0], wall.wall_gap_mm * 1e-3,
+                             wall.wall_stiffness_N_per_mm * 1e3),
+                    _section(knobs[1], None, 0.0))
         self.knobs = [_Knob(p, s) for p, s in zip(knobs, sections, strict=True)]
         self.sheath_curvature_deg = 0.0
         self.reshape(sheath_curvature_deg=sheath_curvature_deg)

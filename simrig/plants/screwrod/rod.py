@@ -13,6 +13,7 @@ monotone table of the tendon moment needed for each tip angle.
 from __future__ import annotations
 
 import bisect
+import math
 
 import numpy as np
 
@@ -89,9 +90,12 @@ def _monotone(theta: list[float], moment: list[float]) -> tuple[list[float], lis
 class BendingSection:
     """Tendon moment (N m) and its slope for a tip angle (rad), in one bending plane."""
 
-    def __init__(self, length_m: float, stiffness_Nm_per_rad: float,
-                 gap_m: float | None = None, wall_N_per_m: float = 0.0) -> None:
+    def __init__(self, length_m: float, stiffness_Nm_per_rad: float, limit_rad: float,
+                 link_Nm_per_rad: float, gap_m: float | None = None,
+                 wall_N_per_m: float = 0.0) -> None:
         self.k = stiffness_Nm_per_rad
+        self.limit_rad = limit_rad
+        self.k_link = link_Nm_per_rad
         self._theta: list[float] = []
         self._moment: list[float] = []
         if gap_m is not None and wall_N_per_m > 0.0:
@@ -100,7 +104,17 @@ class BendingSection:
         self.touch_rad = self._theta[0] if self._theta else float("inf")
 
     def moment(self, theta_rad: float) -> tuple[float, float]:
-        """(moment, d moment / d angle); linear beyond the table's last row."""
+        """(moment, d moment / d angle): the open section (and the wall), plus the closed
+        links' rim contact beyond the bend limit either way."""
+        m, k = self._open(theta_rad)
+        over = abs(theta_rad) - self.limit_rad
+        if over > 0.0:
+            m += math.copysign(self.k_link * over, theta_rad)
+            k += self.k_link
+        return m, k
+
+    def _open(self, theta_rad: float) -> tuple[float, float]:
+        """The open section's moment and slope; linear beyond the wall table's last row."""
         if theta_rad <= self.touch_rad:
             return self.k * theta_rad, self.k
         t, m = self._theta, self._moment

@@ -28,14 +28,15 @@ class ScrewRodKnobParams:
     """Dry acetal-on-acetal thread (handbook 0.25-0.35): at this lead (13.0 deg) the collar is
     just self-locking (driving efficiency 0.42, back-driving -0.20), as steerable handles are
     built to hold their bend when let go."""
-    handle_friction_Nm: float = 0.008
-    """O-ring seal of the collar (TEE current near 0 in the dead zone: a few mA)."""
+    handle_friction_Nm: float = 0.005
+    """O-ring seal of the collar (TEE current near 0 in the dead zone: a few mA; set from
+    0.008)."""
     handle_presliding_deg: float = 1.0
     """Knob travel over which the thread and seal friction turn round (elastic thread flanks)."""
-    slack_pos_mm: float = 2.7
-    slack_neg_mm: float = 2.7
-    """Tendon slack at assembly; 2.7 mm is 30 knob deg on this collar (paper/TEE dead zones:
-    tens of knob degrees; set from 2.1 so that the torque rises on engagement)."""
+    slack_pos_mm: float = 2.65
+    slack_neg_mm: float = 2.65
+    """Tendon slack at assembly; 2.65 mm is 30 knob deg on this collar (paper/TEE dead zones:
+    tens of knob degrees; set from 2.1 between the engagement-rise and release-slope checks)."""
     toe_mm: float = 0.05
     """UHMWPE braid toe: elongation over which the braid's fibres straighten (a pre-stretched
     braid: 0.005 % of 1.25 m; set from 0.4 so that the torque rises on engagement)."""
@@ -54,14 +55,16 @@ class ScrewRodKnobParams:
     sheath_length_m: float = 1.0
     """Insertion tube (TEE/ICE: about 1 m)."""
     sheath_wrap_deg: float = 250.0
-    """Total turning of the sheath path (curves in the body and the handle exit); the bending
-    section adds both planes' bends to it."""
+    """Total turning of the sheath path (curves in the body and the handle exit; set from 200);
+    the bending section adds both planes' bends to it."""
     sheath_friction: float = 0.15
     """UHMWPE on a PTFE liner (0.1-0.2)."""
-    sheath_drag_N: float = 0.3
-    """Liner preload: friction of the tendon on its lumen at zero tension."""
-    presliding_mm: float = 0.25
-    """Tendon travel at the contact over which all of it slips (liner and braid compliance)."""
+    sheath_drag_N: float = 0.15
+    """Liner preload: friction of the tendon on its lumen at zero tension (set from 0.3: it
+    holds the released tip off centre by about 3 deg)."""
+    presliding_mm: float = 0.1
+    """Tendon travel at the contact over which all of it slips (liner and braid compliance;
+    set from 0.25)."""
     tendon_offset_mm: float = 2.5
     """Lumen offset from the bending section's axis (7 mm steerable section)."""
     bend_length_mm: float = 50.0
@@ -69,12 +72,12 @@ class ScrewRodKnobParams:
     bend_stiffness_Nm_per_rad: float = 0.01
     """EI / length of the bending section (EI 5e-4 N m^2: soft Pebax and braid over 7 mm;
     set from 0.02 with the tendon's EA, same reason)."""
-    bend_limit_deg: float = 86.0
+    bend_limit_deg: float = 90.0
     """Bend at which the section's link rims close (steerable TEE/ICE sections stop at
-    90-120 deg); beyond it the closed links take the moment."""
+    90-120 deg); beyond it the closed links take the moment (tip ~94 deg at 180 knob deg)."""
     link_stiffness_Nm_per_rad: float = 1.0
     """Stiffness of the closed links (rim contact of moulded polymer links: ~100 x the open
-    section), so that the tip stays within about 90 deg at 180 knob deg."""
+    section)."""
 
     def slack_m(self, sign: int) -> float:
         return (self.slack_pos_mm if sign > 0 else self.slack_neg_mm) * 1e-3
@@ -84,11 +87,11 @@ class ScrewRodKnobParams:
 class WallParams:
     """The compliant wall (oesophagus or gastric wall) the tip meets when bent anteriorly."""
 
-    wall_gap_mm: float = 26.0
-    """Lateral distance from the section's axis to the wall: contact from about 67 deg of bend
-    (oesophageal or gastric lumen ~20-30 mm)."""
-    wall_stiffness_N_per_mm: float = 0.06
-    """Contact stiffness of the wall (soft-tissue indentation 0.05-0.5 N/mm; set from 0.1)."""
+    wall_gap_mm: float = 28.0
+    """Lateral distance from the section's axis to the wall: contact from about 74 deg of bend
+    (oesophageal or gastric lumen ~20-30 mm; set from 24)."""
+    wall_stiffness_N_per_mm: float = 0.1
+    """Contact stiffness of the wall (soft-tissue indentation 0.05-0.5 N/mm)."""
 
 
 NOMINAL_KNOBS = (ScrewRodKnobParams(), ScrewRodKnobParams())

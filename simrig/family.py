@@ -12,8 +12,8 @@ Unit 0 is the nominal unit (no scatter). Units 1-8 are the development set, unit
 held-out set: tune on the first, report the second. The capstan plant is the development plant,
 the lumped plant is held out, the segments plant (written blind in session 9) is held out now,
 the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11,
-written blind) is held out now, the twistshaft plant (session 12) was written blind and tsmd was
-run on it untuned (``PLANT_ROLE``).
+written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
+plant (session 13) was written blind and tsmd was run on it untuned (``PLANT_ROLE``).
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ from simrig.plant import Plant, PlantLoadError, load_plant
 from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
 from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
+from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
 from simrig.plants.stickslip import NOMINAL_KNOBS as STICKSLIP_KNOBS
 from simrig.plants.twistshaft import NOMINAL_KNOBS as TWISTSHAFT_KNOBS
@@ -41,10 +42,12 @@ PLANT_SPECS: dict[str, str] = {
     "segments": "simrig.plants.segments:make_segments_plant",
     "coilpipe": "simrig.plants.coilpipe:make_coilpipe_plant",
     "stickslip": "simrig.plants.stickslip:make_stickslip_plant",
-    "twistshaft": "simrig.plants.twistshaft:make_twistshaft_plant",  # last: the others' seeds hold
+    "twistshaft": "simrig.plants.twistshaft:make_twistshaft_plant",
+    "screwrod": "simrig.plants.screwrod:make_screwrod_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
-              "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "blind"}
+              "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
+              "screwrod": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -182,6 +185,28 @@ SCATTER: dict[str, dict[str, float]] = {
         "handle_friction_Nm": 0.20,  # knob bearing / O-ring
         "handle_presliding_deg": 0.20,
     },
+    "screwrod": {
+        "screw_lead_mm": 0.01,  # moulded collar thread
+        "screw_radius_mm": 0.01,
+        "thread_friction": 0.15,  # dry polymer thread, grease left from assembly
+        "handle_friction_Nm": 0.20,  # O-ring squeeze
+        "handle_presliding_deg": 0.20,  # thread flank fit
+        "slack_pos_mm": 0.15,  # tendon cut and knotted to its nut by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # braid lay
+        "tendon_stiffness_N": 0.15,  # braid lot (EA)
+        "creep_limit_mm": 0.30,  # UHMWPE creep: lot and braid heat-setting scatter widely
+        "creep_time_s": 0.30,
+        "free_length_m": 0.20,  # handle assembly
+        "sheath_length_m": 0.02,  # cut to length
+        "sheath_wrap_deg": 0.10,  # lumen path in the shaft
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "sheath_drag_N": 0.20,  # lumen preload
+        "presliding_mm": 0.20,  # liner and braid compliance
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "bend_length_mm": 0.03,  # moulded links
+        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and braid
+    },
 }
 """Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""
 
@@ -189,7 +214,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "segments": SEGMENTS_KNOBS,
                                         "coilpipe": COILPIPE_KNOBS,
                                         "stickslip": STICKSLIP_KNOBS,
-                                        "twistshaft": TWISTSHAFT_KNOBS}
+                                        "twistshaft": TWISTSHAFT_KNOBS,
+                                        "screwrod": SCREWROD_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -241,6 +267,8 @@ VARIANTS: dict[str, Variant] = {
                           "handle_friction_Nm": 1.5},
             "twistshaft": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                            "handle_friction_Nm": 1.5},
+            "screwrod": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                         "handle_friction_Nm": 1.5, "thread_friction": 1.2},
         },
     ),
     "steel-tendon": Variant(
@@ -260,7 +288,8 @@ VARIANTS: dict[str, Variant] = {
                  "segments": {"tendon_stiffness_N": 0.4},
                  "coilpipe": {"tendon_stiffness_N": 0.4},
                  "stickslip": {"tendon_stiffness_N": 0.4},
-                 "twistshaft": {"tendon_stiffness_N": 0.4}},
+                 "twistshaft": {"tendon_stiffness_N": 0.4},
+                 "screwrod": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -16,12 +17,14 @@ from tsmd.cli import main
 from tsmd.datasheet import (
     CONDITIONING_CYCLES,
     RELEASE_READ_CYCLES,
+    DatasheetError,
     analysed_from,
     knob_constants,
+    readable,
     settle,
     tip_sweep,
 )
-from tsmd.profile import DEFAULT_HANDLE_SLIP_DEG, load_device_model
+from tsmd.profile import DEFAULT_HANDLE_SLIP_DEG, DeviceModel, load_device_model, save_device_model
 from tsmd.recording import Recording, read_recording, write_recording
 
 PERIOD_S = 0.01
@@ -237,3 +240,32 @@ def test_the_loaded_shape_template_is_written_only_when_asked(sweep_files: list[
                for k in load_device_model(plain).knobs)
     assert any(k.loaded_shape_pos is not None or k.loaded_shape_neg is not None
                for k in load_device_model(shaped).knobs)
+
+
+def _with_phi2(device: DeviceModel, **values: Any) -> DeviceModel:
+    return replace(device, knobs=(device.knobs[0], replace(device.knobs[1], **values)))
+
+
+def test_a_measured_read_the_schema_refuses_is_left_out_and_named() -> None:
+    measured = _with_phi2(load_device_model(DEVICE), backlash_release_line_share=7.0,
+                          backlash_release_local_share=0.98)
+    sheet, dropped = readable(measured)
+    assert sheet.knobs[1].backlash_release_line_share is None
+    assert sheet.knobs[1].backlash_release_local_share == 0.98
+    assert sheet.knobs[0] == measured.knobs[0]
+    assert len(dropped) == 1 and "knobs.phi2.backlash_release_line_share" in dropped[0]
+
+
+def test_a_measured_sheet_invalid_beyond_its_optional_reads_is_one_error() -> None:
+    with pytest.raises(DatasheetError, match="knobs.phi2.omega"):
+        readable(_with_phi2(load_device_model(DEVICE), omega=-1.0))
+
+
+def test_a_line_share_past_the_release_line_is_written_and_read_back(tmp_path: Path) -> None:
+    """A handle that is harder to back-drive than to drive (a self-locking screw) moves the
+    current past the release line before the tip lets go: a share above 1 is a measurement."""
+    sheet, dropped = readable(_with_phi2(load_device_model(DEVICE),
+                                         backlash_release_line_share=1.06))
+    save_device_model(sheet, tmp_path / "sheet.yaml")
+    assert dropped == []
+    assert load_device_model(tmp_path / "sheet.yaml").knobs[1].backlash_release_line_share == 1.06

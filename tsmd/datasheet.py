@@ -17,6 +17,7 @@ import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,7 +32,17 @@ from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.datasheet_release import median_ratio, median_share, release_reads
 from tsmd.datasheet_shape import measure_loaded_shape
 from tsmd.errors import TsmdError
-from tsmd.profile import DEFAULT_HANDLE_SLIP_DEG, DeviceKnob, DeviceModel, ReferencePoint
+from tsmd.profile import (
+    DEFAULT_HANDLE_SLIP_DEG,
+    KNOB_NAMES,
+    DeviceKnob,
+    DeviceModel,
+    ProfileError,
+    ReferencePoint,
+    device_model_from_mapping,
+    device_model_to_mapping,
+)
+from tsmd.profile.schema import plain_values
 from tsmd.recording import Recording
 from tsmd.replay import run_trajectory
 from tsmd.stack import knob_limits
@@ -315,3 +326,32 @@ def device_model(name: str, constants: Sequence[KnobConstants], config: TsmdConf
     limits = knob_limits(config)
     knobs = tuple(c.device_knob(lim) for c, lim in zip(constants, limits, strict=True))
     return DeviceModel(name, (knobs[0], knobs[1]), description)
+
+
+OPTIONAL_READS = tuple(f.name for f in dataclasses.fields(DeviceKnob) if f.default is None)
+"""The sheet's measured values a device model may lack (the schema reads them when present)."""
+
+
+def readable(device: DeviceModel) -> tuple[DeviceModel, list[str]]:
+    """The sheet as the schema will read it back: a measured optional value the schema refuses
+    is left out and named, so the rules that need it are no candidates, instead of the whole
+    measurement being lost when the file is written. A refusal of anything else is an error."""
+    dropped: list[str] = []
+    for _ in range(2 * len(OPTIONAL_READS) + 1):
+        try:
+            device_model_from_mapping(plain_values(device_model_to_mapping(device)), "sheet")
+            return device, dropped
+        except ProfileError as exc:
+            message = str(exc).removeprefix("sheet: ")
+            hit = next(((i, name) for i, knob in enumerate(device.knobs)
+                        for name in OPTIONAL_READS
+                        if message.startswith(f"knobs.{KNOB_NAMES[i]}.{name}:")), None)
+            if hit is None:
+                raise DatasheetError(f"the measured sheet is not valid: {message}") from None
+            i, name = hit
+            knobs = list(device.knobs)
+            left_out: dict[str, Any] = {name: None}
+            knobs[i] = dataclasses.replace(knobs[i], **left_out)
+            device = dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+            dropped.append(f"{message}: left out of the sheet")
+    raise DatasheetError("the measured sheet is not valid")  # pragma: no cover - bounded above

@@ -29,6 +29,7 @@ from tsmd.datasheet import (
     device_model,
     knob_constants,
     measure_device_constants,
+    readable,
     swept_knob,
 )
 from tsmd.datasheet_bend import BENDS_DEG, bend_relation, rig_calibration
@@ -174,6 +175,9 @@ def main(args: argparse.Namespace) -> int:
         source = "recordings " + ", ".join(Path(p).name for p in args.from_recording)
     device = device_model(args.device_model, constants, config, args.description,
                           loaded_shape=args.loaded_shape)
+    device, dropped = readable(device)
+    for line in dropped:
+        print(f"warning: {line}")
     if args.plant is not None and seeds:
         device = _choose_rule(device, config, args.plant, params, seeds)
     if args.plant is not None and args.bend_relation:

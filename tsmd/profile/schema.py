@@ -213,7 +213,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional(k.get("backlash_settle_lag_deg"), "backlash_settle_lag_deg", -10.0, 10.0,
                      "deg"),
             backlash_release_line_share=optional(k.get("backlash_release_line_share"),
-                                                 "backlash_release_line_share", 0.5, 1.0, ""),
+                                                 "backlash_release_line_share", 0.5, 1.5, ""),
             backlash_release_local_share=optional(k.get("backlash_release_local_share"),
                                                   "backlash_release_local_share", 0.5, 1.5, ""),
             backlash_release_rule=_release_rule(r, k, key),

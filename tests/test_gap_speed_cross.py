@@ -155,6 +155,18 @@ def test_stickslip_cases_scale_the_units_own_relaxation_and_coupling_is_not_run(
     assert not stickslip.supports("coupling")
 
 
+def test_twistshaft_coupling_moves_the_units_own_lumens_and_rate_creep_are_not_run() -> None:
+    twist = PRESETS["twistshaft"]
+    none = twist.build_unit(102, 0.1)
+    coupled = twist.build_unit(102, 0.1, "coupling", **twist.case_effects("coupling"))
+    for k in (0, 1):
+        assert coupled.knobs[k].lumen_angle_error_deg == pytest.approx(
+            4.5 * none.knobs[k].lumen_angle_error_deg)
+        assert coupled.knobs[k].lumen_helix_deg == none.knobs[k].lumen_helix_deg
+    assert not twist.supports("rate")
+    assert not twist.supports("creep")
+
+
 def test_a_case_the_data_plant_lacks_is_not_run(monkeypatch: pytest.MonkeyPatch) -> None:
     import tsmd.gap.crosstest as crosstest
 

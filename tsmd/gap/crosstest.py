@@ -143,6 +143,23 @@ tendon EA halved, 3.73 deg. "None" is the nominal physics as written: relaxing t
 stick-slip, the brake and the bend's coupling are its base (docs/gap.md "Session 12")."""
 
 
+TWISTSHAFT_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 120.0}}
+"""The twistshaft plant's one effect keyword: a 120 deg sheath bend, 12.8 deg of tip (tip RMSE
+effect on minus off, unit 1, noise-free, 120 s of the experiment motion at 50 Hz). The plant is
+quasi-static with no load relaxation: no rate or creep physics, those cases are not run. Its
+warm-up (24 -> 37 C in 60 s from every reset) is base physics: every recording, the data
+sheet's included, starts at insertion (docs/gap.md "Session 13")."""
+
+TWISTSHAFT_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"lumen_angle_error_deg": 4.5},
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Twistshaft effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion): its lumens sit off their planes (1.5 deg) and the shaft's twist turns the planes, a
+coupling of its base; the case puts the lumens 4.5 times as far off, 1.53 deg (the others'
+coupling 1.5 deg); the tendon EA halved, 3.59 deg."""
+
+
 @dataclass(frozen=True)
 class PlantSpec:
     """A plant as ``module:factory`` + fixed keyword parameters + what to fit as a simulator.
@@ -205,6 +222,8 @@ PRESETS: dict[str, PlantSpec] = {
                           knob_effects=COILPIPE_KNOB_EFFECTS),
     "stickslip": PlantSpec(PLANT_SPECS["stickslip"], {}, (), "stickslip", family="stickslip",
                            effects=STICKSLIP_EFFECTS, knob_effects=STICKSLIP_KNOB_EFFECTS),
+    "twistshaft": PlantSpec(PLANT_SPECS["twistshaft"], {}, (), "twistshaft", family="twistshaft",
+                            effects=TWISTSHAFT_EFFECTS, knob_effects=TWISTSHAFT_KNOB_EFFECTS),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

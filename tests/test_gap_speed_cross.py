@@ -10,10 +10,11 @@ import pytest
 from support.gap import StandInPlant, make_recording
 
 from simrig.family import family_member
-from tsmd.gap.crosstest import PRESETS, make_session, parse_plant_spec
+from tsmd.gap.crosstest import make_session
 from tsmd.gap.data import GapSeries, Split, fit_windows, make_split, series_from_recording
 from tsmd.gap.fit import ParamSpec, fit_base
 from tsmd.gap.model import Evaluator, build_views
+from tsmd.gap.presets import PRESETS, parse_plant_spec
 from tsmd.gap.selftest import EFFECTS
 
 

@@ -245,15 +245,19 @@ def _unit_drift(by_config: dict[str, dict[str, TestData]]) -> tuple[FloatArray, 
 
 def _spread(values: FloatArray, noise: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Mean over units (axis 0) of per-unit ``values`` with the variance of each (``noise``):
-    the mean, its noise, and the variance a further unit has about it beyond its own noise
-    (the units' sample variance less their mean noise, times 1 + 1/n for the mean's
-    uncertainty; 0 from one unit)."""
+    the mean, its noise, and the allowance a further unit has about it beyond its own noise,
+    as a variance: the square of a one-sided 95 % prediction bound from the units' spread
+    (sample variance less their mean noise, times 1 + 1/n for the mean's uncertainty, times
+    Student's t at n - 1 degrees of freedom squared: a unit's constants move the model's
+    contrast along few directions, so its deviation is bounded like one normal value, not
+    averaged over many points); 0 from one unit."""
     n = values.shape[0]
     mean = values.mean(axis=0)
     own = noise.mean(axis=0)
     if n < 2:
         return mean, own, np.zeros_like(mean)
-    spread = np.maximum(values.var(axis=0, ddof=1) - own, 0.0) * (1.0 + 1.0 / n)
+    bound = float(stats.t.ppf(0.95, n - 1)) ** 2 * (1.0 + 1.0 / n)
+    spread = np.maximum(values.var(axis=0, ddof=1) - own, 0.0) * bound
     return mean, own / n, spread
 
 

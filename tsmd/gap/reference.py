@@ -44,8 +44,8 @@ class LoopReference:
     noise_per_point: float
     """Expected squared contrast per point from the reference's repeat noise alone."""
     scatter_per_point: float = 0.0
-    """Expected squared contrast per point by which a unit of the model lies from the
-    reference: the reference units' spread about their mean (0 from one unit)."""
+    """Squared contrast per point a unit of the model may lie from the reference: the
+    reference units' spread about their mean as a 95 % prediction bound (0 from one unit)."""
 
     def at(self, lp: Loops, levels: Sequence[str]) -> FloatArray | None:
         """The reference contrast at ``lp``'s points (levels in ``levels``' order), or None

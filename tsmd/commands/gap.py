@@ -78,10 +78,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "protocol recordings); with it and the protocol in the recordings "
                              "tendon compliance can be named")
     parser.add_argument("--model-reference", default=None, metavar="REC,REC...",
-                        help="the protocol recorded on a reference unit of the catheter model "
-                             "(the data sheet's unit): what the model has always (its own "
-                             "rate, coupling and creep contrasts); effects are then named only "
-                             "for what a unit has beyond it")
+                        help="the protocol recorded on reference units of the catheter model "
+                             "(the data sheet's unit, better several: the header's catheter "
+                             "tells them apart): what the model has always (its own rate, "
+                             "coupling and creep contrasts) and, from two or more units, how "
+                             "far a unit may lie from it; effects are then named only for what "
+                             "a unit has beyond that")
     parser.add_argument("--sizes", default="120,300",
                         help="selftest: recording lengths in s (comma-separated)")
     parser.add_argument("--seeds", default="0,1", help="selftest: noise/unit seeds")

@@ -12,8 +12,9 @@ from numpy.typing import NDArray
 
 from tsmd import cli
 from tsmd.gap import compliance, crosstest
-from tsmd.gap.crosstest import PRESETS, make_session
+from tsmd.gap.crosstest import make_session
 from tsmd.gap.data import GapSeries, series_from_recording
+from tsmd.gap.presets import PRESETS
 from tsmd.gap.signature import SignatureScore
 from tsmd.gap.structure import rank_scores
 from tsmd.recording import Recording, write_recording
@@ -181,6 +182,15 @@ def test_a_data_sheet_unit_that_is_scored_or_negative_is_one_line(
                      "--seeds", "5", "--sheet-unit", unit, "--out", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "data-sheet unit" in err
+
+
+@pytest.mark.parametrize("units", ["0,5", "-1"])
+def test_a_reference_unit_that_is_scored_or_negative_is_one_line(
+        units: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = cli.main(["gap", "selftest", "--data-plant", "capstan", "--sim-plant", "capstan",
+                     "--seeds", "5", "--reference-units", units, "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "reference unit" in err
 
 
 @pytest.mark.parametrize("kind", ["no-segments", "missing"])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Callable
 from pathlib import Path
@@ -383,3 +384,42 @@ def test_a_subtracted_reference_counts_its_own_repeat_noise() -> None:
     assert plain is not None and own is not None
     beyond = beyond_reference(plain, own, data.levels, reference.loops["rate"])
     assert noise_ss(beyond) > noise_ss(plain)
+
+
+def _units(*models: Effect) -> list[GapSeries]:
+    """Protocol series of several catheters of a model, one per ``models`` entry."""
+    return [dataclasses.replace(s, catheter=f"unit-{u}")
+            for u, m in enumerate(models) for s in _session(m, seed=20 + u)[0]]
+
+
+def test_a_reference_from_one_unit_has_no_spread_and_from_scattered_units_their_spread() -> None:
+    one = product_reference(_units(_widening(0.02)))
+    alike = product_reference(_units(_widening(0.02), _widening(0.02), _widening(0.02)))
+    scattered = product_reference(_units(_widening(0.01), _widening(0.03), _widening(0.05)))
+    assert one.units == 1 and scattered.units == 3
+    assert one.loops["rate"].scatter_per_point == 0.0
+    assert scattered.loops["rate"].scatter_per_point > 10.0 * alike.loops["rate"].scatter_per_point
+
+
+def test_a_unit_within_its_models_spread_is_not_named_but_one_beyond_it_is() -> None:
+    reference = product_reference(_units(_widening(0.01), _widening(0.03), _widening(0.05)))
+
+    def scores(unit: Effect) -> set[str]:
+        series, residuals = _session(unit)
+        return _named({s.name: s for s in contrast_scores(
+            series, residuals, n_tried=6, tip_noise_deg=0.1, current_noise_A=0.004,
+            reference=reference)})
+
+    assert "rate" in _named(_against_model(_widening(0.05), _widening(0.03)))
+    assert "rate" not in scores(_widening(0.05))
+    assert "rate" in scores(_widening(0.15))
+
+
+def test_creep_the_models_units_scatter_over_counts_as_noise_of_its_reference() -> None:
+    def creep(gain: float) -> Effect:
+        return lambda t, q: gain * _creep(t, q)
+
+    one = product_reference(_units(creep(1.0)))
+    scattered = product_reference(_units(creep(0.0), creep(1.0), creep(2.0)))
+    assert one.creep is not None and scattered.creep is not None
+    assert float(scattered.creep[1].mean()) > 10.0 * float(one.creep[1].mean())

@@ -10,10 +10,11 @@ import pytest
 from support.gap import StandInPlant, make_recording
 
 from simrig.family import family_member
-from tsmd.gap.crosstest import PRESETS, make_session, parse_plant_spec
+from tsmd.gap.crosstest import make_session
 from tsmd.gap.data import GapSeries, Split, fit_windows, make_split, series_from_recording
 from tsmd.gap.fit import ParamSpec, fit_base
 from tsmd.gap.model import Evaluator, build_views
+from tsmd.gap.presets import PRESETS, parse_plant_spec
 from tsmd.gap.selftest import EFFECTS
 
 
@@ -153,6 +154,18 @@ def test_stickslip_cases_scale_the_units_own_relaxation_and_coupling_is_not_run(
         assert slow.knobs[k].creep_slow_share == pytest.approx(1.5 * none.knobs[k].creep_slow_share)
         assert fast.knobs[k].creep_slow_share == none.knobs[k].creep_slow_share
     assert not stickslip.supports("coupling")
+
+
+def test_twistshaft_coupling_moves_the_units_own_lumens_and_rate_creep_are_not_run() -> None:
+    twist = PRESETS["twistshaft"]
+    none = twist.build_unit(102, 0.1)
+    coupled = twist.build_unit(102, 0.1, "coupling", **twist.case_effects("coupling"))
+    for k in (0, 1):
+        assert coupled.knobs[k].lumen_angle_error_deg == pytest.approx(
+            4.5 * none.knobs[k].lumen_angle_error_deg)
+        assert coupled.knobs[k].lumen_helix_deg == none.knobs[k].lumen_helix_deg
+    assert not twist.supports("rate")
+    assert not twist.supports("creep")
 
 
 def test_a_case_the_data_plant_lacks_is_not_run(monkeypatch: pytest.MonkeyPatch) -> None:

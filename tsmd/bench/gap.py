@@ -17,10 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
-from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
+from tsmd.gap.crosstest import cross_config, run_crosstest
 from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
+from tsmd.gap.presets import parse_plant_spec
 from tsmd.gap.result import GapConfig
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,

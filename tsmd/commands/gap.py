@@ -21,11 +21,12 @@ import yaml
 from simrig.plant import load_plant
 from tsmd.gap.compliance import reference_deg_per_A
 from tsmd.gap.contrast import product_reference
-from tsmd.gap.crosstest import cross_config, parse_plant_spec, run_crosstest
+from tsmd.gap.crosstest import cross_config, run_crosstest
 from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.fit import ParamSpec
+from tsmd.gap.presets import parse_plant_spec
 from tsmd.gap.protocol import protocol_trajectory
 from tsmd.gap.reference import ProductReference
 from tsmd.gap.report import finite_json, write_report
@@ -77,10 +78,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "protocol recordings); with it and the protocol in the recordings "
                              "tendon compliance can be named")
     parser.add_argument("--model-reference", default=None, metavar="REC,REC...",
-                        help="the protocol recorded on a reference unit of the catheter model "
-                             "(the data sheet's unit): what the model has always (its own "
-                             "rate, coupling and creep contrasts); effects are then named only "
-                             "for what a unit has beyond it")
+                        help="the protocol recorded on reference units of the catheter model "
+                             "(the data sheet's unit, better several: the header's catheter "
+                             "tells them apart): what the model has always (its own rate, "
+                             "coupling and creep contrasts) and, from two or more units, how "
+                             "far a unit may lie from it; effects are then named only for what "
+                             "a unit has beyond that")
     parser.add_argument("--sizes", default="120,300",
                         help="selftest: recording lengths in s (comma-separated)")
     parser.add_argument("--seeds", default="0,1", help="selftest: noise/unit seeds")
@@ -100,16 +103,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="selftest across plants: the plant that makes the 'real' data "
                              "(preset capstan, capstan-other, lumped, segments, coilpipe, "
                              "stickslip, "
-                             "or module:factory[@{json}])")
+                             "twistshaft, or module:factory[@{json}])")
     parser.add_argument("--sim-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant used as the simulator")
     parser.add_argument("--sheet-unit", type=int, default=0, metavar="N",
                         help="selftest across plants: the unit of the data plant whose protocol "
                              "gives the compliance data sheet (default 0, the nominal unit; "
                              "never one of --seeds)")
+    parser.add_argument("--reference-units", default="0,5,6,7,8", metavar="N,N...",
+                        help="selftest across plants: the units of the data plant the model "
+                             "reference is measured on (what the model has always, and from "
+                             "their spread how far a unit may lie from it; default 0,5,6,7,8; "
+                             "never one of --seeds; one unit: no spread, as in session 12)")
     parser.add_argument("--no-reference", action="store_true",
-                        help="selftest across plants: no model reference (what the data plant's "
-                             "model has always, from the data sheet's unit); every rate, "
+                        help="selftest across plants: no model reference; every rate, "
                              "coupling and creep contrast is then named, as before session 12")
     parser.add_argument("--no-protocol", action="store_true",
                         help="selftest across plants: sessions without the matched-condition "
@@ -269,8 +276,10 @@ def _selftest(args: argparse.Namespace) -> int:
     try:
         sizes = [float(x) for x in args.sizes.split(",")]
         seeds = [int(x) for x in args.seeds.split(",")]
+        ref_units = [int(x) for x in args.reference_units.split(",")]
     except ValueError:
-        raise GapError("--sizes and --seeds take comma-separated numbers") from None
+        raise GapError("--sizes, --seeds and --reference-units take comma-separated "
+                       "numbers") from None
 
     def progress(c: Any) -> None:
         print(f"  {c.case:<11} {c.duration_s:5.0f} s seed {c.seed}: {c.verdict:<26} "
@@ -288,7 +297,7 @@ def _selftest(args: argparse.Namespace) -> int:
         result = run_crosstest(data, sim, cases, sizes, seeds, rate_hz,
                                cross_config(sim.fit, args.method), progress=progress,
                                matched=not args.no_protocol, sheet_unit=args.sheet_unit,
-                               reference=not args.no_reference)
+                               reference_units=() if args.no_reference else ref_units)
     else:
         result = run_selftest(cases, sizes, seeds, rate_hz,
                               GapConfig(fit_specs=BUILTIN_FIT_SPECS, method=args.method),

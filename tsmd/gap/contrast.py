@@ -183,32 +183,82 @@ def _drift_beyond(by_config: dict[str, dict[str, TestData]],
 
 
 def product_reference(series: Sequence[GapSeries]) -> ProductReference:
-    """What the model has always, from the protocol recorded on the data sheet's unit (any
-    configurations): each referenced loop test's level contrast of the measured signals, mean
-    over configurations, and the currents' loaded-minus-unloaded dwell slopes."""
-    by_config = collect_tests(series, [measured_windows(s) for s in series])
+    """What the model has always, from the protocol recorded on the data sheet's unit or on
+    several units of the model (grouped by the header's ``catheter``; any configurations): per
+    referenced loop test the level contrast of the measured signals and per dwell pair the
+    currents' loaded-minus-unloaded slopes, each the mean over units of the mean over
+    configurations; with two or more units their spread about it is what a further unit of
+    the model may lie from it (:func:`_spread`)."""
+    units: dict[str, list[GapSeries]] = {}
+    for s in series:
+        units.setdefault(s.catheter, []).append(s)
+    per_unit = [collect_tests(u, [measured_windows(s) for s in u]) for u in units.values()]
     loops: dict[str, LoopReference] = {}
     for test in REFERENCED:
-        found = [(loop_contrast(d[test].loops, d[test].levels), d[test].levels)
-                 for d in by_config.values() if test in d]
-        usable = [(lp, lv) for lp, lv in found if lp is not None]
-        if not usable:
+        found = [m for m in (_unit_contrast(by_config, test) for by_config in per_unit) if m]
+        if not found:
             continue
-        first, levels = usable[0]
-        same = [lp for lp, lv in usable if lp.y.shape == first.y.shape and lv == levels]
-        value = np.mean([contrast_of(lp) for lp in same], axis=0)
-        noise = float(np.mean([noise_ss(lp) for lp in same])) / first.y.shape[2] / len(same)
+        first, levels = found[0][0], found[0][1]
+        same = [m for m in found if m[1] == levels and m[2].shape == found[0][2].shape]
+        value, noise, scatter = _spread(np.array([m[2] for m in same]),
+                                        np.array([m[3] for m in same]))
         loops[test] = LoopReference(tuple(levels), value, first.knob * first.span_deg,
-                                    first.dirn, first.part, noise)
+                                    first.dirn, first.part, float(noise.mean()),
+                                    float(scatter.mean()))
+    slopes = [d for d in (_unit_drift(by_config) for by_config in per_unit) if d is not None]
+    if not slopes:
+        return ProductReference(loops, units=len(units))
+    same_d = [d for d in slopes if d[0].shape == slopes[0][0].shape]
+    diff, noise, scatter = _spread(np.array([d[0] for d in same_d]),
+                                   np.array([d[1] for d in same_d]))
+    return ProductReference(loops, (diff, noise + scatter), len(units))
+
+
+def _unit_contrast(by_config: dict[str, dict[str, TestData]], test: str
+                   ) -> tuple[Loops, list[str], FloatArray, FloatArray] | None:
+    """One unit's measured loops of ``test`` (first configuration), its levels, its level
+    contrast (mean over configurations) and that mean's noise per point."""
+    found = [(loop_contrast(d[test].loops, d[test].levels), d[test].levels)
+             for d in by_config.values() if test in d]
+    usable = [(lp, lv) for lp, lv in found if lp is not None]
+    if not usable:
+        return None
+    first, levels = usable[0]
+    same = [lp for lp, lv in usable if lp.y.shape == first.y.shape and lv == levels]
+    noise = float(np.mean([noise_ss(lp) for lp in same])) / first.y.shape[2] / len(same)
+    value = np.mean([contrast_of(lp) for lp in same], axis=0)
+    return first, levels, value, np.full(value.shape, noise)
+
+
+def _unit_drift(by_config: dict[str, dict[str, TestData]]) -> tuple[FloatArray, FloatArray] | None:
+    """One unit's loaded-minus-unloaded slopes per dwell pair (the pairs load the tendons in
+    turn, + then -: not averaged over) and current, mean over configurations, with the
+    mean's variance."""
     drifts = [d for d in (_drift(c["creep"]) for c in by_config.values() if "creep" in c)
               if d.diff.size]
     if not drifts:
-        return ProductReference(loops)
+        return None
     pairs = [d for d in drifts if d.diff.shape == drifts[0].diff.shape]
-    # per dwell pair: the pairs load the tendons in turn (+ then -), their slopes differ
-    diff = np.mean([d.diff for d in pairs], axis=0)
-    var = np.mean([d.var for d in pairs], axis=0) / len(pairs)
-    return ProductReference(loops, (diff, var))
+    return (np.mean([d.diff for d in pairs], axis=0),
+            np.mean([d.var for d in pairs], axis=0) / len(pairs))
+
+
+def _spread(values: FloatArray, noise: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Mean over units (axis 0) of per-unit ``values`` with the variance of each (``noise``):
+    the mean, its noise, and the allowance a further unit has about it beyond its own noise,
+    as a variance: the square of a one-sided 95 % prediction bound from the units' spread
+    (sample variance less their mean noise, times 1 + 1/n for the mean's uncertainty, times
+    Student's t at n - 1 degrees of freedom squared: a unit's constants move the model's
+    contrast along few directions, so its deviation is bounded like one normal value, not
+    averaged over many points); 0 from one unit."""
+    n = values.shape[0]
+    mean = values.mean(axis=0)
+    own = noise.mean(axis=0)
+    if n < 2:
+        return mean, own, np.zeros_like(mean)
+    bound = float(stats.t.ppf(0.95, n - 1)) ** 2 * (1.0 + 1.0 / n)
+    spread = np.maximum(values.var(axis=0, ddof=1) - own, 0.0) * bound
+    return mean, own / n, spread
 
 
 def excess_rms(loops: Sequence[Loops]) -> float:

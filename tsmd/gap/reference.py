@@ -7,9 +7,10 @@ protocol recorded on the data sheet's unit (with the tracker, as the compliance 
 gives the model's own contrasts of the *measured* signals, independent of any simulator; a unit
 is then compared with it: the residual's contrast plus the simulator's own contrast (the
 measured minus the residual's, on the same rows) minus the reference's is what this unit has
-beyond its model. A unit scatters around its model's reference; the loop tests' size rule (one
-sample's tracker noise, from the data) is the allowance, with the reference's own repeat noise
-counted as noise.
+beyond its model. A unit scatters around its model's reference: measured on several units
+(session 13), the reference is their mean and their spread about it counts as noise, as the
+reference's own repeat noise does, before the size rule (one sample's tracker or current noise)
+is applied; from one unit the spread is unknown and counts as 0 (session 12).
 """
 
 from __future__ import annotations
@@ -42,6 +43,9 @@ class LoopReference:
     part: FloatArray  # (K,)
     noise_per_point: float
     """Expected squared contrast per point from the reference's repeat noise alone."""
+    scatter_per_point: float = 0.0
+    """Squared contrast per point a unit of the model may lie from the reference: the
+    reference units' spread about their mean as a 95 % prediction bound (0 from one unit)."""
 
     def at(self, lp: Loops, levels: Sequence[str]) -> FloatArray | None:
         """The reference contrast at ``lp``'s points (levels in ``levels``' order), or None
@@ -71,8 +75,11 @@ class ProductReference:
 
     loops: dict[str, LoopReference]
     creep: tuple[FloatArray, FloatArray] | None = None
-    """Per dwell pair and current, the loaded-minus-unloaded slope (A/s) and its variance,
-    mean over configurations."""
+    """Per dwell pair and current, the loaded-minus-unloaded slope (A/s), mean over
+    configurations and units, and the variance a unit's slope has about it (the mean's noise
+    plus the units' spread)."""
+    units: int = 1
+    """How many catheters of the model the reference was measured on."""
 
 
 def measured_windows(s: GapSeries) -> FloatArray:
@@ -92,7 +99,8 @@ def beyond_reference(res: Loops, meas: Loops, levels: Sequence[str],
         return res
     sim = contrast_of(meas) - contrast_of(res)
     y = res.y + (sim - own)[:, None, :]
-    return replace(res, y=y, ref_noise_ss=res.y.shape[2] * ref.noise_per_point)
+    per_point = ref.noise_per_point + ref.scatter_per_point
+    return replace(res, y=y, ref_noise_ss=res.y.shape[2] * per_point)
 
 
 def drift_beyond_reference(res: Drift, meas: Drift,

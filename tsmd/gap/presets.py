@@ -1,0 +1,219 @@
+"""The plants the cross-plant self-test knows by name, each effect in the plant's own physics.
+
+A preset is a plant factory with fixed parameters, what to fit when it is the simulator, and how
+each self-test case puts its effect into that plant (its own keywords, or factors on a family
+unit's knob constants); a case the plant has no physics for is not run. The strengths are sized
+before any diagnosis, by the tip RMSE the effect moves (docs/gap.md, per plant's session).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Any
+
+from simrig.family import PLANT_SPECS, family_member
+from simrig.plant import load_plant
+from tsmd.gap.errors import GapError
+from tsmd.gap.fit import ParamSpec
+from tsmd.gap.selftest import BUILTIN_FIT_SPECS, BUILTIN_PLANT, EFFECTS
+
+OTHER_CAPSTAN_KNOBS: tuple[dict[str, float], ...] = (
+    {"sheath_friction": 0.12, "sheath_wrap_deg": 300.0, "slack_pos_mm": 1.2, "slack_neg_mm": 1.5,
+     "tendon_stiffness_N": 5500.0, "bend_friction_Nm": 0.0012,
+     "bend_stiffness_Nm_per_rad": 0.009, "handle_friction_Nm": 0.02, "routing_wrap_deg": 180.0,
+     "sheath_drag_N": 0.3, "pulley_radius_mm": 5.0},
+    {"sheath_friction": 0.15, "sheath_wrap_deg": 330.0, "slack_pos_mm": 1.0, "slack_neg_mm": 1.4,
+     "tendon_stiffness_N": 5000.0, "bend_friction_Nm": 0.001,
+     "bend_stiffness_Nm_per_rad": 0.008, "handle_friction_Nm": 0.018, "routing_wrap_deg": 180.0,
+     "sheath_drag_N": 0.25, "pulley_radius_mm": 5.0},
+)
+"""The stand-in 'other catheter' until an independently formulated plant lands: the capstan
+plant with strongly different physics (half the sheath friction over less wrap, a routed handle,
+smaller pulley, more drag, stiffer and more frictional bending joints, half the slack). Its
+tendon stiffness stays near the default (5000-5500 N against 6000 N): a tendon twice as
+compliant *is* the compliance effect, so a base that differs along one of the six effect axes
+would make the self-test's truth ambiguous ("none" data that need compliance)."""
+
+
+LUMPED_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"coupling": 1.0},
+    "rate": {"viscous_N_s_per_m": 20.0},
+    "compliance": {"tendon_compliance": 1.0},
+    "curvature": {"sheath_curvature_deg": 120.0},
+    "creep": {"creep_compliance_mm_per_N": 0.05},
+}
+"""The self-test effects in the lumped plant's own physics (its keywords), at strengths that move
+the tip about as much as the capstan plant's do (2 x 120 s of the experiment motion, unit 1,
+noise-free, effect on minus off, capstan / lumped): coupling 1.5 / 1.6 deg, rate 1.7 / 1.9 deg,
+compliance 9.8 / 7.6 deg, curvature 12.0 / 8.5 deg, creep 0.35 / 0.42 deg (docs/gap.md)."""
+
+SEGMENTS_BASE: dict[str, Any] = {"coupling": 0.0}
+"""The segments plant couples its two planes by default; its "none" units and its simulator have
+the coupling off, as the other plants' have every effect off."""
+
+SEGMENTS_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"coupling": 1.0},
+    "rate": {"viscous_N_s_per_m": 90.0},
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The self-test effects in the segments plant's own physics, sized like the lumped ones (tip
+RMSE effect on minus off, unit 1, noise-free, 120 s of the experiment motion at 50 Hz; capstan
+coupling 1.47, rate 1.70 deg): its nominal coupling 1.40 deg, lumen drag 90 N s/m (nominal 2)
+1.72 deg, a 120 deg bend 6.91 deg. It has no creep: that case is not run on it."""
+
+SEGMENTS_KNOB_EFFECTS: dict[str, dict[str, float]] = {"compliance": {"tendon_stiffness_N": 0.5}}
+"""Compliance on segments: the unit's tendon EA halved (no keyword of its own; the other plants'
+``tendon_compliance`` 1.0 is exactly that, docs/gap.md). Tip moved 6.42 deg (unit 1)."""
+
+
+COILPIPE_BASE: dict[str, Any] = {"coupling_mm_per_rad2": 0.0}
+"""The coilpipe plant shortens a tendon's path with the other plane's bend by default (0.25
+mm/rad^2); its "none" units and its simulator have that off. What stays on is base physics: the
+shaft's compression under all four tensions (a load coupling of both knobs), LuGre friction
+with Stribeck and viscous terms (a rate dependence of its own) and the tip's relaxing stiffness
+(2 s: a creep of its own); docs/gap.md "Session 11"."""
+
+COILPIPE_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"coupling_mm_per_rad2": 0.55},
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The self-test effects in the coilpipe plant's own keywords, sized like the others before any
+diagnosis (tip RMSE effect on minus off, unit 1, noise-free, 120 s of the experiment motion at
+50 Hz): path coupling 0.55 mm/rad^2 1.51 deg, a 120 deg bend 5.14 deg."""
+
+COILPIPE_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "rate": {"viscous_N_s_per_mm": 8.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+    "creep": {"bend_creep_time_s": 2.0},
+}
+"""Coilpipe effects without a keyword, as factors on the unit's knob constants (same sizing):
+lumen viscosity x8 1.56 deg, tendon EA halved 4.47 deg, the tip cover relaxing twice as slowly
+(2 -> 4 s, its one creep branch) 0.58 deg."""
+
+
+STICKSLIP_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 120.0}}
+"""The stickslip plant's one effect keyword: a 120 deg sheath bend moves its tip by 1.99 deg (tip
+RMSE effect on minus off, unit 1, noise-free, 120 s of the experiment motion at 50 Hz; the
+other plants' 5-12 deg). Its knobs' coupling (each tendon rubs round the whole bent section) is
+base physics with no constant of its own: that case is not run on it (as segments' creep)."""
+
+STICKSLIP_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "rate": {"creep_fast_share": 5.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+    "creep": {"creep_slow_share": 1.5},
+}
+"""Stickslip effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion): its only rate-dependent physics is the tendons' relaxation, so rate is the fast
+(0.5 s) Maxwell branch five times as stiff, 1.11 deg (x3: 0.65; the protocol's 20 against 80
+deg/s loops then differ by 0.36 / 0.16 deg RMS, the nominal unit's own 0.16 / 0.09); creep the
+slow (12 s) branch 1.5 times as stiff, 0.38 deg (the other plants' creep 0.35-0.42 deg); the
+tendon EA halved, 3.73 deg. "None" is the nominal physics as written: relaxing tendons,
+stick-slip, the brake and the bend's coupling are its base (docs/gap.md "Session 12")."""
+
+
+TWISTSHAFT_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 120.0}}
+"""The twistshaft plant's one effect keyword: a 120 deg sheath bend, 12.8 deg of tip (tip RMSE
+effect on minus off, unit 1, noise-free, 120 s of the experiment motion at 50 Hz). The plant is
+quasi-static with no load relaxation: no rate or creep physics, those cases are not run. Its
+warm-up (24 -> 37 C in 60 s from every reset) is base physics: every recording, the data
+sheet's included, starts at insertion (docs/gap.md "Session 13")."""
+
+TWISTSHAFT_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"lumen_angle_error_deg": 4.5},
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Twistshaft effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion): its lumens sit off their planes (1.5 deg) and the shaft's twist turns the planes, a
+coupling of its base; the case puts the lumens 4.5 times as far off, 1.53 deg (the others'
+coupling 1.5 deg); the tendon EA halved, 3.59 deg."""
+
+
+@dataclass(frozen=True)
+class PlantSpec:
+    """A plant as ``module:factory`` + fixed keyword parameters + what to fit as a simulator.
+
+    ``family`` names a :mod:`simrig.family` plant: its units (scatter by unit number: 1-8
+    development, 101-108 held out) are built from the family's draw; otherwise a unit is the
+    factory's own ``unit_variation``/``seed``. ``effects`` maps a self-test case to the plant's
+    effect keywords (default: :data:`tsmd.gap.selftest.EFFECTS`, the capstan plant's).
+    """
+
+    factory: str
+    params: dict[str, Any] = field(default_factory=dict)
+    fit: tuple[ParamSpec, ...] = ()
+    name: str = ""
+    family: str = ""
+    effects: dict[str, dict[str, float]] | None = None
+    knob_effects: dict[str, dict[str, float]] = field(default_factory=dict)
+    """Case -> factors on every knob's constants (a family unit's), for an effect the plant has
+    no keyword for."""
+
+    def build(self, **extra: Any) -> Any:
+        return load_plant(self.factory, {**self.params, **extra})
+
+    def supports(self, case: str) -> bool:
+        """Whether the plant can put this case's effect in its own physics (the sensor lag is
+        the rig's, every plant has it)."""
+        return (self.effects is None or case in ("none", "sensor") or case in self.effects
+                or case in self.knob_effects)
+
+    def case_effects(self, case: str) -> dict[str, float]:
+        if self.effects is None:
+            return dict(EFFECTS[case][0])
+        return dict(self.effects.get(case, {}))
+
+    def build_unit(self, unit: int, unit_variation: float, case: str = "none",
+                   **effects: float) -> Any:
+        """Catheter ``unit`` of this plant with ``effects`` (and ``case``'s knob factors)."""
+        if self.family:
+            member = family_member(self.family, unit)
+            params = {**member.params, **self.params, **effects}
+            factors = self.knob_effects.get(case, {})
+            if factors:
+                params["knobs"] = [{k: v * factors.get(k, 1.0) for k, v in knob.items()}
+                                   for knob in member.params["knobs"]]
+            return load_plant(member.spec, params)
+        return self.build(unit_variation=unit_variation, seed=unit, **effects)
+
+
+PRESETS: dict[str, PlantSpec] = {
+    "capstan": PlantSpec(BUILTIN_PLANT, {}, BUILTIN_FIT_SPECS, "capstan"),
+    "capstan-other": PlantSpec(BUILTIN_PLANT, {"knobs": [dict(k) for k in OTHER_CAPSTAN_KNOBS]},
+                               BUILTIN_FIT_SPECS, "capstan-other"),
+    "lumped": PlantSpec(PLANT_SPECS["lumped"], {}, (), "lumped", family="lumped",
+                        effects=LUMPED_EFFECTS),
+    "segments": PlantSpec(PLANT_SPECS["segments"], dict(SEGMENTS_BASE), (), "segments",
+                          family="segments", effects=SEGMENTS_EFFECTS,
+                          knob_effects=SEGMENTS_KNOB_EFFECTS),
+    "coilpipe": PlantSpec(PLANT_SPECS["coilpipe"], dict(COILPIPE_BASE), (), "coilpipe",
+                          family="coilpipe", effects=COILPIPE_EFFECTS,
+                          knob_effects=COILPIPE_KNOB_EFFECTS),
+    "stickslip": PlantSpec(PLANT_SPECS["stickslip"], {}, (), "stickslip", family="stickslip",
+                           effects=STICKSLIP_EFFECTS, knob_effects=STICKSLIP_KNOB_EFFECTS),
+    "twistshaft": PlantSpec(PLANT_SPECS["twistshaft"], {}, (), "twistshaft", family="twistshaft",
+                            effects=TWISTSHAFT_EFFECTS, knob_effects=TWISTSHAFT_KNOB_EFFECTS),
+}
+"""Named plants for ``--data-plant``/``--sim-plant``."""
+
+
+def parse_plant_spec(text: str) -> PlantSpec:
+    """A preset name, or ``module:factory`` optionally followed by ``@`` and a JSON object."""
+    text = text.strip()
+    if text in PRESETS:
+        return PRESETS[text]
+    factory, _, raw = text.partition("@")
+    if ":" not in factory:
+        raise GapError(f"plant {text!r}: give a preset ({', '.join(PRESETS)}) or "
+                       "module:factory[@{json parameters}]")
+    params: dict[str, Any] = {}
+    if raw:
+        try:
+            loaded = json.loads(raw)
+        except json.JSONDecodeError as exc:
+            raise GapError(f"plant {text!r}: parameters after '@' are not JSON: {exc}") from None
+        if not isinstance(loaded, dict):
+            raise GapError(f"plant {text!r}: parameters after '@' must be a JSON object")
+        params = loaded
+    load_plant(factory, params)  # fail early, with the loader's message
+    return PlantSpec(factory, params, (), text)

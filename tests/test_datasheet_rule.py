@@ -170,3 +170,27 @@ def test_the_knee_survives_the_sheets_yaml_and_a_bad_value_is_one_line() -> None
     with pytest.raises(ProfileError, match="phi2.backlash_knee: must be true or false") as err:
         device_model_from_mapping(mapping)
     assert "\n" not in str(err.value)
+
+
+def test_the_sheet_records_the_gain_its_chosen_rule_and_knee_read() -> None:
+    rules = [dataclasses.replace(scored("line", k, 50), backlash_gain=0.21) for k in (0, 1)]
+    rules += [dataclasses.replace(scored("swing", k, 40), backlash_gain=0.33) for k in (0, 1)]
+    knee = [dataclasses.replace(scored("knee", 0, 56), backlash_gain=0.25),
+            dataclasses.replace(scored("knee", 1, 30), backlash_gain=0.27)]
+    chosen = knee_choice(sheet(rule="line"), rules, knee)
+    assert [k.backlash_knee for k in chosen.knobs] == [True, None]
+    assert [k.reference_rule_backlash_gain for k in chosen.knobs] == [0.25, 0.21]
+
+
+def test_the_rule_gain_survives_the_sheets_yaml_and_a_bad_value_is_one_line() -> None:
+    base = sheet(rule="line")
+    knobs = (dataclasses.replace(base.knobs[0], reference_rule_backlash_gain=0.123),
+             base.knobs[1])
+    mapping = device_model_to_mapping(dataclasses.replace(base, knobs=knobs))
+    assert mapping["knobs"]["phi1"]["reference_rule_backlash_gain"] == 0.123
+    assert "reference_rule_backlash_gain" not in mapping["knobs"]["phi2"]
+    assert device_model_from_mapping(mapping).knobs[0].reference_rule_backlash_gain == 0.123
+    mapping["knobs"]["phi1"]["reference_rule_backlash_gain"] = 1.5
+    with pytest.raises(ProfileError, match="phi1.reference_rule_backlash_gain") as err:
+        device_model_from_mapping(mapping)
+    assert "\n" not in str(err.value)

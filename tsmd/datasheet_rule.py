@@ -20,10 +20,12 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from tsmd.calibration.protocol import fast_protocol
+from tsmd.calibration.tension_play_fit import fit_sweep_sides, sweeps_from_points
 from tsmd.config import TsmdConfig
 from tsmd.profile import DeviceKnob, DeviceModel
 from tsmd.profile.types import RELEASE_RULES
@@ -46,6 +48,9 @@ class RuleScore:
     max_deg: float
     accepted: int
     runs: int
+    backlash_gain: float | None = None
+    """The unit's backlash gain at the other knob's 0 with B by this candidate (mean over the
+    runs): the sheet's ``reference_rule_backlash_gain`` where this candidate is chosen."""
 
     def key(self) -> tuple[int, int]:
         """Better first: more values within the target, then more runs accepted (a refused
@@ -77,6 +82,23 @@ def usable(knob: DeviceKnob, rule: str) -> bool:
     return share is not None
 
 
+def rule_backlash_gain(points: Sequence[Any], knob: int) -> float | None:
+    """``knob``'s backlash gain with the other knob at 0 (mean of both sides) with B as the
+    points were identified, by the estimator every unit's tension play uses; None without such
+    a point or a load ramp to fit."""
+    mine = [p for p in points if p.knob == knob]
+    zero = [s for s in (sweeps_from_points(mine, knob) if mine else []) if s.other_knob_deg == 0]
+    if not zero:
+        return None
+    s = zero[0]
+    try:
+        sides = fit_sweep_sides(s.pos_deg, s.current_A, s.dead_zone_pos_deg, s.dead_zone_neg_deg,
+                                s.backlash_pos_deg, s.backlash_neg_deg)
+    except ValueError:
+        return None
+    return 0.5 * (sides[0].backlash_gain + sides[1].backlash_gain)
+
+
 def knob_errors(errors: Sequence[float], knob: int) -> np.ndarray:
     """One knob's share of :func:`score`'s values (knob 0's parameters first)."""
     n = len(errors) // 2
@@ -102,11 +124,13 @@ def scored(config: TsmdConfig, candidate: DeviceModel, label: str, truth: Truth,
     for knob in (0, 1):
         e = np.concatenate([knob_errors(r.errors, knob) for r in runs])
         finite = e[np.isfinite(e)]
+        gains = [g for g in (rule_backlash_gain(r.points, knob) for r in runs) if g is not None]
         out.append(RuleScore(
             label, knob, int(np.sum(finite <= TARGET_DEG)), e.size,
             float(np.mean(finite)) if finite.size else math.nan,
             float(np.max(finite)) if finite.size else math.nan,
-            sum(r.accepted for r in runs), len(runs)))
+            sum(r.accepted for r in runs), len(runs),
+            float(np.mean(gains)) if gains else None))
     return out
 
 
@@ -148,7 +172,21 @@ def knee_choice(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
         plain = [s for s in rule_scores_ if s.knob == knob and s.rule == k.backlash_release_rule]
         knee = [s for s in knee_scores if s.knob == knob]
         on.append(bool(plain and knee) and knee[0].key() <= plain[0].key())
-    return with_knee(chosen, (on[0], on[1]))
+    return with_rule_gains(with_knee(chosen, (on[0], on[1])), rule_scores_, knee_scores)
+
+
+def with_rule_gains(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
+                    knee_scores: Sequence[RuleScore]) -> DeviceModel:
+    """Each knob's ``reference_rule_backlash_gain``: the gain its chosen rule (with the knee
+    where chosen) read on the sheet's unit; none where that candidate gave none."""
+    knobs = []
+    for knob, k in enumerate(chosen.knobs):
+        pool = knee_scores if k.backlash_knee else [
+            s for s in rule_scores_ if s.rule == k.backlash_release_rule]
+        gains = [s.backlash_gain for s in pool if s.knob == knob and s.backlash_gain is not None]
+        gain = round(gains[0], 3) if gains else None
+        knobs.append(dataclasses.replace(k, reference_rule_backlash_gain=gain))
+    return dataclasses.replace(chosen, knobs=(knobs[0], knobs[1]))
 
 
 def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceModel:

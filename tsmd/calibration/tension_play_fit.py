@@ -11,14 +11,8 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   the turn) fitted by a line and extrapolated to the current that moves the knob the same way
   through the dead zone, where no tendon is loaded (friction and any sensor offset cancel);
 * ``beta = B_A / (A - x0)``: the backlash grows with the load, and the load with ``x - x0``;
-* the loaded slope ``omega``: per unit. The knob travel splits into tip motion and tendon
-  stretch; the stretch per degree of loaded tip motion is what the backlash gives back, so the
-  loaded slope is the release (kinematic) slope times ``1 - beta``. The release slope is a
-  product constant (pulley over moment arm), hence
-  ``omega_unit = omega_sheet (1 - beta_unit) / (1 - beta_sheet)`` with ``beta_sheet`` the
-  data-sheet unit's backlash gain from its own current (``reference_backlash_gain``, read with
-  the settle rule's B) and ``beta_unit`` read the same way (the same load ramps, the settle
-  rule's B), whatever B the play itself is fitted on; without it the data sheet's omega;
+* the loaded slope ``omega``: per unit, from the backlash gains the current shows against the
+  data-sheet unit's (:mod:`tsmd.calibration.unit_slope`);
 * the release line's slope: the locus of backlash ends has slope ``omega / (1 - beta)``, but
   where a product's release path after the backlash is shallower or steeper than that locus (a
   lumped catheter's is 7 % shallower; the current cannot see it: a released tendon's current is
@@ -56,9 +50,10 @@ from tsmd.calibration.fresh_hold import with_fresh_hold
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
 from tsmd.calibration.signal import Conditioned
+from tsmd.calibration.unit_slope import GainReading, gain_scatter, weighed_omega
 from tsmd.compensation.loaded_shape import curved, shaped_height
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
-from tsmd.compensation.tension_play import BETA_RANGE, OMEGA_RANGE, TensionPlayParams
+from tsmd.compensation.tension_play import BETA_RANGE, TensionPlayParams
 
 FloatArray = NDArray[np.float64]
 RAMP_START_DEG = 10.0
@@ -154,18 +149,6 @@ def fit_sweep_sides(pos_deg: FloatArray, current_A: FloatArray, dead_zone_pos_de
         zero = friction_current_A(pos, cur, dead_zone_pos_deg, dead_zone_neg_deg, sign)
         fits.append(fit_side(pos, cur, sign, float(d), float(b), zero))
     return fits[0], fits[1]
-
-
-def unit_omega(sheet_omega: float, sheet_backlash_gain: float | None, unit_backlash_gain: float
-               ) -> float:
-    """The unit's loaded slope: the product's release slope ``omega_sheet / (1 - beta_sheet)``
-    times the unit's ``1 - beta`` (its own stretch share); the sheet's omega without
-    ``beta_sheet``."""
-    if sheet_backlash_gain is None:
-        return float(sheet_omega)
-    lo, hi = OMEGA_RANGE
-    w = sheet_omega * (1.0 - unit_backlash_gain) / (1.0 - sheet_backlash_gain)
-    return min(max(float(w), lo), hi)
 
 
 FAR_ZERO_LOAD_DEG = 89.0
@@ -289,8 +272,7 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                            if s.lag_s is None else s.lag_s for s in order]))
     beta_pos = smoothed_gains(grid, [f.backlash_gain for f in pos_fits])
     beta_neg = smoothed_gains(grid, [f.backlash_gain for f in neg_fits])
-    omega = unit_omega(float(k.omega), getattr(k, "reference_backlash_gain", None),
-                       settle_rule_gain(grid, order, pos_fits, neg_fits, (beta_pos, beta_neg)))
+    omega = loaded_slope(k, grid, order, pos_fits, neg_fits)
     ratio = release_slope_ratio(k)
     sides = []
     for betas, fits in ((beta_pos, pos_fits), (beta_neg, neg_fits)):
@@ -318,23 +300,44 @@ def smoothed_gains(grid: Sequence[float], gains: Sequence[float]) -> list[float]
     return [clamped_gain(b) for b in smooth_over_grid(grid, gains)]
 
 
-def settle_rule_gain(grid: Sequence[float], sweeps: Sequence[SweepCurrent],
-                     pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit],
-                     betas: tuple[Sequence[float], Sequence[float]]) -> float:
-    """This unit's backlash gain at the other knob's 0 (mean of both sides) as the data sheet's
-    ``reference_backlash_gain`` is read: the settle rule's B over the same load ramps, smoothed
-    as the play's ``betas`` (which it is where the sweeps carry no other, or a non-finite, B).
-    A gain read with another rule than the sheet's would move omega by the rules' difference,
-    not the unit's stretch (session 12: variant (c), a product-rule gain on both sides, lost
-    on segments what it won on coilpipe)."""
+def gain_reading(sheet_gain: float, grid: Sequence[float], pos: Sequence[float],
+                 neg: Sequence[float]) -> GainReading:
+    """This unit's gains by one rule, smoothed over the grid and read at the other knob's 0
+    (where the sheet measured its gain; mean of both sides), with their raw scatter."""
+    at_zero = 0.5 * (at_other_knob_zero(grid, smoothed_gains(grid, pos))
+                     + at_other_knob_zero(grid, smoothed_gains(grid, neg)))
+    return GainReading(sheet_gain, at_zero, gain_scatter(pos, neg))
+
+
+def settle_rule_gains(sweeps: Sequence[SweepCurrent], pos_fits: Sequence[SideFit],
+                      neg_fits: Sequence[SideFit]) -> tuple[list[float], list[float]]:
+    """Per side and sweep, the gain with the settle rule's B over the same load ramps (the
+    play's own gains where a sweep carries no other, or a non-finite, B)."""
     settle = [s.settle_backlash_deg for s in sweeps if s.settle_backlash_deg is not None]
     if len(settle) == len(sweeps) and np.isfinite(settle).all():
         pos, neg = ([clamped_gain(b[i] / abs(f.amplitude_deg - f.zero_load_deg))
                      for b, f in zip(settle, fits, strict=True)]
                     for i, fits in enumerate((pos_fits, neg_fits)))
-        betas = (smoothed_gains(grid, pos), smoothed_gains(grid, neg))
-    # the sheet measured its gain with the other knob at 0: compare the unit there
-    return 0.5 * (at_other_knob_zero(grid, betas[0]) + at_other_knob_zero(grid, betas[1]))
+        return pos, neg
+    return [f.backlash_gain for f in pos_fits], [f.backlash_gain for f in neg_fits]
+
+
+def loaded_slope(device_knob: Any, grid: Sequence[float], sweeps: Sequence[SweepCurrent],
+                 pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit]) -> float:
+    """The unit's omega (:mod:`tsmd.calibration.unit_slope`): each backlash gain the sheet
+    holds (the settle rule's, the product rule's) read on this unit with the same rule, the
+    readings weighed by their scatter against the sheet's omega; a sheet without a gain keeps
+    its omega."""
+    readings = []
+    settle_gain = getattr(device_knob, "reference_backlash_gain", None)
+    if settle_gain is not None:
+        readings.append(gain_reading(float(settle_gain), grid,
+                                     *settle_rule_gains(sweeps, pos_fits, neg_fits)))
+    rule_gain = getattr(device_knob, "reference_rule_backlash_gain", None)
+    if rule_gain is not None:
+        readings.append(gain_reading(float(rule_gain), grid, [f.backlash_gain for f in pos_fits],
+                                     [f.backlash_gain for f in neg_fits]))
+    return weighed_omega(float(device_knob.omega), readings)
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from tsmd.calibration.tension_play_fit import unit_omega
+from tsmd.calibration.unit_slope import unit_omega
 from tsmd.compensation.ours import MOVES_WITH_EDGE, OursKnob
 from tsmd.compensation.paper import PaperKnob
 from tsmd.compensation.tension_play import BETA_RANGE

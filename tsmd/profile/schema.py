@@ -119,7 +119,7 @@ def _check_references(r: _Reader, key: str, pos: ReferencePoint, neg: ReferenceP
 _SHAPE_KEYS = ("loaded_shape_pos", "loaded_shape_neg")
 _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
                   "backlash_release_slope_ratio", "reference_release_swing_A",
-                  "backlash_settle_lag_deg")
+                  "backlash_settle_lag_deg", "reference_rule_backlash_gain")
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_release_rule", "backlash_knee")
@@ -218,6 +218,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
                                                   "backlash_release_local_share", 0.5, 1.5, ""),
             backlash_release_rule=_release_rule(r, k, key),
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
+            reference_rule_backlash_gain=optional(k.get("reference_rule_backlash_gain"),
+                                                  "reference_rule_backlash_gain", 0.0, 0.8, ""),
             **{name: _shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS}))
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))

@@ -135,6 +135,11 @@ class DeviceKnob:
     release (stickslip, coilpipe) and too early where the current slows gradually (lumped), so
     ``tsmd datasheet`` turns it on only where it calibrates the sheet's own unit closer to its
     tracked tip (session 12). None or False: off."""
+    reference_rule_backlash_gain: float | None = None
+    """Optional: the data-sheet unit's backlash gain as ``reference_backlash_gain`` but with B
+    by the product's chosen rule and knee (fast calibrations of that unit, ``tsmd
+    datasheet``): method ours reads each unit's gain by that rule too and weighs both readings
+    by their scatter (:mod:`tsmd.calibration.unit_slope`, session 13)."""
 
 
 @dataclass(frozen=True)

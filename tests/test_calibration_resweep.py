@@ -68,6 +68,28 @@ def test_more_half_cycles_narrow_the_uncertainty() -> None:
     assert four.u95_deg < two.u95_deg
 
 
+def test_one_more_half_cycle_narrows_a_two_value_point_by_a_sixth() -> None:
+    # The point's value is a robust mean, not a median (whose third value would buy ~nothing).
+    two = estimate((20.0, 21.0), sigma_pool=0.7, pool_dof=6)
+    assert two.tip_cost_with_deg(1.32, 1) < 0.85 * two.tip_cost_deg(1.32)
+
+
+def test_one_stray_half_cycle_among_four_moves_the_value_by_little() -> None:
+    assert _result(backlash_pos_deg=(20.0, 28.0, 20.4, 19.8)).estimate(
+        "backlash_pos_deg") == pytest.approx(20.2, abs=0.6)
+
+
+def test_the_budget_goes_where_a_resweep_removes_most_tip_cost_not_to_the_worst_point() -> None:
+    swept = (14.0, 26.0, 16.0, 24.0, 20.0, 13.0, 27.0, 22.0)  # already swept 3 times
+    points = [GridPoint(0, -30.0, _result(backlash_pos_deg=(20.0, 26.0))),
+              GridPoint(0, 0.0, _result(backlash_pos_deg=swept)),
+              *(GridPoint(k, o, _result()) for k, o in ((0, 30.0), (1, -30.0), (1, 0.0)))]
+    todo = uncertain_points(points, omegas=(1.32, 1.32))
+    assert {u.index for u in todo} == {0, 1}
+    assert max(todo, key=lambda u: u.worst_tip_cost_deg).index == 1
+    assert todo[0].index == 0
+
+
 def test_a_parameter_no_half_cycle_gave_is_infinitely_uncertain() -> None:
     (est,) = point_estimates([_result(dead_zone_pos_deg=())])
     assert est["dead_zone_pos_deg"].n == 0
@@ -136,6 +158,28 @@ def test_a_sweep_that_disagrees_once_and_then_agrees_is_accepted(
     assert cal.profile.knobs[0].dead_zone_pos_deg[1] == pytest.approx(genuine, abs=1.0)
     assert abs(cal.profile.knobs[0].dead_zone_pos_deg[1] - bogus) > 4.0
     assert cal.sweep_time_s == pytest.approx(PROTO.sweep_time_s + 20.0 * len(cal.notes))
+
+
+def test_when_the_budget_is_spent_the_uncertain_point_is_reported_not_refused(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    real = run_module.identify_recording
+
+    def identify(rec, options=None, source="recording"):  # type: ignore[no-untyped-def]
+        point = real(rec, options, source)
+        if source.startswith(ODD):  # every sweep of ODD, re-sweeps too: cycles 10 deg apart
+            d = point.result.values["dead_zone_pos_deg"]
+            values = {**point.result.values, "dead_zone_pos_deg": (d[0], d[0] + 10.0)}
+            point = dataclasses.replace(point, result=dataclasses.replace(point.result,
+                                                                          values=values))
+        return point
+    monkeypatch.setattr(run_module, "identify_recording", identify)
+    runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
+    cal = run_calibration(runner, "cat-b", load_device_model(DEVICE),
+                          protocol=dataclasses.replace(PROTO, resweep_budget_s=20.0),
+                          limits=QualityLimits(refuse_tip_error_deg=10.0))
+    assert sum(note.startswith("re-sweep ") and "budget" not in note for note in cal.notes) == 1
+    assert any("budget (20 s) spent" in note and f"{ODD}: D_pos" in note for note in cal.notes)
+    assert any("dead_zone_pos_deg" in w for w in cal.quality.warnings)
 
 
 class _CancelOnRun(LockstepPlantRunner):

@@ -28,9 +28,12 @@ import numpy as np
 from scipy import stats
 
 from tsmd.calibration.identify import PARAMETERS, SweepResult
+from tsmd.calibration.signal import walsh_median
 
 MIN_ROBUST = 4
 """From this many half-cycles on, a sweep's own scatter is taken robustly (MAD)."""
+WALSH_EFFICIENCY = 0.955
+"""Variance of the mean over that of :func:`walsh_median`, normal scatter (3/pi)."""
 RESOLUTION_DEG = 0.25
 """One half-cycle's value cannot be surer than the identification's angle grid."""
 
@@ -43,10 +46,21 @@ class Estimate:
     u95_deg: float
     n: int
     spread_deg: float
+    sigma_deg: float = math.nan
+    """One half-cycle's scatter behind ``u95_deg`` (own and pooled, blended)."""
+    dof: int = 0
+    """Degrees of freedom of ``sigma_deg``."""
 
     def tip_cost_deg(self, omega: float) -> float:
         """What an error of ``u95_deg`` costs on the tip once compensated."""
         return abs(omega) * self.u95_deg
+
+    def tip_cost_with_deg(self, omega: float, more: int) -> float:
+        """The tip cost expected once ``more`` half-cycles of the same scatter are pooled in
+        (what a re-sweep would buy); infinite while no half-cycle gave a value."""
+        if self.n == 0 or not math.isfinite(self.sigma_deg):
+            return math.inf
+        return abs(omega) * half_width_deg(self.sigma_deg, self.n + more, self.dof + more)
 
 
 @dataclass(frozen=True)
@@ -62,6 +76,15 @@ class EstimateOptions:
     accuracy target of 2 knob deg at the simulated catheter's slope omega = 1.32, rounded up;
     on a steeper catheter the same knob uncertainty costs more and is swept again sooner."""
     min_sigma_deg: float = RESOLUTION_DEG
+
+
+def half_width_deg(sigma_deg: float, n: int, dof: int) -> float:
+    """95 % half-width of the robust mean (:func:`walsh_median`) of ``n`` half-cycles whose
+    scatter is ``sigma_deg``."""
+    t = float(stats.t.ppf(0.975, dof))
+    # From three values on it is a little less efficient than a mean (0.955 on normal scatter).
+    efficiency = math.sqrt(1.0 / WALSH_EFFICIENCY) if n >= 3 else 1.0
+    return t * efficiency * sigma_deg / math.sqrt(n)
 
 
 def _chi2_median_ratio(dof: int) -> float:
@@ -112,11 +135,8 @@ def estimate(values: Sequence[float], sigma_pool: float, pool_dof: int = 0,
     prior_var = sigma_pool ** 2 if k_prior else 0.0
     var = (k_own * own_var + k_prior * prior_var) / (k_own + k_prior)
     sigma = max(math.sqrt(var), opts.min_sigma_deg)
-    t = float(stats.t.ppf(0.975, k_own + k_prior))
-    # The median of three or more is a little less efficient than a mean (pi/2 in variance).
-    efficiency = math.sqrt(math.pi / 2.0) if v.size >= 3 else 1.0
-    return Estimate(float(np.median(v)), t * efficiency * sigma / math.sqrt(v.size),
-                    int(v.size), float(np.ptp(v)))
+    return Estimate(walsh_median(v), half_width_deg(sigma, v.size, k_own + k_prior),
+                    int(v.size), float(np.ptp(v)), sigma, k_own + k_prior)
 
 
 def point_estimates(results: Sequence[SweepResult],

@@ -51,7 +51,7 @@ from tsmd.calibration.release import (
     release_slope_ratio,
     release_swing,
 )
-from tsmd.calibration.signal import Conditioned, FloatArray, condition
+from tsmd.calibration.signal import Conditioned, FloatArray, condition, walsh_median
 
 PARAMETERS: tuple[str, ...] = (
     "dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_pos_deg", "backlash_neg_deg")
@@ -111,9 +111,8 @@ class SweepResult:
         return self.half_cycles[:self.own_half_cycles]
 
     def estimate(self, name: str) -> float:
-        """Median over the half-cycles (NaN when none gave a value)."""
-        v = self.values.get(name, ())
-        return float(np.median(v)) if v else math.nan
+        """The half-cycles' robust mean (:func:`walsh_median`; NaN when none gave a value)."""
+        return walsh_median(np.asarray(self.values.get(name, ()), dtype=float))
 
     def spread(self, name: str) -> float:
         """Largest minus smallest value over the half-cycles (0 with one value)."""

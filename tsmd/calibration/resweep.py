@@ -2,10 +2,12 @@
 
 After the protocol's sweeps, every parameter of every grid point has an estimate and a 95 %
 uncertainty (:mod:`tsmd.calibration.estimate`). A grid point where a parameter's uncertainty
-costs more than the gate allows on the tip, or where no half-cycle gave it, is swept again
-(``Protocol.resweep_cycles`` more cycles), worst first, while the protocol's re-sweep budget
+costs more than the gate allows on the tip, or where no half-cycle gave it, is a candidate for
+another sweep (``Protocol.resweep_cycles`` more cycles) while the protocol's re-sweep budget
 (``Protocol.resweep_budget_s`` of extra sweeping) lasts; the re-sweep's half-cycles are pooled
-with the first sweep's.
+with the first sweep's. The budget is small (the fast protocol's buys two cycles), so it goes
+where it removes the most tip cost over the gate, not to the worst point: a point already swept
+again gains less from a third sweep than one still on its first (its cost falls as 1/sqrt(n)).
 """
 
 from __future__ import annotations
@@ -29,6 +31,9 @@ class Uncertain:
     """Index into the list of grid points."""
     names: tuple[str, ...]
     worst_tip_cost_deg: float
+    gain_deg: float = math.inf
+    """Tip cost over the gate, summed over the point's parameters, that one more re-sweep is
+    expected to remove (infinite where a parameter has no value yet)."""
 
     def describe(self, points: Sequence[GridPoint]) -> str:
         return f"{points[self.index].name}: {', '.join(SHORT[n] for n in self.names)} uncertain"
@@ -40,9 +45,25 @@ def point_estimates(points: Sequence[GridPoint],
     return estimate_points([p.result for p in points], options)
 
 
+def resweep_gain_deg(estimates: dict[str, Estimate], omega: float, more: int,
+                     max_tip_error_deg: float) -> float:
+    """Tip cost over ``max_tip_error_deg`` that ``more`` half-cycles per parameter are expected
+    to remove, summed over the parameters (infinite where one has no value)."""
+    gain = 0.0
+    for e in estimates.values():
+        now = e.tip_cost_deg(omega)
+        if not math.isfinite(now):
+            return math.inf
+        after = e.tip_cost_with_deg(omega, more)
+        gain += max(now - max_tip_error_deg, 0.0) - max(after - max_tip_error_deg, 0.0)
+    return gain
+
+
 def uncertain_points(points: Sequence[GridPoint], omegas: Sequence[float],
-                     options: EstimateOptions | None = None) -> list[Uncertain]:
-    """Grid points the gate does not accept, the costliest on the tip first."""
+                     options: EstimateOptions | None = None,
+                     more_half_cycles: int = 1) -> list[Uncertain]:
+    """Grid points the gate does not accept, the one a re-sweep of ``more_half_cycles`` per
+    parameter helps most first (ties: the costliest)."""
     opts = options or EstimateOptions()
     found = []
     for i, est in enumerate(point_estimates(points, opts)):
@@ -51,8 +72,18 @@ def uncertain_points(points: Sequence[GridPoint], omegas: Sequence[float],
         bad = tuple(n for n, c in costs.items() if not c <= opts.max_tip_error_deg)
         if bad:
             worst = max(costs[n] for n in bad)
-            found.append(Uncertain(i, bad, worst if math.isfinite(worst) else math.inf))
-    return sorted(found, key=lambda u: -u.worst_tip_cost_deg)
+            gain = resweep_gain_deg(est, omega, more_half_cycles, opts.max_tip_error_deg)
+            found.append(Uncertain(i, bad, worst if math.isfinite(worst) else math.inf, gain))
+    return sorted(found, key=lambda u: (-u.gain_deg, -u.worst_tip_cost_deg))
+
+
+def budget_spent_note(points: Sequence[GridPoint], todo: Sequence[Uncertain],
+                      budget_s: float) -> str:
+    """One line: the re-sweep budget is spent and these grid points are still over the gate
+    (the quality check then warns or refuses by their tip cost)."""
+    still = "; ".join(f"{u.describe(points)} (up to {u.worst_tip_cost_deg:.1f} deg on the tip)"
+                      for u in todo)
+    return f"re-sweep budget ({budget_s:.0f} s) spent; still over the gate: {still}"
 
 
 def pooled(point: GridPoint, again: GridPoint) -> GridPoint:

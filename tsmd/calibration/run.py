@@ -45,7 +45,12 @@ from tsmd.calibration.player import (
 )
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import paper_protocol, sweep_run
-from tsmd.calibration.resweep import pool_repeats, pooled, uncertain_points
+from tsmd.calibration.resweep import (
+    budget_spent_note,
+    pool_repeats,
+    pooled,
+    uncertain_points,
+)
 from tsmd.calibration.tension_play_fit import with_prefit, with_tension_play
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
@@ -173,6 +178,8 @@ class SweepRuns:
     """Extra sweeping spent on re-sweeps (within the protocol's budget)."""
     resweeps: list[str] = field(default_factory=list)
     """One line per re-sweep: which grid point and why."""
+    budget_note: str = ""
+    """Which grid points were still over the gate when the budget ran out (empty: none)."""
 
 
 def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceModel, *,
@@ -202,6 +209,8 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
                               proto.sweep_time_s + runs.resweep_time_s, runs.motion_time_s,
                               runs.wall_time_s)
     calibration.notes.extend(runs.resweeps)
+    if runs.budget_note:
+        calibration.notes.append(runs.budget_note)
     return calibration
 
 
@@ -236,6 +245,7 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
     tracker = Progress(progress, [len(r.q_deg) * period_s for r in plan])
     resweep_s = 0.0
     notes: list[str] = []
+    budget_note = ""
     try:
         for i, planned in enumerate(plan):
             tracker.begin(i, planned.sweep.label)
@@ -245,11 +255,13 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
             identifier.check()  # a sweep that cannot be identified stops the protocol early
         points = identifier.results()
         while omegas is not None:
-            todo = uncertain_points(points, omegas, estimate)
+            todo = uncertain_points(points, omegas, estimate,
+                                    max(1, math.floor(proto.resweep_cycles)))
             if not todo:
                 break
             again = proto.resweep(plan[todo[0].index].sweep)
             if resweep_s + again.duration_s > proto.resweep_budget_s + 1e-6:
+                budget_note = budget_spent_note(points, todo, proto.resweep_budget_s)
                 break
             why = todo[0].describe(points)
             notes.append(f"re-sweep {len(notes) + 1}: {why}; {again.cycles:g} more cycles")
@@ -267,7 +279,8 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
             raise CalibrationCancelledError(f"{exc}; knobs returned to 0, nothing saved") from None
         raise
     identifier.close()
-    return SweepRuns(points, player.motion_s, time.monotonic() - wall0, resweep_s, notes)
+    return SweepRuns(points, player.motion_s, time.monotonic() - wall0, resweep_s, notes,
+                     budget_note)
 
 
 def _identify_detached(rec: Recording, options: KnobOptions, label: str,

@@ -42,6 +42,19 @@ def robust_sigma(x: FloatArray) -> float:
     return float(1.4826 * np.median(np.abs(x - np.median(x))))
 
 
+def walsh_median(values: FloatArray) -> float:
+    """Hodges-Lehmann location: the median of every pair's mean (each value with itself
+    included). As efficient as the mean on normal scatter (95 %), where the median of a few
+    half-cycles wastes a third of them (a re-sweep's third value would barely narrow it), and
+    still robust: one stray value among four moves it by a fraction of its distance. NaN when
+    empty."""
+    v = np.asarray(values, dtype=float)
+    if v.size == 0:
+        return float("nan")
+    i, j = np.triu_indices(v.size)
+    return float(np.median(0.5 * (v[i] + v[j])))
+
+
 def white_noise_sigma(x: FloatArray) -> float:
     """Noise level of a signal with a smooth trend, from its first differences."""
     if x.size < 3:

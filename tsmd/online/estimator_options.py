@@ -33,6 +33,11 @@ class EstimatorOptions:
     """A crossing inward beyond the gate while the friction rose (the knob's slope change, or
     this ramp's slope against the slope in use, beyond ``slope_in_use_tolerance``) measures
     nothing, as the knee does in knee mode (session 12, stickslip 101 phi2; docs/online.md)."""
+    fresh_agreement: bool = True
+    """Both edges of a knob agree only on suspects each taken after the other edge's last
+    measurement within the gate (:meth:`EdgeTracker.agrees_with`; session 13, lumped 102
+    without a change). Off: any two last suspects within ``confirm_spread_deg`` (until
+    session 12)."""
     pooled_slope_change: bool = True
     """The slope in use (and the gain from it, and the bend share) moves with the median of
     both tendons' last ramps' slope ratios, not with one edge's change as far as the other's

@@ -384,11 +384,8 @@ class EdgeTracker:
     def agrees_with(self, other: EdgeTracker) -> bool:
         """Both edges of a knob have a suspect and they agree: the knob's shape changed (a
         slack or curvature change moves both tendons' edges outward together; a spike does not
-        hit both tendons' ramps alike). With :attr:`EstimatorOptions.fresh_agreement`, a
-        suspect older than the other edge's last measurement within the gate agrees with
-        nothing: that edge read where it was after it, so no change moved both (lumped 102
-        without a change: one ramp 2.2 deg out on each tendon, 12 s apart with an ordinary
-        one between, made a 2.4 deg "change" followed and undone 17 s later)."""
+        hit both tendons' ramps alike); with ``fresh_agreement`` only suspects each newer
+        than the other edge's last reading within the gate (that edge read where it was)."""
         fresh = not self.options.fresh_agreement or (
             self.suspect_order > other.accepted_order
             and other.suspect_order > self.accepted_order)

@@ -410,7 +410,7 @@ def test_an_inward_crossing_on_a_steeper_ramp_measures_nothing() -> None:
 
 
 def test_without_the_rule_a_steeper_ramp_moves_the_edge_inward() -> None:
-    tracker, partner = learned(), learned()
+    tracker, partner = learned(EstimatorOptions(refuse_inward_on_steeper=False)), learned()
     for _ in range(2):
         tracker.update(steeper_at_the_same_edge(1.13), EDGE_DEG, partner)
     assert tracker.applied_deg < -1.5

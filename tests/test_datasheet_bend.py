@@ -11,7 +11,7 @@ from test_online_bend import bent_by, fake_profile
 
 from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.config import default_sim_config
-from tsmd.datasheet_bend import bend_relation, rig_calibration
+from tsmd.datasheet_bend import bend_relation, rig_calibration, sheet_with_bend
 from tsmd.errors import TsmdError
 from tsmd.online.bend import BendRelation, sheet_bend_relation, with_bend_relation
 from tsmd.profile import device_model_from_mapping, device_model_to_mapping, load_device_model
@@ -45,3 +45,20 @@ def test_a_plant_that_cannot_bend_is_refused_in_one_line() -> None:
     with pytest.raises(TsmdError, match="--bend-relation: .*cannot change shape") as err:
         run(30.0)
     assert "\n" not in str(err.value)
+
+
+def test_a_product_whose_bends_move_no_edge_keeps_its_sheet_without_a_relation() -> None:
+    device = load_device_model(DEVICE)
+    kept, line = sheet_with_bend(device, lambda bend_deg: fake_profile(20.0, 5.0, 0.3))
+    assert kept == device and sheet_bend_relation(kept) is None
+    assert line.startswith("no bend relation on the sheet") and "\n" not in line
+
+
+def test_the_sheet_gets_the_relation_its_bends_give() -> None:
+    def calibrate_bent(bend_deg: float) -> Any:
+        return fake_profile(20.0, 5.0, 0.3) if bend_deg == 0.0 else bent_by(
+            bend_deg / 10.0, bend_deg / 12.0, 1.0 + 0.006 * bend_deg)
+
+    device, line = sheet_with_bend(load_device_model(DEVICE), calibrate_bent)
+    assert sheet_bend_relation(device) == BendRelation(1.2, 0.06)
+    assert line.startswith("bend relation on the sheet's unit")

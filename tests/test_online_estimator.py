@@ -115,6 +115,24 @@ def test_both_edges_of_a_knob_agreeing_confirm_a_change_at_once() -> None:
     assert pos.applied_deg == pytest.approx(4.0)
 
 
+def test_a_suspect_older_than_the_other_edges_ordinary_reading_agrees_with_nothing() -> None:
+    pos, neg = learned(), learned()
+    neg.update(ramp_with_edge(EDGE_DEG + 2.2), EDGE_DEG)
+    pos.update(ramp_with_edge(EDGE_DEG + 0.3), EDGE_DEG)  # this edge read where it was after
+    pos.update(ramp_with_edge(EDGE_DEG + 2.4), EDGE_DEG)
+    assert pos.suspects and neg.suspects
+    assert not pos.agrees_with(neg) and not neg.agrees_with(pos)
+
+
+def test_without_fresh_agreement_a_suspect_before_the_other_edges_reading_agrees() -> None:
+    options = EstimatorOptions(fresh_agreement=False)
+    pos, neg = learned(options), learned(options)
+    neg.update(ramp_with_edge(EDGE_DEG + 2.2), EDGE_DEG)
+    pos.update(ramp_with_edge(EDGE_DEG + 0.3), EDGE_DEG)
+    pos.update(ramp_with_edge(EDGE_DEG + 2.4), EDGE_DEG)
+    assert pos.agrees_with(neg)
+
+
 def test_edges_of_a_knob_that_disagree_confirm_nothing() -> None:
     pos, neg = learned(), learned()
     pos.update(ramp_with_edge(EDGE_DEG + 4.0), EDGE_DEG)
@@ -392,7 +410,7 @@ def test_an_inward_crossing_on_a_steeper_ramp_measures_nothing() -> None:
 
 
 def test_without_the_rule_a_steeper_ramp_moves_the_edge_inward() -> None:
-    tracker, partner = learned(), learned()
+    tracker, partner = learned(EstimatorOptions(refuse_inward_on_steeper=False)), learned()
     for _ in range(2):
         tracker.update(steeper_at_the_same_edge(1.13), EDGE_DEG, partner)
     assert tracker.applied_deg < -1.5

@@ -22,7 +22,8 @@ from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.calibration.run import calibrate
 from tsmd.config import TsmdConfig
 from tsmd.errors import TsmdError
-from tsmd.online.bend import BendRelation, measure_bend_relation
+from tsmd.online.apply import OnlineError
+from tsmd.online.bend import BendRelation, measure_bend_relation, with_bend_relation
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.replay import LockstepRunner
 
@@ -49,6 +50,23 @@ def bend_relation(calibrate_bent: CalibrateBent,
     return measure_bend_relation(straight, bent)
 
 
+def sheet_with_bend(device: DeviceModel, calibrate_bent: CalibrateBent,
+                    bends_deg: Sequence[float] = BENDS_DEG) -> tuple[DeviceModel, str]:
+    """The sheet with the product's relation and a line saying what it is; a product whose
+    bends move no edge (stickslip unit 0, session 13: 0.5 deg nowhere) has none, and the sheet
+    measured before it is kept without one rather than lost (the daemon then moves x0 with
+    the edge, as for any sheet without a relation)."""
+    try:
+        bend = bend_relation(calibrate_bent, bends_deg)
+    except OnlineError as exc:
+        return device, f"no bend relation on the sheet: {exc}"
+    return with_bend_relation(device, bend), (
+        f"bend relation on the sheet's unit (straight and "
+        f"{'/'.join(f'{b:g}' for b in bends_deg)} deg): release line "
+        f"{bend.release_per_edge:.3f} deg per edge deg, beta x (1 + "
+        f"{bend.gain_per_release_deg:.4f} per release deg)")
+
+
 def rig_calibration(factory: Callable[[], Plant], device: DeviceModel, config: TsmdConfig,
                     seed: int = BEND_SEED) -> CalibrateBent:
     """Calibrations of the simulated rig's plant under ``device``'s sheet, bent on demand."""
@@ -66,4 +84,5 @@ def rig_calibration(factory: Callable[[], Plant], device: DeviceModel, config: T
     return run
 
 
-__all__ = ["BENDS_DEG", "BEND_SEED", "CalibrateBent", "bend_relation", "rig_calibration"]
+__all__ = ["BENDS_DEG", "BEND_SEED", "CalibrateBent", "bend_relation", "rig_calibration",
+           "sheet_with_bend"]

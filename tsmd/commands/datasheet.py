@@ -32,7 +32,7 @@ from tsmd.datasheet import (
     readable,
     swept_knob,
 )
-from tsmd.datasheet_bend import BENDS_DEG, bend_relation, rig_calibration
+from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
 from tsmd.datasheet_rule import (
     RULE_NOISE_SEEDS,
     choose_knee,
@@ -40,7 +40,6 @@ from tsmd.datasheet_rule import (
     rule_scores,
     sheet_truth,
 )
-from tsmd.online.bend import with_bend_relation
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.recording import read_recording
 
@@ -137,13 +136,12 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
 
 def _with_bend(device: DeviceModel, config: TsmdConfig,
                factory: Callable[[], Plant]) -> DeviceModel:
-    """The sheet with the product's bend relation, from its unit calibrated straight and bent."""
+    """The sheet with the product's bend relation, from its unit calibrated straight and bent
+    (without one, said in one line, when no bend moved an edge)."""
     t0 = time.monotonic()
-    bend = bend_relation(rig_calibration(factory, device, config))
-    print(f"bend relation on the sheet's unit (straight and {'/'.join(f'{b:g}' for b in BENDS_DEG)}"
-          f" deg): release line {bend.release_per_edge:.3f} deg per edge deg, beta x (1 + "
-          f"{bend.gain_per_release_deg:.4f} per release deg); {time.monotonic() - t0:.0f} s")
-    return with_bend_relation(device, bend)
+    device, line = sheet_with_bend(device, rig_calibration(factory, device, config))
+    print(f"{line}; {time.monotonic() - t0:.0f} s")
+    return device
 
 
 def _or_none(value: float | None, decimals: int) -> str:

@@ -22,6 +22,7 @@ coupling the profile knows is not mistaken for a change).
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from statistics import median
@@ -31,6 +32,9 @@ from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
 from tsmd.online.slopes import common_change, pooled_change, shrunk_ratio
+
+_ORDER = itertools.count()
+"""One order over every tracker's measurements, so two edges can tell whose came first."""
 
 
 @dataclass
@@ -89,6 +93,10 @@ class EdgeTracker:
     """Crossings inward beyond the gate while the friction rose: no measurement taken."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
+    suspect_order: int = -1
+    """When (:data:`_ORDER`) the last suspect was taken; -1: none yet."""
+    accepted_order: int = -1
+    """When the last measurement within the gate was taken (the edge read where it was)."""
     bins: OtherKnobBins = field(init=False)
     """Where the edge reads against the other knob's angle (:mod:`tsmd.online.other_knob`)."""
     _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
@@ -355,6 +363,7 @@ class EdgeTracker:
         self.last_measurement_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()
+            self.accepted_order = next(_ORDER)
             key = self.bins.key(other_deg)
             learned = self.bins.learned(key)
             self.bins.teach(key, raw_deg - self.estimate_deg)
@@ -366,6 +375,7 @@ class EdgeTracker:
                 [*self.accepted, *[self.level_deg] * (o.window - len(self.accepted))])
         else:
             self.suspects = [*self.suspects, m][-o.confirm:]
+            self.suspect_order = next(_ORDER)
             if len(self.suspects) >= o.confirm and (max(self.suspects) - min(self.suspects)
                                                     <= o.confirm_spread_deg):
                 events += self.follow(median(self.suspects), "consecutive ramps agree")
@@ -374,9 +384,13 @@ class EdgeTracker:
     def agrees_with(self, other: EdgeTracker) -> bool:
         """Both edges of a knob have a suspect and they agree: the knob's shape changed (a
         slack or curvature change moves both tendons' edges outward together; a spike does not
-        hit both tendons' ramps alike)."""
+        hit both tendons' ramps alike); with ``fresh_agreement`` only suspects each newer
+        than the other edge's last reading within the gate (that edge read where it was)."""
+        fresh = not self.options.fresh_agreement or (
+            self.suspect_order > other.accepted_order
+            and other.suspect_order > self.accepted_order)
         return (bool(self.suspects) and bool(other.suspects) and self.frozen_for == 0
-                and other.frozen_for == 0
+                and other.frozen_for == 0 and fresh
                 and abs(self.suspects[-1] - other.suspects[-1]) <= self.options.confirm_spread_deg)
 
     def follow(self, new_deg: float, why: str, feature: str = ""

@@ -29,10 +29,17 @@ class EstimatorOptions:
     moves its edges +2.75..+3.4 deg; with the change shrunk to none the crossing, 15 deg out,
     read ~2 deg short and the ramps beyond 15 % measured nothing (lumped 1, 2: offsets
     0-1.8 deg; docs/online.md, Session 10)."""
-    refuse_inward_on_steeper: bool = False
+    refuse_inward_on_steeper: bool = True
     """A crossing inward beyond the gate while the friction rose (the knob's slope change, or
     this ramp's slope against the slope in use, beyond ``slope_in_use_tolerance``) measures
-    nothing, as the knee does in knee mode (session 12, stickslip 101 phi2; docs/online.md)."""
+    nothing, as the knee does in knee mode (session 12, stickslip 101 phi2). On since session
+    13: with ``fresh_agreement`` the one run it made worse (lumped 102 without a change) is
+    the same with it, and stickslip 104's bend went from 2.02 to 1.02 x fresh (docs/online.md)."""
+    fresh_agreement: bool = True
+    """Both edges of a knob agree only on suspects each taken after the other edge's last
+    measurement within the gate (:meth:`EdgeTracker.agrees_with`; session 13, lumped 102
+    without a change). Off: any two last suspects within ``confirm_spread_deg`` (until
+    session 12)."""
     pooled_slope_change: bool = True
     """The slope in use (and the gain from it, and the bend share) moves with the median of
     both tendons' last ramps' slope ratios, not with one edge's change as far as the other's

@@ -9,7 +9,9 @@ import pytest
 
 from simrig.family import PLANT_SPECS
 from simrig.scenario import ShapeChange
+from tsmd.bench import online
 from tsmd.bench.online import add_arguments, make_unit, mixed_motion, reversal_times, shape_change
+from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.errors import TsmdError
 
 
@@ -36,13 +38,7 @@ def test_mixed_motion_stays_inside_the_knob_range_and_starts_at_rest() -> None:
     assert len(reversal_times(t, q[:, 0], 0.0)) >= 20
 
 
-def test_a_unit_whose_calibration_is_refused_is_one_line_and_the_bench_goes_on(
-        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    import argparse
-
-    from tsmd.bench import online
-    from tsmd.calibration.errors import CalibrationRefusedError
-
+def _all_refused(monkeypatch: pytest.MonkeyPatch) -> int:
     def refused(unit: int, *_: object) -> dict[str, object]:
         raise CalibrationRefusedError(f"calibration refused (unit {unit}): too uncertain", [])
 
@@ -52,9 +48,21 @@ def test_a_unit_whose_calibration_is_refused_is_one_line_and_the_bench_goes_on(
     monkeypatch.setattr(online, "drift_unit", refused)
     parser = argparse.ArgumentParser()
     online.add_arguments(parser)
-    assert online.main(parser.parse_args(["--units", "7,8", "--drift-s", "10"])) == 0
-    lines = [ln for ln in capsys.readouterr().out.splitlines() if "refused" in ln]
+    return online.main(parser.parse_args(["--units", "7,8", "--drift-s", "10"]))
+
+
+def test_a_unit_whose_calibration_is_refused_is_one_line_and_the_bench_goes_on(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    _all_refused(monkeypatch)
+    lines = [ln for ln in capsys.readouterr().out.splitlines()
+             if ln.startswith("| ") and "refused" in ln]
     assert len(lines) == 4 and "| 7 |" in lines[0] and "| 8 |" in lines[1]
+
+
+def test_a_bench_that_scored_no_unit_says_so_and_fails(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    assert _all_refused(monkeypatch) == 1
+    assert "no unit scored" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("plant", sorted(PLANT_SPECS))

@@ -288,6 +288,7 @@ def main(args: argparse.Namespace) -> int:
     med, p99, top = hot_path_us()
     print(f"hot path (loop-side observe, two knobs): median {med:.2f} us, p99 {p99:.2f} us, "
           f"max {top:.1f} us")
+    refused_all = False
     if not args.no_change:
         print(f"\nshape change {args.change} at {args.change_at:g} s; RMSE from each knob's "
               f"{REVERSALS}th reversal after it to {args.after_s:g} s after it (tip deg)\n")
@@ -321,7 +322,12 @@ def main(args: argparse.Namespace) -> int:
                   f"{r['max_before_deg']:.2f}; on/fresh per reversal "
                   f"interval phi1 / phi2: {trend}; {len(r['events'])} warnings; "
                   f"3 runs {r['wall_s']:.0f} s wall | | | | | | | |", flush=True)
-        ratios = [r for r in ratios if math.isfinite(r)] or [math.nan]
+        scored = [r for r in ratios if math.isfinite(r)]
+        if not scored:
+            print("\non / fresh: no unit scored (every calibration before or after the change "
+                  "was refused: see the table)")
+            refused_all = True
+        ratios = scored or [math.nan]
         before_ratios = before_ratios or [math.nan]
         print(f"\non / fresh: mean {np.mean(ratios):.2f}, worst {max(ratios):.2f} "
               f"(target <= 1.2); on / before: mean {np.mean(before_ratios):.2f}, worst "
@@ -350,4 +356,4 @@ def main(args: argparse.Namespace) -> int:
             for w in d["warnings"]:
                 print(f"|   | warning at {w['t']:.0f} s: {w['event']} {w.get('reason', '')} "
                       "| | | | | | |")
-    return 0
+    return 1 if refused_all else 0

@@ -26,6 +26,7 @@ from tsmd.calibration import (
 )
 from tsmd.calibration import run as run_module
 from tsmd.calibration.assemble import GridPoint, check_quality
+from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.calibration.estimate import estimate, point_estimates, pooled_sigma
 from tsmd.calibration.identify import PARAMETERS, HalfCycle, SweepResult
 from tsmd.calibration.protocol import fast_protocol, paper_protocol
@@ -119,9 +120,9 @@ def test_the_fast_protocol_with_its_whole_budget_stays_within_a_third_of_the_pap
     assert fast.resweep_budget_s >= fast.resweep(fast.sweeps[0]).duration_s
 
 
-def _disagree_once(monkeypatch: pytest.MonkeyPatch) -> list[str]:
-    """The first identification of ODD finds its cycles 8 deg apart on D_pos; later ones are
-    what the sweep really shows."""
+def _disagree_once(monkeypatch: pytest.MonkeyPatch, apart_deg: float = 8.0) -> list[str]:
+    """The first identification of ODD finds its cycles ``apart_deg`` apart on D_pos; later
+    ones are what the sweep really shows."""
     seen: list[str] = []
     real = run_module.identify_recording
 
@@ -130,7 +131,7 @@ def _disagree_once(monkeypatch: pytest.MonkeyPatch) -> list[str]:
         seen.append(source)
         if source == ODD and seen.count(ODD) == 1:
             d = point.result.values["dead_zone_pos_deg"]
-            values = {**point.result.values, "dead_zone_pos_deg": (d[0], d[0] + 8.0)}
+            values = {**point.result.values, "dead_zone_pos_deg": (d[0], d[0] + apart_deg)}
             point = dataclasses.replace(point, result=dataclasses.replace(point.result,
                                                                           values=values))
         return point
@@ -180,6 +181,30 @@ def test_when_the_budget_is_spent_the_uncertain_point_is_reported_not_refused(
     assert sum(note.startswith("re-sweep ") and "budget" not in note for note in cal.notes) == 1
     assert any("budget (20 s) spent" in note and f"{ODD}: D_pos" in note for note in cal.notes)
     assert any("dead_zone_pos_deg" in w for w in cal.quality.warnings)
+
+
+def test_a_point_that_would_refuse_is_swept_again_beyond_the_budget(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    seen = _disagree_once(monkeypatch, 30.0)
+    runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
+    cal = run_calibration(runner, "cat-s", load_device_model(DEVICE),
+                          protocol=dataclasses.replace(PROTO, resweep_budget_s=0.0,
+                                                       rescue_budget_s=40.0),
+                          limits=QualityLimits(refuse_tip_error_deg=5.0))
+    assert seen.count(ODD) == 2
+    assert any(f"{ODD}: D_pos" in n and "it would refuse the calibration" in n
+               for n in cal.notes)
+
+
+def test_without_a_rescue_budget_the_point_that_would_refuse_is_refused(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    _disagree_once(monkeypatch, 30.0)
+    runner = LockstepPlantRunner(make_tendon_sheath_plant(), PERIOD_S)
+    with pytest.raises(CalibrationRefusedError, match="dead_zone_pos_deg"):
+        run_calibration(runner, "cat-n", load_device_model(DEVICE),
+                        protocol=dataclasses.replace(PROTO, resweep_budget_s=0.0,
+                                                     rescue_budget_s=0.0),
+                        limits=QualityLimits(refuse_tip_error_deg=5.0))
 
 
 class _CancelOnRun(LockstepPlantRunner):

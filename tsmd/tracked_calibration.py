@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import PchipInterpolator
 
 from simrig.plant import Plant, PlantStep, as_plant_step, load_plant
-from tsmd.calibration.assemble import GridPoint
+from tsmd.calibration.assemble import GridPoint, QualityLimits
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.identify import PARAMETERS
 from tsmd.calibration.player import sweep_metadata
@@ -100,7 +100,8 @@ def play_protocol(config: TsmdConfig, device: DeviceModel, proto: Protocol, nois
                             plant=wrap(plant) if wrap else plant) as runner:
             if inject is not None:
                 inject(runner)
-            runs = run_sweeps(runner, proto, options=device_options(None, device), omegas=omegas)
+            runs = run_sweeps(runner, proto, options=device_options(None, device), omegas=omegas,
+                              refuse_tip_error_deg=QualityLimits().refuse_tip_error_deg)
         finish("bench", device, runs.points, amplitude_deg=90.0)
         accepted, reason = True, ""
     except CalibrationError as exc:

@@ -72,6 +72,12 @@ def _two_speed_stroke(amplitude_deg: float) -> tuple[NDArray[np.float64], NDArra
     return x, cum / cum[-1]
 
 
+RESCUE_BUDGET_S = 100.0
+"""Six one-cycle re-sweeps of the fast protocol (0.06 Hz): what a calibration may add to avoid
+a refusal (screwrod, session 13: half-cycles 4 deg apart refused 2 of 4 healthy units with no
+re-sweep of the refused points, the budget spent elsewhere)."""
+
+
 @dataclass(frozen=True)
 class Protocol:
     """An ordered list of sweeps plus how the knobs move between them."""
@@ -84,6 +90,10 @@ class Protocol:
     """Cycles of a re-sweep of a grid point whose estimates are too uncertain."""
     resweep_budget_s: float = 0.0
     """Extra sweeping allowed for re-sweeps, in seconds (0: none)."""
+    rescue_budget_s: float = RESCUE_BUDGET_S
+    """Sweeping beyond ``resweep_budget_s``, spent only on grid points whose uncertainty would
+    otherwise refuse the calibration: a refused healthy catheter leaves the robot unusable, a
+    minute more of sweeping does not."""
 
     def resweep(self, sweep: Sweep) -> Sweep:
         """The sweep that measures ``sweep``'s grid point again."""
@@ -91,7 +101,8 @@ class Protocol:
 
     @property
     def max_sweep_time_s(self) -> float:
-        """Sweeping including the whole re-sweep budget: the protocol's worst case."""
+        """Sweeping including the whole re-sweep budget: the protocol's worst case for a catheter
+        it accepts without the rescue budget (spent only where a refusal would follow)."""
         return self.sweep_time_s + self.resweep_budget_s
 
     @property

@@ -77,6 +77,12 @@ def uncertain_points(points: Sequence[GridPoint], omegas: Sequence[float],
     return sorted(found, key=lambda u: (-u.gain_deg, -u.worst_tip_cost_deg))
 
 
+def refusing(todo: Sequence[Uncertain], refuse_tip_error_deg: float) -> list[Uncertain]:
+    """The uncertain points that would refuse the calibration, the costliest on the tip first."""
+    return sorted((u for u in todo if u.worst_tip_cost_deg > refuse_tip_error_deg),
+                  key=lambda u: -u.worst_tip_cost_deg)
+
+
 def budget_spent_note(points: Sequence[GridPoint], todo: Sequence[Uncertain],
                       budget_s: float) -> str:
     """One line: the re-sweep budget is spent and these grid points are still over the gate

@@ -49,6 +49,7 @@ from tsmd.calibration.resweep import (
     budget_spent_note,
     pool_repeats,
     pooled,
+    refusing,
     uncertain_points,
 )
 from tsmd.calibration.tension_play_fit import with_prefit, with_tension_play
@@ -202,7 +203,8 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
     runs = run_sweeps(runner, proto, progress=progress, cancel=cancel,
                       options=device_options(options, device), isolate=isolate,
                       live_loop=live_loop, omegas=omegas,
-                      estimate=(limits or QualityLimits()).estimate)
+                      estimate=(limits or QualityLimits()).estimate,
+                      refuse_tip_error_deg=(limits or QualityLimits()).refuse_tip_error_deg)
     profile, report = finish(catheter_id, device, runs.points, limits=limits,
                              amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
     calibration = Calibration(profile, runs.points, report, proto.name,
@@ -219,10 +221,12 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
                options: KnobOptions = None, isolate: bool = False,
                live_loop: bool = True,
                omegas: Sequence[float] | None = None,
-               estimate: EstimateOptions | None = None) -> SweepRuns:
+               estimate: EstimateOptions | None = None,
+               refuse_tip_error_deg: float = math.inf) -> SweepRuns:
     """Run and identify each sweep in turn, then re-sweep uncertain grid points within the
-    protocol's budget (``omegas`` given: the data sheet's slopes for the tip-error gate); the
-    knobs end at 0 whatever happens.
+    protocol's budget (``omegas`` given: the data sheet's slopes for the tip-error gate), then
+    those that would cost more than ``refuse_tip_error_deg`` on the tip (a refusal) within the
+    protocol's rescue budget; the knobs end at 0 whatever happens.
 
     ``isolate``: identify in a separate process, overlapped with the next sweep. The
     change-point search is pure Python and holds the GIL; in the daemon's process it delays a
@@ -260,11 +264,19 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
             if not todo:
                 break
             again = proto.resweep(plan[todo[0].index].sweep)
+            rescue = ""
             if resweep_s + again.duration_s > proto.resweep_budget_s + 1e-6:
-                budget_note = budget_spent_note(points, todo, proto.resweep_budget_s)
-                break
+                rescued = refusing(todo, refuse_tip_error_deg)
+                again = proto.resweep(plan[rescued[0].index].sweep) if rescued else again
+                budget_s = proto.resweep_budget_s + (proto.rescue_budget_s if rescued else 0.0)
+                if not rescued or resweep_s + again.duration_s > budget_s + 1e-6:
+                    budget_note = budget_spent_note(points, todo, budget_s)
+                    break
+                todo = rescued
+                rescue = " (beyond the re-sweep budget: it would refuse the calibration)"
             why = todo[0].describe(points)
-            notes.append(f"re-sweep {len(notes) + 1}: {why}; {again.cycles:g} more cycles")
+            notes.append(f"re-sweep {len(notes) + 1}: {why}; {again.cycles:g} more cycles"
+                         f"{rescue}")
             run = sweep_run(again, player.q_last, period_s, proto)
             tracker.begin(tracker.add(len(run.q_deg) * period_s), f"{again.label} ({why})")
             rec = player.play(again, f"re-sweep {len(notes)}", tracker, run)

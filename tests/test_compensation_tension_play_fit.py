@@ -27,6 +27,7 @@ from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
     BETA_RANGE,
+    TensionPlayParams,
     release_line,
     tension_play_from_mapping,
     tension_play_to_mapping,
@@ -372,22 +373,25 @@ def _with_settle_backlash(sweeps: list[SweepCurrent], settle_deg: float) -> list
     return [dataclasses.replace(s, settle_backlash_deg=(settle_deg, settle_deg)) for s in sweeps]
 
 
-def test_the_play_is_fitted_on_the_profiles_backlash_not_the_settle_rules() -> None:
+def _rule_and_settle_fits() -> tuple[TensionPlayParams, TensionPlayParams]:
+    """The play fitted where the profile's rule reads B 15 deg and the settle rule 25, and
+    where both read 25."""
     grid = (-90.0, 0.0, 90.0)
     knob = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.2)
     rule = fit_tension_play(_with_settle_backlash(
         [synthetic_sweep(g, backlash_deg=15.0) for g in grid], 25.0), knob)
     settle = fit_tension_play([synthetic_sweep(g, backlash_deg=25.0) for g in grid], knob)
+    return rule, settle
+
+
+def test_the_play_is_fitted_on_the_profiles_backlash_not_the_settle_rules() -> None:
+    rule, settle = _rule_and_settle_fits()
     assert rule.backlash_gain_pos[1] == pytest.approx(15.0 / (90.0 - X0_POS), rel=0.02)
     assert rule.backlash_gain_pos[1] < settle.backlash_gain_pos[1]
 
 
 def test_a_settle_rule_sheet_gain_scales_omega_by_the_units_settle_rule_gain() -> None:
-    grid = (-90.0, 0.0, 90.0)
-    knob = dataclasses.replace(DEVICE_KNOB, reference_backlash_gain=0.2)
-    rule = fit_tension_play(_with_settle_backlash(
-        [synthetic_sweep(g, backlash_deg=15.0) for g in grid], 25.0), knob)
-    settle = fit_tension_play([synthetic_sweep(g, backlash_deg=25.0) for g in grid], knob)
+    rule, settle = _rule_and_settle_fits()
     assert rule.omega == pytest.approx(settle.omega)
 
 

@@ -81,7 +81,7 @@ def make_session(data: PlantSpec, case: str, duration_s: float, rate_hz: float, 
             meta = {"source": f"gap cross-plant selftest ({data.name or data.factory}, {kind})",
                     "catheter": f"unit-{seed}", "configuration": config}
             cols = _measure(plant, t, q, rate_hz, EFFECTS[case][1], 10 * seed + i + 2 * m,
-                            tip_noise_deg, current_noise_A)
+                            tip_noise_deg, current_noise_A, data.max_step_s)
             if seg is not None:
                 cols["segment"] = np.asarray(seg, dtype=float)
                 meta["segments"] = encode_table(table)
@@ -91,9 +91,9 @@ def make_session(data: PlantSpec, case: str, duration_s: float, rate_hz: float, 
 
 def _measure(plant: Any, t: FloatArray, q: FloatArray, rate_hz: float, lag_s: float,
              noise_seed: int, tip_noise_deg: float,
-             current_noise_A: float) -> dict[str, FloatArray]:
+             current_noise_A: float, max_step_s: float = 0.0) -> dict[str, FloatArray]:
     """Drive ``plant`` along ``q``; the recording's columns as tracker and sensors read them."""
-    true_tip, true_A = drive_plant(plant, q, rate_hz)
+    true_tip, true_A = drive_plant(plant, q, rate_hz, max_step_s)
     tracker = EmTracker(noise_deg=tip_noise_deg, seed=noise_seed)
     sensors = [CurrentSensor(lag_s=lag_s, offset_A=0.003 * (1 - 2 * k),
                              noise_A=current_noise_A, seed=7 * noise_seed + k)

@@ -119,6 +119,28 @@ quasi-static with no load relaxation: no rate or creep physics, those cases are 
 warm-up (24 -> 37 C in 60 s from every reset) is base physics: every recording, the data
 sheet's included, starts at insertion (docs/gap.md "Session 13")."""
 
+SCREWROD_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 120.0}}
+"""The screwrod plant's one effect keyword: a 120 deg sheath bend (adds to every tendon's wrap).
+Its cross-coupling (both planes' bends add to each tendon's wrap) has no constant of its own and
+it has no speed-dependent physics (Iwan contacts, a Norton creep in time): coupling and rate are
+not run. Its tendons' creep is base physics as well (every recording, the reference units'
+included, starts uncreeped at insertion): "none" is the nominal physics (docs/gap.md "Session
+14")."""
+
+SCREWROD_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "compliance": {"tendon_stiffness_N": 0.5},
+    "creep": {"creep_time_s": 0.07},
+}
+"""Screwrod effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion, the plant stepped at 4 ms): the braid's EA halved, 3.97 deg; its tendons creeping 14
+times as fast (0.07 x the creep time: 17 s at 15 N, a braid not heat-set), 0.37 deg (the base
+creep alone 0.03 deg; the other plants' creep 0.35-0.42 deg). The 120 deg bend: 1.41 deg."""
+
+SCREWROD_MAX_STEP_S = 0.004
+"""The screwrod plant holds its tip to 0.2 deg at steps up to 4 ms (its tests); at 20 ms its
+walled knob's Newton step overshoots (torque spikes of hundreds of N m, tip 10 deg off)."""
+
+
 TWISTSHAFT_KNOB_EFFECTS: dict[str, dict[str, float]] = {
     "coupling": {"lumen_angle_error_deg": 4.5},
     "compliance": {"tendon_stiffness_N": 0.5},
@@ -148,6 +170,10 @@ class PlantSpec:
     knob_effects: dict[str, dict[str, float]] = field(default_factory=dict)
     """Case -> factors on every knob's constants (a family unit's), for an effect the plant has
     no keyword for."""
+    max_step_s: float = 0.0
+    """Longest step the plant's physics holds at as data (0: the recording's own step); a
+    recording at a coarser rate is made by stepping it finer and sampling (a real catheter is
+    continuous; its recorder only samples it)."""
 
     def build(self, **extra: Any) -> Any:
         return load_plant(self.factory, {**self.params, **extra})
@@ -193,6 +219,9 @@ PRESETS: dict[str, PlantSpec] = {
                            effects=STICKSLIP_EFFECTS, knob_effects=STICKSLIP_KNOB_EFFECTS),
     "twistshaft": PlantSpec(PLANT_SPECS["twistshaft"], {}, (), "twistshaft", family="twistshaft",
                             effects=TWISTSHAFT_EFFECTS, knob_effects=TWISTSHAFT_KNOB_EFFECTS),
+    "screwrod": PlantSpec(PLANT_SPECS["screwrod"], {}, (), "screwrod", family="screwrod",
+                          effects=SCREWROD_EFFECTS, knob_effects=SCREWROD_KNOB_EFFECTS,
+                          max_step_s=SCREWROD_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

@@ -130,10 +130,19 @@ def unit_knobs(seed: int, variation: float,
             for knob in (DEFAULT_KNOBS if defaults is None else defaults)]
 
 
-def drive_plant(plant: Any, q: NDArray[np.float64], rate_hz: float) -> tuple[NDArray[np.float64],
-                                                                            NDArray[np.float64]]:
+def drive_plant(plant: Any, q: NDArray[np.float64], rate_hz: float,
+                max_step_s: float = 0.0) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Step a plant along knob angles ``q`` (rows x 2); returns the true tip angle (deg) and the
-    true motor current (A: torque / (gear * kt) plus motor Coulomb friction), both noise-free."""
+    true motor current (A: torque / (gear * kt) plus motor Coulomb friction), both noise-free.
+    With ``max_step_s`` shorter than a row, the plant is stepped that finely along the knobs'
+    straight lines between rows and read at the rows (a plant valid only at short steps)."""
+    sub = int(np.ceil(1.0 / (rate_hz * max_step_s) - 1e-9)) if max_step_s > 0.0 else 1
+    if sub > 1 and len(q) > 1:
+        rows = np.arange(len(q), dtype=float)
+        fine = np.arange((len(q) - 1) * sub + 1) / sub
+        q_fine = np.stack([np.interp(fine, rows, q[:, j]) for j in range(q.shape[1])], axis=1)
+        tip, cur = drive_plant(plant, q_fine, rate_hz * sub)
+        return tip[::sub], cur[::sub]
     tip, torque = simulate(plant, np.arange(len(q)) / rate_hz, q)
     vel = np.diff(q, axis=0, prepend=q[:1]) * rate_hz
     return tip, torque / (GEAR_RATIO * KT_NM_PER_A) + MOTOR_COULOMB_A * np.tanh(vel / 0.5)

@@ -12,6 +12,7 @@ from numpy.typing import NDArray
 
 from tsmd import cli
 from tsmd.gap import compliance, crosstest
+from tsmd.gap.contrast import product_reference
 from tsmd.gap.crosstest import make_session
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.presets import PRESETS
@@ -207,3 +208,51 @@ def test_a_model_reference_without_the_protocol_is_one_line(
                      "--out", str(tmp_path / "out")])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
+
+
+def _scaled(series: list[GapSeries], figure_factor: float) -> list[GapSeries]:
+    """The same recordings read with the current scaled: the figure times ``figure_factor``."""
+    return [dataclasses.replace(s, current_A=s.current_A / figure_factor) for s in series]
+
+
+def test_a_sheet_from_one_unit_has_no_allowance_and_from_scattered_units_their_spread() -> None:
+    unit = _protocol_series(0, "none", 0.0)
+    one = compliance.sheet_from_units([unit])
+    scattered = compliance.sheet_from_units(
+        [unit, _scaled(unit, 1.15), _scaled(unit, 1.0 / 1.15)])
+    assert one is not None and scattered is not None
+    assert one.allowance_log_var == (0.0, 0.0)
+    assert min(scattered.allowance_log_var) > 0.01
+    assert scattered.figure_deg_per_A == pytest.approx(one.figure_deg_per_A, rel=0.02)
+
+
+def test_a_unit_within_its_models_spread_is_not_named_but_one_beyond_it_is() -> None:
+    unit = _protocol_series(0, "none", 0.0)
+    one = compliance.sheet_from_units([unit])
+    scattered = compliance.sheet_from_units(
+        [unit, _scaled(unit, 1.15), _scaled(unit, 1.0 / 1.15)])
+    assert one is not None and scattered is not None
+    softer = _scaled(_protocol_series(5, "none"), 1.4)
+    named = compliance.compliance_score(softer, one, 7)
+    within = compliance.compliance_score(softer, scattered, 7)
+    beyond = compliance.compliance_score(_scaled(_protocol_series(5, "none"), 2.5), scattered, 7)
+    assert named is not None and named.significant
+    assert within is not None and not within.significant
+    assert beyond is not None and beyond.significant
+
+
+def test_the_sheets_own_noise_widens_the_figures_bound() -> None:
+    series = _scaled(_protocol_series(5, "none"), 1.4)
+    exact = compliance.compliance_score(series, compliance.ComplianceSheet(_sheet()), 7)
+    noisy = compliance.compliance_score(
+        series, compliance.ComplianceSheet(_sheet(), noise_log_var=(0.05, 0.05)), 7)
+    assert exact is not None and noisy is not None
+    assert exact.significant and not noisy.significant
+
+
+def test_a_model_reference_from_several_units_carries_their_compliance_sheet() -> None:
+    units = [dataclasses.replace(s, catheter=f"unit-{u}")
+             for u in (0, 6) for s in _protocol_series(u, "none")]
+    reference = product_reference(units)
+    assert reference.units == 2 and reference.compliance is not None
+    assert all(np.isfinite(reference.compliance.figure_deg_per_A))

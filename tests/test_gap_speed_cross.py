@@ -15,7 +15,7 @@ from tsmd.gap.data import GapSeries, Split, fit_windows, make_split, series_from
 from tsmd.gap.fit import ParamSpec, fit_base
 from tsmd.gap.model import Evaluator, build_views
 from tsmd.gap.presets import PRESETS, parse_plant_spec
-from tsmd.gap.selftest import EFFECTS
+from tsmd.gap.selftest import EFFECTS, drive_plant, trajectory
 
 
 def _long_series(duration_s: float = 600.0) -> tuple[GapSeries, Split]:
@@ -166,6 +166,30 @@ def test_twistshaft_coupling_moves_the_units_own_lumens_and_rate_creep_are_not_r
         assert coupled.knobs[k].lumen_helix_deg == none.knobs[k].lumen_helix_deg
     assert not twist.supports("rate")
     assert not twist.supports("creep")
+
+
+def test_screwrod_cases_scale_the_units_tendons_and_coupling_rate_are_not_run() -> None:
+    screw = PRESETS["screwrod"]
+    none = screw.build_unit(102, 0.1)
+    creep = screw.build_unit(102, 0.1, "creep", **screw.case_effects("creep"))
+    for k in (0, 1):
+        assert creep.knobs[k].p.creep_time_s == pytest.approx(0.07 * none.knobs[k].p.creep_time_s)
+        assert creep.knobs[k].p.creep_limit_mm == none.knobs[k].p.creep_limit_mm
+    assert not screw.supports("coupling")
+    assert not screw.supports("rate")
+
+
+def test_a_plant_valid_at_short_steps_is_stepped_finely_and_read_at_the_rows() -> None:
+    # the screwrod plant's walled knob overshoots at 20 ms steps (torque spikes of ~1000 N m)
+    screw = PRESETS["screwrod"]
+    _t, q = trajectory(36.0, 50.0)
+    tip, cur = drive_plant(screw.build_unit(0, 0.0), q, 50.0, screw.max_step_s)
+    rows = np.arange(len(q), dtype=float)
+    fine = np.arange((len(q) - 1) * 10 + 1) / 10
+    q_ms = np.stack([np.interp(fine, rows, q[:, j]) for j in (0, 1)], axis=1)
+    tip_ms, _ = drive_plant(screw.build_unit(0, 0.0), q_ms, 500.0)
+    assert np.abs(cur).max() < 1.0
+    assert np.abs(tip - tip_ms[::10]).max() < 0.2
 
 
 def test_a_case_the_data_plant_lacks_is_not_run(monkeypatch: pytest.MonkeyPatch) -> None:

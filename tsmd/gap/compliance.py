@@ -30,6 +30,7 @@ from scipy import stats
 
 from tsmd.gap.data import GapSeries
 from tsmd.gap.signature import SIGNATURES, SignatureScore
+from tsmd.gap.stats import unit_spread
 
 FloatArray = NDArray[np.float64]
 
@@ -55,9 +56,10 @@ then a sensor's lag of 0.1 s has caught up at the protocol's speeds (a lag is an
 PRE_WINDOW_S = 0.2
 """The current at a reversal: its mean over this long before it."""
 TOLERANCE = 0.25
-"""The data sheet's tolerance of the figure (a tendon lot's stiffness, the friction's share):
-a unit is named more compliant only when the lower confidence bound of its ratio to the data
-sheet exceeds 1 + this."""
+"""The smallest excess named: a unit is named more compliant only when the lower confidence
+bound of its ratio to the data sheet exceeds 1 + this, and when the sheet was measured on
+several units, further by their spread (:class:`ComplianceSheet`; added in quadrature on the
+log scale, as the loop tests add the units' spread to one sample's noise)."""
 TOGETHER_DEG = 2.0
 """Only reversals with the other knob at the same angle (the protocol moves both knobs
 together in its warm-up, rate loops and dwells): the other knob's angle changes the load, and
@@ -249,31 +251,82 @@ reference_deg_per_A = lost_motion_per_A
 the catheter model (the manufacturer's bench, or the nominal unit of a simulated family)."""
 
 
-def compliance_score(series: Sequence[GapSeries], reference: Sequence[float], n_tried: int,
-                     family_alpha: float = 0.05, min_share: float = 0.05) -> SignatureScore | None:
+@dataclass(frozen=True)
+class ComplianceSheet:
+    """The model's figure per knob (deg/A; NaN: no unit read it), the log variance of that
+    figure's noise, and the log variance a further unit may lie from it (a one-sided 95 %
+    prediction bound from the units' spread beyond their own noise; 0 from one unit). A figure
+    from one unit scatters like any unit (twistshaft unit 0 reads 0.8-0.9 of its units'
+    centre), so a sheet from several units is the centre a unit is compared with."""
+
+    figure_deg_per_A: tuple[float, float]
+    noise_log_var: tuple[float, float] = (0.0, 0.0)
+    allowance_log_var: tuple[float, float] = (0.0, 0.0)
+
+
+def sheet_from_units(units: Sequence[Sequence[GapSeries]]) -> ComplianceSheet | None:
+    """The sheet from the protocol of each of several units (one list of series per unit):
+    per knob the mean over the units that read it of the log figure, that mean's noise and the
+    units' spread (:func:`tsmd.gap.stats.unit_spread`); None when no unit reads either knob."""
+    per_unit = [_figures(u) for u in units]
+    figure, noise, allowance = [], [], []
+    for knob in (0, 1):
+        read = [found[1] for f in per_unit if (found := f[knob]) is not None]
+        if not read:
+            figure.append(float("nan"))
+            noise.append(0.0)
+            allowance.append(0.0)
+            continue
+        mean, own, spread = unit_spread(np.array([[np.log(c.slope)] for c in read]),
+                                        np.array([[c.log_var] for c in read]))
+        figure.append(float(np.exp(mean[0])))
+        noise.append(float(own[0]))
+        allowance.append(float(spread[0]))
+    if not np.isfinite(figure).any():
+        return None
+    return ComplianceSheet((figure[0], figure[1]), (noise[0], noise[1]),
+                           (allowance[0], allowance[1]))
+
+
+def compliance_score(series: Sequence[GapSeries], reference: Sequence[float] | ComplianceSheet,
+                     n_tried: int, family_alpha: float = 0.05,
+                     min_share: float = 0.05) -> SignatureScore | None:
     """Compliance named when the one-sided lower bound (level ``family_alpha / n_tried``; the
-    null's spread from the repeats at each load, a jackknife) of the figure's ratio to
-    ``reference`` (geometric mean over the knobs with a readable figure) exceeds
-    1 + :data:`TOLERANCE`. Share: the held-out shrink of the load contrast's excess over the
-    data sheet's, the figure fitted on one configuration and scored on the other. None when
-    no knob has enough readable reversals."""
+    null's spread from the repeats at each load, a jackknife, and the sheet's own noise) of the
+    figure's ratio to the sheet (geometric mean over the knobs both read) exceeds the bar:
+    1 + :data:`TOLERANCE`, widened by the units' spread when the sheet has one. Share: the
+    held-out shrink of the load contrast's excess over the sheet's, the figure fitted on one
+    configuration and scored on the other. None when no knob has enough readable reversals."""
+    sheet = (reference if isinstance(reference, ComplianceSheet)
+             else ComplianceSheet((float(reference[0]), float(reference[1]))))
     per_knob = _figures(series)
-    found = [(f, ref) for f, ref in zip(per_knob, reference, strict=True) if f is not None]
+    found = [(f, ref, nv, av) for f, ref, nv, av in zip(
+        per_knob, sheet.figure_deg_per_A, sheet.noise_log_var, sheet.allowance_log_var,
+        strict=True) if f is not None and np.isfinite(ref) and ref > 0.0]
     if not found:
         return None
-    slopes = np.array([c.slope for (_, c), _ in found])
-    refs = np.array([ref for _, ref in found])
-    log_ratio = float(np.mean(np.log(slopes / refs)))
-    se = float(np.sqrt(sum(c.log_var for (_, c), _ in found))) / len(found)
+    slopes = np.array([c.slope for (_, c), _, _, _ in found])
+    refs = np.array([ref for _, ref, _, _ in found])
+    # knobs weighted by their figures' precision: one knob's tip barely out of its dead zone
+    # reads a figure ten times as noisy as the other's
+    weight = 1.0 / np.array([max(c.log_var + nv, 1e-12) for (_, c), _, nv, _ in found])
+    weight /= weight.sum()
+    log_ratio = float(weight @ np.log(slopes / refs))
+    se = float(np.sqrt(sum(w ** 2 * (c.log_var + nv)
+                           for w, ((_, c), _, nv, _) in zip(weight, found, strict=True))))
+    # a unit's constants move both knobs' figures together: the allowances' weighted mean,
+    # not their average's shrunken spread
+    allowance = float(weight @ np.sqrt([av for _, _, _, av in found]))
+    bar = float(np.hypot(np.log1p(TOLERANCE), allowance))
     z_alpha = float(stats.norm.isf(family_alpha / max(n_tried, 1)))
     ratio, lower = float(np.exp(log_ratio)), float(np.exp(log_ratio - z_alpha * se))
-    share, lo, hi = _heldout_shrink([r for (r, _), _ in found], list(refs))
-    z = (log_ratio - np.log1p(TOLERANCE)) / se if se > 0 else float("nan")
+    share, lo, hi = _heldout_shrink([r for (r, _), _, _, _ in found], list(refs))
+    z = (log_ratio - bar) / se if se > 0 else float("nan")
     title, _ = SIGNATURES["compliance"]
-    significant = bool(lower > 1.0 + TOLERANCE and share >= min_share)
+    significant = bool(lower > np.exp(bar) and share >= min_share)
     return SignatureScore("compliance", title, f"{CONDITION} (x{ratio:.2f}, lower bound "
-                          f"x{lower:.2f})", share, (lo, hi), significant, share, 0.0,
-                          float(np.clip(z, -40.0, 40.0)))
+                          f"x{lower:.2f}, bar x{np.exp(bar):.2f})", share, (lo, hi),
+                          significant, share, 0.0, float(np.clip(z, -40.0, 40.0)))
 
 
 def _heldout_shrink(per_knob: Sequence[Reversals],

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
+from tsmd.gap.compliance import sheet_from_units
 from tsmd.gap.data import GapSeries
 from tsmd.gap.dwell import CREEP_CHANNELS, Drift, drift_shrink, drift_size, drift_stat, dwell_slope
 from tsmd.gap.loops import (
@@ -42,6 +43,7 @@ from tsmd.gap.reference import (
     measured_windows,
 )
 from tsmd.gap.signature import SIGNATURES, SignatureScore
+from tsmd.gap.stats import unit_spread
 
 FloatArray = NDArray[np.float64]
 
@@ -188,7 +190,7 @@ def product_reference(series: Sequence[GapSeries]) -> ProductReference:
     referenced loop test the level contrast of the measured signals and per dwell pair the
     currents' loaded-minus-unloaded slopes, each the mean over units of the mean over
     configurations; with two or more units their spread about it is what a further unit of
-    the model may lie from it (:func:`_spread`)."""
+    the model may lie from it (:func:`tsmd.gap.stats.unit_spread`)."""
     units: dict[str, list[GapSeries]] = {}
     for s in series:
         units.setdefault(s.catheter, []).append(s)
@@ -200,18 +202,19 @@ def product_reference(series: Sequence[GapSeries]) -> ProductReference:
             continue
         first, levels = found[0][0], found[0][1]
         same = [m for m in found if m[1] == levels and m[2].shape == found[0][2].shape]
-        value, noise, scatter = _spread(np.array([m[2] for m in same]),
+        value, noise, scatter = unit_spread(np.array([m[2] for m in same]),
                                         np.array([m[3] for m in same]))
         loops[test] = LoopReference(tuple(levels), value, first.knob * first.span_deg,
                                     first.dirn, first.part, float(noise.mean()),
                                     float(scatter.mean()))
+    sheet = sheet_from_units(list(units.values()))
     slopes = [d for d in (_unit_drift(by_config) for by_config in per_unit) if d is not None]
     if not slopes:
-        return ProductReference(loops, units=len(units))
+        return ProductReference(loops, units=len(units), compliance=sheet)
     same_d = [d for d in slopes if d[0].shape == slopes[0][0].shape]
-    diff, noise, scatter = _spread(np.array([d[0] for d in same_d]),
+    diff, noise, scatter = unit_spread(np.array([d[0] for d in same_d]),
                                    np.array([d[1] for d in same_d]))
-    return ProductReference(loops, (diff, noise + scatter), len(units))
+    return ProductReference(loops, (diff, noise + scatter), len(units), sheet)
 
 
 def _unit_contrast(by_config: dict[str, dict[str, TestData]], test: str
@@ -241,24 +244,6 @@ def _unit_drift(by_config: dict[str, dict[str, TestData]]) -> tuple[FloatArray, 
     pairs = [d for d in drifts if d.diff.shape == drifts[0].diff.shape]
     return (np.mean([d.diff for d in pairs], axis=0),
             np.mean([d.var for d in pairs], axis=0) / len(pairs))
-
-
-def _spread(values: FloatArray, noise: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Mean over units (axis 0) of per-unit ``values`` with the variance of each (``noise``):
-    the mean, its noise, and the allowance a further unit has about it beyond its own noise,
-    as a variance: the square of a one-sided 95 % prediction bound from the units' spread
-    (sample variance less their mean noise, times 1 + 1/n for the mean's uncertainty, times
-    Student's t at n - 1 degrees of freedom squared: a unit's constants move the model's
-    contrast along few directions, so its deviation is bounded like one normal value, not
-    averaged over many points); 0 from one unit."""
-    n = values.shape[0]
-    mean = values.mean(axis=0)
-    own = noise.mean(axis=0)
-    if n < 2:
-        return mean, own, np.zeros_like(mean)
-    bound = float(stats.t.ppf(0.95, n - 1)) ** 2 * (1.0 + 1.0 / n)
-    spread = np.maximum(values.var(axis=0, ddof=1) - own, 0.0) * bound
-    return mean, own / n, spread
 
 
 def excess_rms(loops: Sequence[Loops]) -> float:

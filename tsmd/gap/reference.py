@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.gap.compliance import ComplianceSheet
 from tsmd.gap.data import GapSeries
 from tsmd.gap.dwell import Drift
 from tsmd.gap.loops import Loops, contrast_of
@@ -80,6 +81,9 @@ class ProductReference:
     plus the units' spread)."""
     units: int = 1
     """How many catheters of the model the reference was measured on."""
+    compliance: ComplianceSheet | None = None
+    """The model's lost motion per ampere from the same units, with its noise and the units'
+    spread (session 14): the compliance test's data sheet when present."""
 
 
 def measured_windows(s: GapSeries) -> FloatArray:

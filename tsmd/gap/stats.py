@@ -81,3 +81,22 @@ def pooled_ljung_box(segments: Sequence[NDArray[np.float64]], lags: int = 20,
     stride = max(total // max_points, 1)
     pieces = [s[::stride] for s in segments if len(s)]
     return ljung_box(np.concatenate(pieces), lags)
+
+
+def unit_spread(values: NDArray[np.float64], noise: NDArray[np.float64]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Mean over units (axis 0) of per-unit ``values`` with the variance of each (``noise``):
+    the mean, its noise, and the allowance a further unit has about it beyond its own noise,
+    as a variance: the square of a one-sided 95 % prediction bound from the units' spread
+    (sample variance less their mean noise, times 1 + 1/n for the mean's uncertainty, times
+    Student's t at n - 1 degrees of freedom squared: a unit's constants move the model's
+    contrast along few directions, so its deviation is bounded like one normal value, not
+    averaged over many points); 0 from one unit."""
+    n = values.shape[0]
+    mean = values.mean(axis=0)
+    own = noise.mean(axis=0)
+    if n < 2:
+        return mean, own, np.zeros_like(mean)
+    bound = float(stats.t.ppf(0.95, n - 1)) ** 2 * (1.0 + 1.0 / n)
+    spread = np.maximum(values.var(axis=0, ddof=1) - own, 0.0) * bound
+    return mean, own / n, spread

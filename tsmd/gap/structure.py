@@ -48,9 +48,12 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         found = contrast_scores(series, residuals, len(sres.scores), cfg.family_alpha,
                                 cfg.min_share, float(np.sqrt(np.mean(noise_var[:2]))),
                                 float(np.sqrt(np.mean(noise_var[2:]))), cfg.product_reference)
-        if cfg.compliance_reference is not None:
-            stretch = compliance_score(series, cfg.compliance_reference, len(sres.scores),
-                                       cfg.family_alpha, cfg.min_share)
+        ref = cfg.product_reference
+        sheet = (ref.compliance if ref is not None and ref.compliance is not None
+                 else cfg.compliance_reference)
+        if sheet is not None:
+            stretch = compliance_score(series, sheet, len(sres.scores), cfg.family_alpha,
+                                       cfg.min_share)
             found += [stretch] if stretch is not None else []
         names = {c.name for c in found}
         kept = [s for s in sres.scores if s.name not in names]

@@ -17,7 +17,7 @@ from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.errors import GapError
 from tsmd.gap.loops import Loops, loop_contrast, noise_ss, smooth_along
 from tsmd.gap.protocol import Segment, decode_table, encode_table, protocol
-from tsmd.gap.reference import beyond_reference, measured_windows
+from tsmd.gap.reference import beyond_reference, measured_windows, own_scale
 from tsmd.gap.signature import SignatureScore
 from tsmd.gap.structure import rank_scores
 from tsmd.recording import Recording, read_trajectory
@@ -423,3 +423,16 @@ def test_creep_the_models_units_scatter_over_counts_as_noise_of_its_reference() 
     scattered = product_reference(_units(creep(0.0), creep(1.0), creep(2.0)))
     assert one.creep is not None and scattered.creep is not None
     assert float(scattered.creep[1].mean()) > 10.0 * float(one.creep[1].mean())
+
+
+def test_a_unit_with_less_of_its_models_own_contrast_is_not_named_but_more_is() -> None:
+    # a twistshaft unit with halved tendons keeps 0.5-0.7 of its model's coupling contrast
+    assert "rate" not in _named(_against_model(_widening(0.01), _widening(0.04)))
+    assert "rate" in _named(_against_model(_widening(0.12), _widening(0.04)))
+
+
+def test_the_own_scale_is_the_units_projection_on_its_models_contrast_at_most_one() -> None:
+    own = np.array([[1.0, -2.0, 0.5], [-1.0, 2.0, -0.5]])
+    assert own_scale(0.6 * own, own) == pytest.approx(0.6)
+    assert own_scale(2.5 * own, own) == 1.0
+    assert own_scale(-own, own) == 0.0

@@ -94,17 +94,31 @@ def measured_windows(s: GapSeries) -> FloatArray:
 def beyond_reference(res: Loops, meas: Loops, levels: Sequence[str],
                      ref: LoopReference | None) -> Loops:
     """The residual loops less the model's own contrast: ``res`` plus the simulator's own
-    contrast (``meas`` - ``res``, the same rows) minus the reference's. Unchanged without a
-    reference or when the levels do not match."""
+    contrast (``meas`` - ``res``, the same rows) minus the reference's, scaled down to what
+    the unit has of it when that is less (:func:`own_scale`). Unchanged without a reference or
+    when the levels do not match."""
     if ref is None:
         return res
     own = ref.at(res, levels)
     if own is None or meas.y.shape != res.y.shape:
         return res
-    sim = contrast_of(meas) - contrast_of(res)
-    y = res.y + (sim - own)[:, None, :]
+    measured = contrast_of(meas)
+    sim = measured - contrast_of(res)
+    y = res.y + (sim - own_scale(measured, own) * own)[:, None, :]
     per_point = ref.noise_per_point + ref.scatter_per_point
     return replace(res, y=y, ref_noise_ss=res.y.shape[2] * per_point)
+
+
+def own_scale(measured: FloatArray, own: FloatArray) -> float:
+    """How much of its model's own contrast a unit's measured contrast has (its projection on
+    the reference's), at most all of it: a unit with less of the model's own contrast than the
+    model has no effect added along it. A twistshaft unit with its tendons halved keeps 0.5-0.7
+    of its model's coupling contrast, and the rest, counted beyond the reference, was named
+    coupling (docs/gap.md "Session 14"); an added coupling has 2.3-3 times the model's."""
+    norm = float((own * own).sum())
+    if norm <= 0.0:
+        return 1.0
+    return float(np.clip((measured * own).sum() / norm, 0.0, 1.0))
 
 
 def drift_beyond_reference(res: Drift, meas: Drift,

@@ -83,7 +83,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "tells them apart): what the model has always (its own rate, "
                              "coupling and creep contrasts) and, from two or more units, how "
                              "far a unit may lie from it; effects are then named only for what "
-                             "a unit has beyond that")
+                             "a unit has beyond that. Its units' lost motion per ampere is the "
+                             "compliance sheet then, in place of --compliance-sheet")
     parser.add_argument("--sizes", default="120,300",
                         help="selftest: recording lengths in s (comma-separated)")
     parser.add_argument("--seeds", default="0,1", help="selftest: noise/unit seeds")

@@ -286,7 +286,7 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         dead_zone_neg_deg=tuple(d_neg), backlash_gain_pos=sides[0][0],
         backlash_gain_neg=sides[1][0], zero_load_pos_deg=sides[0][1],
         zero_load_neg_deg=sides[1][1], lag_s=min(max(lag, 0.0), 1.0), shape_pos=shape_pos,
-        shape_neg=shape_neg)
+        shape_neg=shape_neg, other_tip_gain=float(getattr(k, "other_tip_gain", None) or 0.0))
 
 
 def clamped_gain(beta: float) -> float:

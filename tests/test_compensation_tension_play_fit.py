@@ -11,14 +11,13 @@ import pytest
 import yaml
 from support.profiles import DEVICE, make_profile
 
+from tsmd.calibration.release_path import release_slope_ratio, release_through_amplitude
 from tsmd.calibration.tension_play_fit import (
     SweepCurrent,
     fit_side,
     fit_tension_play,
     friction_current_A,
     median_of_three,
-    release_slope_ratio,
-    release_through_amplitude,
     smooth_over_grid,
 )
 from tsmd.calibration.unit_slope import unit_omega

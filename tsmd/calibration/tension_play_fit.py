@@ -17,9 +17,11 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   where a product's release path after the backlash is shallower or steeper than that locus (a
   lumped catheter's is 7 % shallower; the current cannot see it: a released tendon's current is
   friction only), the data sheet's tracked ``release_omega`` gives the product's ratio
-  ``release_omega (1 - beta_sheet) / omega_sheet`` (:func:`release_slope_ratio`); the unit's
+  ``release_omega (1 - beta_sheet) / omega_sheet``
+  (:func:`tsmd.calibration.release_path.release_slope_ratio`); the unit's
   release line then has that ratio times its own locus slope and still passes through its own
-  backlash end at the calibration amplitude (:func:`release_through_amplitude`);
+  backlash end at the calibration amplitude (:func:`~tsmd.calibration.release_path.
+  release_through_amplitude`);
 * the plateau heights ``H``: product constants, from the data sheet's reference points through
   the edges the current showed on the data-sheet unit (``reference_dead_zone_*_deg``), so that
   each unit's loaded line moves with its own edges (more slack: the tip reaches less at +-90).
@@ -49,6 +51,7 @@ from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.fresh_hold import with_fresh_hold
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
+from tsmd.calibration.release_path import release_slope_ratio, release_through_amplitude
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.unit_slope import GainReading, gain_scatter, weighed_omega
 from tsmd.compensation.loaded_shape import curved, shaped_height
@@ -151,43 +154,6 @@ def fit_sweep_sides(pos_deg: FloatArray, current_A: FloatArray, dead_zone_pos_de
     return fits[0], fits[1]
 
 
-FAR_ZERO_LOAD_DEG = 89.0
-"""A moved zero-load point stays within +-this (the profile keeps x0 within +-90 deg)."""
-RELEASE_RATIO_RANGE: tuple[float, float] = (0.7, 1.3)
-"""Plausible release-path over backlash-end-locus slope ratios; outside, the sheet is refused."""
-
-
-def release_slope_ratio(device_knob: Any) -> float:
-    """The product's release-path slope over its backlash-end locus slope, from the data sheet:
-    ``release_omega (1 - reference_backlash_gain) / omega`` (tracked release slope against the
-    locus the current's backlash gain gives on the same unit); 1 without both keys."""
-    release = getattr(device_knob, "release_omega", None)
-    gain = getattr(device_knob, "reference_backlash_gain", None)
-    if release is None or gain is None:
-        return 1.0
-    ratio = float(release) * (1.0 - float(gain)) / float(device_knob.omega)
-    lo, hi = RELEASE_RATIO_RANGE
-    if not lo <= ratio <= hi:
-        raise ValueError(f"data sheet: release_omega {release} gives a release/locus slope ratio "
-                         f"{ratio:.2f} outside [{lo}, {hi}]")
-    return ratio
-
-
-def release_through_amplitude(beta: float, zero_load_deg: float, amplitude_deg: float,
-                              ratio: float) -> tuple[float, float]:
-    """(beta', x0') whose release line has ``ratio`` times the slope of (beta, x0)'s and passes
-    through the same backlash end at the amplitude: ``A - beta (A - x0) = A - beta' (A - x0')``.
-    The loaded line and the backlash identified at the amplitude are unchanged."""
-    if ratio == 1.0:
-        return beta, zero_load_deg
-    lo, hi = BETA_RANGE
-    backlash = beta * (amplitude_deg - zero_load_deg)  # signed: negative on the negative side
-    # never shallower than the loaded line, and x0' within the profile's range (+-FAR_ZERO_LOAD)
-    floor = max(lo + 0.01, abs(backlash) / (abs(amplitude_deg) + FAR_ZERO_LOAD_DEG))
-    b = min(max(1.0 - (1.0 - beta) / ratio, floor), hi)
-    return b, amplitude_deg - backlash / b
-
-
 def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list[float]:
     """Least-squares polynomial over the grid: degree 2 (a coupling that differs at both ends
     of the other knob's range from its middle is at least quadratic; on three grid points a
@@ -286,7 +252,7 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         dead_zone_neg_deg=tuple(d_neg), backlash_gain_pos=sides[0][0],
         backlash_gain_neg=sides[1][0], zero_load_pos_deg=sides[0][1],
         zero_load_neg_deg=sides[1][1], lag_s=min(max(lag, 0.0), 1.0), shape_pos=shape_pos,
-        shape_neg=shape_neg)
+        shape_neg=shape_neg, other_tip_gain=float(getattr(k, "other_tip_gain", None) or 0.0))
 
 
 def clamped_gain(beta: float) -> float:

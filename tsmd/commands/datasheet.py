@@ -33,6 +33,7 @@ from tsmd.datasheet import (
     swept_knob,
 )
 from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
+from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_rule import (
     RULE_NOISE_SEEDS,
     choose_knee,
@@ -134,6 +135,26 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
     return chosen
 
 
+def _with_coupling(device: DeviceModel, config: TsmdConfig, factory: Callable[[], Plant],
+                   seed: int) -> DeviceModel:
+    """The sheet with each knob's coupling to the other plane (its unit swept with the other
+    knob held at -90 and +90 deg)."""
+    t0 = time.monotonic()
+    edges = tuple(min(abs(_edge(k.reference_dead_zone_pos_deg)),
+                      abs(_edge(k.reference_dead_zone_neg_deg))) for k in device.knobs)
+    gains = measure_other_tip_gains(factory, (edges[0], edges[1]), seed, config)
+    knobs = tuple(dataclasses.replace(k, other_tip_gain=round(g, 4))
+                  for k, g in zip(device.knobs, gains, strict=True))
+    print(f"  other-plane coupling: phi1 {gains[0]:+.4f}, phi2 {gains[1]:+.4f} tip deg per "
+          f"other tip deg ({time.monotonic() - t0:.0f} s)")
+    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+
+def _edge(value: float | None) -> float:
+    """A sheet's reference edge, or where the family's plants have theirs when it lacks one."""
+    return 20.0 if value is None else float(value)
+
+
 def _with_bend(device: DeviceModel, config: TsmdConfig,
                factory: Callable[[], Plant]) -> DeviceModel:
     """The sheet with the product's bend relation, from its unit calibrated straight and bent
@@ -176,6 +197,8 @@ def main(args: argparse.Namespace) -> int:
     device, dropped = readable(device)
     for line in dropped:
         print(f"warning: {line}")
+    if args.plant is not None:
+        device = _with_coupling(device, config, factory, args.seed)
     if args.plant is not None and seeds:
         device = _choose_rule(device, config, args.plant, params, seeds)
     if args.plant is not None and args.bend_relation:
@@ -183,7 +206,8 @@ def main(args: argparse.Namespace) -> int:
     comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "
                f"(tsmd datasheet) on {source}:\n"
                f"each knob swept +-{SWEEP_AMPLITUDE_DEG:g} deg at {SWEEP_HZ:g} Hz, other knob "
-               f"at 0 deg, analysed after {CONDITIONING_CYCLES:g} conditioning cycle(s); tip "
+               f"at 0 deg (and held at +-90 deg for the planes' coupling), analysed after "
+               f"{CONDITIONING_CYCLES:g} conditioning cycle(s); tip "
                f"from the tracker.\nLimits: limits.* of the configuration.")
     save_device_model(device, args.out, comment)
     for name, c in zip(("phi1", "phi2"), constants, strict=True):

@@ -28,8 +28,12 @@ from numpy.typing import NDArray
 from tsmd.compensation.grid import ParameterField
 from tsmd.compensation.loaded_shape import LoadedShape, curved, steepest_slope
 from tsmd.compensation.ours_knob import (
+    PLATEAU_MARGIN_DEG,
     KnobCommand,
+    fresh_progress,
     motion,
+    own_plane_deg,
+    own_plane_plan,
     watch,
 )
 from tsmd.compensation.planned import Planner
@@ -40,7 +44,6 @@ from tsmd.compensation.tension_play import (
     PlayState,
     TensionPlayParams,
     fresh_branches,
-    fresh_state_ends,
     interp_linear,
     inverse_step,
     model_step,
@@ -58,7 +61,6 @@ TABLE_STEP_DEG = 0.25
 """Resolution of the other knob's angle in the precomputed branches."""
 MOVE_FROM_REST_S = 1.0
 """How long after leaving rest the look-ahead trusts the desired angle's acceleration fully."""
-_PLATEAU_MARGIN_DEG = 1.0
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
 
@@ -82,6 +84,8 @@ class OursKnob:
     """The product's loaded-branch template per side (None: straight); a fresh knob's first
     loading and release (``fresh_branches``) stay straight."""
     shape_neg: LoadedShape | None = None
+    other_tip_gain: float = 0.0
+    """Tip degrees in this plane per tip degree of the other (the product's, data sheet)."""
     _table: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
     _fresh: tuple[tuple[Branches, ...], ...] = dataclasses.field(init=False, repr=False,
                                                                  compare=False)
@@ -115,7 +119,7 @@ class OursKnob:
                    p.omega, p.height_pos_deg, p.height_neg_deg, p.lag_s, p.fresh_hold_deg,
                    # the profile's fresh numbers come together from one first sweep
                    p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None,
-                   curved(p.shape_pos), curved(p.shape_neg))
+                   curved(p.shape_pos), curved(p.shape_neg), p.other_tip_gain)
 
     @property
     def is_fresh_known(self) -> bool:
@@ -176,6 +180,9 @@ class OursCompensator:
         # faster than any knob can make the tip move (release slope <= 5 omega T')
         jump_deg_s = 5.0 * max(k.omega * steepest_slope(k.shape_pos, k.shape_neg)
                                for k in self.knobs) * self.v_max
+        self._gains = (self.knobs[0].other_tip_gain, self.knobs[1].other_tip_gain)
+        self._plan_source: object = None
+        self._plan_own: list[list[float]] = []
         for kc, knob in zip(self._k, self.knobs, strict=True):
             kc.ahead_s = knob.lag_s + 0.5 * (self._n_avg - 1) * self.period_s
             kc.ahead_ticks = round(kc.ahead_s / self.period_s)
@@ -196,6 +203,7 @@ class OursCompensator:
         loaded) a knob whose profile knows the fresh hold (``fresh_hold_deg``) uses the fresh
         branches until its first release has ended."""
         q = [float(v) if math.isfinite(v) else 0.0 for v in np.asarray(q_deg, dtype=float)]
+        q = [own_plane_deg(q[0], q[1], self._gains[0]), own_plane_deg(q[1], q[0], self._gains[1])]
         fresh = [self.fresh_catheter and k.is_fresh_known for k in self.knobs]
         x = [0.0, 0.0]
         states = [PlayState(0.0, 0.0, 1, 0.0)] * 2
@@ -213,6 +221,11 @@ class OursCompensator:
         (the loop playing a trajectory says so every tick; without it the next command is
         causal): the dead-zone crossings and sharp turns are then timed on the plan
         (:class:`tsmd.compensation.planned.Planner`)."""
+        gains = self._gains
+        if gains != (0.0, 0.0):  # the plan as each knob's model must give it, made once
+            if plan_deg is not self._plan_source:
+                self._plan_source, self._plan_own = plan_deg, own_plane_plan(plan_deg, gains)
+            plan_deg = self._plan_own
         self._planner.set(plan_deg, index)
 
     def command(self, q_deg: NDArray[np.float64], dt_s: float) -> NDArray[np.float64]:
@@ -225,13 +238,16 @@ class OursCompensator:
         planner = self._planner
         planned = planner.take()
         out = []
-        for col, kc, qi, b in ((0, k0, float(q_deg[0]), b0), (1, k1, float(q_deg[1]), b1)):
+        q0, q1 = float(q_deg[0]), float(q_deg[1])
+        g0, g1 = self._gains
+        for col, kc, qi, b in ((0, k0, own_plane_deg(q0, q1, g0), b0),
+                               (1, k1, own_plane_deg(q1, q0, g1), b1)):
             if qi - qi == 0.0:  # finite; otherwise the command stays where it is
                 self._track(kc, qi, b, planned, dt)
                 if planned:
                     kc.out = planner.command(kc.plan, kc.state, kc.out, kc.ahead_ticks, col, b)
                 if kc.fresh:
-                    _fresh_progress(kc)
+                    fresh_progress(kc)
             if n == 1:
                 x, kc.lim_v, kc.lim_target = step_floats(kc.lim_deg, kc.lim_v, kc.lim_target,
                                                          kc.out, kc.limits, period)
@@ -282,7 +298,8 @@ class OursCompensator:
         period = self.period_s
         dt, _ = self._elapsed(dt_s)
         for i, kc in enumerate(self._k):
-            qi, x = float(q_deg[i]), float(motor_deg[i])
+            qi = own_plane_deg(float(q_deg[i]), float(q_deg[1 - i]), self._gains[i])
+            x = float(motor_deg[i])
             if qi - qi == 0.0:
                 watch(kc, qi, dt, self._n_avg)
                 motion(kc, qi, dt, period)
@@ -292,7 +309,7 @@ class OursCompensator:
                 b = self.knobs[i].at(float(motor_deg[1 - i]), kc.fresh, kc.first_side)
                 kc.state = model_step(kc.state, x, b)
                 if kc.fresh:
-                    _fresh_progress(kc)
+                    fresh_progress(kc)
                 kc.out = x
                 kc.hold = 0
                 kc.plan.direction = 0  # a planned crossing is this compensator's own
@@ -334,7 +351,7 @@ class OursCompensator:
         (both tendons slack, the catheter at home): there the knob is never moved on its own."""
         state = kc.state
         y = state.y_deg
-        if kc.plateau_lo_deg - _PLATEAU_MARGIN_DEG <= y <= kc.plateau_hi_deg + _PLATEAU_MARGIN_DEG:
+        if kc.plateau_lo_deg - PLATEAU_MARGIN_DEG <= y <= kc.plateau_hi_deg + PLATEAU_MARGIN_DEG:
             return False
         x = 0.5 * (interp_linear(y, b.falling_deg, b.knots)
                    + interp_linear(y, b.rising_deg, b.knots))
@@ -385,18 +402,6 @@ class OursCompensator:
             horizon_s = 0.5 * (jump / self.v_max + self.v_max / self.a_max)
         kc.hold = d
         return ahead
-
-
-def _fresh_progress(kc: KnobCommand) -> None:
-    """Which side a fresh knob loaded first, and whether its first release has ended."""
-    y = kc.state.y_deg
-    if kc.first_side == 0:
-        if y > kc.plateau_hi_deg + _PLATEAU_MARGIN_DEG:
-            kc.first_side = 1
-        elif y < kc.plateau_lo_deg - _PLATEAU_MARGIN_DEG:
-            kc.first_side = -1
-    elif fresh_state_ends(kc.state, kc.first_side, kc.fresh_hi_deg, kc.fresh_lo_deg):
-        kc.fresh = False
 
 
 def ours_knobs(params: Sequence[TensionPlayParams], interpolation: str = "pchip"

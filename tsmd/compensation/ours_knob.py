@@ -12,10 +12,14 @@ angle's motion, and read as one period it doubled or tripled the velocity estima
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 from tsmd.compensation.planned import PlanHold
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import PlayState
+from tsmd.compensation.tension_play import PlayState, fresh_state_ends
+
+PLATEAU_MARGIN_DEG = 1.0
+"""An output this far beyond the plateaus is off them (a loaded side, not the dead zone)."""
 
 REVERSAL_DEADBAND_DEG = 0.1
 """A desired angle that turns back by less than this is held: an exact inverse would make the
@@ -157,3 +161,33 @@ def motion(kc: KnobCommand, q_raw: float, dt_s: float, period_s: float
     elif kc.held_s > 1.5 * period_s:
         kc.v_raw = kc.accel = 0.0  # standing: the next move starts from rest
     return qi, dq, v
+
+
+def own_plane_deg(q_deg: float, other_q_deg: float, other_tip_gain: float) -> float:
+    """What one knob's model must give for the tip to reach ``q_deg`` in its plane: a shaft
+    that turns the planes into each other adds ``other_tip_gain`` times the other plane's tip
+    angle (the other knob's desired angle: its compensation brings the tip there). Without a
+    gain, or with a non-finite other angle, the desired angle itself."""
+    if other_tip_gain == 0.0 or other_q_deg - other_q_deg != 0.0:
+        return q_deg
+    return q_deg - other_tip_gain * other_q_deg
+
+
+def own_plane_plan(plan_deg: Sequence[Sequence[float]], gains: tuple[float, float]
+                   ) -> list[list[float]]:
+    """A played trajectory's rows as each knob's model must give them (:func:`own_plane_deg`)."""
+    g0, g1 = gains
+    return [[own_plane_deg(float(r[0]), float(r[1]), g0),
+             own_plane_deg(float(r[1]), float(r[0]), g1)] for r in plan_deg]
+
+
+def fresh_progress(kc: KnobCommand) -> None:
+    """Which side a fresh knob loaded first, and whether its first release has ended."""
+    y = kc.state.y_deg
+    if kc.first_side == 0:
+        if y > kc.plateau_hi_deg + PLATEAU_MARGIN_DEG:
+            kc.first_side = 1
+        elif y < kc.plateau_lo_deg - PLATEAU_MARGIN_DEG:
+            kc.first_side = -1
+    elif fresh_state_ends(kc.state, kc.first_side, kc.fresh_hi_deg, kc.fresh_lo_deg):
+        kc.fresh = False

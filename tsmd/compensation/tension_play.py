@@ -36,6 +36,8 @@ BETA_RANGE: tuple[float, float] = (0.0, 0.8)
 """Backlash per knob degree of load: 0 = no backlash; 0.8 = release slope 5 omega."""
 OMEGA_RANGE: tuple[float, float] = (0.2, 5.0)
 """Plausible loaded tip/knob slopes (tip deg per knob deg)."""
+OTHER_TIP_GAIN_RANGE: tuple[float, float] = (-0.5, 0.5)
+"""Plausible tip degrees of one plane per tip degree of the other (a twisted shaft: ~0.09)."""
 _FLAT_SLOPE = 1e-6  # makes the envelopes strictly increasing so that they can be inverted
 _FAR_DEG = 1000.0
 
@@ -53,6 +55,8 @@ class TensionPlayParams:
     first release before the other tendon takes over (:func:`fresh_branches`); 0: not known.
     ``fresh_edge_delay_deg``: how much later (knob deg) its first loading's current edge lies
     than the conditioned one's; from there the tip leaves straight (0) along the loaded slope.
+    ``other_tip_gain``: the product's tip degrees in this plane per tip degree of the other
+    (data sheet, tracked on its unit; 0: the planes do not turn into each other).
     """
 
     omega: float
@@ -70,6 +74,7 @@ class TensionPlayParams:
     fresh_edge_delay_deg: float = 0.0
     shape_pos: LoadedShape | None = None
     shape_neg: LoadedShape | None = None
+    other_tip_gain: float = 0.0
 
     def columns(self) -> NDArray[np.float64]:
         """(n, 6): D_pos, D_neg, beta_pos, beta_neg, x0_pos, x0_neg per grid point."""
@@ -86,8 +91,10 @@ _ROWS: dict[str, tuple[float, float]] = {
 _SCALARS: dict[str, tuple[float, float]] = {
     "omega": OMEGA_RANGE, "height_pos_deg": (-90.0, 90.0), "height_neg_deg": (-90.0, 90.0),
     "lag_s": (0.0, 1.0), "fresh_hold_deg": (0.0, 90.0), "fresh_edge_delay_deg": (-45.0, 45.0),
+    "other_tip_gain": OTHER_TIP_GAIN_RANGE,
 }
-_OPTIONAL = {"lag_s", "fresh_hold_deg", "fresh_edge_delay_deg"}
+_OPTIONAL = {"lag_s", "fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain"}
+_WRITTEN_IF_SET = {"fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain"}
 _SHAPES = {"loaded_shape_pos": "shape_pos", "loaded_shape_neg": "shape_neg"}
 
 
@@ -124,17 +131,18 @@ def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
         raise ValueError("other_knob_deg: needs >= 2 strictly increasing values")
     s = {k: _number(m.get(k, 0.0), k, *r) for k, r in _SCALARS.items()}
     r = {k: _numbers(m[k], k, len(grid), *lim) for k, lim in _ROWS.items()}
+    pos_shape, neg_shape = (shape_from_mapping(m[k], k) if m.get(k) is not None else None
+                            for k in _SHAPES)
     return TensionPlayParams(
         s["omega"], s["height_pos_deg"], s["height_neg_deg"], grid, r["dead_zone_pos_deg"],
         r["dead_zone_neg_deg"], r["backlash_gain_pos"], r["backlash_gain_neg"],
         r["zero_load_pos_deg"], r["zero_load_neg_deg"], s["lag_s"], s["fresh_hold_deg"],
-        s["fresh_edge_delay_deg"],
-        *(shape_from_mapping(m[k], k) if m.get(k) is not None else None for k in _SHAPES))
+        s["fresh_edge_delay_deg"], pos_shape, neg_shape, other_tip_gain=s["other_tip_gain"])
 
 
 def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
     out: dict[str, Any] = {k: float(getattr(p, k)) for k in _SCALARS
-                           if not k.startswith("fresh_") or getattr(p, k) != 0.0}
+                           if k not in _WRITTEN_IF_SET or getattr(p, k) != 0.0}
     out["other_knob_deg"] = list(p.other_knob_deg)
     out.update({k: list(getattr(p, k)) for k in _ROWS})
     for key, attr in _SHAPES.items():

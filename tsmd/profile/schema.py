@@ -14,7 +14,11 @@ import numpy as np
 from tsmd.compensation.grid import INTERPOLATION_METHODS
 from tsmd.compensation.loaded_shape import LoadedShape, shape_from_mapping, shape_to_mapping
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
+from tsmd.compensation.tension_play import (
+    OTHER_TIP_GAIN_RANGE,
+    tension_play_from_mapping,
+    tension_play_to_mapping,
+)
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
     BEND_GAIN_PER_RELEASE_RANGE,
@@ -123,6 +127,8 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_release_rule", "backlash_knee")
+_COUPLING_KEYS = ("other_tip_gain",)
+"""Optional data-sheet numbers of the planes' coupling, written only when measured."""
 
 
 def _shape(r: _Reader, value: Any, where: str) -> LoadedShape | None:
@@ -220,6 +226,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
             reference_rule_backlash_gain=optional(k.get("reference_rule_backlash_gain"),
                                                   "reference_rule_backlash_gain", 0.0, 0.8, ""),
+            other_tip_gain=optional(k.get("other_tip_gain"), "other_tip_gain",
+                                    *OTHER_TIP_GAIN_RANGE, ""),
             **{name: _shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS}))
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))
@@ -266,7 +274,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             shape = getattr(k, key)
             if shape is not None:
                 knobs[name][key] = shape_to_mapping(shape)
-        for key in _RELEASE_RULE_KEYS:
+        for key in _RELEASE_RULE_KEYS + _COUPLING_KEYS:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
     out: dict[str, Any] = {"schema_version": device.schema_version,

@@ -140,6 +140,11 @@ class DeviceKnob:
     by the product's chosen rule and knee (fast calibrations of that unit, ``tsmd
     datasheet``): method ours reads each unit's gain by that rule too and weighs both readings
     by their scatter (:mod:`tsmd.calibration.unit_slope`, session 13)."""
+    other_tip_gain: float | None = None
+    """Optional, tracked on the data-sheet unit: how many degrees this knob's tip plane shows per
+    degree the other plane's tip is bent (a shaft that winds up in torsion turns the planes into
+    each other; the current cannot see it). Method ours aims each knob at its desired angle less
+    this times the other knob's (session 14); None: 0."""
 
 
 @dataclass(frozen=True)

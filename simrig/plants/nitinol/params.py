@@ -28,12 +28,12 @@ class NitinolKnobParams:
     """Handle drum; 5-8 mm on steerable-catheter and TEE handles (knob torques of 0.1-0.2 Nm at
     the paper's and the TEE data's currents)."""
     slack_pos_mm: float = 2.2
-    """Tendon length beyond its path at assembly (crimped by hand): sets the dead zone, 1.9 mm on
-    a 5 mm drum is 22 knob degrees (the paper's and TEE dead zones: 20-30 deg)."""
+    """Tendon length beyond its path at assembly (crimped by hand): sets the dead zone, 2.2 mm on
+    a 5 mm drum is 25 knob degrees (the paper's and TEE dead zones: 20-30 deg)."""
     slack_neg_mm: float = 2.2
     tendon_stiffness_N: float = 16000.0
-    """EA of a 0.45 mm 7x7 stainless wire rope (metallic area ~0.11 mm^2, effective modulus
-    ~110 GPa of a stranded rope)."""
+    """EA of a 0.5-0.55 mm 7x7 stainless wire rope (metallic area ~0.15 mm^2 at the ~110 GPa
+    effective modulus of a stranded rope)."""
     free_length_m: float = 0.15
     """Tendon inside the handle, drum to sheath entry."""
     sheath_length_m: float = 1.0
@@ -41,12 +41,12 @@ class NitinolKnobParams:
     contact_fraction: float = 0.5
     """Where along the sheath the lumped lumen contact sits: the centroid of a uniformly
     distributed contact (not scattered)."""
-    sheath_wrap_deg: float = 300.0
-    """Total turning of the lumen along the insertion tube laid through a pharynx model
-    (90-180 deg of curve plus meander)."""
+    sheath_wrap_deg: float = 250.0
+    """Total turning of the lumen along the insertion tube laid through a pharynx and oesophagus
+    model (90-180 deg of curve, plus the lumen's own helix and meander: 1-2 turns in all)."""
     sheath_friction: float = 0.09
     """Boundary friction of stainless rope on a PTFE liner with silicone lubricant left from
-    assembly (0.04-0.1 for lubricated PTFE/steel pairs)."""
+    assembly (0.04-0.1 for lubricated PTFE/steel pairs; dry 0.1-0.2)."""
     sheath_drag_N: float = 0.4
     """Tension-independent drag of the liner on the rope (lumen ovality preload)."""
     film_damping_N_s_per_mm: float = 0.15
@@ -61,9 +61,9 @@ class NitinolKnobParams:
     bend_length_mm: float = 50.0
     """Steerable section of a TEE probe: 40-60 mm."""
     cover_stiffness_Nm_per_rad: float = 0.007
-    """Links and silicone cover of the bending section in this plane (EI/L of a 12 mm, 1 mm wall
-    silicone sleeve at E 2-5 MPa is 0.01-0.03 Nm/rad); a flat-wire braid makes the planes
-    differ by 10-30 %."""
+    """Links and silicone cover of the bending section in this plane (EI/L of a 12 mm sleeve of
+    0.5 mm wall at E 2-5 MPa: 0.005-0.015 Nm/rad); a flat-wire braid makes the planes differ
+    by 10-30 %."""
     handle_friction_Nm: float = 0.015
     """Knob O-ring and bearing: the flat torque in the dead zone (the paper's current in phase 1
     sits at 10-20 % of its peak)."""
@@ -74,20 +74,21 @@ class NitinolKnobParams:
     catheters and endoscopes: 1.5-4 mm, walls 0.1-0.3 mm)."""
     backbone_id_mm: float = 2.3
     slot_stiffness_factor: float = 0.2
-    """Share of the plain tube's bending stiffness the laser-cut slots leave (20-40 % for the
+    """Share of the plain tube's bending stiffness the laser-cut slots leave (10-40 % for the
     interlocking and staggered cuts of steerable spines); the struts strain as the tube would."""
     austenite_modulus_GPa: float = 55.0
     """Austenite modulus of superelastic NiTi: 40-75 GPa (ASTM F2516 reports 50-70)."""
     upper_plateau_MPa: float = 480.0
     """Loading (austenite -> martensite) plateau at 37 C: 400-550 MPa for medical wire/tube."""
     lower_plateau_MPa: float = 150.0
-    """Unloading (martensite -> austenite) plateau at 37 C: 150-300 MPa."""
+    """Unloading (martensite -> austenite) plateau at 37 C: 150-300 MPa (a wide flag: the
+    tube's loop is large)."""
     transformation_strain: float = 0.045
     """Plateau length in strain: 4-6 %."""
     plateau_hardening: float = 0.1
-    """Rise of the plateau moment per unit transformed fraction, over its onset moment: a tube's
-    moment keeps rising as the transformed shell grows inward (Berg 1995; tubes in bending show
-    a sloped, not flat, plateau)."""
+    """Rise of the plateau moment per unit transformed fraction, over its onset moment: in
+    bending the moment keeps rising on the plateau as the transformed shell grows inward
+    (a tube's plastic-to-elastic section moduli differ by 5-30 %)."""
     clausius_clapeyron_MPa_per_K: float = 6.5
     """dSigma/dT of both plateaus: 5-8 MPa/K for NiTi (Clausius-Clapeyron)."""
 

@@ -148,8 +148,8 @@ class NitinolPlant:
             else:  # the kept end's value halved (Illinois): no stalling on one side
                 f0 *= 0.5
             x1, f1 = x2, f2
-        _, x, k.u_mm, k.tension_N = best
-        return x
+        _, k.bend_rad, k.u_mm, k.tension_N = best
+        return k.bend_rad
 
 
 def make_nitinol_plant(knobs: Sequence[Mapping[str, Any]] | None = None,

@@ -13,7 +13,8 @@ held-out set: tune on the first, report the second. The capstan plant is the dev
 the lumped plant is held out, the segments plant (written blind in session 9) is held out now,
 the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11,
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
-plant (session 13) was written blind and tsmd was run on it untuned (``PLANT_ROLE``).
+plant (session 13) is held out now, the nitinol plant (session 14) was written blind and tsmd was
+run on it untuned (``PLANT_ROLE``). ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
 from __future__ import annotations
@@ -25,11 +26,13 @@ from typing import Any
 
 import numpy as np
 
+from simrig.family_scatter import SCATTER
 from simrig.motor import MotorParams
 from simrig.plant import Plant, PlantLoadError, load_plant
 from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
 from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
+from simrig.plants.nitinol import NOMINAL_KNOBS as NITINOL_KNOBS
 from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
 from simrig.plants.stickslip import NOMINAL_KNOBS as STICKSLIP_KNOBS
@@ -43,179 +46,24 @@ PLANT_SPECS: dict[str, str] = {
     "coilpipe": "simrig.plants.coilpipe:make_coilpipe_plant",
     "stickslip": "simrig.plants.stickslip:make_stickslip_plant",
     "twistshaft": "simrig.plants.twistshaft:make_twistshaft_plant",
-    "screwrod": "simrig.plants.screwrod:make_screwrod_plant",  # last: the others' seeds hold
+    "screwrod": "simrig.plants.screwrod:make_screwrod_plant",
+    "nitinol": "simrig.plants.nitinol:make_nitinol_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
-              "screwrod": "blind"}
+              "screwrod": "held-out", "nitinol": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
 
-SCATTER: dict[str, dict[str, float]] = {
-    "capstan": {
-        "pulley_radius_mm": 0.02,  # machined part
-        "slack_pos_mm": 0.15,  # assembly: tendon cut and crimped by hand
-        "slack_neg_mm": 0.15,
-        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
-        "tendon_stiffness_N": 0.15,  # tendon lot (EA)
-        "sheath_length_m": 0.02,
-        "free_length_m": 0.20,
-        "sheath_friction": 0.15,  # coating, lubricant
-        "sheath_wrap_deg": 0.10,  # coil pitch
-        "routing_wrap_deg": 0.10,
-        "routing_friction": 0.15,
-        "sheath_drag_N": 0.20,
-        "bend_stiffness_Nm_per_rad": 0.15,  # polymer cover, links
-        "bend_friction_Nm": 0.20,
-        "handle_friction_Nm": 0.20,  # knob bearing / brake setting
-        "handle_stiction_Nm": 0.20,
-        "handle_slip_deg": 0.20,
-    },
-    "lumped": {
-        "pulley_radius_mm": 0.02,
-        "slack_pos_mm": 0.15,
-        "slack_neg_mm": 0.15,
-        "toe_mm": 0.20,
-        "tendon_stiffness_N": 0.15,
-        "sheath_length_m": 0.02,
-        "free_length_m": 0.20,
-        "guide_wrap_deg": 0.10,
-        "guide_friction": 0.15,
-        "sheath_wrap_deg": 0.10,
-        "sheath_friction": 0.15,
-        "sheath_drag_N": 0.20,
-        "presliding_mm": 0.20,
-        "tendon_offset_mm": 0.05,
-        "bend_stiffness_Nm_per_rad": 0.15,
-        "bend_friction_Nm": 0.20,
-        "bend_presliding_deg": 0.20,
-        "handle_friction_Nm": 0.20,
-        "handle_presliding_deg": 0.20,
-    },
-    "segments": {
-        "pulley_radius_mm": 0.02,  # machined part
-        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
-        "slack_neg_mm": 0.15,
-        "toe_mm": 0.20,  # crimp geometry
-        "tendon_stiffness_N": 0.15,  # tendon lot (EA)
-        "free_length_m": 0.20,  # handle assembly
-        "sheath_length_m": 0.02,  # cut to length
-        "sheath_friction": 0.15,  # liner coating, lubricant
-        "sheath_wrap_deg": 0.10,  # lumen helix pitch
-        "sheath_drag_N": 0.20,  # lumen preload
-        "presliding_mm": 0.20,  # contact micro-geometry
-        "stick_fraction": 0.10,
-        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
-        "bend_stiffness_Nm_per_rad": 0.15,  # polymer cover, links
-        "bend_stiffening_per_rad2": 0.20,
-        "bend_hysteresis_Nm": 0.20,  # link rubbing
-        "bend_yield_deg": 0.20,
-        "handle_friction_Nm": 0.20,  # knob bearing / brake setting
-        "handle_presliding_deg": 0.20,
-    },
-    "coilpipe": {
-        "pulley_radius_mm": 0.02,  # machined drum
-        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
-        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
-        "slack_neg_mm": 0.15,
-        "toe_mm": 0.20,  # crimp and strand lay
-        "tendon_stiffness_N": 0.15,  # cable lot (EA)
-        "free_length_m": 0.20,  # handle assembly
-        "sheath_length_m": 0.02,  # cut to length
-        "sheath_friction": 0.15,  # liner coating, lubricant
-        "sheath_wrap_deg": 0.10,  # lumen helix pitch
-        "sheath_drag_N": 0.25,  # liner preload on the cable
-        "stribeck_ratio": 0.05,  # static/kinetic ratio of the liner (1.24-1.37 at 1.3)
-        "stribeck_speed_mm_s": 0.30,  # lubricant film: the least known of the friction constants
-        "viscous_N_s_per_mm": 0.30,  # lubricant amount and viscosity
-        "presliding_mm": 0.20,  # contact micro-geometry
-        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
-        "bend_creep_stiffness_Nm_per_rad": 0.25,  # polymer batch, moulding
-        "bend_creep_time_s": 0.30,
-        "handle_friction_Nm": 0.20,  # knob bearing / detent setting
-        "handle_presliding_deg": 0.20,
-        "gear_backlash_deg": 0.30,  # adapter tooth play (tolerance stack of two parts)
-        "gear_stiffness_Nm_per_deg": 0.20,  # adapter material and fit
-    },
-    "stickslip": {
-        "pulley_radius_mm": 0.02,  # machined drum
-        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
-        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
-        "slack_neg_mm": 0.15,
-        "toe_mm": 0.20,  # crimp and braid lay
-        "tendon_stiffness_N": 0.15,  # braid lot (EA)
-        "creep_fast_share": 0.20,  # polymer lot and braid tension: relaxation scatters widely
-        "creep_fast_time_s": 0.30,
-        "creep_slow_share": 0.20,
-        "creep_slow_time_s": 0.30,
-        "free_length_pos_m": 0.20,  # handle assembly
-        "free_length_neg_m": 0.20,
-        "sheath_length_m": 0.02,  # cut to length
-        "sheath_wrap_deg": 0.10,  # lumen helix pitch
-        "sheath_friction": 0.15,  # liner coating, lubricant
-        "stiction_ratio": 0.05,  # one material pair
-        "sheath_drag_N": 0.20,  # liner preload
-        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
-        "bend_stiffening_per_rad2": 0.20,  # cover strain-hardening, polymer batch
-        "tip_mass_g": 0.10,  # transducer head and links
-        "tip_length_mm": 0.03,  # moulded links
-        "drive_stiffness_Nm_per_rad": 0.20,  # cable tension set at assembly, coupling fit
-        "handle_friction_Nm": 0.25,  # knob brake as left by the last user: the least controlled
-        "brake_stiction_ratio": 0.05,  # one pad material
-    },
-    "twistshaft": {
-        "pulley_radius_mm": 0.02,  # machined drum
-        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
-        "lumen_angle_error_deg": 0.50,  # angular tolerance of the extrusion die (1-3 deg)
-        "lumen_helix_deg": 0.30,  # extrusion twist: the least controlled geometry
-        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
-        "slack_neg_mm": 0.15,
-        "toe_mm": 0.20,  # braid lay and crimp
-        "tendon_stiffness_N": 0.15,  # braid lot (EA)
-        "free_length_m": 0.20,  # handle assembly
-        "sheath_length_m": 0.02,  # cut to length
-        "bend_length_mm": 0.05,  # moulded links
-        "sheath_wrap_deg": 0.10,  # lumen path in the shaft
-        "sheath_friction": 0.15,  # liner coating, lubricant
-        "friction_exponent": 0.05,  # one material pair (0.67-0.9 over materials)
-        "contact_load_N": 0.25,  # surface roughness of the liner
-        "sheath_drag_N": 0.20,  # lumen preload
-        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
-        "handle_friction_Nm": 0.20,  # knob bearing / O-ring
-        "handle_presliding_deg": 0.20,
-    },
-    "screwrod": {
-        "screw_lead_mm": 0.01,  # moulded collar thread
-        "screw_radius_mm": 0.01,
-        "thread_friction": 0.15,  # dry polymer thread, grease left from assembly
-        "handle_friction_Nm": 0.20,  # O-ring squeeze
-        "handle_presliding_deg": 0.20,  # thread flank fit
-        "slack_pos_mm": 0.15,  # tendon cut and knotted to its nut by hand
-        "slack_neg_mm": 0.15,
-        "toe_mm": 0.20,  # braid lay
-        "tendon_stiffness_N": 0.15,  # braid lot (EA)
-        "creep_limit_mm": 0.30,  # UHMWPE creep: lot and braid heat-setting scatter widely
-        "creep_time_s": 0.30,
-        "free_length_m": 0.20,  # handle assembly
-        "sheath_length_m": 0.02,  # cut to length
-        "sheath_wrap_deg": 0.10,  # lumen path in the shaft
-        "sheath_friction": 0.15,  # liner coating, lubricant
-        "sheath_drag_N": 0.20,  # lumen preload
-        "presliding_mm": 0.20,  # liner and braid compliance
-        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
-        "bend_length_mm": 0.03,  # moulded links
-        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and braid
-    },
-}
-"""Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""
 
 _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMPED_KNOBS,
                                         "segments": SEGMENTS_KNOBS,
                                         "coilpipe": COILPIPE_KNOBS,
                                         "stickslip": STICKSLIP_KNOBS,
                                         "twistshaft": TWISTSHAFT_KNOBS,
-                                        "screwrod": SCREWROD_KNOBS}
+                                        "screwrod": SCREWROD_KNOBS,
+                                        "nitinol": NITINOL_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -269,6 +117,8 @@ VARIANTS: dict[str, Variant] = {
                            "handle_friction_Nm": 1.5},
             "screwrod": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                          "handle_friction_Nm": 1.5, "thread_friction": 1.2},
+            "nitinol": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                        "handle_friction_Nm": 1.5, "film_damping_N_s_per_mm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -289,7 +139,8 @@ VARIANTS: dict[str, Variant] = {
                  "coilpipe": {"tendon_stiffness_N": 0.4},
                  "stickslip": {"tendon_stiffness_N": 0.4},
                  "twistshaft": {"tendon_stiffness_N": 0.4},
-                 "screwrod": {"tendon_stiffness_N": 0.4}},
+                 "screwrod": {"tendon_stiffness_N": 0.4},
+                 "nitinol": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

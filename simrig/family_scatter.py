@@ -1,0 +1,192 @@
+"""Unit-to-unit scatter of every built-in plant's constants (used by :mod:`simrig.family`).
+
+Relative half-range of a uniform draw around the nominal value, per plant and constant, with
+why it scatters that much; a plant's table lists only the constants a unit draws (the others
+are the product's design).
+"""
+
+from __future__ import annotations
+
+SCATTER: dict[str, dict[str, float]] = {
+    "capstan": {
+        "pulley_radius_mm": 0.02,  # machined part
+        "slack_pos_mm": 0.15,  # assembly: tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "tendon_stiffness_N": 0.15,  # tendon lot (EA)
+        "sheath_length_m": 0.02,
+        "free_length_m": 0.20,
+        "sheath_friction": 0.15,  # coating, lubricant
+        "sheath_wrap_deg": 0.10,  # coil pitch
+        "routing_wrap_deg": 0.10,
+        "routing_friction": 0.15,
+        "sheath_drag_N": 0.20,
+        "bend_stiffness_Nm_per_rad": 0.15,  # polymer cover, links
+        "bend_friction_Nm": 0.20,
+        "handle_friction_Nm": 0.20,  # knob bearing / brake setting
+        "handle_stiction_Nm": 0.20,
+        "handle_slip_deg": 0.20,
+    },
+    "lumped": {
+        "pulley_radius_mm": 0.02,
+        "slack_pos_mm": 0.15,
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,
+        "tendon_stiffness_N": 0.15,
+        "sheath_length_m": 0.02,
+        "free_length_m": 0.20,
+        "guide_wrap_deg": 0.10,
+        "guide_friction": 0.15,
+        "sheath_wrap_deg": 0.10,
+        "sheath_friction": 0.15,
+        "sheath_drag_N": 0.20,
+        "presliding_mm": 0.20,
+        "tendon_offset_mm": 0.05,
+        "bend_stiffness_Nm_per_rad": 0.15,
+        "bend_friction_Nm": 0.20,
+        "bend_presliding_deg": 0.20,
+        "handle_friction_Nm": 0.20,
+        "handle_presliding_deg": 0.20,
+    },
+    "segments": {
+        "pulley_radius_mm": 0.02,  # machined part
+        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # crimp geometry
+        "tendon_stiffness_N": 0.15,  # tendon lot (EA)
+        "free_length_m": 0.20,  # handle assembly
+        "sheath_length_m": 0.02,  # cut to length
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "sheath_wrap_deg": 0.10,  # lumen helix pitch
+        "sheath_drag_N": 0.20,  # lumen preload
+        "presliding_mm": 0.20,  # contact micro-geometry
+        "stick_fraction": 0.10,
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "bend_stiffness_Nm_per_rad": 0.15,  # polymer cover, links
+        "bend_stiffening_per_rad2": 0.20,
+        "bend_hysteresis_Nm": 0.20,  # link rubbing
+        "bend_yield_deg": 0.20,
+        "handle_friction_Nm": 0.20,  # knob bearing / brake setting
+        "handle_presliding_deg": 0.20,
+    },
+    "coilpipe": {
+        "pulley_radius_mm": 0.02,  # machined drum
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # crimp and strand lay
+        "tendon_stiffness_N": 0.15,  # cable lot (EA)
+        "free_length_m": 0.20,  # handle assembly
+        "sheath_length_m": 0.02,  # cut to length
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "sheath_wrap_deg": 0.10,  # lumen helix pitch
+        "sheath_drag_N": 0.25,  # liner preload on the cable
+        "stribeck_ratio": 0.05,  # static/kinetic ratio of the liner (1.24-1.37 at 1.3)
+        "stribeck_speed_mm_s": 0.30,  # lubricant film: the least known of the friction constants
+        "viscous_N_s_per_mm": 0.30,  # lubricant amount and viscosity
+        "presliding_mm": 0.20,  # contact micro-geometry
+        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
+        "bend_creep_stiffness_Nm_per_rad": 0.25,  # polymer batch, moulding
+        "bend_creep_time_s": 0.30,
+        "handle_friction_Nm": 0.20,  # knob bearing / detent setting
+        "handle_presliding_deg": 0.20,
+        "gear_backlash_deg": 0.30,  # adapter tooth play (tolerance stack of two parts)
+        "gear_stiffness_Nm_per_deg": 0.20,  # adapter material and fit
+    },
+    "stickslip": {
+        "pulley_radius_mm": 0.02,  # machined drum
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # crimp and braid lay
+        "tendon_stiffness_N": 0.15,  # braid lot (EA)
+        "creep_fast_share": 0.20,  # polymer lot and braid tension: relaxation scatters widely
+        "creep_fast_time_s": 0.30,
+        "creep_slow_share": 0.20,
+        "creep_slow_time_s": 0.30,
+        "free_length_pos_m": 0.20,  # handle assembly
+        "free_length_neg_m": 0.20,
+        "sheath_length_m": 0.02,  # cut to length
+        "sheath_wrap_deg": 0.10,  # lumen helix pitch
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "stiction_ratio": 0.05,  # one material pair
+        "sheath_drag_N": 0.20,  # liner preload
+        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
+        "bend_stiffening_per_rad2": 0.20,  # cover strain-hardening, polymer batch
+        "tip_mass_g": 0.10,  # transducer head and links
+        "tip_length_mm": 0.03,  # moulded links
+        "drive_stiffness_Nm_per_rad": 0.20,  # cable tension set at assembly, coupling fit
+        "handle_friction_Nm": 0.25,  # knob brake as left by the last user: the least controlled
+        "brake_stiction_ratio": 0.05,  # one pad material
+    },
+    "twistshaft": {
+        "pulley_radius_mm": 0.02,  # machined drum
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "lumen_angle_error_deg": 0.50,  # angular tolerance of the extrusion die (1-3 deg)
+        "lumen_helix_deg": 0.30,  # extrusion twist: the least controlled geometry
+        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # braid lay and crimp
+        "tendon_stiffness_N": 0.15,  # braid lot (EA)
+        "free_length_m": 0.20,  # handle assembly
+        "sheath_length_m": 0.02,  # cut to length
+        "bend_length_mm": 0.05,  # moulded links
+        "sheath_wrap_deg": 0.10,  # lumen path in the shaft
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "friction_exponent": 0.05,  # one material pair (0.67-0.9 over materials)
+        "contact_load_N": 0.25,  # surface roughness of the liner
+        "sheath_drag_N": 0.20,  # lumen preload
+        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
+        "handle_friction_Nm": 0.20,  # knob bearing / O-ring
+        "handle_presliding_deg": 0.20,
+    },
+    "screwrod": {
+        "screw_lead_mm": 0.01,  # moulded collar thread
+        "screw_radius_mm": 0.01,
+        "thread_friction": 0.15,  # dry polymer thread, grease left from assembly
+        "handle_friction_Nm": 0.20,  # O-ring squeeze
+        "handle_presliding_deg": 0.20,  # thread flank fit
+        "slack_pos_mm": 0.15,  # tendon cut and knotted to its nut by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # braid lay
+        "tendon_stiffness_N": 0.15,  # braid lot (EA)
+        "creep_limit_mm": 0.30,  # UHMWPE creep: lot and braid heat-setting scatter widely
+        "creep_time_s": 0.30,
+        "free_length_m": 0.20,  # handle assembly
+        "sheath_length_m": 0.02,  # cut to length
+        "sheath_wrap_deg": 0.10,  # lumen path in the shaft
+        "sheath_friction": 0.15,  # liner coating, lubricant
+        "sheath_drag_N": 0.20,  # lumen preload
+        "presliding_mm": 0.20,  # liner and braid compliance
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "bend_length_mm": 0.03,  # moulded links
+        "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and braid
+    },
+    "nitinol": {
+        "pulley_radius_mm": 0.02,  # machined drum
+        "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "tendon_stiffness_N": 0.10,  # wire-rope lot (EA: steel scatters less than polymer)
+        "free_length_m": 0.20,  # handle assembly
+        "sheath_length_m": 0.02,  # cut to length
+        "sheath_wrap_deg": 0.10,  # lumen path in the shaft
+        "sheath_friction": 0.15,  # liner and how much lubricant assembly left
+        "sheath_drag_N": 0.20,  # lumen ovality
+        "film_damping_N_s_per_mm": 0.30,  # lubricant amount and viscosity: the least controlled
+        "tendon_offset_mm": 0.05,  # lumen placement in the moulding
+        "offset_ratio_neg": 0.03,  # the second lumen against the first (one mould)
+        "bend_length_mm": 0.03,  # laser-cut spine length
+        "cover_stiffness_Nm_per_rad": 0.15,  # silicone cover and braid
+        "handle_friction_Nm": 0.20,  # knob O-ring squeeze
+        "handle_presliding_deg": 0.20,
+        "backbone_od_mm": 0.003,  # drawn NiTi tube: +-0.01 mm on 2 mm (the tube is one part:
+        "backbone_id_mm": 0.003,  # the plant takes the mean of the two knobs' draws)
+        "slot_stiffness_factor": 0.10,  # laser kerf width
+        "austenite_modulus_GPa": 0.10,  # heat treatment of the lot
+        "upper_plateau_MPa": 0.06,  # Af of the lot (+-3 K at 6.5 MPa/K) and processing
+        "lower_plateau_MPa": 0.10,  # the lower plateau scatters more than the upper
+        "transformation_strain": 0.10,
+        "plateau_hardening": 0.20,  # cut pattern and texture
+    },
+}
+"""Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""

@@ -104,6 +104,9 @@ class SweepResult:
     own_half_cycles: int | None = None
     """How many of ``half_cycles`` (the first) index ``data``; the re-sweeps' index their own
     recordings (None: all of them)."""
+    offset_u95_deg: dict[str, float] = field(default_factory=dict)
+    """Per parameter the 95 % half-width of the product's reading offset subtracted from its
+    values (:mod:`tsmd.calibration.reading_offset`); none subtracted: absent."""
 
     @property
     def data_half_cycles(self) -> tuple[HalfCycle, ...]:
@@ -124,7 +127,7 @@ class SweepResult:
         values = {name: self.values.get(name, ()) + other.values.get(name, ())
                   for name in PARAMETERS}
         return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
-                           self.resweeps + 1, len(self.data_half_cycles))
+                           self.resweeps + 1, len(self.data_half_cycles), self.offset_u95_deg)
 
     @property
     def snr(self) -> float:

@@ -45,6 +45,7 @@ from tsmd.calibration.player import (
 )
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import paper_protocol, sweep_run
+from tsmd.calibration.reading_offset import corrected
 from tsmd.calibration.resweep import (
     budget_spent_note,
     pool_repeats,
@@ -101,7 +102,8 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
                           k.backlash_settle_lag_deg, k.backlash_release_line_share,
                           k.backlash_release_rule, k.backlash_release_local_share)
         # the product's knee (tsmd datasheet) where the sheet turns it on
-        chosen.append(replace(one, backlash_knee=True) if k.backlash_knee else one)
+        one = replace(one, backlash_knee=True) if k.backlash_knee else one
+        chosen.append(replace(one, reading_offset=k.reading_offset))
     return chosen[0], chosen[1]
 
 
@@ -142,7 +144,8 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
                                 sweep_start_s=start_s)
     except CalibrationError as exc:
         raise CalibrationError(f"{source} ({KNOB_LABELS[knob]} sweep): {exc}") from None
-    return GridPoint(knob, other, result, rec)
+    return GridPoint(knob, other, corrected(result, opts.reading_offset if opts else None,
+                                            other), rec)
 
 
 def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,

@@ -33,6 +33,7 @@ from tsmd.datasheet import (
     swept_knob,
 )
 from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
+from tsmd.datasheet_offset import with_reading_offset
 from tsmd.datasheet_rule import (
     RULE_NOISE_SEEDS,
     choose_knee,
@@ -41,6 +42,7 @@ from tsmd.datasheet_rule import (
     sheet_truth,
 )
 from tsmd.profile import DeviceModel, save_device_model
+from tsmd.profile.reading_offset import ReadingOffset
 from tsmd.recording import read_recording
 
 
@@ -118,7 +120,8 @@ def _rule_seeds(text: str) -> list[int]:
 
 def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
                  params: dict[str, Any], seeds: list[int]) -> DeviceModel:
-    """The sheet with each knob's backlash rule, chosen on its own unit's calibrations."""
+    """The sheet with each knob's backlash rule, chosen on its own unit's calibrations, and
+    the product's reading offset measured with that rule."""
     unit = config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=params))
     t0 = time.monotonic()
     truth = sheet_truth(unit)
@@ -131,7 +134,25 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
               f"{','.join(map(str, seeds))}: {mine}; with the knee: {knee[knob].text()} -> "
               f"{k.backlash_release_rule}, knee {'on' if k.backlash_knee else 'off'}")
     print(f"  rule choice: {time.monotonic() - t0:.0f} s")
+    t0 = time.monotonic()
+    chosen, _ = with_reading_offset(chosen, unit, truth, seeds)
+    for name, k in zip(("phi1", "phi2"), chosen.knobs, strict=True):
+        print(f"{name} reading offset (current minus tip, deg, at the other knob's "
+              f"{_angles(k.reading_offset)}): {_offsets(k.reading_offset)}")
+    print(f"  reading offset: {time.monotonic() - t0:.0f} s")
     return chosen
+
+
+def _angles(offset: ReadingOffset | None) -> str:
+    return "none" if offset is None else "/".join(f"{a:+.0f}" for a in offset.other_knob_deg)
+
+
+def _offsets(offset: ReadingOffset | None) -> str:
+    if offset is None:
+        return "none"
+    return "; ".join(f"{name} " + " ".join(f"{m:+.2f}+-{u:.2f}" for m, u in
+                                           zip(g.mean_deg, g.u95_deg, strict=True))
+                     for name, g in offset.grids)
 
 
 def _with_bend(device: DeviceModel, config: TsmdConfig,

@@ -15,6 +15,7 @@ from tsmd.compensation.grid import INTERPOLATION_METHODS
 from tsmd.compensation.loaded_shape import LoadedShape, shape_from_mapping, shape_to_mapping
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
+from tsmd.profile.reading_offset import ReadingOffset, offset_from_mapping, offset_to_mapping
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
     BEND_GAIN_PER_RELEASE_RANGE,
@@ -134,6 +135,15 @@ def _shape(r: _Reader, value: Any, where: str) -> LoadedShape | None:
         raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
 
 
+def _offset(r: _Reader, value: Any, where: str) -> ReadingOffset | None:
+    if value is None:
+        return None
+    try:
+        return offset_from_mapping(value, where)
+    except ValueError as exc:
+        raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
+
+
 def _release_rule(r: _Reader, k: Mapping[str, Any], key: str) -> str | None:
     value = k.get("backlash_release_rule")
     if value is None:
@@ -220,6 +230,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
             reference_rule_backlash_gain=optional(k.get("reference_rule_backlash_gain"),
                                                   "reference_rule_backlash_gain", 0.0, 0.8, ""),
+            reading_offset=_offset(r, k.get("reading_offset"), f"{key}.reading_offset"),
             **{name: _shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS}))
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))
@@ -269,6 +280,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         for key in _RELEASE_RULE_KEYS:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
+        if k.reading_offset is not None:
+            knobs[name]["reading_offset"] = offset_to_mapping(k.reading_offset)
     out: dict[str, Any] = {"schema_version": device.schema_version,
                            "device_model": device.device_model,
                            "description": device.description, "knobs": knobs}

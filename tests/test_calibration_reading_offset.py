@@ -12,9 +12,9 @@ import pytest
 from support.profiles import DEVICE as DEVICE_PATH
 
 from tsmd.calibration.estimate import point_estimates
-from tsmd.calibration.identify import SweepResult
 from tsmd.calibration.reading_offset import corrected, offset_at
 from tsmd.calibration.run import device_options
+from tsmd.calibration.sweep_result import SweepResult
 from tsmd.datasheet_offset import offset_readings, reading_offsets
 from tsmd.profile import (
     ProfileError,

@@ -17,8 +17,8 @@ from collections import defaultdict
 from collections.abc import Sequence
 
 from tsmd.calibration.estimate import point_estimates
-from tsmd.calibration.identify import PARAMETERS, SweepResult
 from tsmd.calibration.protocol import fast_protocol
+from tsmd.calibration.sweep_result import PARAMETERS, SweepResult
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_rule import Truth
 from tsmd.profile import DeviceModel

@@ -27,8 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from tsmd.calibration.identify import PARAMETERS, SweepResult
 from tsmd.calibration.signal import walsh_median
+from tsmd.calibration.sweep_result import PARAMETERS, SweepResult
 
 MIN_ROBUST = 4
 """From this many half-cycles on, a sweep's own scatter is taken robustly (MAD)."""

@@ -16,7 +16,7 @@ import dataclasses
 
 import numpy as np
 
-from tsmd.calibration.identify import SweepResult
+from tsmd.calibration.sweep_result import SweepResult
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 
 MIN_OFFSET_DEG = 1.0

@@ -68,8 +68,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "
                              "each backlash rule; the better rule per knob goes into the sheet "
-                             "(docs/calibration.md, session 11; 'none': no choice, the sheet "
-                             "keeps the rule its shares imply)")
+                             "(docs/calibration.md, session 11), then the unit calibrated with "
+                             "it once per seed gives the product's reading offset (session 14; "
+                             "'none': no choice and no offset, the sheet keeps the rule its "
+                             "shares imply)")
     parser.add_argument("--bend-relation", action="store_true",
                         help="with --plant: also calibrate the unit straight and with its sheath "
                              "bent 30/60/90 deg and write the product's bend relation for online "

@@ -32,11 +32,12 @@ from tsmd.calibration import (
 )
 from tsmd.calibration.assemble import GridPoint, QualityReport, check_quality, cross_check_device
 from tsmd.calibration.errors import CalibrationRefusedError
-from tsmd.calibration.identify import IdentifyOptions, SweepResult
+from tsmd.calibration.identify import IdentifyOptions
 from tsmd.calibration.player import sweep_metadata
 from tsmd.calibration.protocol import sweep_run
 from tsmd.calibration.run import _Identifier, finish, run_sweeps
 from tsmd.calibration.signal import condition, lowpass
+from tsmd.calibration.sweep_result import SweepResult
 from tsmd.config import default_sim_config
 from tsmd.profile import ProfileStore, load_device_model
 from tsmd.recording import Recording, read_recording, write_recording

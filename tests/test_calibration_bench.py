@@ -6,7 +6,7 @@ import math
 
 from tsmd.bench.calibration_family import CatheterRun, family_table
 from tsmd.calibration.assemble import GridPoint
-from tsmd.calibration.identify import PARAMETERS, SweepResult
+from tsmd.calibration.sweep_result import PARAMETERS, SweepResult
 from tsmd.tracked_calibration import ProtocolRun, score
 
 GRID = (-90.0, -60.0, -30.0, 0.0, 30.0, 60.0, 90.0)

@@ -14,7 +14,7 @@ from support.calibration import sweep_recording
 from tsmd.calibration import CalibrationError, Sweep, identify_sweep
 from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.health import check_slips, find_slip
-from tsmd.calibration.identify import SweepResult
+from tsmd.calibration.sweep_result import SweepResult
 from tsmd.recording import Recording
 
 SWEEP = Sweep(0, 0.0, 90.0, 0.1, 2.0, "triangle")

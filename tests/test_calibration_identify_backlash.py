@@ -26,7 +26,7 @@ import pytest
 
 from tsmd.calibration import CalibrationError, identify_sweep
 from tsmd.calibration.assemble import GridPoint, check_quality
-from tsmd.calibration.identify import SweepResult
+from tsmd.calibration.sweep_result import SweepResult
 
 RATE_HZ = 250.0
 AMPLITUDE_DEG = 90.0

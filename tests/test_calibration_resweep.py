@@ -28,11 +28,11 @@ from tsmd.calibration import run as run_module
 from tsmd.calibration.assemble import GridPoint, check_quality
 from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.calibration.estimate import estimate, point_estimates, pooled_sigma
-from tsmd.calibration.identify import PARAMETERS, HalfCycle, SweepResult
 from tsmd.calibration.protocol import fast_protocol, paper_protocol
 from tsmd.calibration.report import _plot_currents
-from tsmd.calibration.resweep import uncertain_points
+from tsmd.calibration.resweep import Choice, Uncertain, choose_resweep, uncertain_points
 from tsmd.calibration.signal import Conditioned
+from tsmd.calibration.sweep_result import PARAMETERS, HalfCycle, SweepResult
 from tsmd.profile import ProfileStore, load_device_model
 
 PERIOD_S = 0.004
@@ -253,3 +253,19 @@ def test_the_report_plots_a_resweeps_half_cycles_only_on_their_own_recording(
     assert merged.data_half_cycles == first.half_cycles
     _plot_currents(plt, [GridPoint(0, 0.0, merged)], tmp_path / "currents.png")
     assert (tmp_path / "currents.png").exists()
+
+
+def test_beyond_the_resweep_budget_only_a_point_that_would_refuse_is_swept_again() -> None:
+    todo = [Uncertain(0, ("backlash_pos_deg",), 4.0, 1.0),
+            Uncertain(1, ("backlash_neg_deg",), 6.0, 0.5)]
+
+    def choose(spent_s: float) -> Choice:
+        return choose_resweep(todo, spent_s, lambda i: 25.0, 50.0, 100.0, 5.0)
+
+    within = choose(0.0)
+    assert within.point is todo[0] and not within.rescue
+    rescued = choose(50.0)
+    assert rescued.point is todo[1] and rescued.rescue
+    spent = choose(140.0)
+    assert spent.point is None and spent.budget_s == 150.0
+    assert choose_resweep(todo[:1], 50.0, lambda i: 25.0, 50.0, 100.0, 5.0).point is None

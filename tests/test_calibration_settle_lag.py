@@ -9,14 +9,10 @@ from functools import cache
 import numpy as np
 import pytest
 
-from tsmd.calibration.identify import (
-    HalfCycle,
-    analyse_half_cycle,
-    settle_rule_backlash,
-    split_half_cycles,
-)
+from tsmd.calibration.identify import analyse_half_cycle, settle_rule_backlash, split_half_cycles
 from tsmd.calibration.options import SETTLED_FRACTION, IdentifyOptions, for_product
 from tsmd.calibration.signal import Conditioned
+from tsmd.calibration.sweep_result import HalfCycle
 
 
 @cache

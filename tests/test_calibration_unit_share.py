@@ -9,15 +9,11 @@ from functools import cache
 import numpy as np
 import pytest
 
-from tsmd.calibration.identify import (
-    HalfCycle,
-    analyse_half_cycle,
-    split_half_cycles,
-    unit_share_backlash,
-)
+from tsmd.calibration.identify import analyse_half_cycle, split_half_cycles, unit_share_backlash
 from tsmd.calibration.options import SHARE_PER_SLOPE_RATIO, IdentifyOptions, for_product
 from tsmd.calibration.release import release_slope_ratio
 from tsmd.calibration.signal import Conditioned
+from tsmd.calibration.sweep_result import HalfCycle
 
 LOADED_SLOPE_A_PER_DEG = 0.02
 EDGE_TRAVEL_DEG = 120.0

@@ -42,7 +42,7 @@ from tsmd.profile import (
     device_model_from_mapping,
     device_model_to_mapping,
 )
-from tsmd.profile.schema import plain_values
+from tsmd.profile.schema import OPTIONAL_KNOB_RANGES, plain_values
 from tsmd.recording import Recording
 from tsmd.replay import run_trajectory
 from tsmd.stack import knob_limits
@@ -328,30 +328,27 @@ def device_model(name: str, constants: Sequence[KnobConstants], config: TsmdConf
     return DeviceModel(name, (knobs[0], knobs[1]), description)
 
 
-OPTIONAL_READS = tuple(f.name for f in dataclasses.fields(DeviceKnob) if f.default is None)
-"""The sheet's measured values a device model may lack (the schema reads them when present)."""
-
-
 def readable(device: DeviceModel) -> tuple[DeviceModel, list[str]]:
-    """The sheet as the schema will read it back: a measured optional value the schema refuses
-    is left out and named, so the rules that need it are no candidates, instead of the whole
-    measurement being lost when the file is written. A refusal of anything else is an error."""
+    """The sheet as the schema will read it back: a measured optional value outside the
+    schema's range for it (:data:`tsmd.profile.schema.OPTIONAL_KNOB_RANGES`) is left out and
+    named, so the rules that need it are no candidates, instead of the whole measurement being
+    lost when the file is written. A refusal of anything else is an error."""
     dropped: list[str] = []
-    for _ in range(2 * len(OPTIONAL_READS) + 1):
-        try:
-            device_model_from_mapping(plain_values(device_model_to_mapping(device)), "sheet")
-            return device, dropped
-        except ProfileError as exc:
-            message = str(exc).removeprefix("sheet: ")
-            hit = next(((i, name) for i, knob in enumerate(device.knobs)
-                        for name in OPTIONAL_READS
-                        if message.startswith(f"knobs.{KNOB_NAMES[i]}.{name}:")), None)
-            if hit is None:
-                raise DatasheetError(f"the measured sheet is not valid: {message}") from None
-            i, name = hit
-            knobs = list(device.knobs)
+    knobs = list(device.knobs)
+    for i, knob in enumerate(device.knobs):
+        for name, (lo, hi, unit) in OPTIONAL_KNOB_RANGES.items():
+            value = getattr(knob, name)
+            if value is None or (math.isfinite(value) and lo <= value <= hi):
+                continue
             left_out: dict[str, Any] = {name: None}
             knobs[i] = dataclasses.replace(knobs[i], **left_out)
-            device = dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
-            dropped.append(f"{message}: left out of the sheet")
-    raise DatasheetError("the measured sheet is not valid")  # pragma: no cover - bounded above
+            dropped.append(f"knobs.{KNOB_NAMES[i]}.{name}: {value} {unit} is outside the "
+                           f"plausible range [{lo}, {hi}]: left out of the sheet"
+                           .replace("  ", " "))
+    device = dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+    try:
+        device_model_from_mapping(plain_values(device_model_to_mapping(device)), "sheet")
+    except ProfileError as exc:
+        raise DatasheetError("the measured sheet is not valid: "
+                             f"{str(exc).removeprefix('sheet: ')}") from None
+    return device, dropped

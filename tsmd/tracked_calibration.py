@@ -21,10 +21,10 @@ from scipy.interpolate import PchipInterpolator
 from simrig.plant import Plant, PlantStep, as_plant_step, load_plant
 from tsmd.calibration.assemble import GridPoint, QualityLimits
 from tsmd.calibration.errors import CalibrationError
-from tsmd.calibration.identify import PARAMETERS
 from tsmd.calibration.player import sweep_metadata
 from tsmd.calibration.protocol import Protocol, paper_protocol, sweep_run
 from tsmd.calibration.run import device_options, finish, run_sweeps
+from tsmd.calibration.sweep_result import PARAMETERS
 from tsmd.config import TsmdConfig
 from tsmd.profile import DeviceModel
 from tsmd.recording import Recording

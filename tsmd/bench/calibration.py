@@ -34,9 +34,10 @@ from tsmd.bench.calibration_faults import fault_table
 from tsmd.bench.calibration_time import main_time
 from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.errors import CalibrationError
-from tsmd.calibration.identify import PARAMETERS, IdentifyOptions, split_half_cycles
+from tsmd.calibration.identify import IdentifyOptions, split_half_cycles
 from tsmd.calibration.offline import SHORT
 from tsmd.calibration.run import identify_recording
+from tsmd.calibration.sweep_result import PARAMETERS
 from tsmd.config import resolve_data_path
 from tsmd.errors import TsmdError
 from tsmd.profile import load_device_model

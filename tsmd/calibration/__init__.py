@@ -7,7 +7,7 @@ identification of one sweep; ``calibrate_from_recordings`` identifies logged swe
 
 from tsmd.calibration.assemble import GridPoint, QualityLimits, check_quality
 from tsmd.calibration.errors import CalibrationCancelledError, CalibrationError
-from tsmd.calibration.identify import IdentifyOptions, SweepResult, identify_sweep
+from tsmd.calibration.identify import IdentifyOptions, identify_sweep
 from tsmd.calibration.protocol import Protocol, Sweep, fast_protocol, paper_protocol
 from tsmd.calibration.run import (
     Calibration,
@@ -16,6 +16,7 @@ from tsmd.calibration.run import (
     identify_recording,
     run_calibration,
 )
+from tsmd.calibration.sweep_result import SweepResult
 
 __all__ = [
     "Calibration", "CalibrationCancelledError", "CalibrationError", "GridPoint", "IdentifyOptions",

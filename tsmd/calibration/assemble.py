@@ -16,7 +16,7 @@ import numpy as np
 
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.estimate import Estimate, EstimateOptions, point_estimates
-from tsmd.calibration.identify import PARAMETERS, SweepResult
+from tsmd.calibration.sweep_result import PARAMETERS, SweepResult
 from tsmd.calibration.tension_play_fit import SweepPrefit
 from tsmd.compensation.paper import height_from_reference
 from tsmd.profile import KNOB_NAMES, CatheterProfile, DeviceModel, KnobProfile

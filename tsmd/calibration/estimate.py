@@ -27,8 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from tsmd.calibration.identify import PARAMETERS, SweepResult
 from tsmd.calibration.signal import walsh_median
+from tsmd.calibration.sweep_result import PARAMETERS, SweepResult
 
 MIN_ROBUST = 4
 """From this many half-cycles on, a sweep's own scatter is taken robustly (MAD)."""
@@ -50,6 +50,9 @@ class Estimate:
     """One half-cycle's scatter behind ``u95_deg`` (own and pooled, blended)."""
     dof: int = 0
     """Degrees of freedom of ``sigma_deg``."""
+    offset_u95_deg: float = 0.0
+    """The 95 % half-width of the product's reading offset subtracted from the values (part of
+    ``u95_deg``; no re-sweep narrows it)."""
 
     def tip_cost_deg(self, omega: float) -> float:
         """What an error of ``u95_deg`` costs on the tip once compensated."""
@@ -60,7 +63,8 @@ class Estimate:
         (what a re-sweep would buy); infinite while no half-cycle gave a value."""
         if self.n == 0 or not math.isfinite(self.sigma_deg):
             return math.inf
-        return abs(omega) * half_width_deg(self.sigma_deg, self.n + more, self.dof + more)
+        return abs(omega) * math.hypot(half_width_deg(self.sigma_deg, self.n + more,
+                                                      self.dof + more), self.offset_u95_deg)
 
 
 @dataclass(frozen=True)
@@ -117,8 +121,9 @@ def pooled_sigma(results: Sequence[SweepResult], names: Sequence[str],
 
 
 def estimate(values: Sequence[float], sigma_pool: float, pool_dof: int = 0,
-             options: EstimateOptions | None = None) -> Estimate:
-    """Median of the half-cycles' values and its 95 % half-width (see the module docstring)."""
+             options: EstimateOptions | None = None, offset_u95_deg: float = 0.0) -> Estimate:
+    """Robust mean of the half-cycles' values and its 95 % half-width (see the module
+    docstring), the reading offset's half-width ``offset_u95_deg`` added in quadrature."""
     opts = options or EstimateOptions()
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]
@@ -131,12 +136,13 @@ def estimate(values: Sequence[float], sigma_pool: float, pool_dof: int = 0,
         own_var = min(own_var, (1.4826 * float(np.median(np.abs(v - np.median(v))))) ** 2)
     k_prior = min(pool_dof, opts.max_prior_dof) if math.isfinite(sigma_pool) else 0
     if k_own + k_prior == 0:
-        return Estimate(float(v[0]), math.inf, 1, 0.0)
+        return Estimate(float(v[0]), math.inf, 1, 0.0, offset_u95_deg=offset_u95_deg)
     prior_var = sigma_pool ** 2 if k_prior else 0.0
     var = (k_own * own_var + k_prior * prior_var) / (k_own + k_prior)
     sigma = max(math.sqrt(var), opts.min_sigma_deg)
-    return Estimate(walsh_median(v), half_width_deg(sigma, v.size, k_own + k_prior),
-                    int(v.size), float(np.ptp(v)), sigma, k_own + k_prior)
+    half = math.hypot(half_width_deg(sigma, v.size, k_own + k_prior), offset_u95_deg)
+    return Estimate(walsh_median(v), half, int(v.size), float(np.ptp(v)), sigma, k_own + k_prior,
+                    offset_u95_deg)
 
 
 def point_estimates(results: Sequence[SweepResult],
@@ -146,7 +152,8 @@ def point_estimates(results: Sequence[SweepResult],
     opts = options or EstimateOptions()
     pools = {name: pooled_sigma(results, names, opts.min_sigma_deg)
              for names in KINDS.values() for name in names}
-    return [{name: estimate(r.values.get(name, ()), *pools[name], options=opts)
+    return [{name: estimate(r.values.get(name, ()), *pools[name], options=opts,
+                            offset_u95_deg=r.offset_u95_deg.get(name, 0.0))
              for name in PARAMETERS} for r in results]
 
 

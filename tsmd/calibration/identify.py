@@ -21,7 +21,7 @@ decreasing ones (after the positive end) give ``B_pos`` and ``D_neg``, as in the
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -51,95 +51,8 @@ from tsmd.calibration.release import (
     release_slope_ratio,
     release_swing,
 )
-from tsmd.calibration.signal import Conditioned, FloatArray, condition, walsh_median
-
-PARAMETERS: tuple[str, ...] = (
-    "dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_pos_deg", "backlash_neg_deg")
-SHORT = {"dead_zone_pos_deg": "D_pos", "dead_zone_neg_deg": "D_neg",
-         "backlash_pos_deg": "B_pos", "backlash_neg_deg": "B_neg"}
-
-
-@dataclass(frozen=True)
-class HalfCycle:
-    """One monotonic stretch between reversals and what was found in it (indices into arrays)."""
-
-    direction: int
-    start: int
-    stop: int
-    after_reversal: bool
-    peak_index: int | None = None
-    backlash_end_index: int | None = None
-    edge_index: int | None = None
-    backlash_deg: float = math.nan
-    edge_deg: float = math.nan
-    plateau_A: float = math.nan
-    rise_A: float = math.nan
-    snr: float = math.nan
-    problems: tuple[str, ...] = ()
-    slip: str | None = None
-    """Where the loaded current dropped while the knob moved on, if it did."""
-    release_swing_A: float = math.nan
-    """After a reversal: the current's swing to its release level
-    (:func:`tsmd.calibration.release.release_swing`)."""
-
-    @property
-    def backlash_name(self) -> str:
-        return "backlash_neg_deg" if self.direction > 0 else "backlash_pos_deg"
-
-    @property
-    def edge_name(self) -> str:
-        return "dead_zone_pos_deg" if self.direction > 0 else "dead_zone_neg_deg"
-
-
-@dataclass(frozen=True)
-class SweepResult:
-    """Everything one sweep gave: conditioned signals, half-cycles, values per parameter."""
-
-    data: Conditioned
-    half_cycles: tuple[HalfCycle, ...]
-    values: dict[str, tuple[float, ...]] = field(default_factory=dict)
-    """Each parameter's value from every half-cycle that gave one, in time order."""
-    resweeps: int = 0
-    """How many re-sweeps were pooled into this result."""
-    own_half_cycles: int | None = None
-    """How many of ``half_cycles`` (the first) index ``data``; the re-sweeps' index their own
-    recordings (None: all of them)."""
-
-    @property
-    def data_half_cycles(self) -> tuple[HalfCycle, ...]:
-        """The half-cycles whose indices point into ``data`` (the first sweep's)."""
-        return self.half_cycles[:self.own_half_cycles]
-
-    def estimate(self, name: str) -> float:
-        """The half-cycles' robust mean (:func:`walsh_median`; NaN when none gave a value)."""
-        return walsh_median(np.asarray(self.values.get(name, ()), dtype=float))
-
-    def spread(self, name: str) -> float:
-        """Largest minus smallest value over the half-cycles (0 with one value)."""
-        v = self.values.get(name, ())
-        return float(np.ptp(v)) if v else math.nan
-
-    def merged(self, other: SweepResult) -> SweepResult:
-        """This sweep's half-cycles pooled with a re-sweep's (the first sweep's signals kept)."""
-        values = {name: self.values.get(name, ()) + other.values.get(name, ())
-                  for name in PARAMETERS}
-        return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
-                           self.resweeps + 1, len(self.data_half_cycles))
-
-    @property
-    def snr(self) -> float:
-        values = [h.snr for h in self.half_cycles if math.isfinite(h.snr)]
-        return float(min(values)) if values else math.nan
-
-    @property
-    def median_snr(self) -> float:
-        """The typical half-cycle's signal (one weak half-cycle gives no value, not a verdict)."""
-        values = [h.snr for h in self.half_cycles if math.isfinite(h.snr)]
-        return float(np.median(values)) if values else math.nan
-
-    @property
-    def problems(self) -> tuple[str, ...]:
-        return tuple(p for h in self.half_cycles for p in h.problems)
+from tsmd.calibration.signal import Conditioned, FloatArray, condition
+from tsmd.calibration.sweep_result import PARAMETERS, HalfCycle, SweepResult
 
 
 def find_reversals(cmd_deg: FloatArray, min_reversal_deg: float) -> list[int]:

@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 
 from tsmd.calibration.assemble import GridPoint
-from tsmd.calibration.identify import PARAMETERS, SHORT
 from tsmd.calibration.protocol import GRID_DEG
 from tsmd.calibration.resweep import point_estimates, uncertainty_table
+from tsmd.calibration.sweep_result import PARAMETERS, SHORT
 from tsmd.recording import Recording, RecordingError, read_recording
 from tsmd.tee import DEFAULT_STEPS_PER_KNOB_DEG, load_tee_acquisition
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from tsmd.profile.reading_offset import ReadingOffset
+
 
 @dataclass(frozen=True)
 class IdentifyOptions:
@@ -80,6 +82,9 @@ class IdentifyOptions:
     """A run of flat pieces shorter than this after a reversal is a pause in the transient (a
     turn of the filtered reversal, a speed change), not the release level, which lasts until
     the dead-zone edge."""
+    reading_offset: ReadingOffset | None = None
+    """The product's reading offset from the data sheet, subtracted from this knob's values
+    where sure (:mod:`tsmd.calibration.reading_offset`); None: the values as read."""
     max_tracking_error_deg: float = 10.0
     min_follow_ratio: float = 0.5
     """The knob must travel at least this fraction of the commanded travel (else: stalled)."""

@@ -15,9 +15,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tsmd.calibration.assemble import KNOB_LABELS, GridPoint, knob_grid
-from tsmd.calibration.identify import PARAMETERS, SHORT
 from tsmd.calibration.offline import identification_table
 from tsmd.calibration.resweep import point_estimates
+from tsmd.calibration.sweep_result import PARAMETERS, SHORT
 
 if TYPE_CHECKING:
     from tsmd.calibration.run import Calibration

@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from tsmd.calibration.assemble import KNOB_LABELS, GridPoint
 from tsmd.calibration.estimate import Estimate, EstimateOptions
 from tsmd.calibration.estimate import point_estimates as estimate_points
-from tsmd.calibration.identify import SHORT
+from tsmd.calibration.sweep_result import SHORT
 
 
 @dataclass(frozen=True)
@@ -81,6 +81,33 @@ def refusing(todo: Sequence[Uncertain], refuse_tip_error_deg: float) -> list[Unc
     """The uncertain points that would refuse the calibration, the costliest on the tip first."""
     return sorted((u for u in todo if u.worst_tip_cost_deg > refuse_tip_error_deg),
                   key=lambda u: -u.worst_tip_cost_deg)
+
+
+@dataclass(frozen=True)
+class Choice:
+    """What to sweep again next: a point (rescue: beyond the re-sweep budget, because it would
+    refuse the calibration), or nothing, with the budget that ran out."""
+
+    point: Uncertain | None
+    rescue: bool
+    budget_s: float
+
+
+def choose_resweep(todo: Sequence[Uncertain], spent_s: float, duration_s: Callable[[int], float],
+                   resweep_budget_s: float, rescue_budget_s: float,
+                   refuse_tip_error_deg: float) -> Choice:
+    """The next re-sweep: the first of ``todo`` while the re-sweep budget pays for it
+    (``duration_s`` of a point's re-sweep, ``spent_s`` so far); beyond it, the costliest point
+    that would refuse the calibration while the rescue budget lasts; else none."""
+    if spent_s + duration_s(todo[0].index) <= resweep_budget_s + 1e-6:
+        return Choice(todo[0], False, resweep_budget_s)
+    rescued = refusing(todo, refuse_tip_error_deg)
+    if not rescued:
+        return Choice(None, False, resweep_budget_s)
+    budget_s = resweep_budget_s + rescue_budget_s
+    if spent_s + duration_s(rescued[0].index) > budget_s + 1e-6:
+        return Choice(None, True, budget_s)
+    return Choice(rescued[0], True, budget_s)
 
 
 def budget_spent_note(points: Sequence[GridPoint], todo: Sequence[Uncertain],

@@ -45,11 +45,12 @@ from tsmd.calibration.player import (
 )
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import paper_protocol, sweep_run
+from tsmd.calibration.reading_offset import corrected
 from tsmd.calibration.resweep import (
     budget_spent_note,
+    choose_resweep,
     pool_repeats,
     pooled,
-    refusing,
     uncertain_points,
 )
 from tsmd.calibration.tension_play_fit import with_prefit, with_tension_play
@@ -101,7 +102,8 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
                           k.backlash_settle_lag_deg, k.backlash_release_line_share,
                           k.backlash_release_rule, k.backlash_release_local_share)
         # the product's knee (tsmd datasheet) where the sheet turns it on
-        chosen.append(replace(one, backlash_knee=True) if k.backlash_knee else one)
+        one = replace(one, backlash_knee=True) if k.backlash_knee else one
+        chosen.append(replace(one, reading_offset=k.reading_offset))
     return chosen[0], chosen[1]
 
 
@@ -142,7 +144,8 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
                                 sweep_start_s=start_s)
     except CalibrationError as exc:
         raise CalibrationError(f"{source} ({KNOB_LABELS[knob]} sweep): {exc}") from None
-    return GridPoint(knob, other, result, rec)
+    return GridPoint(knob, other, corrected(result, opts.reading_offset if opts else None,
+                                            other), rec)
 
 
 def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
@@ -263,25 +266,22 @@ def run_sweeps(runner: TrajectoryRunner, proto: SweepProtocol, *,
                                     max(1, math.floor(proto.resweep_cycles)))
             if not todo:
                 break
-            again = proto.resweep(plan[todo[0].index].sweep)
-            rescue = ""
-            if resweep_s + again.duration_s > proto.resweep_budget_s + 1e-6:
-                rescued = refusing(todo, refuse_tip_error_deg)
-                again = proto.resweep(plan[rescued[0].index].sweep) if rescued else again
-                budget_s = proto.resweep_budget_s + (proto.rescue_budget_s if rescued else 0.0)
-                if not rescued or resweep_s + again.duration_s > budget_s + 1e-6:
-                    budget_note = budget_spent_note(points, todo, budget_s)
-                    break
-                todo = rescued
-                rescue = " (beyond the re-sweep budget: it would refuse the calibration)"
-            why = todo[0].describe(points)
+            choice = choose_resweep(
+                todo, resweep_s, lambda i: proto.resweep(plan[i].sweep).duration_s,
+                proto.resweep_budget_s, proto.rescue_budget_s, refuse_tip_error_deg)
+            if choice.point is None:
+                budget_note = budget_spent_note(points, todo, choice.budget_s)
+                break
+            i = choice.point.index
+            again = proto.resweep(plan[i].sweep)
+            rescue = " (beyond the re-sweep budget: it would refuse the calibration)"
+            why = choice.point.describe(points)
             notes.append(f"re-sweep {len(notes) + 1}: {why}; {again.cycles:g} more cycles"
-                         f"{rescue}")
+                         f"{rescue if choice.rescue else ''}")
             run = sweep_run(again, player.q_last, period_s, proto)
             tracker.begin(tracker.add(len(run.q_deg) * period_s), f"{again.label} ({why})")
             rec = player.play(again, f"re-sweep {len(notes)}", tracker, run)
-            point = points[todo[0].index]
-            points[todo[0].index] = pooled(point, identifier.identify(rec, again.label))
+            points[i] = pooled(points[i], identifier.identify(rec, again.label))
             resweep_s += again.duration_s
         player.return_to_zero()
     except BaseException as exc:

@@ -34,6 +34,7 @@ from tsmd.datasheet import (
 )
 from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
 from tsmd.datasheet_coupling import measure_other_tip_gains
+from tsmd.datasheet_offset import with_reading_offset
 from tsmd.datasheet_rule import (
     RULE_NOISE_SEEDS,
     choose_knee,
@@ -42,6 +43,7 @@ from tsmd.datasheet_rule import (
     sheet_truth,
 )
 from tsmd.profile import DeviceModel, save_device_model
+from tsmd.profile.reading_offset import ReadingOffset
 from tsmd.recording import read_recording
 
 
@@ -67,8 +69,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "
                              "each backlash rule; the better rule per knob goes into the sheet "
-                             "(docs/calibration.md, session 11; 'none': no choice, the sheet "
-                             "keeps the rule its shares imply)")
+                             "(docs/calibration.md, session 11), then the unit calibrated with "
+                             "it once per seed gives the product's reading offset (session 14; "
+                             "'none': no choice and no offset, the sheet keeps the rule its "
+                             "shares imply)")
     parser.add_argument("--bend-relation", action="store_true",
                         help="with --plant: also calibrate the unit straight and with its sheath "
                              "bent 30/60/90 deg and write the product's bend relation for online "
@@ -119,7 +123,8 @@ def _rule_seeds(text: str) -> list[int]:
 
 def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
                  params: dict[str, Any], seeds: list[int]) -> DeviceModel:
-    """The sheet with each knob's backlash rule, chosen on its own unit's calibrations."""
+    """The sheet with each knob's backlash rule, chosen on its own unit's calibrations, and
+    the product's reading offset measured with that rule."""
     unit = config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=params))
     t0 = time.monotonic()
     truth = sheet_truth(unit)
@@ -132,6 +137,12 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
               f"{','.join(map(str, seeds))}: {mine}; with the knee: {knee[knob].text()} -> "
               f"{k.backlash_release_rule}, knee {'on' if k.backlash_knee else 'off'}")
     print(f"  rule choice: {time.monotonic() - t0:.0f} s")
+    t0 = time.monotonic()
+    chosen, _ = with_reading_offset(chosen, unit, truth, seeds)
+    for name, k in zip(("phi1", "phi2"), chosen.knobs, strict=True):
+        print(f"{name} reading offset (current minus tip, deg, at the other knob's "
+              f"{_angles(k.reading_offset)}): {_offsets(k.reading_offset)}")
+    print(f"  reading offset: {time.monotonic() - t0:.0f} s")
     return chosen
 
 
@@ -153,6 +164,18 @@ def _with_coupling(device: DeviceModel, config: TsmdConfig, factory: Callable[[]
 def _edge(value: float | None) -> float:
     """A sheet's reference edge, or where the family's plants have theirs when it lacks one."""
     return 20.0 if value is None else float(value)
+
+
+def _angles(offset: ReadingOffset | None) -> str:
+    return "none" if offset is None else "/".join(f"{a:+.0f}" for a in offset.other_knob_deg)
+
+
+def _offsets(offset: ReadingOffset | None) -> str:
+    if offset is None:
+        return "none"
+    return "; ".join(f"{name} " + " ".join(f"{m:+.2f}+-{u:.2f}" for m, u in
+                                           zip(g.mean_deg, g.u95_deg, strict=True))
+                     for name, g in offset.grids)
 
 
 def _with_bend(device: DeviceModel, config: TsmdConfig,

@@ -19,6 +19,7 @@ from tsmd.compensation.tension_play import (
     tension_play_from_mapping,
     tension_play_to_mapping,
 )
+from tsmd.profile.reading_offset import ReadingOffset, offset_from_mapping, offset_to_mapping
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
     BEND_GAIN_PER_RELEASE_RANGE,
@@ -120,6 +121,26 @@ def _check_references(r: _Reader, key: str, pos: ReferencePoint, neg: ReferenceP
         raise r.fail(key, "reference_pos.tip_deg must be above reference_neg.tip_deg")
 
 
+OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
+    "reference_backlash_pos_deg": (0.0, 90.0, "deg"),
+    "reference_backlash_neg_deg": (0.0, 90.0, "deg"),
+    "dead_zone_offset_deg": (-20.0, 20.0, "deg"),
+    "reference_dead_zone_pos_deg": (0.0, 90.0, "deg"),
+    "reference_dead_zone_neg_deg": (-90.0, 0.0, "deg"),
+    "reference_backlash_gain": (0.0, 0.8, ""),
+    "backlash_settle_fraction": (0.5, 1.0, ""),
+    "backlash_release_slope_ratio": (-1.0, 1.0, ""),
+    "reference_release_swing_A": (0.0, 100.0, "A"),
+    "backlash_settle_lag_deg": (-10.0, 10.0, "deg"),
+    "backlash_release_line_share": (0.5, 1.5, ""),
+    "backlash_release_local_share": (0.5, 1.5, ""),
+    "reference_rule_backlash_gain": (0.0, 0.8, ""),
+    "other_tip_gain": (*OTHER_TIP_GAIN_RANGE, ""),
+}
+"""The data sheet's optional measured numbers per knob and their plausible ranges: the schema
+reads them with these, and ``tsmd datasheet`` leaves out a measured one outside its range
+(:func:`tsmd.datasheet.readable`)."""
+
 _SHAPE_KEYS = ("loaded_shape_pos", "loaded_shape_neg")
 _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
                   "backlash_release_slope_ratio", "reference_release_swing_A",
@@ -136,6 +157,15 @@ def _shape(r: _Reader, value: Any, where: str) -> LoadedShape | None:
         return None
     try:
         return shape_from_mapping(value, where)
+    except ValueError as exc:
+        raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
+
+
+def _offset(r: _Reader, value: Any, where: str) -> ReadingOffset | None:
+    if value is None:
+        return None
+    try:
+        return offset_from_mapping(value, where)
     except ValueError as exc:
         raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
 
@@ -193,41 +223,33 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             raise r.fail(key, "release_omega, reference_backlash_pos_deg and "
                          "reference_backlash_neg_deg go together (all or none)")
 
-        def optional(value: Any, name: str, lo: float, hi: float, unit: str,
-                     where: str = key) -> float | None:
-            return None if value is None else r.number(value, f"{where}.{name}", lo, hi, unit)
+        def optional(name: str, k: Mapping[str, Any] = k, key: str = key) -> float | None:
+            lo, hi, unit = OPTIONAL_KNOB_RANGES[name]
+            value = k.get(name)
+            return None if value is None else r.number(value, f"{key}.{name}", lo, hi, unit)
 
         knobs.append(DeviceKnob(
             r.omega(r.get(k, "omega", key + "."), key + ".omega"), pos, neg, limits,
             None if release is None else r.omega(release, key + ".release_omega"),
-            optional(b_pos, "reference_backlash_pos_deg", 0.0, 90.0, "deg"),
-            optional(b_neg, "reference_backlash_neg_deg", 0.0, 90.0, "deg"),
-            optional(k.get("dead_zone_offset_deg"), "dead_zone_offset_deg", -20.0, 20.0, "deg"),
-            optional(k.get("reference_dead_zone_pos_deg"), "reference_dead_zone_pos_deg", 0.0,
-                     90.0, "deg"),
-            optional(k.get("reference_dead_zone_neg_deg"), "reference_dead_zone_neg_deg", -90.0,
-                     0.0, "deg"),
+            optional("reference_backlash_pos_deg"),
+            optional("reference_backlash_neg_deg"),
+            optional("dead_zone_offset_deg"),
+            optional("reference_dead_zone_pos_deg"),
+            optional("reference_dead_zone_neg_deg"),
             r.number(k.get("handle_slip_deg", DEFAULT_HANDLE_SLIP_DEG), key + ".handle_slip_deg",
                      0.01, 45.0, "deg"),
-            optional(k.get("reference_backlash_gain"), "reference_backlash_gain", 0.0, 0.8, ""),
-            optional(k.get("backlash_settle_fraction"), "backlash_settle_fraction", 0.5, 1.0,
-                     ""),
-            optional(k.get("backlash_release_slope_ratio"), "backlash_release_slope_ratio",
-                     -1.0, 1.0, ""),
-            optional(k.get("reference_release_swing_A"), "reference_release_swing_A", 0.0,
-                     100.0, "A"),
-            optional(k.get("backlash_settle_lag_deg"), "backlash_settle_lag_deg", -10.0, 10.0,
-                     "deg"),
-            backlash_release_line_share=optional(k.get("backlash_release_line_share"),
-                                                 "backlash_release_line_share", 0.5, 1.5, ""),
-            backlash_release_local_share=optional(k.get("backlash_release_local_share"),
-                                                  "backlash_release_local_share", 0.5, 1.5, ""),
+            optional("reference_backlash_gain"),
+            optional("backlash_settle_fraction"),
+            optional("backlash_release_slope_ratio"),
+            optional("reference_release_swing_A"),
+            optional("backlash_settle_lag_deg"),
+            backlash_release_line_share=optional("backlash_release_line_share"),
+            backlash_release_local_share=optional("backlash_release_local_share"),
             backlash_release_rule=_release_rule(r, k, key),
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
-            reference_rule_backlash_gain=optional(k.get("reference_rule_backlash_gain"),
-                                                  "reference_rule_backlash_gain", 0.0, 0.8, ""),
-            other_tip_gain=optional(k.get("other_tip_gain"), "other_tip_gain",
-                                    *OTHER_TIP_GAIN_RANGE, ""),
+            reference_rule_backlash_gain=optional("reference_rule_backlash_gain"),
+            other_tip_gain=optional("other_tip_gain"),
+            reading_offset=_offset(r, k.get("reading_offset"), f"{key}.reading_offset"),
             **{name: _shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS}))
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))
@@ -277,6 +299,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         for key in _RELEASE_RULE_KEYS + _COUPLING_KEYS:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
+        if k.reading_offset is not None:
+            knobs[name]["reading_offset"] = offset_to_mapping(k.reading_offset)
     out: dict[str, Any] = {"schema_version": device.schema_version,
                            "device_model": device.device_model,
                            "description": device.description, "knobs": knobs}

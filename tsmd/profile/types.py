@@ -15,6 +15,7 @@ from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import TensionPlayParams
 from tsmd.errors import TsmdError
+from tsmd.profile.reading_offset import ReadingOffset
 
 PROFILE_SCHEMA_VERSION = 1
 DEVICE_SCHEMA_VERSION = 1
@@ -145,6 +146,11 @@ class DeviceKnob:
     degree the other plane's tip is bent (a shaft that winds up in torsion turns the planes into
     each other; the current cannot see it). Method ours aims each knob at its desired angle less
     this times the other knob's (session 14); None: 0."""
+    reading_offset: ReadingOffset | None = None
+    """Optional, measured on the data-sheet unit (``tsmd datasheet``, its fast calibrations
+    against its tracked tip, session 14): what the current reads minus what the tip shows, per
+    parameter and other-knob angle (:mod:`tsmd.profile.reading_offset`); calibration subtracts
+    it where it is sure and large enough (:mod:`tsmd.calibration.reading_offset`). None: none."""
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,67 @@
+"""The product's reading offset applied to a sweep's values (session 14).
+
+The data sheet measures, on its tracked unit, what the current reads minus what the tip shows
+per parameter and other-knob angle (:mod:`tsmd.profile.reading_offset`). Where that offset is
+a product's bias (twistshaft's B at the other knob's +-90 deg, screwrod's B), every unit of the
+product reads off by about as much in every half-cycle, and subtracting it moves the values
+onto the tip. Where it is small or not sure it is noise of one unit, and subtracting it would
+carry unit 0's noise into every unit: such an offset is not applied (shrunk to nothing). An
+applied offset brings its own uncertainty, which the gate adds to the half-cycles'
+(:class:`tsmd.calibration.estimate.Estimate`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from tsmd.calibration.sweep_result import SweepResult
+from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
+
+MIN_OFFSET_DEG = 1.0
+"""An offset below this (half the 2 deg accuracy target) is not applied: what it would gain is
+below what unit-to-unit scatter of the offset costs."""
+MIN_OFFSET_U95_RATIO = 1.0
+"""An offset is applied only where it exceeds its own 95 % half-width this many times (its
+interval excludes zero): one measured inconsistently over the sheet unit's half-cycles is not."""
+
+
+def applied_deg(grid: OffsetGrid) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Per other-knob angle: (offset applied, its 95 % half-width); 0, 0 where not applied."""
+    shift, u95 = [], []
+    for m, u in zip(grid.mean_deg, grid.u95_deg, strict=True):
+        use = abs(m) >= MIN_OFFSET_DEG and abs(m) > MIN_OFFSET_U95_RATIO * u
+        shift.append(m if use else 0.0)
+        u95.append(u if use else 0.0)
+    return tuple(shift), tuple(u95)
+
+
+def offset_at(offset: ReadingOffset, name: str, other_deg: float) -> tuple[float, float]:
+    """(offset to subtract, its 95 % half-width) of ``name`` with the other knob at
+    ``other_deg``: linear between the sheet's angles, held beyond them."""
+    grid = offset.grid(name)
+    if grid is None:
+        return 0.0, 0.0
+    shift, u95 = applied_deg(grid)
+    at = np.asarray(offset.other_knob_deg, dtype=float)
+    return (float(np.interp(other_deg, at, np.asarray(shift))),
+            float(np.interp(other_deg, at, np.asarray(u95))))
+
+
+def corrected(result: SweepResult, offset: ReadingOffset | None,
+              other_deg: float) -> SweepResult:
+    """``result`` with every half-cycle's value moved by the product's offset at this grid
+    point, and the offsets' half-widths kept for the gate (unchanged without an offset)."""
+    if offset is None:
+        return result
+    values = dict(result.values)
+    u95: dict[str, float] = {}
+    for name, v in result.values.items():
+        shift, u = offset_at(offset, name, other_deg)
+        if shift != 0.0:
+            values[name] = tuple(x - shift for x in v)
+            u95[name] = u
+    if not u95:
+        return result
+    return dataclasses.replace(result, values=values, offset_u95_deg=u95)

@@ -1,0 +1,85 @@
+"""The product's reading offset, measured on the data sheet's tracked unit (session 14).
+
+The sheet's unit is calibrated with the fast protocol from its current alone, as every unit is,
+with the sheet's chosen rules; each half-cycle's D and B minus the tracked tip's (the threshold
+truth, :func:`tsmd.tip_truth.tip_truth`) at the same grid point is one reading of the product's
+offset there. Per parameter and other-knob angle the offset is their robust mean with a 95 %
+half-width pooled as a calibration pools its own half-cycles
+(:func:`tsmd.calibration.estimate.point_estimates`): the sheet says how sure it is, the
+calibration decides what to apply (:mod:`tsmd.calibration.reading_offset`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections import defaultdict
+from collections.abc import Sequence
+
+from tsmd.calibration.estimate import point_estimates
+from tsmd.calibration.protocol import fast_protocol
+from tsmd.calibration.sweep_result import PARAMETERS, SweepResult
+from tsmd.config import TsmdConfig
+from tsmd.datasheet_rule import Truth
+from tsmd.profile import DeviceModel
+from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
+from tsmd.tracked_calibration import ProtocolRun, play_protocol
+
+
+def offset_readings(runs: Sequence[ProtocolRun], truth: Truth
+                    ) -> dict[tuple[int, float], dict[str, list[float]]]:
+    """Per (knob, other-knob angle): each parameter's half-cycle values minus the tip's, over
+    every run (refused runs count too: their values are read the same way)."""
+    out: dict[tuple[int, float], dict[str, list[float]]] = defaultdict(
+        lambda: defaultdict(list))
+    for run in runs:
+        for p in run.points:
+            tip = truth.get((p.knob, float(p.other_deg)))
+            if tip is None:
+                continue
+            for name in PARAMETERS:
+                ref = tip.get(name, math.nan)
+                out[(p.knob, float(p.other_deg))][name] += [
+                    v - ref for v in p.result.values.get(name, ()) if math.isfinite(v - ref)]
+    return out
+
+
+def reading_offsets(readings: dict[tuple[int, float], dict[str, list[float]]]
+                    ) -> tuple[ReadingOffset | None, ReadingOffset | None]:
+    """Each knob's offset grid from :func:`offset_readings` (None for a knob without readings
+    at every one of its angles)."""
+    keys = sorted(readings)
+    results = [SweepResult(None, (), {n: tuple(readings[k][n]) for n in PARAMETERS})  # type: ignore[arg-type]
+               for k in keys]
+    estimates = dict(zip(keys, point_estimates(results), strict=True))
+    knobs: list[ReadingOffset | None] = []
+    for knob in (0, 1):
+        mine = [k for k in keys if k[0] == knob]
+        grids = []
+        for name in PARAMETERS:
+            es = [estimates[k][name] for k in mine]
+            if not es or any(e.n == 0 or not math.isfinite(e.u95_deg) for e in es):
+                continue
+            grids.append((name, OffsetGrid(tuple(round(e.value, 2) for e in es),
+                                           tuple(round(e.u95_deg, 2) for e in es),
+                                           tuple(e.n for e in es))))
+        knobs.append(ReadingOffset(tuple(k[1] for k in mine), tuple(grids))
+                     if mine and grids else None)
+    return knobs[0], knobs[1]
+
+
+def without_offset(device: DeviceModel) -> DeviceModel:
+    knobs = tuple(dataclasses.replace(k, reading_offset=None) for k in device.knobs)
+    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+
+def with_reading_offset(device: DeviceModel, config: TsmdConfig, truth: Truth,
+                        noise_seeds: Sequence[int]) -> tuple[DeviceModel, list[ProtocolRun]]:
+    """The sheet with each knob's reading offset, from fast calibrations of its own unit
+    (``config.sim``) with the sheet as chosen (no offset applied while measuring it)."""
+    plain = without_offset(device)
+    runs = [play_protocol(config, plain, fast_protocol(), seed) for seed in noise_seeds]
+    offsets = reading_offsets(offset_readings(runs, truth))
+    knobs = tuple(dataclasses.replace(k, reading_offset=o)
+                  for k, o in zip(plain.knobs, offsets, strict=True))
+    return dataclasses.replace(plain, knobs=(knobs[0], knobs[1])), runs

@@ -13,6 +13,13 @@ from dataclasses import dataclass
 @dataclass(frozen=True)
 class EstimatorOptions:
     baseline_ramps: int = 3
+    settle_ramps: int = 6
+    """The reference keeps being re-learned on the last ``baseline_ramps`` ramps that read
+    within the gate (they do not measure) until the reference of this many re-learnings ago
+    reads the latest ones within ``deadband_deg`` with a slope within
+    ``slope_in_use_tolerance``, or a change is followed (:mod:`tsmd.online.reference`). 0: the
+    first ``baseline_ramps`` ramps fix it (until session 13; twistshaft 101, 102 without a
+    change: edges moved up to 1.15 deg, the reference learned during the 60 s warm-up)."""
     window: int = 5
     gate_deg: float = 1.5
     confirm: int = 2

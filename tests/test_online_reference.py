@@ -1,0 +1,58 @@
+"""The estimator's reference: learned from the first ramps, re-learned while it settles."""
+
+from __future__ import annotations
+
+from tsmd.online.estimator import EdgeTracker
+from tsmd.online.estimator_options import EstimatorOptions
+from tsmd.online.features import LoadedRamp
+
+EDGE_DEG = 20.0
+LEVEL_A = 0.05
+SLOPE = 0.003
+
+
+def ramp(edge_deg: float, slope: float = SLOPE) -> LoadedRamp:
+    """A ramp (positive side) crossing LEVEL_A at ``edge_deg``."""
+    return LoadedRamp(0, 1, edge_deg + 10.0, LEVEL_A + slope * 10.0, slope, 0.0, 0.0, 200, 0.003)
+
+
+def settling_drift(options: EstimatorOptions) -> EdgeTracker:
+    """A catheter warming up: 16 ramps whose crossing creeps 0.12 deg outward per ramp and
+    whose slope flattens 1 % per ramp, then 20 ramps where it stays."""
+    tracker = EdgeTracker(0, 1, options)
+    for i in range(36):
+        k = min(i, 15)
+        tracker.update(ramp(EDGE_DEG + 0.12 * k, SLOPE * (1.0 - 0.01 * k)), EDGE_DEG)
+    return tracker
+
+
+def test_behaviour_settling_under_an_early_reference_is_not_followed() -> None:
+    tracker = settling_drift(EstimatorOptions())
+    assert tracker.applied_deg == 0.0
+    assert tracker.reference.settled and tracker.reference.relearned > 0
+
+
+def test_with_the_reference_fixed_at_once_the_same_settling_is_followed() -> None:
+    tracker = settling_drift(EstimatorOptions(settle_ramps=0))
+    assert tracker.applied_deg > 1.0
+
+
+def test_the_reference_settles_once_it_stops_moving() -> None:
+    o = EstimatorOptions()
+    tracker = EdgeTracker(0, 1, o)
+    for _ in range(o.baseline_ramps + o.settle_ramps - 1):
+        tracker.update(ramp(EDGE_DEG), EDGE_DEG)
+    assert not tracker.reference.settled and tracker.status()["state"] == "settling"
+    tracker.update(ramp(EDGE_DEG), EDGE_DEG)
+    assert tracker.reference.settled and tracker.status()["state"] == "tracking"
+
+
+def test_a_change_while_the_reference_settles_is_followed_and_fixes_it() -> None:
+    o = EstimatorOptions()
+    tracker = EdgeTracker(0, 1, o)
+    for _ in range(o.baseline_ramps + 1):
+        tracker.update(ramp(EDGE_DEG), EDGE_DEG)
+    tracker.update(ramp(EDGE_DEG + 4.0), EDGE_DEG)
+    tracker.update(ramp(EDGE_DEG + 4.2), EDGE_DEG)
+    assert tracker.applied_deg > 3.5
+    assert tracker.reference.settled

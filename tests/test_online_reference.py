@@ -56,3 +56,24 @@ def test_a_change_while_the_reference_settles_is_followed_and_fixes_it() -> None
     tracker.update(ramp(EDGE_DEG + 4.2), EDGE_DEG)
     assert tracker.applied_deg > 3.5
     assert tracker.reference.settled
+
+
+def after_two_steeper_ramps(options: EstimatorOptions) -> EdgeTracker:
+    """A bend: ramps 12 % steeper, the edge 2.5 deg further out; the first ramp is read with
+    the slope in use before it moved (inside the gate), the second with the new one."""
+    tracker = EdgeTracker(0, 1, options)
+    for _ in range(options.baseline_ramps + options.settle_ramps):
+        tracker.update(ramp(EDGE_DEG), EDGE_DEG)
+    for _ in range(2):
+        tracker.update(ramp(EDGE_DEG + 2.5, 1.12 * SLOPE), EDGE_DEG)
+    return tracker
+
+
+def test_a_ramp_read_with_a_lagging_slope_is_read_again_once_the_slope_moved() -> None:
+    tracker = after_two_steeper_ramps(EstimatorOptions(reread_on_slope_change=True))
+    assert tracker.applied_deg > 2.0 and tracker.n_reread == 1
+
+
+def test_without_reading_again_the_same_bend_waits_for_a_third_ramp() -> None:
+    tracker = after_two_steeper_ramps(EstimatorOptions(reread_on_slope_change=False))
+    assert tracker.applied_deg == 0.0

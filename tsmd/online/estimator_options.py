@@ -42,6 +42,10 @@ class EstimatorOptions:
     nothing, as the knee does in knee mode (session 12, stickslip 101 phi2). On since session
     13: with ``fresh_agreement`` the one run it made worse (lumped 102 without a change) is
     the same with it, and stickslip 104's bend went from 2.02 to 1.02 x fresh (docs/online.md)."""
+    reread_on_slope_change: bool = False
+    """The last crossing ramp is read again when the slope in use has moved beyond
+    ``slope_in_use_tolerance`` since it was read; outward beyond the gate it becomes a
+    suspect (:meth:`EdgeTracker._reread`; session 14, lumped 103 phi2 after a bend)."""
     fresh_agreement: bool = True
     """Both edges of a knob agree only on suspects each taken after the other edge's last
     measurement within the gate (:meth:`EdgeTracker.agrees_with`; session 13, lumped 102

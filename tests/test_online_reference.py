@@ -77,3 +77,14 @@ def test_a_ramp_read_with_a_lagging_slope_is_read_again_once_the_slope_moved() -
 def test_without_reading_again_the_same_bend_waits_for_a_third_ramp() -> None:
     tracker = after_two_steeper_ramps(EstimatorOptions(reread_on_slope_change=False))
     assert tracker.applied_deg == 0.0
+
+
+def test_steeper_ramps_while_settling_are_a_change_not_settling() -> None:
+    o = EstimatorOptions()
+    tracker = EdgeTracker(0, 1, o)
+    for _ in range(o.baseline_ramps + 1):
+        tracker.update(ramp(EDGE_DEG), EDGE_DEG)
+    for _ in range(8):  # a bend: 12 % more friction, the edge 1.2 deg out (inside the gate)
+        tracker.update(ramp(EDGE_DEG + 1.2, 1.12 * SLOPE), EDGE_DEG)
+    assert tracker.reference.settled and tracker.reference.relearned <= 1
+    assert tracker.applied_deg > 0.8

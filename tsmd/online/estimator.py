@@ -237,8 +237,11 @@ class EdgeTracker(SlopeReadings):
             self.n_odd_crossing += 1
             self.last_measurement_deg = math.nan
             return events
-        if not self.reference.settled and self._settling(ramp, profile_edge_deg, raw):
-            return events
+        if not self.reference.settled:
+            if change > tol:  # the knob's friction rose: a change, against the reference
+                self.reference.fix()
+            elif not rose and self._settling(ramp, profile_edge_deg, raw):
+                return events
         self._measured(raw, ramp.other_deg, events)
         return events
 
@@ -278,7 +281,10 @@ class EdgeTracker(SlopeReadings):
     def _settling(self, ramp: LoadedRamp, profile_edge_deg: float, raw_deg: float) -> bool:
         """While the reference settles, a crossing within the gate re-learns it instead of
         measuring (the catheter's behaviour moving under a reference learned too early is not
-        a change; :mod:`tsmd.online.reference`); True when the ramp was taken so."""
+        a change; :mod:`tsmd.online.reference`); True when the ramp was taken so. Not a ramp
+        steeper than the slope in use, and no ramp once the knob's slopes rose: more friction
+        is a bend, whose first crossings read inside the gate (lumped 103 phi2, 60 deg: ramps
+        1.11-1.16 x, the bend re-learned into the reference and never followed)."""
         m = raw_deg - self.bins.bias_deg(ramp.other_deg)
         if abs(m - self.estimate_deg) > self.options.gate_deg:
             return False

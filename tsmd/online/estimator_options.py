@@ -13,13 +13,16 @@ from dataclasses import dataclass
 @dataclass(frozen=True)
 class EstimatorOptions:
     baseline_ramps: int = 3
-    settle_ramps: int = 6
-    """The reference keeps being re-learned on the last ``baseline_ramps`` ramps that read
-    within the gate (they do not measure) until the reference of this many re-learnings ago
+    settle_ramps: int = 0
+    """With n > 0 the reference keeps being re-learned on the last ``baseline_ramps`` ramps
+    that read within the gate (they do not measure) until the reference of n re-learnings ago
     reads the latest ones within ``deadband_deg`` with a slope within
-    ``slope_in_use_tolerance``, or a change is followed (:mod:`tsmd.online.reference`). 0: the
-    first ``baseline_ramps`` ramps fix it (until session 13; twistshaft 101, 102 without a
-    change: edges moved up to 1.15 deg, the reference learned during the 60 s warm-up)."""
+    ``slope_in_use_tolerance``, a change is followed or the knob's slopes rose
+    (:mod:`tsmd.online.reference`). 0 (default): the first ``baseline_ramps`` ramps fix it.
+    Session 14 measured 6 (docs/online.md): twistshaft 101, 102 and lumped 101 without a change
+    no longer drift (1.48, 1.11, 2.17 deg -> 0.47, 0.58, 0), but coilpipe 101 and screwrod 101
+    drift more (2.15 -> 2.94, 0.69 -> 1.80 deg) and lumped 103 phi1 after a bend with the
+    relation tracks 2.21 x fresh instead of 1.11: off until those are understood."""
     window: int = 5
     gate_deg: float = 1.5
     confirm: int = 2

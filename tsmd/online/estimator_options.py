@@ -19,10 +19,11 @@ class EstimatorOptions:
     reads the latest ones within ``deadband_deg`` with a slope within
     ``slope_in_use_tolerance``, a change is followed or the knob's slopes rose
     (:mod:`tsmd.online.reference`). 0 (default): the first ``baseline_ramps`` ramps fix it.
-    Session 14 measured 6 (docs/online.md): twistshaft 101, 102 and lumped 101 without a change
-    no longer drift (1.48, 1.11, 2.17 deg -> 0.47, 0.58, 0), but coilpipe 101 and screwrod 101
-    drift more (2.15 -> 2.94, 0.69 -> 1.80 deg) and lumped 103 phi1 after a bend with the
-    relation tracks 2.21 x fresh instead of 1.11: off until those are understood."""
+    Session 14 measured 6 (docs/online.md): twistshaft 101-104 and lumped 101 without a change
+    drift less (up to 1.75 and 2.17 deg -> 0.58 and 0), but coilpipe 101, screwrod 101 and
+    lumped 103 drift more (2.15 -> 2.94, 0.69 -> 1.80, 0 -> 0.78 deg) and lumped 103 phi1
+    after a bend with the relation tracks 2.21 x fresh instead of 1.11: off until those are
+    understood."""
     window: int = 5
     gate_deg: float = 1.5
     confirm: int = 2

@@ -29,10 +29,12 @@ def ramp_through(edge_deg: float, slope: float) -> LoadedRamp:
 
 
 def learned(options: EstimatorOptions | None = None) -> EdgeTracker:
+    """A tracker whose reference is learned and settled on ramps at the profile's edge."""
     tracker = EdgeTracker(0, 1, options or EstimatorOptions())
-    for _ in range(tracker.options.baseline_ramps):
+    o = tracker.options
+    for _ in range(o.baseline_ramps + o.settle_ramps):
         tracker.update(ramp_with_edge(EDGE_DEG), EDGE_DEG)
-    assert not tracker.learning
+    assert not tracker.learning and tracker.reference.settled
     return tracker
 
 
@@ -249,7 +251,7 @@ def estimates_under_coupling(seed: int, shift_deg: float, shift_from: int,
     """The estimate after each ramp of a static other-knob coupling with noise; every bin
     shifted by ``shift_deg`` from ramp ``shift_from`` on (within the gate: no confirmation)."""
     tracker = EdgeTracker(0, 1, EstimatorOptions())
-    for _ in range(tracker.options.baseline_ramps):
+    for _ in range(tracker.options.baseline_ramps + tracker.options.settle_ramps):
         tracker.update(ramp_at_other(EDGE_DEG, -15.0), EDGE_DEG)
     rng = np.random.default_rng(seed)
     others = list(COUPLING_DEG)
@@ -294,7 +296,7 @@ def learned_knob(options: EstimatorOptions | None = None) -> tuple[EdgeTracker, 
     """Both tendons of a knob past their baseline, knees at the calibrated edge."""
     o = options or EstimatorOptions()
     pos, neg = EdgeTracker(0, 1, o), EdgeTracker(0, -1, o)
-    for _ in range(pos.options.baseline_ramps):
+    for _ in range(pos.options.baseline_ramps + pos.options.settle_ramps):
         pos.update(ramp_with_knee(EDGE_DEG), EDGE_DEG, neg)
         neg.update(ramp_with_knee(EDGE_DEG), EDGE_DEG, pos)
     return pos, neg

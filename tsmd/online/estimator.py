@@ -1,11 +1,13 @@
 """Dead-zone edge offsets from loaded ramps: bounded, with hysteresis, confidence and freezes.
 
 One :class:`EdgeTracker` per knob and side. The first ``baseline_ramps`` ramps after start
-fix the reference (the profile is taken as right at the start of use, right after its
+learn the reference (the profile is taken as right at the start of use, right after its
 calibration): the current level the ramp has at the calibrated edge, the ramp's slope and the
-residual between the edge at that level and the profile's edge. Afterwards each ramp measures
-the offset of the edge from the profile's (at the other knob's angle of that ramp, so the
-coupling the profile knows is not mistaken for a change).
+residual between the edge at that level and the profile's edge; while it settles it is
+re-learned on the latest ramps within the gate (:mod:`tsmd.online.reference`). Afterwards
+each ramp measures the offset of the edge from the profile's (at the other knob's angle of
+that ramp, so the coupling the profile knows is not mistaken for a change). What the slopes
+alone say (knee mode, gain, bend share) is :mod:`tsmd.online.edge_slopes`.
 
 - **Noise**: the estimate is the median of the last ``window`` accepted measurements.
 - **Spikes / outliers**: a measurement further than ``gate_deg`` from the estimate is held as
@@ -28,17 +30,19 @@ from dataclasses import dataclass, field
 from statistics import median
 from typing import Any
 
+from tsmd.online.edge_slopes import SlopeReadings
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
-from tsmd.online.slopes import common_change, pooled_change, shrunk_ratio
+from tsmd.online.reference import SettlingReference
+from tsmd.online.slopes import common_change, shrunk_ratio
 
 _ORDER = itertools.count()
 """One order over every tracker's measurements, so two edges can tell whose came first."""
 
 
 @dataclass
-class EdgeTracker:
+class EdgeTracker(SlopeReadings):
     """The offset of one dead-zone edge (knob, side) from the profile's; see the module."""
 
     knob: int
@@ -99,15 +103,19 @@ class EdgeTracker:
     """When the last measurement within the gate was taken (the edge read where it was)."""
     bins: OtherKnobBins = field(init=False)
     """Where the edge reads against the other knob's angle (:mod:`tsmd.online.other_knob`)."""
-    _baseline: list[tuple[LoadedRamp, float]] = field(default_factory=list)
+    held: tuple[LoadedRamp, float, float] | None = None
+    """The last crossing ramp, its profile edge and the slope it was read with (re-read when
+    the slope in use moves: :meth:`_reread`)."""
+    n_reread: int = 0
+    """Ramps that became suspects when re-read with a slope in use that had moved."""
+    reference: SettlingReference = field(init=False)
+    """The reference being learned, re-learned while it settles (:mod:`tsmd.online.reference`)."""
 
     def __post_init__(self) -> None:
         o = self.options
         self.bins = OtherKnobBins(o.other_bin_deg, o.bin_min, o.bin_window)
-
-    @property
-    def learning(self) -> bool:
-        return self.level_A is None
+        self.reference = SettlingReference(o.baseline_ramps, o.settle_ramps, o.deadband_deg,
+                                           o.slope_in_use_tolerance)
 
     @property
     def confidence(self) -> float:
@@ -134,117 +142,6 @@ class EdgeTracker:
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
         return 1.0 / self.options.slope_ratio_max <= ratio <= self.options.slope_ratio_max
 
-    @property
-    def knee_mode(self) -> bool:
-        """Both tendons' ramps of the knob changed slope the same way (:attr:`knee_direction`):
-        the sheath's friction changed the engagement, and the knee, not a level crossing,
-        places the edge (capstan unit 2, 60 deg bend: ramps 1.17-1.37 x, the crossing 11 deg
-        inward, the knee 4-6 deg outward; a slack change leaves the slopes, lumped 101: 0.85-1.07
-        x). Not otherwise: on the lumped toe the knee scatters by +-3 deg (session 7)."""
-        return self.knee_direction != 0
-
-    @property
-    def knee_direction(self) -> int:
-        """+1 when both tendons' ramps got steeper (more friction: :attr:`knee_mode`), -1
-        flatter, 0 not in knee mode.
-
-        Besides the medians of three ramps, **the last ramp of each tendon alone** counts
-        when both changed the same way beyond twice the tolerance (30 %): a bend shows in
-        the first ramp of each tendon after it, and waiting for the medians cost two ramps
-        per edge (capstan unit 1 phi2: followed 134 s, not 112 s, after a bend at 80 s;
-        the RMSE window begins at 113 s). One ramp's slope scatters by 20-50 % now and then,
-        so one tendon alone, or a change within 30 %, does not count."""
-        tol = self.options.same_slope_tolerance
-        own, other = self.slope_change, self.partner_change
-        if own * other > 0.0 and min(abs(own), abs(other)) > tol:
-            return 1 if own > 0.0 else -1
-        own, other = self.last_change, self.partner_last_change
-        if own * other > 0.0 and min(abs(own), abs(other)) > 2.0 * tol:
-            return 1 if own > 0.0 else -1
-        return 0
-
-    @property
-    def last_change(self) -> float:
-        """The last ramp's slope against the reference, minus 1 (0 while learning)."""
-        if self.slope_ref_A_per_deg is None or not self.recent_slopes:
-            return 0.0
-        return self.recent_slopes[-1] / self.slope_ref_A_per_deg - 1.0
-
-    @property
-    def gain_ratio(self) -> float:
-        """How much this tendon's backlash gain beta changed: as its loaded current's slope,
-        as far as the other tendon confirms it, none within the slopes' scatter
-        (:func:`shrunk_ratio`).
-
-        The tension play's backlash after a reversal is the tendon's stretch given back,
-        ``B = c T_r``, with the tension ``T_r = k (x_r - x0)`` the current shows; so
-        ``beta = B / (x_r - x0) = c k``: with the compliance ``c`` unchanged by a bend, beta
-        follows the current's slope ``k`` (capstan units 1, 2, 101 after 60 deg: slope
-        1.2-1.4 x past the knee, the fresh calibrations' beta 1.17-1.28 x). In knee mode
-        only from ramps fitted past their knee (a window that starts on the engagement's
-        grown step reads 2.5-3 x); without such ramps (the lumped plant has no knee) from the
-        slope in use when :attr:`EstimatorOptions.gain_from_slope_in_use`. The release
-        itself is crossed too fast under compensation to measure it (docs/online.md)."""
-        o = self.options
-        if self.learning:
-            return 1.0
-        if self.knee_mode and self.knee_slopes:
-            mine, theirs = self.knee_slope_change, self.partner_knee_change
-            tol = o.same_slope_tolerance
-        elif o.gain_from_slope_in_use:
-            tol = o.slope_in_use_tolerance
-            ratio = shrunk_ratio(1.0 + self._common_change(tol), tol)
-            return min(max(ratio, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
-        else:
-            return 1.0
-        ratio = shrunk_ratio(1.0 + common_change(mine, theirs, tol), tol)
-        return min(max(ratio, 1.0 / o.slope_ratio_max), o.slope_ratio_max)
-
-    def _pooled_ratios(self, partner: EdgeTracker | None) -> list[float]:
-        """Both tendons' last slopes, each against its own reference."""
-        ratios = [x / self.slope_ref_A_per_deg for x in self.recent_slopes
-                  ] if self.slope_ref_A_per_deg else []
-        if partner is not None and partner.slope_ref_A_per_deg:
-            ratios += [x / partner.slope_ref_A_per_deg for x in partner.recent_slopes]
-        return ratios
-
-    def _common_change(self, tol: float) -> float:
-        """The slope change the knob's two tendons share (the slope in use's, the gain's)."""
-        if self.options.pooled_slope_change:
-            return self.knob_change
-        return common_change(self.slope_change, self.partner_change, tol)
-
-    @property
-    def bend_weight(self) -> float:
-        """0..1: how far this tendon's change is a bend (the sheath's friction rose with the
-        edge's move) rather than slack (:class:`tsmd.online.bend.BendRelation` applies in that
-        share): 1 in knee mode with steeper ramps; otherwise the knob's common slope change,
-        none within ``slope_in_use_tolerance`` (a slack change leaves the slopes: lumped 101
-        0.85-1.07 x), in full beyond twice it (a 60 deg bend: 1.04-1.21 x on lumped)."""
-        if self.learning:
-            return 0.0
-        if self.knee_direction > 0 and self.knee_slopes:
-            return 1.0
-        tol = self.options.slope_in_use_tolerance
-        change = self._common_change(tol)
-        return min(max((change - tol) / tol, 0.0), 1.0) if tol > 0 else float(change > 0)
-
-    @property
-    def knee_slope_change(self) -> float:
-        """The median slope of the last ramps fitted past their knee against the reference,
-        minus 1 (0 without such ramps)."""
-        if self.slope_ref_A_per_deg is None or not self.knee_slopes:
-            return 0.0
-        return median(self.knee_slopes) / self.slope_ref_A_per_deg - 1.0
-
-    @property
-    def slope_change(self) -> float:
-        """The median of the last ramps' slopes against the reference, minus 1 (0 while
-        learning)."""
-        if self.slope_ref_A_per_deg is None or not self.recent_slopes:
-            return 0.0
-        return median(self.recent_slopes) / self.slope_ref_A_per_deg - 1.0
-
     def update(self, ramp: LoadedRamp, profile_edge_deg: float,
                partner: EdgeTracker | None = None) -> list[tuple[str, str, dict[str, Any]]]:
         """Take one ramp; returns events (level, name, fields) to report. ``partner``: the
@@ -255,24 +152,11 @@ class EdgeTracker:
         events: list[tuple[str, str, dict[str, Any]]] = []
         tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
         if self.learning:
-            self._baseline.append((ramp, profile_edge_deg))
-            if len(self._baseline) >= o.baseline_ramps:
-                self.level_A = median(r.current_at(d) for r, d in self._baseline)
-                self.slope_ref_A_per_deg = median(r.slope_A_per_deg for r, _ in self._baseline)
-                self.recent_slopes = [r.slope_A_per_deg for r, _ in self._baseline]
-                self.residual_ref_deg = median(
-                    r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
-                    for r, d in self._baseline)
-                for r, d in self._baseline:
-                    self.bins.teach(self.bins.key(r.other_deg), r.side * (
-                        r.crossing_deg(self.level_A, self.slope_ref_A_per_deg) - d
-                        - self.residual_ref_deg))
-                knees = [r.side * (r.knee_deg - d) for r, d in self._baseline
-                         if math.isfinite(r.knee_deg)]
-                if len(knees) * 2 > len(self._baseline):
-                    self.knee_residual_ref_deg = median(knees)
+            if self.reference.add(ramp, profile_edge_deg):
+                self._take_reference()
+                self.recent_slopes = [r.slope_A_per_deg for r, _ in self.reference.window]
                 events.append(("info", "online reference learned",
-                               {**tag, "level_A": round(self.level_A, 4)}))
+                               {**tag, "level_A": round(self.level_A or 0.0, 4)}))
             return events
         assert self.level_A is not None and self.slope_ref_A_per_deg is not None
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
@@ -281,8 +165,7 @@ class EdgeTracker:
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
         self.shared_change = shared
         self.partner_change = 0.0 if partner is None else partner.slope_change
-        self.knob_change = pooled_change(self.slope_change, self.partner_change,
-                                         self._pooled_ratios(partner))
+        self.knob_change = self._knob_change_with(partner)
         self.partner_last_change = 0.0 if partner is None else partner.last_change
         if ramp.past_knee:
             self.knee_slopes = [*self.knee_slopes, ramp.slope_A_per_deg][-o.slope_window:]
@@ -334,6 +217,9 @@ class EdgeTracker:
         tol = o.slope_in_use_tolerance
         change = self.slope_change if partner is None else self._common_change(tol)
         slope = self.slope_ref_A_per_deg * shrunk_ratio(1.0 + change, tol)
+        if o.reread_on_slope_change:
+            self._reread(slope)
+            self.held = (ramp, profile_edge_deg, slope)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
             self.n_odd_slope += 1
             self.last_measurement_deg = math.nan
@@ -351,8 +237,63 @@ class EdgeTracker:
             self.n_odd_crossing += 1
             self.last_measurement_deg = math.nan
             return events
+        if not self.reference.settled:
+            if change > tol:  # the knob's friction rose: a change, against the reference
+                self.reference.fix()
+            elif not rose and self._settling(ramp, profile_edge_deg, raw):
+                return events
         self._measured(raw, ramp.other_deg, events)
         return events
+
+    def _reread(self, slope: float) -> None:
+        """The last crossing ramp read again with the slope in use now, when that moved beyond
+        the tolerance since: a suspect under it joins the suspects (the slope in use follows a
+        friction change two ramps late, and the first ramps after a bend read short or
+        measured nothing; lumped 103 phi2, 60 deg bend: ramps 1.11-1.16 x, crossings 0.76/1.22
+        deg with the old slope, 2.18/2.68 with the new, followed 54 s after the bend)."""
+        if self.held is None or self.level_A is None:
+            return
+        ramp, edge_deg, used = self.held
+        self.held = None
+        o = self.options
+        if (abs(slope / used - 1.0) <= o.slope_in_use_tolerance
+                or abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance):
+            return
+        m = ramp.side * (ramp.crossing_deg(self.level_A, slope) - edge_deg
+                         - self.residual_ref_deg) - self.bins.bias_deg(ramp.other_deg)
+        if m - self.estimate_deg > o.gate_deg:  # outward only: the friction rose
+            self.suspects = [*self.suspects, m][-o.confirm:]
+            self.suspect_order = next(_ORDER)
+            self.n_reread += 1
+
+    def _take_reference(self) -> None:
+        """The reference in use is the settling reference's latest; the bins start again
+        from its ramps (their readings were against the reference before)."""
+        ref = self.reference.current
+        assert ref is not None
+        self.level_A, self.slope_ref_A_per_deg = ref.level_A, ref.slope_A_per_deg
+        self.residual_ref_deg, self.knee_residual_ref_deg = ref.residual_deg, ref.knee_residual_deg
+        self.bins = OtherKnobBins(self.options.other_bin_deg, self.options.bin_min,
+                                  self.options.bin_window)
+        for r, d in self.reference.window:
+            self.bins.teach(self.bins.key(r.other_deg), ref.reading_deg(r, d))
+
+    def _settling(self, ramp: LoadedRamp, profile_edge_deg: float, raw_deg: float) -> bool:
+        """While the reference settles, a crossing within the gate re-learns it instead of
+        measuring (the catheter's behaviour moving under a reference learned too early is not
+        a change; :mod:`tsmd.online.reference`); True when the ramp was taken so. Not a ramp
+        steeper than the slope in use, and no ramp once the knob's slopes rose: more friction
+        is a bend, whose first crossings read inside the gate (lumped 103 phi2, 60 deg: ramps
+        1.11-1.16 x, the bend re-learned into the reference and never followed)."""
+        m = raw_deg - self.bins.bias_deg(ramp.other_deg)
+        if abs(m - self.estimate_deg) > self.options.gate_deg:
+            return False
+        self.suspects.clear()
+        self.last_measurement_deg = m
+        self.accepted_order = next(_ORDER)
+        if self.reference.add(ramp, profile_edge_deg):
+            self._take_reference()
+        return True
 
     def _measured(self, raw_deg: float, other_deg: float,
                   events: list[tuple[str, str, dict[str, Any]]]) -> None:
@@ -411,6 +352,7 @@ class EdgeTracker:
                     "why": why})]
         self.accepted = kept or [new_deg]
         self.estimate_deg = self.level_deg = new_deg
+        self.reference.fix()
         self._apply()
         return events
 
@@ -423,7 +365,7 @@ class EdgeTracker:
 
     def status(self) -> dict[str, Any]:
         state = ("learning" if self.learning else "frozen" if self.frozen_for > 0
-                 else "tracking")
+                 else "tracking" if self.reference.settled else "settling")
         return {"state": state, "offset_deg": round(self.applied_deg, 3),
                 "zero_load_offset_deg": round(self.zero_load_deg, 3),
                 "estimate_deg": round(self.estimate_deg, 3),
@@ -433,4 +375,6 @@ class EdgeTracker:
                 "feature": self.last_feature or None,
                 "backlash_gain_ratio": round(self.gain_ratio, 3),
                 "other_knob_bins_deg": self.bins.biases_deg(),
-                "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None}
+                "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None,
+                "reference_relearned": self.reference.relearned,
+                "reread_ramps": self.n_reread}

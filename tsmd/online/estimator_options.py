@@ -13,6 +13,17 @@ from dataclasses import dataclass
 @dataclass(frozen=True)
 class EstimatorOptions:
     baseline_ramps: int = 3
+    settle_ramps: int = 0
+    """With n > 0 the reference keeps being re-learned on the last ``baseline_ramps`` ramps
+    that read within the gate (they do not measure) until the reference of n re-learnings ago
+    reads the latest ones within ``deadband_deg`` with a slope within
+    ``slope_in_use_tolerance``, a change is followed or the knob's slopes rose
+    (:mod:`tsmd.online.reference`). 0 (default): the first ``baseline_ramps`` ramps fix it.
+    Session 14 measured 6 (docs/online.md): twistshaft 101-104 and lumped 101 without a change
+    drift less (up to 1.75 and 2.17 deg -> 0.58 and 0), but coilpipe 101, screwrod 101 and
+    lumped 103 drift more (2.15 -> 2.94, 0.69 -> 1.80, 0 -> 0.78 deg) and lumped 103 phi1
+    after a bend with the relation tracks 2.21 x fresh instead of 1.11: off until those are
+    understood."""
     window: int = 5
     gate_deg: float = 1.5
     confirm: int = 2
@@ -35,6 +46,10 @@ class EstimatorOptions:
     nothing, as the knee does in knee mode (session 12, stickslip 101 phi2). On since session
     13: with ``fresh_agreement`` the one run it made worse (lumped 102 without a change) is
     the same with it, and stickslip 104's bend went from 2.02 to 1.02 x fresh (docs/online.md)."""
+    reread_on_slope_change: bool = False
+    """The last crossing ramp is read again when the slope in use has moved beyond
+    ``slope_in_use_tolerance`` since it was read; outward beyond the gate it becomes a
+    suspect (:meth:`EdgeTracker._reread`; session 14, lumped 103 phi2 after a bend)."""
     fresh_agreement: bool = True
     """Both edges of a knob agree only on suspects each taken after the other edge's last
     measurement within the gate (:meth:`EdgeTracker.agrees_with`; session 13, lumped 102

@@ -6,20 +6,20 @@ from __future__ import annotations
 import itertools
 import logging
 import math
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any, TypeVar
 
 import numpy as np
 
 from tsmd.compensation.grid import INTERPOLATION_METHODS
-from tsmd.compensation.loaded_shape import LoadedShape, shape_from_mapping, shape_to_mapping
+from tsmd.compensation.loaded_shape import shape_from_mapping, shape_to_mapping
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
     OTHER_TIP_GAIN_RANGE,
     tension_play_from_mapping,
     tension_play_to_mapping,
 )
-from tsmd.profile.reading_offset import ReadingOffset, offset_from_mapping, offset_to_mapping
+from tsmd.profile.reading_offset import offset_from_mapping, offset_to_mapping
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
     BEND_GAIN_PER_RELEASE_RANGE,
@@ -152,20 +152,16 @@ _COUPLING_KEYS = ("other_tip_gain",)
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
 
 
-def _shape(r: _Reader, value: Any, where: str) -> LoadedShape | None:
+_Block = TypeVar("_Block")
+
+
+def _nested(r: _Reader, value: Any, where: str,
+            parse: Callable[[Any, str], _Block]) -> _Block | None:
+    """A nested block read by its own module's parser, its error re-raised as the schema's."""
     if value is None:
         return None
     try:
-        return shape_from_mapping(value, where)
-    except ValueError as exc:
-        raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
-
-
-def _offset(r: _Reader, value: Any, where: str) -> ReadingOffset | None:
-    if value is None:
-        return None
-    try:
-        return offset_from_mapping(value, where)
+        return parse(value, where)
     except ValueError as exc:
         raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
 
@@ -249,8 +245,10 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
             reference_rule_backlash_gain=optional("reference_rule_backlash_gain"),
             other_tip_gain=optional("other_tip_gain"),
-            reading_offset=_offset(r, k.get("reading_offset"), f"{key}.reading_offset"),
-            **{name: _shape(r, k.get(name), f"{key}.{name}") for name in _SHAPE_KEYS}))
+            reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
+                                   offset_from_mapping),
+            **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)
+               for name in _SHAPE_KEYS}))
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version, *bend)

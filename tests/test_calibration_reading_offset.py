@@ -12,7 +12,7 @@ import pytest
 from support.profiles import DEVICE as DEVICE_PATH
 
 from tsmd.calibration.estimate import point_estimates
-from tsmd.calibration.reading_offset import corrected, offset_at
+from tsmd.calibration.reading_offset import corrected, offset_at, reference_edge_deg
 from tsmd.calibration.run import device_options
 from tsmd.calibration.sweep_result import SweepResult
 from tsmd.datasheet_offset import offset_readings, reading_offsets
@@ -107,3 +107,11 @@ def test_a_sheets_offset_round_trips_and_a_wrong_one_is_one_error_line() -> None
         device_model_from_mapping(m, "sheet.yaml")
     assert "\n" not in str(err.value)
     assert "knobs.phi1.reading_offset" in str(err.value)
+
+
+def test_the_sheets_reference_edge_is_corrected_like_the_units_edges() -> None:
+    o = offset(dead_zone_pos_deg=((-1.5, -1.5, -1.5), (0.3, 0.3, 0.3)))
+    assert reference_edge_deg(o, "dead_zone_pos_deg", 20.0) == pytest.approx(21.5)
+    assert reference_edge_deg(o, "dead_zone_neg_deg", -20.0) == -20.0
+    assert reference_edge_deg(None, "dead_zone_pos_deg", 20.0) == 20.0
+    assert reference_edge_deg(o, "dead_zone_pos_deg", None) is None

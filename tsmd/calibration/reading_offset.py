@@ -49,6 +49,16 @@ def offset_at(offset: ReadingOffset, name: str, other_deg: float) -> tuple[float
             float(np.interp(other_deg, at, np.asarray(u95))))
 
 
+def reference_edge_deg(offset: ReadingOffset | None, name: str,
+                       edge_deg: float | None) -> float | None:
+    """A data sheet's reference dead-zone edge (read from current on its unit, other knob at 0)
+    corrected like every unit's edge, so that the plateau heights built on it and the unit's
+    corrected edges describe the same line (uncorrected, the loaded line moves by the offset)."""
+    if offset is None or edge_deg is None:
+        return edge_deg
+    return float(edge_deg) - offset_at(offset, name, 0.0)[0]
+
+
 def corrected(result: SweepResult, offset: ReadingOffset | None,
               other_deg: float) -> SweepResult:
     """``result`` with every half-cycle's value moved by the product's offset at this grid

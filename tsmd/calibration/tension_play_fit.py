@@ -51,6 +51,7 @@ from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.fresh_hold import with_fresh_hold
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
+from tsmd.calibration.reading_offset import reference_edge_deg
 from tsmd.calibration.release_path import release_slope_ratio, release_through_amplitude
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.unit_slope import GainReading, gain_scatter, weighed_omega
@@ -221,6 +222,11 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     # with its edges); without them the paper's assumption (the line through the reference point)
     ref_pos = getattr(k, "reference_dead_zone_pos_deg", None)
     ref_neg = getattr(k, "reference_dead_zone_neg_deg", None)
+    # the sheet's edges were read from current; the unit's are corrected by the product's
+    # reading offset (other knob at 0, where the sheet read them): read both the same way
+    offset = getattr(k, "reading_offset", None)
+    ref_pos = reference_edge_deg(offset, "dead_zone_pos_deg", ref_pos)
+    ref_neg = reference_edge_deg(offset, "dead_zone_neg_deg", ref_neg)
     edge_pos = at_other_knob_zero(grid, d_pos) if ref_pos is None else float(ref_pos)
     edge_neg = at_other_knob_zero(grid, d_neg) if ref_neg is None else float(ref_neg)
     h_pos, h_neg = plateau_heights(k, edge_pos, edge_neg)

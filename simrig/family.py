@@ -13,8 +13,8 @@ held-out set: tune on the first, report the second. The capstan plant is the dev
 the lumped plant is held out, the segments plant (written blind in session 9) is held out now,
 the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11,
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
-plant (session 13) is held out now, the nitinol plant (session 14) was written blind and tsmd was
-run on it untuned (``PLANT_ROLE``). ``SCATTER`` lives in :mod:`simrig.family_scatter`.
+plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
+now (``PLANT_ROLE``). ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ PLANT_SPECS: dict[str, str] = {
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
-              "screwrod": "held-out", "nitinol": "blind"}
+              "screwrod": "held-out", "nitinol": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

@@ -14,7 +14,8 @@ the lumped plant is held out, the segments plant (written blind in session 9) is
 the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11,
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
-now (``PLANT_ROLE``). ``SCATTER`` lives in :mod:`simrig.family_scatter`.
+now, the helixbelt plant (session 15) is the blind plant (``PLANT_ROLE``). ``SCATTER`` lives in
+:mod:`simrig.family_scatter`.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from simrig.motor import MotorParams
 from simrig.plant import Plant, PlantLoadError, load_plant
 from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
 from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
+from simrig.plants.helixbelt import NOMINAL_KNOBS as HELIXBELT_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
 from simrig.plants.nitinol import NOMINAL_KNOBS as NITINOL_KNOBS
 from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
@@ -47,11 +49,12 @@ PLANT_SPECS: dict[str, str] = {
     "stickslip": "simrig.plants.stickslip:make_stickslip_plant",
     "twistshaft": "simrig.plants.twistshaft:make_twistshaft_plant",
     "screwrod": "simrig.plants.screwrod:make_screwrod_plant",
-    "nitinol": "simrig.plants.nitinol:make_nitinol_plant",  # last: the others' seeds hold
+    "nitinol": "simrig.plants.nitinol:make_nitinol_plant",
+    "helixbelt": "simrig.plants.helixbelt:make_helixbelt_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
-              "screwrod": "held-out", "nitinol": "held-out"}
+              "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -63,7 +66,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "stickslip": STICKSLIP_KNOBS,
                                         "twistshaft": TWISTSHAFT_KNOBS,
                                         "screwrod": SCREWROD_KNOBS,
-                                        "nitinol": NITINOL_KNOBS}
+                                        "nitinol": NITINOL_KNOBS,
+                                        "helixbelt": HELIXBELT_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -119,6 +123,8 @@ VARIANTS: dict[str, Variant] = {
                          "handle_friction_Nm": 1.5, "thread_friction": 1.2},
             "nitinol": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                         "handle_friction_Nm": 1.5, "film_damping_N_s_per_mm": 1.5},
+            "helixbelt": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                          "handle_friction_Nm": 1.5, "braid_friction_Nm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -140,7 +146,8 @@ VARIANTS: dict[str, Variant] = {
                  "stickslip": {"tendon_stiffness_N": 0.4},
                  "twistshaft": {"tendon_stiffness_N": 0.4},
                  "screwrod": {"tendon_stiffness_N": 0.4},
-                 "nitinol": {"tendon_stiffness_N": 0.4}},
+                 "nitinol": {"tendon_stiffness_N": 0.4},
+                 "helixbelt": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

@@ -169,7 +169,7 @@ def test_helixbelt_is_the_blind_plant_registered_last() -> None:
         ({"knobs": [{"tendon_stiffness_N": -1.0}, {}]}, "tendon_stiffness_N must be > 0"),
         ({"knobs": [{"spring": 1.0}, {}]}, "unknown helixbelt knob constants: spring"),
         ({"knobs": [{}]}, "knobs must list 2 knobs"),
-        ({"knobs": [{"contact_fraction": 1.0}, {}]}, "contact_fraction must be in"),
+        ({"knobs": [{"braid_slip_deg": 0.0}, {}]}, "braid_slip_deg must be > 0"),
         ({"sheath_curvature_deg": -5.0}, "sheath_curvature_deg must be finite and >= 0"),
     ],
 )

@@ -7,6 +7,8 @@
   it does not add the two linearly (a helix pays wrap in a straight shaft and gains little more
   when the shaft curves), and the tendon's length does not change with the shaft's curve (each
   turn passes the inside and the outside of the bend alike) - why catheters route tendons so.
+- ``friction_centroid``: where the one lumped contact of a tendon sits: the mean position of
+  its friction along the shaft when loaded.
 - ``mesh_deflection_rad``: the belt's deflection at the drum for a torque: the tooth clearance,
   then a progressive tooth mesh (deflection ~ sqrt(torque): flank contact and the number of
   loaded teeth grow with the load).
@@ -32,6 +34,16 @@ def helix_wrap_rad(length_mm: float, helix_radius_mm: float, helix_pitch_mm: flo
         total += math.sqrt(kappa_h * kappa_h + kappa_s * kappa_s
                            + 2.0 * kappa_h * kappa_s * math.cos(phi))
     return length_mm * total / phases
+
+
+def friction_centroid(friction_exponent: float) -> float:
+    """Where along the shaft (fraction from the handle) the friction of a loaded tendon acts on
+    average: the normal force follows the tension, which falls as exp(-x s / L) (x = mu Theta),
+    so the friction crowds towards the handle; 1/2 when there is none."""
+    x = friction_exponent
+    if x < 1e-6:
+        return 0.5
+    return 1.0 / x - math.exp(-x) / (1.0 - math.exp(-x))
 
 
 def helix_length_factor(helix_radius_mm: float, helix_pitch_mm: float) -> float:

@@ -17,28 +17,29 @@ from dataclasses import dataclass, fields
 class HelixKnobParams:
     """One knob's plane. Lengths mm or m as named, forces N, moments Nm, angles deg."""
 
-    pulley_radius_mm: float = 7.5
-    """Tendon drum radius (the belt's two pulleys are equal: knob and drum turn alike)."""
+    pulley_radius_mm: float = 7.2
+    """Tendon drum radius (the belt's two pulleys are equal: knob and drum turn alike); R/a = 1.6
+    sets the loaded slope, 1.32 on the nominal unit (the paper's catheters: 1.32 +- 0.12)."""
     belt_clearance_deg: float = 3.0
     """Tooth clearance of the belt at the drum, total (both flanks): the drum floats in it
     while neither tendon pulls. 0.2-0.5 mm on a 2 mm pitch (GT2/MXL tooth vs groove), on a
     9 mm pulley about 1.3-3 deg."""
     belt_ref_torque_Nm: float = 0.2
-    belt_ref_deflection_deg: float = 3.0
-    """Mesh deflection (past the clearance) at the reference torque. Tooth-mesh stiffness grows
-    with load as more of each tooth flank and more teeth bear: deflection ~ sqrt(torque)."""
-    slack_pos_mm: float = 2.6
-    slack_neg_mm: float = 2.6
+    belt_ref_deflection_deg: float = 5.0
+    """Mesh deflection (past the clearance) at the reference torque: a 3 mm MXL belt over 60 mm
+    spans (EA ~ 2 kN: ~35 N/mm) and its teeth, 0.65 mm at the pulley's pitch line under 27 N.
+    Tooth-mesh stiffness grows with load as more of each tooth flank and more teeth bear:
+    deflection ~ sqrt(torque)."""
+    slack_pos_mm: float = 3.1
+    slack_neg_mm: float = 3.1
     """Tendon slack at assembly (each tendon crimped and wound by hand)."""
     tendon_stiffness_N: float = 15000.0
     """EA of a 7x19 stainless rope of 0.45 mm (metallic area ~0.1 mm^2, rope modulus ~0.75 of
     the wire's 193 GPa)."""
-    free_length_m: float = 0.08
-    """Tendon from the drum to the shaft's entry, in the handle."""
+    free_length_m: float = 0.16
+    """Tendon from the drum to the shaft's entry, along the handle (a TEE handle is ~0.2 m)."""
     sheath_length_m: float = 1.0
     """Shaft length of a TEE probe (about 1 m to the bending section)."""
-    contact_fraction: float = 0.5
-    """Where along the shaft the lumped lumen contact sits (the helix is uniform: the middle)."""
     helix_radius_mm: float = 3.0
     """Lumen distance from the shaft axis (a 9-10 mm TEE shaft)."""
     helix_pitch_mm: float = 100.0
@@ -50,7 +51,7 @@ class HelixKnobParams:
     sheath_friction: float = 0.12
     """Steel rope on a PTFE lumen liner (0.05-0.1 on smooth wire; more with the rope's strand
     texture). With the helix's wrap mu Theta ~ 1.4: the tendon loses ~3/4 of its tension."""
-    sheath_drag_N: float = 0.12
+    sheath_drag_N: float = 0.08
     """Tension-independent drag of the rope in its lumen (liner ovality, braid pressing in)."""
     tendon_offset_mm: float = 4.5
     """Moment arm of the tendon in the bending section."""
@@ -59,7 +60,7 @@ class HelixKnobParams:
     """The braided bending section's stiffness in this plane (braid and polymer cover)."""
     braid_stiffening_per_rad2: float = 0.04
     """Braid wires lock as the section bends either way: stiffness x (1 + this x total bend^2)."""
-    braid_friction_Nm: float = 0.0013
+    braid_friction_Nm: float = 0.001
     """Saturated inter-wire friction moment of the braid (the Masing backbone's limit)."""
     braid_slip_deg: float = 3.0
     """Bend over which the braid's friction builds up (backbone tanh scale)."""
@@ -89,15 +90,12 @@ class HelixKnobParams:
             if not getattr(self, name) >= 0.0:
                 raise ValueError(f"helixbelt knob constant {name} must be >= 0, "
                                  f"got {getattr(self, name)}")
-        if not 0.0 < self.contact_fraction < 1.0:
-            raise ValueError(f"helixbelt contact_fraction must be in (0, 1), "
-                             f"got {self.contact_fraction}")
         if not abs(self.plane_error_deg) < 45.0:
             raise ValueError(f"helixbelt plane_error_deg must be within +-45, "
                              f"got {self.plane_error_deg}")
 
 
-NOMINAL_KNOBS = (HelixKnobParams(), HelixKnobParams(plane_error_deg=-2.0, slack_pos_mm=2.9,
+NOMINAL_KNOBS = (HelixKnobParams(), HelixKnobParams(plane_error_deg=-2.0, slack_pos_mm=3.4,
                                                      bend_stiffness_Nm_per_rad=0.0135))
 """Nominal unit: the right-left plane's braid is a little softer (the braid is wound for the
 anterior plane) and its tendons were wound with a little more slack."""

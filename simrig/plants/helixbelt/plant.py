@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from simrig.plant import PlantStep, step_inputs
 from simrig.plants.helixbelt.laws import (
+    friction_centroid,
     helix_length_factor,
     helix_wrap_rad,
     masing_moment_Nmm,
@@ -47,14 +48,10 @@ class _Plane:
         self.c = 0.5 * p.belt_clearance_deg * _DEG
         self.d_ref = p.belt_ref_deflection_deg * _DEG
         self.tau_ref = p.belt_ref_torque_Nm * 1000.0
-        shaft_mm = p.sheath_length_m * 1000.0
-        stretch = helix_length_factor(p.helix_radius_mm, p.helix_pitch_mm)
-        prox_mm = p.free_length_m * 1000.0 + p.contact_fraction * shaft_mm * stretch
-        dist_mm = (1.0 - p.contact_fraction) * shaft_mm * stretch + p.bend_length_mm
-        self.k1 = p.tendon_stiffness_N / prox_mm
-        self.k2 = p.tendon_stiffness_N / dist_mm
         self.wrap_rad = 0.0
         self.gain = 1.0
+        self.k1 = self.k2 = p.tendon_stiffness_N
+        self._A = 0.0
         self.set_shape(shaft_curvature_deg, (0.0, 0.0))
         self.F0 = p.sheath_drag_N
         self.K = p.bend_stiffness_Nm_per_rad * 1000.0
@@ -63,7 +60,6 @@ class _Plane:
         self.slip = p.braid_slip_deg * _DEG
         # mesh_deflection_rad inverted for the stuck trial, a quadratic in sqrt(T):
         # q = drum + c + d_ref sqrt(R T / tau_ref)
-        self._A = 1.0 / (self.k1 * self.R)
         self._B = self.d_ref * math.sqrt(self.R / self.tau_ref)
         self.reset()
 
@@ -75,6 +71,12 @@ class _Plane:
                                        p.helix_pitch_mm,
                                        (p.sheath_wrap_deg + shaft_curvature_deg) * _DEG)
         self.gain = math.exp(p.sheath_friction * self.wrap_rad)
+        shaft_mm = p.sheath_length_m * 1000.0 * helix_length_factor(p.helix_radius_mm,
+                                                                    p.helix_pitch_mm)
+        share = friction_centroid(p.sheath_friction * self.wrap_rad)
+        self.k1 = p.tendon_stiffness_N / (p.free_length_m * 1000.0 + share * shaft_mm)
+        self.k2 = p.tendon_stiffness_N / ((1.0 - share) * shaft_mm + p.bend_length_mm)
+        self._A = 1.0 / (self.k1 * self.R)
         self.slack = (p.slack_pos_mm + slack_delta_mm[0], p.slack_neg_mm + slack_delta_mm[1])
         if min(self.slack) < 0.0:
             raise ValueError(f"helixbelt tendon slack must stay >= 0, got {self.slack} mm")

@@ -18,7 +18,7 @@ from tsmd.compensation import (
     build_compensator,
 )
 from tsmd.compensation.grid import ParameterField
-from tsmd.compensation.ours import OursKnob
+from tsmd.compensation.ours_table import OursKnob
 from tsmd.compensation.paper import at_other_knob_zero, offset_edges, plateau_heights
 from tsmd.compensation.safety import LimiterState, limit_step
 from tsmd.profile import load_profile

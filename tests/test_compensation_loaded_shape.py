@@ -17,7 +17,8 @@ from tsmd.compensation.loaded_shape import (
     shape_to_mapping,
     shaped_height,
 )
-from tsmd.compensation.ours import OursCompensator, ours_knobs
+from tsmd.compensation.ours import OursCompensator
+from tsmd.compensation.ours_table import ours_knobs
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.shaped_play import shaped_branches
 from tsmd.compensation.tension_play import (

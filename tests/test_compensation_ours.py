@@ -11,7 +11,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tsmd.compensation.ours import MOVES_WITH_EDGE, OursCompensator, OursKnob, ours_knobs
+from tsmd.compensation.ours import OursCompensator
+from tsmd.compensation.ours_table import MOVES_WITH_EDGE, OursKnob, ours_knobs
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
     BETA_RANGE,

@@ -11,7 +11,8 @@ import pytest
 import yaml
 from support.profiles import DEVICE
 
-from tsmd.compensation.ours import OursCompensator, ours_knobs
+from tsmd.compensation.ours import OursCompensator
+from tsmd.compensation.ours_table import ours_knobs
 from tsmd.compensation.tension_play import (
     TensionPlayParams,
     tension_play_from_mapping,

@@ -11,8 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_compensation_ours import LIMITS, PERIOD_S, params, random_params, samples
 
-from tsmd.compensation.ours import OursCompensator, ours_knobs
+from tsmd.compensation.ours import OursCompensator
 from tsmd.compensation.ours_knob import KnobCommand, motion
+from tsmd.compensation.ours_table import ours_knobs
 from tsmd.compensation.safety import MAX_TICK_PERIODS, KnobLimiter, KnobLimits, tick_time_s
 from tsmd.compensation.tension_play import TensionPlayParams
 

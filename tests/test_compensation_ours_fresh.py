@@ -8,13 +8,14 @@ import dataclasses
 import numpy as np
 import pytest
 
-from tsmd.compensation.ours import OursCompensator, ours_knobs
+from tsmd.compensation.fresh_play import fresh_branches
+from tsmd.compensation.ours import OursCompensator
+from tsmd.compensation.ours_table import ours_knobs
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
     PlayState,
     TensionPlayParams,
     branches,
-    fresh_branches,
     model_step,
     tension_play_from_mapping,
     tension_play_to_mapping,

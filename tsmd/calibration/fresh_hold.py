@@ -5,7 +5,7 @@ their initial tension) and visits +A before coming down to -A: on that first way
 other tendon takes over later than on every later release (the capstan plant: ~8-17 knob deg
 on the family's units). The current shows it as the negative edge of that first falling
 half-cycle lying above the edge of the later ones; the difference is the profile's
-``fresh_hold_deg`` (:func:`tsmd.compensation.tension_play.fresh_branches`). Only the knob
+``fresh_hold_deg`` (:func:`tsmd.compensation.fresh_play.fresh_branches`). Only the knob
 swept first is fresh when its sweep starts: the other knob has been moved (loaded) by then.
 """
 

@@ -233,6 +233,9 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     # the product's loaded-branch template (data sheet) bends the line through the reference
     shape_pos = curved(getattr(k, "loaded_shape_pos", None))
     shape_neg = curved(getattr(k, "loaded_shape_neg", None))
+    shape_grid = getattr(k, "loaded_shape_grid", None)
+    if shape_grid is not None:  # templates over the other knob: H where the sheet read it, at 0
+        shape_pos, shape_neg = (curved(g.at(0.0)) for g in shape_grid)
     if shape_pos is not None:
         h_pos = shaped_height(k.reference_pos.knob_deg, k.reference_pos.tip_deg, edge_pos,
                               float(k.omega), shape_pos)
@@ -258,7 +261,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         dead_zone_neg_deg=tuple(d_neg), backlash_gain_pos=sides[0][0],
         backlash_gain_neg=sides[1][0], zero_load_pos_deg=sides[0][1],
         zero_load_neg_deg=sides[1][1], lag_s=min(max(lag, 0.0), 1.0), shape_pos=shape_pos,
-        shape_neg=shape_neg, other_tip_gain=float(getattr(k, "other_tip_gain", None) or 0.0))
+        shape_neg=shape_neg, other_tip_gain=float(getattr(k, "other_tip_gain", None) or 0.0),
+        shape_grid=shape_grid)
 
 
 def clamped_gain(beta: float) -> float:

@@ -42,6 +42,7 @@ from tsmd.datasheet_rule import (
     rule_scores,
     sheet_truth,
 )
+from tsmd.datasheet_shape_grid import measure_shape_grids
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.profile.reading_offset import ReadingOffset
 from tsmd.recording import read_recording
@@ -64,7 +65,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=2000, help="simulated rig's noise seed")
     parser.add_argument("--loaded-shape", action="store_true",
                         help="also write each knob's loaded-branch template (ours then bends its "
-                             "loaded lines by it; off by default, docs/model.md Session 10)")
+                             "loaded lines by it; off by default, docs/model.md Session 10) and, "
+                             "with --plant, its templates over the other knob's angle (the "
+                             "calibration grid, 14 more sweeps; Session 15)")
     parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "
@@ -161,6 +164,22 @@ def _with_coupling(device: DeviceModel, config: TsmdConfig, factory: Callable[[]
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
+def _with_shape_grid(device: DeviceModel, config: TsmdConfig, factory: Callable[[], Plant],
+                     seed: int) -> DeviceModel:
+    """The sheet with each knob's loaded-branch templates over the other knob's angle."""
+    t0 = time.monotonic()
+    grids = measure_shape_grids(factory, [round(k.omega, 2) for k in device.knobs], seed, config)
+    knobs = tuple(dataclasses.replace(k, loaded_shape_grid=g)
+                  for k, g in zip(device.knobs, grids, strict=True))
+    for name, (pos, _neg) in zip(("phi1", "phi2"), grids, strict=True):
+        # the template's mean slope over its first 30 deg past the edge, per other-knob angle
+        print(f"  {name} loaded shape over the other knob: " + " ".join(
+            f"{a:+.0f}:{s.at(30.0) / 30.0:.2f}"
+            for a, s in zip(pos.other_knob_deg, pos.shapes, strict=True)))
+    print(f"  loaded-shape grid: {time.monotonic() - t0:.0f} s")
+    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+
 def _edge(value: float | None) -> float:
     """A sheet's reference edge, or where the family's plants have theirs when it lacks one."""
     return 20.0 if value is None else float(value)
@@ -222,6 +241,8 @@ def main(args: argparse.Namespace) -> int:
         print(f"warning: {line}")
     if args.plant is not None:
         device = _with_coupling(device, config, factory, args.seed)
+    if args.plant is not None and args.loaded_shape:
+        device = _with_shape_grid(device, config, factory, args.seed)
     if args.plant is not None and seeds:
         device = _choose_rule(device, config, args.plant, params, seeds)
     if args.plant is not None and args.bend_relation:

@@ -19,7 +19,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.grid import ParameterField
-from tsmd.compensation.ours import OursCompensator, ours_knobs
+from tsmd.compensation.ours import OursCompensator
+from tsmd.compensation.ours_table import ours_knobs
 from tsmd.compensation.paper import PaperCompensator, PaperKnob
 from tsmd.compensation.safety import KnobLimiter, KnobLimits
 from tsmd.errors import TsmdError

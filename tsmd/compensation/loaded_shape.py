@@ -127,6 +127,78 @@ def shaped_height(knob_deg: float, tip_deg: float, dead_zone_deg: float, omega: 
     return tip_deg + omega * shape.at(dead_zone_deg - knob_deg)
 
 
+@dataclass(frozen=True)
+class ShapeGrid:
+    """One side's templates over the other knob's angle (the product's, data sheet).
+
+    Where both planes bend one shared spine (a superelastic tube: nitinol), the other plane's
+    bend has already transformed part of it, and the knob's knee moves or vanishes (unit 0
+    phi1: tip 0.53 then 1.05 knob deg of travel per deg past the edge with the other knob at
+    0, about 0.9 throughout at +-60, 0.97 at +-90; docs/model.md, Session 15). Between the
+    angles the templates are interpolated linearly at every knot of either; outside, held.
+    """
+
+    other_knob_deg: tuple[float, ...]
+    shapes: tuple[LoadedShape, ...]
+
+    def __post_init__(self) -> None:
+        g = self.other_knob_deg
+        if len(g) != len(self.shapes) or len(g) < 2:
+            raise ValueError(f"needs >= 2 other-knob angles, one template each, got {len(g)} "
+                             f"and {len(self.shapes)}")
+        if not all(math.isfinite(v) for v in g) or any(b <= a for a, b in itertools.pairwise(g)):
+            raise ValueError(f"other_knob_deg must be finite and increase strictly: {list(g)}")
+
+    def at(self, other_deg: float) -> LoadedShape:
+        """The template at the other knob's angle (a weighted mean of its two neighbours)."""
+        g = self.other_knob_deg
+        if not other_deg > g[0]:
+            return self.shapes[0]
+        if not other_deg < g[-1]:
+            return self.shapes[-1]
+        i = bisect_right(g, other_deg) - 1
+        w = (other_deg - g[i]) / (g[i + 1] - g[i])
+        a, b = self.shapes[i], self.shapes[i + 1]
+        if w == 0.0 or a == b:
+            return a
+        knots = sorted({*a.travel_deg, *b.travel_deg})
+        return LoadedShape(tuple(knots),
+                           tuple((1.0 - w) * a.at(u) + w * b.at(u) for u in knots))
+
+
+def shape_grid_from_mapping(m: Mapping[str, Any], name: str) -> tuple[ShapeGrid, ShapeGrid]:
+    """A ``loaded_shape_grid`` block (``other_knob_deg``, ``pos`` and ``neg``: one template per
+    angle) as the two sides' grids; ValueError naming the key."""
+    if not isinstance(m, Mapping):
+        raise ValueError(f"{name}: must be a mapping with other_knob_deg, pos and neg")
+    unknown = set(m) - {"other_knob_deg", "pos", "neg"}
+    if unknown:
+        raise ValueError(f"{name}.{sorted(unknown)[0]}: unknown key")
+    grid = m.get("other_knob_deg")
+    if isinstance(grid, str) or not isinstance(grid, Sequence) or any(
+            isinstance(x, bool) or not isinstance(x, int | float) for x in grid):
+        raise ValueError(f"{name}.other_knob_deg: must be a list of numbers")
+    sides = []
+    for side in ("pos", "neg"):
+        raw = m.get(side)
+        if isinstance(raw, str) or not isinstance(raw, Sequence):
+            raise ValueError(f"{name}.{side}: must be a list of templates")
+        shapes = tuple(shape_from_mapping(s, f"{name}.{side}[{i}]") for i, s in enumerate(raw))
+        try:
+            sides.append(ShapeGrid(tuple(float(x) for x in grid), shapes))
+        except ValueError as exc:
+            raise ValueError(f"{name}.{side}: {exc}") from None
+    return sides[0], sides[1]
+
+
+def shape_grid_to_mapping(pos: ShapeGrid, neg: ShapeGrid) -> dict[str, Any]:
+    if pos.other_knob_deg != neg.other_knob_deg:
+        raise ValueError("the two sides' templates must share their other-knob angles")
+    return {"other_knob_deg": list(pos.other_knob_deg),
+            "pos": [shape_to_mapping(s) for s in pos.shapes],
+            "neg": [shape_to_mapping(s) for s in neg.shapes]}
+
+
 def _interp(x: float, xs: tuple[float, ...], ys: tuple[float, ...]) -> float:
     """Linear on strictly increasing ``xs``, the last piece extrapolated (x > xs[0] here)."""
     i = min(bisect_right(xs, x) - 1, len(xs) - 2)

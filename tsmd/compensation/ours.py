@@ -17,16 +17,12 @@ and lists, no numpy on scalars and no allocation beyond the output array.
 from __future__ import annotations
 
 import copy
-import dataclasses
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from tsmd.compensation.grid import ParameterField
-from tsmd.compensation.loaded_shape import LoadedShape, curved, steepest_slope
 from tsmd.compensation.ours_knob import (
     PLATEAU_MARGIN_DEG,
     KnobCommand,
@@ -36,105 +32,22 @@ from tsmd.compensation.ours_knob import (
     own_plane_plan,
     watch,
 )
+from tsmd.compensation.ours_table import OursKnob
 from tsmd.compensation.planned import Planner
 from tsmd.compensation.safety import KnobLimits, step_floats, tick_time_s
-from tsmd.compensation.shaped_play import model_branches
 from tsmd.compensation.tension_play import (
     Branches,
     PlayState,
-    TensionPlayParams,
-    fresh_branches,
     interp_linear,
     inverse_step,
     model_step,
     rest_state,
 )
 
-OURS_COLUMNS: tuple[str, ...] = ("dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_gain_pos",
-                                 "backlash_gain_neg", "zero_load_pos_deg", "zero_load_neg_deg")
-"""The columns of :attr:`OursKnob.field`, in the order :func:`branches` takes them. A slack
-change moves a tendon's whole characteristic along the knob axis: its edge and its zero-load
-point move together (:data:`MOVES_WITH_EDGE`)."""
-MOVES_WITH_EDGE: dict[str, str] = {"dead_zone_pos_deg": "zero_load_pos_deg",
-                                   "dead_zone_neg_deg": "zero_load_neg_deg"}
-TABLE_STEP_DEG = 0.25
-"""Resolution of the other knob's angle in the precomputed branches."""
 MOVE_FROM_REST_S = 1.0
 """How long after leaving rest the look-ahead trusts the desired angle's acceleration fully."""
 _MAX_LEAD_DEG = 10.0
 _JUMP_MIN_DEG = 3.0
-
-
-@dataclass(frozen=True)
-class OursKnob:
-    """One knob's parameters over the other knob's angle, with its branches precomputed.
-
-    ``field`` holds :data:`OURS_COLUMNS`; the table is built here (milliseconds), never in a
-    tick: online re-estimation builds shifted knobs on its own thread (``dataclasses.replace``).
-    """
-
-    field: ParameterField
-    omega: float
-    height_pos_deg: float
-    height_neg_deg: float
-    lag_s: float = 0.0
-    fresh_hold_deg: float = 0.0
-    fresh_edge_delay_deg: float | None = None
-    shape_pos: LoadedShape | None = None
-    """The product's loaded-branch template per side (None: straight); a fresh knob's first
-    loading and release (``fresh_branches``) stay straight."""
-    shape_neg: LoadedShape | None = None
-    other_tip_gain: float = 0.0
-    """Tip degrees in this plane per tip degree of the other (the product's, data sheet)."""
-    _table: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
-    _fresh: tuple[tuple[Branches, ...], ...] = dataclasses.field(init=False, repr=False,
-                                                                 compare=False)
-    _lo: float = dataclasses.field(init=False, repr=False, compare=False)
-    _step: float = dataclasses.field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        if self.field.columns != OURS_COLUMNS:
-            raise ValueError(f"the field must hold {OURS_COLUMNS}, got {self.field.columns}")
-        grid = self.field.grid_deg
-        lo, hi = float(grid[0]), float(grid[-1])
-        n = max(2, round((hi - lo) / TABLE_STEP_DEG) + 1)
-        step = (hi - lo) / (n - 1)
-        rows = [[float(v) for v in self.field.at(lo + i * step)] for i in range(n)]
-        w, h_pos, h_neg = self.omega, self.height_pos_deg, self.height_neg_deg
-        table = tuple(model_branches(w, h_pos, h_neg, r[0], r[1], r[2], r[3], r[4], r[5],
-                                     self.shape_pos, self.shape_neg) for r in rows)
-        # a fresh knob's tables by the side it loaded first: -1, none yet, +1
-        fresh = tuple(tuple(fresh_branches(b, w, r[0], r[1], h_pos, h_neg, self.fresh_hold_deg,
-                                           self.fresh_edge_delay_deg, side)
-                            for b, r in zip(table, rows, strict=True))
-                      for side in (-1, 0, 1)) if self.is_fresh_known else (table,) * 3
-        object.__setattr__(self, "_table", table)
-        object.__setattr__(self, "_fresh", fresh)
-        object.__setattr__(self, "_lo", lo)
-        object.__setattr__(self, "_step", step)
-
-    @classmethod
-    def from_params(cls, p: TensionPlayParams, interpolation: str = "pchip") -> OursKnob:
-        return cls(ParameterField(p.other_knob_deg, p.columns(), interpolation, OURS_COLUMNS),
-                   p.omega, p.height_pos_deg, p.height_neg_deg, p.lag_s, p.fresh_hold_deg,
-                   # the profile's fresh numbers come together from one first sweep
-                   p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None,
-                   curved(p.shape_pos), curved(p.shape_neg), p.other_tip_gain)
-
-    @property
-    def is_fresh_known(self) -> bool:
-        """The profile says how a fresh catheter differs (else it is taken as conditioned)."""
-        return self.fresh_hold_deg > 0.0 or self.fresh_edge_delay_deg is not None
-
-    def at(self, other_deg: float, fresh: bool = False, side: int = 0) -> Branches:
-        """The branches at the other knob's angle (nearest table row, clamped to the grid);
-        ``fresh``: those of a fresh catheter before its first release has ended, loaded first
-        on ``side`` (0: not yet)."""
-        table = self._fresh[side + 1] if fresh else self._table
-        if other_deg != other_deg:  # NaN
-            return table[0]
-        i = int((other_deg - self._lo) / self._step + 0.5)
-        return table[0 if i < 0 else (i if i < len(table) else len(table) - 1)]
 
 
 class OursCompensator:
@@ -178,8 +91,7 @@ class OursCompensator:
 
     def _set_constants(self) -> None:
         # faster than any knob can make the tip move (release slope <= 5 omega T')
-        jump_deg_s = 5.0 * max(k.omega * steepest_slope(k.shape_pos, k.shape_neg)
-                               for k in self.knobs) * self.v_max
+        jump_deg_s = 5.0 * max(k.omega * k.steepest_shape_slope for k in self.knobs) * self.v_max
         self._gains = (self.knobs[0].other_tip_gain, self.knobs[1].other_tip_gain)
         self._plan_source: object = None
         self._plan_own: list[list[float]] = []
@@ -402,10 +314,3 @@ class OursCompensator:
             horizon_s = 0.5 * (jump / self.v_max + self.v_max / self.a_max)
         kc.hold = d
         return ahead
-
-
-def ours_knobs(params: Sequence[TensionPlayParams], interpolation: str = "pchip"
-               ) -> tuple[OursKnob, OursKnob]:
-    """Both knobs from a profile's per-knob tension-play parameters."""
-    return (OursKnob.from_params(params[0], interpolation),
-            OursKnob.from_params(params[1], interpolation))

@@ -14,9 +14,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from tsmd.compensation.fresh_play import fresh_state_ends
 from tsmd.compensation.planned import PlanHold
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import PlayState, fresh_state_ends
+from tsmd.compensation.tension_play import PlayState
 
 PLATEAU_MARGIN_DEG = 1.0
 """An output this far beyond the plateaus is off them (a loaded side, not the dead zone)."""

@@ -30,7 +30,14 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from tsmd.compensation.loaded_shape import LoadedShape, shape_from_mapping, shape_to_mapping
+from tsmd.compensation.loaded_shape import (
+    LoadedShape,
+    ShapeGrid,
+    shape_from_mapping,
+    shape_grid_from_mapping,
+    shape_grid_to_mapping,
+    shape_to_mapping,
+)
 
 BETA_RANGE: tuple[float, float] = (0.0, 0.8)
 """Backlash per knob degree of load: 0 = no backlash; 0.8 = release slope 5 omega."""
@@ -52,11 +59,14 @@ class TensionPlayParams:
     ``height_*_deg``: plateau heights from the data sheet's reference points (paper, H).
     ``lag_s``: delay of the drive's actual position behind its command.
     ``fresh_hold_deg``: how much further a fresh (never loaded) catheter's knob travels on its
-    first release before the other tendon takes over (:func:`fresh_branches`); 0: not known.
+    first release before the other tendon takes over
+    (:func:`tsmd.compensation.fresh_play.fresh_branches`); 0: not known.
     ``fresh_edge_delay_deg``: how much later (knob deg) its first loading's current edge lies
     than the conditioned one's; from there the tip leaves straight (0) along the loaded slope.
     ``other_tip_gain``: the product's tip degrees in this plane per tip degree of the other
     (data sheet, tracked on its unit; 0: the planes do not turn into each other).
+    ``shape_grid``: the product's templates (positive, negative side) over the other knob's
+    angle (data sheet); where given they replace ``shape_pos``/``shape_neg`` in the model.
     """
 
     omega: float
@@ -75,6 +85,7 @@ class TensionPlayParams:
     shape_pos: LoadedShape | None = None
     shape_neg: LoadedShape | None = None
     other_tip_gain: float = 0.0
+    shape_grid: tuple[ShapeGrid, ShapeGrid] | None = None
 
     def columns(self) -> NDArray[np.float64]:
         """(n, 6): D_pos, D_neg, beta_pos, beta_neg, x0_pos, x0_neg per grid point."""
@@ -96,6 +107,7 @@ _SCALARS: dict[str, tuple[float, float]] = {
 _OPTIONAL = {"lag_s", "fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain"}
 _WRITTEN_IF_SET = {"fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain"}
 _SHAPES = {"loaded_shape_pos": "shape_pos", "loaded_shape_neg": "shape_neg"}
+_SHAPE_GRID = "loaded_shape_grid"
 
 
 def _number(value: Any, name: str, lo: float, hi: float) -> float:
@@ -119,11 +131,11 @@ def _numbers(values: Any, name: str, n: int | None, lo: float, hi: float) -> tup
 
 def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
     """Validate a profile's ``tension_play`` block (ValueError naming the key)."""
-    known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES}
+    known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES, _SHAPE_GRID}
     for key in m:
         if key not in known:
             raise ValueError(f"{key}: unknown key")
-    for key in known - _OPTIONAL - set(_SHAPES):
+    for key in known - _OPTIONAL - set(_SHAPES) - {_SHAPE_GRID}:
         if key not in m:
             raise ValueError(f"{key}: missing key")
     grid = _numbers(m["other_knob_deg"], "other_knob_deg", None, -180.0, 180.0)
@@ -137,7 +149,9 @@ def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
         s["omega"], s["height_pos_deg"], s["height_neg_deg"], grid, r["dead_zone_pos_deg"],
         r["dead_zone_neg_deg"], r["backlash_gain_pos"], r["backlash_gain_neg"],
         r["zero_load_pos_deg"], r["zero_load_neg_deg"], s["lag_s"], s["fresh_hold_deg"],
-        s["fresh_edge_delay_deg"], pos_shape, neg_shape, other_tip_gain=s["other_tip_gain"])
+        s["fresh_edge_delay_deg"], pos_shape, neg_shape, other_tip_gain=s["other_tip_gain"],
+        shape_grid=(shape_grid_from_mapping(m[_SHAPE_GRID], _SHAPE_GRID)
+                    if m.get(_SHAPE_GRID) is not None else None))
 
 
 def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
@@ -149,6 +163,8 @@ def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
         shape = getattr(p, attr)
         if shape is not None:
             out[key] = shape_to_mapping(shape)
+    if p.shape_grid is not None:
+        out[_SHAPE_GRID] = shape_grid_to_mapping(*p.shape_grid)
     return out
 
 
@@ -279,77 +295,6 @@ def envelopes(kinks: set[float], rising: Callable[[float], float],
         hi.append(max(r, f) + tilt)
     return Branches(tuple(xs), tuple(lo), tuple(hi), widest_flat(xs, lo, omega),
                     widest_flat(xs, hi, omega))
-
-
-def fresh_branches(b: Branches, omega: float, d_pos: float, d_neg: float, h_pos: float,
-                   h_neg: float, hold_deg: float, edge_delay_deg: float | None = None,
-                   side: int = 0) -> Branches:
-    """The branches of a fresh catheter (straight, never loaded) until its first release ends.
-
-    On the capstan plant a fresh catheter's first loading starts from straight (tip 0) at its
-    current edge, ``edge_delay_deg`` beyond the conditioned edge (None: not known), which puts
-    its loaded line outward of the conditioned one; and its first release stops early: the
-    tip holds where the other side's loaded line is ``hold_deg`` knob degrees inside its edge
-    (``H_neg + omega hold`` after a positive loading, mirrored after a negative one), then
-    follows that (conditioned) loaded line; from then on the catheter is conditioned
-    (:func:`branches`). ``side``: the side loaded first (0: none yet, both lines shifted and no
-    hold; +1: the rising line shifted and the positive hold; -1 mirrored).
-    """
-    if hold_deg <= 0.0 and edge_delay_deg is None:
-        return b
-    y_pos = h_neg + omega * hold_deg  # the hold after a positive loading
-    y_neg = h_pos - omega * hold_deg
-    # how far outward (knob deg) the first loaded line lies: from straight at the delayed edge
-    s_pos = s_neg = 0.0
-    if edge_delay_deg is not None:
-        s_pos = max(-h_pos / omega - edge_delay_deg, 0.0) if side >= 0 else 0.0
-        s_neg = max(h_neg / omega - edge_delay_deg, 0.0) if side <= 0 else 0.0
-
-    def untilted(x: float, ys: tuple[float, ...]) -> float:
-        return interp_linear(x, b.knots, ys) - _FLAT_SLOPE * omega * x
-
-    def falling(x: float) -> float:
-        f = untilted(x, b.falling_deg)
-        if side > 0:
-            f = max(f, min(y_pos, h_neg + omega * (x - d_neg)))
-        return min(f, h_neg + omega * (x - s_neg - d_neg)) if x - s_neg < d_neg else f
-
-    def rising(x: float) -> float:
-        r = untilted(x, b.rising_deg)
-        if side < 0:
-            r = min(r, max(y_neg, h_pos + omega * (x - d_pos)))
-        return max(r, h_pos + omega * (x + s_pos - d_pos)) if x + s_pos > d_pos else r
-
-    extra = [d_neg + hold_deg, d_pos - hold_deg, d_pos - s_pos, d_neg + s_neg]
-    extra += [b.falling_inverse(y_pos), b.rising_inverse(y_neg)] if hold_deg > 0.0 else []
-    xs = sorted({*b.knots, *(x for x in extra if -_FAR_DEG < x < _FAR_DEG)})
-    xs = [x for i, x in enumerate(xs) if i == 0 or x - xs[i - 1] > 1e-9]
-    r = [rising(x) for x in xs]
-    f = [falling(x) for x in xs]
-    # the outward-shifted lines may cross: where they do, the envelopes have a kink too
-    for i in range(len(xs) - 1):
-        da, db = r[i] - f[i], r[i + 1] - f[i + 1]
-        if da * db < 0.0:
-            xs.append(xs[i] + (xs[i + 1] - xs[i]) * da / (da - db))
-    xs = sorted(xs)
-    lo = [min(rising(x), falling(x)) + _FLAT_SLOPE * omega * x for x in xs]
-    hi = [max(rising(x), falling(x)) + _FLAT_SLOPE * omega * x for x in xs]
-    return Branches(tuple(xs), tuple(lo), tuple(hi), widest_flat(xs, lo, omega),
-                    widest_flat(xs, hi, omega))
-
-
-def fresh_state_ends(state: PlayState, first_side: int, h_pos: float, h_neg: float,
-                     margin_deg: float = 0.5) -> bool:
-    """True once a fresh knob's first release has handed over to the other tendon for good:
-    after a first positive loading the output went below the falling plateau ``h_neg`` (on the
-    negative loaded line, where the fresh and the conditioned branches agree), mirrored after a
-    negative one. Above it the conditioned model's falling branch is the release line, which
-    the tip on the loaded line is not on."""
-    if first_side > 0 and state.direction < 0:
-        return state.y_deg < h_neg - margin_deg
-    if first_side < 0 and state.direction > 0:
-        return state.y_deg > h_pos + margin_deg
-    return False
 
 
 class PlayState(NamedTuple):

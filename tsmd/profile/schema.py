@@ -12,7 +12,12 @@ from typing import Any, TypeVar
 import numpy as np
 
 from tsmd.compensation.grid import INTERPOLATION_METHODS
-from tsmd.compensation.loaded_shape import shape_from_mapping, shape_to_mapping
+from tsmd.compensation.loaded_shape import (
+    shape_from_mapping,
+    shape_grid_from_mapping,
+    shape_grid_to_mapping,
+    shape_to_mapping,
+)
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
     OTHER_TIP_GAIN_RANGE,
@@ -248,7 +253,9 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)
-               for name in _SHAPE_KEYS}))
+               for name in _SHAPE_KEYS},
+            loaded_shape_grid=_nested(r, k.get("loaded_shape_grid"),
+                                      f"{key}.loaded_shape_grid", shape_grid_from_mapping)))
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version, *bend)
@@ -294,6 +301,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             shape = getattr(k, key)
             if shape is not None:
                 knobs[name][key] = shape_to_mapping(shape)
+        if k.loaded_shape_grid is not None:
+            knobs[name]["loaded_shape_grid"] = shape_grid_to_mapping(*k.loaded_shape_grid)
         for key in _RELEASE_RULE_KEYS + _COUPLING_KEYS:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tsmd.compensation.grid import CALIBRATION_GRID_DEG
-from tsmd.compensation.loaded_shape import LoadedShape
+from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import TensionPlayParams
@@ -151,6 +151,12 @@ class DeviceKnob:
     against its tracked tip, session 14): what the current reads minus what the tip shows, per
     parameter and other-knob angle (:mod:`tsmd.profile.reading_offset`); calibration subtracts
     it where it is sure and large enough (:mod:`tsmd.calibration.reading_offset`). None: none."""
+    loaded_shape_grid: tuple[ShapeGrid, ShapeGrid] | None = None
+    """Optional, tracked on the data-sheet unit (``tsmd datasheet --loaded-shape``): the
+    loaded-branch templates (positive, negative side) over the other knob's angle, where the
+    other plane's bend changes the knob's branch (a spine both planes share, session 15);
+    method ours bends each unit's lines by the template at the other knob's angle. None: the
+    one template ``loaded_shape_pos/neg`` (or straight lines) at every angle."""
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,8 @@
 The model and its inverse are :mod:`tsmd.compensation.tension_play`; every catheter-specific
 parameter comes from that catheter's calibration current (:mod:`tsmd.calibration.
 tension_play_fit`). This module runs it once per tick for two knobs: each knob's branches
-follow the other knob's command (precomputed over that angle, so a tick only looks a row up);
+follow the other knob's command (precomputed over that angle, :mod:`tsmd.compensation.
+ours_table`, so a tick only looks a row up);
 the desired angle is led by the drive's lag; a jump across the dead zone is started early; the
 command goes through the knob's limits and a short moving average (bounded jerk). Time is each
 tick's elapsed time as the loop measured it (``dt_s``): a late tick on a loaded machine moves

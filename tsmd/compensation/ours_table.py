@@ -25,6 +25,8 @@ MOVES_WITH_EDGE: dict[str, str] = {"dead_zone_pos_deg": "zero_load_pos_deg",
                                    "dead_zone_neg_deg": "zero_load_neg_deg"}
 TABLE_STEP_DEG = 0.25
 """Resolution of the other knob's angle in the precomputed branches."""
+
+
 @dataclass(frozen=True)
 class OursKnob:
     """One knob's parameters over the other knob's angle, with its branches precomputed.

@@ -256,3 +256,28 @@ def test_a_model_reference_from_several_units_carries_their_compliance_sheet() -
     reference = product_reference(units)
     assert reference.units == 2 and reference.compliance is not None
     assert all(np.isfinite(reference.compliance.figure_deg_per_A))
+
+
+def test_a_measured_spread_is_not_counted_twice_but_an_unknown_one_is_the_tolerance() -> None:
+    # x1.52, lower bound about x1.13: beyond a spread measured as nil, not the tolerance
+    softer = _scaled(_protocol_series(5, "none"), 1.5)
+    noise = (0.03, 0.03)
+    one = compliance.ComplianceSheet(_sheet(), noise_log_var=noise, units=1)
+    several = compliance.ComplianceSheet(_sheet(), noise_log_var=noise, units=5)
+    from_one = compliance.compliance_score(softer, one, 7)
+    from_several = compliance.compliance_score(softer, several, 7)
+    assert from_one is not None and from_several is not None
+    assert from_several.significant and not from_one.significant
+
+
+def _scaled_knobs(series: list[GapSeries], factors: tuple[float, float]) -> list[GapSeries]:
+    """The same recordings with each knob's figure times its factor."""
+    return [dataclasses.replace(s, current_A=s.current_A / np.array(factors)) for s in series]
+
+
+def test_a_unit_read_above_the_sheet_on_one_knob_only_is_not_named() -> None:
+    unit = _protocol_series(5, "none")
+    both = compliance.compliance_score(_scaled_knobs(unit, (2.0, 2.0)), _sheet(), 7)
+    one = compliance.compliance_score(_scaled_knobs(unit, (2.0, 0.6)), _sheet(), 7)
+    assert both is not None and both.significant
+    assert one is not None and not one.significant

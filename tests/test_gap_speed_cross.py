@@ -179,6 +179,21 @@ def test_screwrod_cases_scale_the_units_tendons_and_coupling_rate_are_not_run() 
     assert not screw.supports("rate")
 
 
+def test_nitinol_cases_scale_the_units_film_and_rope_and_coupling_creep_are_not_run() -> None:
+    niti = PRESETS["nitinol"]
+    none = niti.build_unit(102, 0.1)
+    rate = niti.build_unit(102, 0.1, "rate", **niti.case_effects("rate"))
+    soft = niti.build_unit(102, 0.1, "compliance", **niti.case_effects("compliance"))
+    for k in (0, 1):
+        assert rate.knobs[k].p.film_damping_N_s_per_mm == pytest.approx(
+            5.0 * none.knobs[k].p.film_damping_N_s_per_mm)
+        assert soft.knobs[k].p.tendon_stiffness_N == pytest.approx(
+            0.5 * none.knobs[k].p.tendon_stiffness_N)
+        assert rate.knobs[k].p.tendon_stiffness_N == none.knobs[k].p.tendon_stiffness_N
+    assert not niti.supports("coupling")
+    assert not niti.supports("creep")
+
+
 def test_a_plant_valid_at_short_steps_is_stepped_finely_and_read_at_the_rows() -> None:
     # the screwrod plant's walled knob overshoots at 20 ms steps (torque spikes of ~1000 N m)
     screw = PRESETS["screwrod"]

@@ -141,6 +141,24 @@ SCREWROD_MAX_STEP_S = 0.004
 walled knob's Newton step overshoots (torque spikes of hundreds of N m, tip 10 deg off)."""
 
 
+NITINOL_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 120.0}}
+"""The nitinol plant's one effect keyword: a 120 deg sheath bend (adds to every lumen's wrap),
+1.61 deg of tip (tip RMSE effect on minus off, unit 1, noise-free, 120 s of the experiment motion
+at 50 Hz). Its planes' coupling (one superelastic spine for both planes; the bend adds wrap) has
+no constant of its own and nothing in it drifts in time: coupling and creep are not run. The
+lubricant film's speed-dependent friction is base physics; "none" is the nominal physics
+(docs/gap.md "Session 15")."""
+
+NITINOL_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "rate": {"film_damping_N_s_per_mm": 5.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Nitinol effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion): the lubricant film five times as viscous, 1.43 deg (x3 0.73, x8 2.48; the others'
+rate 1.1-1.9 deg); the wire rope's EA halved, 8.27 deg. Its physics hold at 20 ms steps (tip
+0.03 deg RMS from 4 ms ones, unit 1): no finer stepping."""
+
+
 TWISTSHAFT_KNOB_EFFECTS: dict[str, dict[str, float]] = {
     "coupling": {"lumen_angle_error_deg": 4.5},
     "compliance": {"tendon_stiffness_N": 0.5},
@@ -222,6 +240,8 @@ PRESETS: dict[str, PlantSpec] = {
     "screwrod": PlantSpec(PLANT_SPECS["screwrod"], {}, (), "screwrod", family="screwrod",
                           effects=SCREWROD_EFFECTS, knob_effects=SCREWROD_KNOB_EFFECTS,
                           max_step_s=SCREWROD_MAX_STEP_S),
+    "nitinol": PlantSpec(PLANT_SPECS["nitinol"], {}, (), "nitinol", family="nitinol",
+                         effects=NITINOL_EFFECTS, knob_effects=NITINOL_KNOB_EFFECTS),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

@@ -275,11 +275,10 @@ class OnlineWorker:
             held, held_other = self.trackers[(1 - ramp.knob, 1)], self.trackers[(1 - ramp.knob, -1)]
             if self._knob_agrees(held, held_other):
                 why = "both edges of the knob agree"
-                events = held.follow(held.suspects[-1], why)
+                events = self._follow_other(held, held.suspects[-1], why, "")
                 events += self._follow_other(held_other, held_other.suspects[-1], why, "")
                 for level, event, fields in events:
                     self._emit(level, event, **fields)
-                self._emit_offset(held)
 
     @staticmethod
     def _knob_agrees(tracker: EdgeTracker, other: EdgeTracker) -> bool:

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from statistics import median
 from typing import Any
@@ -109,6 +110,9 @@ class EdgeTracker(SlopeReadings):
     n_reread: int = 0
     """Ramps that became suspects when re-read with a slope in use that had moved."""
     reference: SettlingReference = field(init=False)
+    other_knob_shows: Callable[[int], bool] | None = field(default=None, repr=False)
+    """Whether the other knob's edges show a change this way (+1 outward, -1 inward;
+    :func:`tsmd.online.cross_knob.knob_shows`, set by the worker); None: not asked."""
     """The reference being learned, re-learned while it settles (:mod:`tsmd.online.reference`)."""
 
     def __post_init__(self) -> None:
@@ -317,10 +321,16 @@ class EdgeTracker(SlopeReadings):
         else:
             self.suspects = [*self.suspects, m][-o.confirm:]
             self.suspect_order = next(_ORDER)
-            if len(self.suspects) >= o.confirm and (max(self.suspects) - min(self.suspects)
-                                                    <= o.confirm_spread_deg):
+            if (len(self.suspects) >= o.confirm and max(self.suspects) - min(self.suspects)
+                    <= o.confirm_spread_deg and self.confirmed_elsewhere(median(self.suspects))):
                 events += self.follow(median(self.suspects), "consecutive ramps agree")
         self._apply()
+
+    def confirmed_elsewhere(self, new_deg: float) -> bool:
+        """The other knob shows a change the way ``new_deg`` is from the estimate (always
+        when not asked: :attr:`other_knob_shows`)."""
+        direction = 1 if new_deg > self.estimate_deg else -1
+        return self.other_knob_shows is None or self.other_knob_shows(direction)
 
     def agrees_with(self, other: EdgeTracker) -> bool:
         """Both edges of a knob have a suspect and they agree: the knob's shape changed (a

@@ -26,6 +26,11 @@ class EstimatorOptions:
     understood."""
     window: int = 5
     gate_deg: float = 1.5
+    other_knob_confirms: bool = False
+    """A change is followed on a knob only once the other knob's edges show it too
+    (:mod:`tsmd.online.cross_knob`): a slack or sheath change moves both knobs' edges, while
+    the coil-pipe plant's phi1 crossings read 2-3 deg out for minutes on their own (units 1,
+    2 without a change: followed, tracking worse than with online off)."""
     confirm: int = 2
     confirm_spread_deg: float = 2.0
     max_offset_deg: float = 12.0

@@ -15,6 +15,7 @@ import math
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -28,6 +29,7 @@ from tsmd.online.apply import (
     shifted_knob,
 )
 from tsmd.online.bend import BendRelation, bend_targets
+from tsmd.online.cross_knob import knob_shows
 from tsmd.online.estimator import EdgeTracker
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import (
@@ -90,6 +92,9 @@ class OnlineWorker:
         self.bend = bend
         self.trackers = {(knob, side): EdgeTracker(knob, side, estimator or EstimatorOptions())
                          for knob in (0, 1) for side in (1, -1)}
+        if (estimator or EstimatorOptions()).other_knob_confirms:
+            for (knob, _), tr in self.trackers.items():
+                tr.other_knob_shows = partial(self._knob_shows, 1 - knob)
         self.rate_deg_s = rate_deg_s
         self.gain_rate_per_s = gain_rate_per_s
         self.gains: Offsets = ONE_GAINS
@@ -254,26 +259,50 @@ class OnlineWorker:
         events = tracker.update(ramp, d_pos if ramp.side > 0 else d_neg, other)
         bend = (tracker.bend_suspect and tracker.options.follow_bend_at_once
                 and other.frozen_for == 0)
-        if bend or tracker.agrees_with(other):
-            other_before = other.applied_deg
+        if bend or self._knob_agrees(tracker, other):
             value = tracker.suspects[-1]
             why = ("a bend on both tendons of the knob" if bend
                    else "both edges of the knob agree")
             events += tracker.follow(value, why)
-            events += other.follow(value if bend else other.suspects[-1], why,
-                                   "knee" if bend else "")
-            if other.applied_deg != other_before:
-                self._emit("info", "online offset", knob=ramp.knob,
-                           side="pos" if other.side > 0 else "neg",
-                           offset_deg=round(other.applied_deg, 3),
-                           confidence=round(other.confidence, 2))
+            events += self._follow_other(other, value if bend else other.suspects[-1], why,
+                                         "knee" if bend else "")
         for level, event, fields in events:
             self._emit(level, event, **fields)
         if tracker.applied_deg != before:
-            self._emit("info", "online offset", knob=ramp.knob,
-                       side="pos" if ramp.side > 0 else "neg",
-                       offset_deg=round(tracker.applied_deg, 3),
-                       confidence=round(tracker.confidence, 2))
+            self._emit_offset(tracker)
+        if tracker.other_knob_shows is not None and tracker.applied_deg != before:
+            # this knob's change may be what the other knob's held suspects waited for
+            held, held_other = self.trackers[(1 - ramp.knob, 1)], self.trackers[(1 - ramp.knob, -1)]
+            if self._knob_agrees(held, held_other):
+                why = "both edges of the knob agree"
+                events = self._follow_other(held, held.suspects[-1], why, "")
+                events += self._follow_other(held_other, held_other.suspects[-1], why, "")
+                for level, event, fields in events:
+                    self._emit(level, event, **fields)
+
+    @staticmethod
+    def _knob_agrees(tracker: EdgeTracker, other: EdgeTracker) -> bool:
+        """Both edges of a knob hold agreeing suspects, and the other knob shows the change
+        too when that is asked (:attr:`EdgeTracker.other_knob_shows`)."""
+        return tracker.agrees_with(other) and tracker.confirmed_elsewhere(tracker.suspects[-1])
+
+    def _follow_other(self, other: EdgeTracker, value: float, why: str, feature: str
+                      ) -> list[tuple[str, str, dict[str, Any]]]:
+        before = other.applied_deg
+        events = other.follow(value, why, feature)
+        if other.applied_deg != before:
+            self._emit_offset(other)
+        return events
+
+    def _emit_offset(self, tracker: EdgeTracker) -> None:
+        self._emit("info", "online offset", knob=tracker.knob,
+                   side="pos" if tracker.side > 0 else "neg",
+                   offset_deg=round(tracker.applied_deg, 3),
+                   confidence=round(tracker.confidence, 2))
+
+    def _knob_shows(self, knob: int, direction: int) -> bool:
+        """Whether ``knob``'s edges show a change ``direction`` (:func:`knob_shows`)."""
+        return knob_shows((self.trackers[(knob, 1)], self.trackers[(knob, -1)]), direction)
 
     def _targets(self) -> Offsets:
         return self._per_edge("applied_deg") if self.enabled else ZERO_OFFSETS

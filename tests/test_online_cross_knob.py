@@ -1,0 +1,56 @@
+"""A change is followed only once both knobs show it (``other_knob_confirms``): a shape change
+moves every tendon's edge, one knob's crossings wandering on their own (coilpipe) do not."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+from support.online import profile_edges, rows
+
+from tsmd.compensation import build_compensator
+from tsmd.loop import ROW_COLUMNS
+from tsmd.online import OnlineWorker
+from tsmd.online.estimator_options import EstimatorOptions
+from tsmd.profile import load_profile
+
+PROFILE = Path(__file__).resolve().parents[1] / "profiles" / "example-sim.yaml"
+CONFIRMS = EstimatorOptions(other_knob_confirms=True)
+
+
+@pytest.fixture(scope="module")
+def profile() -> Any:
+    return load_profile(PROFILE)
+
+
+def run(profile: Any, options: EstimatorOptions, knobs_moved: tuple[int, ...],
+        shift_deg: float) -> OnlineWorker:
+    """200 s of both knobs; from 100 s on the edges of ``knobs_moved`` read ``shift_deg``
+    further out."""
+    comp = build_compensator(profile, "ours", 0.004)
+    worker = OnlineWorker(comp, 0.004, ROW_COLUMNS, estimator=options, drain_every=25)
+    moved, still = profile_edges(comp.knobs, shift_deg, at_s=100.0), profile_edges(comp.knobs)
+
+    def edges(t: float, knob: int, other_deg: float) -> tuple[float, float]:
+        return (moved if knob in knobs_moved else still)(t, knob, other_deg)
+
+    for row in rows(200.0, edges):
+        worker.observe(row, True)
+    worker.drain()
+    return worker
+
+
+def test_behaviour_one_knob_reading_out_is_followed_without_the_rule(profile: Any) -> None:
+    worker = run(profile, EstimatorOptions(), (0,), 3.0)
+    assert min(worker.trackers[(0, s)].applied_deg for s in (1, -1)) > 2.0
+
+
+def test_one_knob_reading_out_alone_is_not_followed_with_the_rule(profile: Any) -> None:
+    worker = run(profile, CONFIRMS, (0,), 3.0)
+    assert max(abs(tr.applied_deg) for tr in worker.trackers.values()) <= 0.5
+
+
+def test_a_change_both_knobs_show_is_followed_on_both_with_the_rule(profile: Any) -> None:
+    worker = run(profile, CONFIRMS, (0, 1), 4.0)
+    assert all(tr.applied_deg == pytest.approx(4.0, abs=0.8) for tr in worker.trackers.values())

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ from tsmd.bench.accuracy import tracking_errors
 from tsmd.bench.accuracy_scenarios import PERIOD_S, conditioned, scenarios
 from tsmd.compensation.ours import OursCompensator
 from tsmd.config import resolve_data_path
-from tsmd.profile import load_profile
+from tsmd.profile import load_device_model, load_profile
 
 
 def test_protocol_has_the_papers_scenarios() -> None:
@@ -157,3 +158,20 @@ def test_family_bench_fails_when_no_unit_could_be_scored(
                                                              no_extra=True))
     assert family_accuracy.main(args) == 1
     assert "no unit was scored" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("plant", sorted(set(PLANT_SPECS) - {"capstan"}))
+def test_family_bench_uses_the_plant_s_shipped_sheet_by_default(plant: str) -> None:
+    path = family_accuracy.sheet_path(plant, None)
+    assert path.name == f"{plant}.yaml" and path.exists()
+    assert load_device_model(path).device_model == f"family-{plant}"
+
+
+def test_family_bench_uses_the_sheet_it_is_given(tmp_path: Path) -> None:
+    given = tmp_path / "sheet.yaml"
+    assert family_accuracy.sheet_path("nitinol", given) == given
+
+
+def test_family_bench_scores_capstan_with_its_built_in_sheet() -> None:
+    assert family_accuracy.sheet_path("capstan", None).name == "sim-catheter.yaml"
+    assert family_accuracy.sheet_path(None, None).name == "sim-catheter.yaml"

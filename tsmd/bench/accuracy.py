@@ -229,8 +229,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="use this profile file instead of calibrating")
     parser.add_argument("--save-profile", type=Path, default=None,
                         help="write the profile the benchmark used here")
-    parser.add_argument("--device", type=Path,
-                        default=resolve_data_path("profiles/devices/sim-catheter.yaml"))
+    parser.add_argument("--device", type=Path, default=None,
+                        help="the product's data sheet (default: capstan's "
+                             "profiles/devices/sim-catheter.yaml; with --family the plant's "
+                             "shipped sheet)")
     parser.add_argument("--coupling", type=float, default=0.0,
                         help="plant knob-coupling strength (0 = the default simulated catheter)")
     parser.add_argument("--unit-variation", type=float, default=0.0,
@@ -278,7 +280,8 @@ def main(args: argparse.Namespace) -> int:
     n_seeds = args.seeds if args.seeds is not None else (1 if quick else 5)
     if n_seeds < 1:
         raise TsmdError("--seeds must be at least 1")
-    device = load_device_model(args.device)
+    device = load_device_model(args.device if args.device is not None
+                               else resolve_data_path("profiles/devices/sim-catheter.yaml"))
     coupling = float(args.coupling)
     unit_variation = float(args.unit_variation)
     if not 0.0 <= unit_variation < 0.5:

@@ -29,7 +29,6 @@ from simrig.plant import PlantLoadError, load_plant
 from tsmd.bench.accuracy import calibrated_profile, compute_time_us, run_scenario
 from tsmd.bench.accuracy_report import plot_runs
 from tsmd.bench.accuracy_scenarios import PERIOD_S, Scenario, scenarios
-from tsmd.bench.realism import data_sheet
 from tsmd.calibration.errors import CalibrationError
 from tsmd.config import resolve_data_path
 from tsmd.errors import TsmdError
@@ -103,6 +102,20 @@ def unit_profile(unit: int, device: Any, make: Callable[[], Any], directory: Pat
     return profile
 
 
+def sheet_path(family: str | None, device: Path | None) -> Path:
+    """The data sheet a run uses: the one asked for, else the family plant's shipped sheet.
+
+    The shipped sheets are what `tsmd datasheet` measured on each plant's unit 0, every
+    per-product field included (rule, reading offset, templates); a sheet measured here from
+    the slope and reference points alone would silently drop them.
+    """
+    if device is not None:
+        return device
+    if family is None or family == "capstan":
+        return resolve_data_path("profiles/devices/sim-catheter.yaml")
+    return resolve_data_path(f"profiles/devices/family/{family}.yaml")
+
+
 def namespace_from(args: argparse.Namespace) -> argparse.Namespace:
     """This bench's options from another bench's (``tsmd bench accuracy --family ...``): its own
     defaults, overridden by every option ``args`` sets to something other than None."""
@@ -119,7 +132,8 @@ def namespace_from(args: argparse.Namespace) -> argparse.Namespace:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--family", choices=sorted(PLANT_SPECS), default=None,
                         help="score units of a family plant (simrig.family) instead of --plant; "
-                             "the data sheet is measured on that plant's nominal unit")
+                             "the data sheet is --device, by default the plant's shipped one "
+                             "(profiles/devices/family/<plant>.yaml, measured on its unit 0)")
     parser.add_argument("--units", default="101,102",
                         help="with --family: comma-separated unit numbers (1-8 development, "
                              "101-108 held out)")
@@ -133,8 +147,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quick", action="store_true", help="the paper's quick scenario set")
     parser.add_argument("--no-extra", action="store_true", help="skip the extra scenarios")
     parser.add_argument("--fresh", action="store_true", help="fresh plant, no conditioning")
-    parser.add_argument("--device", type=Path,
-                        default=resolve_data_path("profiles/devices/sim-catheter.yaml"))
+    parser.add_argument("--device", type=Path, default=None,
+                        help="the product's data sheet (default: with --family the plant's "
+                             "shipped sheet, else capstan's profiles/devices/sim-catheter.yaml)")
     parser.add_argument("--report", type=Path, default=None)
     parser.add_argument("--profiles", type=Path, default=None,
                         help="keep each unit's calibrated profile here as unit-<n>.yaml and "
@@ -155,7 +170,7 @@ def main(args: argparse.Namespace) -> int:
     except ValueError:
         raise TsmdError(f"--unit-seeds must be integers, got {args.unit_seeds!r}") from None
     methods = [m.strip() for m in str(args.methods).split(",") if m.strip()]
-    device = load_device_model(args.device)
+    device = load_device_model(sheet_path(args.family, args.device))
     scen = scenarios(bool(args.quick)) + ([] if args.no_extra else extra_scenarios())
     t0 = time.perf_counter()
     lines = [f"plant {args.plant} {json.dumps(base)}; unit_variation {args.unit_variation}; "
@@ -170,12 +185,9 @@ def main(args: argparse.Namespace) -> int:
             members = [family_member(args.family, u) for u in numbers]
         except (ValueError, PlantLoadError) as exc:
             raise TsmdError(f"--units: {exc}") from None
-        # measured on unit 0 for every family (as `tsmd datasheet` would): it then carries
-        # every per-product constant this tsmd uses, whatever the packaged sheet predates
-        print(f"measuring the data sheet on {args.family} unit 0 ...", flush=True)
-        device = data_sheet(family_member(args.family, 0), args.device)
         lines[0] = (f"family plant {args.family} ({PLANT_ROLE[args.family]}); units {numbers}; "
-                    f"data sheet from unit 0; start {'fresh' if args.fresh else 'conditioned'}")
+                    f"data sheet {sheet_path(args.family, args.device)} ({device.device_model}); "
+                    f"start {'fresh' if args.fresh else 'conditioned'}")
         units = [(m.unit, m.build) for m in members]
     for seed in seeds if args.family is None else []:
         params = dict(base)

@@ -194,6 +194,23 @@ def test_nitinol_cases_scale_the_units_film_and_rope_and_coupling_creep_are_not_
     assert not niti.supports("creep")
 
 
+def test_helixbelt_cases_scale_the_units_plane_error_and_rope_and_rate_creep_are_not_run(
+) -> None:
+    helix = PRESETS["helixbelt"]
+    none = helix.build_unit(102, 0.1)
+    coupled = helix.build_unit(102, 0.1, "coupling", **helix.case_effects("coupling"))
+    soft = helix.build_unit(102, 0.1, "compliance", **helix.case_effects("compliance"))
+    for k in (0, 1):
+        assert coupled.knobs[k].plane_error_deg == pytest.approx(
+            2.2 * none.knobs[k].plane_error_deg)
+        assert soft.knobs[k].tendon_stiffness_N == pytest.approx(
+            0.5 * none.knobs[k].tendon_stiffness_N)
+        assert coupled.knobs[k].tendon_stiffness_N == none.knobs[k].tendon_stiffness_N
+    assert helix.case_effects("curvature") == {"sheath_curvature_deg": 120.0}
+    assert not helix.supports("rate")
+    assert not helix.supports("creep")
+
+
 def test_a_plant_valid_at_short_steps_is_stepped_finely_and_read_at_the_rows() -> None:
     # the screwrod plant's walled knob overshoots at 20 ms steps (torque spikes of ~1000 N m)
     screw = PRESETS["screwrod"]

@@ -159,6 +159,25 @@ rate 1.1-1.9 deg); the wire rope's EA halved, 8.27 deg. Its physics hold at 20 m
 0.03 deg RMS from 4 ms ones, unit 1): no finer stepping."""
 
 
+HELIXBELT_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 120.0}}
+"""The helixbelt plant's one effect keyword: a 120 deg sheath bend (added to the shaft's lay),
+0.05 deg of tip (tip RMSE effect on minus off, unit 1, noise-free, 120 s of the experiment motion
+at 50 Hz; 0.22 deg at most): its tendons run in a helix, whose wrap and length barely change
+with the shaft's curve. It is quasi-static with nothing that drifts in time and nothing speed-
+dependent at the tip (the knob seal's friction saturates at 2 deg/s, on the motor only): rate
+and creep are not run. "None" is the nominal physics as written (docs/gap.md "Session 15")."""
+
+HELIXBELT_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"plane_error_deg": 2.2},
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Helixbelt effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion): the helix's phase error at the tip (each plane bends out of its knob's plane, the
+planes' cross-coupling) 2.2 times the unit's, 1.51 deg (x2 1.26, x2.5 1.89, x3 2.52; the others'
+coupling 1.5 deg); the rope's EA halved, 2.03 deg. Its physics hold at 20 ms steps (tip 0.0005
+deg RMS from 4 ms ones, unit 1): no finer stepping."""
+
+
 TWISTSHAFT_KNOB_EFFECTS: dict[str, dict[str, float]] = {
     "coupling": {"lumen_angle_error_deg": 4.5},
     "compliance": {"tendon_stiffness_N": 0.5},
@@ -242,6 +261,8 @@ PRESETS: dict[str, PlantSpec] = {
                           max_step_s=SCREWROD_MAX_STEP_S),
     "nitinol": PlantSpec(PLANT_SPECS["nitinol"], {}, (), "nitinol", family="nitinol",
                          effects=NITINOL_EFFECTS, knob_effects=NITINOL_KNOB_EFFECTS),
+    "helixbelt": PlantSpec(PLANT_SPECS["helixbelt"], {}, (), "helixbelt", family="helixbelt",
+                           effects=HELIXBELT_EFFECTS, knob_effects=HELIXBELT_KNOB_EFFECTS),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

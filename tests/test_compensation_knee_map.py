@@ -18,6 +18,7 @@ from tsmd.compensation.knee_map import KNEE_RATIO_RANGE, moved_knee
 from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
 from tsmd.profile import load_device_model, save_device_model
+from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 from tsmd.profile.types import DeviceModel
 
 STRAIGHT_KNOTS = LoadedShape((0.0, 10.0, 60.0), (0.0, 10.0, 60.0))
@@ -109,3 +110,21 @@ def test_the_fit_stores_the_units_knee_and_copies_the_sheets() -> None:
     p = fit_tension_play([synthetic_sweep(a) for a in (-90.0, 0.0, 90.0)], knob)
     assert p.sheet_loaded_knee_deg == (30.0, 31.0)
     assert p.loaded_knee_deg is None  # a straight ramp shows no knee
+
+
+def test_the_fit_reads_the_units_knee_past_the_edge_as_the_current_read_it() -> None:
+    """Calibration subtracts the product's reading offset from the edges; the knee is read past
+    the edge before that, as on the sheet's unit (else every knee moves by the offset)."""
+    pos, cur = kneed_sweep(28.0, edge_deg=20.0)
+    grid_deg = (-90.0, 0.0, 90.0)
+    offsets = (("dead_zone_pos_deg", OffsetGrid((-1.5,) * 3, (0.1,) * 3, (4, 4, 4))),
+               ("dead_zone_neg_deg", OffsetGrid((1.5,) * 3, (0.1,) * 3, (4, 4, 4))))
+    # the edges as calibration hands them over: the read edges less the offset
+    sweeps = [dataclasses.replace(synthetic_sweep(a), t_s=np.arange(pos.size) * 0.004,
+                                  cmd_deg=pos, pos_deg=pos, current_A=cur,
+                                  dead_zone_pos_deg=21.5, dead_zone_neg_deg=-21.5)
+              for a in grid_deg]
+    knob = dataclasses.replace(DEVICE_KNOB, reading_offset=ReadingOffset(grid_deg, offsets))
+    p = fit_tension_play(sweeps, knob)
+    assert p.loaded_knee_deg is not None
+    assert p.loaded_knee_deg == pytest.approx((28.0, 28.0), abs=0.5)

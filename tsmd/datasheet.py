@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
 from tsmd.calibration.identify import identify_sweep
+from tsmd.calibration.loaded_knee import read_loaded_knee
 from tsmd.calibration.tension_play_fit import fit_sweep_sides
 from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.safety import KnobLimits
@@ -123,6 +124,9 @@ class KnobConstants:
     loaded_shape_pos: LoadedShape | None = None
     """The loaded branch's template per side (:mod:`tsmd.datasheet_shape`; None: not seen)."""
     loaded_shape_neg: LoadedShape | None = None
+    loaded_knee_pos_deg: float | None = None
+    """The loaded current ramp's knee per side (:mod:`tsmd.calibration.loaded_knee`)."""
+    loaded_knee_neg_deg: float | None = None
 
     def device_knob(self, limits: KnobLimits, decimals: int = 2) -> DeviceKnob:
         """The data sheet's knob entry, rounded as a data sheet is printed."""
@@ -154,6 +158,10 @@ class KnobConstants:
             backlash_settle_lag_deg=(None if self.settle_lag_deg is None
                                      else r(self.settle_lag_deg)),
             loaded_shape_pos=self.loaded_shape_pos, loaded_shape_neg=self.loaded_shape_neg,
+            loaded_knee_pos_deg=(None if self.loaded_knee_pos_deg is None
+                                 else r(self.loaded_knee_pos_deg)),
+            loaded_knee_neg_deg=(None if self.loaded_knee_neg_deg is None
+                                 else r(self.loaded_knee_neg_deg)),
             backlash_release_line_share=(None if self.release_line_share is None
                                          else round(float(self.release_line_share), 4)),
             backlash_release_local_share=(None if self.release_local_share is None
@@ -268,6 +276,9 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
     # the template at the omega the sheet prints, from the current's edges as printed
     shapes = [measure_loaded_shape(pos, tip, round(cur.estimate(f"dead_zone_{s}_deg"), 2),
                                    round(omega, 2), side) for s, side in (("pos", 1), ("neg", -1))]
+    knees = [read_loaded_knee(cur.data.pos_deg, cur.data.current_filtered_A,
+                              cur.estimate(f"dead_zone_{s}_deg"), side)
+             for s, side in (("pos", 1), ("neg", -1))]
     line_shares = [r.line_share for r in reads if math.isfinite(r.line_share)]
     local_shares = [r.local_share for r in reads if math.isfinite(r.local_share)]
     return KnobConstants(
@@ -285,7 +296,9 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
         settle_lag_deg=float(np.median(lags)) if lags else None,
         release_line_share=float(np.median(line_shares)) if line_shares else None,
         release_local_share=float(np.median(local_shares)) if local_shares else None,
-        release_reversals=len(reads), loaded_shape_pos=shapes[0], loaded_shape_neg=shapes[1])
+        release_reversals=len(reads), loaded_shape_pos=shapes[0], loaded_shape_neg=shapes[1],
+        loaded_knee_pos_deg=None if knees[0] is None else knees[0].travel_deg,
+        loaded_knee_neg_deg=None if knees[1] is None else knees[1].travel_deg)
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -321,7 +334,8 @@ def device_model(name: str, constants: Sequence[KnobConstants], config: TsmdConf
     if len(constants) != 2:
         raise DatasheetError(f"need the constants of 2 knobs, got {len(constants)}")
     if not loaded_shape:
-        constants = [dataclasses.replace(c, loaded_shape_pos=None, loaded_shape_neg=None)
+        constants = [dataclasses.replace(c, loaded_shape_pos=None, loaded_shape_neg=None,
+                                         loaded_knee_pos_deg=None, loaded_knee_neg_deg=None)
                      for c in constants]
     limits = knob_limits(config)
     knobs = tuple(c.device_knob(lim) for c, lim in zip(constants, limits, strict=True))

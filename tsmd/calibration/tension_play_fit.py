@@ -51,7 +51,8 @@ from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.fresh_hold import with_fresh_hold
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
-from tsmd.calibration.reading_offset import reference_edge_deg
+from tsmd.calibration.loaded_knee import sweep_knees
+from tsmd.calibration.reading_offset import offset_at, reference_edge_deg
 from tsmd.calibration.release_path import release_slope_ratio, release_through_amplitude
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.unit_slope import GainReading, gain_scatter, weighed_omega
@@ -242,6 +243,16 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     if shape_neg is not None:
         h_neg = shaped_height(k.reference_neg.knob_deg, k.reference_neg.tip_deg, edge_neg,
                               float(k.omega), shape_neg)
+    # the knee past the edge as the current read it (the sheet's is read so): the product's
+    # reading offset the calibration subtracted from the edges added back
+    near_zero = min(order, key=lambda w: abs(w.other_knob_deg))  # where the sheet reads its own
+    read_pos, read_neg = ((0.0 if offset is None
+                           else offset_at(offset, name, near_zero.other_knob_deg)[0])
+                          for name in ("dead_zone_pos_deg", "dead_zone_neg_deg"))
+    knee, knee_u95 = sweep_knees(near_zero.pos_deg, near_zero.current_A,
+                                 near_zero.dead_zone_pos_deg + read_pos,
+                                 near_zero.dead_zone_neg_deg + read_neg)
+    ks_pos, ks_neg = (getattr(k, f"loaded_knee_{s}_deg", None) for s in ("pos", "neg"))
     lag = float(np.median([estimate_lag_s(np.asarray(s.t_s, float), np.asarray(s.cmd_deg, float),
                                           np.asarray(s.pos_deg, float))
                            if s.lag_s is None else s.lag_s for s in order]))
@@ -262,7 +273,9 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         backlash_gain_neg=sides[1][0], zero_load_pos_deg=sides[0][1],
         zero_load_neg_deg=sides[1][1], lag_s=min(max(lag, 0.0), 1.0), shape_pos=shape_pos,
         shape_neg=shape_neg, other_tip_gain=float(getattr(k, "other_tip_gain", None) or 0.0),
-        shape_grid=shape_grid)
+        shape_grid=shape_grid, loaded_knee_deg=knee, loaded_knee_u95_deg=knee_u95,
+        sheet_loaded_knee_deg=(None if ks_pos is None or ks_neg is None
+                               else (float(ks_pos), float(ks_neg))))
 
 
 def clamped_gain(beta: float) -> float:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 from tsmd.compensation.fresh_play import fresh_branches
 from tsmd.compensation.grid import ParameterField
+from tsmd.compensation.knee_map import moved_grid, moved_knee
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid, curved, steepest_slope
 from tsmd.compensation.shaped_play import model_branches
 from tsmd.compensation.tension_play import Branches, TensionPlayParams
@@ -81,11 +82,19 @@ class OursKnob:
 
     @classmethod
     def from_params(cls, p: TensionPlayParams, interpolation: str = "pchip") -> OursKnob:
+        shape_pos, shape_neg, grid = p.shape_pos, p.shape_neg, p.shape_grid
+        if p.loaded_knee_deg is not None and p.sheet_loaded_knee_deg is not None:
+            # the templates' knee where this unit's current puts it (sheet and unit read alike)
+            (ks_pos, ks_neg), (ku_pos, ku_neg) = p.sheet_loaded_knee_deg, p.loaded_knee_deg
+            shape_pos = None if shape_pos is None else moved_knee(shape_pos, ks_pos, ku_pos)
+            shape_neg = None if shape_neg is None else moved_knee(shape_neg, ks_neg, ku_neg)
+            grid = None if grid is None else (moved_grid(grid[0], ks_pos, ku_pos),
+                                              moved_grid(grid[1], ks_neg, ku_neg))
         return cls(ParameterField(p.other_knob_deg, p.columns(), interpolation, OURS_COLUMNS),
                    p.omega, p.height_pos_deg, p.height_neg_deg, p.lag_s, p.fresh_hold_deg,
                    # the profile's fresh numbers come together from one first sweep
                    p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None,
-                   curved(p.shape_pos), curved(p.shape_neg), p.other_tip_gain, p.shape_grid)
+                   curved(shape_pos), curved(shape_neg), p.other_tip_gain, grid)
 
     def shapes_at(self, other_deg: float) -> tuple[LoadedShape | None, LoadedShape | None]:
         """The templates (positive, negative side) at the other knob's angle."""

@@ -67,6 +67,11 @@ class TensionPlayParams:
     (data sheet, tracked on its unit; 0: the planes do not turn into each other).
     ``shape_grid``: the product's templates (positive, negative side) over the other knob's
     angle (data sheet); where given they replace ``shape_pos``/``shape_neg`` in the model.
+    ``loaded_knee_deg``: the unit's knee of the loaded current ramp (positive, negative side;
+    travel past the edge, other knob at 0: :mod:`tsmd.calibration.loaded_knee`), with
+    ``loaded_knee_u95_deg``; ``sheet_loaded_knee_deg`` the data-sheet unit's, read the same way.
+    Where both knees are given method ours moves the templates' knee to the unit's
+    (:mod:`tsmd.compensation.knee_map`); otherwise the templates as they are.
     """
 
     omega: float
@@ -86,6 +91,9 @@ class TensionPlayParams:
     shape_neg: LoadedShape | None = None
     other_tip_gain: float = 0.0
     shape_grid: tuple[ShapeGrid, ShapeGrid] | None = None
+    loaded_knee_deg: tuple[float, float] | None = None
+    loaded_knee_u95_deg: tuple[float, float] | None = None
+    sheet_loaded_knee_deg: tuple[float, float] | None = None
 
     def columns(self) -> NDArray[np.float64]:
         """(n, 6): D_pos, D_neg, beta_pos, beta_neg, x0_pos, x0_neg per grid point."""
@@ -108,6 +116,8 @@ _OPTIONAL = {"lag_s", "fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain"
 _WRITTEN_IF_SET = {"fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain"}
 _SHAPES = {"loaded_shape_pos": "shape_pos", "loaded_shape_neg": "shape_neg"}
 _SHAPE_GRID = "loaded_shape_grid"
+_KNEES = ("loaded_knee_deg", "loaded_knee_u95_deg", "sheet_loaded_knee_deg")
+"""Optional pairs (positive, negative side), written only when set."""
 
 
 def _number(value: Any, name: str, lo: float, hi: float) -> float:
@@ -131,11 +141,11 @@ def _numbers(values: Any, name: str, n: int | None, lo: float, hi: float) -> tup
 
 def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
     """Validate a profile's ``tension_play`` block (ValueError naming the key)."""
-    known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES, _SHAPE_GRID}
+    known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES, _SHAPE_GRID, *_KNEES}
     for key in m:
         if key not in known:
             raise ValueError(f"{key}: unknown key")
-    for key in known - _OPTIONAL - set(_SHAPES) - {_SHAPE_GRID}:
+    for key in known - _OPTIONAL - set(_SHAPES) - {_SHAPE_GRID} - set(_KNEES):
         if key not in m:
             raise ValueError(f"{key}: missing key")
     grid = _numbers(m["other_knob_deg"], "other_knob_deg", None, -180.0, 180.0)
@@ -145,13 +155,19 @@ def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
     r = {k: _numbers(m[k], k, len(grid), *lim) for k, lim in _ROWS.items()}
     pos_shape, neg_shape = (shape_from_mapping(m[k], k) if m.get(k) is not None else None
                             for k in _SHAPES)
+    knees = {k: _knee_pair(m[k], k) if m.get(k) is not None else None for k in _KNEES}
     return TensionPlayParams(
         s["omega"], s["height_pos_deg"], s["height_neg_deg"], grid, r["dead_zone_pos_deg"],
         r["dead_zone_neg_deg"], r["backlash_gain_pos"], r["backlash_gain_neg"],
         r["zero_load_pos_deg"], r["zero_load_neg_deg"], s["lag_s"], s["fresh_hold_deg"],
         s["fresh_edge_delay_deg"], pos_shape, neg_shape, other_tip_gain=s["other_tip_gain"],
         shape_grid=(shape_grid_from_mapping(m[_SHAPE_GRID], _SHAPE_GRID)
-                    if m.get(_SHAPE_GRID) is not None else None))
+                    if m.get(_SHAPE_GRID) is not None else None), **knees)
+
+
+def _knee_pair(values: Any, name: str) -> tuple[float, float]:
+    pos, neg = _numbers(values, name, 2, 0.0, 90.0)
+    return pos, neg
 
 
 def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
@@ -165,6 +181,10 @@ def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
             out[key] = shape_to_mapping(shape)
     if p.shape_grid is not None:
         out[_SHAPE_GRID] = shape_grid_to_mapping(*p.shape_grid)
+    for key in _KNEES:
+        pair = getattr(p, key)
+        if pair is not None:
+            out[key] = [float(v) for v in pair]
     return out
 
 

@@ -141,6 +141,8 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "backlash_release_local_share": (0.5, 1.5, ""),
     "reference_rule_backlash_gain": (0.0, 0.8, ""),
     "other_tip_gain": (*OTHER_TIP_GAIN_RANGE, ""),
+    "loaded_knee_pos_deg": (0.0, 90.0, "deg"),
+    "loaded_knee_neg_deg": (0.0, 90.0, "deg"),
 }
 """The data sheet's optional measured numbers per knob and their plausible ranges: the schema
 reads them with these, and ``tsmd datasheet`` leaves out a measured one outside its range
@@ -153,7 +155,7 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_release_rule", "backlash_knee")
-_COUPLING_KEYS = ("other_tip_gain",)
+_COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
 
 
@@ -250,6 +252,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
             reference_rule_backlash_gain=optional("reference_rule_backlash_gain"),
             other_tip_gain=optional("other_tip_gain"),
+            loaded_knee_pos_deg=optional("loaded_knee_pos_deg"),
+            loaded_knee_neg_deg=optional("loaded_knee_neg_deg"),
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)

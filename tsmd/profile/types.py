@@ -157,6 +157,13 @@ class DeviceKnob:
     other plane's bend changes the knob's branch (a spine both planes share, session 15);
     method ours bends each unit's lines by the template at the other knob's angle. None: the
     one template ``loaded_shape_pos/neg`` (or straight lines) at every angle."""
+    loaded_knee_pos_deg: float | None = None
+    """Optional, on the data-sheet unit (``tsmd datasheet --loaded-shape``): the knee of its
+    loaded current ramp, knob travel past the current's edge with the other knob at 0
+    (:mod:`tsmd.calibration.loaded_knee`). Where the sheet and a unit's profile both carry one,
+    method ours moves the templates' knee to the unit's (:mod:`tsmd.compensation.knee_map`,
+    session 15). None: the templates as measured."""
+    loaded_knee_neg_deg: float | None = None
 
 
 @dataclass(frozen=True)

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import itertools
 import logging
-import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from typing import Any, TypeVar
 
 import numpy as np
@@ -24,6 +23,7 @@ from tsmd.compensation.tension_play import (
     tension_play_from_mapping,
     tension_play_to_mapping,
 )
+from tsmd.profile.reader import Reader
 from tsmd.profile.reading_offset import offset_from_mapping, offset_to_mapping
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
@@ -33,7 +33,6 @@ from tsmd.profile.types import (
     DEVICE_SCHEMA_VERSION,
     ID_PATTERN,
     KNOB_NAMES,
-    OMEGA_RANGE,
     PROFILE_SCHEMA_VERSION,
     RELEASE_RULES,
     CatheterProfile,
@@ -47,79 +46,7 @@ from tsmd.profile.types import (
 _log = logging.getLogger("tsmd.profile")
 
 
-class _Reader:
-    def __init__(self, origin: str) -> None:
-        self.origin = origin
-
-    def fail(self, key: str, reason: str) -> ProfileError:
-        return ProfileError(f"{self.origin}: {key}: {reason}")
-
-    def mapping(self, data: Any, key: str) -> Mapping[str, Any]:
-        if not isinstance(data, Mapping):
-            raise self.fail(key, f"must be a mapping, got {type(data).__name__}")
-        return data
-
-    def get(self, data: Mapping[str, Any], name: str, path: str) -> Any:
-        if name not in data:
-            raise self.fail(f"{path}{name}", "missing key")
-        return data[name]
-
-    def number(self, value: Any, key: str, lo: float | None = None, hi: float | None = None,
-               unit: str = "") -> float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.fail(key, f"must be a number{' in ' + unit if unit else ''}, got {value!r}")
-        v = float(value)
-        if math.isnan(v):
-            raise self.fail(key, "is NaN")
-        if math.isinf(v):
-            raise self.fail(key, "is infinite")
-        if (lo is not None and v < lo) or (hi is not None and v > hi):
-            raise self.fail(key, f"{v} {unit} is outside the plausible range [{lo}, {hi}]".replace(
-                "  ", " "))
-        return v
-
-    def text(self, value: Any, key: str) -> str:
-        if not isinstance(value, str) or not value.strip():
-            raise self.fail(key, f"must be a non-empty string, got {value!r}")
-        return value
-
-    def numbers(self, value: Any, key: str, n: int | None, lo: float, hi: float,
-                unit: str) -> tuple[float, ...]:
-        if not isinstance(value, Sequence) or isinstance(value, str):
-            raise self.fail(key, f"must be a list of numbers, got {type(value).__name__}")
-        if n is not None and len(value) != n:
-            raise self.fail(key, f"must have {n} values (one per grid point), got {len(value)}")
-        return tuple(self.number(v, f"{key}[{i}]", lo, hi, unit) for i, v in enumerate(value))
-
-    def version(self, data: Mapping[str, Any], supported: int) -> int:
-        v = self.get(data, "schema_version", "")
-        if isinstance(v, bool) or not isinstance(v, int):
-            raise self.fail("schema_version", f"must be an integer, got {v!r}")
-        if v != supported:
-            raise self.fail("schema_version",
-                            f"unknown schema version {v} (this tsmd reads version {supported})")
-        return v
-
-    def reference(self, data: Any, key: str) -> ReferencePoint:
-        m = self.mapping(data, key)
-        return ReferencePoint(
-            self.number(self.get(m, "knob_deg", key + "."), key + ".knob_deg",
-                        -ANGLE_RANGE_DEG, ANGLE_RANGE_DEG, "deg"),
-            self.number(self.get(m, "tip_deg", key + "."), key + ".tip_deg",
-                        -ANGLE_RANGE_DEG, ANGLE_RANGE_DEG, "deg"))
-
-    def omega(self, value: Any, key: str) -> float:
-        return self.number(value, key, OMEGA_RANGE[0], OMEGA_RANGE[1], "tip deg per knob deg")
-
-    def knob_map(self, data: Mapping[str, Any], path: str) -> list[tuple[str, Any]]:
-        knobs = self.mapping(self.get(data, "knobs", path), path + "knobs")
-        for name in knobs:
-            if name not in KNOB_NAMES:
-                raise self.fail(f"{path}knobs.{name}", f"unknown knob (expected {KNOB_NAMES})")
-        return [(name, self.get(knobs, name, f"{path}knobs.")) for name in KNOB_NAMES]
-
-
-def _check_references(r: _Reader, key: str, pos: ReferencePoint, neg: ReferencePoint) -> None:
+def _check_references(r: Reader, key: str, pos: ReferencePoint, neg: ReferencePoint) -> None:
     if not (pos.knob_deg > 0 > neg.knob_deg):
         raise r.fail(key, "reference_pos.knob_deg must be > 0 and reference_neg.knob_deg < 0")
     if not pos.tip_deg > neg.tip_deg:
@@ -162,7 +89,7 @@ _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg"
 _Block = TypeVar("_Block")
 
 
-def _nested(r: _Reader, value: Any, where: str,
+def _nested(r: Reader, value: Any, where: str,
             parse: Callable[[Any, str], _Block]) -> _Block | None:
     """A nested block read by its own module's parser, its error re-raised as the schema's."""
     if value is None:
@@ -173,7 +100,7 @@ def _nested(r: _Reader, value: Any, where: str,
         raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
 
 
-def _release_rule(r: _Reader, k: Mapping[str, Any], key: str) -> str | None:
+def _release_rule(r: Reader, k: Mapping[str, Any], key: str) -> str | None:
     value = k.get("backlash_release_rule")
     if value is None:
         return None
@@ -188,14 +115,14 @@ def _release_rule(r: _Reader, k: Mapping[str, Any], key: str) -> str | None:
     return rule
 
 
-def _knee(r: _Reader, value: Any, where: str) -> bool | None:
+def _knee(r: Reader, value: Any, where: str) -> bool | None:
     if value is None or isinstance(value, bool):
         return value
     raise r.fail(where, f"must be true or false, got {value!r}")
 
 
 def device_model_from_mapping(data: Any, origin: str = "device model") -> DeviceModel:
-    r = _Reader(origin)
+    r = Reader(origin)
     m = r.mapping(data, "top level")
     version = r.version(m, DEVICE_SCHEMA_VERSION)
     name = r.text(r.get(m, "device_model", ""), "device_model")
@@ -265,7 +192,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version, *bend)
 
 
-def _bend_relation(r: _Reader, raw: Any) -> tuple[float | None, float | None]:
+def _bend_relation(r: Reader, raw: Any) -> tuple[float | None, float | None]:
     """The sheet's optional bend relation (both numbers or the key absent)."""
     if raw is None:
         return None, None
@@ -325,7 +252,7 @@ def _ref_map(p: ReferencePoint) -> dict[str, float]:
     return {"knob_deg": p.knob_deg, "tip_deg": p.tip_deg}
 
 
-def _knob_from_mapping(r: _Reader, raw: Any, key: str) -> KnobProfile:
+def _knob_from_mapping(r: Reader, raw: Any, key: str) -> KnobProfile:
     k = r.mapping(raw, key)
     p = key + "."
     omega = r.omega(r.get(k, "omega", p), p + "omega")
@@ -359,7 +286,7 @@ def _knob_from_mapping(r: _Reader, raw: Any, key: str) -> KnobProfile:
 
 def profile_from_mapping(data: Any, origin: str = "profile") -> CatheterProfile:
     """Validate a parsed YAML document and build the profile (ProfileError on any problem)."""
-    r = _Reader(origin)
+    r = Reader(origin)
     m = r.mapping(data, "top level")
     version = r.version(m, PROFILE_SCHEMA_VERSION)
     catheter_id = r.text(r.get(m, "catheter_id", ""), "catheter_id")

@@ -29,6 +29,19 @@ Offsets = tuple[tuple[float, float], tuple[float, float]]
 ZERO_OFFSETS: Offsets = ((0.0, 0.0), (0.0, 0.0))
 
 
+ONE_GAINS: Offsets = ((1.0, 1.0), (1.0, 1.0))
+"""Backlash gain ratios (pos, neg) per knob that leave the profile's beta."""
+GAIN_STEP = 0.05
+"""The published backlash gain ratios move in steps of at least this (or to the target)."""
+
+
+def towards(current: Offsets, target: Offsets, step: float) -> Offsets:
+    """Each value moved towards its target by at most ``step``."""
+    (a, b), (c, d) = ((x + max(-step, min(step, g - x)) for x, g in zip(cur, tgt, strict=True))
+                      for cur, tgt in zip(current, target, strict=True))
+    return ((a, b), (c, d))
+
+
 class OnlineError(TsmdError):
     """Online estimates cannot be applied or saved as asked."""
 

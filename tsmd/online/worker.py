@@ -21,12 +21,15 @@ from typing import Any
 import numpy as np
 
 from tsmd.online.apply import (
+    GAIN_STEP,
+    ONE_GAINS,
     ZERO_OFFSETS,
     Offsets,
     OnlineError,
     apply_knobs,
     edges_at,
     shifted_knob,
+    towards,
 )
 from tsmd.online.bend import BendRelation, bend_targets
 from tsmd.online.cross_knob import knob_shows
@@ -335,10 +338,10 @@ class OnlineWorker:
         version, current, _ = self.published
         dt = max(t_s - self._t_publish, 0.0)
         self._t_publish = t_s
-        new = _towards(current, self._targets(), self.rate_deg_s * dt)
-        zero_loads = _towards(self.zero_loads, self._zero_load_targets(), self.rate_deg_s * dt)
+        new = towards(current, self._targets(), self.rate_deg_s * dt)
+        zero_loads = towards(self.zero_loads, self._zero_load_targets(), self.rate_deg_s * dt)
         targets = self._gain_targets()
-        self._gains_moving = _towards(self._gains_moving, targets, self.gain_rate_per_s * dt)
+        self._gains_moving = towards(self._gains_moving, targets, self.gain_rate_per_s * dt)
         gains = self._gains_moving
         if (max(abs(a - b) for g, h in zip(gains, self.gains, strict=True)
                 for a, b in zip(g, h, strict=True)) < GAIN_STEP and gains != targets):
@@ -396,15 +399,3 @@ class OnlineWorker:
         if self.on_event is not None:
             self.on_event(level, event, **fields)
 
-
-ONE_GAINS: Offsets = ((1.0, 1.0), (1.0, 1.0))
-"""Backlash gain ratios (pos, neg) per knob that leave the profile's beta."""
-GAIN_STEP = 0.05
-"""The published backlash gain ratios move in steps of at least this (or to the target)."""
-
-
-def _towards(current: Offsets, target: Offsets, step: float) -> Offsets:
-    """Each value moved towards its target by at most ``step``."""
-    (a, b), (c, d) = ((x + max(-step, min(step, g - x)) for x, g in zip(cur, tgt, strict=True))
-                      for cur, tgt in zip(current, target, strict=True))
-    return ((a, b), (c, d))

@@ -170,7 +170,8 @@ def main(args: argparse.Namespace) -> int:
     except ValueError:
         raise TsmdError(f"--unit-seeds must be integers, got {args.unit_seeds!r}") from None
     methods = [m.strip() for m in str(args.methods).split(",") if m.strip()]
-    device = load_device_model(sheet_path(args.family, args.device))
+    sheet = sheet_path(args.family, args.device)
+    device = load_device_model(sheet)
     scen = scenarios(bool(args.quick)) + ([] if args.no_extra else extra_scenarios())
     t0 = time.perf_counter()
     lines = [f"plant {args.plant} {json.dumps(base)}; unit_variation {args.unit_variation}; "
@@ -186,7 +187,7 @@ def main(args: argparse.Namespace) -> int:
         except (ValueError, PlantLoadError) as exc:
             raise TsmdError(f"--units: {exc}") from None
         lines[0] = (f"family plant {args.family} ({PLANT_ROLE[args.family]}); units {numbers}; "
-                    f"data sheet {sheet_path(args.family, args.device)} ({device.device_model}); "
+                    f"data sheet {sheet} ({device.device_model}); "
                     f"start {'fresh' if args.fresh else 'conditioned'}")
         units = [(m.unit, m.build) for m in members]
     for seed in seeds if args.family is None else []:

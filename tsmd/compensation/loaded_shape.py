@@ -77,21 +77,27 @@ class LoadedShape:
         return _interp(t_deg, self.shaped_deg, self.travel_deg)
 
 
-def shape_from_mapping(m: Mapping[str, Any], name: str) -> LoadedShape:
-    """A ``loaded_shape_*`` block (``travel_deg``, ``shaped_deg``); ValueError naming it."""
+def _check_keys(m: Any, name: str, keys: tuple[str, ...]) -> None:
+    """``m`` a mapping holding no key but ``keys``; ValueError naming the first defect."""
     if not isinstance(m, Mapping):
-        raise ValueError(f"{name}: must be a mapping with travel_deg and shaped_deg")
-    unknown = set(m) - {"travel_deg", "shaped_deg"}
+        raise ValueError(f"{name}: must be a mapping with {', '.join(keys[:-1])} and {keys[-1]}")
+    unknown = set(m) - set(keys)
     if unknown:
         raise ValueError(f"{name}.{sorted(unknown)[0]}: unknown key")
-    values = []
-    for key in ("travel_deg", "shaped_deg"):
-        v = m.get(key)
-        if isinstance(v, str) or not isinstance(v, Sequence):
-            raise ValueError(f"{name}.{key}: must be a list of numbers")
-        if any(isinstance(x, bool) or not isinstance(x, int | float) for x in v):
-            raise ValueError(f"{name}.{key}: must be a list of numbers")
-        values.append(tuple(float(x) for x in v))
+
+
+def _numbers(v: Any, key: str) -> tuple[float, ...]:
+    """``v`` as a tuple of floats; ValueError naming ``key`` if it is not a list of numbers."""
+    if isinstance(v, str) or not isinstance(v, Sequence) or any(
+            isinstance(x, bool) or not isinstance(x, int | float) for x in v):
+        raise ValueError(f"{key}: must be a list of numbers")
+    return tuple(float(x) for x in v)
+
+
+def shape_from_mapping(m: Mapping[str, Any], name: str) -> LoadedShape:
+    """A ``loaded_shape_*`` block (``travel_deg``, ``shaped_deg``); ValueError naming it."""
+    _check_keys(m, name, ("travel_deg", "shaped_deg"))
+    values = [_numbers(m.get(key), f"{name}.{key}") for key in ("travel_deg", "shaped_deg")]
     try:
         return LoadedShape(values[0], values[1])
     except ValueError as exc:
@@ -169,15 +175,8 @@ class ShapeGrid:
 def shape_grid_from_mapping(m: Mapping[str, Any], name: str) -> tuple[ShapeGrid, ShapeGrid]:
     """A ``loaded_shape_grid`` block (``other_knob_deg``, ``pos`` and ``neg``: one template per
     angle) as the two sides' grids; ValueError naming the key."""
-    if not isinstance(m, Mapping):
-        raise ValueError(f"{name}: must be a mapping with other_knob_deg, pos and neg")
-    unknown = set(m) - {"other_knob_deg", "pos", "neg"}
-    if unknown:
-        raise ValueError(f"{name}.{sorted(unknown)[0]}: unknown key")
-    grid = m.get("other_knob_deg")
-    if isinstance(grid, str) or not isinstance(grid, Sequence) or any(
-            isinstance(x, bool) or not isinstance(x, int | float) for x in grid):
-        raise ValueError(f"{name}.other_knob_deg: must be a list of numbers")
+    _check_keys(m, name, ("other_knob_deg", "pos", "neg"))
+    grid = _numbers(m.get("other_knob_deg"), f"{name}.other_knob_deg")
     sides = []
     for side in ("pos", "neg"):
         raw = m.get(side)
@@ -185,7 +184,7 @@ def shape_grid_from_mapping(m: Mapping[str, Any], name: str) -> tuple[ShapeGrid,
             raise ValueError(f"{name}.{side}: must be a list of templates")
         shapes = tuple(shape_from_mapping(s, f"{name}.{side}[{i}]") for i, s in enumerate(raw))
         try:
-            sides.append(ShapeGrid(tuple(float(x) for x in grid), shapes))
+            sides.append(ShapeGrid(grid, shapes))
         except ValueError as exc:
             raise ValueError(f"{name}.{side}: {exc}") from None
     return sides[0], sides[1]

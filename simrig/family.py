@@ -14,7 +14,7 @@ the lumped plant is held out, the segments plant (written blind in session 9) is
 the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11,
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
-now, the helixbelt plant (session 15) is the blind plant (``PLANT_ROLE``). ``SCATTER`` lives in
+now, the helixbelt plant (session 15, written blind) is held out now (``PLANT_ROLE``). ``SCATTER`` lives in
 :mod:`simrig.family_scatter`.
 """
 
@@ -54,7 +54,7 @@ PLANT_SPECS: dict[str, str] = {
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
-              "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "blind"}
+              "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

@@ -158,9 +158,9 @@ def test_the_plant_loads_from_its_spec_and_from_the_family() -> None:
     assert isinstance(family_member("helixbelt", 101).build(), HelixBeltPlant)
 
 
-def test_helixbelt_is_the_blind_plant_registered_last() -> None:
+def test_helixbelt_is_registered_last_and_held_out() -> None:
     assert list(PLANT_SPECS)[-1] == "helixbelt"
-    assert PLANT_ROLE["helixbelt"] == "blind"
+    assert PLANT_ROLE["helixbelt"] == "held-out"
 
 
 @pytest.mark.parametrize(

@@ -14,8 +14,8 @@ the lumped plant is held out, the segments plant (written blind in session 9) is
 the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11,
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
-now, the helixbelt plant (session 15, written blind) is held out now (``PLANT_ROLE``). ``SCATTER`` lives in
-:mod:`simrig.family_scatter`.
+now, the helixbelt plant (session 15, written blind) is held out now (``PLANT_ROLE``).
+``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
 from __future__ import annotations

@@ -12,12 +12,13 @@ import pytest
 from numpy.typing import NDArray
 
 from tsmd import cli
-from tsmd.gap.contrast import collect_tests, contrast_scores, lag_share, product_reference
+from tsmd.gap.contrast import collect_tests, contrast_scores, product_reference
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.errors import GapError
-from tsmd.gap.loops import Loops, loop_contrast, noise_ss, smooth_along
+from tsmd.gap.loops import Loops, contrast_of, loop_contrast, noise_ss, smooth_along
 from tsmd.gap.protocol import Segment, decode_table, encode_table, protocol
-from tsmd.gap.reference import beyond_reference, measured_windows, own_scale
+from tsmd.gap.reference import LoopReference, beyond_reference, measured_windows, own_scale
+from tsmd.gap.sensor import lag_share
 from tsmd.gap.signature import SignatureScore
 from tsmd.gap.structure import rank_scores
 from tsmd.recording import Recording, read_trajectory
@@ -436,3 +437,50 @@ def test_the_own_scale_is_the_units_projection_on_its_models_contrast_at_most_on
     assert own_scale(0.6 * own, own) == pytest.approx(0.6)
     assert own_scale(2.5 * own, own) == 1.0
     assert own_scale(-own, own) == 0.0
+
+
+def _two_knob_loops(contrast: Arr) -> Loops:
+    """Noise-free loops of two knobs' parts whose level contrast is ``contrast`` (levels x K)."""
+    k = contrast.shape[1]
+    y = np.repeat(contrast[:, None, :], 2, axis=1)
+    knob = np.tile(np.linspace(-0.9, 0.9, k // 2), 2)
+    part = np.repeat([0.0, 1.0], k // 2)
+    return Loops(y, np.zeros(k), knob, np.ones(k), part, span_deg=40.0)
+
+
+def test_a_units_shortfall_of_its_models_contrast_on_one_knob_is_no_excess_on_the_other() -> None:
+    own = np.vstack([np.linspace(-1.0, 1.0, 8), -np.linspace(-1.0, 1.0, 8)])
+    lp = _two_knob_loops(own)
+    ref = LoopReference(("minus", "plus"), own, lp.knob * lp.span_deg, lp.dirn, lp.part, 0.0)
+    unit = own * np.where(lp.part == 0, 0.7, 1.5)  # helixbelt unit 1: 0.71 and 1.48
+    residual = _two_knob_loops(np.zeros_like(own))  # the simulator has none of it
+    beyond = contrast_of(beyond_reference(residual, _two_knob_loops(unit), ["minus", "plus"],
+                                          ref))
+    assert np.allclose(beyond[:, lp.part == 0], 0.0)
+    assert np.allclose(beyond[:, lp.part == 1], 0.5 * own[:, lp.part == 1])
+
+
+def test_a_unit_inside_its_models_spread_counted_over_both_levels_is_not_named() -> None:
+    # units 0.01-0.05 and a unit of 0.11: inside their spread counted over both levels, as the
+    # repeats' noise is; beyond it counted on one level (before session 16: named rate)
+    reference = product_reference(_units(_widening(0.01), _widening(0.03), _widening(0.05)))
+    series, residuals = _session(_widening(0.11))
+    scores = {s.name: s for s in contrast_scores(series, residuals, n_tried=6, tip_noise_deg=0.1,
+                                                 current_noise_A=0.004, reference=reference)}
+    assert "rate" not in _named(scores)
+
+
+def test_a_current_lag_its_model_has_always_explains_nothing_beyond_its_reference() -> None:
+    lagged = product_reference(_units(_lagged_current, _lagged_current, _lagged_current))
+    assert lagged.currents is not None
+    assert lag_share(*_session(_lagged_current), reference=lagged.currents) == (0.0, 0.0, 0.0)
+
+
+def test_a_current_lag_its_model_has_not_is_explained_beyond_its_reference() -> None:
+    def nothing(t: Arr, q: Arr) -> Arr:
+        return np.zeros((len(t), 4))
+
+    plain = product_reference(_units(nothing, nothing, nothing))
+    assert plain.currents is not None
+    share = lag_share(*_session(_lagged_current), reference=plain.currents)
+    assert share is not None and share[0] > 0.5

@@ -23,6 +23,7 @@ from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.presets import parse_plant_spec
 from tsmd.gap.result import GapConfig
+from tsmd.gap.score import selftest_markdown
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,
     BUILTIN_PLANT,
@@ -32,7 +33,6 @@ from tsmd.gap.selftest import (
     effect_size,
     make_real_recording,
     run_selftest,
-    selftest_markdown,
 )
 
 

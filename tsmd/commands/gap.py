@@ -31,13 +31,13 @@ from tsmd.gap.protocol import protocol_trajectory
 from tsmd.gap.reference import ProductReference
 from tsmd.gap.report import finite_json, write_report
 from tsmd.gap.result import GapConfig
+from tsmd.gap.score import selftest_markdown
 from tsmd.gap.selftest import (
     BUILTIN_FIT_SPECS,
     BUILTIN_PLANT,
     EFFECTS,
     complete_knobs,
     run_selftest,
-    selftest_markdown,
 )
 from tsmd.recording import Recording, read_recording, write_trajectory
 from tsmd.tee import load_tee_acquisition

@@ -29,7 +29,6 @@ from tsmd.gap.loops import (
     anova,
     bend_design,
     contrast_of,
-    lag_design,
     loop_contrast,
     loop_shrink,
     noise_ss,
@@ -195,33 +194,43 @@ def product_reference(series: Sequence[GapSeries]) -> ProductReference:
     for s in series:
         units.setdefault(s.catheter, []).append(s)
     per_unit = [collect_tests(u, [measured_windows(s) for s in u]) for u in units.values()]
-    loops: dict[str, LoopReference] = {}
-    for test in REFERENCED:
-        found = [m for m in (_unit_contrast(by_config, test) for by_config in per_unit) if m]
-        if not found:
-            continue
-        first, levels = found[0][0], found[0][1]
-        same = [m for m in found if m[1] == levels and m[2].shape == found[0][2].shape]
-        value, noise, scatter = unit_spread(np.array([m[2] for m in same]),
-                                        np.array([m[3] for m in same]))
-        loops[test] = LoopReference(tuple(levels), value, first.knob * first.span_deg,
-                                    first.dirn, first.part, float(noise.mean()),
-                                    float(scatter.mean()))
+    loops = {test: ref for test in REFERENCED
+             if (ref := _loop_reference(per_unit, test, "loops")) is not None}
+    currents = _loop_reference(per_unit, "rate", "currents")
     sheet = sheet_from_units(list(units.values()))
     slopes = [d for d in (_unit_drift(by_config) for by_config in per_unit) if d is not None]
     if not slopes:
-        return ProductReference(loops, units=len(units), compliance=sheet)
+        return ProductReference(loops, units=len(units), compliance=sheet, currents=currents)
     same_d = [d for d in slopes if d[0].shape == slopes[0][0].shape]
     diff, noise, scatter = unit_spread(np.array([d[0] for d in same_d]),
                                    np.array([d[1] for d in same_d]))
-    return ProductReference(loops, (diff, noise + scatter), len(units), sheet)
+    return ProductReference(loops, (diff, noise + scatter), len(units), sheet, currents)
 
 
-def _unit_contrast(by_config: dict[str, dict[str, TestData]], test: str
+def _loop_reference(per_unit: Sequence[dict[str, dict[str, TestData]]], test: str,
+                    channel: str) -> LoopReference | None:
+    """One loop test's reference (``channel``: the tips' ``loops`` or the ``currents``) from
+    every unit's measured contrast: their mean, its noise and their spread, per point summed
+    over the levels as the repeats' noise is counted (:func:`tsmd.gap.loops.noise_ss`; before
+    session 16 the spread was counted per level only, a third of it on the coupling test)."""
+    found = [m for m in (_unit_contrast(by_config, test, channel) for by_config in per_unit) if m]
+    if not found:
+        return None
+    first, levels = found[0][0], found[0][1]
+    same = [m for m in found if m[1] == levels and m[2].shape == found[0][2].shape]
+    value, noise, scatter = unit_spread(np.array([m[2] for m in same]),
+                                        np.array([m[3] for m in same]) / len(levels))
+    return LoopReference(tuple(levels), value, first.knob * first.span_deg, first.dirn,
+                         first.part, float(noise.sum(axis=0).mean()),
+                         float(scatter.sum(axis=0).mean()))
+
+
+def _unit_contrast(by_config: dict[str, dict[str, TestData]], test: str, channel: str = "loops"
                    ) -> tuple[Loops, list[str], FloatArray, FloatArray] | None:
     """One unit's measured loops of ``test`` (first configuration), its levels, its level
-    contrast (mean over configurations) and that mean's noise per point."""
-    found = [(loop_contrast(d[test].loops, d[test].levels), d[test].levels)
+    contrast (mean over configurations) and that mean's noise per point (the expected sum of
+    squares over the levels at a point)."""
+    found = [(loop_contrast(getattr(d[test], channel), d[test].levels), d[test].levels)
              for d in by_config.values() if test in d]
     usable = [(lp, lv) for lp, lv in found if lp is not None]
     if not usable:
@@ -328,39 +337,6 @@ def _drift(data: TestData) -> Drift:
     return Drift(np.array(diffs, dtype=float).reshape(len(diffs), -1),
                  np.array(vars_, dtype=float).reshape(len(vars_), -1),
                  np.array(spans, dtype=float))
-
-
-def lag_share(series: Sequence[GapSeries],
-              residuals: Sequence[FloatArray]) -> tuple[float, float, float] | None:
-    """Share of the rate test's current contrast (fast against slow loops) that a lag of the
-    current explains, fitted on one configuration and scored on the other (mean, lowest,
-    highest over the held-out configurations); None without such a contrast."""
-    by_config = collect_tests(series, residuals)
-    found = [loop_contrast(d["rate"].currents, d["rate"].levels)
-             for d in by_config.values() if "rate" in d]
-    loops = [lp for lp in found if lp is not None]
-    speeds = _level_speeds(series, "rate")
-    if len(loops) < 2 or len(speeds) < 2 or min(speeds) <= 0.0:
-        return None
-    design = lag_design(speeds)
-    shrinks = [loop_shrink(loops[:i] + loops[i + 1:], loops[i], design)
-               for i in range(len(loops))]
-    finite = [x for x in shrinks if np.isfinite(x)]
-    return (float(np.mean(finite)), min(finite), max(finite)) if finite else None
-
-
-def _level_speeds(series: Sequence[GapSeries], test: str) -> list[float]:
-    """Median knob speed (deg/s) of each level of ``test``, from the recorded motion."""
-    speeds: dict[str, list[FloatArray]] = {}
-    for s in series:
-        if s.segment is None:
-            continue
-        dt = np.diff(s.t_s, prepend=s.t_s[0] - 1.0)
-        v = np.abs(np.diff(s.knob_deg, axis=0, prepend=s.knob_deg[:1])) / dt[:, None]
-        for i, seg in enumerate(s.segments):
-            if seg.test == test:
-                speeds.setdefault(seg.level, []).append(v[s.segment == i].max(axis=1))
-    return [float(np.median(np.concatenate(v))) for v in speeds.values()]
 
 
 def segments_present(series: Sequence[GapSeries]) -> bool:

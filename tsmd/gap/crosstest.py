@@ -24,6 +24,7 @@ from simrig.tracker import EmTracker
 from tsmd.gap.compliance import reference_deg_per_A
 from tsmd.gap.contrast import product_reference
 from tsmd.gap.data import GapSeries, series_from_recording
+from tsmd.gap.detectable import footprint
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.fit import ParamSpec
@@ -31,15 +32,8 @@ from tsmd.gap.presets import PlantSpec
 from tsmd.gap.protocol import Segment, encode_table, protocol
 from tsmd.gap.reference import ProductReference
 from tsmd.gap.result import GapConfig
-from tsmd.gap.selftest import (
-    EFFECTS,
-    SelftestCase,
-    SelftestResult,
-    _cur_rmse,
-    _tip_rmse,
-    drive_plant,
-    trajectory,
-)
+from tsmd.gap.score import SelftestCase, SelftestResult
+from tsmd.gap.selftest import EFFECTS, _cur_rmse, _tip_rmse, drive_plant, trajectory
 from tsmd.recording import Recording
 
 FloatArray = NDArray[np.float64]
@@ -55,10 +49,15 @@ def cross_config(fit: Sequence[ParamSpec], method: str = "signature") -> GapConf
 
 CONFIGS: tuple[str, str] = ("straight", "looped")
 
+TIP_NOISE_DEG = 0.1
+CURRENT_NOISE_A = 0.004
+"""The sessions' tracker and current-sensor noise per sample (the rig's)."""
+
 
 def make_session(data: PlantSpec, case: str, duration_s: float, rate_hz: float, seed: int,
-                 unit_variation: float = 0.1, tip_noise_deg: float = 0.1,
-                 current_noise_A: float = 0.004, matched: bool = True) -> list[Recording]:
+                 unit_variation: float = 0.1, tip_noise_deg: float = TIP_NOISE_DEG,
+                 current_noise_A: float = CURRENT_NOISE_A,
+                 matched: bool = True) -> list[Recording]:
     """One unit's session: half the time in each sheath configuration, the effect switched on.
 
     The same unit (``seed``) in both configurations; curvature bends the sheath of the looped
@@ -150,10 +149,16 @@ def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float
                    rate_hz: float = 50.0, config: GapConfig | None = None,
                    matched: bool = True, sheet_unit: int = 0,
                    reference_units: Sequence[int] = REFERENCE_UNITS) -> SelftestCase:
-    """Make one session and diagnose it blind with the other plant as the simulator."""
+    """Make one session and diagnose it blind with the other plant as the simulator; the
+    case carries its effect's footprint on the ground truth (scoring only)."""
     recs = make_session(data, case, duration_s, rate_hz, seed, matched=matched)
-    return diagnose_session(recs, data, sim, case, duration_s, seed, rate_hz, config,
-                            matched, sheet_unit, reference_units)
+    out = diagnose_session(recs, data, sim, case, duration_s, seed, rate_hz, config,
+                           matched, sheet_unit, reference_units)
+    if EFFECTS[case][2] is None:
+        return out
+    fp = footprint(data, case, seed, duration_s, rate_hz)
+    return dataclasses.replace(out, footprint_tip_deg=fp.tip_deg, footprint_cur_A=fp.cur_A,
+                               detectable=fp.detectable(TIP_NOISE_DEG, CURRENT_NOISE_A))
 
 
 def diagnose_session(recs: Sequence[Recording], data: PlantSpec, sim: PlantSpec, case: str,

@@ -45,8 +45,9 @@ class LoopReference:
     noise_per_point: float
     """Expected squared contrast per point from the reference's repeat noise alone."""
     scatter_per_point: float = 0.0
-    """Squared contrast per point a unit of the model may lie from the reference: the
-    reference units' spread about their mean as a 95 % prediction bound (0 from one unit)."""
+    """Squared contrast per point (summed over the levels, as ``noise_per_point``) a unit of
+    the model may lie from the reference: the reference units' spread about their mean as a
+    95 % prediction bound (0 from one unit)."""
 
     def at(self, lp: Loops, levels: Sequence[str]) -> FloatArray | None:
         """The reference contrast at ``lp``'s points (levels in ``levels``' order), or None
@@ -84,6 +85,9 @@ class ProductReference:
     compliance: ComplianceSheet | None = None
     """The model's lost motion per ampere from the same units, with its noise and the units'
     spread (session 14): the compliance test's data sheet when present."""
+    currents: LoopReference | None = None
+    """The rate test's fast-slow contrast of the measured currents (session 16): what the
+    sensor-lag test compares a unit with."""
 
 
 def measured_windows(s: GapSeries) -> FloatArray:
@@ -95,8 +99,10 @@ def beyond_reference(res: Loops, meas: Loops, levels: Sequence[str],
                      ref: LoopReference | None) -> Loops:
     """The residual loops less the model's own contrast: ``res`` plus the simulator's own
     contrast (``meas`` - ``res``, the same rows) minus the reference's, scaled down to what
-    the unit has of it when that is less (:func:`own_scale`). Unchanged without a reference or
-    when the levels do not match."""
+    the unit has of it when that is less (:func:`own_scale`), knob by knob (since session 16:
+    one scale for both knobs counted a unit's shortfall on one knob as an excess on the other;
+    helixbelt development unit 1 reads 0.71 and 1.48 of its model's contrast on the two).
+    Unchanged without a reference or when the levels do not match."""
     if ref is None:
         return res
     own = ref.at(res, levels)
@@ -104,7 +110,11 @@ def beyond_reference(res: Loops, meas: Loops, levels: Sequence[str],
         return res
     measured = contrast_of(meas)
     sim = measured - contrast_of(res)
-    y = res.y + (sim - own_scale(measured, own) * own)[:, None, :]
+    scale = np.ones(res.part.shape)
+    for p in np.unique(res.part):  # each knob's tendon and lumen scatter on their own
+        mine = res.part == p
+        scale[mine] = own_scale(measured[:, mine], own[:, mine])
+    y = res.y + (sim - scale * own)[:, None, :]
     per_point = ref.noise_per_point + ref.scatter_per_point
     return replace(res, y=y, ref_noise_ss=res.y.shape[2] * per_point)
 

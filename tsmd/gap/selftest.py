@@ -16,7 +16,7 @@ from __future__ import annotations
 import importlib
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -30,6 +30,7 @@ from tsmd.gap.data import series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.fit import ParamSpec
 from tsmd.gap.result import GapConfig, GapResult
+from tsmd.gap.score import SelftestCase, SelftestResult
 from tsmd.gap.simulate import simulate
 from tsmd.recording import Recording
 
@@ -234,78 +235,6 @@ def complete_knobs(params: dict[str, Any]) -> dict[str, Any]:
     return params
 
 
-@dataclass
-class SelftestCase:
-    case: str
-    duration_s: float
-    seed: int
-    expected: str | None
-    verdict: str
-    top: str | None
-    share: float | None
-    tip_rmse_before: float
-    tip_rmse_after: float | None
-    cur_rmse_before: float
-    cur_rmse_after: float | None
-    wall_s: float
-    excess_shrink: float | None = None
-    """Held-out: share of the remaining excess the named effect removes (signature method)."""
-    physics_tip_rmse: float | None = None
-    """Held-out tip RMSE of the physics simulator alone (the base mismatch, signature method)."""
-
-    @property
-    def correct(self) -> bool:
-        return self.top == self.expected
-
-
-@dataclass
-class SelftestResult:
-    cases: list[SelftestCase] = field(default_factory=list)
-
-    def confusion(self) -> dict[str, dict[str, int]]:
-        """Rows: effect put in the data; columns: top-1 diagnosis ('none' = nothing significant)."""
-        out: dict[str, dict[str, int]] = {}
-        for c in self.cases:
-            row = out.setdefault(c.case, {})
-            key = c.top or "none"
-            row[key] = row.get(key, 0) + 1
-        return out
-
-    def summary(self) -> dict[str, Any]:
-        effect_cases = [c for c in self.cases if c.expected is not None]
-        null_cases = [c for c in self.cases if c.expected is None]
-        shrink = [1 - c.tip_rmse_after / c.tip_rmse_before for c in effect_cases
-                  if c.correct and c.tip_rmse_after is not None and c.tip_rmse_before > 0]
-        cur_shrink = [1 - c.cur_rmse_after / c.cur_rmse_before for c in effect_cases
-                      if c.correct and c.cur_rmse_after is not None and c.cur_rmse_before > 0]
-        return {
-            "top1_accuracy": (sum(c.correct for c in effect_cases) / len(effect_cases)
-                              if effect_cases else float("nan")),
-            "n_effect_cases": len(effect_cases),
-            "false_alarms": sum(c.top is not None for c in null_cases),
-            "n_null_cases": len(null_cases),
-            "median_tip_rmse_shrink_when_correct": float(np.median(shrink)) if shrink
-            else float("nan"),
-            "median_current_rmse_shrink_when_correct": float(np.median(cur_shrink))
-            if cur_shrink else float("nan"),
-            "median_wall_s": _median([c.wall_s for c in self.cases]),
-            "median_excess_shrink_when_correct": _median(
-                [c.excess_shrink for c in effect_cases if c.correct]),
-            "worst_excess_shrink_when_correct": _min(
-                [c.excess_shrink for c in effect_cases if c.correct]),
-        }
-
-
-def _median(values: Sequence[float | None]) -> float:
-    found = [v for v in values if v is not None]
-    return float(np.median(found)) if found else float("nan")
-
-
-def _min(values: Sequence[float | None]) -> float:
-    found = [v for v in values if v is not None]
-    return float(np.min(found)) if found else float("nan")
-
-
 def _tip_rmse(m: dict[str, float] | None) -> float | None:
     if m is None:
         return None
@@ -351,37 +280,3 @@ def run_selftest(cases: Sequence[str], sizes_s: Sequence[float], seeds: Sequence
                 if progress is not None:
                     progress(c)
     return result
-
-
-def selftest_markdown(result: SelftestResult) -> str:
-    s = result.summary()
-    lines = ["| figure | value |", "| --- | ---: |",
-             f"| top-1 accuracy (effect cases) | {s['top1_accuracy']:.0%} "
-             f"({sum(c.correct for c in result.cases if c.expected)}/{s['n_effect_cases']}) |",
-             f"| false alarms (no-effect cases) | {s['false_alarms']}/{s['n_null_cases']} |",
-             f"| median held-out tip RMSE shrink, correct cases | "
-             f"{s['median_tip_rmse_shrink_when_correct']:.0%} |",
-             f"| median held-out current RMSE shrink, correct cases | "
-             f"{s['median_current_rmse_shrink_when_correct']:.0%} |",
-             f"| median / worst held-out shrink of the named effect's excess, correct cases | "
-             f"{s['median_excess_shrink_when_correct']:.0%} / "
-             f"{s['worst_excess_shrink_when_correct']:.0%} |",
-             f"| median wall time per diagnosis | {s['median_wall_s']:.1f} s |", "",
-             "Confusion matrix (rows: effect in the data; columns: top-1 diagnosis):", ""]
-    conf = result.confusion()
-    cols = sorted({k for row in conf.values() for k in row} | {"none"})
-    lines += ["| data \\ diagnosis | " + " | ".join(cols) + " |",
-              "| --- |" + " ---: |" * len(cols)]
-    for case, row in conf.items():
-        lines.append(f"| {case} | " + " | ".join(str(row.get(c, 0)) for c in cols) + " |")
-    lines += ["", "| case | size (s) | seed | verdict | top-1 | share | tip RMSE before -> after "
-              "(deg) | current RMSE before -> after (A) | wall (s) |",
-              "| --- | ---: | ---: | --- | --- | ---: | --- | --- | ---: |"]
-    for c in result.cases:
-        after_tip = "-" if c.tip_rmse_after is None else f"{c.tip_rmse_after:.3f}"
-        after_cur = "-" if c.cur_rmse_after is None else f"{c.cur_rmse_after:.4f}"
-        share = "-" if c.share is None else f"{c.share:.0%}"
-        lines.append(f"| {c.case} | {c.duration_s:.0f} | {c.seed} | {c.verdict} | "
-                     f"{c.top or 'none'} | {share} | {c.tip_rmse_before:.3f} -> {after_tip} | "
-                     f"{c.cur_rmse_before:.4f} -> {after_cur} | {c.wall_s:.1f} |")
-    return "\n".join(lines)

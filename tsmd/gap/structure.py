@@ -15,13 +15,13 @@ from tsmd.gap.contrast import (
     LOOP_TESTS,
     UNMATCHED,
     contrast_scores,
-    lag_share,
     segments_present,
 )
 from tsmd.gap.data import GapSeries, Split
 from tsmd.gap.layer import heldout_metrics, stack_views
 from tsmd.gap.model import CHANNELS, Evaluator, Prediction, View, build_views
 from tsmd.gap.result import CandidateScore, GapConfig, GapResult
+from tsmd.gap.sensor import lag_share
 from tsmd.gap.signature import SignatureScore, score_signatures
 from tsmd.gap.simulate import smooth_velocity
 
@@ -57,7 +57,7 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
             found += [stretch] if stretch is not None else []
         names = {c.name for c in found}
         kept = [s for s in sres.scores if s.name not in names]
-        lag = lag_share(series, residuals)
+        lag = lag_share(series, residuals, ref.currents if ref is not None else None)
         for s in kept:
             s.significant = s.significant and s.name not in UNMATCHED
             if s.name == "sensor" and lag is not None:

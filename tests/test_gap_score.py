@@ -1,0 +1,45 @@
+"""Self-test scoring: an injected effect below the data's noise is expected to read none."""
+
+from __future__ import annotations
+
+from tsmd.gap.detectable import Footprint, footprint
+from tsmd.gap.presets import PRESETS
+from tsmd.gap.score import SelftestCase, SelftestResult, selftest_markdown
+
+
+def _case(case: str, expected: str | None, top: str | None,
+          detectable: bool | None) -> SelftestCase:
+    return SelftestCase(case, 240.0, 1, expected, "v", top, None, 1.0, None, 0.01, None, 1.0,
+                        detectable=detectable)
+
+
+def test_a_sheath_bend_on_the_helix_plant_leaves_less_than_the_noise_halved_tendons_more() -> None:
+    bend = footprint(PRESETS["helixbelt"], "curvature", 1, 60.0, 50.0)
+    tendons = footprint(PRESETS["helixbelt"], "compliance", 1, 60.0, 50.0)
+    assert not bend.detectable(0.1, 0.004)
+    assert tendons.detectable(0.1, 0.004)
+
+
+def test_a_current_lag_is_detectable_on_the_current_alone() -> None:
+    lag = footprint(PRESETS["helixbelt"], "sensor", 1, 60.0, 50.0)
+    assert lag.tip_deg == 0.0
+    assert lag.detectable(0.1, 0.004)
+    assert not Footprint(0.0, 0.003).detectable(0.1, 0.004)
+
+
+def test_an_effect_below_detection_read_none_is_a_miss_strictly_and_right_as_detectable() -> None:
+    result = SelftestResult([_case("curvature", "curvature", None, False),
+                             _case("coupling", "coupling", "coupling", True),
+                             _case("none", None, None, None)])
+    s = result.summary()
+    assert s["top1_accuracy"] == 0.5
+    assert s["top1_accuracy_detectable"] == 1.0
+    assert (s["n_below_detection"], s["below_detection_read_none"]) == (1, 1)
+    assert result.cases[0].correct_detectable and not result.cases[0].correct
+    assert "below detection read none (expected) | 1/1" in selftest_markdown(result)
+
+
+def test_an_effect_below_detection_that_is_named_is_right_strictly_only() -> None:
+    lucky = _case("curvature", "curvature", "curvature", False)
+    assert lucky.correct and not lucky.correct_detectable
+    assert SelftestResult([lucky]).summary()["below_detection_read_none"] == 0

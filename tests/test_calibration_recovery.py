@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 from support.profiles import DEVICE as DEVICE_PATH
 
-from tsmd.calibration.assemble import GridPoint
+from tsmd.calibration.assemble import GridPoint, QualityLimits, QualityReport, _check_uncertainty
+from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.identify import analyse_half_cycle, split_half_cycles
 from tsmd.calibration.options import BacklashReference, IdentifyOptions, for_product
 from tsmd.calibration.reading_offset import corrected
@@ -27,6 +28,7 @@ from tsmd.calibration.recovery import (
 from tsmd.calibration.resweep import uncertain_points
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.sweep_result import HalfCycle, SweepResult
+from tsmd.datasheet_rule import usable
 from tsmd.profile import (
     ProfileError,
     device_model_from_mapping,
@@ -161,6 +163,18 @@ def test_no_reading_offset_applies_to_an_unseen_backlash_and_its_width_reaches_t
     assert out.offset_u95_deg == {"backlash_pos_deg": 3.6, "backlash_neg_deg": 0.5}
 
 
+def test_an_unseen_backlash_is_warned_and_flagged_in_the_quality_figures_not_refused() -> None:
+    values = {"dead_zone_pos_deg": (30.0, 30.1), "dead_zone_neg_deg": (-30.0, -30.1),
+              "backlash_pos_deg": (9.0, 9.1), "backlash_neg_deg": (8.0, 8.1)}
+    wide = SweepResult(None, (), values, unseen={"backlash_pos_deg": 4.0})  # type: ignore[arg-type]
+    point = GridPoint(0, 0.0, corrected(wide, None, 0.0))
+    report = QualityReport()
+    _check_uncertainty(point, point_estimates([point.result])[0], 1.46, QualityLimits(), report)
+    assert not report.problems  # 1.46 x 4 deg is beyond the 5 deg a reading is refused at
+    assert any("backlash_pos_deg cannot be seen in the current" in w for w in report.warnings)
+    assert report.figures["phi1_backlash_pos_unseen_at_+0_u95_deg"] == pytest.approx(4.0, abs=0.1)
+
+
 def test_an_unseen_backlash_is_not_swept_again() -> None:
     values = {"dead_zone_pos_deg": (30.0, 30.1), "dead_zone_neg_deg": (-30.0, -30.1),
               "backlash_pos_deg": (9.0, 9.1), "backlash_neg_deg": (8.0, 8.1)}
@@ -194,3 +208,9 @@ def test_the_recovery_rule_and_its_lag_round_trip_through_the_sheet() -> None:
     again = device_model_from_mapping(device_model_to_mapping(device))
     assert again.knobs[0].backlash_release_rule == "recovery"
     assert again.knobs[0].backlash_recovery_lag_deg == -3.3
+
+
+def test_tsmd_datasheet_offers_the_recovery_rule_only_to_a_knob_with_its_lag() -> None:
+    knob = load_device_model(DEVICE_PATH).knobs[0]
+    assert not usable(knob, "recovery")
+    assert usable(dataclasses.replace(knob, backlash_recovery_lag_deg=-3.3), "recovery")

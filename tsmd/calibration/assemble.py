@@ -162,6 +162,9 @@ def _check_uncertainty(p: GridPoint, estimates: dict[str, Estimate], omega: floa
             continue
         costs.append(cost)
         if name in p.result.unseen:
+            # the per-value flag the profile keeps: this value is the sheet's, not a reading
+            report.figures[f"{KNOB_LABELS[p.knob]}_{name.removesuffix('_deg')}_unseen_at_"
+                           f"{p.other_deg:+.0f}_u95_deg"] = e.u95_deg
             report.warnings.append(
                 f"{p.name}: {name} cannot be seen in the current (no half-cycle's recovery "
                 f"after the reversal stands out of the noise): {e.value:.1f} +- "

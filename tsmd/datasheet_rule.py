@@ -76,9 +76,11 @@ def with_rule(device: DeviceModel, rule: str) -> DeviceModel:
 
 
 def usable(knob: DeviceKnob, rule: str) -> bool:
-    """Whether the knob's sheet has the share ``rule`` needs."""
+    """Whether the knob's sheet has the share ``rule`` needs (the lag for "recovery", which
+    ``tsmd datasheet`` does not measure yet: no candidate on a fresh sheet)."""
     share = {"line": knob.backlash_release_line_share,
-             "local": knob.backlash_release_local_share}.get(rule, 1.0)
+             "local": knob.backlash_release_local_share,
+             "recovery": knob.backlash_recovery_lag_deg}.get(rule, 1.0)
     return share is not None
 
 
@@ -139,7 +141,7 @@ def rule_scores(config: TsmdConfig, device: DeviceModel,
                 truth: Truth | None = None) -> list[RuleScore]:
     """Each rule on the sheet's unit (``config.sim``), scored per knob."""
     truth = sheet_truth(config) if truth is None else truth
-    return [one for rule in RELEASE_RULES
+    return [one for rule in RELEASE_RULES if any(usable(k, rule) for k in device.knobs)
             for one in scored(config, with_rule(device, rule), rule, truth, noise_seeds)]
 
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.estimate import Estimate, EstimateOptions, point_estimates
+from tsmd.calibration.recovery import BACKLASH_SWING_SCATTER, expected_backlash_deg
 from tsmd.calibration.sweep_result import PARAMETERS, SweepResult
 from tsmd.calibration.tension_play_fit import SweepPrefit
 from tsmd.compensation.paper import height_from_reference
@@ -160,7 +161,16 @@ def _check_uncertainty(p: GridPoint, estimates: dict[str, Estimate], omega: floa
         if not math.isfinite(cost):
             continue
         costs.append(cost)
-        if cost > lim.refuse_tip_error_deg:
+        if name in p.result.unseen:
+            # the per-value flag the profile keeps: this value is the sheet's, not a reading
+            report.figures[f"{KNOB_LABELS[p.knob]}_{name.removesuffix('_deg')}_unseen_at_"
+                           f"{p.other_deg:+.0f}_u95_deg"] = e.u95_deg
+            report.warnings.append(
+                f"{p.name}: {name} cannot be seen in the current (no half-cycle's recovery "
+                f"after the reversal stands out of the noise): {e.value:.1f} +- "
+                f"{e.u95_deg:.1f} deg (95 %) is the data sheet's backlash scaled by this "
+                f"unit's swing, up to {cost:.1f} deg on the tip; no re-sweep narrows it")
+        elif cost > lim.refuse_tip_error_deg:
             report.problems.append(f"{what} (> {lim.refuse_tip_error_deg:g} allowed)")
         elif cost > lim.estimate.max_tip_error_deg:
             report.warnings.append(f"{what} (target {lim.estimate.max_tip_error_deg:g})")
@@ -172,22 +182,6 @@ BACKLASH_DATASHEET_MIN_RATIO = 0.8
 share of the data sheet's reference backlash is flagged. It flagged healthy units whose
 backlash is small (capstan development units 1, 2, 4-7 and lumped 103 phi2: 0.59-0.78 with B
 within 2 deg of the tip), the units' backlashes spreading +-40 % around the sheet unit's."""
-
-BACKLASH_SWING_EXPONENT = 0.78
-"""A healthy unit's backlash grows with its current's swing after a reversal:
-B ~ swing ** 0.78 (development units 1-8 of both plants, fast sweeps, other knob at 0; one
-exponent, each plant anchored on its own units; log residual sd 0.09 on both)."""
-BACKLASH_SWING_SCATTER = 0.09
-"""Log standard deviation of a healthy unit's backlash about :data:`BACKLASH_SWING_EXPONENT`'s
-law (same fit)."""
-
-
-def expected_backlash_deg(reference_deg: float, swing_A: float,
-                          reference_swing_A: float) -> float:
-    """The backlash a unit whose current swings ``swing_A`` after a reversal should show, from
-    the data-sheet unit's (``reference_deg`` at ``reference_swing_A``)."""
-    return reference_deg * (swing_A / reference_swing_A) ** BACKLASH_SWING_EXPONENT
-
 
 def cross_check_device(points: Sequence[GridPoint], device: DeviceModel,
                        report: QualityReport, tip_target_deg: float = 3.0) -> None:

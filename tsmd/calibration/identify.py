@@ -44,6 +44,7 @@ from tsmd.calibration.pieces import (
     knee_edge,
     linear_pieces,
 )
+from tsmd.calibration.recovery import recovery_end
 from tsmd.calibration.release import (
     EDGE_CLEARANCE_DEG,
     backlash_end,
@@ -134,6 +135,7 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         problems.append(f"{where}: no stretch of constant current")
 
     peak: int | None = None
+    visibility = math.nan
     settle = 0
     backlash_deg = math.nan
     swing = math.nan
@@ -147,9 +149,14 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         start_k = peak if peak is not None else 0
         branch_stop = (plateau_run[1] - round(EDGE_CLEARANCE_DEG / step)
                        if plateau_run[1] < end else None)
-        found = (None if flat is None
-                 else backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts,
-                                   branch_stop))
+        if opts.backlash == "recovery":
+            recovery = recovery_end(grid[:end], yg[:end], noise, branch_stop)
+            found = None if recovery is None else recovery.end
+            visibility = math.nan if recovery is None else recovery.visibility
+        else:
+            found = (None if flat is None
+                     else backlash_end(grid[:end], yg[:end], start_k, pieces, flat, noise, opts,
+                                       branch_stop))
         if found is not None and opts.backlash == "fraction" and opts.backlash_knee:
             found = resolvable_end(grid[:end], yg[:end], found, branch_stop)
         if found is None:
@@ -159,8 +166,9 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
             settle = found
             # The backlash counts from the reversal (the model's X_ref); by the settle rule
             # it ends where the data sheet's unit let go after its current settled.
-            lagged = min(settle + round(opts.backlash_settle_lag_deg / step), end - 1) \
-                if opts.backlash == "settle" else settle
+            lag_deg = {"settle": opts.backlash_settle_lag_deg,
+                       "recovery": opts.backlash_recovery_lag_deg}.get(opts.backlash, 0.0)
+            lagged = min(max(settle + round(lag_deg / step), 0), end - 1)
             backlash_deg = float(grid[lagged] - grid[0])
             swing = release_swing(grid[:end], yg[:end], settle)
 
@@ -199,7 +207,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
         if after_reversal and math.isfinite(backlash_deg) else None,
         edge_index=index_at(edge_k) if math.isfinite(edge_deg) else None,
         backlash_deg=backlash_deg, edge_deg=edge_deg, plateau_A=direction * plateau,
-        rise_A=rise, snr=snr, problems=tuple(problems), slip=slip, release_swing_A=swing)
+        rise_A=rise, snr=snr, problems=tuple(problems), slip=slip, release_swing_A=swing,
+        backlash_visibility=visibility)
 
 
 def _index_at(pos: FloatArray, direction: int, grid: FloatArray, k: int, start: int) -> int:
@@ -292,7 +301,8 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
     check_slips([h.slip for h in halves if h.snr >= opts.min_snr])
     values: dict[str, list[float]] = {name: [] for name in PARAMETERS}
     for h in halves:
-        if math.isfinite(h.backlash_deg):
+        seen = not h.backlash_visibility < opts.min_backlash_visibility  # NaN: other rules
+        if math.isfinite(h.backlash_deg) and seen:
             values[h.backlash_name].append(h.backlash_deg)
         if math.isfinite(h.edge_deg):
             values[h.edge_name].append(h.edge_deg)

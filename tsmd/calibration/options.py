@@ -5,6 +5,31 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from tsmd.profile.reading_offset import ReadingOffset
+from tsmd.profile.types import DeviceKnob
+
+
+@dataclass(frozen=True)
+class BacklashReference:
+    """The data sheet's backlash on its unit (other knob at 0) and its current's swing there:
+    what a unit whose current does not show its backlash is given instead
+    (:func:`tsmd.calibration.recovery.unseen_backlash_deg`)."""
+
+    pos_deg: float
+    neg_deg: float
+    swing_A: float
+    bend_gain: float = 1.0
+    """The backlash with the other knob at +-90 deg over what the swing alone predicts
+    (``DeviceKnob.backlash_bend_gain``)."""
+
+    @staticmethod
+    def of(knob: DeviceKnob) -> BacklashReference | None:
+        """The sheet knob's reference, None where it lacks a backlash or the swing."""
+        pos, neg, swing = (knob.reference_backlash_pos_deg, knob.reference_backlash_neg_deg,
+                           knob.reference_release_swing_A)
+        if pos is None or neg is None or swing is None or not swing > 0.0:
+            return None
+        gain = knob.backlash_bend_gain
+        return BacklashReference(pos, neg, swing, 1.0 if gain is None else gain)
 
 
 @dataclass(frozen=True)
@@ -47,7 +72,20 @@ class IdentifyOptions:
     """Stretch of current before it settles that is extended to meet the constant level."""
     backlash: str = "settle"
     """"settle" (the paper's point a2): where the current joins the release level within the
-    noise; "fraction": where it has made up ``backlash_fraction`` of its jump to that level."""
+    noise; "fraction": where it has made up ``backlash_fraction`` of its jump to that level;
+    "recovery" (a self-locking handle, session 16): where the current's recovery from its
+    overshoot past the release level ends (:mod:`tsmd.calibration.recovery`), plus
+    ``backlash_recovery_lag_deg``."""
+    backlash_recovery_lag_deg: float = 0.0
+    """"recovery": knob travel from the recovery's end to the tip's release on the data
+    sheet's unit (``DeviceKnob.backlash_recovery_lag_deg``)."""
+    min_backlash_visibility: float = 20.0
+    """"recovery": a half-cycle whose recovery explains the current better than a line by less
+    than this (noise variance x log n) does not show its backlash (screwrod development units
+    1-8: below 20 the ends scatter by 3.5-5.6 deg sd, above by 0.9-1.9)."""
+    unseen_backlash: BacklashReference | None = None
+    """"recovery": where no half-cycle of a sweep shows the backlash, the sheet's reference
+    scaled by the unit's swing is used and flagged (None: no value)."""
     backlash_fraction: float = 0.975
     release_level: str = "median"
     """"fraction": what the share is of. "median" (sheets before session 10): the swing to the
@@ -118,7 +156,9 @@ def for_product(options: IdentifyOptions, settle_fraction: float | None,
                 settle_lag_deg: float | None = None,
                 line_share: float | None = None,
                 rule: str | None = None,
-                local_share: float | None = None) -> IdentifyOptions:
+                local_share: float | None = None,
+                recovery_lag_deg: float | None = None,
+                reference: BacklashReference | None = None) -> IdentifyOptions:
     """The identification for one knob of a product whose data sheet measured how far the
     current has come back when the tip starts to move: below :data:`SETTLED_FRACTION` the
     backlash ends at that share of the current's swing ("fraction"), moved per sweep by the
@@ -127,9 +167,14 @@ def for_product(options: IdentifyOptions, settle_fraction: float | None,
     else as ``options`` say. A sheet's ``line_share`` (the share of the gap to the release
     line) replaces ``settle_fraction`` and its coefficient, unless the sheet's ``rule`` is
     "swing" (``DeviceKnob.backlash_release_rule``: the product keeps the share of the swing)
-    or "local" (the share ``local_share`` of the gap to the branch just beyond the end)."""
+    or "local" (the share ``local_share`` of the gap to the branch just beyond the end), or
+    "recovery" (the end of the current's recovery from its overshoot plus
+    ``recovery_lag_deg``, the sheet's ``reference`` where no half-cycle shows it)."""
     if options.backlash != "settle":
         return options
+    if rule == "recovery" and recovery_lag_deg is not None:
+        return replace(options, backlash="recovery", backlash_recovery_lag_deg=recovery_lag_deg,
+                       unseen_backlash=reference)
     if rule == "local" and local_share is not None:
         return replace(options, backlash="fraction", backlash_fraction=local_share,
                        release_level="local")

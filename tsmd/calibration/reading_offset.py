@@ -62,14 +62,15 @@ def reference_edge_deg(offset: ReadingOffset | None, name: str,
 def corrected(result: SweepResult, offset: ReadingOffset | None,
               other_deg: float) -> SweepResult:
     """``result`` with every half-cycle's value moved by the product's offset at this grid
-    point, and the offsets' half-widths kept for the gate (unchanged without an offset)."""
-    if offset is None:
-        return result
+    point, and the offsets' half-widths kept for the gate (unchanged without an offset), the
+    half-widths of the backlashes the current does not show (``result.unseen``) with them."""
     values = dict(result.values)
-    u95: dict[str, float] = {}
+    # A backlash the current does not show is the sheet's, not a reading: no offset, and its
+    # own half-width goes to the gate in the offset's place.
+    u95: dict[str, float] = dict(result.unseen)
     for name, v in result.values.items():
-        shift, u = offset_at(offset, name, other_deg)
-        if shift != 0.0:
+        shift, u = (0.0, 0.0) if offset is None else offset_at(offset, name, other_deg)
+        if shift != 0.0 and name not in result.unseen:
             values[name] = tuple(x - shift for x in v)
             u95[name] = u
     if not u95:

@@ -68,7 +68,9 @@ def uncertain_points(points: Sequence[GridPoint], omegas: Sequence[float],
     found = []
     for i, est in enumerate(point_estimates(points, opts)):
         omega = omegas[points[i].knob]
-        costs = {n: e.tip_cost_deg(omega) for n, e in est.items()}
+        # a backlash the current does not show is not narrowed by sweeping again
+        costs = {n: e.tip_cost_deg(omega) for n, e in est.items()
+                 if n not in points[i].result.unseen}
         bad = tuple(n for n, c in costs.items() if not c <= opts.max_tip_error_deg)
         if bad:
             worst = max(costs[n] for n in bad)

@@ -37,7 +37,7 @@ from tsmd.calibration.errors import (
 )
 from tsmd.calibration.estimate import EstimateOptions
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
-from tsmd.calibration.options import for_product
+from tsmd.calibration.options import BacklashReference, for_product
 from tsmd.calibration.player import (
     Player,
     Progress,
@@ -46,6 +46,7 @@ from tsmd.calibration.player import (
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import paper_protocol, sweep_run
 from tsmd.calibration.reading_offset import corrected
+from tsmd.calibration.recovery import with_unseen
 from tsmd.calibration.resweep import (
     budget_spent_note,
     choose_resweep,
@@ -100,7 +101,8 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
     for k in device.knobs:
         one = for_product(base, k.backlash_settle_fraction, k.backlash_release_slope_ratio,
                           k.backlash_settle_lag_deg, k.backlash_release_line_share,
-                          k.backlash_release_rule, k.backlash_release_local_share)
+                          k.backlash_release_rule, k.backlash_release_local_share,
+                          k.backlash_recovery_lag_deg, BacklashReference.of(k))
         # the product's knee (tsmd datasheet) where the sheet turns it on
         one = replace(one, backlash_knee=True) if k.backlash_knee else one
         chosen.append(replace(one, reading_offset=k.reading_offset))
@@ -144,7 +146,8 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
                                 sweep_start_s=start_s)
     except CalibrationError as exc:
         raise CalibrationError(f"{source} ({KNOB_LABELS[knob]} sweep): {exc}") from None
-    return GridPoint(knob, other, corrected(result, opts.reading_offset if opts else None,
+    return GridPoint(knob, other, corrected(with_unseen(result, opts, other),
+                                            opts.reading_offset if opts else None,
                                             other), rec)
 
 

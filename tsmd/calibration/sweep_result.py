@@ -41,6 +41,9 @@ class HalfCycle:
     release_swing_A: float = math.nan
     """After a reversal: the current's swing to its release level
     (:func:`tsmd.calibration.release.release_swing`)."""
+    backlash_visibility: float = math.nan
+    """Rule "recovery": how clearly the current shows where the backlash ends
+    (:class:`tsmd.calibration.recovery.Recovery`); NaN under the other rules."""
 
     @property
     def backlash_name(self) -> str:
@@ -67,6 +70,10 @@ class SweepResult:
     offset_u95_deg: dict[str, float] = field(default_factory=dict)
     """Per parameter the 95 % half-width of the product's reading offset subtracted from its
     values (:mod:`tsmd.calibration.reading_offset`); none subtracted: absent."""
+    unseen: dict[str, float] = field(default_factory=dict)
+    """Backlashes the current does not show at this grid point: their values are the data
+    sheet's reference scaled by the unit's swing (:mod:`tsmd.calibration.recovery`), with this
+    95 % half-width; no reading offset applies to them and no re-sweep narrows them."""
 
     @property
     def data_half_cycles(self) -> tuple[HalfCycle, ...]:
@@ -87,7 +94,8 @@ class SweepResult:
         values = {name: self.values.get(name, ()) + other.values.get(name, ())
                   for name in PARAMETERS}
         return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
-                           self.resweeps + 1, len(self.data_half_cycles), self.offset_u95_deg)
+                           self.resweeps + 1, len(self.data_half_cycles), self.offset_u95_deg,
+                           {**self.unseen, **other.unseen})
 
     @property
     def snr(self) -> float:

@@ -66,6 +66,8 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "backlash_settle_lag_deg": (-10.0, 10.0, "deg"),
     "backlash_release_line_share": (0.5, 1.5, ""),
     "backlash_release_local_share": (0.5, 1.5, ""),
+    "backlash_recovery_lag_deg": (-10.0, 10.0, "deg"),
+    "backlash_bend_gain": (0.5, 2.0, ""),
     "reference_rule_backlash_gain": (0.0, 0.8, ""),
     "other_tip_gain": (*OTHER_TIP_GAIN_RANGE, ""),
     "loaded_knee_pos_deg": (0.0, 90.0, "deg"),
@@ -81,7 +83,8 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
                   "backlash_settle_lag_deg", "reference_rule_backlash_gain")
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
-                      "backlash_release_rule", "backlash_knee")
+                      "backlash_recovery_lag_deg", "backlash_bend_gain", "backlash_release_rule",
+                      "backlash_knee")
 _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
 
@@ -109,7 +112,8 @@ def _release_rule(r: Reader, k: Mapping[str, Any], key: str) -> str | None:
         raise r.fail(f"{key}.backlash_release_rule",
                      f"{rule!r} is not one of {', '.join(RELEASE_RULES)}")
     for needs, share in (("line", "backlash_release_line_share"),
-                         ("local", "backlash_release_local_share")):
+                         ("local", "backlash_release_local_share"),
+                         ("recovery", "backlash_recovery_lag_deg")):
         if rule == needs and k.get(share) is None:
             raise r.fail(f"{key}.backlash_release_rule", f"'{needs}' needs {share}")
     return rule
@@ -175,6 +179,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             optional("backlash_settle_lag_deg"),
             backlash_release_line_share=optional("backlash_release_line_share"),
             backlash_release_local_share=optional("backlash_release_local_share"),
+            backlash_recovery_lag_deg=optional("backlash_recovery_lag_deg"),
+            backlash_bend_gain=optional("backlash_bend_gain"),
             backlash_release_rule=_release_rule(r, k, key),
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
             reference_rule_backlash_gain=optional("reference_rule_backlash_gain"),

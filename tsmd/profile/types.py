@@ -19,7 +19,7 @@ from tsmd.profile.reading_offset import ReadingOffset
 
 PROFILE_SCHEMA_VERSION = 1
 DEVICE_SCHEMA_VERSION = 1
-RELEASE_RULES = ("line", "swing", "local")
+RELEASE_RULES = ("line", "swing", "local", "recovery")
 """The backlash rules a data sheet can name (``DeviceKnob.backlash_release_rule``)."""
 KNOB_NAMES: tuple[str, str] = ("phi1", "phi2")
 ANGLE_RANGE_DEG = 360.0
@@ -129,6 +129,16 @@ class DeviceKnob:
     the one whose calibration of the sheet's own unit best reproduces its tracked tip (session
     11); without it a sheet keeps the rule its fields imply (line where the line share is
     given)."""
+    backlash_recovery_lag_deg: float | None = None
+    """Optional, on the data-sheet unit: knob travel from the end of the current's recovery
+    from its overshoot after a reversal (:func:`tsmd.calibration.recovery.recovery_end`) to
+    where the tip has moved back 1 deg (median over the reversals); needed by the rule
+    "recovery" (a self-locking handle, session 16)."""
+    backlash_bend_gain: float | None = None
+    """Optional, on the data-sheet unit: its tip's backlash with the other knob at +-90 deg over
+    what its reference backlash scaled by the current's swing there predicts, relative to the
+    same at the other knob's 0 (:func:`tsmd.calibration.recovery.bend_gain`); the rule
+    "recovery" scales a backlash the current does not show by it (1 without it)."""
     backlash_knee: bool | None = None
     """Optional, the product's choice of the knee (:mod:`tsmd.calibration.knee`): a fraction
     rule's backlash end beyond the point where the current's rise falls below its own scatter

@@ -69,6 +69,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "loaded lines by it; off by default, docs/model.md Session 10) and, "
                              "with --plant, its templates over the other knob's angle (the "
                              "calibration grid, 14 more sweeps; Session 15)")
+    parser.add_argument("--tip-backlash-gain", action="store_true",
+                        help="with --plant: also track the tip's backlash after reversals at "
+                             "+-60 and +-90 deg (2 sweeps more per knob); method ours then takes "
+                             "the release-path ratio against the gain reading nearer it (opt-in "
+                             "per product, docs/model.md Session 16)")
     parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "
@@ -254,6 +259,7 @@ def main(args: argparse.Namespace) -> int:
         print(f"warning: {line}")
     if args.plant is not None:
         device = _with_coupling(device, config, factory, args.seed)
+    if args.plant is not None and args.tip_backlash_gain:
         device = _with_tip_backlash_gain(device, config, factory, args.seed)
     if args.plant is not None and args.loaded_shape:
         device = _with_shape_grid(device, config, factory, args.seed)

@@ -20,12 +20,33 @@ RELEASE_RATIO_RANGE: tuple[float, float] = (0.7, 1.3)
 """Plausible release-path over backlash-end-locus slope ratios; outside, the sheet is refused."""
 
 
+def ratio_gain(device_knob: Any) -> float | None:
+    """The sheet unit's backlash gain the ratio is taken against: the settle rule's
+    (``reference_backlash_gain``, sessions 7-15) or the product rule's
+    (``reference_rule_backlash_gain``, the reading every unit's ``beta`` is fitted with), the one
+    whose moved gain on the sheet's own unit, ``1 - omega (1 - rule) / (release_omega (1 -
+    gain))``, is nearer the backlash growth its tracker showed between reversals at 60 and 90
+    deg (``reference_tip_backlash_gain``, session 16); the settle rule's without that key."""
+    settle = getattr(device_knob, "reference_backlash_gain", None)
+    rule = getattr(device_knob, "reference_rule_backlash_gain", None)
+    tip = getattr(device_knob, "reference_tip_backlash_gain", None)
+    release = getattr(device_knob, "release_omega", None)
+    if settle is None or rule is None or tip is None or release is None:
+        return None if settle is None else float(settle)
+    omega = float(device_knob.omega)
+
+    def miss(gain: float) -> float:
+        return abs(1.0 - omega * (1.0 - float(rule)) / (float(release) * (1.0 - gain)) - tip)
+
+    return float(min((float(settle), float(rule)), key=miss))
+
+
 def release_slope_ratio(device_knob: Any) -> float:
     """The product's release-path slope over its backlash-end locus slope, from the data sheet:
-    ``release_omega (1 - reference_backlash_gain) / omega`` (tracked release slope against the
-    locus the current's backlash gain gives on the same unit); 1 without both keys."""
+    ``release_omega (1 - gain) / omega`` (tracked release slope against the locus the current's
+    backlash gain gives on the same unit; the gain by :func:`ratio_gain`); 1 without them."""
     release = getattr(device_knob, "release_omega", None)
-    gain = getattr(device_knob, "reference_backlash_gain", None)
+    gain = ratio_gain(device_knob)
     if release is None or gain is None:
         return 1.0
     ratio = float(release) * (1.0 - float(gain)) / float(device_knob.omega)

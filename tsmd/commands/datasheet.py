@@ -32,6 +32,7 @@ from tsmd.datasheet import (
     readable,
     swept_knob,
 )
+from tsmd.datasheet_amplitude import measure_tip_backlash_gains
 from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
 from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_offset import with_reading_offset
@@ -68,6 +69,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "loaded lines by it; off by default, docs/model.md Session 10) and, "
                              "with --plant, its templates over the other knob's angle (the "
                              "calibration grid, 14 more sweeps; Session 15)")
+    parser.add_argument("--tip-backlash-gain", action="store_true",
+                        help="with --plant: also track the tip's backlash after reversals at "
+                             "+-60 and +-90 deg (2 sweeps more per knob); method ours then takes "
+                             "the release-path ratio against the gain reading nearer it (opt-in "
+                             "per product, docs/model.md Session 16)")
     parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "
@@ -164,6 +170,18 @@ def _with_coupling(device: DeviceModel, config: TsmdConfig, factory: Callable[[]
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
+def _with_tip_backlash_gain(device: DeviceModel, config: TsmdConfig,
+                            factory: Callable[[], Plant], seed: int) -> DeviceModel:
+    """The sheet with each knob's tip backlash growth per degree of reversal amplitude."""
+    t0 = time.monotonic()
+    gains = measure_tip_backlash_gains(factory, seed, config)
+    knobs = tuple(dataclasses.replace(k, reference_tip_backlash_gain=(
+        None if g is None else round(g, 3))) for k, g in zip(device.knobs, gains, strict=True))
+    print(f"  tip backlash gain (60 -> 90 deg reversals): phi1 {_or_none(gains[0], 3)}, phi2 "
+          f"{_or_none(gains[1], 3)} ({time.monotonic() - t0:.0f} s)")
+    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+
 def _with_shape_grid(device: DeviceModel, config: TsmdConfig, factory: Callable[[], Plant],
                      seed: int) -> DeviceModel:
     """The sheet with each knob's loaded-branch templates over the other knob's angle."""
@@ -241,6 +259,8 @@ def main(args: argparse.Namespace) -> int:
         print(f"warning: {line}")
     if args.plant is not None:
         device = _with_coupling(device, config, factory, args.seed)
+    if args.plant is not None and args.tip_backlash_gain:
+        device = _with_tip_backlash_gain(device, config, factory, args.seed)
     if args.plant is not None and args.loaded_shape:
         device = _with_shape_grid(device, config, factory, args.seed)
     if args.plant is not None and seeds:

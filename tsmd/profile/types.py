@@ -151,6 +151,12 @@ class DeviceKnob:
     by the product's chosen rule and knee (fast calibrations of that unit, ``tsmd
     datasheet``): method ours reads each unit's gain by that rule too and weighs both readings
     by their scatter (:mod:`tsmd.calibration.unit_slope`, session 13)."""
+    reference_tip_backlash_gain: float | None = None
+    """Optional, tracked on the data-sheet unit (``tsmd datasheet --tip-backlash-gain``, opt-in,
+    session 16): how much the tip's backlash grows per degree of reversal amplitude (reversals
+    at 60 and 90 deg, :mod:`tsmd.datasheet_amplitude`). Method ours takes its release-path
+    ratio against the gain reading that brings the sheet unit's moved gain nearer it
+    (:func:`tsmd.calibration.release_path.ratio_gain`); None: the settle rule's."""
     other_tip_gain: float | None = None
     """Optional, tracked on the data-sheet unit: how many degrees this knob's tip plane shows per
     degree the other plane's tip is bent (a shaft that winds up in torsion turns the planes into

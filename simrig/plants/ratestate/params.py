@@ -48,8 +48,9 @@ class RateStateKnobParams:
     """Where along the shaft (0 handle, 1 tip) the shaft's main curve lies (the pharynx)."""
     curve_share: float = 0.45
     """Share of ``sheath_wrap_deg`` concentrated in that curve (the rest uniform)."""
-    sheath_friction: float = 0.15
-    """Reference friction coefficient mu0 of steel rope on a PTFE liner (0.05-0.2)."""
+    sheath_friction: float = 0.2
+    """Reference friction coefficient mu0 of steel rope on a PTFE liner, dry to boundary
+    lubricated (0.05-0.25; the rope's strands make it rougher than a wire)."""
     ageing_b: float = 0.006
     """Dieterich state coefficient b: mu = mu0 + b ln(1 + theta / theta_c); polymer contacts
     age strongly (PTFE static/kinetic ~1.2-1.4 after minutes of dwell)."""
@@ -61,8 +62,10 @@ class RateStateKnobParams:
     """Preload drag of the lumen on the rope (ovality), summed over the shaft's contacts; the
     capstan amplifies it into the tip's residual bend after a release (~6 deg: the TEE probe's
     plateaus lie 4-5 % of its range apart)."""
-    presliding_mm: float = 0.03
-    """Liner shear before gross slip under the reference load (1 N per contact)."""
+    presliding_mm: float = 0.05
+    """Tangential travel of a contact before gross slip under the reference load (1 N per
+    contact): the liner's shear and the rope's strands slipping on each other. It makes the
+    contacts a shear-lag chain, so a reversal reaches the tip gradually (rounded corners)."""
     tendon_offset_mm: float = 4.2
     """Lumen offset from the bending section's neutral axis (12 mm TEE tip)."""
     bend_stiffness_Nm_per_rad: float = 0.022

@@ -12,6 +12,7 @@ wrap to the distal contacts of every tendon.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -60,10 +61,6 @@ class RateStatePlant:
             lengths[[n, n + 1]] = half + p.bend_length_mm
             k[i] = p.tendon_stiffness_N / lengths
             slack[i, 0], slack[i, m] = p.slack_pos_mm, p.slack_neg_mm
-            wrap = wrap_profile_rad(p.sheath_wrap_deg, n, p.curve_position, p.curve_share,
-                                    sheath_curvature_deg)
-            self._wrap[i, :n] = wrap
-            self._wrap[i, n + 1:] = wrap[::-1]
             r_t = p.tendon_offset_mm
             ground[i, n] = 1000.0 * p.bend_stiffness_Nm_per_rad / r_t**2
             contact[i] = REFERENCE_CONTACT_LOAD_N / p.presliding_mm
@@ -73,6 +70,7 @@ class RateStatePlant:
             self._mu0[i], self._b[i] = p.sheath_friction, p.ageing_b
             self._dc[i], self._cutoff[i] = p.ageing_dc_mm, p.ageing_cutoff_s
             self._link[i] = p.link_friction
+        self._set_wrap(sheath_curvature_deg)
         can_slide = np.ones(shape_n, dtype=bool)
         buckled = chain.BUCKLED_SHARE * k
         buckled[:, [0, m]] = 0.0  # the slack rope in the handle pushes nothing
@@ -83,6 +81,42 @@ class RateStatePlant:
         self._handle_speed = np.array([p.handle_speed_deg_s for p in self.knobs])
         self.last_iterations = 0
         self.reset()
+
+    def _set_wrap(self, sheath_curvature_deg: float) -> None:
+        """Each contact's wrap (rad) from the shaft's profile, the negative tendon's mirrored
+        (its first contact from the tip is the distal one)."""
+        n = NODES
+        for i, p in enumerate(self.knobs):
+            wrap = wrap_profile_rad(p.sheath_wrap_deg, n, p.curve_position, p.curve_share,
+                                    sheath_curvature_deg)
+            self._wrap[i, :n] = wrap
+            self._wrap[i, n + 1:] = wrap[::-1]
+        self.sheath_curvature_deg = sheath_curvature_deg
+
+    def reshape(self, **changes: Any) -> None:
+        """Change the catheter mid-run, the tendons staying where they are:
+        ``sheath_curvature_deg`` (the shaft's extra bend, deg) and ``slack_delta_mm``
+        (per knob ``(pos, neg)`` added to each tendon's slack, e.g. a stretched rope)."""
+        unknown = sorted(set(changes) - {"sheath_curvature_deg", "slack_delta_mm"})
+        if unknown:
+            raise PlantLoadError(f"ratestate cannot reshape {', '.join(unknown)}; it takes "
+                                 f"sheath_curvature_deg and slack_delta_mm")
+        if "sheath_curvature_deg" in changes:
+            bend = float(changes["sheath_curvature_deg"])
+            if not (math.isfinite(bend) and bend >= 0.0):
+                raise PlantLoadError(f"sheath_curvature_deg must be >= 0, got {bend!r}")
+            self._set_wrap(bend)
+        if "slack_delta_mm" in changes:
+            delta = np.asarray(changes["slack_delta_mm"], dtype=float)
+            if delta.shape != (2, 2) or not np.all(np.isfinite(delta)):
+                raise PlantLoadError(f"slack_delta_mm must be ((pos, neg), (pos, neg)) in mm, "
+                                     f"got {changes['slack_delta_mm']!r}")
+            slack = self._const.slack_mm.copy()
+            slack[:, 0] += delta[:, 0]
+            slack[:, -1] += delta[:, 1]
+            if np.any(slack < 0.0):
+                raise PlantLoadError("slack_delta_mm would make a tendon's slack negative")
+            self._const = dataclasses.replace(self._const, slack_mm=slack)
 
     def reset(self) -> None:
         """Straight, tension-free tendons; every contact freshly aged by one cut-off time."""

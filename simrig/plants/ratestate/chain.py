@@ -9,10 +9,11 @@ nothing (``g``: the slack there), one in a lumen buckles into the lumen's cleara
 back with a small share of its stiffness (``BUCKLED_SHARE``).
 Node ``i`` balances ``T_(i+1) - T_i = kg_i d_i + f_i``: ``kg`` is the tip's bending spring,
 ``f`` a contact force, elastic ``kc (d - z)`` about its anchor ``z`` while it sticks, and
-``s (c (T_i + T_(i+1)) + p)`` while it slides (normal force from the local tension and wrap,
-plus preload). The active sets (taut elements, sliding contacts and their direction) are found
-by a semi-smooth Newton iteration started from the last step's; each iteration is one batched
-linear solve.
+``s (c (|T_i| + |T_(i+1)|) + p)`` while it slides (normal force from the local tension and
+wrap, a buckled rope pressing on the lumen's other side, plus preload). The active sets (taut
+elements, sliding contacts and their direction) are found by a semi-smooth Newton iteration
+started from the last step's, switching one kind at a time; each iteration is one LAPACK
+tridiagonal solve (``dgtsv``) of both knobs' chains stacked.
 """
 
 from __future__ import annotations
@@ -27,7 +28,10 @@ FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
 MAX_ITERATIONS = 8
-MAX_SPLITS = 4
+TIE_N = 1e-9
+TIE_MM = 1e-12
+"""A contact at its bound, or an element at zero stretch, keeps its state within these (a tie
+in floating point would otherwise switch it back and forth)."""
 BUCKLED_SHARE = 0.02
 """Axial stiffness of a rope buckled into its lumen's clearance, as a share of its tensile
 stiffness (helical buckling in a tube: the lumen wall holds the rope, weakly)."""
@@ -60,21 +64,7 @@ class ChainConstants:
     can_slide: BoolArray
 
 
-def solve(state: ChainState, const: ChainConstants, start_mm: FloatArray, end_mm: FloatArray,
-          coupling: FloatArray, depth: int = 0) -> tuple[ChainState, FloatArray, FloatArray, int]:
-    """:func:`solve_once`; where its active-set iteration does not settle (a large change of
-    contact states in one step), the drums' move from ``start_mm`` to ``end_mm`` is split in
-    halves, up to ``MAX_SPLITS`` times."""
-    answer = solve_once(state, const, end_mm, coupling)
-    if answer[3] < MAX_ITERATIONS or depth >= MAX_SPLITS:
-        return answer
-    middle_mm = 0.5 * (start_mm + end_mm)
-    half, _, _, n1 = solve(state, const, start_mm, middle_mm, coupling, depth + 1)
-    full, tension, force, n2 = solve(half, const, middle_mm, end_mm, coupling, depth + 1)
-    return full, tension, force, MAX_ITERATIONS + n1 + n2
-
-
-def solve_once(state: ChainState, const: ChainConstants, end_mm: FloatArray, coupling: FloatArray
+def solve(state: ChainState, const: ChainConstants, end_mm: FloatArray, coupling: FloatArray
                ) -> tuple[ChainState, FloatArray, FloatArray, int]:
     """The loops' equilibrium with both drum ends at ``end_mm`` (per knob) and friction
     coefficients ``coupling`` (``c`` above, per node). Returns the new state, the element
@@ -99,8 +89,9 @@ def solve_once(state: ChainState, const: ChainConstants, end_mm: FloatArray, cou
         left, right = ek[:, :-1], ek[:, 1:]
         sig = direction * coupling
         stick = direction == 0.0
-        upper = right * (1.0 - sig)
-        lower = left * (1.0 + sig)
+        sense = np.where(taut, 1.0, -1.0)  # |T| = sense T
+        upper = right * (1.0 - sig * sense[:, 1:])
+        lower = left * (1.0 + sig * sense[:, :-1])
         rhs = (upper * g[:, 1:] - lower * g[:, :-1] - kcz * stick + direction * p - eps_d)
         rhs[:, 0] -= lower[:, 0] * end_mm
         rhs[:, -1] -= upper[:, -1] * end_mm
@@ -112,11 +103,15 @@ def solve_once(state: ChainState, const: ChainConstants, end_mm: FloatArray, cou
         d = dgtsv(sub, diag.ravel(), sup, rhs.ravel())[3].reshape(knobs, m)
         line[:, 1:-1] = d
         stretch = line[:, 1:] - line[:, :-1] - g
-        new_taut = stretch > 0.0
+        new_taut = np.where(taut, stretch > -TIE_MM, stretch > TIE_MM)
         tension = np.where(new_taut, k, kb) * stretch
-        bound = coupling * (tension[:, :-1] + tension[:, 1:]) + p
+        pressing = np.abs(tension)
+        bound = coupling * (pressing[:, :-1] + pressing[:, 1:]) + p
         trial = kc * d - kcz
-        new_direction = np.sign(trial) * (const.can_slide & (np.abs(trial) > bound))
+        sliding = direction != 0.0
+        keeps = sliding & (direction * trial >= bound - TIE_N)
+        starts = ~sliding & (np.abs(trial) > bound + TIE_N)
+        new_direction = np.where(keeps, direction, np.sign(trial) * (const.can_slide & starts))
         contacts_same = bool((new_direction == direction).all())
         elements_same = bool((new_taut == taut).all())
         if (contacts_same and elements_same) or iterations >= MAX_ITERATIONS:
@@ -128,6 +123,8 @@ def solve_once(state: ChainState, const: ChainConstants, end_mm: FloatArray, cou
             taut = new_taut
         else:
             direction = new_direction
-    force = np.where(direction != 0.0, direction * bound, trial)
+    # Where the sets did not settle (rare: a slack, buckled rope dragged through its lumen),
+    # the last iterate's contact forces are projected onto their friction bounds.
+    force = np.where(direction != 0.0, direction * bound, np.clip(trial, -bound, bound))
     anchor = np.where(direction != 0.0, d - force / kc, state.anchor_mm)
     return ChainState(d, anchor, taut, direction), tension, force, iterations

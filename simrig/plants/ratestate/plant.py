@@ -139,9 +139,7 @@ class RateStatePlant:
         coupling[:, n] = self._link
         end_mm = -self._radius_mm * np.radians(q)
         old = self._state
-        start_mm = -self._radius_mm * np.radians(self._knob_deg)
-        state, tension, _, self.last_iterations = chain.solve(old, self._const, start_mm, end_mm,
-                                                              coupling)
+        state, tension, _, self.last_iterations = chain.solve(old, self._const, end_mm, coupling)
         self._age_s = age_after(self._age_s, state.anchor_mm - old.anchor_mm, dt_s, self._dc)
         self._state = state
         self._tip_deg = np.degrees(-state.d_mm[:, n] / self._offset_mm)

@@ -9,11 +9,11 @@ nothing (``g``: the slack there), one in a lumen buckles into the lumen's cleara
 back with a small share of its stiffness (``BUCKLED_SHARE``).
 Node ``i`` balances ``T_(i+1) - T_i = kg_i d_i + f_i``: ``kg`` is the tip's bending spring,
 ``f`` a contact force, elastic ``kc (d - z)`` about its anchor ``z`` while it sticks, and
-``s (c (|T_i| + |T_(i+1)|) + p)`` while it slides (normal force from the local tension and
-wrap, a buckled rope pressing on the lumen's other side, plus preload). The active sets (taut
-elements, sliding contacts and their direction) are found by a semi-smooth Newton iteration
-started from the last step's, switching one kind at a time; each iteration is one LAPACK
-tridiagonal solve (``dgtsv``) of both knobs' chains stacked.
+``s (c (T⁺_i + T⁺_(i+1)) + p)`` while it slides (normal force from the local tension and wrap;
+a buckled rope's small push presses nothing: ``T⁺ = max(T, 0)``; plus preload). The active
+sets (taut elements, sliding contacts and their direction) are found by a semi-smooth Newton
+iteration started from the last step's, switching one kind at a time; each iteration is one
+LAPACK tridiagonal solve (``dgtsv``) of both knobs' chains stacked.
 """
 
 from __future__ import annotations
@@ -89,9 +89,8 @@ def solve(state: ChainState, const: ChainConstants, end_mm: FloatArray, coupling
         left, right = ek[:, :-1], ek[:, 1:]
         sig = direction * coupling
         stick = direction == 0.0
-        sense = np.where(taut, 1.0, -1.0)  # |T| = sense T
-        upper = right * (1.0 - sig * sense[:, 1:])
-        lower = left * (1.0 + sig * sense[:, :-1])
+        upper = right * (1.0 - sig * taut[:, 1:])  # only a pulled rope presses on its lumen
+        lower = left * (1.0 + sig * taut[:, :-1])
         rhs = (upper * g[:, 1:] - lower * g[:, :-1] - kcz * stick + direction * p - eps_d)
         rhs[:, 0] -= lower[:, 0] * end_mm
         rhs[:, -1] -= upper[:, -1] * end_mm
@@ -105,7 +104,7 @@ def solve(state: ChainState, const: ChainConstants, end_mm: FloatArray, coupling
         stretch = line[:, 1:] - line[:, :-1] - g
         new_taut = np.where(taut, stretch > -TIE_MM, stretch > TIE_MM)
         tension = np.where(new_taut, k, kb) * stretch
-        pressing = np.abs(tension)
+        pressing = np.maximum(tension, 0.0)
         bound = coupling * (pressing[:, :-1] + pressing[:, 1:]) + p
         trial = kc * d - kcz
         sliding = direction != 0.0

@@ -60,7 +60,7 @@ class RateStateKnobParams:
     """Cut-off time theta_c of the ageing logarithm (keeps mu finite at theta -> 0)."""
     sheath_drag_N: float = 0.15
     """Preload drag of the lumen on the rope (ovality), summed over the shaft's contacts; the
-    capstan amplifies it into the tip's residual bend after a release (~6 deg: the TEE probe's
+    capstan amplifies it into the tip's residual bend after a release (~7 deg: the TEE probe's
     plateaus lie 4-5 % of its range apart)."""
     presliding_mm: float = 0.05
     """Tangential travel of a contact before gross slip under the reference load (1 N per

@@ -20,8 +20,13 @@ from typing import Any
 import numpy as np
 
 from simrig.plant import PlantLoadError, PlantStep, step_inputs
-from simrig.plants.ratestate import chain
-from simrig.plants.ratestate.chain import ChainConstants, ChainState, FloatArray
+from simrig.plants.ratestate.chain import (
+    BUCKLED_SHARE,
+    ChainConstants,
+    ChainState,
+    FloatArray,
+    solve,
+)
 from simrig.plants.ratestate.laws import age_after, aged_friction, wrap_profile_rad
 from simrig.plants.ratestate.params import NODES, RateStateKnobParams, knob_params
 
@@ -72,7 +77,7 @@ class RateStatePlant:
             self._link[i] = p.link_friction
         self._set_wrap(sheath_curvature_deg)
         can_slide = np.ones(shape_n, dtype=bool)
-        buckled = chain.BUCKLED_SHARE * k
+        buckled = BUCKLED_SHARE * k
         buckled[:, [0, m]] = 0.0  # the slack rope in the handle pushes nothing
         self._const = ChainConstants(k, buckled, slack, ground, contact, drag, can_slide)
         self._radius_mm = np.array([p.pulley_radius_mm for p in self.knobs])
@@ -139,7 +144,7 @@ class RateStatePlant:
         coupling[:, n] = self._link
         end_mm = -self._radius_mm * np.radians(q)
         old = self._state
-        state, tension, _, self.last_iterations = chain.solve(old, self._const, end_mm, coupling)
+        state, tension, _, self.last_iterations = solve(old, self._const, end_mm, coupling)
         self._age_s = age_after(self._age_s, state.anchor_mm - old.anchor_mm, dt_s, self._dc)
         self._state = state
         self._tip_deg = np.degrees(-state.d_mm[:, n] / self._offset_mm)

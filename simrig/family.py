@@ -14,8 +14,8 @@ the lumped plant is held out, the segments plant (written blind in session 9) is
 the coilpipe plant (session 10, written blind) is held out now, the stickslip plant (session 11,
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
-now, the helixbelt plant (session 15, written blind) is held out now (``PLANT_ROLE``).
-``SCATTER`` lives in :mod:`simrig.family_scatter`.
+now, the helixbelt plant (session 15, written blind) is held out now, the ratestate plant
+(session 16) is written blind (``PLANT_ROLE``). ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
 from __future__ import annotations
@@ -35,6 +35,7 @@ from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
 from simrig.plants.helixbelt import NOMINAL_KNOBS as HELIXBELT_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
 from simrig.plants.nitinol import NOMINAL_KNOBS as NITINOL_KNOBS
+from simrig.plants.ratestate import NOMINAL_KNOBS as RATESTATE_KNOBS
 from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
 from simrig.plants.stickslip import NOMINAL_KNOBS as STICKSLIP_KNOBS
@@ -50,11 +51,13 @@ PLANT_SPECS: dict[str, str] = {
     "twistshaft": "simrig.plants.twistshaft:make_twistshaft_plant",
     "screwrod": "simrig.plants.screwrod:make_screwrod_plant",
     "nitinol": "simrig.plants.nitinol:make_nitinol_plant",
-    "helixbelt": "simrig.plants.helixbelt:make_helixbelt_plant",  # last: the others' seeds hold
+    "helixbelt": "simrig.plants.helixbelt:make_helixbelt_plant",
+    "ratestate": "simrig.plants.ratestate:make_ratestate_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
-              "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out"}
+              "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
+              "ratestate": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -67,7 +70,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "twistshaft": TWISTSHAFT_KNOBS,
                                         "screwrod": SCREWROD_KNOBS,
                                         "nitinol": NITINOL_KNOBS,
-                                        "helixbelt": HELIXBELT_KNOBS}
+                                        "helixbelt": HELIXBELT_KNOBS,
+                                        "ratestate": RATESTATE_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -125,6 +129,8 @@ VARIANTS: dict[str, Variant] = {
                         "handle_friction_Nm": 1.5, "film_damping_N_s_per_mm": 1.5},
             "helixbelt": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                           "handle_friction_Nm": 1.5, "braid_friction_Nm": 1.5},
+            "ratestate": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                          "handle_friction_Nm": 1.5, "link_friction": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -147,7 +153,8 @@ VARIANTS: dict[str, Variant] = {
                  "twistshaft": {"tendon_stiffness_N": 0.4},
                  "screwrod": {"tendon_stiffness_N": 0.4},
                  "nitinol": {"tendon_stiffness_N": 0.4},
-                 "helixbelt": {"tendon_stiffness_N": 0.4}},
+                 "helixbelt": {"tendon_stiffness_N": 0.4},
+                 "ratestate": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

@@ -71,6 +71,9 @@ class EdgeTracker(SlopeReadings):
     frozen_reason: str = ""
     n_ramps: int = 0
     last_measurement_deg: float = math.nan
+    last_reading_deg: float = math.nan
+    """The latest measurement any ramp gave (NaN: none yet), kept across ramps that measure
+    nothing; the other knob's confirmation reads it (:mod:`tsmd.online.cross_knob`)."""
     recent_slopes: list[float] = field(default_factory=list)
     last_feature: str = ""
     """What placed the last measurement: "knee" or "crossing"."""
@@ -293,7 +296,7 @@ class EdgeTracker(SlopeReadings):
         if abs(m - self.estimate_deg) > self.options.gate_deg:
             return False
         self.suspects.clear()
-        self.last_measurement_deg = m
+        self.last_measurement_deg = self.last_reading_deg = m
         self.accepted_order = next(_ORDER)
         if self.reference.add(ramp, profile_edge_deg):
             self._take_reference()
@@ -305,7 +308,7 @@ class EdgeTracker(SlopeReadings):
         accepted, or a suspect (followed when confirmed)."""
         o = self.options
         m = raw_deg - self.bins.bias_deg(other_deg)
-        self.last_measurement_deg = m
+        self.last_measurement_deg = self.last_reading_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()
             self.accepted_order = next(_ORDER)

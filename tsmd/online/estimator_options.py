@@ -31,6 +31,12 @@ class EstimatorOptions:
     (:mod:`tsmd.online.cross_knob`): a slack or sheath change moves both knobs' edges, while
     the coil-pipe plant's phi1 crossings read 2-3 deg out for minutes on their own (units 1,
     2 without a change: followed, tracking worse than with online off)."""
+    other_knob_lean: float = 0.5
+    """With ``other_knob_confirms``, the other knob also shows a change when both its edges'
+    latest readings lie that way from their estimates by at least this fraction of
+    ``gate_deg`` (:func:`tsmd.online.cross_knob.knob_shows`): a change that moves all four
+    edges may read on one knob below its gate first (coilpipe 1, +0.5 mm slack: phi1 read
+    +0.83/+0.92 deg while phi2 was followed; without the lean phi2 waited 31 s). 0: off."""
     confirm: int = 2
     confirm_spread_deg: float = 2.0
     max_offset_deg: float = 12.0

@@ -43,7 +43,7 @@ def run(profile: Any, options: EstimatorOptions, knobs_moved: tuple[int, ...],
 
 
 def test_behaviour_one_knob_reading_out_is_followed_without_the_rule(profile: Any) -> None:
-    worker = run(profile, EstimatorOptions(), (0,), 3.0)
+    worker = run(profile, EstimatorOptions(other_knob_confirms=False), (0,), 3.0)
     assert min(worker.trackers[(0, s)].applied_deg for s in (1, -1)) > 2.0
 
 

@@ -99,6 +99,10 @@ class EdgeTracker(SlopeReadings):
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_odd_crossing: int = 0
     """Crossings inward beyond the gate while the friction rose: no measurement taken."""
+    n_odd_speed: int = 0
+    """Ramps at a knob speed beyond ``speed_ratio_max`` of the reference's: no measurement."""
+    speed_ref_deg_s: float = math.nan
+    """The reference ramps' median knob speed (NaN: not learned, or no speeds)."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
     suspect_order: int = -1
@@ -194,6 +198,10 @@ class EdgeTracker(SlopeReadings):
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
+        if not self._speed_matches(ramp):
+            self.n_odd_speed += 1
+            self.last_measurement_deg = math.nan
+            return events
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
         direction = self.knee_direction
         first_knee = self.last_feature != "knee"
@@ -252,6 +260,14 @@ class EdgeTracker(SlopeReadings):
         self._measured(raw, ramp.other_deg, events)
         return events
 
+    def _speed_matches(self, ramp: LoadedRamp) -> bool:
+        """The ramp ran at a knob speed within ``speed_ratio_max`` of the reference's (True
+        when either is unknown or the rule is off)."""
+        f, ref = self.options.speed_ratio_max, self.speed_ref_deg_s
+        if not (f > 0 and math.isfinite(ref) and ref > 0 and math.isfinite(ramp.speed_deg_s)):
+            return True
+        return ref / f <= ramp.speed_deg_s <= ref * f
+
     def _reread(self, slope: float) -> None:
         """The last crossing ramp read again with the slope in use now, when that moved beyond
         the tolerance since: a suspect under it joins the suspects (the slope in use follows a
@@ -280,6 +296,8 @@ class EdgeTracker(SlopeReadings):
         assert ref is not None
         self.level_A, self.slope_ref_A_per_deg = ref.level_A, ref.slope_A_per_deg
         self.residual_ref_deg, self.knee_residual_ref_deg = ref.residual_deg, ref.knee_residual_deg
+        speeds = [r.speed_deg_s for r, _ in self.reference.window if math.isfinite(r.speed_deg_s)]
+        self.speed_ref_deg_s = median(speeds) if speeds else math.nan
         self.bins = OtherKnobBins(self.options.other_bin_deg, self.options.bin_min,
                                   self.options.bin_window)
         for r, d in self.reference.window:
@@ -385,6 +403,7 @@ class EdgeTracker(SlopeReadings):
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
                 "odd_slope_ramps": self.n_odd_slope, "odd_knee_ramps": self.n_odd_knee,
                 "odd_crossing_ramps": self.n_odd_crossing, "refused_ramps": self.n_refused,
+                "odd_speed_ramps": self.n_odd_speed,
                 "feature": self.last_feature or None,
                 "backlash_gain_ratio": round(self.gain_ratio, 3),
                 "other_knob_bins_deg": self.bins.biases_deg(),

@@ -24,9 +24,15 @@ class EstimatorOptions:
     lumped 103 drift more (2.15 -> 2.94, 0.69 -> 1.80, 0 -> 0.78 deg) and lumped 103 phi1
     after a bend with the relation tracks 2.21 x fresh instead of 1.11: off until those are
     understood."""
+    speed_ratio_max: float = 2.0
+    """A ramp whose knob speed is beyond this factor of the reference ramps' (median) measures
+    nothing (``odd_speed_ramps``): the sheath's friction depends on the speed, so the level the
+    reference learned at the edge does not hold at another (coilpipe 1 without a change, the
+    reference at 16-21 deg/s: strokes at 3.9-7.2 deg/s read -1.0..-2.4 deg; lumped 5-6, at
+    5-10 deg/s, +0.4..+2.5). 0: off (until session 16)."""
     window: int = 5
     gate_deg: float = 1.5
-    other_knob_confirms: bool = False
+    other_knob_confirms: bool = True
     """A change is followed on a knob only once the other knob's edges show it too
     (:mod:`tsmd.online.cross_knob`): a slack or sheath change moves both knobs' edges, while
     the coil-pipe plant's phi1 crossings read 2-3 deg out for minutes on their own (units 1,

@@ -12,7 +12,9 @@ from support.online import profile_edges, rows
 from tsmd.compensation import build_compensator
 from tsmd.loop import ROW_COLUMNS
 from tsmd.online import OnlineWorker
+from tsmd.online.estimator import EdgeTracker
 from tsmd.online.estimator_options import EstimatorOptions
+from tsmd.online.features import LoadedRamp
 from tsmd.profile import load_profile
 
 PROFILE = Path(__file__).resolve().parents[1] / "profiles" / "example-sim.yaml"
@@ -71,3 +73,30 @@ def test_without_the_lean_a_change_below_the_other_knobs_gate_waits(profile: Any
 def test_the_other_knob_leaning_the_other_way_does_not_confirm(profile: Any) -> None:
     worker = run(profile, CONFIRMS, (0,), 3.0, others_deg=-1.0)
     assert max(abs(worker.trackers[(0, s)].applied_deg) for s in (1, -1)) <= 0.5
+
+
+def _ramp(edge_deg: float) -> LoadedRamp:
+    """A ramp of the positive edge crossing 0.05 A at ``edge_deg``."""
+    return LoadedRamp(0, 1, edge_deg + 10.0, 0.08, 0.003, 0.0, 0.0, 200, 0.003)
+
+
+def _tracker_never_confirmed() -> EdgeTracker:
+    tracker = EdgeTracker(0, 1, CONFIRMS, other_knob_shows=lambda direction: False)
+    for _ in range(CONFIRMS.baseline_ramps):
+        tracker.update(_ramp(20.0), 20.0)
+    return tracker
+
+
+def test_a_first_change_the_other_knob_does_not_show_is_not_followed() -> None:
+    tracker = _tracker_never_confirmed()
+    for _ in range(3):
+        tracker.update(_ramp(23.0), 20.0)
+    assert tracker.applied_deg == 0.0
+
+
+def test_after_a_followed_change_the_edge_refines_it_on_its_own_ramps() -> None:
+    tracker = _tracker_never_confirmed()
+    tracker.follow(4.5, "both knobs showed it")
+    for _ in range(3):
+        tracker.update(_ramp(23.0), 20.0)
+    assert tracker.applied_deg == pytest.approx(3.0, abs=0.01)

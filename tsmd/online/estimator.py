@@ -349,9 +349,13 @@ class EdgeTracker(SlopeReadings):
 
     def confirmed_elsewhere(self, new_deg: float) -> bool:
         """The other knob shows a change the way ``new_deg`` is from the estimate (always
-        when not asked: :attr:`other_knob_shows`)."""
+        when not asked: :attr:`other_knob_shows`, and once this edge followed a change: the
+        other knob confirms that the catheter changed, the edge's own ramps then place it;
+        screwrod 1 after +0.5 mm of slack: phi2's first follow 1.5 deg too far out, its
+        correction refused, on / fresh 0.91 -> 1.41)."""
         direction = 1 if new_deg > self.estimate_deg else -1
-        return self.other_knob_shows is None or self.other_knob_shows(direction)
+        return (self.other_knob_shows is None or self.level_deg != 0.0
+                or self.other_knob_shows(direction))
 
     def agrees_with(self, other: EdgeTracker) -> bool:
         """Both edges of a knob have a suspect and they agree: the knob's shape changed (a

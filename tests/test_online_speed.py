@@ -37,20 +37,30 @@ def test_the_reference_learns_its_ramps_speed() -> None:
     assert after(EstimatorOptions(), []).speed_ref_deg_s == pytest.approx(REFERENCE_SPEED)
 
 
-def test_slow_ramps_reading_out_measure_nothing() -> None:
-    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG + 3.0, 5.0)] * 3)
+def test_slow_ramps_reading_in_measure_nothing() -> None:
+    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG - 3.0, 5.0)] * 3)
     assert tracker.applied_deg == 0.0
     assert tracker.n_odd_speed == 3
 
 
-def test_the_same_ramps_at_the_reference_speed_are_followed() -> None:
-    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG + 3.0, 15.0)] * 3)
+def test_slow_ramps_within_the_gate_leave_the_estimate() -> None:
+    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG + 1.0, 5.0)] * 5)
+    assert tracker.estimate_deg == 0.0
+
+
+def test_slow_ramps_reading_out_beyond_the_gate_are_followed() -> None:
+    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG + 3.0, 5.0)] * 3)
     assert tracker.applied_deg == pytest.approx(3.0, abs=0.01)
+
+
+def test_the_same_ramps_at_the_reference_speed_are_followed() -> None:
+    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG - 3.0, 15.0)] * 3)
+    assert tracker.applied_deg == pytest.approx(-3.0, abs=0.01)
 
 
 def test_with_the_rule_off_slow_ramps_measure() -> None:
-    tracker = after(EstimatorOptions(speed_ratio_max=0.0), [ramp(EDGE_DEG + 3.0, 5.0)] * 3)
-    assert tracker.applied_deg == pytest.approx(3.0, abs=0.01)
+    tracker = after(EstimatorOptions(speed_ratio_max=0.0), [ramp(EDGE_DEG - 3.0, 5.0)] * 3)
+    assert tracker.applied_deg == pytest.approx(-3.0, abs=0.01)
 
 
 def test_the_loaded_ramp_carries_the_knob_speed_over_its_window() -> None:

@@ -100,7 +100,10 @@ class EdgeTracker(SlopeReadings):
     n_odd_crossing: int = 0
     """Crossings inward beyond the gate while the friction rose: no measurement taken."""
     n_odd_speed: int = 0
-    """Ramps at a knob speed beyond ``speed_ratio_max`` of the reference's: no measurement."""
+    """Ramps at a knob speed beyond ``speed_ratio_max`` of the reference's that measured
+    nothing (all but those reading outward beyond the gate)."""
+    odd_speed: bool = False
+    """The last ramp ran at a speed beyond ``speed_ratio_max`` of the reference's."""
     speed_ref_deg_s: float = math.nan
     """The reference ramps' median knob speed (NaN: not learned, or no speeds)."""
     n_refused: int = 0
@@ -198,10 +201,7 @@ class EdgeTracker(SlopeReadings):
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
-        if not self._speed_matches(ramp):
-            self.n_odd_speed += 1
-            self.last_measurement_deg = math.nan
-            return events
+        self.odd_speed = not self._speed_matches(ramp)
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
         direction = self.knee_direction
         first_knee = self.last_feature != "knee"
@@ -326,6 +326,13 @@ class EdgeTracker(SlopeReadings):
         accepted, or a suspect (followed when confirmed)."""
         o = self.options
         m = raw_deg - self.bins.bias_deg(other_deg)
+        if self.odd_speed and m - self.estimate_deg <= o.gate_deg:
+            # the friction's speed dependence: no reading, but a widening beyond the gate is
+            # what a slack or a bend does and stays a suspect (lumped 1, 60 deg bend: read
+            # first on ramps at 4.6-7 deg/s against the reference's 15.5)
+            self.n_odd_speed += 1
+            self.last_measurement_deg = math.nan
+            return
         self.last_measurement_deg = self.last_reading_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()

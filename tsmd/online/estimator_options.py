@@ -26,10 +26,13 @@ class EstimatorOptions:
     understood."""
     speed_ratio_max: float = 2.0
     """A ramp whose knob speed is beyond this factor of the reference ramps' (median) measures
-    nothing (``odd_speed_ramps``): the sheath's friction depends on the speed, so the level the
-    reference learned at the edge does not hold at another (coilpipe 1 without a change, the
-    reference at 16-21 deg/s: strokes at 3.9-7.2 deg/s read -1.0..-2.4 deg; lumped 5-6, at
-    5-10 deg/s, +0.4..+2.5). 0: off (until session 16)."""
+    nothing (``odd_speed_ramps``) unless it reads outward beyond the gate: the sheath's
+    friction depends on the speed, so the level the reference learned at the edge does not
+    hold at another (coilpipe 1 without a change, the reference at 16-21 deg/s: strokes at
+    3.9-7.2 deg/s read -1.0..-2.4 deg; lumped 5-6, at 5-10 deg/s, +0.4..+2.5), while a slack
+    or a bend widens the dead zone and may show first on such ramps (lumped 1, 60 deg bend: a
+    hard gate delayed phi1's follow by 22 s, on / fresh 0.92 -> 1.11). 0: off (until session
+    16)."""
     window: int = 5
     gate_deg: float = 1.5
     other_knob_confirms: bool = True

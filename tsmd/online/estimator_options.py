@@ -35,11 +35,14 @@ class EstimatorOptions:
     16)."""
     window: int = 5
     gate_deg: float = 1.5
-    other_knob_confirms: bool = True
+    other_knob_confirms: bool = False
     """A change is followed on a knob only once the other knob's edges show it too
     (:mod:`tsmd.online.cross_knob`): a slack or sheath change moves both knobs' edges, while
     the coil-pipe plant's phi1 crossings read 2-3 deg out for minutes on their own (units 1,
-    2 without a change: followed, tracking worse than with online off)."""
+    2 without a change: followed, tracking worse than with online off). Off by default:
+    with it (and ``other_knob_lean``) coilpipe 1-2 without a change follow less (2.05 -> 0.58,
+    3.00 -> 2.20 deg), but coilpipe 2's +0.5 mm slack on phi2 tracked 2.37 x fresh instead of
+    1.37 (phi1 read the slack 40 s late; docs/online.md, Session 16)."""
     other_knob_lean: float = 0.5
     """With ``other_knob_confirms``, the other knob also shows a change when both its edges'
     latest readings lie that way from their estimates by at least this fraction of

@@ -71,6 +71,9 @@ class EdgeTracker(SlopeReadings):
     frozen_reason: str = ""
     n_ramps: int = 0
     last_measurement_deg: float = math.nan
+    last_reading_deg: float = math.nan
+    """The latest measurement any ramp gave (NaN: none yet), kept across ramps that measure
+    nothing; the other knob's confirmation reads it (:mod:`tsmd.online.cross_knob`)."""
     recent_slopes: list[float] = field(default_factory=list)
     last_feature: str = ""
     """What placed the last measurement: "knee" or "crossing"."""
@@ -96,6 +99,13 @@ class EdgeTracker(SlopeReadings):
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_odd_crossing: int = 0
     """Crossings inward beyond the gate while the friction rose: no measurement taken."""
+    n_odd_speed: int = 0
+    """Ramps at a knob speed beyond ``speed_ratio_max`` of the reference's that measured
+    nothing (all but those reading outward beyond the gate)."""
+    odd_speed: bool = False
+    """The last ramp ran at a speed beyond ``speed_ratio_max`` of the reference's."""
+    speed_ref_deg_s: float = math.nan
+    """The reference ramps' median knob speed (NaN: not learned, or no speeds)."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
     suspect_order: int = -1
@@ -191,6 +201,7 @@ class EdgeTracker(SlopeReadings):
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
+        self.odd_speed = not self._speed_matches(ramp)
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
         direction = self.knee_direction
         first_knee = self.last_feature != "knee"
@@ -249,6 +260,14 @@ class EdgeTracker(SlopeReadings):
         self._measured(raw, ramp.other_deg, events)
         return events
 
+    def _speed_matches(self, ramp: LoadedRamp) -> bool:
+        """The ramp ran at a knob speed within ``speed_ratio_max`` of the reference's (True
+        when either is unknown or the rule is off)."""
+        f, ref = self.options.speed_ratio_max, self.speed_ref_deg_s
+        if not (f > 0 and math.isfinite(ref) and ref > 0 and math.isfinite(ramp.speed_deg_s)):
+            return True
+        return ref / f <= ramp.speed_deg_s <= ref * f
+
     def _reread(self, slope: float) -> None:
         """The last crossing ramp read again with the slope in use now, when that moved beyond
         the tolerance since: a suspect under it joins the suspects (the slope in use follows a
@@ -277,6 +296,8 @@ class EdgeTracker(SlopeReadings):
         assert ref is not None
         self.level_A, self.slope_ref_A_per_deg = ref.level_A, ref.slope_A_per_deg
         self.residual_ref_deg, self.knee_residual_ref_deg = ref.residual_deg, ref.knee_residual_deg
+        speeds = [r.speed_deg_s for r, _ in self.reference.window if math.isfinite(r.speed_deg_s)]
+        self.speed_ref_deg_s = median(speeds) if speeds else math.nan
         self.bins = OtherKnobBins(self.options.other_bin_deg, self.options.bin_min,
                                   self.options.bin_window)
         for r, d in self.reference.window:
@@ -293,7 +314,7 @@ class EdgeTracker(SlopeReadings):
         if abs(m - self.estimate_deg) > self.options.gate_deg:
             return False
         self.suspects.clear()
-        self.last_measurement_deg = m
+        self.last_measurement_deg = self.last_reading_deg = m
         self.accepted_order = next(_ORDER)
         if self.reference.add(ramp, profile_edge_deg):
             self._take_reference()
@@ -305,7 +326,14 @@ class EdgeTracker(SlopeReadings):
         accepted, or a suspect (followed when confirmed)."""
         o = self.options
         m = raw_deg - self.bins.bias_deg(other_deg)
-        self.last_measurement_deg = m
+        if self.odd_speed and m - self.estimate_deg <= o.gate_deg:
+            # the friction's speed dependence: no reading, but a widening beyond the gate is
+            # what a slack or a bend does and stays a suspect (lumped 1, 60 deg bend: read
+            # first on ramps at 4.6-7 deg/s against the reference's 15.5)
+            self.n_odd_speed += 1
+            self.last_measurement_deg = math.nan
+            return
+        self.last_measurement_deg = self.last_reading_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()
             self.accepted_order = next(_ORDER)
@@ -328,9 +356,13 @@ class EdgeTracker(SlopeReadings):
 
     def confirmed_elsewhere(self, new_deg: float) -> bool:
         """The other knob shows a change the way ``new_deg`` is from the estimate (always
-        when not asked: :attr:`other_knob_shows`)."""
+        when not asked: :attr:`other_knob_shows`, and once this edge followed a change: the
+        other knob confirms that the catheter changed, the edge's own ramps then place it;
+        screwrod 1 after +0.5 mm of slack: phi2's first follow 1.5 deg too far out, its
+        correction refused, on / fresh 0.91 -> 1.41)."""
         direction = 1 if new_deg > self.estimate_deg else -1
-        return self.other_knob_shows is None or self.other_knob_shows(direction)
+        return (self.other_knob_shows is None or self.level_deg != 0.0
+                or self.other_knob_shows(direction))
 
     def agrees_with(self, other: EdgeTracker) -> bool:
         """Both edges of a knob have a suspect and they agree: the knob's shape changed (a
@@ -382,6 +414,7 @@ class EdgeTracker(SlopeReadings):
                 "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
                 "odd_slope_ramps": self.n_odd_slope, "odd_knee_ramps": self.n_odd_knee,
                 "odd_crossing_ramps": self.n_odd_crossing, "refused_ramps": self.n_refused,
+                "odd_speed_ramps": self.n_odd_speed,
                 "feature": self.last_feature or None,
                 "backlash_gain_ratio": round(self.gain_ratio, 3),
                 "other_knob_bins_deg": self.bins.biases_deg(),

@@ -24,13 +24,31 @@ class EstimatorOptions:
     lumped 103 drift more (2.15 -> 2.94, 0.69 -> 1.80, 0 -> 0.78 deg) and lumped 103 phi1
     after a bend with the relation tracks 2.21 x fresh instead of 1.11: off until those are
     understood."""
+    speed_ratio_max: float = 2.0
+    """A ramp whose knob speed is beyond this factor of the reference ramps' (median) measures
+    nothing (``odd_speed_ramps``) unless it reads outward beyond the gate: the sheath's
+    friction depends on the speed, so the level the reference learned at the edge does not
+    hold at another (coilpipe 1 without a change, the reference at 16-21 deg/s: strokes at
+    3.9-7.2 deg/s read -1.0..-2.4 deg; lumped 5-6, at 5-10 deg/s, +0.4..+2.5), while a slack
+    or a bend widens the dead zone and may show first on such ramps (lumped 1, 60 deg bend: a
+    hard gate delayed phi1's follow by 22 s, on / fresh 0.92 -> 1.11). 0: off (until session
+    16)."""
     window: int = 5
     gate_deg: float = 1.5
     other_knob_confirms: bool = False
     """A change is followed on a knob only once the other knob's edges show it too
     (:mod:`tsmd.online.cross_knob`): a slack or sheath change moves both knobs' edges, while
     the coil-pipe plant's phi1 crossings read 2-3 deg out for minutes on their own (units 1,
-    2 without a change: followed, tracking worse than with online off)."""
+    2 without a change: followed, tracking worse than with online off). Off by default:
+    with it (and ``other_knob_lean``) coilpipe 1-2 without a change follow less (2.05 -> 0.58,
+    3.00 -> 2.20 deg), but coilpipe 2's +0.5 mm slack on phi2 tracked 2.37 x fresh instead of
+    1.37 (phi1 read the slack 40 s late; docs/online.md, Session 16)."""
+    other_knob_lean: float = 0.5
+    """With ``other_knob_confirms``, the other knob also shows a change when both its edges'
+    latest readings lie that way from their estimates by at least this fraction of
+    ``gate_deg`` (:func:`tsmd.online.cross_knob.knob_shows`): a change that moves all four
+    edges may read on one knob below its gate first (coilpipe 1, +0.5 mm slack: phi1 read
+    +0.83/+0.92 deg while phi2 was followed; without the lean phi2 waited 31 s). 0: off."""
     confirm: int = 2
     confirm_spread_deg: float = 2.0
     max_offset_deg: float = 12.0

@@ -93,6 +93,10 @@ class LoadedRamp:
     """The current's step up at the knee (the tendon engaging); for per-ramp diagnosis."""
     past_knee: bool = False
     """The window was placed past this stroke's own knee (not by the expected edge)."""
+    speed_deg_s: float = math.nan
+    """The knob's mean speed over the window: the sheath's friction, and so the current on the
+    ramp, depends on it (coilpipe: strokes at 4-7 deg/s read 1-2.4 deg inward of those at
+    ~20 deg/s)."""
 
     def current_at(self, knob_deg: float) -> float:
         """The line's current at a knob angle."""
@@ -251,6 +255,8 @@ def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
     if not (np.all(np.isfinite(y)) and np.all(np.isfinite(x))):
         return Rejected(stroke.knob, "non-finite samples in the loaded window")
     stick = np.exp(-stroke.slip_deg[sel] / o.handle_slip_deg)
+    span_s = float(stroke.t_s[sel][-1] - stroke.t_s[sel][0])
+    speed = float(x.max() - x.min()) / span_s if span_s > 0 else math.nan
     a, b, r = _line(x, y, stick)
     sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
     if sigma > 0:
@@ -264,4 +270,4 @@ def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
     return LoadedRamp(stroke.knob, side, float(x.mean()), a, b,
                       float(np.median(stroke.other_deg[sel])), float(stroke.t_s[sel][-1]),
                       int(x.size), noise, knee[0], knee[1],
-                      expected_edge_deg == knee[0])
+                      expected_edge_deg == knee[0], speed)

@@ -1,0 +1,73 @@
+"""A ramp at a knob speed far from the reference ramps' measures nothing: the sheath's friction,
+and so the current on the loaded ramp, depends on the speed."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from tsmd.online.estimator import EdgeTracker
+from tsmd.online.estimator_options import EstimatorOptions
+from tsmd.online.features import LoadedRamp, Stroke, loaded_ramp
+
+EDGE_DEG = 20.0
+LEVEL_A = 0.05
+SLOPE = 0.003
+REFERENCE_SPEED = 20.0
+
+
+def ramp(edge_deg: float, speed_deg_s: float = REFERENCE_SPEED) -> LoadedRamp:
+    """A ramp whose crossing of LEVEL_A is at ``edge_deg`` (positive side), run at a speed."""
+    base = LoadedRamp(0, 1, edge_deg + 10.0, LEVEL_A + SLOPE * 10.0, SLOPE, 0.0, 0.0, 200, 0.003)
+    return dataclasses.replace(base, speed_deg_s=speed_deg_s)
+
+
+def after(options: EstimatorOptions, ramps: list[LoadedRamp]) -> EdgeTracker:
+    tracker = EdgeTracker(0, 1, options)
+    for _ in range(options.baseline_ramps):
+        tracker.update(ramp(EDGE_DEG), EDGE_DEG)
+    for r in ramps:
+        tracker.update(r, EDGE_DEG)
+    return tracker
+
+
+def test_the_reference_learns_its_ramps_speed() -> None:
+    assert after(EstimatorOptions(), []).speed_ref_deg_s == pytest.approx(REFERENCE_SPEED)
+
+
+def test_slow_ramps_reading_in_measure_nothing() -> None:
+    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG - 3.0, 5.0)] * 3)
+    assert tracker.applied_deg == 0.0
+    assert tracker.n_odd_speed == 3
+
+
+def test_slow_ramps_within_the_gate_leave_the_estimate() -> None:
+    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG + 1.0, 5.0)] * 5)
+    assert tracker.estimate_deg == 0.0
+
+
+def test_slow_ramps_reading_out_beyond_the_gate_are_followed() -> None:
+    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG + 3.0, 5.0)] * 3)
+    assert tracker.applied_deg == pytest.approx(3.0, abs=0.01)
+
+
+def test_the_same_ramps_at_the_reference_speed_are_followed() -> None:
+    tracker = after(EstimatorOptions(), [ramp(EDGE_DEG - 3.0, 15.0)] * 3)
+    assert tracker.applied_deg == pytest.approx(-3.0, abs=0.01)
+
+
+def test_with_the_rule_off_slow_ramps_measure() -> None:
+    tracker = after(EstimatorOptions(speed_ratio_max=0.0), [ramp(EDGE_DEG - 3.0, 5.0)] * 3)
+    assert tracker.applied_deg == pytest.approx(-3.0, abs=0.01)
+
+
+def test_the_loaded_ramp_carries_the_knob_speed_over_its_window() -> None:
+    t = np.arange(0.0, 2.0, 0.004)
+    pos = 20.0 * t
+    current = 0.01 + 0.003 * np.maximum(pos - 10.0, 0.0)
+    stroke = Stroke(0, 1, t, pos, pos, current, np.zeros_like(t), pos - pos[0])
+    found = loaded_ramp(stroke, 10.0)
+    assert isinstance(found, LoadedRamp)
+    assert found.speed_deg_s == pytest.approx(20.0, rel=0.02)

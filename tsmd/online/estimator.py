@@ -24,13 +24,13 @@ alone say (knee mode, gain, bend share) is :mod:`tsmd.online.edge_slopes`.
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from statistics import median
 from typing import Any
 
+from tsmd.online.edge_reference import ORDER, ReferenceReadings
 from tsmd.online.edge_slopes import SlopeReadings
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
@@ -38,12 +38,9 @@ from tsmd.online.other_knob import OtherKnobBins
 from tsmd.online.reference import SettlingReference
 from tsmd.online.slopes import common_change, shrunk_ratio
 
-_ORDER = itertools.count()
-"""One order over every tracker's measurements, so two edges can tell whose came first."""
-
 
 @dataclass
-class EdgeTracker(SlopeReadings):
+class EdgeTracker(SlopeReadings, ReferenceReadings):
     """The offset of one dead-zone edge (knob, side) from the profile's; see the module."""
 
     knob: int
@@ -109,7 +106,7 @@ class EdgeTracker(SlopeReadings):
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
     suspect_order: int = -1
-    """When (:data:`_ORDER`) the last suspect was taken; -1: none yet."""
+    """When (:data:`~tsmd.online.edge_reference.ORDER`) the last suspect was taken; -1: none yet."""
     accepted_order: int = -1
     """When the last measurement within the gate was taken (the edge read where it was)."""
     bins: OtherKnobBins = field(init=False)
@@ -260,14 +257,6 @@ class EdgeTracker(SlopeReadings):
         self._measured(raw, ramp.other_deg, events)
         return events
 
-    def _speed_matches(self, ramp: LoadedRamp) -> bool:
-        """The ramp ran at a knob speed within ``speed_ratio_max`` of the reference's (True
-        when either is unknown or the rule is off)."""
-        f, ref = self.options.speed_ratio_max, self.speed_ref_deg_s
-        if not (f > 0 and math.isfinite(ref) and ref > 0 and math.isfinite(ramp.speed_deg_s)):
-            return True
-        return ref / f <= ramp.speed_deg_s <= ref * f
-
     def _reread(self, slope: float) -> None:
         """The last crossing ramp read again with the slope in use now, when that moved beyond
         the tolerance since: a suspect under it joins the suspects (the slope in use follows a
@@ -286,39 +275,8 @@ class EdgeTracker(SlopeReadings):
                          - self.residual_ref_deg) - self.bins.bias_deg(ramp.other_deg)
         if m - self.estimate_deg > o.gate_deg:  # outward only: the friction rose
             self.suspects = [*self.suspects, m][-o.confirm:]
-            self.suspect_order = next(_ORDER)
+            self.suspect_order = next(ORDER)
             self.n_reread += 1
-
-    def _take_reference(self) -> None:
-        """The reference in use is the settling reference's latest; the bins start again
-        from its ramps (their readings were against the reference before)."""
-        ref = self.reference.current
-        assert ref is not None
-        self.level_A, self.slope_ref_A_per_deg = ref.level_A, ref.slope_A_per_deg
-        self.residual_ref_deg, self.knee_residual_ref_deg = ref.residual_deg, ref.knee_residual_deg
-        speeds = [r.speed_deg_s for r, _ in self.reference.window if math.isfinite(r.speed_deg_s)]
-        self.speed_ref_deg_s = median(speeds) if speeds else math.nan
-        self.bins = OtherKnobBins(self.options.other_bin_deg, self.options.bin_min,
-                                  self.options.bin_window)
-        for r, d in self.reference.window:
-            self.bins.teach(self.bins.key(r.other_deg), ref.reading_deg(r, d))
-
-    def _settling(self, ramp: LoadedRamp, profile_edge_deg: float, raw_deg: float) -> bool:
-        """While the reference settles, a crossing within the gate re-learns it instead of
-        measuring (the catheter's behaviour moving under a reference learned too early is not
-        a change; :mod:`tsmd.online.reference`); True when the ramp was taken so. Not a ramp
-        steeper than the slope in use, and no ramp once the knob's slopes rose: more friction
-        is a bend, whose first crossings read inside the gate (lumped 103 phi2, 60 deg: ramps
-        1.11-1.16 x, the bend re-learned into the reference and never followed)."""
-        m = raw_deg - self.bins.bias_deg(ramp.other_deg)
-        if abs(m - self.estimate_deg) > self.options.gate_deg:
-            return False
-        self.suspects.clear()
-        self.last_measurement_deg = self.last_reading_deg = m
-        self.accepted_order = next(_ORDER)
-        if self.reference.add(ramp, profile_edge_deg):
-            self._take_reference()
-        return True
 
     def _measured(self, raw_deg: float, other_deg: float,
                   events: list[tuple[str, str, dict[str, Any]]]) -> None:
@@ -336,7 +294,7 @@ class EdgeTracker(SlopeReadings):
         self.last_measurement_deg = self.last_reading_deg = m
         if abs(m - self.estimate_deg) <= o.gate_deg:
             self.suspects.clear()
-            self.accepted_order = next(_ORDER)
+            self.accepted_order = next(ORDER)
             key = self.bins.key(other_deg)
             learned = self.bins.learned(key)
             self.bins.teach(key, raw_deg - self.estimate_deg)
@@ -348,7 +306,7 @@ class EdgeTracker(SlopeReadings):
                 [*self.accepted, *[self.level_deg] * (o.window - len(self.accepted))])
         else:
             self.suspects = [*self.suspects, m][-o.confirm:]
-            self.suspect_order = next(_ORDER)
+            self.suspect_order = next(ORDER)
             if (len(self.suspects) >= o.confirm and max(self.suspects) - min(self.suspects)
                     <= o.confirm_spread_deg and self.confirmed_elsewhere(median(self.suspects))):
                 events += self.follow(median(self.suspects), "consecutive ramps agree")

@@ -1,0 +1,79 @@
+"""The reference an edge tracker reads against, and the ramps it is learned from.
+
+A mixin of :class:`tsmd.online.estimator.EdgeTracker`: the reference (current level, slope,
+residuals, the ramps' knob speed) taken from the settling reference
+(:mod:`tsmd.online.reference`), re-learned on crossings within the gate while it settles, and
+the speed rule that keeps a ramp run much faster or slower than the reference's from
+measuring (the sheath's friction is speed-dependent).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from statistics import median
+
+from tsmd.online.estimator_options import EstimatorOptions
+from tsmd.online.features import LoadedRamp
+from tsmd.online.other_knob import OtherKnobBins
+from tsmd.online.reference import SettlingReference
+
+ORDER = itertools.count()
+"""One order over every tracker's measurements, so two edges can tell whose came first."""
+
+
+class ReferenceReadings:
+    """The reference of one edge tracker (see the module)."""
+
+    options: EstimatorOptions
+    reference: SettlingReference
+    bins: OtherKnobBins
+    level_A: float | None
+    slope_ref_A_per_deg: float | None
+    residual_ref_deg: float
+    knee_residual_ref_deg: float
+    speed_ref_deg_s: float
+    estimate_deg: float
+    suspects: list[float]
+    last_measurement_deg: float
+    last_reading_deg: float
+    accepted_order: int
+
+    def _speed_matches(self, ramp: LoadedRamp) -> bool:
+        """The ramp ran at a knob speed within ``speed_ratio_max`` of the reference's (True
+        when either is unknown or the rule is off)."""
+        f, ref = self.options.speed_ratio_max, self.speed_ref_deg_s
+        if not (f > 0 and math.isfinite(ref) and ref > 0 and math.isfinite(ramp.speed_deg_s)):
+            return True
+        return ref / f <= ramp.speed_deg_s <= ref * f
+
+    def _take_reference(self) -> None:
+        """The reference in use is the settling reference's latest; the bins start again
+        from its ramps (their readings were against the reference before)."""
+        ref = self.reference.current
+        assert ref is not None
+        self.level_A, self.slope_ref_A_per_deg = ref.level_A, ref.slope_A_per_deg
+        self.residual_ref_deg, self.knee_residual_ref_deg = ref.residual_deg, ref.knee_residual_deg
+        speeds = [r.speed_deg_s for r, _ in self.reference.window if math.isfinite(r.speed_deg_s)]
+        self.speed_ref_deg_s = median(speeds) if speeds else math.nan
+        self.bins = OtherKnobBins(self.options.other_bin_deg, self.options.bin_min,
+                                  self.options.bin_window)
+        for r, d in self.reference.window:
+            self.bins.teach(self.bins.key(r.other_deg), ref.reading_deg(r, d))
+
+    def _settling(self, ramp: LoadedRamp, profile_edge_deg: float, raw_deg: float) -> bool:
+        """While the reference settles, a crossing within the gate re-learns it instead of
+        measuring (the catheter's behaviour moving under a reference learned too early is not
+        a change; :mod:`tsmd.online.reference`); True when the ramp was taken so. Not a ramp
+        steeper than the slope in use, and no ramp once the knob's slopes rose: more friction
+        is a bend, whose first crossings read inside the gate (lumped 103 phi2, 60 deg: ramps
+        1.11-1.16 x, the bend re-learned into the reference and never followed)."""
+        m = raw_deg - self.bins.bias_deg(ramp.other_deg)
+        if abs(m - self.estimate_deg) > self.options.gate_deg:
+            return False
+        self.suspects.clear()
+        self.last_measurement_deg = self.last_reading_deg = m
+        self.accepted_order = next(ORDER)
+        if self.reference.add(ramp, profile_edge_deg):
+            self._take_reference()
+        return True

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from simrig.family import PLANT_SPECS
+from simrig.family import PLANT_ROLE, PLANT_SPECS
 from simrig.scenario import ShapeChange
 from tsmd.bench.cache_key import keyed_cache
 from tsmd.bench.online_bend import product_bend_relation
@@ -244,8 +244,8 @@ def hot_path_us(n: int = 20000) -> tuple[float, float, float]:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--plant", choices=sorted(PLANT_SPECS), default="capstan",
-                        help="the family (capstan: development plant, lumped: held out, "
-                        "segments: blind)")
+                        help="the family: " + ", ".join(
+                            f"{name} ({role})" for name, role in PLANT_ROLE.items()))
     parser.add_argument("--units", default="0,1,2",
                         help="units of the family (0 nominal, 1-8 development, 101-108 held out)")
     parser.add_argument("--change", default="slack:0.5",

@@ -77,7 +77,7 @@ def with_rule(device: DeviceModel, rule: str) -> DeviceModel:
 
 def usable(knob: DeviceKnob, rule: str) -> bool:
     """Whether the knob's sheet has the share ``rule`` needs (the lag for "recovery", which
-    ``tsmd datasheet`` does not measure yet: no candidate on a fresh sheet)."""
+    ``tsmd datasheet --recovery-rule`` measures first, :mod:`tsmd.datasheet_recovery`)."""
     share = {"line": knob.backlash_release_line_share,
              "local": knob.backlash_release_local_share,
              "recovery": knob.backlash_recovery_lag_deg}.get(rule, 1.0)

@@ -36,6 +36,7 @@ from tsmd.datasheet_amplitude import measure_tip_backlash_gains
 from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
 from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_offset import with_reading_offset
+from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
 from tsmd.datasheet_rule import (
     RULE_NOISE_SEEDS,
     choose_knee,
@@ -82,6 +83,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "it once per seed gives the product's reading offset (session 14; "
                              "'none': no choice and no offset, the sheet keeps the rule its "
                              "shares imply)")
+    parser.add_argument("--recovery-rule", action="store_true",
+                        help="with --plant: also offer the backlash rule 'recovery' (a "
+                             "self-locking handle): its lag and bend gain measured on the unit's "
+                             "fast calibrations under it (one more run per rule seed), kept on a "
+                             "knob that chooses it (docs/calibration.md, session 16)")
     parser.add_argument("--bend-relation", action="store_true",
                         help="with --plant: also calibrate the unit straight and with its sheath "
                              "bent 30/60/90 deg and write the product's bend relation for online "
@@ -131,14 +137,25 @@ def _rule_seeds(text: str) -> list[int]:
 
 
 def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
-                 params: dict[str, Any], seeds: list[int]) -> DeviceModel:
-    """The sheet with each knob's backlash rule, chosen on its own unit's calibrations, and
-    the product's reading offset measured with that rule."""
+                 params: dict[str, Any], seeds: list[int], recovery: bool = False
+                 ) -> DeviceModel:
+    """The sheet with each knob's backlash rule, chosen on its own unit's calibrations
+    (``recovery``: "recovery" offered too, its constants measured first), and the product's
+    reading offset measured with that rule."""
     unit = config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=params))
-    t0 = time.monotonic()
     truth = sheet_truth(unit)
+    if recovery:
+        t0 = time.monotonic()
+        device, _ = with_recovery_constants(device, unit, truth, seeds)
+        for name, k in zip(("phi1", "phi2"), device.knobs, strict=True):
+            print(f"{name} recovery rule on the sheet's unit, fast protocol, noise seeds "
+                  f"{','.join(map(str, seeds))}: lag {_or_none(k.backlash_recovery_lag_deg, 2)} "
+                  f"deg, bend gain {_or_none(k.backlash_bend_gain, 3)}")
+        print(f"  recovery constants: {time.monotonic() - t0:.0f} s")
+    t0 = time.monotonic()
     scores = rule_scores(unit, device, seeds, truth)
     chosen, knee = choose_knee(unit, choose_rules(device, scores), scores, truth, seeds)
+    chosen = recovery_where_chosen(chosen)
     for knob, name in enumerate(("phi1", "phi2")):
         mine = "; ".join(s.text() for s in scores if s.knob == knob)
         k = chosen.knobs[knob]
@@ -236,6 +253,9 @@ def main(args: argparse.Namespace) -> int:
         raise DatasheetError("--bend-relation goes with --plant (the unit is calibrated bent on "
                              "the simulated rig)")
     seeds = _rule_seeds(args.rule_seeds)
+    if args.recovery_rule and (args.plant is None or not seeds):
+        raise DatasheetError("--recovery-rule goes with --plant and rule seeds (the rule is "
+                             "offered in the rule choice on the simulated rig)")
     if args.plant is not None:
         config = load_config(args.config) if args.config is not None else default_sim_config()
         params = _params(args.params)
@@ -264,7 +284,7 @@ def main(args: argparse.Namespace) -> int:
     if args.plant is not None and args.loaded_shape:
         device = _with_shape_grid(device, config, factory, args.seed)
     if args.plant is not None and seeds:
-        device = _choose_rule(device, config, args.plant, params, seeds)
+        device = _choose_rule(device, config, args.plant, params, seeds, args.recovery_rule)
     if args.plant is not None and args.bend_relation:
         device = _with_bend(device, config, factory)
     comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "

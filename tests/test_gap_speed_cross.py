@@ -211,6 +211,23 @@ def test_helixbelt_cases_scale_the_units_plane_error_and_rope_and_rate_creep_are
     assert not helix.supports("creep")
 
 
+def test_ratestate_cases_scale_the_units_ageing_and_rope_and_coupling_creep_are_not_run(
+) -> None:
+    rs = PRESETS["ratestate"]
+    none = rs.build_unit(102, 0.1)
+    rate = rs.build_unit(102, 0.1, "rate", **rs.case_effects("rate"))
+    soft = rs.build_unit(102, 0.1, "compliance", **rs.case_effects("compliance"))
+    for k in (0, 1):
+        assert rate.knobs[k].ageing_b == pytest.approx(10.0 * none.knobs[k].ageing_b)
+        assert soft.knobs[k].tendon_stiffness_N == pytest.approx(
+            0.5 * none.knobs[k].tendon_stiffness_N)
+        assert rate.knobs[k].tendon_stiffness_N == none.knobs[k].tendon_stiffness_N
+    assert rs.case_effects("curvature") == {"sheath_curvature_deg": 120.0}
+    assert 0.0 < rs.max_step_s < 0.02
+    assert not rs.supports("coupling")
+    assert not rs.supports("creep")
+
+
 def test_a_plant_valid_at_short_steps_is_stepped_finely_and_read_at_the_rows() -> None:
     # the screwrod plant's walled knob overshoots at 20 ms steps (torque spikes of ~1000 N m)
     screw = PRESETS["screwrod"]

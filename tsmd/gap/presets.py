@@ -178,6 +178,30 @@ coupling 1.5 deg); the rope's EA halved, 2.03 deg. Its physics hold at 20 ms ste
 deg RMS from 4 ms ones, unit 1): no finer stepping."""
 
 
+RATESTATE_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 120.0}}
+"""The ratestate plant's one effect keyword: a 120 deg sheath bend (mid-shaft, adds to every
+lumen contact's wrap), 1.94 deg of tip (tip RMSE effect on minus off, unit 1, noise-free, 120 s
+of the experiment motion at 50 Hz). Its planes' coupling (both planes' bend adds wrap to every
+tendon's distal contacts) has no constant of its own (``bend_lumen_friction`` rubs the own
+plane's bend as well), and nothing moves at a held knob (contact ageing raises friction, it
+moves no tendon): coupling and creep are not run. "None" is the nominal physics as written
+(docs/gap.md "Session 16, round 2")."""
+
+RATESTATE_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "rate": {"ageing_b": 10.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Ratestate effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion, the plant stepped at 4 ms): its only speed-dependent physics is the contacts'
+rate-and-state friction, so rate is the state coefficient b ten times the unit's, 1.31 deg (x8
+1.06, x11 1.59; the others' rate 1.1-1.9 deg; it makes the contacts stick-slip, whose events
+move with the step: 0.9 deg RMS between 4 and 1 ms steps); the rope's EA halved, 3.74 deg."""
+
+RATESTATE_MAX_STEP_S = 0.004
+"""The nominal ratestate unit's tip lies within 0.08 deg (0.005 RMS) of 1 ms steps at 4 ms steps,
+0.72 deg (0.05 RMS) at 20 ms (unit 1, 120 s of the experiment motion)."""
+
+
 TWISTSHAFT_KNOB_EFFECTS: dict[str, dict[str, float]] = {
     "coupling": {"lumen_angle_error_deg": 4.5},
     "compliance": {"tendon_stiffness_N": 0.5},
@@ -263,6 +287,9 @@ PRESETS: dict[str, PlantSpec] = {
                          effects=NITINOL_EFFECTS, knob_effects=NITINOL_KNOB_EFFECTS),
     "helixbelt": PlantSpec(PLANT_SPECS["helixbelt"], {}, (), "helixbelt", family="helixbelt",
                            effects=HELIXBELT_EFFECTS, knob_effects=HELIXBELT_KNOB_EFFECTS),
+    "ratestate": PlantSpec(PLANT_SPECS["ratestate"], {}, (), "ratestate", family="ratestate",
+                           effects=RATESTATE_EFFECTS, knob_effects=RATESTATE_KNOB_EFFECTS,
+                           max_step_s=RATESTATE_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

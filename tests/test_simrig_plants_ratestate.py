@@ -1,4 +1,4 @@
-"""The ratestate plant (blind, session 16): its laws, its behaviours, and its refusals."""
+"""The ratestate plant (written blind in session 16, held out since session 17): its laws, its behaviours, and its refusals."""
 
 from __future__ import annotations
 
@@ -155,9 +155,9 @@ def test_a_curved_shaft_needs_more_torque_and_bends_the_tip_less() -> None:
     assert tau_c[-1] > tau_s[-1] and tip_c[-1] < tip_s[-1]
 
 
-def test_ratestate_is_registered_last_and_blind() -> None:
+def test_ratestate_is_registered_last_and_held_out() -> None:
     assert list(PLANT_SPECS)[-1] == "ratestate"
-    assert PLANT_ROLE["ratestate"] == "blind"
+    assert PLANT_ROLE["ratestate"] == "held-out"
     assert isinstance(family_member("ratestate", 101).build(), RateStatePlant)
     assert set(SCATTER["ratestate"]) <= set(family_member("ratestate", 0).params["knobs"][0])
 

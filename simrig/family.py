@@ -15,7 +15,8 @@ the coilpipe plant (session 10, written blind) is held out now, the stickslip pl
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
 now, the helixbelt plant (session 15, written blind) is held out now, the ratestate plant
-(session 16, written blind) is held out now (``PLANT_ROLE``). ``SCATTER`` lives in :mod:`simrig.family_scatter`.
+(session 16, written blind) is held out now (``PLANT_ROLE``). ``SCATTER`` lives in
+:mod:`simrig.family_scatter`.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The ratestate plant (written blind in session 16, held out since session 17): its laws, its behaviours, and its refusals."""
+"""The ratestate plant (blind in session 16, held out since 17): laws, behaviours, refusals."""
 
 from __future__ import annotations
 

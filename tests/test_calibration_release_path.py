@@ -1,5 +1,5 @@
 """The gain the product's release-path ratio is taken against, and the sheet's tip backlash
-gain it is chosen by (session 16)."""
+gain it is chosen by (session 16; read at the lines' corners: session 17)."""
 
 from __future__ import annotations
 
@@ -72,3 +72,29 @@ def test_the_tip_gain_is_the_mean_backlash_growth_per_degree_of_amplitude() -> N
 
 def test_a_side_without_a_backlash_gives_no_tip_gain() -> None:
     assert backlash_growth((6.0, math.nan), (9.0, 11.0)) is None
+
+
+def test_a_line_read_tip_gain_decides_over_the_threshold_read_one() -> None:
+    knob = dataclasses.replace(KNOB, reference_tip_backlash_gain=moved_gain(SETTLE),
+                               reference_tip_line_backlash_gain=moved_gain(RULE) + 0.005)
+    assert ratio_gain(knob) == RULE
+    assert release_slope_ratio(knob) == pytest.approx(RELEASE * (1 - RULE) / OMEGA)
+
+
+def test_a_line_read_tip_gain_alone_chooses_the_gain() -> None:
+    knob = dataclasses.replace(KNOB, reference_tip_line_backlash_gain=moved_gain(SETTLE) - 0.005)
+    assert ratio_gain(knob) == SETTLE
+
+
+def test_the_line_read_tip_gain_round_trips_and_is_range_checked() -> None:
+    data = device_model_to_mapping(load_device_model(DEVICE))
+    data["knobs"]["phi2"]["reference_tip_line_backlash_gain"] = 0.173
+    device = device_model_from_mapping(data)
+    assert device.knobs[1].reference_tip_line_backlash_gain == 0.173
+    assert device.knobs[0].reference_tip_line_backlash_gain is None
+    mapping = device_model_to_mapping(device)["knobs"]
+    assert mapping["phi2"]["reference_tip_line_backlash_gain"] == 0.173
+    assert "reference_tip_line_backlash_gain" not in mapping["phi1"]
+    data["knobs"]["phi2"]["reference_tip_line_backlash_gain"] = 0.9
+    with pytest.raises(ProfileError, match=r"knobs.phi2.reference_tip_line_backlash_gain"):
+        device_model_from_mapping(data)

@@ -10,6 +10,14 @@ current cannot tell (session 16, helixbelt: the settle rule's made unit 2's phi2
 +-90 deg (0.04 Hz, other knob at 0) and the tip's backlash read as the scoring truth reads it
 (:func:`tsmd.tip_truth.tip_reading`); its growth per degree of amplitude is
 ``reference_tip_backlash_gain``, against which the ratio's gain is chosen.
+
+Read at the 1 deg threshold, a tip that starts back gradually after a reversal (friction
+distributed along the tendon: presliding, rounded corners) shows a backlash that grows more
+slowly than the knob travel to the release line the model draws (ratestate's sheet unit: 0.133
+per degree at the threshold, 0.173 to the line, whose every release path is one line). The
+growth read at the corners of the paper's lines (``by="lines"``) is
+``reference_tip_line_backlash_gain`` (session 17); where the sheet has it, the ratio's gain is
+chosen against it.
 """
 
 from __future__ import annotations
@@ -44,8 +52,10 @@ def amplitude_sweep(knob: int, amplitude_deg: float, period_s: float
 
 
 def tip_backlash_deg(plant_factory: Callable[[], Plant], knob: int, amplitude_deg: float,
-                     seed: int, config: TsmdConfig) -> tuple[float, float]:
-    """The tip's backlash (positive, negative side) after reversals at +-``amplitude_deg``."""
+                     seed: int, config: TsmdConfig, by: str = "threshold"
+                     ) -> tuple[float, float]:
+    """The tip's backlash (positive, negative side) after reversals at +-``amplitude_deg``,
+    read ``by`` one of :data:`tsmd.tip_truth.TRUTHS`."""
     period_s = config.loop.period_s
     t, q, skip = settle(*amplitude_sweep(knob, amplitude_deg, period_s), period_s)
     rec = run_trajectory(t, q, config=config, profile=None, method="none", seed=seed,
@@ -53,21 +63,24 @@ def tip_backlash_deg(plant_factory: Callable[[], Plant], knob: int, amplitude_de
     a = skip + round(CONDITIONING_CYCLES / SWEEP_HZ / period_s)
     k = knob + 1
     try:
-        b = tip_reading(rec["t"][a:], rec[f"cmd{k}"][a:], rec[f"pos{k}"][a:], rec[f"tip{k}"][a:])
+        b = tip_reading(rec["t"][a:], rec[f"cmd{k}"][a:], rec[f"pos{k}"][a:], rec[f"tip{k}"][a:],
+                        by)
     except SweepAnalysisError as exc:
         raise TsmdError(f"tip backlash gain: knob {k} at +-{amplitude_deg:g} deg: {exc}") from None
     return float(b.backlash_pos_deg), float(b.backlash_neg_deg)
 
 
 def measure_tip_backlash_gains(plant_factory: Callable[[], Plant], seed: int = 2000,
-                               config: TsmdConfig | None = None
+                               config: TsmdConfig | None = None, by: str = "threshold"
                                ) -> tuple[float | None, float | None]:
     """Each knob's tip backlash growth per degree of reversal amplitude (mean of both sides,
-    from +-60 to +-90 deg); None where a side's backlash could not be read."""
+    from +-60 to +-90 deg), read ``by`` the threshold or the lines; None where a side's
+    backlash could not be read."""
     cfg = config if config is not None else default_sim_config()
-    gains = [backlash_growth(tip_backlash_deg(plant_factory, knob, SMALL_AMPLITUDE_DEG, seed, cfg),
-                             tip_backlash_deg(plant_factory, knob, SWEEP_AMPLITUDE_DEG, seed, cfg))
-             for knob in (0, 1)]
+    gains = [backlash_growth(
+        tip_backlash_deg(plant_factory, knob, SMALL_AMPLITUDE_DEG, seed, cfg, by),
+        tip_backlash_deg(plant_factory, knob, SWEEP_AMPLITUDE_DEG, seed, cfg, by))
+        for knob in (0, 1)]
     return gains[0], gains[1]
 
 

@@ -26,10 +26,16 @@ def ratio_gain(device_knob: Any) -> float | None:
     (``reference_rule_backlash_gain``, the reading every unit's ``beta`` is fitted with), the one
     whose moved gain on the sheet's own unit, ``1 - omega (1 - rule) / (release_omega (1 -
     gain))``, is nearer the backlash growth its tracker showed between reversals at 60 and 90
-    deg (``reference_tip_backlash_gain``, session 16); the settle rule's without that key."""
+    deg (``reference_tip_backlash_gain``, session 16); the settle rule's without that key.
+    Where the sheet also has the growth read at the corners of the paper's lines
+    (``reference_tip_line_backlash_gain``, session 17), the choice is made against it: the
+    model's backlash is the knob travel to its release line, which a tip with rounded
+    corners reaches after the 1 deg threshold has fired."""
     settle = getattr(device_knob, "reference_backlash_gain", None)
     rule = getattr(device_knob, "reference_rule_backlash_gain", None)
-    tip = getattr(device_knob, "reference_tip_backlash_gain", None)
+    tip = getattr(device_knob, "reference_tip_line_backlash_gain", None)
+    if tip is None:
+        tip = getattr(device_knob, "reference_tip_backlash_gain", None)
     release = getattr(device_knob, "release_omega", None)
     if settle is None or rule is None or tip is None or release is None:
         return None if settle is None else float(settle)

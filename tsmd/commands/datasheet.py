@@ -75,6 +75,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "+-60 and +-90 deg (2 sweeps more per knob); method ours then takes "
                              "the release-path ratio against the gain reading nearer it (opt-in "
                              "per product, docs/model.md Session 16)")
+    parser.add_argument("--tip-line-backlash-gain", action="store_true",
+                        help="with --plant: the same sweeps with the tip's backlash read at the "
+                             "corners of the paper's lines instead of at the 1 deg threshold; "
+                             "the ratio's gain is then chosen against it (a tip with rounded "
+                             "corners; opt-in per product, docs/model.md Session 17)")
     parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "
@@ -188,14 +193,18 @@ def _with_coupling(device: DeviceModel, config: TsmdConfig, factory: Callable[[]
 
 
 def _with_tip_backlash_gain(device: DeviceModel, config: TsmdConfig,
-                            factory: Callable[[], Plant], seed: int) -> DeviceModel:
-    """The sheet with each knob's tip backlash growth per degree of reversal amplitude."""
+                            factory: Callable[[], Plant], seed: int, by: str = "threshold"
+                            ) -> DeviceModel:
+    """The sheet with each knob's tip backlash growth per degree of reversal amplitude, the
+    backlash read ``by`` the 1 deg threshold or the lines' corners (its own key)."""
     t0 = time.monotonic()
-    gains = measure_tip_backlash_gains(factory, seed, config)
-    knobs = tuple(dataclasses.replace(k, reference_tip_backlash_gain=(
-        None if g is None else round(g, 3))) for k, g in zip(device.knobs, gains, strict=True))
-    print(f"  tip backlash gain (60 -> 90 deg reversals): phi1 {_or_none(gains[0], 3)}, phi2 "
-          f"{_or_none(gains[1], 3)} ({time.monotonic() - t0:.0f} s)")
+    gains = measure_tip_backlash_gains(factory, seed, config, by)
+    rounded = [None if g is None else round(g, 3) for g in gains]
+    knobs = tuple(dataclasses.replace(k, reference_tip_backlash_gain=g) if by == "threshold"
+                  else dataclasses.replace(k, reference_tip_line_backlash_gain=g)
+                  for k, g in zip(device.knobs, rounded, strict=True))
+    print(f"  tip backlash gain by {by} (60 -> 90 deg reversals): phi1 {_or_none(gains[0], 3)}, "
+          f"phi2 {_or_none(gains[1], 3)} ({time.monotonic() - t0:.0f} s)")
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
@@ -281,6 +290,8 @@ def main(args: argparse.Namespace) -> int:
         device = _with_coupling(device, config, factory, args.seed)
     if args.plant is not None and args.tip_backlash_gain:
         device = _with_tip_backlash_gain(device, config, factory, args.seed)
+    if args.plant is not None and args.tip_line_backlash_gain:
+        device = _with_tip_backlash_gain(device, config, factory, args.seed, by="lines")
     if args.plant is not None and args.loaded_shape:
         device = _with_shape_grid(device, config, factory, args.seed)
     if args.plant is not None and seeds:

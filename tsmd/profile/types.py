@@ -157,6 +157,13 @@ class DeviceKnob:
     at 60 and 90 deg, :mod:`tsmd.datasheet_amplitude`). Method ours takes its release-path
     ratio against the gain reading that brings the sheet unit's moved gain nearer it
     (:func:`tsmd.calibration.release_path.ratio_gain`); None: the settle rule's."""
+    reference_tip_line_backlash_gain: float | None = None
+    """Optional, tracked on the data-sheet unit (``tsmd datasheet --tip-line-backlash-gain``,
+    opt-in, session 17): the same growth with the tip's backlash read at the corners of the
+    paper's lines (where the release line meets the reversal's level) instead of at the 1 deg
+    threshold, which a tip that starts back gradually after a reversal (rounded corners) reaches
+    early. Where given, :func:`~tsmd.calibration.release_path.ratio_gain` chooses against it
+    instead of ``reference_tip_backlash_gain``."""
     other_tip_gain: float | None = None
     """Optional, tracked on the data-sheet unit: how many degrees this knob's tip plane shows per
     degree the other plane's tip is bent (a shaft that winds up in torsion turns the planes into

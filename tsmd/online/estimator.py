@@ -135,16 +135,6 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                                            o.slope_in_use_tolerance)
 
     @property
-    def gain_ratio(self) -> float:
-        """The slopes' gain (:attr:`SlopeReadings.gain_ratio`), once an edge of the knob has
-        followed a change (:attr:`EstimatorOptions.gain_after_follow`); 1 before."""
-        followed = self.level_deg != 0.0 or (self.partner is not None
-                                             and self.partner.level_deg != 0.0)
-        if self.options.gain_after_follow and not followed:
-            return 1.0
-        return super().gain_ratio
-
-    @property
     def confidence(self) -> float:
         """0..1: how many measurements back the estimate, and how well they agree."""
         if self.learning or not self.accepted:

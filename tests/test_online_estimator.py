@@ -412,7 +412,8 @@ def test_an_inward_crossing_on_a_steeper_ramp_measures_nothing() -> None:
 
 
 def test_without_the_rule_a_steeper_ramp_moves_the_edge_inward() -> None:
-    tracker, partner = learned(EstimatorOptions(refuse_inward_on_steeper=False)), learned()
+    tracker = learned(EstimatorOptions(refuse_inward_on_steeper=False, partner_confirms=False))
+    partner = learned()
     for _ in range(2):
         tracker.update(steeper_at_the_same_edge(1.13), EDGE_DEG, partner)
     assert tracker.applied_deg < -1.5

@@ -23,6 +23,14 @@ class SlopeReadings:
     partner_last_change: float
     partner_knee_change: float
     knob_change: float
+    level_deg: float
+    partner: SlopeReadings | None
+
+    @property
+    def knob_followed(self) -> bool:
+        """An edge of the knob followed a change (its level left the profile's)."""
+        return self.level_deg != 0.0 or (self.partner is not None
+                                         and self.partner.level_deg != 0.0)
 
     @property
     def learning(self) -> bool:
@@ -79,10 +87,12 @@ class SlopeReadings:
         only from ramps fitted past their knee (a window that starts on the engagement's
         grown step reads 2.5-3 x); without such ramps (the lumped plant has no knee) from the
         slope in use when :attr:`EstimatorOptions.gain_from_slope_in_use`. The release
-        itself is crossed too fast under compensation to measure it (docs/online.md)."""
+        itself is crossed too fast under compensation to measure it (docs/online.md). Only
+        once an edge of the knob followed a change (:attr:`EstimatorOptions.gain_after_follow`):
+        a bend, what moves beta, widens the edges too."""
         o = self.options
-        if self.learning:
-            return 1.0
+        if self.learning or (o.gain_after_follow and not self.knob_followed):
+            return 1.0  # without a followed change the slopes follow the knob's speed
         if self.knee_mode and self.knee_slopes:
             mine, theirs = self.knee_slope_change, self.partner_knee_change
             tol = o.same_slope_tolerance

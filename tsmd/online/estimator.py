@@ -35,6 +35,7 @@ from tsmd.online.edge_slopes import SlopeReadings
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
+from tsmd.online.partner import partner_left_band, partner_shows_change
 from tsmd.online.reference import SettlingReference
 from tsmd.online.slopes import common_change, shrunk_ratio
 
@@ -121,6 +122,11 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """Whether the other knob's edges show a change this way (+1 outward, -1 inward;
     :func:`tsmd.online.cross_knob.knob_shows`, set by the worker); None: not asked."""
     """The reference being learned, re-learned while it settles (:mod:`tsmd.online.reference`)."""
+    partner: EdgeTracker | None = field(default=None, repr=False, compare=False)
+    """The knob's other edge (set by the worker, or by :meth:`update`'s ``partner``)."""
+    n_partner_held: int = 0
+    """Changes (or estimates beyond the dead band) held because the other edge of the knob
+    showed none (:attr:`EstimatorOptions.partner_confirms`)."""
 
     def __post_init__(self) -> None:
         o = self.options
@@ -160,6 +166,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         o = self.options
         self.n_ramps += 1
         self.bend_suspect = False
+        self.partner = partner or self.partner
         events: list[tuple[str, str, dict[str, Any]]] = []
         tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
         if self.learning:
@@ -317,10 +324,16 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         when not asked: :attr:`other_knob_shows`, and once this edge followed a change: the
         other knob confirms that the catheter changed, the edge's own ramps then place it;
         screwrod 1 after +0.5 mm of slack: phi2's first follow 1.5 deg too far out, its
-        correction refused, on / fresh 0.91 -> 1.41)."""
+        correction refused, on / fresh 0.91 -> 1.41); and, the first change, the knob's
+        other edge shows one too (:attr:`EstimatorOptions.partner_confirms`)."""
         direction = 1 if new_deg > self.estimate_deg else -1
-        return (self.other_knob_shows is None or self.level_deg != 0.0
-                or self.other_knob_shows(direction))
+        if self.level_deg != 0.0:
+            return True
+        if self.options.partner_confirms and not partner_shows_change(
+                self.partner, self.options.partner_lean * self.options.gate_deg):
+            self.n_partner_held += 1
+            return False
+        return self.other_knob_shows is None or self.other_knob_shows(direction)
 
     def agrees_with(self, other: EdgeTracker) -> bool:
         """Both edges of a knob have a suspect and they agree: the knob's shape changed (a
@@ -359,7 +372,13 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     def _apply(self) -> None:
         o = self.options
         if abs(self.estimate_deg - self.applied_deg) > o.deadband_deg:
-            self.applied_deg = max(-o.max_offset_deg, min(o.max_offset_deg, self.estimate_deg))
+            leaves = abs(self.estimate_deg) > abs(self.applied_deg)
+            if (o.partner_confirms and leaves and self.level_deg == 0.0
+                    and not partner_left_band(self.partner, o.deadband_deg)):
+                self.n_partner_held += 1  # one edge's estimate off the profile on its own
+            else:
+                self.applied_deg = max(-o.max_offset_deg,
+                                       min(o.max_offset_deg, self.estimate_deg))
         if self.last_feature != "knee" or not o.keep_zero_load_in_bend:
             self.zero_load_deg = self.applied_deg
 
@@ -378,4 +397,4 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                 "other_knob_bins_deg": self.bins.biases_deg(),
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None,
                 "reference_relearned": self.reference.relearned,
-                "reread_ramps": self.n_reread}
+                "reread_ramps": self.n_reread, "partner_held": self.n_partner_held}

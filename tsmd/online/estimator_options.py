@@ -49,6 +49,22 @@ class EstimatorOptions:
     ``gate_deg`` (:func:`tsmd.online.cross_knob.knob_shows`): a change that moves all four
     edges may read on one knob below its gate first (coilpipe 1, +0.5 mm slack: phi1 read
     +0.83/+0.92 deg while phi2 was followed; without the lean phi2 waited 31 s). 0: off."""
+    partner_confirms: bool = True
+    """An edge leaves the profile's value (its first followed change, or an estimate within
+    the gate beyond the dead band) only once the knob's other edge shows a change too, either
+    way (:mod:`tsmd.online.partner`): a shape change moves both edges of a knob, one edge's
+    readings wander on their own (coilpipe 1 without a change: phi1 pos followed to +2.04 deg
+    while phi1 neg read -0.17/+0.68, tracking 0.6-1.3 deg worse for 250 s). Off: each edge on
+    its own (until session 16)."""
+    partner_lean: float = 0.5
+    """With ``partner_confirms``: the other edge shows a change when its latest reading lies
+    this fraction of ``gate_deg`` or more from its estimate (or it followed one)."""
+    gain_after_follow: bool = True
+    """The backlash gain moves only once an edge of the knob has followed a change: without
+    one the loaded ramps' slopes follow the knob's speed (coilpipe 1 and lumped 6 without a
+    change: gains 1.10-1.13 for 10-60 s, lumped 6's phi1 0.58 deg worse over that window);
+    a bend, which is what moves beta, widens the edges. Off: the gain follows the slopes
+    whenever they moved (until session 16)."""
     confirm: int = 2
     confirm_spread_deg: float = 2.0
     max_offset_deg: float = 12.0

@@ -95,6 +95,8 @@ class OnlineWorker:
         self.bend = bend
         self.trackers = {(knob, side): EdgeTracker(knob, side, estimator or EstimatorOptions())
                          for knob in (0, 1) for side in (1, -1)}
+        for (knob, side), tr in self.trackers.items():
+            tr.partner = self.trackers[(knob, -side)]
         if (estimator or EstimatorOptions()).other_knob_confirms:
             for (knob, _), tr in self.trackers.items():
                 tr.other_knob_shows = partial(self._knob_shows, 1 - knob)

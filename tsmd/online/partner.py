@@ -1,0 +1,47 @@
+"""Whether the knob's other edge shows a change too, before an edge leaves the profile's value.
+
+A catheter's shape change moves both dead-zone edges of a knob: a slack or a sheath bend widens
+both (every tendon's path or wrap grows), a path change of the shaft shifts both the same way
+along the knob's axis (one edge out, the other in). One edge's readings moving on their own is
+what the current does without any change (session 17, development units, 600 s of mixed use:
+coilpipe 1's phi1 positive edge read +2.03 and +2.04 deg on two strokes, followed as a change
+while its negative edge read -0.17 and +0.68 on either side of them, and phi1 tracked 0.6-1.3
+deg worse than with online off for the 250 s it stayed; lumped 6's phi1 negative edge crept to
++0.49 deg within the gate while its positive edge stayed below the dead band, 0.1-0.2 deg worse).
+So the first change away from the profile waits until the other edge of the knob shows one as
+well, either way; once a change was followed the edges refine on their own (a correction of a
+follow that went too far is one edge's).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Protocol
+
+
+class EdgeView(Protocol):
+    """What the rule reads of an edge tracker (:class:`tsmd.online.estimator.EdgeTracker`)."""
+
+    level_deg: float
+    estimate_deg: float
+    last_reading_deg: float
+
+
+def partner_shows_change(partner: EdgeView | None, lean_deg: float) -> bool:
+    """The knob's other edge followed a change, or its latest reading lies ``lean_deg`` or
+    more from its estimate (either way: a widening or a shift). True without a partner."""
+    if partner is None or partner.level_deg != 0.0:
+        return True
+    reading = partner.last_reading_deg - partner.estimate_deg
+    return math.isfinite(reading) and abs(reading) >= lean_deg
+
+
+def partner_left_band(partner: EdgeView | None, deadband_deg: float) -> bool:
+    """The knob's other edge followed a change or its estimate left the dead band (either way):
+    an estimate within the gate may then move this edge off the profile's value too."""
+    if partner is None or partner.level_deg != 0.0:
+        return True
+    return abs(partner.estimate_deg) > deadband_deg
+
+
+__all__ = ["EdgeView", "partner_left_band", "partner_shows_change"]

@@ -13,7 +13,7 @@ from support.calibration import sweep_recording
 
 from tsmd.calibration import CalibrationError, Sweep, identify_sweep
 from tsmd.calibration.estimate import point_estimates
-from tsmd.calibration.health import check_slips, find_slip
+from tsmd.calibration.health import check_sensor, check_slips, find_slip
 from tsmd.calibration.sweep_result import SweepResult
 from tsmd.recording import Recording
 
@@ -95,6 +95,17 @@ def test_a_clipped_sensor_is_refused_as_saturated(rec: Recording) -> None:
     limit = 0.5 * float(np.max(np.abs(cur)))
     with pytest.raises(CalibrationError, match="saturated"):
         _identify(rec, np.clip(cur, -limit, limit))
+
+
+def test_a_large_reading_that_recurs_with_larger_ones_beyond_it_is_no_clipping(
+        rec: Recording) -> None:
+    # A quantised current dwelling near its peak: one large value in many separate stretches,
+    # as often as a clipped one, but the sensor also reads past it.
+    cur = np.round(rec["cur1"] / 0.002) * 0.002
+    lo, hi = np.quantile(cur, [0.02, 0.06])
+    cur[(cur >= lo) & (cur <= hi)] = lo
+    assert np.count_nonzero(cur == lo) >= 0.02 * cur.size and np.any(cur < lo)
+    check_sensor(rec["t"], rec["pos1"], cur)
 
 
 def _load(drop_at_deg: float | None) -> tuple[np.ndarray, np.ndarray, int]:

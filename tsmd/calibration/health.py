@@ -29,8 +29,8 @@ class HealthLimits:
     stuck_min_travel_deg: float = 10.0
     """... while the knob travels this far: the sensor is stuck."""
     saturated_fraction: float = 0.02
-    """This share of the samples exactly at one of the largest readings, in separate runs:
-    clipped."""
+    """This share of the samples exactly at one of the largest readings, in separate runs, and
+    none beyond it on its side: clipped."""
     slip_drop_fraction: float = 0.3
     """A loaded current falling by this share of its rise ..."""
     slip_drop_deg: float = 1.0
@@ -68,7 +68,11 @@ def check_sensor(t_s: FloatArray, pos_deg: FloatArray, current_A: FloatArray,
     at = np.concatenate([[False], cur == value, [False]]).astype(np.int8)
     runs = int(np.sum(np.diff(at) == 1))
     large = abs(value) >= float(np.quantile(np.abs(cur), 0.9))
-    if share >= lim.saturated_fraction and large and runs >= 2 and float(np.ptp(cur)) > 0:
+    # A clipped sensor reads nothing beyond its rail; a quantised current (2 mA steps) that
+    # dwells near its peak repeats one large reading just as often but reads past it too.
+    beyond = int(np.count_nonzero(cur > value if value > 0 else cur < value))
+    if (share >= lim.saturated_fraction and large and runs >= 2 and beyond == 0
+            and float(np.ptp(cur)) > 0):
         raise CalibrationError(
             f"the current sensor is saturated: {share:.0%} of the readings sit exactly at "
             f"{value * 1e3:.1f} mA, in {runs} separate stretches (clipped)")

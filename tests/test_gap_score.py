@@ -43,3 +43,22 @@ def test_an_effect_below_detection_that_is_named_is_right_strictly_only() -> Non
     lucky = _case("curvature", "curvature", "curvature", False)
     assert lucky.correct and not lucky.correct_detectable
     assert SelftestResult([lucky]).summary()["below_detection_read_none"] == 0
+
+
+def test_an_effect_read_within_the_units_spread_is_counted_apart_and_stays_a_miss() -> None:
+    inside = _case("coupling", "coupling", None, True)
+    inside.within_spread = "coupling"
+    null = _case("none", None, None, None)
+    null.within_spread = "coupling"
+    result = SelftestResult([inside, null, _case("rate", "rate", "rate", True)])
+    s = result.summary()
+    assert s["top1_accuracy"] == 0.5 and not inside.correct
+    assert (s["within_spread_own_effect"], s["within_spread_null"]) == (1, 1)
+    assert s["false_alarms"] == 0
+    assert "units' spread' (not counted above) | 1/2" in selftest_markdown(result)
+
+
+def test_another_effect_read_within_the_spread_is_no_reading_of_the_one_put_in() -> None:
+    other = _case("rate", "rate", None, True)
+    other.within_spread = "coupling"
+    assert not other.spread_reading

@@ -192,6 +192,8 @@ def diagnose_session(recs: Sequence[Recording], data: PlantSpec, sim: PlantSpec,
                  None)
     shrink = next((s["raw_share"] for s in structure.get("signatures", [])
                    if s["name"] == top), None)
+    inside = [s["name"] for s in structure.get("signatures", [])
+              if np.isfinite(s.get("within_spread_deg", float("nan")))]
     figures = structure.get("figures", {})
     layer = figures.get("layer", result.before)
     before_tip, before_cur = _tip_rmse(layer), _cur_rmse(layer)
@@ -199,7 +201,8 @@ def diagnose_session(recs: Sequence[Recording], data: PlantSpec, sim: PlantSpec,
     return SelftestCase(case, duration_s, seed, EFFECTS[case][2], result.verdict, top, share,
                         before_tip, _tip_rmse(result.after_top), before_cur,
                         _cur_rmse(result.after_top), wall, excess_shrink=shrink,
-                        physics_tip_rmse=_tip_rmse(figures.get("physics")))
+                        physics_tip_rmse=_tip_rmse(figures.get("physics")),
+                        within_spread=inside[0] if inside and top is None else None)
 
 
 def run_crosstest(data: PlantSpec, sim: PlantSpec, cases: Sequence[str],

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from tsmd.gap.crosstest import speed_footprint
 from tsmd.gap.detectable import Footprint, footprint
 from tsmd.gap.presets import PRESETS
 from tsmd.gap.score import SelftestCase, SelftestResult, selftest_markdown
@@ -62,3 +63,13 @@ def test_another_effect_read_within_the_spread_is_no_reading_of_the_one_put_in()
     other = _case("rate", "rate", None, True)
     other.within_spread = "coupling"
     assert not other.spread_reading
+
+
+def test_a_rate_case_is_sized_by_its_speed_contrast_not_by_how_far_it_moves_the_tip() -> None:
+    # stickslip's fast relaxation branch x5 moves the tip 1.1 deg over the motion, but its
+    # loops at 20 and 80 deg/s by less than one sample's noise; lumped's viscous sheath more
+    branch = speed_footprint(PRESETS["stickslip"], 1, 50.0)
+    viscous = speed_footprint(PRESETS["lumped"], 1, 50.0)
+    assert footprint(PRESETS["stickslip"], "rate", 1, 60.0, 50.0).detectable(0.1, 0.004)
+    assert not branch.detectable(0.1, 0.004)
+    assert viscous.detectable(0.1, 0.004)

@@ -22,15 +22,16 @@ from numpy.typing import NDArray
 from simrig.current_sensor import CurrentSensor
 from simrig.tracker import EmTracker
 from tsmd.gap.compliance import reference_deg_per_A
-from tsmd.gap.contrast import product_reference
+from tsmd.gap.contrast import collect_tests, product_reference
 from tsmd.gap.data import GapSeries, series_from_recording
-from tsmd.gap.detectable import footprint
+from tsmd.gap.detectable import Footprint, footprint
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.fit import ParamSpec
+from tsmd.gap.loops import contrast_of, loop_contrast
 from tsmd.gap.presets import PlantSpec
 from tsmd.gap.protocol import Segment, encode_table, protocol
-from tsmd.gap.reference import ProductReference
+from tsmd.gap.reference import ProductReference, measured_windows
 from tsmd.gap.result import GapConfig
 from tsmd.gap.score import SelftestCase, SelftestResult
 from tsmd.gap.selftest import EFFECTS, _cur_rmse, _tip_rmse, drive_plant, trajectory
@@ -156,9 +157,39 @@ def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float
                            matched, sheet_unit, reference_units)
     if EFFECTS[case][2] is None:
         return out
-    fp = footprint(data, case, seed, duration_s, rate_hz)
+    fp = (speed_footprint(data, seed, rate_hz) if case == "rate"
+          else footprint(data, case, seed, duration_s, rate_hz))
     return dataclasses.replace(out, footprint_tip_deg=fp.tip_deg, footprint_cur_A=fp.cur_A,
                                detectable=fp.detectable(TIP_NOISE_DEG, CURRENT_NOISE_A))
+
+
+def speed_footprint(data: PlantSpec, unit: int, rate_hz: float,
+                    unit_variation: float = 0.1) -> Footprint:
+    """The rate case's footprint where a rate dependence is defined, on the change of the
+    response with speed: the protocol's fast-minus-slow loop contrast of the true tips and
+    currents (noise-free, both configurations), effect on minus off, RMS over the matched
+    points (session 17). A rate case's physics may move the tip over the whole motion by
+    far more than it changes with speed (stickslip's fast relaxation branch x5: 1.1 deg of tip,
+    0.09 deg of speed contrast on unit 1; ratestate's ageing x10, docs/gap.md "Session 16,
+    round 2"); no one can name a rate dependence whose speed contrast is below the noise."""
+    def contrasts(case: str) -> tuple[FloatArray, FloatArray]:
+        recs = make_session(data, case, 4.0, rate_hz, unit, unit_variation, 0.0, 0.0)
+        series = [series_from_recording(r, f"footprint-{i}") for i, r in enumerate(recs)
+                  if "segments" in r.metadata]
+        tests = collect_tests(series, [measured_windows(s) for s in series])
+        tip: list[FloatArray] = []
+        cur: list[FloatArray] = []
+        for by_test in tests.values():
+            t = by_test["rate"]
+            for found, out in ((loop_contrast(t.loops, t.levels), tip),
+                               (loop_contrast(t.currents, t.levels), cur)):
+                if found is not None:
+                    out.append(contrast_of(found))
+        return np.array(tip), np.array(cur)
+
+    (tip0, cur0), (tip1, cur1) = contrasts("none"), contrasts("rate")
+    return Footprint(float(np.sqrt(np.mean((tip1 - tip0) ** 2))),
+                     float(np.sqrt(np.mean((cur1 - cur0) ** 2))))
 
 
 def diagnose_session(recs: Sequence[Recording], data: PlantSpec, sim: PlantSpec, case: str,

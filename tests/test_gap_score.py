@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-from tsmd.gap.crosstest import speed_footprint
-from tsmd.gap.detectable import Footprint, footprint
+from tsmd.gap.detectable import Footprint, condition_footprint, footprint
 from tsmd.gap.presets import PRESETS
 from tsmd.gap.score import SelftestCase, SelftestResult, selftest_markdown
 
@@ -68,8 +67,18 @@ def test_another_effect_read_within_the_spread_is_no_reading_of_the_one_put_in()
 def test_a_rate_case_is_sized_by_its_speed_contrast_not_by_how_far_it_moves_the_tip() -> None:
     # stickslip's fast relaxation branch x5 moves the tip 1.1 deg over the motion, but its
     # loops at 20 and 80 deg/s by less than one sample's noise; lumped's viscous sheath more
-    branch = speed_footprint(PRESETS["stickslip"], 1, 50.0)
-    viscous = speed_footprint(PRESETS["lumped"], 1, 50.0)
+    branch = condition_footprint(PRESETS["stickslip"], "rate", 1, 50.0)
+    viscous = condition_footprint(PRESETS["lumped"], "rate", 1, 50.0)
     assert footprint(PRESETS["stickslip"], "rate", 1, 60.0, 50.0).detectable(0.1, 0.004)
     assert not branch.detectable(0.1, 0.004)
     assert viscous.detectable(0.1, 0.004)
+
+
+def test_a_creep_case_is_sized_by_its_drift_at_a_held_knob() -> None:
+    # stickslip's slow relaxation branch x1.5 moves the tip 0.38 deg over the motion, but the
+    # currents over a held dwell by 3.3 mA; the lumped plant's creep by more than 4 mA
+    branch = condition_footprint(PRESETS["stickslip"], "creep", 1, 50.0)
+    creep = condition_footprint(PRESETS["lumped"], "creep", 1, 50.0)
+    assert footprint(PRESETS["stickslip"], "creep", 1, 60.0, 50.0).detectable(0.1, 0.004)
+    assert not branch.detectable(0.1, 0.004)
+    assert creep.detectable(0.1, 0.004)

@@ -17,28 +17,21 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
-from simrig.current_sensor import CurrentSensor
-from simrig.tracker import EmTracker
 from tsmd.gap.compliance import reference_deg_per_A
-from tsmd.gap.contrast import collect_tests, product_reference
+from tsmd.gap.contrast import product_reference
 from tsmd.gap.data import GapSeries, series_from_recording
-from tsmd.gap.detectable import Footprint, footprint
+from tsmd.gap.detectable import condition_footprint, footprint
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.fit import ParamSpec
-from tsmd.gap.loops import contrast_of, loop_contrast
 from tsmd.gap.presets import PlantSpec
-from tsmd.gap.protocol import Segment, encode_table, protocol
-from tsmd.gap.reference import ProductReference, measured_windows
+from tsmd.gap.reference import ProductReference
 from tsmd.gap.result import GapConfig
 from tsmd.gap.score import SelftestCase, SelftestResult
-from tsmd.gap.selftest import EFFECTS, _cur_rmse, _tip_rmse, drive_plant, trajectory
+from tsmd.gap.selftest import EFFECTS, _cur_rmse, _tip_rmse
+from tsmd.gap.session import CURRENT_NOISE_A, TIP_NOISE_DEG, make_session
 from tsmd.recording import Recording
-
-FloatArray = NDArray[np.float64]
-
 
 
 def cross_config(fit: Sequence[ParamSpec], method: str = "signature") -> GapConfig:
@@ -46,66 +39,6 @@ def cross_config(fit: Sequence[ParamSpec], method: str = "signature") -> GapConf
     structural layer takes the base mismatch (and a physics fit of a plant with other physics
     costs most of the time); the candidate method fits ``fit`` as `tsmd gap` does."""
     return GapConfig(fit_specs=() if method == "signature" else tuple(fit), method=method)
-
-
-CONFIGS: tuple[str, str] = ("straight", "looped")
-
-TIP_NOISE_DEG = 0.1
-CURRENT_NOISE_A = 0.004
-"""The sessions' tracker and current-sensor noise per sample (the rig's)."""
-
-
-def make_session(data: PlantSpec, case: str, duration_s: float, rate_hz: float, seed: int,
-                 unit_variation: float = 0.1, tip_noise_deg: float = TIP_NOISE_DEG,
-                 current_noise_A: float = CURRENT_NOISE_A,
-                 matched: bool = True) -> list[Recording]:
-    """One unit's session: half the time in each sheath configuration, the effect switched on.
-
-    The same unit (``seed``) in both configurations; curvature bends the sheath of the looped
-    one only. With ``matched`` each configuration also gets a recording of the
-    matched-condition protocol (:mod:`tsmd.gap.protocol`), the identification experiment's
-    second part. Tracker and current noise differ per recording.
-    """
-    effects = data.case_effects(case)
-    t_e, q_e = trajectory(duration_s / 2.0, rate_hz)
-    motions: list[tuple[str, FloatArray, FloatArray, FloatArray | None, list[Segment]]] = [
-        ("experiment", t_e, q_e, None, [])]
-    if matched:
-        motions.append(("protocol", *protocol(rate_hz)))
-    out = []
-    for i, config in enumerate(CONFIGS):
-        eff = {k: v for k, v in effects.items()
-               if k != "sheath_curvature_deg" or config == "looped"}
-        for m, (kind, t, q, seg, table) in enumerate(motions):
-            plant = data.build_unit(seed, unit_variation, case, **eff)
-            meta = {"source": f"gap cross-plant selftest ({data.name or data.factory}, {kind})",
-                    "catheter": f"unit-{seed}", "configuration": config}
-            cols = _measure(plant, t, q, rate_hz, EFFECTS[case][1], 10 * seed + i + 2 * m,
-                            tip_noise_deg, current_noise_A, data.max_step_s)
-            if seg is not None:
-                cols["segment"] = np.asarray(seg, dtype=float)
-                meta["segments"] = encode_table(table)
-            out.append(Recording(cols, meta))
-    return out
-
-
-def _measure(plant: Any, t: FloatArray, q: FloatArray, rate_hz: float, lag_s: float,
-             noise_seed: int, tip_noise_deg: float,
-             current_noise_A: float, max_step_s: float = 0.0) -> dict[str, FloatArray]:
-    """Drive ``plant`` along ``q``; the recording's columns as tracker and sensors read them."""
-    true_tip, true_A = drive_plant(plant, q, rate_hz, max_step_s)
-    tracker = EmTracker(noise_deg=tip_noise_deg, seed=noise_seed)
-    sensors = [CurrentSensor(lag_s=lag_s, offset_A=0.003 * (1 - 2 * k),
-                             noise_A=current_noise_A, seed=7 * noise_seed + k)
-               for k in range(2)]
-    dt = 1.0 / rate_hz
-    tip = np.array([tracker.measure(row) for row in true_tip])
-    cur = np.array([[sensors[j].measure(dt, float(row[j])) for j in range(2)]
-                    for row in true_A])
-    cols = {"t": t, "q1": q[:, 0], "q2": q[:, 1], "cmd1": q[:, 0], "cmd2": q[:, 1],
-            "pos1": q[:, 0], "pos2": q[:, 1], "cur1": cur[:, 0], "cur2": cur[:, 1],
-            "tip1": tip[:, 0], "tip2": tip[:, 1]}
-    return {k: np.array(v, dtype=float) for k, v in cols.items()}
 
 
 _SHEET_SERIES: dict[str, list[GapSeries]] = {}
@@ -157,39 +90,10 @@ def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float
                            matched, sheet_unit, reference_units)
     if EFFECTS[case][2] is None:
         return out
-    fp = (speed_footprint(data, seed, rate_hz) if case == "rate"
+    fp = (condition_footprint(data, case, seed, rate_hz) if case in ("rate", "creep")
           else footprint(data, case, seed, duration_s, rate_hz))
     return dataclasses.replace(out, footprint_tip_deg=fp.tip_deg, footprint_cur_A=fp.cur_A,
                                detectable=fp.detectable(TIP_NOISE_DEG, CURRENT_NOISE_A))
-
-
-def speed_footprint(data: PlantSpec, unit: int, rate_hz: float,
-                    unit_variation: float = 0.1) -> Footprint:
-    """The rate case's footprint where a rate dependence is defined, on the change of the
-    response with speed: the protocol's fast-minus-slow loop contrast of the true tips and
-    currents (noise-free, both configurations), effect on minus off, RMS over the matched
-    points (session 17). A rate case's physics may move the tip over the whole motion by
-    far more than it changes with speed (stickslip's fast relaxation branch x5: 1.1 deg of tip,
-    0.09 deg of speed contrast on unit 1; ratestate's ageing x10, docs/gap.md "Session 16,
-    round 2"); no one can name a rate dependence whose speed contrast is below the noise."""
-    def contrasts(case: str) -> tuple[FloatArray, FloatArray]:
-        recs = make_session(data, case, 4.0, rate_hz, unit, unit_variation, 0.0, 0.0)
-        series = [series_from_recording(r, f"footprint-{i}") for i, r in enumerate(recs)
-                  if "segments" in r.metadata]
-        tests = collect_tests(series, [measured_windows(s) for s in series])
-        tip: list[FloatArray] = []
-        cur: list[FloatArray] = []
-        for by_test in tests.values():
-            t = by_test["rate"]
-            for found, out in ((loop_contrast(t.loops, t.levels), tip),
-                               (loop_contrast(t.currents, t.levels), cur)):
-                if found is not None:
-                    out.append(contrast_of(found))
-        return np.array(tip), np.array(cur)
-
-    (tip0, cur0), (tip1, cur1) = contrasts("none"), contrasts("rate")
-    return Footprint(float(np.sqrt(np.mean((tip1 - tip0) ** 2))),
-                     float(np.sqrt(np.mean((cur1 - cur0) ** 2))))
 
 
 def diagnose_session(recs: Sequence[Recording], data: PlantSpec, sim: PlantSpec, case: str,

@@ -20,7 +20,7 @@ from tsmd.gap.protocol import Segment, decode_table, encode_table, protocol
 from tsmd.gap.reference import LoopReference, beyond_reference, measured_windows, own_scale
 from tsmd.gap.sensor import lag_share
 from tsmd.gap.signature import SignatureScore
-from tsmd.gap.structure import rank_scores
+from tsmd.gap.structure import rank_scores, spread_note
 from tsmd.recording import Recording, read_trajectory
 
 RATE_HZ = 25.0
@@ -484,3 +484,34 @@ def test_a_current_lag_its_model_has_not_is_explained_beyond_its_reference() -> 
     assert plain.currents is not None
     share = lag_share(*_session(_lagged_current), reference=plain.currents)
     assert share is not None and share[0] > 0.5
+
+
+def _spread_scores(unit: Effect) -> dict[str, SignatureScore]:
+    """Scores of a unit against a reference of three units scattered 0.01-0.05 deg per deg/s."""
+    reference = product_reference(_units(_widening(0.01), _widening(0.03), _widening(0.05)))
+    series, residuals = _session(unit)
+    return {s.name: s for s in contrast_scores(series, residuals, n_tried=6, tip_noise_deg=0.1,
+                                               current_noise_A=0.004, reference=reference)}
+
+
+def test_a_unit_beyond_its_models_mean_but_inside_its_spread_reads_within_the_spread() -> None:
+    rate = _spread_scores(_widening(0.11))["rate"]
+    assert not rate.significant
+    assert rate.within_spread_deg > 0.1
+    assert rate.spread_deg > 0.0
+
+
+def test_a_unit_at_its_models_mean_does_not_read_within_the_spread() -> None:
+    assert np.isnan(_spread_scores(_widening(0.03))["rate"].within_spread_deg)
+
+
+def test_a_named_effect_is_not_also_read_within_the_spread() -> None:
+    rate = _spread_scores(_widening(0.3))["rate"]
+    assert rate.significant and np.isnan(rate.within_spread_deg)
+
+
+def test_the_verdict_says_an_effect_inside_the_spread_cannot_be_told_from_unit_scatter() -> None:
+    scores = list(_spread_scores(_widening(0.11)).values())
+    note = spread_note(scores)
+    assert "rate dependence" in note.lower() and "unit scatter" in note
+    assert spread_note([s for s in scores if s.name != "rate"]) == ""

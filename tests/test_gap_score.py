@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from tsmd.gap.detectable import Footprint, footprint
+from tsmd.gap.detectable import Footprint, condition_footprint, footprint
 from tsmd.gap.presets import PRESETS
 from tsmd.gap.score import SelftestCase, SelftestResult, selftest_markdown
 
@@ -43,3 +43,42 @@ def test_an_effect_below_detection_that_is_named_is_right_strictly_only() -> Non
     lucky = _case("curvature", "curvature", "curvature", False)
     assert lucky.correct and not lucky.correct_detectable
     assert SelftestResult([lucky]).summary()["below_detection_read_none"] == 0
+
+
+def test_an_effect_read_within_the_units_spread_is_counted_apart_and_stays_a_miss() -> None:
+    inside = _case("coupling", "coupling", None, True)
+    inside.within_spread = "coupling"
+    null = _case("none", None, None, None)
+    null.within_spread = "coupling"
+    result = SelftestResult([inside, null, _case("rate", "rate", "rate", True)])
+    s = result.summary()
+    assert s["top1_accuracy"] == 0.5 and not inside.correct
+    assert (s["within_spread_own_effect"], s["within_spread_null"]) == (1, 1)
+    assert s["false_alarms"] == 0
+    assert "units' spread' (not counted above) | 1/2" in selftest_markdown(result)
+
+
+def test_another_effect_read_within_the_spread_is_no_reading_of_the_one_put_in() -> None:
+    other = _case("rate", "rate", None, True)
+    other.within_spread = "coupling"
+    assert not other.spread_reading
+
+
+def test_a_rate_case_is_sized_by_its_speed_contrast_not_by_how_far_it_moves_the_tip() -> None:
+    # stickslip's fast relaxation branch x5 moves the tip 1.1 deg over the motion, but its
+    # loops at 20 and 80 deg/s by less than one sample's noise; lumped's viscous sheath more
+    branch = condition_footprint(PRESETS["stickslip"], "rate", 1, 50.0)
+    viscous = condition_footprint(PRESETS["lumped"], "rate", 1, 50.0)
+    assert footprint(PRESETS["stickslip"], "rate", 1, 60.0, 50.0).detectable(0.1, 0.004)
+    assert not branch.detectable(0.1, 0.004)
+    assert viscous.detectable(0.1, 0.004)
+
+
+def test_a_creep_case_is_sized_by_its_drift_at_a_held_knob() -> None:
+    # stickslip's slow relaxation branch x1.5 moves the tip 0.38 deg over the motion, but the
+    # currents over a held dwell by 3.3 mA; the lumped plant's creep by more than 4 mA
+    branch = condition_footprint(PRESETS["stickslip"], "creep", 1, 50.0)
+    creep = condition_footprint(PRESETS["lumped"], "creep", 1, 50.0)
+    assert footprint(PRESETS["stickslip"], "creep", 1, 60.0, 50.0).detectable(0.1, 0.004)
+    assert not branch.detectable(0.1, 0.004)
+    assert creep.detectable(0.1, 0.004)

@@ -26,7 +26,7 @@ from tsmd.gap.data import GapSeries, parse_holdout, series_from_recording
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.fit import ParamSpec
-from tsmd.gap.presets import parse_plant_spec
+from tsmd.gap.presets import PRESETS, parse_plant_spec
 from tsmd.gap.protocol import protocol_trajectory
 from tsmd.gap.reference import ProductReference
 from tsmd.gap.report import finite_json, write_report
@@ -102,9 +102,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "or the earlier candidate transforms around the plant")
     parser.add_argument("--data-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant that makes the 'real' data "
-                             "(preset capstan, capstan-other, lumped, segments, coilpipe, "
-                             "stickslip, "
-                             "twistshaft, or module:factory[@{json}])")
+                             f"(preset {', '.join(PRESETS)}, or module:factory[@{{json}}])")
     parser.add_argument("--sim-plant", default=None, metavar="SPEC",
                         help="selftest across plants: the plant used as the simulator")
     parser.add_argument("--sheet-unit", type=int, default=0, metavar="N",

@@ -14,7 +14,7 @@ contrast a small effect model fitted on the other configuration removes.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -148,9 +148,34 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
             condition += f"; {1e3 * size:.1f} mA over a loaded dwell above the slopes' noise"
         elif np.isfinite(size):
             condition += f"; contrast {size:.3f} deg above the repeats' noise"
-        out.append(SignatureScore(name, title, condition, share, lo_hi, sig, share, 0.0, _z(p),
-                                  size if test in LOOP_TESTS else float("nan")))
+        score = SignatureScore(name, title, condition, share, lo_hi, sig, share, 0.0, _z(p),
+                               size if test in LOOP_TESTS else float("nan"))
+        if test in REFERENCED and reference is not None and test in reference.loops:
+            spread = reference.loops[test]
+            score.spread_deg = float(np.sqrt(spread.scatter_per_point / len(spread.levels)))
+            if not sig and p < crit:
+                score.within_spread_deg = within_spread(loops, spread, min_share, noise)
+        out.append(score)
     return out
+
+
+def within_spread(loops: Sequence[Loops], ref: LoopReference, min_share: float,
+                  noise_deg: float | None) -> float:
+    """A referenced loop test's contrast beyond the model's mean unit (deg) when, counting the
+    reference's repeat noise only, it would be named (share and size rule), else NaN: the
+    unit then lies beyond its model's mean but inside its units' spread. Same mechanism, only
+    its size tells: a unit with a small base and the effect added is as large as a unit of
+    large base without it (helixbelt 106, docs/gap.md "Session 16"), so nobody can name an
+    effect there; the verdict says so instead of reading "none"."""
+    if ref.scatter_per_point <= 0.0 or noise_deg is None:
+        return float("nan")
+    lean = [replace(lp, ref_noise_ss=lp.y.shape[2] * ref.noise_per_point) for lp in loops]
+    shrinks = [loop_shrink(lean[:i] + lean[i + 1:], lean[i]) for i in range(len(lean))]
+    finite = [x for x in shrinks if np.isfinite(x)]
+    size = excess_rms(lean)
+    if finite and float(np.mean(finite)) >= min_share and size >= noise_deg:
+        return size
+    return float("nan")
 
 
 def collect_tests(series: Sequence[GapSeries],

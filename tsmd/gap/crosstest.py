@@ -17,27 +17,21 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
-from simrig.current_sensor import CurrentSensor
-from simrig.tracker import EmTracker
 from tsmd.gap.compliance import reference_deg_per_A
 from tsmd.gap.contrast import product_reference
 from tsmd.gap.data import GapSeries, series_from_recording
-from tsmd.gap.detectable import footprint
+from tsmd.gap.detectable import condition_footprint, footprint
 from tsmd.gap.diagnose import diagnose
 from tsmd.gap.errors import GapError
 from tsmd.gap.fit import ParamSpec
 from tsmd.gap.presets import PlantSpec
-from tsmd.gap.protocol import Segment, encode_table, protocol
 from tsmd.gap.reference import ProductReference
 from tsmd.gap.result import GapConfig
 from tsmd.gap.score import SelftestCase, SelftestResult
-from tsmd.gap.selftest import EFFECTS, _cur_rmse, _tip_rmse, drive_plant, trajectory
+from tsmd.gap.selftest import EFFECTS, _cur_rmse, _tip_rmse
+from tsmd.gap.session import CURRENT_NOISE_A, TIP_NOISE_DEG, make_session
 from tsmd.recording import Recording
-
-FloatArray = NDArray[np.float64]
-
 
 
 def cross_config(fit: Sequence[ParamSpec], method: str = "signature") -> GapConfig:
@@ -45,66 +39,6 @@ def cross_config(fit: Sequence[ParamSpec], method: str = "signature") -> GapConf
     structural layer takes the base mismatch (and a physics fit of a plant with other physics
     costs most of the time); the candidate method fits ``fit`` as `tsmd gap` does."""
     return GapConfig(fit_specs=() if method == "signature" else tuple(fit), method=method)
-
-
-CONFIGS: tuple[str, str] = ("straight", "looped")
-
-TIP_NOISE_DEG = 0.1
-CURRENT_NOISE_A = 0.004
-"""The sessions' tracker and current-sensor noise per sample (the rig's)."""
-
-
-def make_session(data: PlantSpec, case: str, duration_s: float, rate_hz: float, seed: int,
-                 unit_variation: float = 0.1, tip_noise_deg: float = TIP_NOISE_DEG,
-                 current_noise_A: float = CURRENT_NOISE_A,
-                 matched: bool = True) -> list[Recording]:
-    """One unit's session: half the time in each sheath configuration, the effect switched on.
-
-    The same unit (``seed``) in both configurations; curvature bends the sheath of the looped
-    one only. With ``matched`` each configuration also gets a recording of the
-    matched-condition protocol (:mod:`tsmd.gap.protocol`), the identification experiment's
-    second part. Tracker and current noise differ per recording.
-    """
-    effects = data.case_effects(case)
-    t_e, q_e = trajectory(duration_s / 2.0, rate_hz)
-    motions: list[tuple[str, FloatArray, FloatArray, FloatArray | None, list[Segment]]] = [
-        ("experiment", t_e, q_e, None, [])]
-    if matched:
-        motions.append(("protocol", *protocol(rate_hz)))
-    out = []
-    for i, config in enumerate(CONFIGS):
-        eff = {k: v for k, v in effects.items()
-               if k != "sheath_curvature_deg" or config == "looped"}
-        for m, (kind, t, q, seg, table) in enumerate(motions):
-            plant = data.build_unit(seed, unit_variation, case, **eff)
-            meta = {"source": f"gap cross-plant selftest ({data.name or data.factory}, {kind})",
-                    "catheter": f"unit-{seed}", "configuration": config}
-            cols = _measure(plant, t, q, rate_hz, EFFECTS[case][1], 10 * seed + i + 2 * m,
-                            tip_noise_deg, current_noise_A, data.max_step_s)
-            if seg is not None:
-                cols["segment"] = np.asarray(seg, dtype=float)
-                meta["segments"] = encode_table(table)
-            out.append(Recording(cols, meta))
-    return out
-
-
-def _measure(plant: Any, t: FloatArray, q: FloatArray, rate_hz: float, lag_s: float,
-             noise_seed: int, tip_noise_deg: float,
-             current_noise_A: float, max_step_s: float = 0.0) -> dict[str, FloatArray]:
-    """Drive ``plant`` along ``q``; the recording's columns as tracker and sensors read them."""
-    true_tip, true_A = drive_plant(plant, q, rate_hz, max_step_s)
-    tracker = EmTracker(noise_deg=tip_noise_deg, seed=noise_seed)
-    sensors = [CurrentSensor(lag_s=lag_s, offset_A=0.003 * (1 - 2 * k),
-                             noise_A=current_noise_A, seed=7 * noise_seed + k)
-               for k in range(2)]
-    dt = 1.0 / rate_hz
-    tip = np.array([tracker.measure(row) for row in true_tip])
-    cur = np.array([[sensors[j].measure(dt, float(row[j])) for j in range(2)]
-                    for row in true_A])
-    cols = {"t": t, "q1": q[:, 0], "q2": q[:, 1], "cmd1": q[:, 0], "cmd2": q[:, 1],
-            "pos1": q[:, 0], "pos2": q[:, 1], "cur1": cur[:, 0], "cur2": cur[:, 1],
-            "tip1": tip[:, 0], "tip2": tip[:, 1]}
-    return {k: np.array(v, dtype=float) for k, v in cols.items()}
 
 
 _SHEET_SERIES: dict[str, list[GapSeries]] = {}
@@ -156,7 +90,8 @@ def run_cross_case(data: PlantSpec, sim: PlantSpec, case: str, duration_s: float
                            matched, sheet_unit, reference_units)
     if EFFECTS[case][2] is None:
         return out
-    fp = footprint(data, case, seed, duration_s, rate_hz)
+    fp = (condition_footprint(data, case, seed, rate_hz) if case in ("rate", "creep")
+          else footprint(data, case, seed, duration_s, rate_hz))
     return dataclasses.replace(out, footprint_tip_deg=fp.tip_deg, footprint_cur_A=fp.cur_A,
                                detectable=fp.detectable(TIP_NOISE_DEG, CURRENT_NOISE_A))
 
@@ -192,6 +127,8 @@ def diagnose_session(recs: Sequence[Recording], data: PlantSpec, sim: PlantSpec,
                  None)
     shrink = next((s["raw_share"] for s in structure.get("signatures", [])
                    if s["name"] == top), None)
+    inside = [s["name"] for s in structure.get("signatures", [])
+              if np.isfinite(s.get("within_spread_deg", float("nan")))]
     figures = structure.get("figures", {})
     layer = figures.get("layer", result.before)
     before_tip, before_cur = _tip_rmse(layer), _cur_rmse(layer)
@@ -199,7 +136,8 @@ def diagnose_session(recs: Sequence[Recording], data: PlantSpec, sim: PlantSpec,
     return SelftestCase(case, duration_s, seed, EFFECTS[case][2], result.verdict, top, share,
                         before_tip, _tip_rmse(result.after_top), before_cur,
                         _cur_rmse(result.after_top), wall, excess_shrink=shrink,
-                        physics_tip_rmse=_tip_rmse(figures.get("physics")))
+                        physics_tip_rmse=_tip_rmse(figures.get("physics")),
+                        within_spread=inside[0] if inside and top is None else None)
 
 
 def run_crosstest(data: PlantSpec, sim: PlantSpec, cases: Sequence[str],

@@ -45,6 +45,10 @@ class SelftestCase:
     """Whether the footprint reaches one sample's noise on the tip or the current (None: not
     measured, taken as detectable)."""
 
+    within_spread: str | None = None
+    """The effect the diagnosis found beyond the model's mean unit but inside its units'
+    spread, when it named nothing else (None: no such reading)."""
+
     @property
     def correct(self) -> bool:
         """Top-1 against the effect put in (strict)."""
@@ -59,6 +63,13 @@ class SelftestCase:
     def correct_detectable(self) -> bool:
         """Top-1 against what the data can show (:attr:`expected_detectable`)."""
         return self.top == self.expected_detectable
+
+    @property
+    def spread_reading(self) -> bool:
+        """Nothing named, the effect put in read as inside the model's units' spread: the
+        verdict says the effect may be there but cannot be told from unit scatter."""
+        return (self.top is None and self.expected is not None
+                and self.within_spread == self.expected)
 
 
 @dataclass
@@ -94,6 +105,9 @@ class SelftestResult:
             "n_detectable_effect_cases": len(shown),
             "n_below_detection": len(below),
             "below_detection_read_none": sum(c.top is None for c in below),
+            "within_spread_own_effect": sum(c.spread_reading for c in effect_cases),
+            "within_spread_null": sum(c.top is None and c.within_spread is not None
+                                      for c in null_cases),
             "median_tip_rmse_shrink_when_correct": float(np.median(shrink)) if shrink
             else float("nan"),
             "median_current_rmse_shrink_when_correct": float(np.median(cur_shrink))
@@ -137,6 +151,11 @@ def selftest_markdown(result: SelftestResult) -> str:
                   f"({n_shown}/{s['n_detectable_effect_cases']}) |",
                   f"| effect cases below detection read none (expected) | "
                   f"{s['below_detection_read_none']}/{s['n_below_detection']} |"]
+    if s["within_spread_own_effect"] or s["within_spread_null"]:
+        lines += [f"| effect cases read 'within the model's units' spread' (not counted above) | "
+                  f"{s['within_spread_own_effect']}/{s['n_effect_cases']} |",
+                  f"| no-effect cases read 'within the model's units' spread' (no alarm) | "
+                  f"{s['within_spread_null']}/{s['n_null_cases']} |"]
     lines += [f"| false alarms (no-effect cases) | {s['false_alarms']}/{s['n_null_cases']} |",
               f"| median held-out tip RMSE shrink, correct cases | "
               f"{s['median_tip_rmse_shrink_when_correct']:.0%} |",

@@ -137,6 +137,14 @@ class SignatureScore:
     """How many surrogate standard deviations the true condition's gain lies above theirs."""
     size_deg: float = float("nan")
     """A matched loop test's contrast above the repeats' noise (deg; NaN for the others)."""
+    within_spread_deg: float = float("nan")
+    """A referenced loop test (rate, coupling) not significant whose contrast beyond the
+    model's mean unit would be (p, share and size counting the reference's noise only): its
+    size there (deg). Such a unit lies inside its model's units' spread, where an effect
+    cannot be told from unit scatter (session 17); NaN otherwise."""
+    spread_deg: float = float("nan")
+    """The model's units' spread that test's contrast is allowed (deg RMS per matched point;
+    NaN without a reference of two or more units)."""
 
 
 @dataclass

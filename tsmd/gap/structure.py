@@ -78,6 +78,7 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
                 else float("nan"))
     verdict, summary = _structure_verdict(gap_present, absorbed, sres.layer_ratio, sig, figures,
                                           matched)
+    summary += spread_note(sres.scores) if gap_present else ""
     cands = [CandidateScore(s.name, s.title, f"depends on {s.condition}", {}, s.share, s.ci,
                             s.significant, s.raw_share, {}, {}, "signature")
              for s in sres.scores]
@@ -115,6 +116,19 @@ def rank_scores(scores: Sequence[SignatureScore]) -> list[SignatureScore]:
     for i, s in zip(loops, by_size, strict=True):
         ordered[i] = s
     return ordered
+
+
+def spread_note(scores: Sequence[SignatureScore]) -> str:
+    """The verdict's sentence for effects inside the model's units' spread: their contrast
+    beyond the model's mean unit would be named, but the model's own units scatter as far, so
+    an effect cannot be told from unit scatter (docs/gap.md "Session 17"). Empty when none."""
+    inside = [s for s in scores if np.isfinite(s.within_spread_deg)]
+    return "".join(
+        f" {s.title[0].upper()}{s.title[1:]} present beyond this catheter model's mean unit "
+        f"({s.within_spread_deg:.2f} deg of contrast), but within the spread of its units "
+        f"({s.spread_deg:.2f} deg): an effect cannot be told from unit scatter; compare with "
+        f"more units of the model, or test the effect by changing its condition on the rig."
+        for s in inside)
 
 
 def _residuals(series: Sequence[GapSeries], split: Split, ev: Evaluator,

@@ -125,8 +125,9 @@ def spread_note(scores: Sequence[SignatureScore]) -> str:
     inside = [s for s in scores if np.isfinite(s.within_spread_deg)]
     return "".join(
         f" {s.title[0].upper()}{s.title[1:]} present beyond this catheter model's mean unit "
-        f"({s.within_spread_deg:.2f} deg of contrast), but within the spread of its units "
-        f"({s.spread_deg:.2f} deg): an effect cannot be told from unit scatter; compare with "
+        f"({s.within_spread_deg:.2f} deg of contrast), but not clearly beyond the spread of "
+        f"its units ({s.spread_deg:.2f} deg): an effect cannot be told from unit scatter; "
+        f"compare with "
         f"more units of the model, or test the effect by changing its condition on the rig."
         for s in inside)
 

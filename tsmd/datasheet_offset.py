@@ -26,10 +26,12 @@ from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 from tsmd.tracked_calibration import ProtocolRun, play_protocol
 
 
-def offset_readings(runs: Sequence[ProtocolRun], truth: Truth
+def offset_readings(runs: Sequence[ProtocolRun], truth: Truth,
+                    parameters: Sequence[str] = PARAMETERS, skip_unseen: bool = False
                     ) -> dict[tuple[int, float], dict[str, list[float]]]:
     """Per (knob, other-knob angle): each parameter's half-cycle values minus the tip's, over
-    every run (refused runs count too: their values are read the same way)."""
+    every run (refused runs count too: their values are read the same way); ``skip_unseen``
+    leaves out values that are the sheet's fallback, not a reading (``SweepResult.unseen``)."""
     out: dict[tuple[int, float], dict[str, list[float]]] = defaultdict(
         lambda: defaultdict(list))
     for run in runs:
@@ -37,7 +39,9 @@ def offset_readings(runs: Sequence[ProtocolRun], truth: Truth
             tip = truth.get((p.knob, float(p.other_deg)))
             if tip is None:
                 continue
-            for name in PARAMETERS:
+            for name in parameters:
+                if skip_unseen and name in p.result.unseen:
+                    continue
                 ref = tip.get(name, math.nan)
                 out[(p.knob, float(p.other_deg))][name] += [
                     v - ref for v in p.result.values.get(name, ()) if math.isfinite(v - ref)]

@@ -24,6 +24,7 @@ import numpy as np
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.calibration.recovery import bend_gain
 from tsmd.config import TsmdConfig
+from tsmd.datasheet_offset import offset_readings
 from tsmd.datasheet_rule import Truth
 from tsmd.profile import DeviceKnob, DeviceModel
 from tsmd.profile.schema import OPTIONAL_KNOB_RANGES
@@ -44,17 +45,11 @@ def probe_sheet(device: DeviceModel) -> DeviceModel:
 def recovery_lags(runs: Sequence[ProtocolRun], truth: Truth) -> tuple[float | None, ...]:
     """Per knob: the median over every half-cycle that shows its recovery (runs with no lag)
     of the tip's B minus the value read; None for a knob where none shows it."""
+    readings = offset_readings(runs, truth, BACKLASHES, skip_unseen=True)
     lags: list[list[float]] = [[], []]
-    for run in runs:
-        for p in run.points:
-            tip = truth.get((p.knob, float(p.other_deg)))
-            if tip is None:
-                continue
-            for name in BACKLASHES:
-                if name in p.result.unseen:  # the sheet's fallback, not a reading
-                    continue
-                lags[p.knob] += [tip[name] - v for v in p.result.values.get(name, ())
-                                 if math.isfinite(tip[name] - v)]
+    for (knob, _), by_name in readings.items():
+        for name in BACKLASHES:
+            lags[knob] += [-d for d in by_name[name]]
     return tuple(float(np.median(x)) if x else None for x in lags)
 
 

@@ -13,7 +13,8 @@ import math
 import os
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -49,6 +50,18 @@ def set_normal_scheduling() -> str | None:
     except (OSError, AttributeError) as exc:
         return f"SCHED_OTHER refused ({_reason(exc)})"
     return None
+
+
+@contextmanager
+def fifo_scheduling(priority: int) -> Iterator[str | None]:
+    """SCHED_FIFO at ``priority`` for the calling thread inside the block, the normal scheduler
+    after it; yields the reason it was refused (then nothing changed), or None."""
+    refused = set_fifo(priority)
+    try:
+        yield refused
+    finally:
+        if refused is None:
+            set_normal_scheduling()
 
 
 def set_affinity(cpu: int) -> str | None:

@@ -5,12 +5,23 @@ from __future__ import annotations
 import argparse
 from types import ModuleType
 
-from tsmd.bench import accuracy, bus, calibration, family_accuracy, gap, loop, online, realism
+from tsmd.bench import (
+    accuracy,
+    bus,
+    calibration,
+    compute,
+    family_accuracy,
+    gap,
+    loop,
+    online,
+    realism,
+)
 
 BENCHMARKS: dict[str, tuple[ModuleType, str]] = {
     "bus": (bus, "CAN frames, bus load, CPU and latency per tick"),
     "loop": (loop, "control-loop lateness, jitter, overruns; cyclictest beside it"),
     "accuracy": (accuracy, "the paper's tracking protocol: none / paper / ours"),
+    "compute": (compute, "the compensator's cost per tick, normal scheduler and SCHED_FIFO"),
     "calibration": (calibration, "identified D and B against ground truth"),
     "gap": (gap, "sim-to-real gap diagnosis self-test and speed"),
     "family": (family_accuracy, "tracking on catheter units each calibrated from current"),

@@ -29,6 +29,7 @@ from simrig.plant import PlantLoadError, load_plant
 from tsmd.bench.accuracy import calibrated_profile, compute_time_us, run_scenario
 from tsmd.bench.accuracy_report import plot_runs
 from tsmd.bench.accuracy_scenarios import PERIOD_S, Scenario, scenarios
+from tsmd.bench.error_split import split_run
 from tsmd.calibration.errors import CalibrationError
 from tsmd.config import resolve_data_path
 from tsmd.errors import TsmdError
@@ -156,6 +157,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "reuse it when present (scoring again without recalibrating)")
     parser.add_argument("--plots", type=Path, default=None,
                         help="directory for time and input-output figures of the first unit")
+    parser.add_argument("--split", action="store_true",
+                        help="after each row, ours' error per knob split by the branch its "
+                             "model is on (loaded, release, plateau, backlash; tip: diagnosis)")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -217,6 +221,8 @@ def main(args: argparse.Namespace) -> int:
                     + f" | {red:.1f} | {red_p:.1f} | {ratio:.2f} |")
             lines.append(line)
             print(line, f"({time.perf_counter() - t0:.0f} s)", flush=True)
+            if args.split and "ours" in res:
+                lines += _split_lines(seed, res["ours"], profile)
             if args.plots is not None and seed == units[0][0]:
                 runs = list(res.values())
                 name = f"family-unit{seed}-{s.group}-{s.name}".replace(" ", "_")
@@ -250,6 +256,17 @@ def main(args: argparse.Namespace) -> int:
     lines.append(f"rows missing a target: {len(misses)} of {len(rows)}")
     lines.append(f"wall time {time.perf_counter() - t0:.0f} s")
     return _emit(lines, args.report, 0)
+
+
+def _split_lines(unit: int, run: Any, profile: CatheterProfile) -> list[str]:
+    """Report lines of ours' error split by the model's branch (:mod:`tsmd.bench.error_split`)."""
+    params = [k.tension_play for k in profile.knobs if k.tension_play is not None]
+    if len(params) != 2:
+        return []
+    splits = split_run(run.q_deg, run.cmd_deg, run.tip_deg, params, run.scenario.knobs, PERIOD_S)
+    out = [f"| {unit} | split of ours' error, {s.line()} |" for s in splits]
+    print("\n".join(out), flush=True)
+    return out
 
 
 def _emit(lines: list[str], report: Path | None, status: int) -> int:

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import stats
@@ -53,6 +53,16 @@ class Estimate:
     offset_u95_deg: float = 0.0
     """The 95 % half-width of the product's reading offset subtracted from the values (part of
     ``u95_deg``; no re-sweep narrows it)."""
+    unit_u95_deg: float = 0.0
+    """The 95 % half-width of what the current cannot show of this unit (a backlash's share of
+    the gap to the release line: :meth:`SweepResult.share_u95_deg`). Not part of ``u95_deg``,
+    which the gate judges by what sweeps can narrow; part of :attr:`reported_u95_deg`."""
+
+    @property
+    def reported_u95_deg(self) -> float:
+        """The 95 % half-width a calibration reports: ``u95_deg`` and ``unit_u95_deg`` in
+        quadrature."""
+        return math.hypot(self.u95_deg, self.unit_u95_deg)
 
     def tip_cost_deg(self, omega: float) -> float:
         """What an error of ``u95_deg`` costs on the tip once compensated."""
@@ -152,8 +162,9 @@ def point_estimates(results: Sequence[SweepResult],
     opts = options or EstimateOptions()
     pools = {name: pooled_sigma(results, names, opts.min_sigma_deg)
              for names in KINDS.values() for name in names}
-    return [{name: estimate(r.values.get(name, ()), *pools[name], options=opts,
-                            offset_u95_deg=r.offset_u95_deg.get(name, 0.0))
+    return [{name: replace(estimate(r.values.get(name, ()), *pools[name], options=opts,
+                                    offset_u95_deg=r.offset_u95_deg.get(name, 0.0)),
+                           unit_u95_deg=r.share_u95_deg(name))
              for name in PARAMETERS} for r in results]
 
 

@@ -36,7 +36,7 @@ from tsmd.calibration.health import (
     find_slip,
 )
 from tsmd.calibration.knee import resolvable_end
-from tsmd.calibration.options import IdentifyOptions
+from tsmd.calibration.options import LINE_SHARE_UNIT_U95, IdentifyOptions
 from tsmd.calibration.pieces import (
     constant_phase,
     fitted_edge,
@@ -54,6 +54,11 @@ from tsmd.calibration.release import (
 )
 from tsmd.calibration.signal import Conditioned, FloatArray, condition
 from tsmd.calibration.sweep_result import PARAMETERS, HalfCycle, SweepResult
+
+SHARE_STEP = 0.01
+"""Half the share interval over which a release end's travel per unit of share is read (the
+end at the share -+ this much): wide enough that the current's noise moves the two ends
+little, narrow against the share's own range (0.90-0.97 on segments)."""
 
 
 def find_reversals(cmd_deg: FloatArray, min_reversal_deg: float) -> list[int]:
@@ -259,8 +264,21 @@ def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
         h = halves[i]
         out[i] = replace(h, backlash_deg=float(grid[k_new] - grid[0]),
                          backlash_end_index=_index_at(pos, h.direction, grid, k_new, h.start),
-                         release_swing_A=release_swing(grid, yg, k_new))
+                         release_swing_A=release_swing(grid, yg, k_new),
+                         share_u95_deg=(_share_u95_deg(grid, yg, k, share, opts, stops[j])
+                                        if opts.release_level == "line" else math.nan))
     return tuple(out)
+
+
+def _share_u95_deg(grid: FloatArray, yg: FloatArray, k: int, share: float,
+                   opts: IdentifyOptions, stop: int | None) -> float:
+    """The 95 % half-width of one release end that the share's unit part gives: the knob
+    travel between the ends at ``share`` -+ ``SHARE_STEP``, per unit of share, times
+    ``LINE_SHARE_UNIT_U95`` (a slow approach to the release line: a wide B)."""
+    ends = [fraction_end(grid, yg, min(k, yg.size - 1), share + d, opts, stop)
+            for d in (-SHARE_STEP, SHARE_STEP)]
+    travel_per_share = abs(float(grid[ends[1]] - grid[ends[0]])) / (2.0 * SHARE_STEP)
+    return LINE_SHARE_UNIT_U95 * travel_per_share
 
 
 def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],

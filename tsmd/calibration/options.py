@@ -151,6 +151,18 @@ the half-cycles of the development units (lumped 1-8 seeds 0 and 1: -0.54; segme
 against the sweep's mean ratio (session 10)."""
 
 
+LINE_SHARE_UNIT_U95 = 0.026
+"""The 95 % half-width of what the slope ratio leaves unknown of a unit's share of the gap to
+the release line at the tip's release: t(0.975, 13) x 0.0120, the standard deviation of the
+share's unit part once the product's pattern over the other knob and the ratio's move are taken
+out, over the 14 knobs of segments development units 1, 3-8 (noise seed 0, fast protocol). The
+plant's constants behind it (docs/calibration.md, session 18): the contacts' presliding
+displacement moves the tip's B by -+0.6 deg over its scatter with under 3 mA of change in the
+motor current, and the ratio follows the sheath's friction-wrap product only to r -0.95. No
+sweep narrows it: it widens the reported half-width of B
+(:attr:`tsmd.calibration.estimate.Estimate.reported_u95_deg`), not the gate's."""
+
+
 def for_product(options: IdentifyOptions, settle_fraction: float | None,
                 slope_ratio: float | None = None,
                 settle_lag_deg: float | None = None,

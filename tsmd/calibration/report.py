@@ -24,7 +24,8 @@ if TYPE_CHECKING:
 
 
 def grid_table(cal: Calibration) -> str:
-    """D and B per knob and grid point with their 95 % uncertainty, as Markdown."""
+    """D and B per knob and grid point with their 95 % uncertainty (what sweeps narrow and what
+    the current cannot show of the unit, :attr:`Estimate.reported_u95_deg`), as Markdown."""
     estimates = dict(zip((id(p) for p in cal.points), point_estimates(cal.points), strict=True))
     lines = []
     for knob in (0, 1):
@@ -40,7 +41,7 @@ def grid_table(cal: Calibration) -> str:
         for other in grid:
             point = next(p for p in cal.points if p.knob == knob and p.other_deg == other)
             est = estimates[id(point)]
-            cells = [f"{other:+.0f}", *(f"{est[n].value:.1f} +- {est[n].u95_deg:.1f}"
+            cells = [f"{other:+.0f}", *(f"{est[n].value:.1f} +- {est[n].reported_u95_deg:.1f}"
                                          for n in PARAMETERS),
                      str(point.result.resweeps), f"{point.result.median_snr:.0f}"]
             lines.append("| " + " | ".join(cells) + " |")

@@ -44,6 +44,10 @@ class HalfCycle:
     backlash_visibility: float = math.nan
     """Rule "recovery": how clearly the current shows where the backlash ends
     (:class:`tsmd.calibration.recovery.Recovery`); NaN under the other rules."""
+    share_u95_deg: float = math.nan
+    """Rule "line" moved by the unit's slope ratio: the 95 % half-width of ``backlash_deg`` that
+    the share's unit part the ratio cannot know gives (knob travel per unit of share at the end
+    times :data:`tsmd.calibration.options.LINE_SHARE_UNIT_U95`); NaN under the other rules."""
 
     @property
     def backlash_name(self) -> str:
@@ -83,6 +87,13 @@ class SweepResult:
     def estimate(self, name: str) -> float:
         """The half-cycles' robust mean (:func:`walsh_median`; NaN when none gave a value)."""
         return walsh_median(np.asarray(self.values.get(name, ()), dtype=float))
+
+    def share_u95_deg(self, name: str) -> float:
+        """The 95 % half-width of a backlash that no sweep narrows (its half-cycles' median of
+        :attr:`HalfCycle.share_u95_deg`); 0 where the rule has none."""
+        v = [h.share_u95_deg for h in self.half_cycles
+             if h.backlash_name == name and math.isfinite(h.share_u95_deg)]
+        return float(np.median(v)) if v else 0.0
 
     def spread(self, name: str) -> float:
         """Largest minus smallest value over the half-cycles (0 with one value)."""

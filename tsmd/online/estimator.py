@@ -37,7 +37,7 @@ from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
 from tsmd.online.partner import partner_left_band, partner_shows_change
 from tsmd.online.reference import SettlingReference
-from tsmd.online.slopes import common_change, shrunk_ratio
+from tsmd.online.slopes import common_change, nearest_between, shrunk_ratio
 
 
 @dataclass
@@ -244,8 +244,11 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             self.last_measurement_deg = math.nan
             return events
         self.last_feature = "crossing"
-        raw = ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
-                           - self.residual_ref_deg)
+        raw = self._crossing(ramp, profile_edge_deg, slope)
+        if o.flatter_reads_between and slope < self.slope_ref_A_per_deg:
+            raw = nearest_between(raw, self._crossing(ramp, profile_edge_deg,
+                                                      self.slope_ref_A_per_deg),
+                                  self.estimate_deg + self.bins.bias_deg(ramp.other_deg))
         rose = change > tol or ramp.slope_A_per_deg / slope - 1.0 > tol
         if o.refuse_inward_on_steeper and rose and raw - self.estimate_deg < -o.gate_deg:
             # More friction along the tendon (the knob's ramps, or this one, steeper beyond
@@ -264,6 +267,13 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         self._measured(raw, ramp.other_deg, events)
         return events
 
+    def _crossing(self, ramp: LoadedRamp, edge_deg: float, slope: float) -> float:
+        """How far outward of the profile's edge the line through the ramp's window centre with
+        ``slope`` crosses the reference level (the reference's own residual taken out)."""
+        assert self.level_A is not None
+        return ramp.side * (ramp.crossing_deg(self.level_A, slope) - edge_deg
+                            - self.residual_ref_deg)
+
     def _reread(self, slope: float) -> None:
         """The last crossing ramp read again with the slope in use now, when that moved beyond
         the tolerance since: a suspect under it joins the suspects (the slope in use follows a
@@ -278,8 +288,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         if (abs(slope / used - 1.0) <= o.slope_in_use_tolerance
                 or abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance):
             return
-        m = ramp.side * (ramp.crossing_deg(self.level_A, slope) - edge_deg
-                         - self.residual_ref_deg) - self.bins.bias_deg(ramp.other_deg)
+        m = self._crossing(ramp, edge_deg, slope) - self.bins.bias_deg(ramp.other_deg)
         if m - self.estimate_deg > o.gate_deg:  # outward only: the friction rose
             self.suspects = [*self.suspects, m][-o.confirm:]
             self.suspect_order = next(ORDER)

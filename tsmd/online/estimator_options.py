@@ -85,6 +85,14 @@ class EstimatorOptions:
     nothing, as the knee does in knee mode (session 12, stickslip 101 phi2). On since session
     13: with ``fresh_agreement`` the one run it made worse (lumped 102 without a change) is
     the same with it, and stickslip 104's bend went from 2.02 to 1.02 x fresh (docs/online.md)."""
+    flatter_reads_between: bool = True
+    """Ramps flatter than the reference (the slope in use below it) read the crossing with
+    both slopes, the reference's and the one in use, and take the point between the two
+    nearest the estimate: a slack or a bend does not flatten the ramps, a softer catheter
+    does without moving the edge (twistshaft 1-2 warming in the patient: ramps 0.86-0.93 x,
+    crossings -0.6..-1.8 deg with the slope in use, +0.5..+0.8 with the reference's, while
+    the tip's edge stayed within +-0.3 deg; followed, phi2 tracked 0.3-1.6 deg worse than
+    with online off). Off: the slope in use alone (until session 17)."""
     reread_on_slope_change: bool = False
     """The last crossing ramp is read again when the slope in use has moved beyond
     ``slope_in_use_tolerance`` since it was read; outward beyond the gate it becomes a

@@ -42,6 +42,7 @@ def test_flatter_ramps_about_their_centre_leave_the_edges_in_place() -> None:
     pos, neg = run_knob(EstimatorOptions(), 0.0, 0.9)
     assert (pos.applied_deg, neg.applied_deg) == (0.0, 0.0)
     assert pos.estimate_deg == pytest.approx(0.0, abs=1e-9)
+    assert pos.status()["between_ramps"] > 0
 
 
 def test_without_the_rule_flatter_ramps_move_the_edges_inward() -> None:

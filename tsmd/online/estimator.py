@@ -37,7 +37,7 @@ from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
 from tsmd.online.partner import partner_left_band, partner_shows_change
 from tsmd.online.reference import SettlingReference
-from tsmd.online.slopes import common_change, nearest_between, shrunk_ratio
+from tsmd.online.slopes import common_change, shrunk_ratio
 
 
 @dataclass
@@ -124,6 +124,9 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """The reference being learned, re-learned while it settles (:mod:`tsmd.online.reference`)."""
     partner: EdgeTracker | None = field(default=None, repr=False, compare=False)
     """The knob's other edge (set by the worker, or by :meth:`update`'s ``partner``)."""
+    n_between: int = 0
+    """Crossings of ramps flatter than the reference read between the two slopes' readings
+    (:attr:`EstimatorOptions.flatter_reads_between`)."""
     n_partner_held: int = 0
     """Changes (or estimates beyond the dead band) held because the other edge of the knob
     showed none (:attr:`EstimatorOptions.partner_confirms`)."""
@@ -244,11 +247,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             self.last_measurement_deg = math.nan
             return events
         self.last_feature = "crossing"
-        raw = self._crossing(ramp, profile_edge_deg, slope)
-        if o.flatter_reads_between and slope < self.slope_ref_A_per_deg:
-            raw = nearest_between(raw, self._crossing(ramp, profile_edge_deg,
-                                                      self.slope_ref_A_per_deg),
-                                  self.estimate_deg + self.bins.bias_deg(ramp.other_deg))
+        raw = self._crossing_read(ramp, profile_edge_deg, slope)
         rose = change > tol or ramp.slope_A_per_deg / slope - 1.0 > tol
         if o.refuse_inward_on_steeper and rose and raw - self.estimate_deg < -o.gate_deg:
             # More friction along the tendon (the knob's ramps, or this one, steeper beyond
@@ -266,13 +265,6 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                 return events
         self._measured(raw, ramp.other_deg, events)
         return events
-
-    def _crossing(self, ramp: LoadedRamp, edge_deg: float, slope: float) -> float:
-        """How far outward of the profile's edge the line through the ramp's window centre with
-        ``slope`` crosses the reference level (the reference's own residual taken out)."""
-        assert self.level_A is not None
-        return ramp.side * (ramp.crossing_deg(self.level_A, slope) - edge_deg
-                            - self.residual_ref_deg)
 
     def _reread(self, slope: float) -> None:
         """The last crossing ramp read again with the slope in use now, when that moved beyond
@@ -406,4 +398,5 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                 "other_knob_bins_deg": self.bins.biases_deg(),
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None,
                 "reference_relearned": self.reference.relearned,
-                "reread_ramps": self.n_reread, "partner_held": self.n_partner_held}
+                "reread_ramps": self.n_reread, "partner_held": self.n_partner_held,
+                "between_ramps": self.n_between}

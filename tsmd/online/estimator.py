@@ -181,14 +181,17 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             return events
         assert self.level_A is not None and self.slope_ref_A_per_deg is not None
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
-        self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
+        self.odd_speed = not self._speed_matches(ramp)
+        slope_counts = not (self.odd_speed and o.slopes_at_reference_speed)
+        if slope_counts:
+            self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         shared = 0.0 if partner is None else common_change(
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
         self.shared_change = shared
         self.partner_change = 0.0 if partner is None else partner.slope_change
         self.knob_change = self._knob_change_with(partner)
         self.partner_last_change = 0.0 if partner is None else partner.last_change
-        if ramp.past_knee:
+        if ramp.past_knee and slope_counts:
             self.knee_slopes = [*self.knee_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         self.partner_knee_change = 0.0 if partner is None else partner.knee_slope_change
         shared_ok = (abs(shared) >= 2.0 * o.same_slope_tolerance
@@ -208,7 +211,6 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
-        self.odd_speed = not self._speed_matches(ramp)
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
         direction = self.knee_direction
         first_knee = self.last_feature != "knee"

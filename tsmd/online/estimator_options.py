@@ -33,6 +33,13 @@ class EstimatorOptions:
     or a bend widens the dead zone and may show first on such ramps (lumped 1, 60 deg bend: a
     hard gate delayed phi1's follow by 22 s, on / fresh 0.92 -> 1.11). 0: off (until session
     16)."""
+    slopes_at_reference_speed: bool = True
+    """Only ramps at a knob speed within ``speed_ratio_max`` of the reference's feed the
+    slopes (the slope change, knee mode, the gain): a slow stroke's steeper ramp is the
+    friction's speed dependence, not the sheath's (coilpipe 2 without a change: ramps at
+    8.7-9 deg/s against the reference's 21, 1.58-1.86 x, put phi1 in knee mode and a knee
+    +3.25 deg out was followed with the other edge's +1.87; the tip's edge stayed within
+    +-0.3 deg). Off: every ramp's slope counts (until session 17)."""
     window: int = 5
     gate_deg: float = 1.5
     other_knob_confirms: bool = False

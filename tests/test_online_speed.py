@@ -94,3 +94,15 @@ def test_slow_ramps_slopes_leave_the_knob_out_of_knee_mode() -> None:
 def test_with_every_slope_counting_slow_steep_ramps_set_knee_mode() -> None:
     pos = knob_after_slow_steep_ramps(EstimatorOptions(slopes_at_reference_speed=False))
     assert pos.knee_direction == 1
+
+
+def test_slow_ramps_slopes_count_once_a_ramp_at_the_reference_speed_changed_alike() -> None:
+    o = EstimatorOptions()
+    pos, neg = EdgeTracker(0, 1, o), EdgeTracker(0, -1, o)
+    for _ in range(o.baseline_ramps):
+        pos.update(ramp(EDGE_DEG), EDGE_DEG, neg)
+        neg.update(ramp(EDGE_DEG), EDGE_DEG, pos)
+    neg.update(dataclasses.replace(ramp(EDGE_DEG), slope_A_per_deg=1.2 * SLOPE), EDGE_DEG, pos)
+    pos.update(dataclasses.replace(ramp(EDGE_DEG, 8.0), slope_A_per_deg=1.6 * SLOPE), EDGE_DEG,
+               neg)
+    assert pos.last_change == pytest.approx(0.6)

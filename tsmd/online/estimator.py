@@ -101,6 +101,8 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """Ramps at a knob speed beyond ``speed_ratio_max`` of the reference's that measured
     nothing (all but those reading outward beyond the gate)."""
     odd_speed: bool = False
+    speed_ref_change: float = 0.0
+    """The slope change of the edge's last ramp at the reference's speed."""
     """The last ramp ran at a speed beyond ``speed_ratio_max`` of the reference's."""
     speed_ref_deg_s: float = math.nan
     """The reference ramps' median knob speed (NaN: not learned, or no speeds)."""
@@ -182,7 +184,11 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         assert self.level_A is not None and self.slope_ref_A_per_deg is not None
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
         self.odd_speed = not self._speed_matches(ramp)
-        slope_counts = not (self.odd_speed and o.slopes_at_reference_speed)
+        if not self.odd_speed:
+            self.speed_ref_change = ratio - 1.0
+        slope_counts = not (self.odd_speed and o.slopes_at_reference_speed) or any(
+            c * (ratio - 1.0) > 0.0 and abs(c) > o.same_slope_tolerance
+            for c in (self.speed_ref_change, partner.speed_ref_change if partner else 0.0))
         if slope_counts:
             self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         shared = 0.0 if partner is None else common_change(

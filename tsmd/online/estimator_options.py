@@ -34,12 +34,16 @@ class EstimatorOptions:
     hard gate delayed phi1's follow by 22 s, on / fresh 0.92 -> 1.11). 0: off (until session
     16)."""
     slopes_at_reference_speed: bool = True
-    """Only ramps at a knob speed within ``speed_ratio_max`` of the reference's feed the
-    slopes (the slope change, knee mode, the gain): a slow stroke's steeper ramp is the
-    friction's speed dependence, not the sheath's (coilpipe 2 without a change: ramps at
-    8.7-9 deg/s against the reference's 21, 1.58-1.86 x, put phi1 in knee mode and a knee
-    +3.25 deg out was followed with the other edge's +1.87; the tip's edge stayed within
-    +-0.3 deg). Off: every ramp's slope counts (until session 17)."""
+    """A ramp at a knob speed beyond ``speed_ratio_max`` of the reference's feeds the slopes
+    (the slope in use, knee mode, the gain) only once the knob's last ramp at the reference's
+    speed (either edge) changed slope the same way by more than ``same_slope_tolerance``: a
+    slow stroke's steeper ramp is the friction's speed dependence, not the sheath's (coilpipe
+    2 without a change: ramps at 8.7-9 deg/s against the reference's 21, 1.58-1.86 x, put
+    phi1 in knee mode and into the slope in use; a knee +3.25 deg out and a crossing +1.87
+    were followed, the tip's edge stayed within +-0.3 deg), while after a bend the ramps at
+    the reference's speed steepen too (lumped 1, 60 deg: 1.13-1.18 x) and the slow ones then
+    count (with none of them counting, phi1 followed 30 s later, 0.87 -> 1.38 x fresh). Off:
+    every ramp's slope counts (until session 17)."""
     window: int = 5
     gate_deg: float = 1.5
     other_knob_confirms: bool = False

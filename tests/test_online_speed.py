@@ -71,3 +71,38 @@ def test_the_loaded_ramp_carries_the_knob_speed_over_its_window() -> None:
     found = loaded_ramp(stroke, 10.0)
     assert isinstance(found, LoadedRamp)
     assert found.speed_deg_s == pytest.approx(20.0, rel=0.02)
+
+
+def knob_after_slow_steep_ramps(options: EstimatorOptions) -> EdgeTracker:
+    """Both edges learned at the reference speed, then one ramp each at 8 deg/s, 1.6 x as
+    steep (a slow stroke's friction)."""
+    pos, neg = EdgeTracker(0, 1, options), EdgeTracker(0, -1, options)
+    for _ in range(options.baseline_ramps):
+        pos.update(ramp(EDGE_DEG), EDGE_DEG, neg)
+        neg.update(ramp(EDGE_DEG), EDGE_DEG, pos)
+    steep = dataclasses.replace(ramp(EDGE_DEG, 8.0), slope_A_per_deg=1.6 * SLOPE)
+    neg.update(steep, EDGE_DEG, pos)
+    pos.update(steep, EDGE_DEG, neg)
+    return pos
+
+
+def test_slow_ramps_slopes_leave_the_knob_out_of_knee_mode() -> None:
+    pos = knob_after_slow_steep_ramps(EstimatorOptions())
+    assert (pos.knee_direction, pos.slope_change) == (0, 0.0)
+
+
+def test_with_every_slope_counting_slow_steep_ramps_set_knee_mode() -> None:
+    pos = knob_after_slow_steep_ramps(EstimatorOptions(slopes_at_reference_speed=False))
+    assert pos.knee_direction == 1
+
+
+def test_slow_ramps_slopes_count_once_a_ramp_at_the_reference_speed_changed_alike() -> None:
+    o = EstimatorOptions()
+    pos, neg = EdgeTracker(0, 1, o), EdgeTracker(0, -1, o)
+    for _ in range(o.baseline_ramps):
+        pos.update(ramp(EDGE_DEG), EDGE_DEG, neg)
+        neg.update(ramp(EDGE_DEG), EDGE_DEG, pos)
+    neg.update(dataclasses.replace(ramp(EDGE_DEG), slope_A_per_deg=1.2 * SLOPE), EDGE_DEG, pos)
+    pos.update(dataclasses.replace(ramp(EDGE_DEG, 8.0), slope_A_per_deg=1.6 * SLOPE), EDGE_DEG,
+               neg)
+    assert pos.last_change == pytest.approx(0.6)

@@ -17,6 +17,7 @@ from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
 from tsmd.online.reference import SettlingReference
+from tsmd.online.slopes import nearest_between
 
 ORDER = itertools.count()
 """One order over every tracker's measurements, so two edges can tell whose came first."""
@@ -38,6 +39,7 @@ class ReferenceReadings:
     last_measurement_deg: float
     last_reading_deg: float
     accepted_order: int
+    n_between: int
 
     def _speed_matches(self, ramp: LoadedRamp) -> bool:
         """The ramp ran at a knob speed within ``speed_ratio_max`` of the reference's (True
@@ -60,6 +62,26 @@ class ReferenceReadings:
                                   self.options.bin_window)
         for r, d in self.reference.window:
             self.bins.teach(self.bins.key(r.other_deg), ref.reading_deg(r, d))
+
+    def _crossing(self, ramp: LoadedRamp, edge_deg: float, slope: float) -> float:
+        """How far outward of the profile's edge the line through the ramp's window centre with
+        ``slope`` crosses the reference level (the reference's own residual taken out)."""
+        assert self.level_A is not None
+        return ramp.side * (ramp.crossing_deg(self.level_A, slope) - edge_deg
+                            - self.residual_ref_deg)
+
+    def _crossing_read(self, ramp: LoadedRamp, edge_deg: float, slope: float) -> float:
+        """The crossing with the slope in use; on a ramp flatter than the reference (with
+        ``flatter_reads_between``) the point between it and the reference slope's crossing
+        nearest the estimate: the slope turned about a point the current does not show (a
+        softer catheter: twistshaft warming in the patient, its tip's edge in place)."""
+        raw = self._crossing(ramp, edge_deg, slope)
+        assert self.slope_ref_A_per_deg is not None
+        if not (self.options.flatter_reads_between and slope < self.slope_ref_A_per_deg):
+            return raw
+        self.n_between += 1
+        return nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
+                               self.estimate_deg + self.bins.bias_deg(ramp.other_deg))
 
     def _settling(self, ramp: LoadedRamp, profile_edge_deg: float, raw_deg: float) -> bool:
         """While the reference settles, a crossing within the gate re-learns it instead of

@@ -101,6 +101,8 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """Ramps at a knob speed beyond ``speed_ratio_max`` of the reference's that measured
     nothing (all but those reading outward beyond the gate)."""
     odd_speed: bool = False
+    speed_ref_change: float = 0.0
+    """The slope change of the edge's last ramp at the reference's speed."""
     """The last ramp ran at a speed beyond ``speed_ratio_max`` of the reference's."""
     speed_ref_deg_s: float = math.nan
     """The reference ramps' median knob speed (NaN: not learned, or no speeds)."""
@@ -124,6 +126,9 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """The reference being learned, re-learned while it settles (:mod:`tsmd.online.reference`)."""
     partner: EdgeTracker | None = field(default=None, repr=False, compare=False)
     """The knob's other edge (set by the worker, or by :meth:`update`'s ``partner``)."""
+    n_between: int = 0
+    """Crossings of ramps flatter than the reference read between the two slopes' readings
+    (:attr:`EstimatorOptions.flatter_reads_between`)."""
     n_partner_held: int = 0
     """Changes (or estimates beyond the dead band) held because the other edge of the knob
     showed none (:attr:`EstimatorOptions.partner_confirms`)."""
@@ -178,14 +183,21 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             return events
         assert self.level_A is not None and self.slope_ref_A_per_deg is not None
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
-        self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
+        self.odd_speed = not self._speed_matches(ramp)
+        if not self.odd_speed:
+            self.speed_ref_change = ratio - 1.0
+        slope_counts = not (self.odd_speed and o.slopes_at_reference_speed) or any(
+            c * (ratio - 1.0) > 0.0 and abs(c) > o.same_slope_tolerance
+            for c in (self.speed_ref_change, partner.speed_ref_change if partner else 0.0))
+        if slope_counts:
+            self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         shared = 0.0 if partner is None else common_change(
             self.slope_change, partner.slope_change, o.same_slope_tolerance)
         self.shared_change = shared
         self.partner_change = 0.0 if partner is None else partner.slope_change
         self.knob_change = self._knob_change_with(partner)
         self.partner_last_change = 0.0 if partner is None else partner.last_change
-        if ramp.past_knee:
+        if ramp.past_knee and slope_counts:
             self.knee_slopes = [*self.knee_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         self.partner_knee_change = 0.0 if partner is None else partner.knee_slope_change
         shared_ok = (abs(shared) >= 2.0 * o.same_slope_tolerance
@@ -205,7 +217,6 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
-        self.odd_speed = not self._speed_matches(ramp)
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
         direction = self.knee_direction
         first_knee = self.last_feature != "knee"
@@ -244,8 +255,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             self.last_measurement_deg = math.nan
             return events
         self.last_feature = "crossing"
-        raw = ramp.side * (ramp.crossing_deg(self.level_A, slope) - profile_edge_deg
-                           - self.residual_ref_deg)
+        raw = self._crossing_read(ramp, profile_edge_deg, slope)
         rose = change > tol or ramp.slope_A_per_deg / slope - 1.0 > tol
         if o.refuse_inward_on_steeper and rose and raw - self.estimate_deg < -o.gate_deg:
             # More friction along the tendon (the knob's ramps, or this one, steeper beyond
@@ -278,8 +288,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         if (abs(slope / used - 1.0) <= o.slope_in_use_tolerance
                 or abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance):
             return
-        m = ramp.side * (ramp.crossing_deg(self.level_A, slope) - edge_deg
-                         - self.residual_ref_deg) - self.bins.bias_deg(ramp.other_deg)
+        m = self._crossing(ramp, edge_deg, slope) - self.bins.bias_deg(ramp.other_deg)
         if m - self.estimate_deg > o.gate_deg:  # outward only: the friction rose
             self.suspects = [*self.suspects, m][-o.confirm:]
             self.suspect_order = next(ORDER)
@@ -397,4 +406,5 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                 "other_knob_bins_deg": self.bins.biases_deg(),
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None,
                 "reference_relearned": self.reference.relearned,
-                "reread_ramps": self.n_reread, "partner_held": self.n_partner_held}
+                "reread_ramps": self.n_reread, "partner_held": self.n_partner_held,
+                "between_ramps": self.n_between}

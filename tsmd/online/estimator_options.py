@@ -33,6 +33,17 @@ class EstimatorOptions:
     or a bend widens the dead zone and may show first on such ramps (lumped 1, 60 deg bend: a
     hard gate delayed phi1's follow by 22 s, on / fresh 0.92 -> 1.11). 0: off (until session
     16)."""
+    slopes_at_reference_speed: bool = True
+    """A ramp at a knob speed beyond ``speed_ratio_max`` of the reference's feeds the slopes
+    (the slope in use, knee mode, the gain) only once the knob's last ramp at the reference's
+    speed (either edge) changed slope the same way by more than ``same_slope_tolerance``: a
+    slow stroke's steeper ramp is the friction's speed dependence, not the sheath's (coilpipe
+    2 without a change: ramps at 8.7-9 deg/s against the reference's 21, 1.58-1.86 x, put
+    phi1 in knee mode and into the slope in use; a knee +3.25 deg out and a crossing +1.87
+    were followed, the tip's edge stayed within +-0.3 deg), while after a bend the ramps at
+    the reference's speed steepen too (lumped 1, 60 deg: 1.13-1.18 x) and the slow ones then
+    count (with none of them counting, phi1 followed 30 s later, 0.87 -> 1.38 x fresh). Off:
+    every ramp's slope counts (until session 17)."""
     window: int = 5
     gate_deg: float = 1.5
     other_knob_confirms: bool = False
@@ -85,6 +96,14 @@ class EstimatorOptions:
     nothing, as the knee does in knee mode (session 12, stickslip 101 phi2). On since session
     13: with ``fresh_agreement`` the one run it made worse (lumped 102 without a change) is
     the same with it, and stickslip 104's bend went from 2.02 to 1.02 x fresh (docs/online.md)."""
+    flatter_reads_between: bool = True
+    """Ramps flatter than the reference (the slope in use below it) read the crossing with
+    both slopes, the reference's and the one in use, and take the point between the two
+    nearest the estimate: a slack or a bend does not flatten the ramps, a softer catheter
+    does without moving the edge (twistshaft 1-2 warming in the patient: ramps 0.86-0.93 x,
+    crossings -0.6..-1.8 deg with the slope in use, +0.5..+0.8 with the reference's, while
+    the tip's edge stayed within +-0.3 deg; followed, phi2 tracked 0.3-1.6 deg worse than
+    with online off). Off: the slope in use alone (until session 17)."""
     reread_on_slope_change: bool = False
     """The last crossing ramp is read again when the slope in use has moved beyond
     ``slope_in_use_tolerance`` since it was read; outward beyond the gate it becomes a

@@ -16,6 +16,13 @@ def shrunk_ratio(ratio: float, tolerance: float) -> float:
     return 1.0 + math.copysign(kept, ratio - 1.0)
 
 
+def nearest_between(a_deg: float, b_deg: float, target_deg: float) -> float:
+    """The point of the interval between two readings nearest ``target_deg`` (``target_deg``
+    itself when the interval holds it): a crossing read with each of two slopes the ramp
+    may have, where nothing says which."""
+    return min(max(target_deg, min(a_deg, b_deg)), max(a_deg, b_deg))
+
+
 def common_change(own: float, partner: float, tolerance: float) -> float:
     """An edge's slope change as far as the knob's other edge confirms it (a sheath's friction
     changes both tendons of a knob alike): none when the partner's goes the other way or

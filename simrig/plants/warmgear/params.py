@@ -24,12 +24,13 @@ class WarmGearKnobParams:
     """Knob pinion (moulded POM, module 0.5): 15 teeth, one mesh period per 24 deg of knob."""
     drum_teeth: float = 20.0
     """Drum gear: the drum turns 15/20 of the knob."""
-    gear_play_deg: float = 2.5
-    """Circumferential backlash of the mesh at the drum (0.22 mm at a 5 mm pitch radius:
-    moulded gears on a loose centre distance, the upper end of ISO 1328 class 11-12)."""
-    mesh_stiffness_Nmm_per_deg: float = 150.0
-    """Drum-side mesh stiffness, averaged over a mesh period (POM teeth, 3 mm face: about
-    1e6 N/m of tooth pair at the pitch circle; Walton and Tessema's polymer-gear data)."""
+    gear_play_deg: float = 3.2
+    """Circumferential backlash of the mesh at the drum (0.28 mm at a 5 mm pitch radius:
+    moulded gears on a loose centre distance, beyond ISO 1328 class 12; set with the slack
+    to give the paper's uncompensated errors)."""
+    mesh_stiffness_Nmm_per_deg: float = 90.0
+    """Drum-side mesh stiffness, averaged over a mesh period (POM teeth, 2 mm face: about
+    2e5 N/m of tooth pair at a 5 mm pitch radius, polymer-gear tooth compliance)."""
     mesh_ripple: float = 0.15
     """Half-swing of the mesh stiffness between single- and double-tooth contact (contact
     ratio about 1.5: two pairs carry half of every mesh period)."""
@@ -38,13 +39,13 @@ class WarmGearKnobParams:
     the pitch point and largest at the ends of the path of contact."""
     drum_friction_Nmm: float = 2.5
     """Drum bearing (bushing and shaft seal) friction torque."""
-    pulley_radius_mm: float = 9.5
+    pulley_radius_mm: float = 10.2
     """Tendon drum radius."""
-    slack_pos_mm: float = 2.4
+    slack_pos_mm: float = 3.3
     """Tendon slack at room temperature, as assembled (hand crimped)."""
-    slack_neg_mm: float = 2.4
-    tendon_stiffness_N: float = 16000.0
-    """EA of a 0.4 mm 1x19 stainless strand (about 0.095 mm^2 at an effective 170 GPa)."""
+    slack_neg_mm: float = 3.3
+    tendon_stiffness_N: float = 11000.0
+    """EA of a 0.35 mm 7x7 stainless wire rope (about 0.073 mm^2 at an effective 150 GPa)."""
     free_length_m: float = 0.15
     """Tendon in the handle, drum to shaft entry."""
     sheath_length_m: float = 1.0
@@ -100,15 +101,15 @@ class ShaftParams:
     warm_time_s: float = 150.0
     """Time constant of the shaft's warm-up in the oesophagus (thin polymer wall and saline:
     a first-order lag of minutes)."""
-    bend_wrap_share: float = 0.3
+    bend_wrap_share: float = 0.5
     """Share of the section's total bend that is the wrap of the section's contact (both
     planes: the other plane's bend adds friction to this one's tendons)."""
 
 
 _NOMINAL_PHI1 = WarmGearKnobParams()
 _NOMINAL_PHI2 = dataclasses.replace(
-    _NOMINAL_PHI1, bend_stiffness_Nm_per_rad=0.028, tendon_offset_mm=4.3, slack_pos_mm=2.2,
-    slack_neg_mm=2.35, pulley_radius_mm=9.0)
+    _NOMINAL_PHI1, bend_stiffness_Nm_per_rad=0.028, tendon_offset_mm=4.3, slack_pos_mm=3.1,
+    slack_neg_mm=3.2, pulley_radius_mm=9.6)
 NOMINAL_KNOBS: tuple[WarmGearKnobParams, WarmGearKnobParams] = (_NOMINAL_PHI1, _NOMINAL_PHI2)
 """phi1 (anterior-posterior) and phi2 (right-left): the section is softer right-left."""
 

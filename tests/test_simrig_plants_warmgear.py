@@ -116,8 +116,9 @@ def test_the_tip_holds_after_a_reversal_then_returns() -> None:
     tip_up, _ = _drive(plant, 0, _ramp(0.0, 80.0))
     tip_back, _ = _drive(plant, 0, _ramp(80.0, 0.0))
     held = tip_back[: len(tip_back) // 40]  # the first 2 deg of knob travel back
-    # it does not return yet; the film's shear, no longer dragging, lets it settle on a little
-    assert np.all(held >= tip_up[-1]) and np.all(held < tip_up[-1] + 0.5)
+    # it does not return yet; the film's shear, no longer dragging, lets it settle on (0.5 deg
+    # after a 20 deg/s pull on the nominal unit)
+    assert np.all(held >= tip_up[-1]) and np.all(held < tip_up[-1] + 1.0)
     assert tip_back[-1] < tip_up[-1] - 40.0
 
 

@@ -15,7 +15,8 @@ the coilpipe plant (session 10, written blind) is held out now, the stickslip pl
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
 now, the helixbelt plant (session 15, written blind) is held out now, the ratestate plant
-(session 16, written blind) is held out now (``PLANT_ROLE``). ``SCATTER`` lives in
+(session 16, written blind) is held out now, the warmgear plant (session 18) is the blind one
+(``PLANT_ROLE``). ``SCATTER`` lives in
 :mod:`simrig.family_scatter`.
 """
 
@@ -41,6 +42,7 @@ from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
 from simrig.plants.stickslip import NOMINAL_KNOBS as STICKSLIP_KNOBS
 from simrig.plants.twistshaft import NOMINAL_KNOBS as TWISTSHAFT_KNOBS
+from simrig.plants.warmgear import NOMINAL_KNOBS as WARMGEAR_KNOBS
 from simrig.rig import DEFAULT_CURRENT_SENSOR
 
 PLANT_SPECS: dict[str, str] = {
@@ -53,12 +55,13 @@ PLANT_SPECS: dict[str, str] = {
     "screwrod": "simrig.plants.screwrod:make_screwrod_plant",
     "nitinol": "simrig.plants.nitinol:make_nitinol_plant",
     "helixbelt": "simrig.plants.helixbelt:make_helixbelt_plant",
-    "ratestate": "simrig.plants.ratestate:make_ratestate_plant",  # last: the others' seeds hold
+    "ratestate": "simrig.plants.ratestate:make_ratestate_plant",
+    "warmgear": "simrig.plants.warmgear:make_warmgear_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
-              "ratestate": "held-out"}
+              "ratestate": "held-out", "warmgear": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -72,7 +75,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "screwrod": SCREWROD_KNOBS,
                                         "nitinol": NITINOL_KNOBS,
                                         "helixbelt": HELIXBELT_KNOBS,
-                                        "ratestate": RATESTATE_KNOBS}
+                                        "ratestate": RATESTATE_KNOBS,
+                                        "warmgear": WARMGEAR_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -132,6 +136,9 @@ VARIANTS: dict[str, Variant] = {
                           "handle_friction_Nm": 1.5, "braid_friction_Nm": 1.5},
             "ratestate": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                           "handle_friction_Nm": 1.5, "link_friction": 1.5},
+            "warmgear": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                         "handle_friction_Nm": 1.5, "mesh_friction": 1.5,
+                         "gear_play_deg": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -155,7 +162,8 @@ VARIANTS: dict[str, Variant] = {
                  "screwrod": {"tendon_stiffness_N": 0.4},
                  "nitinol": {"tendon_stiffness_N": 0.4},
                  "helixbelt": {"tendon_stiffness_N": 0.4},
-                 "ratestate": {"tendon_stiffness_N": 0.4}},
+                 "ratestate": {"tendon_stiffness_N": 0.4},
+                 "warmgear": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

@@ -155,8 +155,9 @@ def test_a_curved_shaft_needs_more_torque_and_bends_the_tip_less() -> None:
     assert tau_c[-1] > tau_s[-1] and tip_c[-1] < tip_s[-1]
 
 
-def test_ratestate_is_registered_last_and_held_out() -> None:
-    assert list(PLANT_SPECS)[-1] == "ratestate"
+def test_ratestate_is_registered_after_helixbelt_and_held_out() -> None:
+    names = list(PLANT_SPECS)
+    assert names.index("ratestate") == names.index("helixbelt") + 1
     assert PLANT_ROLE["ratestate"] == "held-out"
     assert isinstance(family_member("ratestate", 101).build(), RateStatePlant)
     assert set(SCATTER["ratestate"]) <= set(family_member("ratestate", 0).params["knobs"][0])

@@ -212,6 +212,37 @@ coupling of its base; the case puts the lumens 4.5 times as far off, 1.53 deg (t
 coupling 1.5 deg); the tendon EA halved, 3.59 deg."""
 
 
+WARMGEAR_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 60.0}}
+"""The warmgear plant's one effect keyword: a 60 deg sheath bend (added to the shaft contact's
+wrap), 2.10 deg of tip (tip RMSE effect on minus off, unit 1, noise-free, 120 s of the experiment
+motion at 50 Hz, 4 ms steps; unit 2 2.90). The others' 120 deg moves it 15.9 deg (20 ms steps:
+90 deg 10.8, 75 deg 3.63): its lumped contact's friction x wrap reaches the plant's 0.95 cap
+once the film is squeezed, outside the others' 1.1-12.8 deg (30 deg 0.79, 45 deg 1.34). Its
+planes' coupling (the section's total bend, both planes, is the wrap of the tendons' distal
+contact) has no constant of its own (``bend_wrap_share`` rubs the own plane's bend as well: 0.5
+-> 1.0 moves the tip 0.64 deg), and nothing creeps under load: coupling and creep are not run.
+The shaft's warm-up (slack shrinking, section softening after insertion) is base physics: every
+recording, the reference units' included, starts at insertion; with three times the thermal
+mismatch it moves the tip 1.29 deg over the motion but drifts 0.0 deg / 0.6 mA over a held
+loaded dwell beyond an unloaded one (protocol, unit 1), below one sample's noise. "None" is
+the nominal physics as written. Sized on the plant's re-tuned constants (s18-plant a6c2b95;
+docs/gap.md "Session 18")."""
+
+WARMGEAR_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "rate": {"film_viscous_N_s_per_mm": 2.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Warmgear effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion, 4 ms steps): its only speed-dependent physics is the sheath film's shear, so rate is
+the film twice as viscous, 1.63 deg (unit 2 1.62; at 20 ms x1.5 0.81, x2.5 2.39, x3 3.14; the
+others' rate 1.1-1.9 deg), whose protocol fast-minus-slow contrast is 0.69 deg / 1.6 mA (unit
+1; detectable); the rope's EA halved, 3.44 deg (unit 2 3.09)."""
+
+WARMGEAR_MAX_STEP_S = 0.004
+"""The nominal warmgear unit's tip lies within 0.10 deg (0.015 RMS) of 1 ms steps at 4 ms
+steps, 0.50 deg (0.088 RMS) at 20 ms (unit 1, 120 s of the experiment motion): as ratestate."""
+
+
 @dataclass(frozen=True)
 class PlantSpec:
     """A plant as ``module:factory`` + fixed keyword parameters + what to fit as a simulator.
@@ -290,6 +321,9 @@ PRESETS: dict[str, PlantSpec] = {
     "ratestate": PlantSpec(PLANT_SPECS["ratestate"], {}, (), "ratestate", family="ratestate",
                            effects=RATESTATE_EFFECTS, knob_effects=RATESTATE_KNOB_EFFECTS,
                            max_step_s=RATESTATE_MAX_STEP_S),
+    "warmgear": PlantSpec(PLANT_SPECS["warmgear"], {}, (), "warmgear", family="warmgear",
+                          effects=WARMGEAR_EFFECTS, knob_effects=WARMGEAR_KNOB_EFFECTS,
+                          max_step_s=WARMGEAR_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

@@ -53,7 +53,12 @@ from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
 from tsmd.calibration.loaded_knee import sweep_knees
 from tsmd.calibration.reading_offset import offset_at, reference_edge_deg
-from tsmd.calibration.release_path import release_slope_ratio, release_through_amplitude
+from tsmd.calibration.release_end import plateau_moved, side_ratios
+from tsmd.calibration.release_path import (
+    RELEASE_RATIO_RANGE,
+    release_slope_ratio,
+    release_through_amplitude,
+)
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.unit_slope import GainReading, gain_scatter, weighed_omega
 from tsmd.compensation.loaded_shape import curved, shaped_height
@@ -260,10 +265,18 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     beta_neg = smoothed_gains(grid, [f.backlash_gain for f in neg_fits])
     omega = loaded_slope(k, grid, order, pos_fits, neg_fits)
     ratio = release_slope_ratio(k)
+    x0_pos, x0_neg = (smooth_over_grid(grid, [f.zero_load_deg for f in fits])
+                      for fits in (pos_fits, neg_fits))
+    ratios = (ratio, ratio)
+    if getattr(k, "reference_release_end_offset_deg", None) is not None:
+        # the release drawn to its end in this unit's current (session 18)
+        h_pos, h_neg, d_pos, d_neg = plateau_moved(k, omega, h_pos, h_neg, d_pos, d_neg)
+        ratios = side_ratios(order, k, omega, (h_pos, h_neg), (d_pos, d_neg),
+                             (beta_pos, beta_neg), (x0_pos, x0_neg), ratio, RELEASE_RATIO_RANGE)
     sides = []
-    for betas, fits in ((beta_pos, pos_fits), (beta_neg, neg_fits)):
-        x0s = smooth_over_grid(grid, [f.zero_load_deg for f in fits])
-        moved = [release_through_amplitude(b, x0, f.amplitude_deg, ratio)
+    for betas, x0s, fits, side_ratio in ((beta_pos, x0_pos, pos_fits, ratios[0]),
+                                         (beta_neg, x0_neg, neg_fits, ratios[1])):
+        moved = [release_through_amplitude(b, x0, f.amplitude_deg, side_ratio)
                  for b, x0, f in zip(betas, x0s, fits, strict=True)]
         sides.append((tuple(m[0] for m in moved), tuple(m[1] for m in moved)))
     return TensionPlayParams(

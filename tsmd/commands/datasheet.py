@@ -37,6 +37,7 @@ from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
 from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_offset import with_reading_offset
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
+from tsmd.datasheet_release_end import measure_release_end_offsets
 from tsmd.datasheet_rule import (
     RULE_NOISE_SEEDS,
     choose_knee,
@@ -80,6 +81,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "corners of the paper's lines instead of at the 1 deg threshold; "
                              "the ratio's gain is then chosen against it (a tip with rounded "
                              "corners; opt-in per product, docs/model.md Session 17)")
+    parser.add_argument("--release-end-offset", action="store_true",
+                        help="with --plant: also calibrate the unit once more, tracked, and read "
+                             "where the release ends in the current and on the tip; method ours "
+                             "then "
+                             "draws each unit's release line to the end its current shows "
+                             "(opt-in per product, docs/model.md Session 18)")
     parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "
@@ -208,6 +215,23 @@ def _with_tip_backlash_gain(device: DeviceModel, config: TsmdConfig,
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
+def _with_release_end_offset(device: DeviceModel, config: TsmdConfig,
+                             factory: Callable[[], Plant], seed: int) -> DeviceModel:
+    """The sheet with each knob's offset of the tip's release end from the current's and the
+    tip's plateau there (both or neither)."""
+    t0 = time.monotonic()
+    read = measure_release_end_offsets(factory, device, seed, config)
+    knobs = tuple(k if r is None else dataclasses.replace(
+        k, reference_release_end_offset_deg=round(r[0], 2),
+        reference_release_plateau_deg=round(r[1], 2)) for k, r in zip(device.knobs, read,
+                                                                       strict=True))
+    print("  release end, tip minus current / tip plateau: " + ", ".join(
+        f"{n} {'none' if r is None else f'{r[0]:+.2f} / {r[1]:.2f}'} deg"
+        for n, r in zip(("phi1", "phi2"), read, strict=True))
+          + f" ({time.monotonic() - t0:.0f} s)")
+    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+
 def _with_shape_grid(device: DeviceModel, config: TsmdConfig, factory: Callable[[], Plant],
                      seed: int) -> DeviceModel:
     """The sheet with each knob's loaded-branch templates over the other knob's angle."""
@@ -298,6 +322,8 @@ def main(args: argparse.Namespace) -> int:
         device = _choose_rule(device, config, args.plant, params, seeds, args.recovery_rule)
     if args.plant is not None and args.bend_relation:
         device = _with_bend(device, config, factory)
+    if args.plant is not None and args.release_end_offset:
+        device = _with_release_end_offset(device, config, factory, args.seed)
     comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "
                f"(tsmd datasheet) on {source}:\n"
                f"each knob swept +-{SWEEP_AMPLITUDE_DEG:g} deg at {SWEEP_HZ:g} Hz, other knob "

@@ -71,6 +71,8 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "reference_rule_backlash_gain": (0.0, 0.8, ""),
     "reference_tip_backlash_gain": (0.0, 0.8, ""),
     "reference_tip_line_backlash_gain": (0.0, 0.8, ""),
+    "reference_release_end_offset_deg": (-10.0, 10.0, "deg"),
+    "reference_release_plateau_deg": (0.0, 45.0, "deg"),
     "other_tip_gain": (*OTHER_TIP_GAIN_RANGE, ""),
     "loaded_knee_pos_deg": (0.0, 90.0, "deg"),
     "loaded_knee_neg_deg": (0.0, 90.0, "deg"),
@@ -83,7 +85,8 @@ _SHAPE_KEYS = ("loaded_shape_pos", "loaded_shape_neg")
 _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
                   "backlash_release_slope_ratio", "reference_release_swing_A",
                   "backlash_settle_lag_deg", "reference_rule_backlash_gain",
-                  "reference_tip_backlash_gain", "reference_tip_line_backlash_gain")
+                  "reference_tip_backlash_gain", "reference_tip_line_backlash_gain",
+                  "reference_release_end_offset_deg", "reference_release_plateau_deg")
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_recovery_lag_deg", "backlash_bend_gain", "backlash_release_rule",
@@ -189,6 +192,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             reference_rule_backlash_gain=optional("reference_rule_backlash_gain"),
             reference_tip_backlash_gain=optional("reference_tip_backlash_gain"),
             reference_tip_line_backlash_gain=optional("reference_tip_line_backlash_gain"),
+            reference_release_end_offset_deg=optional("reference_release_end_offset_deg"),
+            reference_release_plateau_deg=optional("reference_release_plateau_deg"),
             other_tip_gain=optional("other_tip_gain"),
             loaded_knee_pos_deg=optional("loaded_knee_pos_deg"),
             loaded_knee_neg_deg=optional("loaded_knee_neg_deg"),

@@ -164,6 +164,19 @@ class DeviceKnob:
     threshold, which a tip that starts back gradually after a reversal (rounded corners) reaches
     early. Where given, :func:`~tsmd.calibration.release_path.ratio_gain` chooses against it
     instead of ``reference_tip_backlash_gain``."""
+    reference_release_end_offset_deg: float | None = None
+    """Optional, tracked on the data-sheet unit (``tsmd datasheet --release-end-offset``,
+    opt-in, session 18): how much farther from the dead zone the tip's release ends (reaches
+    its plateau) than the knob current's release ramp turns flat, both read on the same sweeps
+    (:mod:`tsmd.datasheet_release_end`). Where given, method ours reads each unit's release end
+    from its calibration current (:mod:`tsmd.calibration.release_end`), adds this and draws the
+    release line from the unit's backlash end to there, instead of the product's ratio times
+    the unit's locus slope; None: the ratio."""
+    reference_release_plateau_deg: float | None = None
+    """Optional, tracked with ``reference_release_end_offset_deg`` on the same sweeps: the
+    sheet unit's tip plateau after a release (magnitude, mean of both sides). Where both are
+    given, method ours's plateaus are this (each edge moved along its loaded line) and the
+    release line is drawn to the end at it."""
     other_tip_gain: float | None = None
     """Optional, tracked on the data-sheet unit: how many degrees this knob's tip plane shows per
     degree the other plane's tip is bent (a shaft that winds up in torsion turns the planes into

@@ -9,27 +9,11 @@ from simrig.family import PLANT_ROLE, PLANT_SPECS, SCATTER, family_member
 from simrig.plant import Plant, PlantLoadError, load_plant
 from simrig.plants.ratestate import NODES, RateStatePlant, make_ratestate_plant
 from simrig.plants.ratestate.laws import age_after, aged_friction, wrap_profile_rad
+from tests.support.plant_drive import STEP_S, drive_knob, ramp_deg
 
 SPEC = "simrig.plants.ratestate:make_ratestate_plant"
-DT = 0.004
+DT = STEP_S
 
-
-def _drive(plant: RateStatePlant, knob: int, path: np.ndarray, other_deg: float = 0.0
-           ) -> tuple[np.ndarray, np.ndarray]:
-    """Tip and knob torque of ``knob`` along ``path`` (deg), the other knob held."""
-    tips, torques = np.empty_like(path), np.empty_like(path)
-    cmd = np.zeros(2)
-    cmd[1 - knob] = other_deg
-    for i, q in enumerate(path):
-        cmd[knob] = q
-        step = plant.step(DT, cmd)
-        tips[i], torques[i] = step.tip_deg[knob], step.knob_torque_Nm[knob]
-    return tips, torques
-
-
-def _ramp(a: float, b: float, speed_deg_s: float = 20.0) -> np.ndarray:
-    n = max(2, int(abs(b - a) / (speed_deg_s * DT)))
-    return np.linspace(a, b, n)
 
 
 def test_a_stuck_contact_ages_by_the_time_it_stuck() -> None:
@@ -63,30 +47,30 @@ def test_the_plant_follows_the_protocol_and_loads_by_name() -> None:
 
 
 def test_same_inputs_give_the_same_outputs() -> None:
-    path = np.concatenate([_ramp(0.0, 70.0), _ramp(70.0, -40.0)])
+    path = np.concatenate([ramp_deg(0.0, 70.0), ramp_deg(70.0, -40.0)])
     a, b = make_ratestate_plant(), make_ratestate_plant()
-    assert np.array_equal(_drive(a, 0, path)[0], _drive(b, 0, path)[0])
+    assert np.array_equal(drive_knob(a, 0, path)[0], drive_knob(b, 0, path)[0])
 
 
 def test_reset_returns_to_the_straight_unloaded_state() -> None:
     plant = make_ratestate_plant()
-    fresh = _drive(make_ratestate_plant(), 0, _ramp(0.0, 60.0))
-    _drive(plant, 0, _ramp(0.0, 80.0))
+    fresh = drive_knob(make_ratestate_plant(), 0, ramp_deg(0.0, 60.0))
+    drive_knob(plant, 0, ramp_deg(0.0, 80.0))
     plant.reset()
-    again = _drive(plant, 0, _ramp(0.0, 60.0))
+    again = drive_knob(plant, 0, ramp_deg(0.0, 60.0))
     assert np.allclose(fresh[0], again[0]) and np.allclose(fresh[1], again[1])
 
 
 def test_inside_the_slack_the_tip_stays_straight_and_only_the_knob_bearing_loads() -> None:
     plant = make_ratestate_plant()
-    tips, torques = _drive(plant, 0, _ramp(0.0, 10.0))
+    tips, torques = drive_knob(plant, 0, ramp_deg(0.0, 10.0))
     assert np.max(np.abs(tips)) < 1e-6
     assert np.max(np.abs(plant.tensions_N())) < 1e-6
     assert torques[-1] == pytest.approx(plant.knobs[0].handle_friction_Nm, rel=0.01)
 
 
 def test_pulling_further_bends_the_tip_further() -> None:
-    tips, _ = _drive(make_ratestate_plant(), 0, _ramp(0.0, 90.0))
+    tips, _ = drive_knob(make_ratestate_plant(), 0, ramp_deg(0.0, 90.0))
     loaded = tips[tips > 1.0]
     assert loaded.size > 100 and np.all(np.diff(loaded) > -1e-9)
     assert 60.0 < tips[-1] < 110.0
@@ -94,7 +78,7 @@ def test_pulling_further_bends_the_tip_further() -> None:
 
 def test_while_pulling_the_tension_falls_from_the_drum_to_the_tip() -> None:
     plant = make_ratestate_plant()
-    _drive(plant, 0, _ramp(0.0, 80.0))
+    drive_knob(plant, 0, ramp_deg(0.0, 80.0))
     pos = plant.tensions_N()[0, :NODES + 1]
     assert np.all(np.diff(pos) < 0.0)
     assert pos[0] / pos[-1] > 1.5  # friction along the whole shaft (capstan-like)
@@ -102,9 +86,9 @@ def test_while_pulling_the_tension_falls_from_the_drum_to_the_tip() -> None:
 
 def test_a_reversal_unloads_the_tendon_from_the_drum_inwards() -> None:
     plant = make_ratestate_plant()
-    _drive(plant, 0, _ramp(0.0, 80.0))
+    drive_knob(plant, 0, ramp_deg(0.0, 80.0))
     loaded = plant.tensions_N()[0, :NODES + 1].copy()
-    _drive(plant, 0, _ramp(80.0, 78.0))
+    drive_knob(plant, 0, ramp_deg(80.0, 78.0))
     drop = loaded - plant.tensions_N()[0, :NODES + 1]
     assert drop[0] > 1.0 and drop[-1] < 0.25 * drop[0]  # the tip end still holds its load
     assert np.all(np.diff(drop) <= 1e-9)
@@ -112,8 +96,8 @@ def test_a_reversal_unloads_the_tendon_from_the_drum_inwards() -> None:
 
 def test_the_tip_holds_after_a_reversal_then_returns() -> None:
     plant = make_ratestate_plant()
-    _drive(plant, 0, _ramp(0.0, 90.0))
-    tips, _ = _drive(plant, 0, _ramp(90.0, 0.0))
+    drive_knob(plant, 0, ramp_deg(0.0, 90.0))
+    tips, _ = drive_knob(plant, 0, ramp_deg(90.0, 0.0))
     moved = np.argmax(tips < tips[0] - 1.0)
     held_deg = 90.0 * moved / tips.size
     assert 4.0 < held_deg < 25.0
@@ -122,8 +106,8 @@ def test_the_tip_holds_after_a_reversal_then_returns() -> None:
 
 def test_a_closed_knob_cycle_dissipates_energy() -> None:
     plant = make_ratestate_plant(knobs=[{"handle_friction_Nm": 0.0}] * 2)
-    path = np.concatenate([_ramp(0.0, 90.0), _ramp(90.0, -90.0), _ramp(-90.0, 0.0)])
-    _, torques = _drive(plant, 0, path)
+    path = np.concatenate([ramp_deg(0.0, 90.0), ramp_deg(90.0, -90.0), ramp_deg(-90.0, 0.0)])
+    _, torques = drive_knob(plant, 0, path)
     work_J = float(np.sum(0.5 * (torques[1:] + torques[:-1]) * np.radians(np.diff(path))))
     assert work_J > 0.0
 
@@ -131,27 +115,27 @@ def test_a_closed_knob_cycle_dissipates_energy() -> None:
 def test_static_friction_grows_with_the_time_the_tendon_stood_still() -> None:
     def resume_torque(dwell_s: float) -> float:
         plant = make_ratestate_plant()
-        _drive(plant, 0, _ramp(0.0, 60.0))
-        _drive(plant, 0, np.full(int(dwell_s / DT) + 1, 60.0))
-        _, torques = _drive(plant, 0, _ramp(60.0, 64.0))
+        drive_knob(plant, 0, ramp_deg(0.0, 60.0))
+        drive_knob(plant, 0, np.full(int(dwell_s / DT) + 1, 60.0))
+        _, torques = drive_knob(plant, 0, ramp_deg(60.0, 64.0))
         return float(np.max(torques))
 
     assert resume_torque(60.0) > resume_torque(0.0) + 1e-3
 
 
 def test_bending_the_other_plane_adds_friction_to_this_one() -> None:
-    path = _ramp(0.0, 80.0)
-    _, straight = _drive(make_ratestate_plant(), 0, path)
+    path = ramp_deg(0.0, 80.0)
+    _, straight = drive_knob(make_ratestate_plant(), 0, path)
     bent = make_ratestate_plant()
-    _drive(bent, 1, _ramp(0.0, 80.0))
-    _, coupled = _drive(bent, 0, path, other_deg=80.0)
+    drive_knob(bent, 1, ramp_deg(0.0, 80.0))
+    _, coupled = drive_knob(bent, 0, path, other_deg=80.0)
     assert coupled[-1] > straight[-1] * 1.01
 
 
 def test_a_curved_shaft_needs_more_torque_and_bends_the_tip_less() -> None:
-    path = _ramp(0.0, 90.0)
-    tip_s, tau_s = _drive(make_ratestate_plant(), 0, path)
-    tip_c, tau_c = _drive(make_ratestate_plant(sheath_curvature_deg=120.0), 0, path)
+    path = ramp_deg(0.0, 90.0)
+    tip_s, tau_s = drive_knob(make_ratestate_plant(), 0, path)
+    tip_c, tau_c = drive_knob(make_ratestate_plant(sheath_curvature_deg=120.0), 0, path)
     assert tau_c[-1] > tau_s[-1] and tip_c[-1] < tip_s[-1]
 
 
@@ -188,11 +172,11 @@ def test_bad_step_input_is_refused() -> None:
 
 
 def test_more_slack_mid_run_widens_the_dead_zone() -> None:
-    path = _ramp(0.0, 45.0)
+    path = ramp_deg(0.0, 45.0)
     plain, slackened = make_ratestate_plant(), make_ratestate_plant()
     slackened.reshape(slack_delta_mm=((0.5, 0.5), (0.5, 0.5)))
-    tip_plain, _ = _drive(plain, 0, path)
-    tip_slack, _ = _drive(slackened, 0, path)
+    tip_plain, _ = drive_knob(plain, 0, path)
+    tip_slack, _ = drive_knob(slackened, 0, path)
     assert tip_slack[-1] < tip_plain[-1] - 2.0
 
 
@@ -200,8 +184,8 @@ def test_bending_the_shaft_mid_run_adds_friction() -> None:
     plant = make_ratestate_plant()
     plant.reshape(sheath_curvature_deg=120.0)
     assert plant.sheath_curvature_deg == 120.0
-    _, bent = _drive(plant, 0, _ramp(0.0, 80.0))
-    _, straight = _drive(make_ratestate_plant(), 0, _ramp(0.0, 80.0))
+    _, bent = drive_knob(plant, 0, ramp_deg(0.0, 80.0))
+    _, straight = drive_knob(make_ratestate_plant(), 0, ramp_deg(0.0, 80.0))
     assert bent[-1] > straight[-1]
 
 

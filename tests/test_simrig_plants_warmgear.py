@@ -17,27 +17,11 @@ from simrig.plants.warmgear.laws import (
     shaft_temperature_C,
     viscosity_factor,
 )
+from tests.support.plant_drive import STEP_S, drive_knob, ramp_deg
 
 SPEC = "simrig.plants.warmgear:make_warmgear_plant"
-DT = 0.004
+DT = STEP_S
 
-
-def _drive(plant: WarmGearPlant, knob: int, path: np.ndarray, other_deg: float = 0.0
-           ) -> tuple[np.ndarray, np.ndarray]:
-    """Tip and knob torque of ``knob`` along ``path`` (deg), the other knob held."""
-    tips, torques = np.empty_like(path), np.empty_like(path)
-    cmd = np.zeros(2)
-    cmd[1 - knob] = other_deg
-    for i, q in enumerate(path):
-        cmd[knob] = q
-        step = plant.step(DT, cmd)
-        tips[i], torques[i] = step.tip_deg[knob], step.knob_torque_Nm[knob]
-    return tips, torques
-
-
-def _ramp(a: float, b: float, speed_deg_s: float = 20.0) -> np.ndarray:
-    n = max(2, int(abs(b - a) / (speed_deg_s * DT)))
-    return np.linspace(a, b, n)
 
 
 def test_the_shaft_warms_from_room_towards_body_temperature() -> None:
@@ -69,15 +53,15 @@ def test_the_plant_follows_the_protocol_and_loads_by_name() -> None:
 
 
 def test_same_inputs_give_the_same_outputs() -> None:
-    path = _ramp(0.0, 80.0)
-    a = _drive(make_warmgear_plant(), 0, path)
-    b = _drive(make_warmgear_plant(), 0, path)
+    path = ramp_deg(0.0, 80.0)
+    a = drive_knob(make_warmgear_plant(), 0, path)
+    b = drive_knob(make_warmgear_plant(), 0, path)
     assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
 
 
 def test_reset_returns_to_the_straight_unloaded_cold_state() -> None:
     plant = make_warmgear_plant()
-    _drive(plant, 0, _ramp(0.0, 80.0))
+    drive_knob(plant, 0, ramp_deg(0.0, 80.0))
     plant.reset()
     assert plant.t_s == 0.0 and plant.temperature_C == pytest.approx(22.0)
     assert np.all(plant.tensions_N() == 0.0)
@@ -86,7 +70,7 @@ def test_reset_returns_to_the_straight_unloaded_cold_state() -> None:
 
 def test_inside_the_slack_the_tip_stays_straight_and_only_the_handle_loads() -> None:
     """The knob seal, then (past the gear's play) the drum bearing through the mesh."""
-    tip, torque = _drive(make_warmgear_plant(), 0, _ramp(0.0, 8.0))
+    tip, torque = drive_knob(make_warmgear_plant(), 0, ramp_deg(0.0, 8.0))
     p = NOMINAL_KNOBS[0]
     handle_Nm = p.handle_friction_Nm + 1.2 * p.drum_friction_Nmm / 1000.0 * (
         p.pinion_teeth / p.drum_teeth)
@@ -96,8 +80,8 @@ def test_inside_the_slack_the_tip_stays_straight_and_only_the_handle_loads() -> 
 
 
 def test_pulling_further_bends_the_tip_further_and_less_than_the_geometry_allows() -> None:
-    path = _ramp(0.0, 90.0)
-    tip, _ = _drive(make_warmgear_plant(), 0, path)
+    path = ramp_deg(0.0, 90.0)
+    tip, _ = drive_knob(make_warmgear_plant(), 0, path)
     p = NOMINAL_KNOBS[0]
     geometric = 90.0 * p.pulley_radius_mm * p.pinion_teeth / p.drum_teeth / p.tendon_offset_mm
     assert tip[-1] > tip[len(tip) // 2] > 0.0
@@ -105,16 +89,16 @@ def test_pulling_further_bends_the_tip_further_and_less_than_the_geometry_allows
 
 
 def test_a_closed_knob_cycle_dissipates_energy() -> None:
-    path = np.concatenate([_ramp(0.0, 90.0), _ramp(90.0, -90.0), _ramp(-90.0, 0.0)])
-    _, torque = _drive(make_warmgear_plant(), 0, path)
+    path = np.concatenate([ramp_deg(0.0, 90.0), ramp_deg(90.0, -90.0), ramp_deg(-90.0, 0.0)])
+    _, torque = drive_knob(make_warmgear_plant(), 0, path)
     work_J = float(np.sum(torque[1:] * np.diff(np.radians(path))))
     assert work_J > 0.0
 
 
 def test_the_tip_holds_after_a_reversal_then_returns() -> None:
     plant = make_warmgear_plant()
-    tip_up, _ = _drive(plant, 0, _ramp(0.0, 80.0))
-    tip_back, _ = _drive(plant, 0, _ramp(80.0, 0.0))
+    tip_up, _ = drive_knob(plant, 0, ramp_deg(0.0, 80.0))
+    tip_back, _ = drive_knob(plant, 0, ramp_deg(80.0, 0.0))
     held = tip_back[: len(tip_back) // 40]  # the first 2 deg of knob travel back
     # it does not return yet; the film's shear, no longer dragging, lets it settle on (0.5 deg
     # after a 20 deg/s pull on the nominal unit)
@@ -126,45 +110,45 @@ def test_warming_in_the_body_takes_up_slack_and_narrows_the_dead_zone() -> None:
     cold, warm = make_warmgear_plant(), make_warmgear_plant()
     for _ in range(int(600.0 / 0.1)):
         warm.step(0.1, np.zeros(2))
-    path = _ramp(0.0, 30.0)
-    tip_cold, _ = _drive(cold, 0, path)
-    tip_warm, _ = _drive(warm, 0, path)
+    path = ramp_deg(0.0, 30.0)
+    tip_cold, _ = drive_knob(cold, 0, path)
+    tip_warm, _ = drive_knob(warm, 0, path)
     assert warm.temperature_C > 36.0
     assert tip_warm[-1] > tip_cold[-1] + 1.0
 
 
 def test_the_right_left_plane_is_the_softer_one() -> None:
     assert NOMINAL_KNOBS[1].bend_stiffness_Nm_per_rad < NOMINAL_KNOBS[0].bend_stiffness_Nm_per_rad
-    a, _ = _drive(make_warmgear_plant(knobs=[{}, {}]), 0, _ramp(0.0, 70.0))
+    a, _ = drive_knob(make_warmgear_plant(knobs=[{}, {}]), 0, ramp_deg(0.0, 70.0))
     soft = NOMINAL_KNOBS[1].bend_stiffness_Nm_per_rad
-    b, _ = _drive(make_warmgear_plant(knobs=[{"bend_stiffness_Nm_per_rad": soft}, {}]), 0,
-                  _ramp(0.0, 70.0))
+    b, _ = drive_knob(make_warmgear_plant(knobs=[{"bend_stiffness_Nm_per_rad": soft}, {}]), 0,
+                  ramp_deg(0.0, 70.0))
     assert b[-1] > a[-1]
 
 
 def test_bending_the_other_plane_adds_friction_to_this_one() -> None:
-    path = _ramp(0.0, 80.0)
+    path = ramp_deg(0.0, 80.0)
     plain = make_warmgear_plant()
-    _, alone = _drive(plain, 0, path)
+    _, alone = drive_knob(plain, 0, path)
     bent = make_warmgear_plant()
-    _drive(bent, 1, _ramp(0.0, 80.0))
-    _, coupled = _drive(bent, 0, path, other_deg=80.0)
+    drive_knob(bent, 1, ramp_deg(0.0, 80.0))
+    _, coupled = drive_knob(bent, 0, path, other_deg=80.0)
     assert coupled[-1] > alone[-1]
 
 
 def test_a_curved_shaft_needs_more_torque_and_bends_the_tip_less() -> None:
-    path = _ramp(0.0, 90.0)
-    tip_s, tau_s = _drive(make_warmgear_plant(), 0, path)
-    tip_c, tau_c = _drive(make_warmgear_plant(sheath_curvature_deg=120.0), 0, path)
+    path = ramp_deg(0.0, 90.0)
+    tip_s, tau_s = drive_knob(make_warmgear_plant(), 0, path)
+    tip_c, tau_c = drive_knob(make_warmgear_plant(sheath_curvature_deg=120.0), 0, path)
     assert tau_c[-1] > tau_s[-1] and tip_c[-1] < tip_s[-1]
 
 
 def test_more_slack_mid_run_widens_the_dead_zone() -> None:
-    path = _ramp(0.0, 45.0)
+    path = ramp_deg(0.0, 45.0)
     plain, slackened = make_warmgear_plant(), make_warmgear_plant()
     slackened.reshape(slack_delta_mm=((0.5, 0.5), (0.5, 0.5)))
-    tip_plain, _ = _drive(plain, 0, path)
-    tip_slack, _ = _drive(slackened, 0, path)
+    tip_plain, _ = drive_knob(plain, 0, path)
+    tip_slack, _ = drive_knob(slackened, 0, path)
     assert tip_slack[-1] < tip_plain[-1] - 2.0
 
 

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from support.profiles import DEVICE
+from support.profiles import assert_sheet_knob_field_round_trips
 
 from tsmd.calibration.release_end import end_ratio, read_release_end, release_end_ratio
 from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
@@ -16,11 +16,7 @@ from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import release_line
 from tsmd.profile import (
     DeviceKnob,
-    ProfileError,
     ReferencePoint,
-    device_model_from_mapping,
-    device_model_to_mapping,
-    load_device_model,
 )
 
 PERIOD_S = 0.004
@@ -108,14 +104,4 @@ def test_with_the_sheets_offset_the_fitted_release_reaches_the_plateau_at_the_en
 
 
 def test_the_sheets_offset_round_trips_and_is_range_checked() -> None:
-    data = device_model_to_mapping(load_device_model(DEVICE))
-    data["knobs"]["phi1"]["reference_release_end_offset_deg"] = 0.9
-    device = device_model_from_mapping(data)
-    assert device.knobs[0].reference_release_end_offset_deg == 0.9
-    assert device.knobs[1].reference_release_end_offset_deg is None
-    out = device_model_to_mapping(device)["knobs"]
-    assert out["phi1"]["reference_release_end_offset_deg"] == 0.9
-    assert "reference_release_end_offset_deg" not in out["phi2"]
-    data["knobs"]["phi1"]["reference_release_end_offset_deg"] = 30.0
-    with pytest.raises(ProfileError, match=r"knobs.phi1.reference_release_end_offset_deg"):
-        device_model_from_mapping(data)
+    assert_sheet_knob_field_round_trips("reference_release_end_offset_deg", 0, 0.9, 30.0)

@@ -7,18 +7,14 @@ import dataclasses
 import math
 
 import pytest
-from support.profiles import DEVICE
+from support.profiles import assert_sheet_knob_field_round_trips
 
 from tsmd.calibration.release_path import ratio_gain, release_slope_ratio
 from tsmd.compensation.safety import KnobLimits
 from tsmd.datasheet_amplitude import backlash_growth
 from tsmd.profile import (
     DeviceKnob,
-    ProfileError,
     ReferencePoint,
-    device_model_from_mapping,
-    device_model_to_mapping,
-    load_device_model,
 )
 
 SETTLE, RULE, OMEGA, RELEASE = 0.2, 0.16, 1.32, 1.51
@@ -55,15 +51,7 @@ def test_a_sheet_without_the_rule_gain_keeps_the_settle_reading() -> None:
 
 
 def test_the_tip_gain_round_trips_and_is_range_checked() -> None:
-    data = device_model_to_mapping(load_device_model(DEVICE))
-    data["knobs"]["phi1"]["reference_tip_backlash_gain"] = 0.126
-    device = device_model_from_mapping(data)
-    assert device.knobs[0].reference_tip_backlash_gain == 0.126
-    assert device.knobs[1].reference_tip_backlash_gain is None
-    assert device_model_to_mapping(device)["knobs"]["phi1"]["reference_tip_backlash_gain"] == 0.126
-    data["knobs"]["phi1"]["reference_tip_backlash_gain"] = -0.1
-    with pytest.raises(ProfileError, match=r"knobs.phi1.reference_tip_backlash_gain"):
-        device_model_from_mapping(data)
+    assert_sheet_knob_field_round_trips("reference_tip_backlash_gain", 0, 0.126, -0.1)
 
 
 def test_the_tip_gain_is_the_mean_backlash_growth_per_degree_of_amplitude() -> None:
@@ -87,14 +75,4 @@ def test_a_line_read_tip_gain_alone_chooses_the_gain() -> None:
 
 
 def test_the_line_read_tip_gain_round_trips_and_is_range_checked() -> None:
-    data = device_model_to_mapping(load_device_model(DEVICE))
-    data["knobs"]["phi2"]["reference_tip_line_backlash_gain"] = 0.173
-    device = device_model_from_mapping(data)
-    assert device.knobs[1].reference_tip_line_backlash_gain == 0.173
-    assert device.knobs[0].reference_tip_line_backlash_gain is None
-    mapping = device_model_to_mapping(device)["knobs"]
-    assert mapping["phi2"]["reference_tip_line_backlash_gain"] == 0.173
-    assert "reference_tip_line_backlash_gain" not in mapping["phi1"]
-    data["knobs"]["phi2"]["reference_tip_line_backlash_gain"] = 0.9
-    with pytest.raises(ProfileError, match=r"knobs.phi2.reference_tip_line_backlash_gain"):
-        device_model_from_mapping(data)
+    assert_sheet_knob_field_round_trips("reference_tip_line_backlash_gain", 1, 0.173, 0.9)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from support.profiles import DEVICE, make_profile
+from support.profiles import assert_sheet_knob_field_round_trips, make_profile
 
 from tsmd.calibration.release_path import release_slope_ratio, release_through_amplitude
 from tsmd.calibration.tension_play_fit import (
@@ -35,9 +35,6 @@ from tsmd.profile import (
     DeviceKnob,
     ProfileError,
     ReferencePoint,
-    device_model_from_mapping,
-    device_model_to_mapping,
-    load_device_model,
     load_profile,
     profile_to_mapping,
     save_profile,
@@ -207,16 +204,7 @@ def test_unit_omega_stays_within_the_plausible_slopes() -> None:
 
 
 def test_data_sheets_backlash_gain_round_trips_and_is_range_checked() -> None:
-    data = device_model_to_mapping(load_device_model(DEVICE))
-    data["knobs"]["phi1"]["reference_backlash_gain"] = 0.25
-    data["knobs"]["phi2"].pop("reference_backlash_gain", None)
-    device = device_model_from_mapping(data)
-    assert device.knobs[0].reference_backlash_gain == 0.25
-    assert device.knobs[1].reference_backlash_gain is None  # an older sheet: per-product omega
-    assert device_model_to_mapping(device)["knobs"]["phi1"]["reference_backlash_gain"] == 0.25
-    data["knobs"]["phi1"]["reference_backlash_gain"] = 1.5
-    with pytest.raises(ProfileError, match=r"knobs.phi1.reference_backlash_gain"):
-        device_model_from_mapping(data)
+    assert_sheet_knob_field_round_trips("reference_backlash_gain", 0, 0.25, 1.5)
 
 
 def test_sweep_too_small_for_the_dead_zone_is_refused_naming_it() -> None:

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from support.plant_drive import STEP_S, drive_knob, ramp_deg
 
 from simrig.family import PLANT_ROLE, PLANT_SPECS, SCATTER, family_member
 from simrig.plant import Plant, PlantLoadError, load_plant
 from simrig.plants.ratestate import NODES, RateStatePlant, make_ratestate_plant
 from simrig.plants.ratestate.laws import age_after, aged_friction, wrap_profile_rad
-from tests.support.plant_drive import STEP_S, drive_knob, ramp_deg
 
 SPEC = "simrig.plants.ratestate:make_ratestate_plant"
 DT = STEP_S

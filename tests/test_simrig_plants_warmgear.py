@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from support.plant_drive import STEP_S, drive_knob, ramp_deg
 
 from simrig.family import PLANT_ROLE, PLANT_SPECS, SCATTER, family_member
 from simrig.plant import Plant, PlantLoadError, load_plant
@@ -17,7 +18,6 @@ from simrig.plants.warmgear.laws import (
     shaft_temperature_C,
     viscosity_factor,
 )
-from tests.support.plant_drive import STEP_S, drive_knob, ramp_deg
 
 SPEC = "simrig.plants.warmgear:make_warmgear_plant"
 DT = STEP_S

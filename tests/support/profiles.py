@@ -5,8 +5,18 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
+import pytest
+
 from tsmd.compensation.tension_play import TensionPlayParams
-from tsmd.profile import CatheterProfile, KnobProfile, load_device_model, make_knob_profile
+from tsmd.profile import (
+    CatheterProfile,
+    KnobProfile,
+    ProfileError,
+    device_model_from_mapping,
+    device_model_to_mapping,
+    load_device_model,
+    make_knob_profile,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 DEVICE = ROOT / "profiles" / "devices" / "sim-catheter.yaml"
@@ -34,3 +44,22 @@ def make_profile(catheter_id: str = "sim-001", d0: float = 20.0) -> CatheterProf
     return CatheterProfile(catheter_id, device.device_model, "2026-11-22T03:00:00Z",
                            "tsmd 0.1.0", "pchip", (knobs[0], knobs[1]),
                            quality={"cycle_agreement_deg": 0.4})
+
+
+def assert_sheet_knob_field_round_trips(name: str, knob: int, value: float, outside: float
+                                        ) -> None:
+    """An optional per-knob data-sheet field: set on ``knob`` alone it loads there and nowhere
+    else, is written back only there, and ``outside`` its range is refused naming the key."""
+    knob_key, other_key = ("phi1", "phi2") if knob == 0 else ("phi2", "phi1")
+    data = device_model_to_mapping(load_device_model(DEVICE))
+    data["knobs"][knob_key][name] = value
+    data["knobs"][other_key].pop(name, None)
+    device = device_model_from_mapping(data)
+    assert getattr(device.knobs[knob], name) == value
+    assert getattr(device.knobs[1 - knob], name) is None
+    written = device_model_to_mapping(device)["knobs"]
+    assert written[knob_key][name] == value
+    assert name not in written[other_key]
+    data["knobs"][knob_key][name] = outside
+    with pytest.raises(ProfileError, match=rf"knobs.{knob_key}.{name}"):
+        device_model_from_mapping(data)

@@ -134,7 +134,10 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     end = max(3 * min_size, yg.size - round(opts.edge_margin_deg / step))
     pieces = linear_pieces(yg[:end], noise, opts)
     flat = flat_pieces(yg[:end], step, pieces, opts)
-    plateau_run = None if flat is None else constant_phase(pieces, flat, step, opts)
+    current = data.current_filtered_A
+    loaded_swing = 0.5 * float(np.nanmax(current) - np.nanmin(current))
+    plateau_run = (None if flat is None
+                   else constant_phase(pieces, flat, step, opts, yg[:end], loaded_swing))
     if plateau_run is None:
         plateau_run = (0, end)
         problems.append(f"{where}: no stretch of constant current")

@@ -46,16 +46,26 @@ def flat_pieces(yg: FloatArray, step: float, pieces: list[tuple[int, int]],
 
 
 def constant_phase(pieces: list[tuple[int, int]], flat: list[bool], step: float,
-             opts: IdentifyOptions) -> tuple[int, int] | None:
+                   opts: IdentifyOptions, yg: FloatArray | None = None,
+                   loaded_swing: float | None = None) -> tuple[int, int] | None:
     """The constant-current stretch before the dead-zone edge (start, stop on the grid): the last
     run of flat pieces at least ``min_level_deg`` long (else the longest run).
 
     Not simply the longest: the release level after a reversal is flat too, and where the tip
     re-enters the dead zone the released tendon drops its last tension, a short step that cuts
     the two apart; the release run can then be the longer one (fast sweeps, phi2 at +90 deg).
+    Nor a run on the loaded branch: a geared handle's current climbs in steps (one per tooth
+    of mesh), flat between them. With the current ``yg`` and the knob's ``loaded_swing`` (half
+    the sweep's current range), a run standing more than half that swing above the lowest long
+    run is loaded, not slack, and is passed over.
     """
     runs = flat_runs(pieces, flat)
     long_enough = [r for r in runs if (r[1] - r[0]) * step >= opts.min_level_deg]
+    if long_enough and yg is not None and loaded_swing is not None:
+        levels = [float(np.median(yg[a:b])) for a, b in long_enough]
+        slack = min(levels)
+        long_enough = [r for r, level in zip(long_enough, levels, strict=True)
+                       if level - slack <= 0.5 * loaded_swing]
     if long_enough:
         return long_enough[-1]
     return max(runs, key=lambda r: r[1] - r[0], default=None)

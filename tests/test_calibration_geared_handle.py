@@ -43,22 +43,25 @@ def test_a_geared_handles_loaded_steps_are_not_taken_for_the_dead_zone(
         assert max(abs(v - getattr(truth, name)) for v in result.values[name]) < 8.0, name
 
 
+def _two_flat_runs(low_A: float, high_A: float) -> tuple[list[tuple[int, int]], np.ndarray]:
+    """Pieces and current on the grid: 20 deg flat at ``low_A``, a ramp, 20 deg flat at
+    ``high_A``."""
+    n = round(20.0 / IdentifyOptions().grid_step_deg)
+    yg = np.concatenate([np.full(n, low_A), np.linspace(low_A, high_A, n), np.full(n, high_A)])
+    return [(0, n), (n, 2 * n), (2 * n, 3 * n)], yg
+
+
 def test_a_flat_run_far_above_the_slack_level_is_passed_over() -> None:
     opts = IdentifyOptions()
-    step = opts.grid_step_deg
-    n = round(20.0 / step)
-    yg = np.concatenate([np.full(n, 0.02), np.linspace(0.02, 0.15, n), np.full(n, 0.15)])
-    pieces = [(0, n), (n, 2 * n), (2 * n, 3 * n)]
+    pieces, yg = _two_flat_runs(0.02, 0.15)
     flat = [True, False, True]
-    assert constant_phase(pieces, flat, step, opts) == (2 * n, 3 * n)
-    assert constant_phase(pieces, flat, step, opts, yg, loaded_swing=0.16) == (0, n)
+    assert constant_phase(pieces, flat, opts.grid_step_deg, opts) == pieces[2]
+    assert constant_phase(pieces, flat, opts.grid_step_deg, opts, yg,
+                          loaded_swing=0.16) == pieces[0]
 
 
 def test_flat_runs_near_the_slack_level_keep_the_last_one() -> None:
     opts = IdentifyOptions()
-    step = opts.grid_step_deg
-    n = round(20.0 / step)
-    yg = np.concatenate([np.full(n, 0.016), np.linspace(0.016, 0.034, n), np.full(n, 0.034)])
-    pieces = [(0, n), (n, 2 * n), (2 * n, 3 * n)]
-    assert constant_phase(pieces, [True, False, True], step, opts, yg,
-                          loaded_swing=0.16) == (2 * n, 3 * n)
+    pieces, yg = _two_flat_runs(0.016, 0.034)
+    assert constant_phase(pieces, [True, False, True], opts.grid_step_deg, opts, yg,
+                          loaded_swing=0.16) == pieces[2]

@@ -84,8 +84,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--release-end-offset", action="store_true",
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "where the release ends in the current and on the tip; method ours "
-                             "then "
-                             "draws each unit's release line to the end its current shows "
+                             "then draws each unit's release line to the end its current shows "
                              "(opt-in per product, docs/model.md Session 18)")
     parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
                         metavar="LIST",

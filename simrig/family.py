@@ -15,8 +15,8 @@ the coilpipe plant (session 10, written blind) is held out now, the stickslip pl
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
 now, the helixbelt plant (session 15, written blind) is held out now, the ratestate plant
-(session 16, written blind) is held out now, the warmgear plant (session 18) is the blind one
-(``PLANT_ROLE``). ``SCATTER`` lives in
+(session 16, written blind) is held out now, the warmgear plant (session 18) is the blind one,
+the archwave plant (session 19, written blind) is blind too (``PLANT_ROLE``). ``SCATTER`` lives in
 :mod:`simrig.family_scatter`.
 """
 
@@ -32,6 +32,7 @@ import numpy as np
 from simrig.family_scatter import SCATTER
 from simrig.motor import MotorParams
 from simrig.plant import Plant, PlantLoadError, load_plant
+from simrig.plants.archwave import NOMINAL_KNOBS as ARCHWAVE_KNOBS
 from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
 from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
 from simrig.plants.helixbelt import NOMINAL_KNOBS as HELIXBELT_KNOBS
@@ -56,12 +57,13 @@ PLANT_SPECS: dict[str, str] = {
     "nitinol": "simrig.plants.nitinol:make_nitinol_plant",
     "helixbelt": "simrig.plants.helixbelt:make_helixbelt_plant",
     "ratestate": "simrig.plants.ratestate:make_ratestate_plant",
-    "warmgear": "simrig.plants.warmgear:make_warmgear_plant",  # last: the others' seeds hold
+    "warmgear": "simrig.plants.warmgear:make_warmgear_plant",
+    "archwave": "simrig.plants.archwave:make_archwave_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
-              "ratestate": "held-out", "warmgear": "blind"}
+              "ratestate": "held-out", "warmgear": "blind", "archwave": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -76,7 +78,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "nitinol": NITINOL_KNOBS,
                                         "helixbelt": HELIXBELT_KNOBS,
                                         "ratestate": RATESTATE_KNOBS,
-                                        "warmgear": WARMGEAR_KNOBS}
+                                        "warmgear": WARMGEAR_KNOBS,
+                                        "archwave": ARCHWAVE_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -139,6 +142,8 @@ VARIANTS: dict[str, Variant] = {
             "warmgear": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                          "handle_friction_Nm": 1.5, "mesh_friction": 1.5,
                          "gear_play_deg": 1.5},
+            "archwave": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                         "handle_friction_Nm": 1.5, "wave_drag_Nm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -163,7 +168,8 @@ VARIANTS: dict[str, Variant] = {
                  "nitinol": {"tendon_stiffness_N": 0.4},
                  "helixbelt": {"tendon_stiffness_N": 0.4},
                  "ratestate": {"tendon_stiffness_N": 0.4},
-                 "warmgear": {"tendon_stiffness_N": 0.4}},
+                 "warmgear": {"tendon_stiffness_N": 0.4},
+                 "archwave": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

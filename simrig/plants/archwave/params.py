@@ -32,18 +32,18 @@ class ArchWaveKnob:
     thermal_time_s: float = 240.0
     """Winding and housing: one thermal node."""
     winding_resistance_ohm: float = 5.2
-    cogging_mNm: float = 0.10
+    cogging_mNm: float = 0.06
     """Peak cogging torque at the motor shaft."""
     cogging_per_rev: float = 18.0
     """Cogging periods per motor revolution (LCM of 9 slots, 6 poles)."""
     gear_ratio: float = 50.0
     """Strain-wave gearhead ratio (the drive's gear_ratio)."""
     # strain-wave gearhead (polymer flexspline), at its output
-    flex_stiffness_Nm_per_rad: float = 10.0
+    flex_stiffness_Nm_per_rad: float = 5.0
     flex_stiffening_Nm_per_rad3: float = 2000.0
     flex_elastic_share: float = 0.6
     """Share of the small-twist stiffness that is elastic; the rest is Bouc-Wen hysteresis."""
-    flex_hysteresis_deg: float = 0.5
+    flex_hysteresis_deg: float = 2.0
     """Twist at which the hysteretic part saturates (tooth-flank micro-slip)."""
     kinematic_error_deg: float = 0.15
     """Peak transmission error, twice per output revolution."""
@@ -52,38 +52,38 @@ class ArchWaveKnob:
     """Wave-generator bearing and tooth rubbing (Coulomb, at the output)."""
     wave_viscous_Nm_s_per_rad: float = 0.004
     # handle: drum and spring-loaded tensioners
-    pulley_radius_mm: float = 9.0
+    pulley_radius_mm: float = 7.5
     handle_friction_Nm: float = 0.012
     """Knob shaft seal on the catheter's handle."""
-    tensioner_preload_N: float = 0.4
-    tensioner_rate_N_per_mm: float = 0.05
+    tensioner_preload_N: float = 0.08
+    tensioner_rate_N_per_mm: float = 0.01
     """Soft spring of the idler, as seen by the tendon."""
-    slack_pos_mm: float = 2.6
+    slack_pos_mm: float = 2.4
     """Idler travel the drum takes up before the idler bottoms out (pos tendon)."""
-    slack_neg_mm: float = 2.6
+    slack_neg_mm: float = 2.4
     tensioner_reserve_mm: float = 5.0
     """Idler travel the other way before it rests on its outer stop (the tendon goes slack)."""
     # tendons in coil sheaths
-    tendon_stiffness_N: float = 9000.0
+    tendon_stiffness_N: float = 20000.0
     """EA of the steel wire rope."""
     sheath_length_m: float = 1.1
     free_length_m: float = 0.1
-    coil_compliance_mm_per_N: float = 0.04
+    coil_compliance_mm_per_N: float = 0.09
     """Coil sheath shortening under the tendon's load (gaps closing between turns)."""
-    sheath_friction: float = 0.07
+    sheath_friction: float = 0.16
     sheath_wrap_deg: float = 90.0
     """The shaft's lay outside the two path bends (its own gentle turns)."""
-    sheath_drag_N: float = 0.15
+    sheath_drag_N: float = 0.02
     coil_clearance_mm: float = 0.10
     """Radial play of the tendon in its coil: a bend shortens the tendon's path by it."""
     lumen_offset_mm: float = 0.25
     """Offset of the coil bundle from the shaft's neutral axis."""
     # bending section
     tendon_offset_mm: float = 4.5
-    bend_stiffness_Nm_per_rad: float = 0.021
-    bend_stiffening_per_rad2: float = 0.25
+    bend_stiffness_Nm_per_rad: float = 0.015
+    bend_stiffening_per_rad2: float = 0.10
     """Cover strain-hardening with the total bend (both planes)."""
-    section_wrap_share: float = 1.0
+    section_wrap_share: float = 0.5
     """Share of the section's total bend that adds to every tendon's wrap."""
 
 

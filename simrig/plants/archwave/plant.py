@@ -46,37 +46,57 @@ _SPEED_SCALE_RAD_S = math.radians(2.0)
 """Speed over which Coulomb drags build up (tanh smoothing)."""
 
 
+def _tendon(e_mm: float, slack_mm: float, k: ArchWaveKnob, c_free: float, c_sheath: float,
+            g: float, td_prev: float) -> tuple[float, float, float]:
+    """Proximal and distal tension (N) of one tendon drawn in by ``e_mm`` past its rest, and
+    the distal tension's slope d(T_d)/de (N/mm).
+
+    Past the idler's stop the tendon stretches with its mean tension: the free length with the
+    proximal tension, the sheathed length with the mean of the two ends. The coil's friction
+    holds the distal tension inside ``[T_p / g - drag, T_p * g + drag]``: inside, it sticks
+    (the tip holds while the proximal tension changes: backlash); on an edge it slides.
+    """
+    drag = k.sheath_drag_N
+    floor = k.tensioner_preload_N + k.tensioner_rate_N_per_mm * slack_mm
+    if e_mm <= slack_mm:
+        tp, dtp = tensioner_tension(e_mm, slack_mm, k.tensioner_preload_N,
+                                    k.tensioner_rate_N_per_mm, k.tensioner_reserve_mm,
+                                    1.0 / (c_free + c_sheath))
+        lo, hi = max(0.0, tp / g - drag), tp * g + drag
+        if td_prev < lo:
+            return tp, lo, (dtp / g if lo > 0.0 else 0.0)
+        if td_prev > hi:
+            return tp, hi, dtp * g
+        return tp, td_prev, 0.0
+    stretch = e_mm - slack_mm
+    c = c_free + 0.5 * c_sheath
+    tp = floor + (stretch - 0.5 * c_sheath * (td_prev - floor)) / c
+    lo, hi = max(0.0, tp / g - drag), tp * g + drag
+    if lo <= td_prev <= hi:
+        return tp, td_prev, 0.0
+    if td_prev < lo:  # drawn in: the tendon slides towards the handle
+        slope = 1.0 / (c + 0.5 * c_sheath / g)
+        tp = floor + slope * (stretch + 0.5 * c_sheath * (drag + floor * (1.0 - 1.0 / g)))
+        return tp, max(0.0, tp / g - drag), slope / g
+    slope = 1.0 / (c + 0.5 * c_sheath * g)  # released: it slides back towards the tip
+    tp = floor + slope * (stretch - 0.5 * c_sheath * (drag - floor * (1.0 - g)))
+    return max(tp, floor), g * max(tp, floor) + drag, slope * g
+
+
 def _tip_residual(theta: float, k: ArchWaveKnob, other: float, drum_mm: float,
-                  free_pos: float, free_neg: float, g: float, stiff: float,
+                  free_pos: float, free_neg: float, g: float, c_free: float, c_sheath: float,
                   td_pos: float, td_neg: float) -> tuple[float, float, float, float, float, float]:
     """Moment balance of the section at tip angle ``theta`` (rad): residual (N m), its slope,
     and the tendons' proximal and distal tensions (N) it implies."""
     rho = k.tendon_offset_mm
-    e_pos = drum_mm - rho * theta - free_pos
-    e_neg = -drum_mm + rho * theta - free_neg
-    tp_pos, dp_pos = tensioner_tension(e_pos, k.slack_pos_mm, k.tensioner_preload_N,
-                                       k.tensioner_rate_N_per_mm, k.tensioner_reserve_mm, stiff)
-    tp_neg, dp_neg = tensioner_tension(e_neg, k.slack_neg_mm, k.tensioner_preload_N,
-                                       k.tensioner_rate_N_per_mm, k.tensioner_reserve_mm, stiff)
-    drag = k.sheath_drag_N
-    slope = 0.0
-    lo, hi = max(0.0, tp_pos / g - drag), tp_pos * g + drag
-    if td_pos < lo:
-        td_pos, slope = lo, (dp_pos / g if lo > 0.0 else 0.0)
-    elif td_pos > hi:
-        td_pos, slope = hi, dp_pos * g
-    d_pos = slope * rho  # -d(td_pos)/d(theta)
-    slope = 0.0
-    lo, hi = max(0.0, tp_neg / g - drag), tp_neg * g + drag
-    if td_neg < lo:
-        td_neg, slope = lo, (dp_neg / g if lo > 0.0 else 0.0)
-    elif td_neg > hi:
-        td_neg, slope = hi, dp_neg * g
-    d_neg = slope * rho  # d(td_neg)/d(theta)
+    tp_pos, td_pos, s_pos = _tendon(drum_mm - rho * theta - free_pos, k.slack_pos_mm, k,
+                                    c_free, c_sheath, g, td_pos)
+    tp_neg, td_neg, s_neg = _tendon(-drum_mm + rho * theta - free_neg, k.slack_neg_mm, k,
+                                    c_free, c_sheath, g, td_neg)
     kb, c = k.bend_stiffness_Nm_per_rad, k.bend_stiffening_per_rad2
     arm_m = rho * 1e-3
     r = kb * theta * (1.0 + c * (theta * theta + other * other)) - arm_m * (td_pos - td_neg)
-    dr = kb * (1.0 + c * (3.0 * theta * theta + other * other)) + arm_m * (d_pos + d_neg)
+    dr = kb * (1.0 + c * (3.0 * theta * theta + other * other)) + arm_m * rho * (s_pos + s_neg)
     return r, dr, tp_pos, tp_neg, td_pos, td_neg
 
 
@@ -90,8 +110,11 @@ class ArchWavePlant:
         self.path = path
         self.sheath_curvature_deg = sheath_curvature_deg
         self._slack_delta_mm = [[0.0, 0.0], [0.0, 0.0]]
-        self._stiff = [1.0 / ((k.sheath_length_m + k.free_length_m) * 1e3 / k.tendon_stiffness_N
-                              + k.coil_compliance_mm_per_N) for k in knobs]
+        self._c_free = [k.free_length_m * 1e3 / k.tendon_stiffness_N for k in knobs]
+        """Compliance of the free tendon in the handle (mm/N)."""
+        self._c_sheath = [k.sheath_length_m * 1e3 / k.tendon_stiffness_N
+                          + k.coil_compliance_mm_per_N for k in knobs]
+        """Compliance of the sheathed tendon and its coil (mm/N)."""
         self._geometry()
         self.reset()
 
@@ -119,7 +142,7 @@ class ArchWavePlant:
         for i, k in enumerate(self.knobs):
             rest = [tensioner_tension(-self._free_mm[i][j], s, k.tensioner_preload_N,
                                       k.tensioner_rate_N_per_mm, k.tensioner_reserve_mm,
-                                      self._stiff[i])[0]
+                                      1.0 / (self._c_free[i] + self._c_sheath[i]))[0]
                     for j, s in enumerate((k.slack_pos_mm, k.slack_neg_mm))]
             self.distal_N.append(rest)
 
@@ -184,12 +207,12 @@ class ArchWavePlant:
         other = self.tip_rad[1 - i]
         free_pos, free_neg = self._free_mm[i]
         td_pos, td_neg = self.distal_N[i]
-        stiff = self._stiff[i]
+        c_free, c_sheath = self._c_free[i], self._c_sheath[i]
         lo, hi = -math.pi, math.pi
         theta = self.tip_rad[i]
         for _ in range(60):
             r, dr, tp_pos, tp_neg, d_pos, d_neg = _tip_residual(
-                theta, k, other, drum_mm, free_pos, free_neg, g, stiff, td_pos, td_neg)
+                theta, k, other, drum_mm, free_pos, free_neg, g, c_free, c_sheath, td_pos, td_neg)
             if abs(r) < 1e-12:
                 break
             if r > 0.0:

@@ -14,7 +14,8 @@ Per knob, each step (quasi-static but for the friction and heat states):
    each knob's tendons feel the other knob's bend.
 4. The section bends until its stiffening cover balances the distal tensions (Newton with a
    bracket on the one tip angle).
-5. The knob torque is the drum's tendon torque and seal friction, plus the gearhead's wave
+5. The knob torque is the drum's tendon torque and seal friction (its direction from the
+   knob's motion: the twist's own chatter would flip it), plus the gearhead's wave
    generator drag, plus the motor's cogging, divided by how far the motor's torque constant
    is from its data sheet (unit lot and a winding that warms in the sealed handle).
 """
@@ -133,7 +134,6 @@ class ArchWavePlant:
         self.tip_rad = [0.0, 0.0]
         self._twist = [0.0, 0.0]
         self._z = [0.0, 0.0]
-        self._drum_rad: list[float | None] = [None, None]
         self._out_rad: list[float | None] = [None, None]
         self._load_Nm = [0.0, 0.0]
         self.winding_rise_K = [0.0, 0.0]
@@ -179,14 +179,13 @@ class ArchWavePlant:
                    section_rad: float) -> float:
         drum = (out_rad + kinematic_error_rad(out_rad, k.kinematic_error_deg,
                                               k.kinematic_phase_deg) - self._twist[i])
-        prev_drum, prev_out = self._drum_rad[i], self._out_rad[i]
-        drum_speed = 0.0 if prev_drum is None or dt_s <= 0.0 else (drum - prev_drum) / dt_s
+        prev_out = self._out_rad[i]
         out_speed = 0.0 if prev_out is None or dt_s <= 0.0 else (out_rad - prev_out) / dt_s
-        self._drum_rad[i], self._out_rad[i] = drum, out_rad
+        self._out_rad[i] = out_rad
         g = math.exp(k.sheath_friction * (self._wrap_rad[i] + k.section_wrap_share * section_rad))
         tp_pos, tp_neg = self._solve_tip(i, k, drum * k.pulley_radius_mm, g)
         load = (k.pulley_radius_mm * 1e-3 * (tp_pos - tp_neg)
-                + k.handle_friction_Nm * math.tanh(drum_speed / _SPEED_SCALE_RAD_S))
+                + k.handle_friction_Nm * math.tanh(out_speed / _SPEED_SCALE_RAD_S))
         self._twist[i], self._z[i] = flex_twist(
             load, self._twist[i], self._z[i], k.flex_stiffness_Nm_per_rad,
             k.flex_stiffening_Nm_per_rad3, k.flex_elastic_share,

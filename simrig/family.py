@@ -15,8 +15,8 @@ the coilpipe plant (session 10, written blind) is held out now, the stickslip pl
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
 now, the helixbelt plant (session 15, written blind) is held out now, the ratestate plant
-(session 16, written blind) is held out now, the warmgear plant (session 18) is the blind one
-(``PLANT_ROLE``). ``SCATTER`` lives in
+(session 16, written blind) is held out now, the warmgear plant (session 18, written blind) is
+held out now (``PLANT_ROLE``). ``SCATTER`` lives in
 :mod:`simrig.family_scatter`.
 """
 
@@ -61,7 +61,7 @@ PLANT_SPECS: dict[str, str] = {
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
-              "ratestate": "held-out", "warmgear": "blind"}
+              "ratestate": "held-out", "warmgear": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

@@ -15,9 +15,9 @@ the coilpipe plant (session 10, written blind) is held out now, the stickslip pl
 written blind) is held out now, the twistshaft plant (session 12) is held out now, the screwrod
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
 now, the helixbelt plant (session 15, written blind) is held out now, the ratestate plant
-(session 16, written blind) is held out now, the warmgear plant (session 18) is the blind one,
-the archwave plant (session 19, written blind) is blind too (``PLANT_ROLE``). ``SCATTER`` lives in
-:mod:`simrig.family_scatter`.
+(session 16, written blind) is held out now, the warmgear plant (session 18, written blind) is
+held out now, the archwave plant (session 19, written blind) is the blind one (``PLANT_ROLE``).
+``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ PLANT_SPECS: dict[str, str] = {
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
-              "ratestate": "held-out", "warmgear": "blind", "archwave": "blind"}
+              "ratestate": "held-out", "warmgear": "held-out", "archwave": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

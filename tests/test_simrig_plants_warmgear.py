@@ -157,10 +157,10 @@ def test_unknown_reshapes_are_refused() -> None:
         make_warmgear_plant().reshape(stiffness=2.0)
 
 
-def test_warmgear_is_registered_after_ratestate_and_blind() -> None:
+def test_warmgear_is_registered_after_ratestate_and_held_out() -> None:
     names = list(PLANT_SPECS)
     assert names.index("warmgear") == names.index("ratestate") + 1
-    assert PLANT_ROLE["warmgear"] == "blind"
+    assert PLANT_ROLE["warmgear"] == "held-out"
     assert isinstance(family_member("warmgear", 101).build(), WarmGearPlant)
     assert set(SCATTER["warmgear"]) <= set(family_member("warmgear", 0).params["knobs"][0])
 

@@ -21,8 +21,10 @@ from scipy.interpolate import PchipInterpolator
 from simrig.plant import Plant, PlantStep, as_plant_step, load_plant
 from tsmd.calibration.assemble import GridPoint, QualityLimits
 from tsmd.calibration.errors import CalibrationError
+from tsmd.calibration.estimate import KINDS
 from tsmd.calibration.player import sweep_metadata
 from tsmd.calibration.protocol import Protocol, paper_protocol, sweep_run
+from tsmd.calibration.resweep import point_estimates
 from tsmd.calibration.run import device_options, finish, run_sweeps
 from tsmd.calibration.sweep_result import PARAMETERS
 from tsmd.config import TsmdConfig
@@ -70,6 +72,10 @@ class ProtocolRun:
     """|identified - tip| for the 56 values (NaN where either is missing)."""
     errors_lines: list[float] = field(default_factory=list)
     """The same against the line truth (:data:`tsmd.tip_truth.TRUTHS`)."""
+    coverage: dict[str, tuple[int, int]] = field(default_factory=dict)
+    """Per kind of parameter (:data:`tsmd.calibration.estimate.KINDS`): how many of the values
+    measured at a grid point have the tip's truth within their reported 95 % half-width, of how
+    many (:func:`coverage_against`)."""
 
     @property
     def within(self) -> int:
@@ -145,6 +151,25 @@ def score(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]],
     """Fill ``run.errors`` (and ``run.errors_lines`` when the line truth is given)."""
     run.errors = errors_against(run, truth)
     run.errors_lines = errors_against(run, truth_lines) if truth_lines is not None else []
+    run.coverage = coverage_against(run.points, truth)
+
+
+def coverage_against(points: Sequence[GridPoint],
+                     truth: dict[tuple[int, float], dict[str, float]]
+                     ) -> dict[str, tuple[int, int]]:
+    """Per kind of parameter: (values whose |identified - tip| is within the reported 95 %
+    half-width, values scored), over the grid points the protocol measured (the half-width is
+    said per grid point, not between them). An honest half-width covers about 95 %."""
+    out = {kind: (0, 0) for kind in KINDS}
+    for p, est in zip(points, point_estimates(points), strict=True):
+        tip = truth.get((p.knob, float(p.other_deg)), {})
+        for kind, names in KINDS.items():
+            for name in names:
+                error = abs(est[name].value - tip.get(name, math.nan))
+                if math.isfinite(error):
+                    covered, n = out[kind]
+                    out[kind] = (covered + int(error <= est[name].reported_u95_deg), n + 1)
+    return out
 
 
 def truth_sweeps(config: TsmdConfig) -> list[GridPoint]:

@@ -130,7 +130,9 @@ def family(args: argparse.Namespace) -> str:
             print(f"unit {c.unit} seed {c.noise_seed}: " + "; ".join(
                 f"{name} {'accepted' if r.accepted else 'REFUSED'}, {r.within}/"
                 f"{len(r.errors)} within 2 deg, max {r.max_error:.2f}, {len(r.resweeps)} "
-                f"re-sweeps, {r.wall_s:.0f} s" for name, r in c.runs.items()),
+                f"re-sweeps, {r.wall_s:.0f} s, u95 covers " + ", ".join(
+                    f"{kind} {x}/{n}" for kind, (x, n) in r.coverage.items())
+                for name, r in c.runs.items()),
                 file=sys.stderr, flush=True)
     results.sort(key=lambda c: (c.unit, c.noise_seed))
     wall = time.monotonic() - t0

@@ -105,6 +105,7 @@ def family_table(results: Sequence[CatheterRun], protocol: str) -> str:
         + ("" if worst.accepted else f", refused: {worst.reason[:200]}"),
     ]
     lines += line_truth_summary(rows)
+    lines += coverage_summary(rows)
     refused = [(c, r) for c, r in rows if not r.accepted]
     lines += [f"- refused: unit {c.unit} seed {c.noise_seed}: {r.reason[:300]}"
               for c, r in refused]
@@ -122,6 +123,25 @@ def line_truth_summary(rows: Sequence[tuple[CatheterRun, ProtocolRun]]) -> list[
     return [f"- against the line truth (corners of the paper's lines on the tip): "
             f"{int(np.sum(values <= TARGET_DEG))} of {values.size} within {TARGET_DEG:g} deg, "
             f"runs >= 95 %: {good} of {len(scored)}, max {np.nanmax(values):.2f} deg"]
+
+
+def coverage_summary(rows: Sequence[tuple[CatheterRun, ProtocolRun]]) -> list[str]:
+    """How often the reported 95 % half-widths cover the tip's truth, per kind, over the runs
+    and on the worst-covered run (an honest half-width: about 95 %; far above it is too wide)."""
+    kinds = sorted({kind for _, r in rows for kind in r.coverage})
+    if not kinds:
+        return []
+    parts = []
+    for kind in kinds:
+        got = [(c, r.coverage[kind]) for c, r in rows if r.coverage.get(kind, (0, 0))[1]]
+        if not got:
+            continue
+        covered, n = (sum(x[i] for _, x in got) for i in (0, 1))
+        worst_c, (wc, wn) = min(got, key=lambda cx: cx[1][0] / cx[1][1])
+        parts.append(f"{kind} {covered}/{n} ({covered / n:.0%}; worst unit {worst_c.unit} "
+                     f"seed {worst_c.noise_seed} {wc}/{wn})")
+    return [f"- reported 95 % half-width covers the tip's threshold truth (grid points "
+            f"measured): {'; '.join(parts)}"] if parts else []
 
 
 def run_catheter_summary(plant: str, params: dict[str, Any], unit_key: str, unit: int,

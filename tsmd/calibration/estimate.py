@@ -54,8 +54,9 @@ class Estimate:
     """The 95 % half-width of the product's reading offset subtracted from the values (part of
     ``u95_deg``; no re-sweep narrows it)."""
     unit_u95_deg: float = 0.0
-    """The 95 % half-width of what the current cannot show of this unit (a backlash's share of
-    the gap to the release line: :meth:`SweepResult.share_u95_deg`). Not part of ``u95_deg``,
+    """The 95 % half-width of what the current cannot show of this unit (the product's sample's,
+    :mod:`tsmd.calibration.unit_part`, or a backlash's share of the gap to the release line:
+    :meth:`SweepResult.unit_u95_deg`). Not part of ``u95_deg``,
     which the gate judges by what sweeps can narrow; part of :attr:`reported_u95_deg`."""
 
     @property
@@ -164,7 +165,7 @@ def point_estimates(results: Sequence[SweepResult],
              for names in KINDS.values() for name in names}
     return [{name: replace(estimate(r.values.get(name, ()), *pools[name], options=opts,
                                     offset_u95_deg=r.offset_u95_deg.get(name, 0.0)),
-                           unit_u95_deg=r.share_u95_deg(name))
+                           unit_u95_deg=r.unit_u95_deg(name))
              for name in PARAMETERS} for r in results]
 
 

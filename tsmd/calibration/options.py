@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from tsmd.calibration.unit_part import UnitPart
 from tsmd.profile.reading_offset import ReadingOffset
-from tsmd.profile.types import DeviceKnob
+from tsmd.profile.types import DeviceKnob, DeviceModel
 
 
 @dataclass(frozen=True)
@@ -123,6 +124,9 @@ class IdentifyOptions:
     reading_offset: ReadingOffset | None = None
     """The product's reading offset from the data sheet, subtracted from this knob's values
     where sure (:mod:`tsmd.calibration.reading_offset`); None: the values as read."""
+    unit_part: UnitPart | None = None
+    """The product's part of the error that no sweep narrows, from the data sheet's sample
+    (:mod:`tsmd.calibration.unit_part`), reported with each value; None: the share's part."""
     max_tracking_error_deg: float = 10.0
     min_follow_ratio: float = 0.5
     """The knob must travel at least this fraction of the commanded travel (else: stalled)."""
@@ -208,3 +212,19 @@ def for_product(options: IdentifyOptions, settle_fraction: float | None,
     return replace(options, backlash="fraction", backlash_fraction=settle_fraction,
                    backlash_reference_slope_ratio=slope_ratio,
                    backlash_share_per_slope_ratio=SHARE_PER_SLOPE_RATIO)
+
+
+def device_options(options: IdentifyOptions | None, device: DeviceModel
+                   ) -> tuple[IdentifyOptions, IdentifyOptions]:
+    """Each knob's identification with its product's backlash rule from the data sheet."""
+    base = options or IdentifyOptions()
+    chosen = []
+    for k in device.knobs:
+        one = for_product(base, k.backlash_settle_fraction, k.backlash_release_slope_ratio,
+                          k.backlash_settle_lag_deg, k.backlash_release_line_share,
+                          k.backlash_release_rule, k.backlash_release_local_share,
+                          k.backlash_recovery_lag_deg, BacklashReference.of(k))
+        # the product's knee (tsmd datasheet) where the sheet turns it on
+        one = replace(one, backlash_knee=True) if k.backlash_knee else one
+        chosen.append(replace(one, reading_offset=k.reading_offset, unit_part=UnitPart.of(k)))
+    return chosen[0], chosen[1]

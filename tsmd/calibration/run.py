@@ -37,7 +37,7 @@ from tsmd.calibration.errors import (
 )
 from tsmd.calibration.estimate import EstimateOptions
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
-from tsmd.calibration.options import BacklashReference, for_product
+from tsmd.calibration.options import device_options
 from tsmd.calibration.player import (
     Player,
     Progress,
@@ -55,6 +55,7 @@ from tsmd.calibration.resweep import (
     uncertain_points,
 )
 from tsmd.calibration.tension_play_fit import with_prefit, with_tension_play
+from tsmd.calibration.unit_part import with_unit_part
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
 from tsmd.trajectory import TrajectoryRunner
@@ -91,22 +92,6 @@ def _meta_float(rec: Recording, key: str) -> float | None:
 
 KnobOptions = IdentifyOptions | tuple[IdentifyOptions, IdentifyOptions] | None
 """One identification for both knobs, or one per knob (:func:`device_options`)."""
-
-
-def device_options(options: IdentifyOptions | None, device: DeviceModel
-                   ) -> tuple[IdentifyOptions, IdentifyOptions]:
-    """Each knob's identification with its product's backlash rule from the data sheet."""
-    base = options or IdentifyOptions()
-    chosen = []
-    for k in device.knobs:
-        one = for_product(base, k.backlash_settle_fraction, k.backlash_release_slope_ratio,
-                          k.backlash_settle_lag_deg, k.backlash_release_line_share,
-                          k.backlash_release_rule, k.backlash_release_local_share,
-                          k.backlash_recovery_lag_deg, BacklashReference.of(k))
-        # the product's knee (tsmd datasheet) where the sheet turns it on
-        one = replace(one, backlash_knee=True) if k.backlash_knee else one
-        chosen.append(replace(one, reading_offset=k.reading_offset))
-    return chosen[0], chosen[1]
 
 
 def identify_recording(rec: Recording, options: KnobOptions = None,
@@ -146,9 +131,9 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
                                 sweep_start_s=start_s)
     except CalibrationError as exc:
         raise CalibrationError(f"{source} ({KNOB_LABELS[knob]} sweep): {exc}") from None
-    return GridPoint(knob, other, corrected(with_unseen(result, opts, other),
-                                            opts.reading_offset if opts else None,
-                                            other), rec)
+    found = corrected(with_unseen(result, opts, other), opts.reading_offset if opts else None,
+                      other)
+    return GridPoint(knob, other, with_unit_part(found, opts.unit_part if opts else None), rec)
 
 
 def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,

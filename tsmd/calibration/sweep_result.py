@@ -78,6 +78,9 @@ class SweepResult:
     """Backlashes the current does not show at this grid point: their values are the data
     sheet's reference scaled by the unit's swing (:mod:`tsmd.calibration.recovery`), with this
     95 % half-width; no reading offset applies to them and no re-sweep narrows them."""
+    product_u95_deg: dict[str, float] = field(default_factory=dict)
+    """Per parameter, the 95 % half-width of what the product's sample measured that no sweep
+    narrows (:mod:`tsmd.calibration.unit_part`); absent: the share's part, if any."""
 
     @property
     def data_half_cycles(self) -> tuple[HalfCycle, ...]:
@@ -95,6 +98,11 @@ class SweepResult:
              if h.backlash_name == name and math.isfinite(h.share_u95_deg)]
         return float(np.median(v)) if v else 0.0
 
+    def unit_u95_deg(self, name: str) -> float:
+        """The half-width reported beyond the gate's: the product's sample's where the data
+        sheet measured it, else :meth:`share_u95_deg`."""
+        return self.product_u95_deg.get(name, self.share_u95_deg(name))
+
     def spread(self, name: str) -> float:
         """Largest minus smallest value over the half-cycles (0 with one value)."""
         v = self.values.get(name, ())
@@ -106,7 +114,7 @@ class SweepResult:
                   for name in PARAMETERS}
         return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
                            self.resweeps + 1, len(self.data_half_cycles), self.offset_u95_deg,
-                           {**self.unseen, **other.unseen})
+                           {**self.unseen, **other.unseen}, self.product_u95_deg)
 
     @property
     def snr(self) -> float:

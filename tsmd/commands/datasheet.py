@@ -45,6 +45,7 @@ from tsmd.datasheet_rule import (
     rule_scores,
     sheet_truth,
 )
+from tsmd.datasheet_sample import measure_sample
 from tsmd.datasheet_shape_grid import measure_shape_grids
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.profile.reading_offset import ReadingOffset
@@ -99,6 +100,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "self-locking handle): its lag and bend gain measured on the unit's "
                              "fast calibrations under it (one more run per rule seed), kept on a "
                              "knob that chooses it (docs/calibration.md, session 16)")
+    parser.add_argument("--unit-sample", metavar="LIST",
+                        help="with --plant: also calibrate the sheet's unit and these declared "
+                             "sample units (values of --unit-key, e.g. 201,202,203; never units "
+                             "scored elsewhere) with the fast protocol, noise seed the first "
+                             "rule seed, against their tracked tips, and write each knob's "
+                             "dead_zone_unit_u95_deg and backlash_unit_u95_deg "
+                             "(docs/calibration.md, session 19)")
+    parser.add_argument("--unit-key", default="unit",
+                        help="--unit-sample: the plant factory's parameter naming a unit")
     parser.add_argument("--bend-relation", action="store_true",
                         help="with --plant: also calibrate the unit straight and with its sheath "
                              "bent 30/60/90 deg and write the product's bend relation for online "
@@ -274,6 +284,33 @@ def _with_bend(device: DeviceModel, config: TsmdConfig,
     return device
 
 
+def _with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: dict[str, Any],
+                 unit_key: str, units: list[int], seed: int) -> DeviceModel:
+    """The sheet with the product's parts of the error no sweep narrows, from its sample."""
+    t0 = time.monotonic()
+    configs = [config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=p))
+               for p in [params, *({**params, unit_key: u} for u in units)]]
+    device, readings = measure_sample(device, configs, seed)
+    for knob, (name, k) in enumerate(zip(("phi1", "phi2"), device.knobs, strict=True)):
+        n = [len(readings[(knob, kind)][0]) for kind in ("dead-zone edge", "backlash")]
+        print(f"{name} unit part on the sample ({len(configs)} units, noise seed {seed}): D "
+              f"{_or_none(k.dead_zone_unit_u95_deg, 2)} deg over {n[0]} values, B "
+              f"{_or_none(k.backlash_unit_u95_deg, 2)} deg over {n[1]}")
+    print(f"  sample: {time.monotonic() - t0:.0f} s")
+    return device
+
+
+def _units(text: str) -> list[int]:
+    try:
+        units = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise DatasheetError(f"--unit-sample: not a comma-separated list of integers: "
+                             f"{text!r}") from None
+    if not units:
+        raise DatasheetError("--unit-sample: give at least one unit")
+    return units
+
+
 def _or_none(value: float | None, decimals: int) -> str:
     return "none" if value is None else f"{value:.{decimals}f}"
 
@@ -285,6 +322,10 @@ def main(args: argparse.Namespace) -> int:
         raise DatasheetError("--bend-relation goes with --plant (the unit is calibrated bent on "
                              "the simulated rig)")
     seeds = _rule_seeds(args.rule_seeds)
+    sample = _units(args.unit_sample) if args.unit_sample is not None else []
+    if sample and args.plant is None:
+        raise DatasheetError("--unit-sample goes with --plant (the sample is tracked on the "
+                             "simulated rig)")
     if args.recovery_rule and (args.plant is None or not seeds):
         raise DatasheetError("--recovery-rule goes with --plant and rule seeds (the rule is "
                              "offered in the rule choice on the simulated rig)")
@@ -323,6 +364,9 @@ def main(args: argparse.Namespace) -> int:
         device = _with_bend(device, config, factory)
     if args.plant is not None and args.release_end_offset:
         device = _with_release_end_offset(device, config, factory, args.seed)
+    if args.plant is not None and sample:
+        device = _with_sample(device, config, args.plant, params, args.unit_key, sample,
+                              seeds[0] if seeds else 0)
     comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "
                f"(tsmd datasheet) on {source}:\n"
                f"each knob swept +-{SWEEP_AMPLITUDE_DEG:g} deg at {SWEEP_HZ:g} Hz, other knob "

@@ -76,6 +76,8 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "other_tip_gain": (*OTHER_TIP_GAIN_RANGE, ""),
     "loaded_knee_pos_deg": (0.0, 90.0, "deg"),
     "loaded_knee_neg_deg": (0.0, 90.0, "deg"),
+    "dead_zone_unit_u95_deg": (0.0, 20.0, "deg"),
+    "backlash_unit_u95_deg": (0.0, 20.0, "deg"),
 }
 """The data sheet's optional measured numbers per knob and their plausible ranges: the schema
 reads them with these, and ``tsmd datasheet`` leaves out a measured one outside its range
@@ -93,6 +95,8 @@ _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_sha
                       "backlash_knee")
 _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
+_SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
+"""Optional data-sheet numbers measured on the product's sample, written only when measured."""
 
 
 _Block = TypeVar("_Block")
@@ -197,6 +201,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             other_tip_gain=optional("other_tip_gain"),
             loaded_knee_pos_deg=optional("loaded_knee_pos_deg"),
             loaded_knee_neg_deg=optional("loaded_knee_neg_deg"),
+            dead_zone_unit_u95_deg=optional("dead_zone_unit_u95_deg"),
+            backlash_unit_u95_deg=optional("backlash_unit_u95_deg"),
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)
@@ -250,7 +256,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
                 knobs[name][key] = shape_to_mapping(shape)
         if k.loaded_shape_grid is not None:
             knobs[name]["loaded_shape_grid"] = shape_grid_to_mapping(*k.loaded_shape_grid)
-        for key in _RELEASE_RULE_KEYS + _COUPLING_KEYS:
+        for key in _RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         if k.reading_offset is not None:

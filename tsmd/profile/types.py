@@ -200,6 +200,18 @@ class DeviceKnob:
     method ours moves the templates' knee to the unit's (:mod:`tsmd.compensation.knee_map`,
     session 15). None: the templates as measured."""
     loaded_knee_neg_deg: float | None = None
+    dead_zone_unit_u95_deg: float | None = None
+    """Optional, measured on the manufacturer's sample of the product (``tsmd datasheet
+    --unit-sample``: the sheet's unit and declared sample units, each calibrated with the fast
+    protocol and compared with its tracked tip, session 19): the 95 % half-width of what a
+    calibration's dead-zone edge misses of the tip beyond its own half-cycles' scatter (the
+    product's bias and unit-to-unit part, which no sweep narrows,
+    :mod:`tsmd.calibration.unit_part`). Calibration reports it in quadrature with the gate's
+    half-width; None: nothing added."""
+    backlash_unit_u95_deg: float | None = None
+    """Optional, as ``dead_zone_unit_u95_deg`` for the backlash; where given it replaces the
+    share-based part of a "line" rule (:data:`tsmd.calibration.options.LINE_SHARE_UNIT_U95`,
+    measured on segments only)."""
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,71 @@
+"""The part of a calibration's error that no sweep narrows, as the product's sample shows it.
+
+A grid point's 95 % half-width from its half-cycles' scatter (the gate's,
+:class:`tsmd.calibration.estimate.Estimate`) says how sure the reading is of what the current
+shows; it says nothing of how far what the current shows is from the tip. That part is the
+product's: the rule's bias (a dead-zone edge read where the tendon engages, a few tenths of a
+degree before the tip leaves its plateau) and the unit-to-unit part of the plant the motor
+cannot feel (the sheath contacts' presliding, session 18). A manufacturer who calibrates a few
+units of the product with the fast protocol and tracks their tips measures it once
+(``tsmd datasheet --unit-sample``); every unit's calibration reports it in quadrature with its
+own half-width (session 19).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from tsmd.calibration.sweep_result import SweepResult
+from tsmd.profile.types import DeviceKnob
+
+Z95 = 1.96
+"""Two-sided 95 % of a normal spread: the sample's root-mean-square part to a half-width."""
+
+
+@dataclass(frozen=True)
+class UnitPart:
+    """One knob's 95 % half-widths of the product's part, per kind of parameter (deg)."""
+
+    dead_zone_u95_deg: float | None
+    backlash_u95_deg: float | None
+
+    @staticmethod
+    def of(knob: DeviceKnob) -> UnitPart | None:
+        """The sheet knob's part, None where the sheet measured neither."""
+        if knob.dead_zone_unit_u95_deg is None and knob.backlash_unit_u95_deg is None:
+            return None
+        return UnitPart(knob.dead_zone_unit_u95_deg, knob.backlash_unit_u95_deg)
+
+    def u95_deg(self, name: str) -> float | None:
+        """The half-width for parameter ``name`` (None: not measured for its kind)."""
+        return self.backlash_u95_deg if name.startswith("backlash") else self.dead_zone_u95_deg
+
+
+def with_unit_part(result: SweepResult, part: UnitPart | None) -> SweepResult:
+    """``result`` carrying the product's part for every parameter the sheet measured it for
+    (unchanged without one)."""
+    if part is None:
+        return result
+    found = {name: u for name in result.values if (u := part.u95_deg(name)) is not None}
+    if not found:
+        return result
+    return dataclasses.replace(result, product_u95_deg=found)
+
+
+def sample_u95_deg(errors_deg: Sequence[float], gate_u95_deg: Sequence[float]) -> float:
+    """The product's part from a sample's values: each value's error against its tracked tip,
+    with the gate's own 95 % half-width. Errors the gate's half-widths explain (each its
+    half-width over :data:`Z95`, squared) are taken out of their mean square; what is left,
+    bias and unit-to-unit part together, is the part's variance."""
+    e = np.asarray(errors_deg, dtype=float)
+    g = np.asarray(gate_u95_deg, dtype=float)
+    ok = np.isfinite(e) & np.isfinite(g)
+    if not ok.any():
+        raise ValueError("no value with both an error and a half-width")
+    left = float(np.mean(e[ok] ** 2 - (g[ok] / Z95) ** 2))
+    return Z95 * math.sqrt(max(left, 0.0))

@@ -1,0 +1,72 @@
+"""The product's part of a calibration's error that no sweep narrows, measured on its sample.
+
+A manufacturer who tracks the data sheet's unit can as well track a few more units of the same
+product once (the sample: the sheet's unit and declared sample units, never a unit a customer's
+figures are scored on). Each is calibrated from its current alone with the fast protocol under
+the finished sheet, as every unit is, and its values are compared with its tracked tip at the
+protocol's grid points (the threshold truth, :func:`tsmd.tip_truth.tip_truth`); per knob and
+kind of parameter the errors the gate's own half-widths do not explain give the product's part
+(:func:`tsmd.calibration.unit_part.sample_u95_deg`, session 19).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+
+from tsmd.calibration.estimate import KINDS
+from tsmd.calibration.protocol import fast_protocol
+from tsmd.calibration.resweep import point_estimates
+from tsmd.calibration.unit_part import sample_u95_deg
+from tsmd.config import TsmdConfig
+from tsmd.datasheet_rule import sheet_truth
+from tsmd.profile import DeviceModel
+from tsmd.tracked_calibration import ProtocolRun, play_protocol
+
+Readings = dict[tuple[int, str], tuple[list[float], list[float]]]
+"""Per (knob, kind of parameter): the sample's errors against the tip and the gate's 95 %
+half-widths, value by value."""
+
+
+def sample_readings(runs: Sequence[tuple[ProtocolRun, dict[tuple[int, float],
+                                                             dict[str, float]]]]) -> Readings:
+    """Every grid point's value minus its unit's tracked tip, with the gate's half-width, over
+    the sample's runs and their truths (a refused run's values count as they were read)."""
+    out: Readings = {(knob, kind): ([], []) for knob in (0, 1) for kind in KINDS}
+    for run, truth in runs:
+        for p, est in zip(run.points, point_estimates(run.points), strict=True):
+            tip = truth.get((p.knob, float(p.other_deg)), {})
+            for kind, names in KINDS.items():
+                for name in names:
+                    error = est[name].value - tip.get(name, math.nan)
+                    if math.isfinite(error) and math.isfinite(est[name].u95_deg):
+                        out[(p.knob, kind)][0].append(error)
+                        out[(p.knob, kind)][1].append(est[name].u95_deg)
+    return out
+
+
+def with_unit_parts(device: DeviceModel, readings: Readings) -> DeviceModel:
+    """The sheet with each knob's product part per kind (left out where the sample gave no
+    value of that kind)."""
+    knobs = []
+    for knob, k in enumerate(device.knobs):
+        dz, b = (_part(readings.get((knob, kind), ([], []))) for kind in ("dead-zone edge",
+                                                                           "backlash"))
+        knobs.append(dataclasses.replace(k, dead_zone_unit_u95_deg=dz, backlash_unit_u95_deg=b))
+    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+
+def _part(reading: tuple[list[float], list[float]]) -> float | None:
+    errors, gate = reading
+    return round(sample_u95_deg(errors, gate), 2) if errors else None
+
+
+def measure_sample(device: DeviceModel, configs: Sequence[TsmdConfig], noise_seed: int
+                   ) -> tuple[DeviceModel, Readings]:
+    """The sheet with the product's parts, from fast calibrations of every sample unit
+    (``configs``, one sim config each) under ``device``."""
+    runs = [(play_protocol(c, device, fast_protocol(), noise_seed), sheet_truth(c))
+            for c in configs]
+    readings = sample_readings(runs)
+    return with_unit_parts(device, readings), readings

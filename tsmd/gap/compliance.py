@@ -9,6 +9,9 @@ protocol's slow reversals at 40 deg (rate loops) against those at 60 deg (warm-u
 both knobs together, in every configuration, each side of the knob on its own. Each load's lost
 motion is read from the mean of its repeats' return curves (the tracker noise averaged before a
 threshold is applied to it), and the null's spread is the repeats' own: a jackknife over them.
+When the data sheet's units break that premise (a geared handle's play crossed before the tip
+returns from the lighter load only), every unit is read on the release at the heavier load
+instead: the knob travel per ampere over which the motor current gives the load back.
 
 Twice the compliance is, bit for bit, a catheter with half the tendon stiffness (docs/gap.md,
 Limits): nothing inside the data tells "this unit's tendon is softer" from "this model's tendons

@@ -9,6 +9,9 @@ protocol's slow reversals at 40 deg (rate loops) against those at 60 deg (warm-u
 both knobs together, in every configuration, each side of the knob on its own. Each load's lost
 motion is read from the mean of its repeats' return curves (the tracker noise averaged before a
 threshold is applied to it), and the null's spread is the repeats' own: a jackknife over them.
+When the data sheet's units break that premise (a geared handle's play crossed before the tip
+returns from the lighter load only), every unit is read on the release at the heavier load
+instead: the knob travel per ampere over which the motor current gives the load back.
 
 Twice the compliance is, bit for bit, a catheter with half the tendon stiffness (docs/gap.md,
 Limits): nothing inside the data tells "this unit's tendon is softer" from "this model's tendons
@@ -19,119 +22,51 @@ another unit, :func:`reference_deg_per_A`); without one, compliance is not score
 
 from __future__ import annotations
 
-import itertools
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
 from tsmd.gap.data import GapSeries
+from tsmd.gap.reversal import TRAVEL_GRID_DEG, Reversals, reversals
 from tsmd.gap.signature import SIGNATURES, SignatureScore
 from tsmd.gap.stats import unit_spread
 
 FloatArray = NDArray[np.float64]
 
-MAX_SPEED_DEG_S = 45.0
-"""Reversals at most this fast are read (the protocol's 20 and 40 deg/s): a fast reversal
-passes the lost motion in a few samples and adds the current's viscous part to its swing."""
 DEPARTURE_DEG = 1.5
 """The mean return curve read between a third of this and this (or of 0.6 of the curve's full
 return when that is smaller: a soft tendon at the loop amplitude leaves the tip barely out of
 its dead zone)."""
 MIN_RETURN_DEG = 0.3
 """A mean return read below this is no return (the tracker noise of one reversal is 0.1 deg)."""
-TRAVEL_GRID_DEG = np.arange(0.0, 40.0, 0.05)
-"""Knob travel after a reversal on which the repeats' curves are averaged (finer than the
-knob's sample step: a return within one sample still reads between samples)."""
-REFERENCE_TRAVEL_DEG = 1.0
-"""The tip before its return: its mean over this much travel after the reversal."""
 SETTLE_WINDOW_DEG = 2.0
 """The current after the lost motion: its mean over this much travel either side."""
 SETTLE_DEG = 10.0
 """The current after the lost motion is read this far further on the releasing branch: by
 then a sensor's lag of 0.1 s has caught up at the protocol's speeds (a lag is another effect)."""
-PRE_WINDOW_S = 0.2
-"""The current at a reversal: its mean over this long before it."""
 TOLERANCE = 0.25
 """The smallest excess named: a unit is named more compliant only when its ratio to the data
 sheet is at least 1 + this; from a sheet of one unit (spread unknown) its lower confidence
 bound must exceed it too (:func:`compliance_score`)."""
-TOGETHER_DEG = 2.0
-"""Only reversals with the other knob at the same angle (the protocol moves both knobs
-together in its warm-up, rate loops and dwells): the other knob's angle changes the load, and
-coupling is another effect."""
 LEVELS_DEG = (40.0, 60.0)
 """The two loads compared: reversals at the protocol's loop and dwell amplitudes (the
 constant part of the lost motion, slack and the joints' presliding, cancels)."""
 LEVEL_BAND_DEG = 2.0
 MIN_PER_LEVEL = 3
 """Repeats at each load and side for a figure (the jackknife needs a few)."""
+RELEASE_SHARES = (0.75, 0.25)
+"""The current's release after a reversal read between these shares of the way from its level
+before the reversal to its release level: above, the first sample's step (the handle's and the
+motor's friction turning over); below, the approach to the release level."""
+Figure = Literal["load contrast", "release"]
+"""How the lost motion per ampere is read: across the two loads' reversals (the default), or
+within the release of the reversals beyond the slack (:func:`sheet_from_units` decides)."""
 CONDITION = "lost motion per ampere at the reversals against the data sheet"
-
-
-@dataclass(frozen=True)
-class Reversals:
-    """Per slow reversal of one knob: the tip's return and the current against the knob travel
-    after it (on :data:`TRAVEL_GRID_DEG`, NaN beyond the motion), the current before it, the
-    knob angle of the reversal and the configuration."""
-
-    tip_return_deg: FloatArray
-    current_A: FloatArray
-    before_A: FloatArray
-    at_deg: FloatArray
-    config: NDArray[np.int64]
-
-
-def _reversal_pairs(x: FloatArray) -> list[tuple[int, int]]:
-    """(last row moving the old way, first row moving the new way) at each reversal."""
-    s = np.sign(np.round(np.diff(x), 9))
-    moving = np.flatnonzero(s != 0)
-    return [(int(a) + 1, int(b) + 1) for a, b in itertools.pairwise(moving)
-            if s[a] != s[b]]
-
-
-def _after(x: FloatArray, a: int, b: int) -> tuple[FloatArray, int]:
-    """Knob travel from the reversal at row ``a`` over the motion that leaves it, and its end."""
-    direction = np.sign(x[b] - x[a])
-    steps = np.sign(np.round(np.diff(x[b:]), 9))
-    against = np.flatnonzero(steps == -direction)
-    end = b + 1 + (int(against[0]) if against.size else len(steps))
-    return np.abs(x[a:end] - x[a]), end
-
-
-def reversals(series: Sequence[GapSeries], knob: int) -> Reversals:
-    """Every slow reversal of ``knob`` in the protocol recordings with the other knob at the
-    same angle (the first of each recording left out: it starts from the straight catheter)."""
-    configs = sorted({s.config for s in series})
-    ret, cur_on, before, at, cfg = [], [], [], [], []
-    for s in series:
-        if s.segment is None:
-            continue
-        x, tip, cur = s.knob_deg[:, knob], s.tip_deg[:, knob], s.current_A[:, knob]
-        dt = float(np.median(np.diff(s.t_s)))
-        pre = max(round(PRE_WINDOW_S / dt), 1)
-        for a, b in _reversal_pairs(x)[1:]:
-            speed = max(abs(x[a] - x[a - 1]), abs(x[b] - x[a])) / dt
-            if (a < pre or speed > MAX_SPEED_DEG_S
-                    or abs(s.knob_deg[a, 1 - knob] - x[a]) > TOGETHER_DEG):
-                continue
-            travel, end = _after(x, a, b)
-            direction = np.sign(x[b] - x[a])
-            start = float(np.mean(tip[a:end][travel <= REFERENCE_TRAVEL_DEG]))
-            ret.append(np.interp(TRAVEL_GRID_DEG, travel, direction * (tip[a:end] - start),
-                                 right=np.nan))
-            cur_on.append(np.interp(TRAVEL_GRID_DEG, travel, cur[a:end], right=np.nan))
-            before.append(float(np.mean(cur[a - pre:a + 1])))
-            at.append(float(x[a]))
-            cfg.append(configs.index(s.config))
-    grid = len(TRAVEL_GRID_DEG)
-    return Reversals(np.array(ret, dtype=float).reshape(-1, grid),
-                     np.array(cur_on, dtype=float).reshape(-1, grid),
-                     np.array(before, dtype=float), np.array(at, dtype=float),
-                     np.array(cfg, dtype=np.int64))
 
 
 def _onset(curve: FloatArray) -> float:
@@ -169,10 +104,39 @@ def _group(r: Reversals, rows: NDArray[np.int64]) -> tuple[float, float]:
         return lost, float(np.nanmean(swing)) if np.isfinite(swing).any() else float("nan")
 
 
-def _jackknife_var(r: Reversals, rows: NDArray[np.int64]) -> tuple[float, float]:
-    """Variance of :func:`_group`'s two figures from its repeats (leave one out)."""
+def _release(r: Reversals, rows: NDArray[np.int64]) -> tuple[float, float]:
+    """Knob travel (deg) over which the repeats' mean current gives back the middle half of
+    its load (:data:`RELEASE_SHARES`), and that load (A): the mean current before the reversal
+    minus its release level, the mean over :data:`SETTLE_DEG` +- :data:`SETTLE_WINDOW_DEG` of
+    travel. The motor feels the tendon and the handle's gear unload along the travel whatever
+    the load, so no constant part (slack, a gear's play) enters."""
+    side = float(np.sign(np.mean(r.at_deg[rows])))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # columns beyond every motion
+        y = side * np.nanmean(r.current_A[rows], axis=0)
+        settled = np.abs(TRAVEL_GRID_DEG - SETTLE_DEG) <= SETTLE_WINDOW_DEG
+        level = float(np.nanmean(y[settled]))
+    load = float(side * np.mean(r.before_A[rows])) - level
+    if not (np.isfinite(load) and load > 0.0):
+        return float("nan"), float("nan")
+    at = []
+    for share in RELEASE_SHARES:
+        below = np.flatnonzero(y[1:] < level + share * load) + 1
+        if below.size == 0:
+            return float("nan"), float("nan")
+        k = int(below[0])
+        at.append(float(np.interp(level + share * load, [y[k], y[k - 1]],
+                                  [TRAVEL_GRID_DEG[k], TRAVEL_GRID_DEG[k - 1]])))
+    return at[1] - at[0], (RELEASE_SHARES[0] - RELEASE_SHARES[1]) * load
+
+
+def _jackknife_var(r: Reversals, rows: NDArray[np.int64],
+                   read: Callable[[Reversals, NDArray[np.int64]], tuple[float, float]] = _group
+                   ) -> tuple[float, float]:
+    """Variance of a group's two figures (:func:`_group`'s or :func:`_release`'s) from its
+    repeats (leave one out)."""
     n = len(rows)
-    loo = np.array([_group(r, np.delete(rows, i)) for i in range(n)])
+    loo = np.array([read(r, np.delete(rows, i)) for i in range(n)])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         dev = loo - np.nanmean(loo, axis=0)
@@ -202,9 +166,10 @@ class Contrast:
 
 
 def _contrast(r: Reversals, rows: NDArray[np.int64], with_var: bool = False,
-              min_per_group: int = 1) -> Contrast | None:
+              min_per_group: int = 1, figure: Figure = "load contrast") -> Contrast | None:
     """The load contrast over ``rows``: per side of the knob (its two sides differ in slack
-    and in how far the loop leaves the dead zone), sides readable at both loads."""
+    and in how far the loop leaves the dead zone), sides readable at both loads. With
+    ``figure`` "release", per side the release travel and load at the higher load alone."""
     amp = np.abs(r.at_deg[rows])
     side = np.sign(r.at_deg[rows])
     total = np.zeros(4)
@@ -213,6 +178,14 @@ def _contrast(r: Reversals, rows: NDArray[np.int64], with_var: bool = False,
         groups = [rows[(np.abs(amp - level) <= LEVEL_BAND_DEG) & (side == s)]
                   for level in LEVELS_DEG]
         if min(len(g) for g in groups) < min_per_group:
+            continue
+        if figure == "release":
+            travel, load = _release(r, groups[-1])
+            if not np.isfinite([travel, load]).all():
+                continue
+            spread = _jackknife_var(r, groups[-1], _release) if with_var else (0.0, 0.0)
+            total += (travel, load, *spread)
+            found = True
             continue
         (lost_lo, swing_lo), (lost_hi, swing_hi) = (_group(r, g) for g in groups)
         if not np.isfinite([lost_lo, swing_lo, lost_hi, swing_hi]).all():
@@ -224,16 +197,52 @@ def _contrast(r: Reversals, rows: NDArray[np.int64], with_var: bool = False,
     return Contrast(*(float(v) for v in total)) if found else None
 
 
-def _figures(series: Sequence[GapSeries]) -> list[tuple[Reversals, Contrast] | None]:
+def _figures(series: Sequence[GapSeries], figure: Figure = "load contrast"
+             ) -> list[tuple[Reversals, Contrast] | None]:
     """Per knob its reversals and load contrast; None for a knob without a readable one (a
     soft tendon can leave the tip inside its dead zone at the loop amplitude)."""
     out: list[tuple[Reversals, Contrast] | None] = []
     for knob in (0, 1):
         r = reversals(series, knob)
-        c = _contrast(r, np.arange(len(r.at_deg)), with_var=True, min_per_group=MIN_PER_LEVEL)
+        c = _contrast(r, np.arange(len(r.at_deg)), with_var=True, min_per_group=MIN_PER_LEVEL,
+                      figure=figure)
         ok = c is not None and np.isfinite(c.slope) and c.slope > 0.0
         out.append((r, c) if ok and c is not None else None)
     return out
+
+
+def load_growth(series: Sequence[GapSeries]) -> list[tuple[float, float]]:
+    """Per side of each knob read at both loads: how much later the tip returns from the
+    higher load (deg) and that figure's variance (the repeats' jackknife). The load contrast's
+    premise is that it is positive (the constant part cancels). At a light load a released
+    section can be too weak to pull its tendon, and a geared handle's drum, back through the
+    gear's play against the drum's friction; the knob then crosses the play before the tip
+    returns, a constant part the higher load does not have (warmgear, docs/gap.md "Session
+    19")."""
+    out = []
+    for knob in (0, 1):
+        r = reversals(series, knob)
+        amp, side = np.abs(r.at_deg), np.sign(r.at_deg)
+        for s in (1.0, -1.0):
+            groups = [np.flatnonzero((np.abs(amp - level) <= LEVEL_BAND_DEG) & (side == s))
+                      for level in LEVELS_DEG]
+            if min(len(g) for g in groups) < MIN_PER_LEVEL:
+                continue
+            lost_lo, lost_hi = (_group(r, g)[0] for g in groups)
+            if np.isfinite([lost_lo, lost_hi]).all():
+                out.append((lost_hi - lost_lo, sum(_jackknife_var(r, g)[0] for g in groups)))
+    return out
+
+
+def premise_holds(units: Sequence[Sequence[GapSeries]], family_alpha: float = 0.05) -> bool:
+    """False when some side of some unit returns sooner from the higher load beyond its noise
+    (one-sided, level ``family_alpha`` over all the sides tested: a side that merely does not
+    grow, coilpipe's unit 5 knob 1, is noise about a small contrast)."""
+    growth = [g for u in units for g in load_growth(u)]
+    if not growth:
+        return True
+    z_alpha = float(stats.norm.isf(family_alpha / len(growth)))
+    return all(d >= -z_alpha * np.sqrt(v) for d, v in growth)
 
 
 def lost_motion_per_A(series: Sequence[GapSeries]) -> tuple[float, float] | None:
@@ -263,13 +272,20 @@ class ComplianceSheet:
     allowance_log_var: tuple[float, float] = (0.0, 0.0)
     units: int = 1
     """How many units the sheet was measured on: from one, the units' spread is unknown."""
+    figure: Figure = "load contrast"
+    """How the figure is read, on the sheet's units and on the unit compared with it."""
 
 
-def sheet_from_units(units: Sequence[Sequence[GapSeries]]) -> ComplianceSheet | None:
+def sheet_from_units(units: Sequence[Sequence[GapSeries]],
+                     family_alpha: float = 0.05) -> ComplianceSheet | None:
     """The sheet from the protocol of each of several units (one list of series per unit):
     per knob the mean over the units that read it of the log figure, that mean's noise and the
-    units' spread (:func:`tsmd.gap.stats.unit_spread`); None when no unit reads either knob."""
-    per_unit = [_figures(u) for u in units]
+    units' spread (:func:`tsmd.gap.stats.unit_spread`); None when no unit reads either knob.
+    The figure is the load contrast unless the units break its premise (:func:`premise_holds`);
+    then it is the release at the higher load, on every unit (since session 19: warmgear's
+    reference units read 41-159 deg/A by the load contrast, 58-81 by the release)."""
+    kind: Figure = "load contrast" if premise_holds(units, family_alpha) else "release"
+    per_unit = [_figures(u, kind) for u in units]
     figure, noise, allowance = [], [], []
     for knob in (0, 1):
         read = [found[1] for f in per_unit if (found := f[knob]) is not None]
@@ -286,7 +302,7 @@ def sheet_from_units(units: Sequence[Sequence[GapSeries]]) -> ComplianceSheet | 
     if not np.isfinite(figure).any():
         return None
     return ComplianceSheet((figure[0], figure[1]), (noise[0], noise[1]),
-                           (allowance[0], allowance[1]), len(units))
+                           (allowance[0], allowance[1]), len(units), kind)
 
 
 def compliance_score(series: Sequence[GapSeries], reference: Sequence[float] | ComplianceSheet,
@@ -302,10 +318,11 @@ def compliance_score(series: Sequence[GapSeries], reference: Sequence[float] | C
     the figure, not added to a measured spread (that counted the spread twice: stickslip's
     halved tendons read x1.4-1.6 and were missed). Share: the
     held-out shrink of the load contrast's excess over the sheet's, the figure fitted on one
-    configuration and scored on the other. None when no knob has enough readable reversals."""
+    configuration and scored on the other. None when no knob has enough readable reversals.
+    The unit's figure is read as the sheet's was (:attr:`ComplianceSheet.figure`)."""
     sheet = (reference if isinstance(reference, ComplianceSheet)
              else ComplianceSheet((float(reference[0]), float(reference[1]))))
-    per_knob = _figures(series)
+    per_knob = _figures(series, sheet.figure)
     found = [(f, ref, nv, av) for f, ref, nv, av in zip(
         per_knob, sheet.figure_deg_per_A, sheet.noise_log_var, sheet.allowance_log_var,
         strict=True) if f is not None and np.isfinite(ref) and ref > 0.0]
@@ -322,14 +339,16 @@ def compliance_score(series: Sequence[GapSeries], reference: Sequence[float] | C
                  else float(np.log1p(TOLERANCE)))
     z_alpha = float(stats.norm.isf(family_alpha / max(n_tried, 1)))
     ratio, lower = float(np.exp(log_ratio)), float(np.exp(log_ratio - z_alpha * se))
-    share, lo, hi = _heldout_shrink([r for (r, _), _, _, _ in found], list(refs))
+    share, lo, hi = _heldout_shrink([r for (r, _), _, _, _ in found], list(refs),
+                                    sheet.figure)
     z = (log_ratio - allowance) / se if se > 0 else float("nan")
     title, _ = SIGNATURES["compliance"]
     # a unit's tendons are one lot: a softer one raises every knob's figure, and one precise
     # knob far up while the other reads below the sheet is one figure's scatter
     significant = bool(lower > np.exp(allowance) and log_ratio > np.log1p(TOLERANCE)
                        and bool((per_knob_log > 0.0).all()) and share >= min_share)
-    return SignatureScore("compliance", title, f"{CONDITION} (x{ratio:.2f}, lower bound "
+    how = "" if sheet.figure == "load contrast" else ", read on the release"
+    return SignatureScore("compliance", title, f"{CONDITION}{how} (x{ratio:.2f}, lower bound "
                           f"x{lower:.2f} against the units' spread x{np.exp(allowance):.2f}, "
                           f"the smallest named x{1.0 + TOLERANCE:.2f})", share, (lo, hi),
                           significant, share, 0.0, float(np.clip(z, -40.0, 40.0)))
@@ -345,19 +364,20 @@ def knobs_combined(log_ratio: FloatArray, log_var: FloatArray
     return float(w @ log_ratio), float(np.sqrt(w ** 2 @ log_var)), w
 
 
-def _heldout_shrink(per_knob: Sequence[Reversals],
-                    reference: Sequence[float]) -> tuple[float, float, float]:
+def _heldout_shrink(per_knob: Sequence[Reversals], reference: Sequence[float],
+                    figure: Figure = "load contrast") -> tuple[float, float, float]:
     """Mean, lowest and highest over held-out configurations of 1 - (the held-out load
     contrast's lost motion minus the figure fitted on the other configurations times its
     current contrast)^2 / (the same with the data sheet's figure)^2, summed over the knobs;
-    (0, nan, nan) with one configuration."""
+    (0, nan, nan) with one configuration. With ``figure`` "release", the release travel
+    against its load in place of the load contrast."""
     n_cfg = max(int(r.config.max()) + 1 if len(r.config) else 0 for r in per_knob)
     shrinks = []
     for held in range(n_cfg):
         excess = resid = 0.0
         for r, ref in zip(per_knob, reference, strict=True):
-            fit = _contrast(r, np.flatnonzero(r.config != held))
-            test = _contrast(r, np.flatnonzero(r.config == held))
+            fit = _contrast(r, np.flatnonzero(r.config != held), figure=figure)
+            test = _contrast(r, np.flatnonzero(r.config == held), figure=figure)
             if fit is None or test is None or not np.isfinite(fit.slope):
                 continue
             excess += (test.lost_deg - ref * test.swing_A) ** 2

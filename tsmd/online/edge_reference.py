@@ -2,9 +2,10 @@
 
 A mixin of :class:`tsmd.online.estimator.EdgeTracker`: the reference (current level, slope,
 residuals, the ramps' knob speed) taken from the settling reference
-(:mod:`tsmd.online.reference`), re-learned on crossings within the gate while it settles, and
-the speed rule that keeps a ramp run much faster or slower than the reference's from
-measuring (the sheath's friction is speed-dependent).
+(:mod:`tsmd.online.reference`), re-learned on crossings within the gate while it settles, the
+speed rule that keeps a ramp run much faster or slower than the reference's from measuring
+(the sheath's friction is speed-dependent), and the crossings read with more than the slope in
+use (flatter ramps, odd slopes, a re-read after the slope in use moved).
 """
 
 from __future__ import annotations
@@ -39,7 +40,11 @@ class ReferenceReadings:
     last_measurement_deg: float
     last_reading_deg: float
     accepted_order: int
+    suspect_order: int
     n_between: int
+    n_widened: int
+    n_reread: int
+    held: tuple[LoadedRamp, float, float] | None
 
     def _speed_matches(self, ramp: LoadedRamp) -> bool:
         """The ramp ran at a knob speed within ``speed_ratio_max`` of the reference's (True
@@ -83,6 +88,25 @@ class ReferenceReadings:
         return nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
                                self.estimate_deg + self.bins.bias_deg(ramp.other_deg))
 
+    def _widening_read(self, ramp: LoadedRamp, edge_deg: float) -> float | None:
+        """A ramp whose slope disagrees with the slope in use, read with the reference's slope
+        and with its own: the nearer crossing when both lie outward beyond the gate (with
+        ``odd_slopes_read_widening``), else None (it measures nothing). After a change the
+        slope in use lags by two ramps per edge and the slopes scatter (coilpipe 1, +0.5 mm
+        slack: 0.78-1.20 x, the fresh edges +3.4..+4.3 deg; the ramps the slope in use passed
+        over read +2.6..+3.7 with the reference's slope and +5.2..+5.3 with their own); without
+        a change one of the two stays within the gate (coilpipe 2, 600 s: slow strokes
+        1.2-1.9 x read -3.8..+0.6 with the reference's slope, their own +6.1)."""
+        assert self.slope_ref_A_per_deg is not None
+        if not self.options.odd_slopes_read_widening:
+            return None
+        nearer = min(self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
+                     self._crossing(ramp, edge_deg, ramp.slope_A_per_deg))
+        if nearer - self.bins.bias_deg(ramp.other_deg) - self.estimate_deg <= self.options.gate_deg:
+            return None
+        self.n_widened += 1
+        return nearer
+
     def _settling(self, ramp: LoadedRamp, profile_edge_deg: float, raw_deg: float) -> bool:
         """While the reference settles, a crossing within the gate re-learns it instead of
         measuring (the catheter's behaviour moving under a reference learned too early is not
@@ -99,3 +123,23 @@ class ReferenceReadings:
         if self.reference.add(ramp, profile_edge_deg):
             self._take_reference()
         return True
+
+    def _reread(self, slope: float) -> None:
+        """The last crossing ramp read again with the slope in use now, when that moved beyond
+        the tolerance since: a suspect under it joins the suspects (the slope in use follows a
+        friction change two ramps late, and the first ramps after a bend read short or
+        measured nothing; lumped 103 phi2, 60 deg bend: ramps 1.11-1.16 x, crossings 0.76/1.22
+        deg with the old slope, 2.18/2.68 with the new, followed 54 s after the bend)."""
+        if self.held is None or self.level_A is None:
+            return
+        ramp, edge_deg, used = self.held
+        self.held = None
+        o = self.options
+        if (abs(slope / used - 1.0) <= o.slope_in_use_tolerance
+                or abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance):
+            return
+        m = self._crossing(ramp, edge_deg, slope) - self.bins.bias_deg(ramp.other_deg)
+        if m - self.estimate_deg > o.gate_deg:  # outward only: the friction rose
+            self.suspects = [*self.suspects, m][-o.confirm:]
+            self.suspect_order = next(ORDER)
+            self.n_reread += 1

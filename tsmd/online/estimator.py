@@ -93,6 +93,9 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     partner_knee_change: float = 0.0
     n_odd_slope: int = 0
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
+    n_widened: int = 0
+    """Ramps of an odd slope read as a widening: both slopes' crossings outward beyond the
+    gate (:attr:`EstimatorOptions.odd_slopes_read_widening`)."""
     n_odd_knee: int = 0
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_odd_crossing: int = 0
@@ -251,8 +254,13 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             self._reread(slope)
             self.held = (ramp, profile_edge_deg, slope)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
-            self.n_odd_slope += 1
-            self.last_measurement_deg = math.nan
+            widened = self._widening_read(ramp, profile_edge_deg)
+            if widened is None:
+                self.n_odd_slope += 1
+                self.last_measurement_deg = math.nan
+                return events
+            self.last_feature = "crossing"
+            self._measured(widened, ramp.other_deg, events)
             return events
         self.last_feature = "crossing"
         raw = self._crossing_read(ramp, profile_edge_deg, slope)
@@ -273,26 +281,6 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                 return events
         self._measured(raw, ramp.other_deg, events)
         return events
-
-    def _reread(self, slope: float) -> None:
-        """The last crossing ramp read again with the slope in use now, when that moved beyond
-        the tolerance since: a suspect under it joins the suspects (the slope in use follows a
-        friction change two ramps late, and the first ramps after a bend read short or
-        measured nothing; lumped 103 phi2, 60 deg bend: ramps 1.11-1.16 x, crossings 0.76/1.22
-        deg with the old slope, 2.18/2.68 with the new, followed 54 s after the bend)."""
-        if self.held is None or self.level_A is None:
-            return
-        ramp, edge_deg, used = self.held
-        self.held = None
-        o = self.options
-        if (abs(slope / used - 1.0) <= o.slope_in_use_tolerance
-                or abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance):
-            return
-        m = self._crossing(ramp, edge_deg, slope) - self.bins.bias_deg(ramp.other_deg)
-        if m - self.estimate_deg > o.gate_deg:  # outward only: the friction rose
-            self.suspects = [*self.suspects, m][-o.confirm:]
-            self.suspect_order = next(ORDER)
-            self.n_reread += 1
 
     def _measured(self, raw_deg: float, other_deg: float,
                   events: list[tuple[str, str, dict[str, Any]]]) -> None:
@@ -407,4 +395,4 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None,
                 "reference_relearned": self.reference.relearned,
                 "reread_ramps": self.n_reread, "partner_held": self.n_partner_held,
-                "between_ramps": self.n_between}
+                "between_ramps": self.n_between, "widened_ramps": self.n_widened}

@@ -104,6 +104,14 @@ class EstimatorOptions:
     crossings -0.6..-1.8 deg with the slope in use, +0.5..+0.8 with the reference's, while
     the tip's edge stayed within +-0.3 deg; followed, phi2 tracked 0.3-1.6 deg worse than
     with online off). Off: the slope in use alone (until session 17)."""
+    odd_slopes_read_widening: bool = True
+    """A ramp whose slope disagrees with the slope in use beyond ``same_slope_tolerance``
+    (measuring nothing otherwise) is a suspect when its crossings with the reference's slope
+    and with its own both lie outward beyond the gate, at the nearer of the two
+    (:meth:`EdgeTracker._widening_read`): a slack or a bend widens the dead zone whatever the
+    slope, while the slope in use lags a change by two ramps per edge (coilpipe 1, +0.5 mm
+    slack: phi1 pos passed over ramps reading +2.6/+3.7 deg, followed 34 s later, on / fresh
+    2.43 x). Off: such a ramp measures nothing (until session 18)."""
     reread_on_slope_change: bool = False
     """The last crossing ramp is read again when the slope in use has moved beyond
     ``slope_in_use_tolerance`` since it was read; outward beyond the gate it becomes a

@@ -1,6 +1,5 @@
 """The gain the product's release-path ratio is taken against, and the sheet's tip backlash
-gain it is chosen by (session 16; read at the lines' corners: session 17; without one, the
-product rule's: session 19)."""
+gain it is chosen by (session 16; read at the lines' corners: session 17)."""
 
 from __future__ import annotations
 
@@ -29,20 +28,9 @@ def moved_gain(gain: float) -> float:
     return 1.0 - OMEGA * (1.0 - RULE) / (RELEASE * (1.0 - gain))
 
 
-def test_without_the_tip_gain_the_ratio_is_against_the_product_rules_gain() -> None:
-    assert ratio_gain(KNOB) == RULE
-    assert release_slope_ratio(KNOB) == pytest.approx(RELEASE * (1 - RULE) / OMEGA)
-
-
-def test_without_the_tip_gain_the_sheet_units_release_line_keeps_its_tracked_slope() -> None:
-    # the sheet's own unit fits beta with the product rule, so its gain is RULE there
-    locus_slope = OMEGA / (1.0 - RULE)
-    assert release_slope_ratio(KNOB) * locus_slope == pytest.approx(RELEASE)
-
-
-def test_without_the_rule_gain_or_a_tip_gain_the_ratio_is_against_the_settle_rules_gain() -> None:
-    knob = dataclasses.replace(KNOB, reference_rule_backlash_gain=None)
-    assert ratio_gain(knob) == SETTLE
+def test_without_the_tip_gain_the_ratio_is_against_the_settle_rules_gain() -> None:
+    assert ratio_gain(KNOB) == SETTLE
+    assert release_slope_ratio(KNOB) == pytest.approx(RELEASE * (1 - SETTLE) / OMEGA)
 
 
 def test_a_tip_gain_near_the_rule_readings_moved_gain_takes_the_rule_reading() -> None:

@@ -21,27 +21,24 @@ RELEASE_RATIO_RANGE: tuple[float, float] = (0.7, 1.3)
 
 
 def ratio_gain(device_knob: Any) -> float | None:
-    """The sheet unit's backlash gain the ratio is taken against: the product rule's
-    (``reference_rule_backlash_gain``, the reading every unit's ``beta`` is fitted with) or the
-    settle rule's (``reference_backlash_gain``), the one whose moved gain on the sheet's own
-    unit, ``1 - omega (1 - rule) / (release_omega (1 - gain))``, is nearer the backlash growth
-    its tracker showed between reversals at 60 and 90 deg, read at the corners of the paper's
-    lines (``reference_tip_line_backlash_gain``, session 17) or else at the 1 deg threshold
-    (``reference_tip_backlash_gain``, session 16). Without a tip growth, the product rule's
-    (session 19): against it the release line keeps, on the sheet's unit, the slope its tracker
-    showed (``release_omega``); against the settle rule's it was drawn up to 15 % shallower
-    wherever the two rules differ (segments, nitinol), and every sheet that measured the tip's
-    line growth chose the product rule's. The settle rule's where the sheet has no rule gain."""
+    """The sheet unit's backlash gain the ratio is taken against: the settle rule's
+    (``reference_backlash_gain``, sessions 7-15) or the product rule's
+    (``reference_rule_backlash_gain``, the reading every unit's ``beta`` is fitted with), the one
+    whose moved gain on the sheet's own unit, ``1 - omega (1 - rule) / (release_omega (1 -
+    gain))``, is nearer the backlash growth its tracker showed between reversals at 60 and 90
+    deg (``reference_tip_backlash_gain``, session 16); the settle rule's without that key.
+    Where the sheet also has the growth read at the corners of the paper's lines
+    (``reference_tip_line_backlash_gain``, session 17), the choice is made against it: the
+    model's backlash is the knob travel to its release line, which a tip with rounded
+    corners reaches after the 1 deg threshold has fired."""
     settle = getattr(device_knob, "reference_backlash_gain", None)
     rule = getattr(device_knob, "reference_rule_backlash_gain", None)
     tip = getattr(device_knob, "reference_tip_line_backlash_gain", None)
     if tip is None:
         tip = getattr(device_knob, "reference_tip_backlash_gain", None)
     release = getattr(device_knob, "release_omega", None)
-    if settle is None or rule is None or release is None:
+    if settle is None or rule is None or tip is None or release is None:
         return None if settle is None else float(settle)
-    if tip is None:
-        return float(rule)
     omega = float(device_knob.omega)
 
     def miss(gain: float) -> float:

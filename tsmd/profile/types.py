@@ -156,7 +156,7 @@ class DeviceKnob:
     session 16): how much the tip's backlash grows per degree of reversal amplitude (reversals
     at 60 and 90 deg, :mod:`tsmd.datasheet_amplitude`). Method ours takes its release-path
     ratio against the gain reading that brings the sheet unit's moved gain nearer it
-    (:func:`tsmd.calibration.release_path.ratio_gain`); None: the product rule's (session 19)."""
+    (:func:`tsmd.calibration.release_path.ratio_gain`); None: the settle rule's."""
     reference_tip_line_backlash_gain: float | None = None
     """Optional, tracked on the data-sheet unit (``tsmd datasheet --tip-line-backlash-gain``,
     opt-in, session 17): the same growth with the tip's backlash read at the corners of the

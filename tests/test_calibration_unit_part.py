@@ -38,17 +38,26 @@ def _sweep() -> SweepResult:
 def test_errors_the_gates_half_widths_explain_leave_no_product_part() -> None:
     rng = np.random.default_rng(0)
     errors = rng.normal(0.0, 0.5, 4000)
-    assert sample_u95_deg(errors, np.full(errors.size, 0.5 * Z95)) < 0.1
+    assert sample_u95_deg(errors, np.full(errors.size, 0.5 * Z95), 1000) < 0.1
 
 
 def test_a_bias_the_gate_does_not_see_is_the_product_part() -> None:
     errors = np.array([1.0, -1.0, 1.0, -1.0])
-    assert sample_u95_deg(errors, np.zeros(4)) == pytest.approx(Z95)
+    # a large sample: the normal's 1.96 sigma
+    assert sample_u95_deg(errors, np.zeros(4), 100000) == pytest.approx(Z95, rel=1e-3)
 
 
-def test_a_sample_without_a_value_is_refused() -> None:
-    with pytest.raises(ValueError, match="no value"):
-        sample_u95_deg([math.nan], [1.0])
+def test_a_small_sample_predicts_a_new_unit_with_a_wider_half_width() -> None:
+    errors = np.array([1.0, -1.0, 1.0, -1.0])
+    assert sample_u95_deg(errors, np.zeros(4), 4) > 1.5 * sample_u95_deg(errors, np.zeros(4), 100)
+
+
+@pytest.mark.parametrize("errors, units, message", [([math.nan], 4, "no value"),
+                                                    ([1.0], 1, "at least two")])
+def test_a_sample_that_says_nothing_is_refused(errors: list[float], units: int,
+                                               message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        sample_u95_deg(errors, [1.0], units)
 
 
 def test_the_sheets_part_replaces_the_shares_and_reaches_the_dead_zone() -> None:

@@ -46,20 +46,20 @@ def sample_readings(runs: Sequence[tuple[ProtocolRun, dict[tuple[int, float],
     return out
 
 
-def with_unit_parts(device: DeviceModel, readings: Readings) -> DeviceModel:
-    """The sheet with each knob's product part per kind (left out where the sample gave no
-    value of that kind)."""
+def with_unit_parts(device: DeviceModel, readings: Readings, units: int) -> DeviceModel:
+    """The sheet with each knob's product part per kind from a sample of ``units`` units (left
+    out where the sample gave no value of that kind)."""
     knobs = []
     for knob, k in enumerate(device.knobs):
-        dz, b = (_part(readings.get((knob, kind), ([], []))) for kind in ("dead-zone edge",
-                                                                           "backlash"))
+        dz, b = (_part(readings.get((knob, kind), ([], [])), units)
+                 for kind in ("dead-zone edge", "backlash"))
         knobs.append(dataclasses.replace(k, dead_zone_unit_u95_deg=dz, backlash_unit_u95_deg=b))
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
-def _part(reading: tuple[list[float], list[float]]) -> float | None:
+def _part(reading: tuple[list[float], list[float]], units: int) -> float | None:
     errors, gate = reading
-    return round(sample_u95_deg(errors, gate), 2) if errors else None
+    return round(sample_u95_deg(errors, gate, units), 2) if errors else None
 
 
 def measure_sample(device: DeviceModel, configs: Sequence[TsmdConfig], noise_seed: int
@@ -69,4 +69,4 @@ def measure_sample(device: DeviceModel, configs: Sequence[TsmdConfig], noise_see
     runs = [(play_protocol(c, device, fast_protocol(), noise_seed), sheet_truth(c))
             for c in configs]
     readings = sample_readings(runs)
-    return with_unit_parts(device, readings), readings
+    return with_unit_parts(device, readings, len(configs)), readings

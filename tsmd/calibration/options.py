@@ -164,7 +164,9 @@ plant's constants behind it (docs/calibration.md, session 18): the contacts' pre
 displacement moves the tip's B by -+0.6 deg over its scatter with under 3 mA of change in the
 motor current, and the ratio follows the sheath's friction-wrap product only to r -0.95. No
 sweep narrows it: it widens the reported half-width of B
-(:attr:`tsmd.calibration.estimate.Estimate.reported_u95_deg`), not the gate's."""
+(:attr:`tsmd.calibration.estimate.Estimate.reported_u95_deg`), not the gate's, where the data
+sheet did not measure the product's own part on its sample (``backlash_unit_u95_deg``,
+:mod:`tsmd.calibration.unit_part`; session 19: 1.5-4x too wide on lumped and helixbelt)."""
 
 
 def for_product(options: IdentifyOptions, settle_fraction: float | None,

@@ -19,12 +19,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats
 
 from tsmd.calibration.sweep_result import SweepResult
 from tsmd.profile.types import DeviceKnob
 
 Z95 = 1.96
-"""Two-sided 95 % of a normal spread: the sample's root-mean-square part to a half-width."""
+"""Two-sided 95 % of a normal spread: a gate half-width over this is its one-sigma part."""
 
 
 @dataclass(frozen=True)
@@ -57,15 +58,24 @@ def with_unit_part(result: SweepResult, part: UnitPart | None) -> SweepResult:
     return dataclasses.replace(result, product_u95_deg=found)
 
 
-def sample_u95_deg(errors_deg: Sequence[float], gate_u95_deg: Sequence[float]) -> float:
-    """The product's part from a sample's values: each value's error against its tracked tip,
-    with the gate's own 95 % half-width. Errors the gate's half-widths explain (each its
-    half-width over :data:`Z95`, squared) are taken out of their mean square; what is left,
-    bias and unit-to-unit part together, is the part's variance."""
+def sample_u95_deg(errors_deg: Sequence[float], gate_u95_deg: Sequence[float],
+                   units: int) -> float:
+    """The product's part from a sample of ``units`` units' values: each value's error against
+    its tracked tip, with the gate's own 95 % half-width. Errors the gate's half-widths explain
+    (each its half-width over :data:`Z95`, squared) are taken out of their mean square; what is
+    left, bias and unit-to-unit part together, is the part's variance. A new unit's part is
+    predicted from ``units`` draws of it (a unit's values move together: ratestate development
+    unit 4's phi1 B all +2.0..+3.1 deg), so the half-width is the prediction interval's,
+    t(0.975, units - 1) sqrt(1 + 1/units) sigma, not 1.96 sigma (which covered ratestate
+    development units 1-4 75 % on B from a sample of four; docs/calibration.md, session 19)."""
+    if units < 2:
+        raise ValueError(f"a sample of {units} unit(s) says nothing of the unit-to-unit part: "
+                         "give at least two")
     e = np.asarray(errors_deg, dtype=float)
     g = np.asarray(gate_u95_deg, dtype=float)
     ok = np.isfinite(e) & np.isfinite(g)
     if not ok.any():
         raise ValueError("no value with both an error and a half-width")
     left = float(np.mean(e[ok] ** 2 - (g[ok] / Z95) ** 2))
-    return Z95 * math.sqrt(max(left, 0.0))
+    factor = float(stats.t.ppf(0.975, units - 1)) * math.sqrt(1.0 + 1.0 / units)
+    return factor * math.sqrt(max(left, 0.0))

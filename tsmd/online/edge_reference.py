@@ -95,8 +95,9 @@ class ReferenceReadings:
         slope in use lags by two ramps per edge and the slopes scatter (coilpipe 1, +0.5 mm
         slack: 0.78-1.20 x, the fresh edges +3.4..+4.3 deg; the ramps the slope in use passed
         over read +2.6..+3.7 with the reference's slope and +5.2..+5.3 with their own); without
-        a change one of the two stays within the gate (coilpipe 2, 600 s: slow strokes
-        1.2-1.9 x read -3.8..+0.6 with the reference's slope, their own +6.1)."""
+        a change one of the two stays within the gate (coilpipe 2 phi1, 600 s: 19 odd-slope
+        ramps, 0.70-1.86 x, read -3.8..+0.6 with the reference's slope, -9.2..+6.1 with their
+        own)."""
         assert self.slope_ref_A_per_deg is not None
         if not self.options.odd_slopes_read_widening:
             return None

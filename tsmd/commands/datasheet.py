@@ -144,17 +144,24 @@ def _from_recordings(paths: list[str]) -> list[KnobConstants]:
     return [by_knob[0], by_knob[1]]
 
 
+def _int_list(text: str, option: str, what: str, alternative: str = "") -> list[int]:
+    """``text`` as a non-empty comma-separated list of integers, or a one-line error naming
+    ``option``."""
+    try:
+        values = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise DatasheetError(f"{option}: not a comma-separated list of integers"
+                             f"{' or ' + alternative if alternative else ''}: {text!r}") from None
+    if not values:
+        raise DatasheetError(f"{option}: give at least one {what}"
+                             f"{', or ' + alternative if alternative else ''}")
+    return values
+
+
 def _rule_seeds(text: str) -> list[int]:
     if text.strip().lower() == "none":
         return []
-    try:
-        seeds = [int(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise DatasheetError(f"--rule-seeds: not a comma-separated list of integers or "
-                             f"'none': {text!r}") from None
-    if not seeds:
-        raise DatasheetError("--rule-seeds: give at least one seed, or 'none'")
-    return seeds
+    return _int_list(text, "--rule-seeds", "seed", "'none'")
 
 
 def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
@@ -301,14 +308,7 @@ def _with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: di
 
 
 def _units(text: str) -> list[int]:
-    try:
-        units = [int(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise DatasheetError(f"--unit-sample: not a comma-separated list of integers: "
-                             f"{text!r}") from None
-    if not units:
-        raise DatasheetError("--unit-sample: give at least one unit")
-    return units
+    return _int_list(text, "--unit-sample", "unit")
 
 
 def _or_none(value: float | None, decimals: int) -> str:

@@ -17,12 +17,11 @@ from collections.abc import Sequence
 
 from tsmd.calibration.estimate import KINDS
 from tsmd.calibration.protocol import fast_protocol
-from tsmd.calibration.resweep import point_estimates
 from tsmd.calibration.unit_part import sample_u95_deg
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_rule import sheet_truth
 from tsmd.profile import DeviceModel
-from tsmd.tracked_calibration import ProtocolRun, play_protocol
+from tsmd.tracked_calibration import ProtocolRun, play_protocol, value_errors
 
 Readings = dict[tuple[int, str], tuple[list[float], list[float]]]
 """Per (knob, kind of parameter): the sample's errors against the tip and the gate's 95 %
@@ -35,14 +34,10 @@ def sample_readings(runs: Sequence[tuple[ProtocolRun, dict[tuple[int, float],
     the sample's runs and their truths (a refused run's values count as they were read)."""
     out: Readings = {(knob, kind): ([], []) for knob in (0, 1) for kind in KINDS}
     for run, truth in runs:
-        for p, est in zip(run.points, point_estimates(run.points), strict=True):
-            tip = truth.get((p.knob, float(p.other_deg)), {})
-            for kind, names in KINDS.items():
-                for name in names:
-                    error = est[name].value - tip.get(name, math.nan)
-                    if math.isfinite(error) and math.isfinite(est[name].u95_deg):
-                        out[(p.knob, kind)][0].append(error)
-                        out[(p.knob, kind)][1].append(est[name].u95_deg)
+        for knob, kind, error, est in value_errors(run.points, truth):
+            if math.isfinite(est.u95_deg):
+                out[(knob, kind)][0].append(error)
+                out[(knob, kind)][1].append(est.u95_deg)
     return out
 
 

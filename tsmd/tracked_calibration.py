@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -21,7 +21,7 @@ from scipy.interpolate import PchipInterpolator
 from simrig.plant import Plant, PlantStep, as_plant_step, load_plant
 from tsmd.calibration.assemble import GridPoint, QualityLimits
 from tsmd.calibration.errors import CalibrationError
-from tsmd.calibration.estimate import KINDS
+from tsmd.calibration.estimate import KINDS, Estimate
 from tsmd.calibration.player import sweep_metadata
 from tsmd.calibration.protocol import Protocol, paper_protocol, sweep_run
 from tsmd.calibration.resweep import point_estimates
@@ -154,6 +154,20 @@ def score(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]],
     run.coverage = coverage_against(run.points, truth)
 
 
+def value_errors(points: Sequence[GridPoint], truth: dict[tuple[int, float], dict[str, float]]
+                 ) -> Iterator[tuple[int, str, float, Estimate]]:
+    """Per value measured at a grid point with a tip truth: (knob, kind of parameter,
+    identified minus tip, its estimate). Shared by the coverage score and the sheet's sample
+    (:mod:`tsmd.datasheet_sample`)."""
+    for p, est in zip(points, point_estimates(points), strict=True):
+        tip = truth.get((p.knob, float(p.other_deg)), {})
+        for kind, names in KINDS.items():
+            for name in names:
+                error = est[name].value - tip.get(name, math.nan)
+                if math.isfinite(error):
+                    yield p.knob, kind, error, est[name]
+
+
 def coverage_against(points: Sequence[GridPoint],
                      truth: dict[tuple[int, float], dict[str, float]]
                      ) -> dict[str, tuple[int, int]]:
@@ -161,14 +175,9 @@ def coverage_against(points: Sequence[GridPoint],
     half-width, values scored), over the grid points the protocol measured (the half-width is
     said per grid point, not between them). An honest half-width covers about 95 %."""
     out = {kind: (0, 0) for kind in KINDS}
-    for p, est in zip(points, point_estimates(points), strict=True):
-        tip = truth.get((p.knob, float(p.other_deg)), {})
-        for kind, names in KINDS.items():
-            for name in names:
-                error = abs(est[name].value - tip.get(name, math.nan))
-                if math.isfinite(error):
-                    covered, n = out[kind]
-                    out[kind] = (covered + int(error <= est[name].reported_u95_deg), n + 1)
+    for _, kind, error, est in value_errors(points, truth):
+        covered, n = out[kind]
+        out[kind] = (covered + int(abs(error) <= est.reported_u95_deg), n + 1)
     return out
 
 

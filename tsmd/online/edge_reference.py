@@ -43,7 +43,10 @@ class ReferenceReadings:
     suspect_order: int
     n_between: int
     n_widened: int
+    n_steeper: int
     n_reread: int
+    odd_speed: bool
+    ramp_change: float
     held: tuple[LoadedRamp, float, float] | None
 
     def _speed_matches(self, ramp: LoadedRamp) -> bool:
@@ -88,10 +91,12 @@ class ReferenceReadings:
         return nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
                                self.estimate_deg + self.bins.bias_deg(ramp.other_deg))
 
-    def _widening_read(self, ramp: LoadedRamp, edge_deg: float) -> float | None:
-        """A ramp whose slope disagrees with the slope in use, read with the reference's slope
-        and with its own: the nearer crossing when both lie outward beyond the gate (with
-        ``odd_slopes_read_widening``), else None (it measures nothing). After a change the
+    def _widening_read(self, ramp: LoadedRamp, edge_deg: float, slope: float,
+                       partner: ReferenceReadings | None = None) -> float | None:
+        """A ramp whose slope disagrees with the slope in use (``slope``), read with the
+        reference's slope and with its own: the nearer crossing when both lie outward beyond
+        the gate (with ``odd_slopes_read_widening``), its own slope's when the knob's friction
+        rose (:meth:`_knob_steeper`), else None (it measures nothing). After a change the
         slope in use lags by two ramps per edge and the slopes scatter (coilpipe 1, +0.5 mm
         slack: 0.78-1.20 x, the fresh edges +3.4..+4.3 deg; the ramps the slope in use passed
         over read +2.6..+3.7 with the reference's slope and +5.2..+5.3 with their own); without
@@ -99,14 +104,34 @@ class ReferenceReadings:
         ramps, 0.70-1.86 x, read -3.8..+0.6 with the reference's slope, -9.2..+6.1 with their
         own)."""
         assert self.slope_ref_A_per_deg is not None
-        if not self.options.odd_slopes_read_widening:
+        own = self._crossing(ramp, edge_deg, ramp.slope_A_per_deg)
+        steeper = self._knob_steeper(ramp, slope, partner)
+        if steeper:
+            reading = own
+        elif self.options.odd_slopes_read_widening:
+            reading = min(self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg), own)
+        else:
             return None
-        nearer = min(self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
-                     self._crossing(ramp, edge_deg, ramp.slope_A_per_deg))
-        if nearer - self.bins.bias_deg(ramp.other_deg) - self.estimate_deg <= self.options.gate_deg:
+        beyond = reading - self.bins.bias_deg(ramp.other_deg) - self.estimate_deg
+        if beyond <= self.options.gate_deg:
             return None
         self.n_widened += 1
-        return nearer
+        self.n_steeper += steeper
+        return reading
+
+    def _knob_steeper(self, ramp: LoadedRamp, slope: float,
+                      partner: ReferenceReadings | None) -> bool:
+        """The ramp, at the reference's speed, is steeper than the slope in use beyond
+        ``same_slope_tolerance`` and the knob's other tendon's last ramp (any speed) was
+        steeper than its reference by as much (with ``steeper_knob_reads_own``): the sheath's
+        friction rose on both tendons (a bend), which the slope in use follows only two ramps
+        per edge late, and a flatter slope through the window's centre reads the crossing
+        inward (coilpipe 1, 60 deg bend: ramps 1.16-1.34 x read -0.5..+0.6 deg with the
+        reference's slope, +1.9..+3.4 with their own; the fresh edges +2.1..+2.5)."""
+        tol = self.options.same_slope_tolerance
+        return (self.options.steeper_knob_reads_own and not self.odd_speed
+                and partner is not None and partner.ramp_change > tol
+                and ramp.slope_A_per_deg / slope - 1.0 > tol)
 
     def _settling(self, ramp: LoadedRamp, profile_edge_deg: float, raw_deg: float) -> bool:
         """While the reference settles, a crossing within the gate re-learns it instead of

@@ -94,8 +94,11 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     n_odd_slope: int = 0
     """Ramps whose slope disagreed with the slope in use: no measurement taken."""
     n_widened: int = 0
-    """Ramps of an odd slope read as a widening: both slopes' crossings outward beyond the
-    gate (:attr:`EstimatorOptions.odd_slopes_read_widening`)."""
+    """Odd-slope ramps read as a widening (``odd_slopes_read_widening``, or a steeper knob's)."""
+    ramp_change: float = 0.0
+    """The last ramp's own slope against the reference, minus 1, whatever its speed."""
+    n_steeper: int = 0
+    """Of those, steeper ramps read with their own slope (``steeper_knob_reads_own``)."""
     n_odd_knee: int = 0
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_odd_crossing: int = 0
@@ -104,15 +107,15 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """Ramps at a knob speed beyond ``speed_ratio_max`` of the reference's that measured
     nothing (all but those reading outward beyond the gate)."""
     odd_speed: bool = False
+    """The last ramp ran at a speed beyond ``speed_ratio_max`` of the reference's."""
     speed_ref_change: float = 0.0
     """The slope change of the edge's last ramp at the reference's speed."""
-    """The last ramp ran at a speed beyond ``speed_ratio_max`` of the reference's."""
     speed_ref_deg_s: float = math.nan
     """The reference ramps' median knob speed (NaN: not learned, or no speeds)."""
     n_refused: int = 0
     """Ramps refused for a slope beyond ``slope_ratio_max`` of the reference."""
     suspect_order: int = -1
-    """When (:data:`~tsmd.online.edge_reference.ORDER`) the last suspect was taken; -1: none yet."""
+    """When (:data:`~tsmd.online.edge_reference.ORDER`) the last suspect was taken; -1: none."""
     accepted_order: int = -1
     """When the last measurement within the gate was taken (the edge read where it was)."""
     bins: OtherKnobBins = field(init=False)
@@ -123,10 +126,10 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     n_reread: int = 0
     """Ramps that became suspects when re-read with a slope in use that had moved."""
     reference: SettlingReference = field(init=False)
+    """The reference being learned, re-learned while it settles (:mod:`tsmd.online.reference`)."""
     other_knob_shows: Callable[[int], bool] | None = field(default=None, repr=False)
     """Whether the other knob's edges show a change this way (+1 outward, -1 inward;
     :func:`tsmd.online.cross_knob.knob_shows`, set by the worker); None: not asked."""
-    """The reference being learned, re-learned while it settles (:mod:`tsmd.online.reference`)."""
     partner: EdgeTracker | None = field(default=None, repr=False, compare=False)
     """The knob's other edge (set by the worker, or by :meth:`update`'s ``partner``)."""
     n_between: int = 0
@@ -186,6 +189,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             return events
         assert self.level_A is not None and self.slope_ref_A_per_deg is not None
         ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
+        self.ramp_change = ratio - 1.0
         self.odd_speed = not self._speed_matches(ramp)
         if not self.odd_speed:
             self.speed_ref_change = ratio - 1.0
@@ -254,7 +258,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             self._reread(slope)
             self.held = (ramp, profile_edge_deg, slope)
         if abs(ramp.slope_A_per_deg / slope - 1.0) > o.same_slope_tolerance:
-            widened = self._widening_read(ramp, profile_edge_deg)
+            widened = self._widening_read(ramp, profile_edge_deg, slope, self.partner)
             if widened is None:
                 self.n_odd_slope += 1
                 self.last_measurement_deg = math.nan
@@ -395,4 +399,5 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                 "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None,
                 "reference_relearned": self.reference.relearned,
                 "reread_ramps": self.n_reread, "partner_held": self.n_partner_held,
-                "between_ramps": self.n_between, "widened_ramps": self.n_widened}
+                "between_ramps": self.n_between, "widened_ramps": self.n_widened,
+                "steeper_ramps": self.n_steeper}

@@ -112,6 +112,13 @@ class EstimatorOptions:
     slope, while the slope in use lags a change by two ramps per edge (coilpipe 1, +0.5 mm
     slack: phi1 pos passed over ramps reading +2.6/+3.7 deg, followed 34 s later, on / fresh
     2.43 x). Off: such a ramp measures nothing (until session 18)."""
+    steeper_knob_reads_own: bool = True
+    """A ramp at the reference's speed steeper than the slope in use beyond
+    ``same_slope_tolerance``, while the knob's other tendon's last ramp was steeper than its
+    reference by as much, reads the crossing with its own slope (a suspect when outward beyond
+    the gate): both tendons' friction rose, a bend, and the slope in use lags it (coilpipe 1,
+    60 deg bend: phi1 ramps 1.16-1.34 x passed over for 40 s, on / fresh 2.13 x). Off: such a
+    ramp is read as any odd slope (``odd_slopes_read_widening``; until session 19)."""
     reread_on_slope_change: bool = False
     """The last crossing ramp is read again when the slope in use has moved beyond
     ``slope_in_use_tolerance`` since it was read; outward beyond the gate it becomes a

@@ -207,9 +207,17 @@ def test_a_small_friction_change_on_both_edges_is_followed_below_the_slope_toler
 
 
 def test_a_small_friction_change_within_the_slope_tolerance_measures_nothing() -> None:
-    pos, _ = _both_edges_18_percent_steeper(EstimatorOptions(slope_in_use_tolerance=0.15,
-                                                             pooled_slope_change=False))
+    pos, _ = _both_edges_18_percent_steeper(EstimatorOptions(
+        slope_in_use_tolerance=0.15, pooled_slope_change=False, steeper_knob_reads_own=False))
     assert pos.applied_deg == 0.0 and pos.status()["odd_slope_ramps"] > 0
+
+
+def test_a_steeper_knob_reads_its_own_slope_where_the_slope_in_use_stays() -> None:
+    pos, neg = _both_edges_18_percent_steeper(EstimatorOptions(slope_in_use_tolerance=0.15,
+                                                               pooled_slope_change=False))
+    assert pos.applied_deg == pytest.approx(3.0, abs=0.05)
+    assert neg.applied_deg == pytest.approx(3.0, abs=0.05)
+    assert pos.status()["steeper_ramps"] > 0
 
 
 def test_a_friction_change_without_knees_scales_the_backlash_gain_by_the_slope() -> None:

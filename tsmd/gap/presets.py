@@ -243,6 +243,31 @@ WARMGEAR_MAX_STEP_S = 0.004
 steps, 0.50 deg (0.088 RMS) at 20 ms (unit 1, 120 s of the experiment motion): as ratestate."""
 
 
+ARCHWAVE_EFFECTS: dict[str, dict[str, float]] = {"curvature": {"sheath_curvature_deg": 120.0}}
+"""The archwave plant's one effect keyword: a 120 deg sheath bend (added to the path's arch, in
+its plane: wrap for every tendon, path slack by lumen), 4.47 / 3.58 deg of tip (tip RMSE effect
+on minus off, units 1 / 2, noise-free, 120 s of the experiment motion at 50 Hz). Its planes'
+coupling has no constant of its own (``section_wrap_share`` and ``bend_stiffening_per_rad2``
+take the own plane's bend as well: x2 / x3 move the tip 0.22 / 0.64 deg); nothing at the tip
+depends on speed (the wave generator's viscous and Coulomb drags, saturated at 2 deg/s, are on
+the motor: x10 viscous moves the tip 0.000 deg, the current 15 mA RMS) or drifts at a held knob
+(Bouc-Wen is rate-independent; the warming torque constant moves the current only): coupling,
+rate and creep are not run. "None" is the nominal physics as written (docs/gap.md "Session
+20")."""
+
+ARCHWAVE_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "compliance": {"tendon_stiffness_N": 0.5, "coil_compliance_mm_per_N": 2.0},
+}
+"""Compliance on archwave as factors on the unit's knob constants, sized before any diagnosis
+(same criterion): the tendon's whole compliance doubled, the rope's EA halved and its coil
+sheath's shortening per newton doubled (the coil is 60 % of it: the EA halved alone 1.30 / 1.46
+deg, below every other plant's 2.0-9.8), 2.89 / 2.91 deg (units 1 / 2)."""
+
+ARCHWAVE_MAX_STEP_S = 0.004
+"""The archwave unit's tip lies 0.052 deg RMS (0.66 max) from 0.5 ms steps at 20 ms steps,
+0.028 (0.34) at 4 ms (unit 1; unit 2 0.051 / 0.028): the gear's one-step lag, as ratestate."""
+
+
 @dataclass(frozen=True)
 class PlantSpec:
     """A plant as ``module:factory`` + fixed keyword parameters + what to fit as a simulator.
@@ -324,6 +349,9 @@ PRESETS: dict[str, PlantSpec] = {
     "warmgear": PlantSpec(PLANT_SPECS["warmgear"], {}, (), "warmgear", family="warmgear",
                           effects=WARMGEAR_EFFECTS, knob_effects=WARMGEAR_KNOB_EFFECTS,
                           max_step_s=WARMGEAR_MAX_STEP_S),
+    "archwave": PlantSpec(PLANT_SPECS["archwave"], {}, (), "archwave", family="archwave",
+                          effects=ARCHWAVE_EFFECTS, knob_effects=ARCHWAVE_KNOB_EFFECTS,
+                          max_step_s=ARCHWAVE_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

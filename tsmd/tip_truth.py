@@ -27,9 +27,11 @@ TRUTHS = {"threshold": measure_dead_zone_backlash, "lines": measure_by_lines}
 curved branch, so a score names its truth."""
 
 
-def tip_truth(point: GridPoint, by: str = "threshold") -> dict[str, float]:
+def tip_truth(point: GridPoint, by: str = "threshold", tip_noise_deg: float = 0.0,
+              noise_seed: int = 0) -> dict[str, float]:
     """D and B measured on the tracked tip of the sweep (the plant package's analysis), read
-    ``by`` one of :data:`TRUTHS`."""
+    ``by`` one of :data:`TRUTHS`; with ``tip_noise_deg``, on the tip plus that much white
+    noise (seeded): how a tracker's noise moves the reading."""
     rec = point.recording
     if rec is None:
         return {}
@@ -39,6 +41,8 @@ def tip_truth(point: GridPoint, by: str = "threshold") -> dict[str, float]:
     t, pos, tip = rec["t"][m], rec[f"pos{k}"][m], rec[f"tip{k}"][m]
     if not np.isfinite(tip).all():
         return {}
+    if tip_noise_deg > 0.0:
+        tip = tip + np.random.default_rng(noise_seed).normal(0.0, tip_noise_deg, tip.size)
     try:
         truth = tip_reading(t, rec[f"cmd{k}"][m], pos, tip, by)
     except SweepAnalysisError:

@@ -384,28 +384,34 @@ def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
     if y_deg - y_deg != 0.0:  # not finite
         return state
     x_prev, y_prev, direction, held, k = state
+    turned = False
     if y_deg == y_prev:
         if y_prev == held:
             return state
     else:
         turn = 1 if y_deg > y_prev else -1
         if turn != direction:
-            direction, held = turn, y_prev
+            direction, held, turned = turn, y_prev, True
             k = reversal_round(b, x_prev, held, direction)
     if direction > 0:
-        x = interp_linear(y_deg, b.rising_deg, b.knots)
-        if k > 0.0 and y_deg > held:  # the rounded corner, or the other branch if that is later
+        if k > 0.0 and held < y_deg < held + k:  # on the rounded corner, or the other branch
             x = max(interp_linear(held + rounded_gap_deg(y_deg - held, k), b.rising_deg,
                                   b.knots), interp_linear(y_deg, b.falling_deg, b.knots))
+        else:
+            x = interp_linear(y_deg, b.rising_deg, b.knots)
         if x < x_prev:
             x = x_prev
     else:
-        x = interp_linear(y_deg, b.falling_deg, b.knots)
-        if k > 0.0 and y_deg < held:
+        if k > 0.0 and held - k < y_deg < held:
             x = min(interp_linear(held - rounded_gap_deg(held - y_deg, k), b.falling_deg,
                                   b.knots), interp_linear(y_deg, b.rising_deg, b.knots))
+        else:
+            x = interp_linear(y_deg, b.falling_deg, b.knots)
         if x > x_prev:
             x = x_prev
+    if turned and x == x_prev and (k > 0.0 or state.round_deg > 0.0):
+        # the knob does not move, so the catheter sees no reversal: a rounded release goes on
+        return PlayState(x, y_deg, state.direction, state.held_deg, state.round_deg)
     return PlayState(x, y_deg, direction, held, k)
 
 

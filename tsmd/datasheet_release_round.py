@@ -2,15 +2,16 @@
 
 Method ours holds the backlash the current reads after a reversal, then falls on its release
 line. On nitinol the tip leaves that hold gradually and its straight release lies later: the
-sharp corner missed the tip's fall by 2.6 deg rms on the sheet's unit (3.1-4.6 on development
-unit 1), a parabola of half-width 0.85 B with the line 0.25 B later by 0.9
+sharp corner missed the tip's fall by 2.1-2.2 deg rms on the sheet's unit (3.1-4.6 on development
+unit 1), a parabola of half-width 0.70-0.85 B with the line 0.15-0.20 B later by 0.9-1.0
 (:mod:`tsmd.compensation.release_round`; B the unit's backlash at a 90 deg reversal, as its
-current reads it). The tracker on the sheet's unit measures that shape once per product, read
-the way every unit uses it: the sheet's unit calibrated by ``tsmd calibrate``'s own protocol
-(the tracker recording the tip alongside), its profile's hold and release line against the
-tip's fall on the sweep with the other knob at 0, from each reversal to
-:data:`WINDOW_END_DEG` from 0, over a grid of (shift, round). A product whose best pair gains
-less than :data:`MIN_GAIN_DEG` over the sharp corner gets none (the corner stays sharp).
+current reads it; docs/model.md "Session 20"). The tracker on the sheet's unit measures that
+shape once per product, read the way every unit uses it: the sheet's unit calibrated by
+``tsmd calibrate``'s own protocol (the tracker recording the tip alongside), its profile's hold
+and release line against the tip's fall on the sweep with the other knob at 0, from each
+reversal to :data:`WINDOW_END_DEG` from 0, over a grid of (shift, round). A product whose best
+pair gains less than :data:`MIN_GAIN_DEG` over the sharp corner gets none (the corner stays
+sharp).
 """
 
 from __future__ import annotations

@@ -288,7 +288,9 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         shape_neg=shape_neg, other_tip_gain=float(getattr(k, "other_tip_gain", None) or 0.0),
         shape_grid=shape_grid, loaded_knee_deg=knee, loaded_knee_u95_deg=knee_u95,
         sheet_loaded_knee_deg=(None if ks_pos is None or ks_neg is None
-                               else (float(ks_pos), float(ks_neg))))
+                               else (float(ks_pos), float(ks_neg))),
+        release_round=float(getattr(k, "release_round", None) or 0.0),
+        release_shift=float(getattr(k, "release_shift", None) or 0.0))
 
 
 def clamped_gain(beta: float) -> float:

@@ -38,6 +38,7 @@ from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_offset import with_reading_offset
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
 from tsmd.datasheet_release_end import measure_release_end_offsets
+from tsmd.datasheet_release_round import with_release_round
 from tsmd.datasheet_rule import (
     RULE_NOISE_SEEDS,
     choose_knee,
@@ -87,6 +88,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "where the release ends in the current and on the tip; method ours "
                              "then draws each unit's release line to the end its current shows "
                              "(opt-in per product, docs/model.md Session 18)")
+    parser.add_argument("--release-round", action="store_true",
+                        help="with --plant: also calibrate the unit once more, tracked, and fit "
+                             "the tip's rounded start after a reversal (release_round, "
+                             "release_shift; opt-in per product, docs/model.md Session 20)")
     parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "
@@ -364,6 +369,8 @@ def main(args: argparse.Namespace) -> int:
         device = _with_bend(device, config, factory)
     if args.plant is not None and args.release_end_offset:
         device = _with_release_end_offset(device, config, factory, args.seed)
+    if args.plant is not None and args.release_round:
+        device = with_release_round(device, config, factory, args.seed)
     if args.plant is not None and sample:
         device = _with_sample(device, config, args.plant, params, args.unit_key, sample,
                               seeds[0] if seeds else 0)

@@ -14,8 +14,9 @@ from tsmd.compensation.fresh_play import fresh_branches
 from tsmd.compensation.grid import ParameterField
 from tsmd.compensation.knee_map import moved_grid, moved_knee
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid, curved, steepest_slope
+from tsmd.compensation.release_round import reference_backlash_deg, shifted_zero_load_deg
 from tsmd.compensation.shaped_play import model_branches
-from tsmd.compensation.tension_play import Branches, TensionPlayParams
+from tsmd.compensation.tension_play import BETA_RANGE, Branches, TensionPlayParams
 
 OURS_COLUMNS: tuple[str, ...] = ("dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_gain_pos",
                                  "backlash_gain_neg", "zero_load_pos_deg", "zero_load_neg_deg")
@@ -52,6 +53,11 @@ class OursKnob:
     shape_grid: tuple[ShapeGrid, ShapeGrid] | None = None
     """The product's templates over the other knob's angle (positive, negative side); where
     given, each table row takes the templates at its angle instead of ``shape_pos/neg``."""
+    release_round: float = 0.0
+    """The product's rounded release (:mod:`tsmd.compensation.release_round`): half-width in
+    backlashes at a 90 deg reversal; 0: the sharp corner (fresh tables stay sharp)."""
+    release_shift: float = 0.0
+    """How much later the release lines lie, in the same backlashes."""
     _table: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
     _fresh: tuple[tuple[Branches, ...], ...] = dataclasses.field(init=False, repr=False,
                                                                  compare=False)
@@ -67,9 +73,7 @@ class OursKnob:
         step = (hi - lo) / (n - 1)
         rows = [[float(v) for v in self.field.at(lo + i * step)] for i in range(n)]
         w, h_pos, h_neg = self.omega, self.height_pos_deg, self.height_neg_deg
-        table = tuple(model_branches(w, h_pos, h_neg, r[0], r[1], r[2], r[3], r[4], r[5],
-                                     *self.shapes_at(lo + i * step))
-                      for i, r in enumerate(rows))
+        table = tuple(self._row_branches(r, lo + i * step) for i, r in enumerate(rows))
         # a fresh knob's tables by the side it loaded first: -1, none yet, +1
         fresh = tuple(tuple(fresh_branches(b, w, r[0], r[1], h_pos, h_neg, self.fresh_hold_deg,
                                            self.fresh_edge_delay_deg, side)
@@ -79,6 +83,23 @@ class OursKnob:
         object.__setattr__(self, "_fresh", fresh)
         object.__setattr__(self, "_lo", lo)
         object.__setattr__(self, "_step", step)
+
+    def _row_branches(self, r: list[float], other_deg: float) -> Branches:
+        """One table row's branches, the release rounded and shifted where the product says."""
+        w, h_pos, h_neg = self.omega, self.height_pos_deg, self.height_neg_deg
+        x0_pos, x0_neg = r[4], r[5]
+        if self.release_shift != 0.0:
+            x0_pos = shifted_zero_load_deg(r[2], r[4], self.release_shift, 1)
+            x0_neg = shifted_zero_load_deg(r[3], r[5], self.release_shift, -1)
+        b = model_branches(w, h_pos, h_neg, r[0], r[1], r[2], r[3], x0_pos, x0_neg,
+                           *self.shapes_at(other_deg))
+        if self.release_round == 0.0:
+            return b
+        lo, hi = BETA_RANGE
+        k_pos, k_neg = (self.release_round * reference_backlash_deg(beta, x0, side)
+                        * w / (1.0 - min(max(beta, lo), hi))
+                        for beta, x0, side in ((r[2], r[4], 1), (r[3], r[5], -1)))
+        return dataclasses.replace(b, round_pos_deg=k_pos, round_neg_deg=k_neg)
 
     @classmethod
     def from_params(cls, p: TensionPlayParams, interpolation: str = "pchip") -> OursKnob:
@@ -94,7 +115,8 @@ class OursKnob:
                    p.omega, p.height_pos_deg, p.height_neg_deg, p.lag_s, p.fresh_hold_deg,
                    # the profile's fresh numbers come together from one first sweep
                    p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None,
-                   curved(shape_pos), curved(shape_neg), p.other_tip_gain, grid)
+                   curved(shape_pos), curved(shape_neg), p.other_tip_gain, grid,
+                   p.release_round, p.release_shift)
 
     def shapes_at(self, other_deg: float) -> tuple[LoadedShape | None, LoadedShape | None]:
         """The templates (positive, negative side) at the other knob's angle."""

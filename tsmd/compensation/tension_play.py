@@ -38,6 +38,13 @@ from tsmd.compensation.loaded_shape import (
     shape_grid_to_mapping,
     shape_to_mapping,
 )
+from tsmd.compensation.release_round import (
+    RELEASE_ROUND_RANGE,
+    RELEASE_SHIFT_RANGE,
+    reversal_round_deg,
+    rounded_drop_deg,
+    rounded_gap_deg,
+)
 
 BETA_RANGE: tuple[float, float] = (0.0, 0.8)
 """Backlash per knob degree of load: 0 = no backlash; 0.8 = release slope 5 omega."""
@@ -72,6 +79,8 @@ class TensionPlayParams:
     ``loaded_knee_u95_deg``; ``sheet_loaded_knee_deg`` the data-sheet unit's, read the same way.
     Where both knees are given method ours moves the templates' knee to the unit's
     (:mod:`tsmd.compensation.knee_map`); otherwise the templates as they are.
+    ``release_round`` / ``release_shift``: the product's rounded release (data sheet,
+    :mod:`tsmd.compensation.release_round`), in backlashes at a 90 deg reversal; 0: sharp.
     """
 
     omega: float
@@ -94,6 +103,8 @@ class TensionPlayParams:
     loaded_knee_deg: tuple[float, float] | None = None
     loaded_knee_u95_deg: tuple[float, float] | None = None
     sheet_loaded_knee_deg: tuple[float, float] | None = None
+    release_round: float = 0.0
+    release_shift: float = 0.0
 
     def columns(self) -> NDArray[np.float64]:
         """(n, 6): D_pos, D_neg, beta_pos, beta_neg, x0_pos, x0_neg per grid point."""
@@ -110,10 +121,13 @@ _ROWS: dict[str, tuple[float, float]] = {
 _SCALARS: dict[str, tuple[float, float]] = {
     "omega": OMEGA_RANGE, "height_pos_deg": (-90.0, 90.0), "height_neg_deg": (-90.0, 90.0),
     "lag_s": (0.0, 1.0), "fresh_hold_deg": (0.0, 90.0), "fresh_edge_delay_deg": (-45.0, 45.0),
-    "other_tip_gain": OTHER_TIP_GAIN_RANGE,
+    "other_tip_gain": OTHER_TIP_GAIN_RANGE, "release_round": RELEASE_ROUND_RANGE,
+    "release_shift": RELEASE_SHIFT_RANGE,
 }
-_OPTIONAL = {"lag_s", "fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain"}
-_WRITTEN_IF_SET = {"fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain"}
+_OPTIONAL = {"lag_s", "fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain",
+             "release_round", "release_shift"}
+_WRITTEN_IF_SET = {"fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain", "release_round",
+                   "release_shift"}
 _SHAPES = {"loaded_shape_pos": "shape_pos", "loaded_shape_neg": "shape_neg"}
 _SHAPE_GRID = "loaded_shape_grid"
 _KNEES = ("loaded_knee_deg", "loaded_knee_u95_deg", "sheet_loaded_knee_deg")
@@ -162,7 +176,8 @@ def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
         r["zero_load_pos_deg"], r["zero_load_neg_deg"], s["lag_s"], s["fresh_hold_deg"],
         s["fresh_edge_delay_deg"], pos_shape, neg_shape, other_tip_gain=s["other_tip_gain"],
         shape_grid=(shape_grid_from_mapping(m[_SHAPE_GRID], _SHAPE_GRID)
-                    if m.get(_SHAPE_GRID) is not None else None), **knees)
+                    if m.get(_SHAPE_GRID) is not None else None),
+        release_round=s["release_round"], release_shift=s["release_shift"], **knees)
 
 
 def _knee_pair(values: Any, name: str) -> tuple[float, float]:
@@ -225,13 +240,17 @@ def widest_flat(knots: Sequence[float], ys: Sequence[float], omega: float) -> Fl
 
 @dataclass(frozen=True)
 class Branches:
-    """Rising (lower) and falling (upper) branch of one knob, piecewise linear on ``knots``."""
+    """Rising (lower) and falling (upper) branch of one knob, piecewise linear on ``knots``;
+    ``round_pos_deg`` / ``round_neg_deg``: the rounded release's half-width (output deg) after
+    a reversal from the positive / negative side (:mod:`tsmd.compensation.release_round`)."""
 
     knots: tuple[float, ...]
     rising_deg: tuple[float, ...]
     falling_deg: tuple[float, ...]
     rising_flat: Flat | None = None
     falling_flat: Flat | None = None
+    round_pos_deg: float = 0.0
+    round_neg_deg: float = 0.0
 
     def rising(self, x_deg: float) -> float:
         return interp_linear(x_deg, self.knots, self.rising_deg)
@@ -318,21 +337,42 @@ def envelopes(kinks: set[float], rising: Callable[[float], float],
 
 
 class PlayState(NamedTuple):
-    """Command x, model output y, direction of motion, output held since the last reversal."""
+    """Command x, model output y, direction of motion, output held since the last reversal,
+    the rounded release's half-width since then (0: a sharp corner)."""
 
     x_deg: float
     y_deg: float
     direction: int
     held_deg: float
+    round_deg: float = 0.0
+
+
+def reversal_round(b: Branches, x_deg: float, held_deg: float, direction: int) -> float:
+    """The rounded release's half-width after a reversal at ``x_deg`` holding ``held_deg``."""
+    if direction < 0:
+        k = b.round_pos_deg
+        return 0.0 if k == 0.0 else reversal_round_deg(k, b.falling(x_deg) - held_deg)
+    k = b.round_neg_deg
+    return 0.0 if k == 0.0 else reversal_round_deg(k, held_deg - b.rising(x_deg))
 
 
 def model_step(state: PlayState, x_deg: float, b: Branches) -> PlayState:
     """Forward model: the output for input ``x_deg`` (the play between the two branches)."""
     dx = x_deg - state.x_deg
     direction = state.direction if dx == 0.0 else (1 if dx > 0.0 else -1)
-    held = state.held_deg if direction == state.direction else state.y_deg
-    y = max(held, b.rising(x_deg)) if direction > 0 else min(held, b.falling(x_deg))
-    return PlayState(x_deg, y, direction, held)
+    if direction == state.direction:
+        held, k = state.held_deg, state.round_deg
+    else:
+        held = state.y_deg
+        k = reversal_round(b, state.x_deg, held, direction)
+    if k > 0.0:  # rounded, and never beyond the other branch (a hold on its flat part)
+        if direction > 0:
+            y = min(held + rounded_drop_deg(b.rising(x_deg) - held, k), b.falling(x_deg))
+        else:
+            y = max(held - rounded_drop_deg(held - b.falling(x_deg), k), b.rising(x_deg))
+    else:
+        y = max(held, b.rising(x_deg)) if direction > 0 else min(held, b.falling(x_deg))
+    return PlayState(x_deg, y, direction, held, k)
 
 
 def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
@@ -343,23 +383,36 @@ def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
     """
     if y_deg - y_deg != 0.0:  # not finite
         return state
-    x_prev, y_prev, direction, held = state
+    x_prev, y_prev, direction, held, k = state
+    turned = False
     if y_deg == y_prev:
         if y_prev == held:
             return state
     else:
         turn = 1 if y_deg > y_prev else -1
         if turn != direction:
-            direction, held = turn, y_prev
+            direction, held, turned = turn, y_prev, True
+            k = reversal_round(b, x_prev, held, direction)
     if direction > 0:
-        x = interp_linear(y_deg, b.rising_deg, b.knots)
+        if k > 0.0 and held < y_deg < held + k:  # on the rounded corner, or the other branch
+            x = max(interp_linear(held + rounded_gap_deg(y_deg - held, k), b.rising_deg,
+                                  b.knots), interp_linear(y_deg, b.falling_deg, b.knots))
+        else:
+            x = interp_linear(y_deg, b.rising_deg, b.knots)
         if x < x_prev:
             x = x_prev
     else:
-        x = interp_linear(y_deg, b.falling_deg, b.knots)
+        if k > 0.0 and held - k < y_deg < held:
+            x = min(interp_linear(held - rounded_gap_deg(held - y_deg, k), b.falling_deg,
+                                  b.knots), interp_linear(y_deg, b.rising_deg, b.knots))
+        else:
+            x = interp_linear(y_deg, b.falling_deg, b.knots)
         if x > x_prev:
             x = x_prev
-    return PlayState(x, y_deg, direction, held)
+    if turned and x == x_prev and (k > 0.0 or state.round_deg > 0.0):
+        # the knob does not move, so the catheter sees no reversal: a rounded release goes on
+        return PlayState(x, y_deg, state.direction, state.held_deg, state.round_deg)
+    return PlayState(x, y_deg, direction, held, k)
 
 
 def rest_state(y_deg: float, b: Branches, home_deg: float = 0.0) -> PlayState:

@@ -17,6 +17,7 @@ from tsmd.compensation.loaded_shape import (
     shape_grid_to_mapping,
     shape_to_mapping,
 )
+from tsmd.compensation.release_round import RELEASE_ROUND_RANGE, RELEASE_SHIFT_RANGE
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
     OTHER_TIP_GAIN_RANGE,
@@ -78,6 +79,8 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "loaded_knee_neg_deg": (0.0, 90.0, "deg"),
     "dead_zone_unit_u95_deg": (0.0, 20.0, "deg"),
     "backlash_unit_u95_deg": (0.0, 20.0, "deg"),
+    "release_round": (*RELEASE_ROUND_RANGE, ""),
+    "release_shift": (*RELEASE_SHIFT_RANGE, ""),
 }
 """The data sheet's optional measured numbers per knob and their plausible ranges: the schema
 reads them with these, and ``tsmd datasheet`` leaves out a measured one outside its range
@@ -97,6 +100,8 @@ _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg"
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
 _SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
 """Optional data-sheet numbers measured on the product's sample, written only when measured."""
+_ROUND_KEYS = ("release_round", "release_shift")
+"""Optional data-sheet numbers of the rounded release (session 20), written only when set."""
 
 
 _Block = TypeVar("_Block")
@@ -203,6 +208,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             loaded_knee_neg_deg=optional("loaded_knee_neg_deg"),
             dead_zone_unit_u95_deg=optional("dead_zone_unit_u95_deg"),
             backlash_unit_u95_deg=optional("backlash_unit_u95_deg"),
+            release_round=optional("release_round"),
+            release_shift=optional("release_shift"),
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)
@@ -256,7 +263,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
                 knobs[name][key] = shape_to_mapping(shape)
         if k.loaded_shape_grid is not None:
             knobs[name]["loaded_shape_grid"] = shape_grid_to_mapping(*k.loaded_shape_grid)
-        for key in _RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS:
+        for key in _RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS + _ROUND_KEYS:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         if k.reading_offset is not None:

@@ -212,6 +212,14 @@ class DeviceKnob:
     """Optional, as ``dead_zone_unit_u95_deg`` for the backlash; where given it replaces the
     share-based part of a "line" rule (:data:`tsmd.calibration.options.LINE_SHARE_UNIT_U95`,
     measured on segments only)."""
+    release_round: float | None = None
+    """Optional, tracked on the data-sheet unit (session 20): the half-width of the tip's
+    rounded start after a reversal, in backlashes at a 90 deg reversal as the current reads them
+    (:mod:`tsmd.compensation.release_round`); calibration copies it into each unit's profile and
+    method ours scales it by the unit's own backlash. None: a sharp corner."""
+    release_shift: float | None = None
+    """Optional, with ``release_round``: how much later the tip's release line lies than the
+    current's backlash end, in the same backlashes. None: 0."""
 
 
 @dataclass(frozen=True)

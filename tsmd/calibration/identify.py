@@ -53,6 +53,7 @@ from tsmd.calibration.release import (
     release_swing,
 )
 from tsmd.calibration.signal import Conditioned, FloatArray, condition
+from tsmd.calibration.slack_rise import before_sustained_rise
 from tsmd.calibration.sweep_result import PARAMETERS, HalfCycle, SweepResult
 
 SHARE_STEP = 0.01
@@ -138,6 +139,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
     loaded_swing = 0.5 * float(np.nanmax(current) - np.nanmin(current))
     plateau_run = (None if flat is None
                    else constant_phase(pieces, flat, step, opts, yg[:end], loaded_swing))
+    if plateau_run is not None and flat is not None:
+        plateau_run = before_sustained_rise(pieces, flat, step, opts, yg[:end], plateau_run)
     if plateau_run is None:
         plateau_run = (0, end)
         problems.append(f"{where}: no stretch of constant current")

@@ -10,7 +10,7 @@ from support.plant_drive import STEP_S, drive_knob, ramp_deg
 
 from simrig.family import PLANT_ROLE, PLANT_SPECS, SCATTER, family_member
 from simrig.plant import Plant, PlantLoadError, load_plant
-from simrig.plants.jawcrimp import JawCrimpPlant, make_jawcrimp_plant
+from simrig.plants.jawcrimp import NOMINAL_KNOBS, JawCrimpPlant, make_jawcrimp_plant
 from simrig.plants.jawcrimp.laws import (
     crimp_creep_rate_mm_s,
     friction_node,
@@ -18,6 +18,7 @@ from simrig.plants.jawcrimp.laws import (
     jaw_torque_Nmm,
     shaft_shortening_mm,
 )
+from simrig.plants.jawcrimp.params import node_friction
 
 SPEC = "simrig.plants.jawcrimp:make_jawcrimp_plant"
 
@@ -59,6 +60,12 @@ def test_the_crimp_creeps_faster_under_more_load_and_hardens_with_its_slip() -> 
     assert heavy == pytest.approx(64.0 * light)
     assert hardened < 0.2 * heavy
     assert crimp_creep_rate_mm_s(0.0, 0.0, 1e-3, 10.0, 3.0, 0.05) == 0.0
+
+
+def test_the_node_friction_stays_below_one_on_a_long_wrap() -> None:
+    knob = NOMINAL_KNOBS[0]
+    assert node_friction(knob, 0.0) < node_friction(knob, 120.0) < node_friction(knob, 2000.0)
+    assert node_friction(knob, 2000.0) < 1.0
 
 
 def test_the_heart_pulse_averages_to_zero_over_a_beat() -> None:
@@ -168,7 +175,7 @@ def test_jawcrimp_is_registered_last_and_blind() -> None:
         ({"knobs": [{"tendon_stiffness_N": 0.0}, {}]}, "tendon_stiffness_N must be > 0"),
         ({"knobs": [{}, {"sheath_friction": -0.1}]}, "sheath_friction must be >= 0"),
         ({"knobs": [{"node_share": 1.0}, {}]}, "node_share must be in"),
-        ({"knobs": [{"sheath_friction": 2.0}, {}]}, "node friction"),
+        ({"knobs": [{"idler_friction": 0.6}, {}]}, "idler_friction must be < 0.5"),
         ({"sheath_curvature_deg": -10.0}, "sheath_curvature_deg must be >= 0"),
     ],
 )

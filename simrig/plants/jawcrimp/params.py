@@ -23,7 +23,7 @@ class JawCrimpKnob:
     Sources: jaw couplings of 14-20 mm hub diameter (catalogue torsional stiffness of a
     92 Shore A spider about 2-10 N m/rad at rated torque, soft near zero load, 1-2 deg of
     play once the spider has set); steel wire rope 7x7, 0.45 mm (EA about 2e4 N); PTFE-lined
-    lumen on steel rope, mu about 0.1-0.3; plain-bushed idler pulleys (bushing/pulley radius
+    lumen on steel rope, mu about 0.1-0.35; plain-bushed idler pulleys (bushing/pulley radius
     about 0.25, bushing mu about 0.15, 90 deg wrap: 5 % per idler); a TEE shaft of 1 m, 12 mm
     diameter, lumens about 4 mm off the axis; crimp creep of a swaged pull ring (slip rate of a
     power law in the load, hardening with the slip, after the crimp literature's log-time
@@ -49,7 +49,7 @@ class JawCrimpKnob:
     sheath_length_m: float = 1.0
     node_share: float = 0.4
     """Where the lumped friction node sits along the shaft (share of its length proximal of it)."""
-    sheath_friction: float = 0.30
+    sheath_friction: float = 0.34
     sheath_wrap_deg: float = 150.0
     """Total curve of the tendon's lumen along the shaft (in the oesophagus)."""
     sheath_drag_N: float = 0.5
@@ -103,10 +103,13 @@ _NON_NEGATIVE = ("jaw_play_deg", "slack_pos_mm", "slack_neg_mm", "sheath_frictio
 
 
 def node_friction(knob: JawCrimpKnob, curvature_deg: float) -> float:
-    """The node's friction share h: capacity = drag + h (T1 + T2), from the lumen's wrap
-    (mu x wrap / 2 of a lumped contact) and the idlers' bushings."""
+    """The node's friction share h: capacity = drag + h (T1 + T2), from the lumen's wrap and
+    the idlers' bushings. Chosen so that at full slip the node's tension ratio
+    (1 + h) / (1 - h) is the whole lumen's exp(mu x wrap) times each idler's
+    (1 + f) / (1 - f): about mu x wrap / 2 + idlers x f while small, below 1 always."""
     wrap_rad = math.radians(knob.sheath_wrap_deg + curvature_deg)
-    return 0.5 * knob.sheath_friction * wrap_rad + knob.idler_count * knob.idler_friction
+    return math.tanh(0.5 * knob.sheath_friction * wrap_rad
+                     + knob.idler_count * math.atanh(min(knob.idler_friction, 0.99)))
 
 
 def knob_from(values: Mapping[str, Any] | JawCrimpKnob, nominal: JawCrimpKnob,
@@ -130,9 +133,9 @@ def knob_from(values: Mapping[str, Any] | JawCrimpKnob, nominal: JawCrimpKnob,
             raise PlantLoadError(f"jawcrimp {name} must be >= 0, got {value!r}")
     if not 0.0 < knob.node_share < 1.0:
         raise PlantLoadError(f"jawcrimp node_share must be in (0, 1), got {knob.node_share!r}")
-    if not node_friction(knob, curvature_deg) < 0.9:
-        raise PlantLoadError("jawcrimp node friction (sheath_friction x wrap / 2 + idlers) "
-                             "must stay below 0.9")
+    if not knob.idler_friction < 0.5:
+        raise PlantLoadError(f"jawcrimp idler_friction must be < 0.5, got "
+                             f"{knob.idler_friction!r}")
     return knob
 
 

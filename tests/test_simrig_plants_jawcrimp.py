@@ -160,6 +160,26 @@ def test_the_heart_moves_a_free_tip_a_little_and_does_not_drift_it() -> None:
     assert abs(float(np.mean(tip[-round(1.0 / 1.15 / STEP_S):]))) < 0.1
 
 
+def test_more_slack_mid_run_widens_the_dead_zone_and_stays_through_reset() -> None:
+    def engaged_at(plant: JawCrimpPlant) -> float:
+        path = ramp_deg(0.0, 50.0)
+        tip, _ = drive_knob(plant, 0, path)
+        return float(path[np.argmax(tip > 3.0)])
+
+    plant = make_jawcrimp_plant()
+    before = engaged_at(plant)
+    plant.reshape(slack_delta_mm=((0.5, 0.5), (0.5, 0.5)))
+    plant.reset()
+    assert engaged_at(plant) == pytest.approx(before + math.degrees(0.5 / 6.5), abs=0.5)
+
+
+def test_unknown_reshapes_are_refused() -> None:
+    with pytest.raises(PlantLoadError, match="jawcrimp cannot reshape stiffness"):
+        make_jawcrimp_plant().reshape(stiffness=2.0)
+    with pytest.raises(PlantLoadError, match="sheath_curvature_deg must be >= 0"):
+        make_jawcrimp_plant().reshape(sheath_curvature_deg=-5.0)
+
+
 def test_jawcrimp_is_registered_last_and_blind() -> None:
     assert list(PLANT_SPECS)[-1] == "jawcrimp"
     assert PLANT_ROLE["jawcrimp"] == "blind"

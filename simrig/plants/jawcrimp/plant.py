@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from simrig.plant import PlantStep, step_inputs
+from simrig.plant import PlantLoadError, PlantStep, step_inputs
 from simrig.plants.jawcrimp.laws import (
     crimp_creep_rate_mm_s,
     friction_node,
@@ -32,7 +32,8 @@ _TOL_MM = 1e-9
 class _Knob:
     """Constants of one knob in the units the step uses (mm, N, N mm, rad)."""
 
-    def __init__(self, k: JawCrimpKnob, curvature_deg: float) -> None:
+    def __init__(self, k: JawCrimpKnob, curvature_deg: float,
+                 slack_delta_mm: tuple[float, float] = (0.0, 0.0)) -> None:
         self.r = k.pulley_radius_mm
         self.a = k.tendon_offset_mm
         self.play = math.radians(k.jaw_play_deg)
@@ -45,7 +46,7 @@ class _Knob:
         self.k2 = k.tendon_stiffness_N / distal_mm
         self.share = node_friction(k, curvature_deg)
         self.drag = k.sheath_drag_N
-        self.slack = (k.slack_pos_mm, k.slack_neg_mm)
+        self.slack = (k.slack_pos_mm + slack_delta_mm[0], k.slack_neg_mm + slack_delta_mm[1])
         self.bend = k.bend_stiffness_Nmm_per_rad
         self.stiffening = k.bend_stiffening_per_rad2
         self.seal = k.handle_friction_Nm
@@ -67,6 +68,8 @@ class JawCrimpPlant:
     def __init__(self, knobs: tuple[JawCrimpKnob, JawCrimpKnob], curvature_deg: float = 0.0
                  ) -> None:
         self.knobs = knobs
+        self.sheath_curvature_deg = curvature_deg
+        self._slack_delta_mm = [[0.0, 0.0], [0.0, 0.0]]
         self._k = [_Knob(k, curvature_deg) for k in knobs]
         self._gap_mm = 0.5 * (knobs[0].shaft_gap_mm + knobs[1].shaft_gap_mm)
         self._gap_load_N = 0.5 * (knobs[0].shaft_gap_load_N + knobs[1].shaft_gap_load_N)
@@ -87,6 +90,29 @@ class JawCrimpPlant:
         self._tensions = [[0.0, 0.0], [0.0, 0.0]]
         self._q_rad = [0.0, 0.0]
         self._w_rad_s = [0.0, 0.0]
+
+    def reshape(self, **changes: Any) -> None:
+        """A shape change mid-run (kept through ``reset``): ``slack_delta_mm`` ((pos, neg) per
+        knob, added to the ropes' slack) or ``sheath_curvature_deg`` (the lumens' added
+        curve: more friction at the node)."""
+        for name, value in changes.items():
+            if name == "slack_delta_mm":
+                try:
+                    delta = [[float(value[i][j]) for j in (0, 1)] for i in (0, 1)]
+                except (TypeError, ValueError, IndexError):
+                    raise PlantLoadError("slack_delta_mm must be ((pos, neg), (pos, neg)) mm"
+                                         ) from None
+                for i in (0, 1):
+                    for j in (0, 1):
+                        self._slack_delta_mm[i][j] += delta[i][j]
+            elif name == "sheath_curvature_deg":
+                knobs_from(self.knobs, float(value))  # the same checks as at build
+                self.sheath_curvature_deg = float(value)
+            else:
+                raise PlantLoadError(f"jawcrimp cannot reshape {name}")
+        self._k = [_Knob(k, self.sheath_curvature_deg,
+                         (self._slack_delta_mm[i][0], self._slack_delta_mm[i][1]))
+                   for i, k in enumerate(self.knobs)]
 
     @property
     def shortening_mm(self) -> float:

@@ -16,7 +16,8 @@ written blind) is held out now, the twistshaft plant (session 12) is held out no
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
 now, the helixbelt plant (session 15, written blind) is held out now, the ratestate plant
 (session 16, written blind) is held out now, the warmgear plant (session 18, written blind) is
-held out now, the archwave plant (session 19, written blind) is the blind one (``PLANT_ROLE``).
+held out now, the archwave plant (session 19, written blind) and the jawcrimp plant (session 20,
+written blind) are the blind ones (``PLANT_ROLE``).
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -36,6 +37,7 @@ from simrig.plants.archwave import NOMINAL_KNOBS as ARCHWAVE_KNOBS
 from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
 from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
 from simrig.plants.helixbelt import NOMINAL_KNOBS as HELIXBELT_KNOBS
+from simrig.plants.jawcrimp import NOMINAL_KNOBS as JAWCRIMP_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
 from simrig.plants.nitinol import NOMINAL_KNOBS as NITINOL_KNOBS
 from simrig.plants.ratestate import NOMINAL_KNOBS as RATESTATE_KNOBS
@@ -58,12 +60,14 @@ PLANT_SPECS: dict[str, str] = {
     "helixbelt": "simrig.plants.helixbelt:make_helixbelt_plant",
     "ratestate": "simrig.plants.ratestate:make_ratestate_plant",
     "warmgear": "simrig.plants.warmgear:make_warmgear_plant",
-    "archwave": "simrig.plants.archwave:make_archwave_plant",  # last: the others' seeds hold
+    "archwave": "simrig.plants.archwave:make_archwave_plant",
+    "jawcrimp": "simrig.plants.jawcrimp:make_jawcrimp_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
-              "ratestate": "held-out", "warmgear": "held-out", "archwave": "blind"}
+              "ratestate": "held-out", "warmgear": "held-out", "archwave": "blind",
+              "jawcrimp": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -79,7 +83,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "helixbelt": HELIXBELT_KNOBS,
                                         "ratestate": RATESTATE_KNOBS,
                                         "warmgear": WARMGEAR_KNOBS,
-                                        "archwave": ARCHWAVE_KNOBS}
+                                        "archwave": ARCHWAVE_KNOBS,
+                                        "jawcrimp": JAWCRIMP_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -144,6 +149,8 @@ VARIANTS: dict[str, Variant] = {
                          "gear_play_deg": 1.5},
             "archwave": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                          "handle_friction_Nm": 1.5, "wave_drag_Nm": 1.5},
+            "jawcrimp": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                         "handle_friction_Nm": 1.5, "idler_friction": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -169,7 +176,8 @@ VARIANTS: dict[str, Variant] = {
                  "helixbelt": {"tendon_stiffness_N": 0.4},
                  "ratestate": {"tendon_stiffness_N": 0.4},
                  "warmgear": {"tendon_stiffness_N": 0.4},
-                 "archwave": {"tendon_stiffness_N": 0.4}},
+                 "archwave": {"tendon_stiffness_N": 0.4},
+                 "jawcrimp": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

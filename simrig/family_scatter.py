@@ -289,5 +289,29 @@ SCATTER: dict[str, dict[str, float]] = {
         "bend_stiffness_Nm_per_rad": 0.15,  # cover durometer and spine cut
         "bend_stiffening_per_rad2": 0.20,
     },
+    "jawcrimp": {
+        "pulley_radius_mm": 0.02,  # moulded drum
+        "jaw_play_deg": 0.40,  # spider set and hub bore fit
+        "jaw_twist_deg": 0.20,  # spider durometer lot
+        "jaw_torque_Nm": 0.20,
+        "slack_pos_mm": 0.15,  # rope cut and crimped by hand
+        "slack_neg_mm": 0.15,
+        "tendon_stiffness_N": 0.10,  # wire-rope lot (steel)
+        "free_length_m": 0.20,  # handle assembly, idler positions
+        "sheath_length_m": 0.02,  # cut to length
+        "node_share": 0.15,  # where the lumen's friction concentrates
+        "sheath_friction": 0.15,  # liner and rope surface, lubricant
+        "sheath_wrap_deg": 0.10,  # the shaft's lay in the patient
+        "sheath_drag_N": 0.20,  # lumen seal, idler bushing preload
+        "idler_friction": 0.25,  # bushing fit and grease
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "bend_stiffness_Nmm_per_rad": 0.15,  # cover polymer lot
+        "shaft_gap_mm": 0.25,  # coil pitch and how it was pre-compressed
+        "shaft_gap_load_N": 0.20,
+        "shaft_stiffness_N_per_mm": 0.15,
+        "crimp_creep_mm_per_s": 0.40,  # swage pressure
+        "handle_friction_Nm": 0.20,  # knob shaft seal squeeze
+        "heart_moment_Nmm": 0.30,  # where the probe lies against the heart
+    },
 }
 """Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""

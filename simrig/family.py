@@ -16,8 +16,9 @@ written blind) is held out now, the twistshaft plant (session 12) is held out no
 plant (session 13) is held out now, the nitinol plant (session 14, written blind) is held out
 now, the helixbelt plant (session 15, written blind) is held out now, the ratestate plant
 (session 16, written blind) is held out now, the warmgear plant (session 18, written blind) is
-held out now, the archwave plant (session 19, written blind) and the jawcrimp plant (session 20,
-written blind) are the blind ones (``PLANT_ROLE``).
+held out now, the archwave plant (session 19, written blind) is held out now (tuned on its
+development units in session 20), the jawcrimp plant (session 20, written blind) is the blind one
+(``PLANT_ROLE``).
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -66,7 +67,7 @@ PLANT_SPECS: dict[str, str] = {
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
-              "ratestate": "held-out", "warmgear": "held-out", "archwave": "blind",
+              "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
               "jawcrimp": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))

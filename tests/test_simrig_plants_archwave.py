@@ -1,4 +1,4 @@
-"""The archwave plant (blind in session 19): laws, behaviours, registration, refusals."""
+"""The archwave plant (blind in session 19, held out since session 20): laws, behaviours, registration, refusals."""
 
 from __future__ import annotations
 
@@ -142,10 +142,10 @@ def test_unknown_reshapes_are_refused() -> None:
         make_archwave_plant().reshape(stiffness=2.0)
 
 
-def test_archwave_keeps_its_place_after_warmgear_and_is_blind() -> None:
+def test_archwave_keeps_its_place_after_warmgear_and_is_held_out() -> None:
     names = list(PLANT_SPECS)
     assert names.index("archwave") == names.index("warmgear") + 1  # its units' seeds hold
-    assert PLANT_ROLE["archwave"] == "blind"
+    assert PLANT_ROLE["archwave"] == "held-out"
     assert isinstance(family_member("archwave", 101).build(), ArchWavePlant)
     assert set(SCATTER["archwave"]) <= set(family_member("archwave", 0).params["knobs"][0])
 

@@ -28,6 +28,15 @@ def _with_parts(device: DeviceModel) -> DeviceModel:
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
+@pytest.fixture
+def bare(tmp_path: Path) -> Path:
+    """Lumped's shipped sheet without a sample's part (its other lines as shipped)."""
+    path = tmp_path / "bare.yaml"
+    path.write_text("".join(line for line in LUMPED.read_text().splitlines(True)
+                            if "unit_u95_deg" not in line))
+    return path
+
+
 def _changed(before: Path, after: Path) -> list[str]:
     return [line for line in difflib.unified_diff(before.read_text().splitlines(),
                                                   after.read_text().splitlines(), n=0)
@@ -50,20 +59,20 @@ def test_a_unit_twice_is_refused(text: str) -> None:
         sample_units(text, 0)
 
 
-def test_only_the_sample_fields_and_the_header_change(tmp_path: Path) -> None:
+def test_only_the_sample_fields_and_the_header_change(bare: Path, tmp_path: Path) -> None:
     out = tmp_path / "new.yaml"
-    save_device_fields(LUMPED, _with_parts(load_device_model(LUMPED)), SAMPLE_KEYS, out,
+    save_device_fields(bare, _with_parts(load_device_model(bare)), SAMPLE_KEYS, out,
                        "the part, added")
-    changed = _changed(LUMPED, out)
+    changed = _changed(bare, out)
     assert changed == ["+# the part, added", "+    dead_zone_unit_u95_deg: 0.8",
                        "+    backlash_unit_u95_deg: 1.25", "+    dead_zone_unit_u95_deg: 1.8"]
-    assert load_device_model(out) == _with_parts(load_device_model(LUMPED))
+    assert load_device_model(out) == _with_parts(load_device_model(bare))
 
 
-def test_a_part_written_again_replaces_its_lines(tmp_path: Path) -> None:
+def test_a_part_written_again_replaces_its_lines(bare: Path, tmp_path: Path) -> None:
     once, twice = tmp_path / "once.yaml", tmp_path / "twice.yaml"
-    device = _with_parts(load_device_model(LUMPED))
-    save_device_fields(LUMPED, device, SAMPLE_KEYS, once, "")
+    device = _with_parts(load_device_model(bare))
+    save_device_fields(bare, device, SAMPLE_KEYS, once, "")
     save_device_fields(once, device, SAMPLE_KEYS, twice, "")
     assert twice.read_text() == once.read_text()
 
@@ -78,9 +87,9 @@ def test_a_change_beyond_the_fields_is_not_written(tmp_path: Path) -> None:
 
 
 def test_update_calibrates_the_sample_under_the_sheet_and_writes_only_its_part(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+        bare: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     sheet = tmp_path / "lumped.yaml"
-    shutil.copy(LUMPED, sheet)
+    shutil.copy(bare, sheet)
     seen: list[tuple[DeviceModel, list[object]]] = []
 
     def fake(device: DeviceModel, configs: list[object], seed: int
@@ -94,10 +103,10 @@ def test_update_calibrates_the_sample_under_the_sheet_and_writes_only_its_part(
     out = tmp_path / "new.yaml"
     assert main(["datasheet", "--update", str(sheet), *PLANT, "--unit-sample", "201-202",
                  "--out", str(out)]) == 0
-    assert seen[0][0] == load_device_model(LUMPED)
+    assert seen[0][0] == load_device_model(bare)
     assert [p["unit"] for p in seen[0][1]] == [0, 201, 202]  # type: ignore[index]
-    assert sheet.read_text() == LUMPED.read_text()
-    changed = _changed(LUMPED, out)
+    assert sheet.read_text() == bare.read_text()
+    changed = _changed(bare, out)
     assert all(line.startswith("+#") or line.split(":")[0].strip("+ ") in SAMPLE_KEYS
                for line in changed)
     assert any("--unit-sample 201-202" in line for line in changed)

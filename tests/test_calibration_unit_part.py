@@ -108,3 +108,11 @@ def test_a_bad_sample_is_one_line(extra: list[str], message: str, tmp_path: Path
     assert code == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "d.yaml").exists()
+
+
+def test_the_part_moves_no_value_and_no_gate_half_width() -> None:
+    (before,) = point_estimates([_sweep()])
+    (after,) = point_estimates([with_unit_part(_sweep(), UnitPart(0.8, 1.5))])
+    for name, e in before.items():
+        assert (after[name].value, after[name].u95_deg, after[name].n) == pytest.approx(
+            (e.value, e.u95_deg, e.n), nan_ok=True)

@@ -6,7 +6,9 @@ figures are scored on). Each is calibrated from its current alone with the fast 
 the finished sheet, as every unit is, and its values are compared with its tracked tip at the
 protocol's grid points (the threshold truth, :func:`tsmd.tip_truth.tip_truth`); per knob and
 kind of parameter the errors the gate's own half-widths do not explain give the product's part
-(:func:`tsmd.calibration.unit_part.sample_u95_deg`, session 19).
+(:func:`tsmd.calibration.unit_part.sample_u95_deg`, session 19). The part changes only the
+half-width a calibration reports, never a value, the gate or a re-sweep (session 20), so it can
+be added to an existing sheet (``tsmd datasheet --update``).
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from collections.abc import Sequence
 
 from tsmd.calibration.estimate import KINDS
 from tsmd.calibration.protocol import fast_protocol
-from tsmd.calibration.unit_part import sample_u95_deg
+from tsmd.calibration.unit_part import Z95, sample_u95_deg
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_rule import sheet_truth
 from tsmd.profile import DeviceModel
@@ -26,6 +28,9 @@ from tsmd.tracked_calibration import ProtocolRun, play_protocol, value_errors
 Readings = dict[tuple[int, str], tuple[list[float], list[float]]]
 """Per (knob, kind of parameter): the sample's errors against the tip and the gate's 95 %
 half-widths, value by value."""
+
+SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
+"""The sheet's fields the sample writes (per knob); nothing else of the sheet depends on it."""
 
 
 def sample_readings(runs: Sequence[tuple[ProtocolRun, dict[tuple[int, float],
@@ -39,6 +44,25 @@ def sample_readings(runs: Sequence[tuple[ProtocolRun, dict[tuple[int, float],
                 out[(knob, kind)][0].append(error)
                 out[(knob, kind)][1].append(est.u95_deg)
     return out
+
+
+def pooled(per_unit: Sequence[Readings]) -> Readings:
+    """The units' readings as one sample."""
+    out: Readings = {(knob, kind): ([], []) for knob in (0, 1) for kind in KINDS}
+    for readings in per_unit:
+        for key, (errors, gate) in readings.items():
+            out[key][0].extend(errors)
+            out[key][1].extend(gate)
+    return out
+
+
+def left_deg2(reading: tuple[list[float], list[float]]) -> float:
+    """The mean square of the errors the gate's half-widths do not explain (deg^2; NaN without
+    a value): what :func:`sample_u95_deg` takes the part from, so sub-samples can be pooled."""
+    errors, gate = reading
+    if not errors:
+        return math.nan
+    return sum(e * e - (g / Z95) ** 2 for e, g in zip(errors, gate, strict=True)) / len(errors)
 
 
 def with_unit_parts(device: DeviceModel, readings: Readings, units: int) -> DeviceModel:
@@ -58,10 +82,9 @@ def _part(reading: tuple[list[float], list[float]], units: int) -> float | None:
 
 
 def measure_sample(device: DeviceModel, configs: Sequence[TsmdConfig], noise_seed: int
-                   ) -> tuple[DeviceModel, Readings]:
+                   ) -> tuple[DeviceModel, list[Readings]]:
     """The sheet with the product's parts, from fast calibrations of every sample unit
-    (``configs``, one sim config each) under ``device``."""
-    runs = [(play_protocol(c, device, fast_protocol(), noise_seed), sheet_truth(c))
-            for c in configs]
-    readings = sample_readings(runs)
-    return with_unit_parts(device, readings, len(configs)), readings
+    (``configs``, one sim config each) under ``device``; each unit's readings."""
+    per_unit = [sample_readings([(play_protocol(c, device, fast_protocol(), noise_seed),
+                                  sheet_truth(c))]) for c in configs]
+    return with_unit_parts(device, pooled(per_unit), len(configs)), per_unit

@@ -17,6 +17,7 @@ from typing import Any
 
 from simrig.plant import Plant, load_plant
 from tsmd import __version__
+from tsmd.commands.datasheet_sample import int_list, sample_units, update, with_sample
 from tsmd.config import DEFAULT_CONFIG_PATH, TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import (
     ANALYSED_CYCLES,
@@ -46,7 +47,6 @@ from tsmd.datasheet_rule import (
     rule_scores,
     sheet_truth,
 )
-from tsmd.datasheet_sample import measure_sample
 from tsmd.datasheet_shape_grid import measure_shape_grids
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.profile.reading_offset import ReadingOffset
@@ -60,8 +60,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     source.add_argument("--from-recording", nargs="+", metavar="FILE",
                         help="a tracked real unit's sweep recordings, one per knob")
     parser.add_argument("--params", metavar="JSON", help="the plant factory's keyword parameters")
-    parser.add_argument("--device-model", required=True, metavar="NAME",
-                        help="the catheter type's name in the data sheet")
+    parser.add_argument("--device-model", metavar="NAME",
+                        help="the catheter type's name in the data sheet (required unless "
+                             "--update)")
     parser.add_argument("--description", default="", help="one line describing the device")
     parser.add_argument("--out", required=True, metavar="FILE", help="device YAML to write")
     parser.add_argument("--config", metavar="FILE",
@@ -112,6 +113,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "rule seed, against their tracked tips, and write each knob's "
                              "dead_zone_unit_u95_deg and backlash_unit_u95_deg "
                              "(docs/calibration.md, session 19)")
+    parser.add_argument("--update", metavar="FILE",
+                        help="with --plant/--params of the sheet's unit and --unit-sample: add "
+                             "the sample's part to this existing sheet, calibrating the sample "
+                             "under it, and write it to --out with no other field changed (its "
+                             "header records the command; docs/calibration.md, session 20)")
     parser.add_argument("--unit-key", default="unit",
                         help="--unit-sample: the plant factory's parameter naming a unit")
     parser.add_argument("--bend-relation", action="store_true",
@@ -149,24 +155,10 @@ def _from_recordings(paths: list[str]) -> list[KnobConstants]:
     return [by_knob[0], by_knob[1]]
 
 
-def _int_list(text: str, option: str, what: str, alternative: str = "") -> list[int]:
-    """``text`` as a non-empty comma-separated list of integers, or a one-line error naming
-    ``option``."""
-    try:
-        values = [int(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise DatasheetError(f"{option}: not a comma-separated list of integers"
-                             f"{' or ' + alternative if alternative else ''}: {text!r}") from None
-    if not values:
-        raise DatasheetError(f"{option}: give at least one {what}"
-                             f"{', or ' + alternative if alternative else ''}")
-    return values
-
-
 def _rule_seeds(text: str) -> list[int]:
     if text.strip().lower() == "none":
         return []
-    return _int_list(text, "--rule-seeds", "seed", "'none'")
+    return int_list(text, "--rule-seeds", "seed", "'none'")
 
 
 def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
@@ -296,26 +288,6 @@ def _with_bend(device: DeviceModel, config: TsmdConfig,
     return device
 
 
-def _with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: dict[str, Any],
-                 unit_key: str, units: list[int], seed: int) -> DeviceModel:
-    """The sheet with the product's parts of the error no sweep narrows, from its sample."""
-    t0 = time.monotonic()
-    configs = [config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=p))
-               for p in [params, *({**params, unit_key: u} for u in units)]]
-    device, readings = measure_sample(device, configs, seed)
-    for knob, (name, k) in enumerate(zip(("phi1", "phi2"), device.knobs, strict=True)):
-        n = [len(readings[(knob, kind)][0]) for kind in ("dead-zone edge", "backlash")]
-        print(f"{name} unit part on the sample ({len(configs)} units, noise seed {seed}): D "
-              f"{_or_none(k.dead_zone_unit_u95_deg, 2)} deg over {n[0]} values, B "
-              f"{_or_none(k.backlash_unit_u95_deg, 2)} deg over {n[1]}")
-    print(f"  sample: {time.monotonic() - t0:.0f} s")
-    return device
-
-
-def _units(text: str) -> list[int]:
-    return _int_list(text, "--unit-sample", "unit")
-
-
 def _or_none(value: float | None, decimals: int) -> str:
     return "none" if value is None else f"{value:.{decimals}f}"
 
@@ -327,7 +299,13 @@ def main(args: argparse.Namespace) -> int:
         raise DatasheetError("--bend-relation goes with --plant (the unit is calibrated bent on "
                              "the simulated rig)")
     seeds = _rule_seeds(args.rule_seeds)
-    sample = _units(args.unit_sample) if args.unit_sample is not None else []
+    if args.update is not None:
+        return update(args, _params(args.params), seeds[0] if seeds else 0)
+    if args.device_model is None:
+        raise DatasheetError("--device-model is required (or --update FILE)")
+    params = _params(args.params)
+    sample = (sample_units(args.unit_sample, params.get(args.unit_key))
+              if args.unit_sample is not None else [])
     if sample and args.plant is None:
         raise DatasheetError("--unit-sample goes with --plant (the sample is tracked on the "
                              "simulated rig)")
@@ -336,7 +314,6 @@ def main(args: argparse.Namespace) -> int:
                              "offered in the rule choice on the simulated rig)")
     if args.plant is not None:
         config = load_config(args.config) if args.config is not None else default_sim_config()
-        params = _params(args.params)
         load_plant(args.plant, params)  # fail early, with the loader's message
 
         def factory() -> Plant:
@@ -372,8 +349,8 @@ def main(args: argparse.Namespace) -> int:
     if args.plant is not None and args.release_round:
         device = with_release_round(device, config, factory, args.seed)
     if args.plant is not None and sample:
-        device = _with_sample(device, config, args.plant, params, args.unit_key, sample,
-                              seeds[0] if seeds else 0)
+        device = with_sample(device, config, args.plant, params, args.unit_key, sample,
+                             seeds[0] if seeds else 0)
     comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "
                f"(tsmd datasheet) on {source}:\n"
                f"each knob swept +-{SWEEP_AMPLITUDE_DEG:g} deg at {SWEEP_HZ:g} Hz, other knob "

@@ -17,6 +17,7 @@ from tsmd.profile.files import (
     dump_profile,
     load_device_model,
     load_profile,
+    save_device_fields,
     save_device_model,
     save_profile,
 )
@@ -48,6 +49,6 @@ __all__ = [
     "OMEGA_RANGE", "PROFILE_SCHEMA_VERSION", "CatheterProfile", "DeviceKnob", "DeviceModel",
     "KnobProfile", "ProfileError", "ProfileStore", "ReferencePoint", "device_model_from_mapping",
     "device_model_to_mapping", "dump_profile", "load_device_model", "load_profile",
-    "make_knob_profile", "profile_from_mapping", "profile_to_mapping", "save_device_model",
-    "save_profile", "standard_grid",
+    "make_knob_profile", "profile_from_mapping", "profile_to_mapping", "save_device_fields",
+    "save_device_model", "save_profile", "standard_grid",
 ]

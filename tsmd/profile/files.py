@@ -7,6 +7,7 @@ import contextlib
 import os
 import shutil
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -19,8 +20,8 @@ from tsmd.profile.schema import (
     profile_from_mapping,
     profile_to_mapping,
 )
-from tsmd.profile.types import ID_PATTERN, CatheterProfile, DeviceModel, ProfileError
-from tsmd.yamlfile import read_yaml
+from tsmd.profile.types import ID_PATTERN, KNOB_NAMES, CatheterProfile, DeviceModel, ProfileError
+from tsmd.yamlfile import parse_yaml, read_yaml
 
 
 def _read_yaml(path: Path) -> Any:
@@ -66,6 +67,47 @@ def save_device_model(device: DeviceModel, path: str | os.PathLike[str],
                                    allow_unicode=True)
     device_model_from_mapping(yaml.safe_load(text), str(target))  # never write what we cannot read
     _write_atomically(target, text)
+
+
+def save_device_fields(source: str | os.PathLike[str], device: DeviceModel,
+                       keys: Sequence[str], path: str | os.PathLike[str], comment: str) -> None:
+    """Write the data sheet ``source`` to ``path`` (atomically, as :func:`save_device_model`)
+    with each knob's scalar fields ``keys`` as in ``device`` and every other line as it was:
+    its header, then ``comment``, then its body with only those fields' lines changed. Refused
+    in one line when the result would read other than ``device``."""
+    text = Path(source).read_text(encoding="utf-8")
+    lines = text.splitlines(keepends=True)
+    head = next((i for i, line in enumerate(lines) if not line.startswith("#")), len(lines))
+    body = lines[head:]
+    for name, knob in zip(KNOB_NAMES, device.knobs, strict=True):
+        start, end = _knob_block(body, name, str(source))
+        kept = [line for line in body[start:end] if line.split(":")[0].strip() not in keys]
+        added = [f"    {key}: {float(v)!r}\n" for key in keys
+                 if (v := getattr(knob, key)) is not None]
+        body[start:end] = kept + added
+    new = ("".join(lines[:head])
+           + "".join(f"# {line}\n".replace("# \n", "#\n") for line in comment.splitlines())
+           + "".join(body))
+    if device_model_from_mapping(parse_yaml(new, str(path), ProfileError), str(path)) != device:
+        raise ProfileError(f"{source}: its fields other than {', '.join(keys)} would change; "
+                           "not written")
+    _write_atomically(Path(path), new)
+
+
+def _knob_block(body: list[str], name: str, source: str) -> tuple[int, int]:
+    """The lines of knob ``name``'s mapping under ``knobs:`` (after its own line, up to the next
+    line indented less than its fields)."""
+    try:
+        top = body.index("knobs:\n")
+        start = body.index(f"  {name}:\n", top) + 1
+    except ValueError:
+        raise ProfileError(f"{source}: no knobs.{name} block as tsmd writes it (two-space "
+                           "indents)") from None
+    end = next((i for i in range(start, len(body))
+                if body[i].strip() and not body[i].startswith("    ")), len(body))
+    while end > start and not body[end - 1].strip():
+        end -= 1
+    return start, end
 
 
 def _write_atomically(target: Path, text: str) -> None:

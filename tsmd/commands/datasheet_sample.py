@@ -1,0 +1,147 @@
+"""`tsmd datasheet`'s sample: its unit list, its part on a sheet being measured, and
+``--update FILE``: the part added to an existing sheet with nothing else of it changed.
+
+The part only widens the half-width a calibration reports (never a value, the gate or a
+re-sweep: :class:`tsmd.calibration.estimate.Estimate`), so a shipped sheet can carry it without
+being re-measured; its sample is calibrated under exactly that sheet (docs/calibration.md,
+session 20).
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import re
+import time
+from pathlib import Path
+from typing import Any
+
+from simrig.family import DEVELOPMENT_UNITS, HELD_OUT_UNITS
+from simrig.plant import load_plant
+from tsmd import __version__
+from tsmd.config import TsmdConfig, default_sim_config, load_config
+from tsmd.datasheet import DatasheetError
+from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
+from tsmd.profile import DeviceModel, load_device_model, save_device_fields
+
+SCORED_UNITS = frozenset(DEVELOPMENT_UNITS + HELD_OUT_UNITS)
+"""Units a figure is scored on (development and held out): never in a product's sample."""
+
+MEASURING_OPTIONS = ("from_recording", "device_model", "loaded_shape", "tip_backlash_gain",
+                     "tip_line_backlash_gain", "release_end_offset", "recovery_rule",
+                     "bend_relation")
+"""Options that measure a sheet anew: not with ``--update``."""
+
+
+def int_list(text: str, option: str, what: str, alternative: str = "") -> list[int]:
+    """``text`` as a non-empty comma-separated list of integers, or a one-line error naming
+    ``option``."""
+    try:
+        values = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise DatasheetError(f"{option}: not a comma-separated list of integers"
+                             f"{' or ' + alternative if alternative else ''}: {text!r}") from None
+    if not values:
+        raise DatasheetError(f"{option}: give at least one {what}"
+                             f"{', or ' + alternative if alternative else ''}")
+    return values
+
+
+def sample_units(text: str, own_unit: object) -> list[int]:
+    """``--unit-sample``: units and ranges (``201-208``), none scored, none twice, not the
+    sheet's own unit (``own_unit``, always in the sample)."""
+    units: list[int] = []
+    for x in (x.strip() for x in text.split(",") if x.strip()):
+        m = re.fullmatch(r"(\d+)(?:-(\d+))?", x)
+        if m is None:
+            raise DatasheetError(f"--unit-sample: not a comma-separated list of units or "
+                                 f"ranges (201-208): {text!r}")
+        last = int(m[2] if m[2] is not None else m[1])
+        if last < int(m[1]):
+            raise DatasheetError(f"--unit-sample: range {x} runs backwards")
+        units += range(int(m[1]), last + 1)
+    if not units:
+        raise DatasheetError("--unit-sample: give at least one unit")
+    scored = sorted(set(units) & SCORED_UNITS)
+    if scored:
+        raise DatasheetError(f"--unit-sample: unit(s) {','.join(map(str, scored))} are scored "
+                             f"(development 1-8, held out 101-108); a sample never holds one")
+    if len(set(units)) < len(units) or own_unit in units:
+        raise DatasheetError("--unit-sample: a unit twice (the sheet's own unit is always in "
+                             "the sample)")
+    return units
+
+
+def with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: dict[str, Any],
+                unit_key: str, units: list[int], seed: int) -> DeviceModel:
+    """The sheet with the product's parts of the error no sweep narrows, from its sample; each
+    unit's mean square beyond the gate printed, so a sub-sample's part can be pooled again."""
+    t0 = time.monotonic()
+    configs = [config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=p))
+               for p in [params, *({**params, unit_key: u} for u in units)]]
+    device, per_unit = measure_sample(device, configs, seed)
+    kinds = (("D", "dead-zone edge"), ("B", "backlash"))
+    for c, readings in zip(configs, per_unit, strict=True):
+        print(f"  sample unit {c.sim.params.get(unit_key, 'sheet')}: " + "; ".join(
+            f"{name} " + ", ".join(
+                f"{short} {len(readings[(knob, kind)][0])} values, left "
+                f"{_or_none(left_deg2(readings[(knob, kind)]), 3)} deg^2" for short, kind in kinds)
+            for knob, name in enumerate(("phi1", "phi2"))))
+    for knob, (name, k) in enumerate(zip(("phi1", "phi2"), device.knobs, strict=True)):
+        n = [sum(len(r[(knob, kind)][0]) for r in per_unit) for _, kind in kinds]
+        print(f"{name} unit part on the sample ({len(configs)} units, noise seed {seed}): D "
+              f"{_or_none(k.dead_zone_unit_u95_deg, 2)} deg over {n[0]} values, B "
+              f"{_or_none(k.backlash_unit_u95_deg, 2)} deg over {n[1]}")
+    print(f"  sample: {time.monotonic() - t0:.0f} s")
+    return device
+
+
+def update(args: argparse.Namespace, params: dict[str, Any], seed: int) -> int:
+    """``--update FILE``: the sheet with its sample's part, written to ``--out``; nothing else
+    of it changes (checked before writing)."""
+    for name in MEASURING_OPTIONS:
+        if getattr(args, name) not in (None, False):
+            raise DatasheetError(f"--{name.replace('_', '-')} measures a sheet anew: not with "
+                                 "--update (which adds only the sample's part)")
+    if args.plant is None:
+        raise DatasheetError("--update needs --plant (and --params) of the sheet's unit: the "
+                             "sample is tracked on the simulated rig")
+    if args.unit_sample is None:
+        raise DatasheetError("--update adds the sample's part: give --unit-sample")
+    source = Path(args.update)
+    device = load_device_model(source)
+    _same_product(source, args.plant, params)
+    units = sample_units(args.unit_sample, params.get(args.unit_key))
+    config = load_config(args.config) if args.config is not None else default_sim_config()
+    load_plant(args.plant, params)  # fail early, with the loader's message
+    updated = with_sample(device, config, args.plant, params, args.unit_key, units, seed)
+    command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
+               f"'{json.dumps(params)}' --unit-key {args.unit_key} --unit-sample "
+               f"{args.unit_sample} --out FILE")
+    save_device_fields(source, updated, SAMPLE_KEYS, args.out,
+                       f"{', '.join(SAMPLE_KEYS)} added by tsmd {__version__}:\n  {command}\n"
+                       f"  ({len(units) + 1} units, fast protocol, noise seed {seed}; no other "
+                       "field changed)")
+    print(f"tsmd datasheet: wrote {args.out} ({source} with its sample's part)")
+    return 0
+
+
+def _same_product(source: Path, plant: str, params: dict[str, Any]) -> None:
+    """Refuse a sample of another product than the one the sheet's header names (a header
+    naming none, e.g. a hand-written one, is taken at the caller's word)."""
+    head = "".join(line for line in source.read_text(encoding="utf-8").splitlines(True)
+                   if line.startswith("#"))
+    m = re.search(r"plant (\S+) with (\{[^}]*\})", head)
+    if m is None:
+        print(f"warning: {source}'s header names no plant: the sample is taken as units of "
+              f"{plant} with {json.dumps(params)}")
+        return
+    if m[1] != plant or json.loads(m[2]) != params:
+        raise DatasheetError(f"{source} was measured on {m[1]} with {m[2]}, not {plant} with "
+                             f"{json.dumps(params)}: its sample must be units of its product")
+
+
+def _or_none(value: float | None, decimals: int) -> str:
+    return "none" if value is None or not math.isfinite(value) else f"{value:.{decimals}f}"

@@ -1,4 +1,4 @@
-"""The archwave plant (blind in session 19, held out since session 20): laws, behaviours, registration, refusals."""
+"""The archwave plant (blind in session 19, held out from session 20): laws, registration."""
 
 from __future__ import annotations
 

@@ -18,10 +18,11 @@ and the knob angle are used.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from tsmd.calibration.curved_ramp import best_curved_edge
 from tsmd.calibration.signal import FloatArray
 
 
@@ -31,7 +32,7 @@ class BranchFit:
 
     edge_deg: float
     kind: str
-    """"hinge" or "knee"."""
+    """"hinge", "knee" or "curved" (a ramp bending smoothly: its start, no corner)."""
     level_A: float
     ramp_A_per_deg: float
     residual_A: float
@@ -117,7 +118,14 @@ def fit_edge(x: FloatArray, y: FloatArray, noise_A: float, *, knee_slope_ratio: 
     krss = np.where(valid, krss, np.inf)
     j = int(np.argmin(krss))
     penalty = penalty_k * max(noise_A, 1e-12) ** 2 * math.log(max(x.size, 2))
-    if krss[j] + penalty < rss[i]:
+    if not krss[j] + penalty < rss[i]:
+        return best
+    # A corner only if it beats a smoothly bending ramp too (tsmd.calibration.curved_ramp).
+    curved = best_curved_edge(x, y, edges)
+    if curved is None or krss[j] + penalty < curved[1]:
         return BranchFit(float(e2[j]), "knee", float(coef[j, 0]), float(s2[j]),
                          math.sqrt(float(krss[j]) / x.size))
+    if curved[1] + penalty < rss[i]:
+        return replace(best, edge_deg=curved[0], kind="curved",
+                       residual_A=math.sqrt(curved[1] / x.size))
     return best

@@ -45,3 +45,14 @@ def noisy(y: FloatArray, sigma_A: float, seed: int, spikes: int = 0,
         where = rng.choice(y.size, spikes, replace=False)
         out[where] += spike_A * rng.choice([-1.0, 1.0], spikes)
     return out
+
+
+def wall_current(x_deg: FloatArray, engage_deg: float, level_A: float = 0.03,
+                 first_A_per_deg: float = 0.007, loaded_A_per_deg: float = 0.0035,
+                 bend_deg: float = 8.0) -> FloatArray:
+    """The tip pressed into a soft wall that stiffens and saturates: from ``engage_deg`` (where
+    the tip starts to move) the current rises at ``first_A_per_deg`` and its slope falls
+    smoothly (exponentially over ``bend_deg``) to ``loaded_A_per_deg``: no corner."""
+    e = np.maximum(x_deg - engage_deg, 0.0)
+    extra = (first_A_per_deg - loaded_A_per_deg) * bend_deg * (1.0 - np.exp(-e / bend_deg))
+    return level_A + loaded_A_per_deg * e + extra

@@ -18,10 +18,11 @@ and the knob angle are used.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from tsmd.calibration.curved_ramp import best_curved_edge
 from tsmd.calibration.signal import FloatArray
 
 
@@ -31,7 +32,7 @@ class BranchFit:
 
     edge_deg: float
     kind: str
-    """"hinge" or "knee"."""
+    """"hinge", "knee" or "curved" (a ramp bending smoothly: its start, no corner)."""
     level_A: float
     ramp_A_per_deg: float
     residual_A: float
@@ -87,7 +88,8 @@ def _knee_chunk(x: FloatArray, y: FloatArray, e1: FloatArray,
 
 def fit_edge(x: FloatArray, y: FloatArray, noise_A: float, *, knee_slope_ratio: float = 1.5,
              max_knee_deg: float = 15.0, penalty_k: float = 20.0,
-             min_side_deg: float = 2.0, search_step_deg: float = 0.5) -> BranchFit | None:
+             min_side_deg: float = 2.0, search_step_deg: float = 0.5,
+             curve_check: bool = False) -> BranchFit | None:
     """The dead-zone edge in ``y`` (direction-signed current) over ``x`` (direction-signed knob
     angle, increasing), which holds the dead-zone level at its start and the loaded ramp at its
     end. None when no rising ramp fits."""
@@ -117,7 +119,15 @@ def fit_edge(x: FloatArray, y: FloatArray, noise_A: float, *, knee_slope_ratio: 
     krss = np.where(valid, krss, np.inf)
     j = int(np.argmin(krss))
     penalty = penalty_k * max(noise_A, 1e-12) ** 2 * math.log(max(x.size, 2))
-    if krss[j] + penalty < rss[i]:
+    if not krss[j] + penalty < rss[i]:
+        return best
+    # With curve_check, a corner only if it beats a smoothly bending ramp too
+    # (tsmd.calibration.curved_ramp).
+    curved = best_curved_edge(x, y, edges) if curve_check else None
+    if curved is None or krss[j] + penalty < curved[1]:
         return BranchFit(float(e2[j]), "knee", float(coef[j, 0]), float(s2[j]),
                          math.sqrt(float(krss[j]) / x.size))
+    if curved[1] + penalty < rss[i]:
+        return replace(best, edge_deg=curved[0], kind="curved",
+                       residual_A=math.sqrt(curved[1] / x.size))
     return best

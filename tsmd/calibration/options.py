@@ -62,6 +62,11 @@ class IdentifyOptions:
     follows a few degrees later, and the exact start of a gentle rise scatters by 3 deg from
     cycle to cycle; docs/calibration.md)."""
     knee_slope_ratio: float = 1.5
+    edge_curve: bool = False
+    """``edge="fit"``: a knee must also beat a smoothly bending ramp (a curved hinge) by the
+    penalty, else the edge is the curve's start (:mod:`tsmd.calibration.curved_ramp`). The
+    product's choice (data-sheet ``edge_curve``): off, warmgear's real corner read 2-3 deg
+    early; on, jawcrimp's wall-loaded ramp stops flipping between its start and a knee."""
     fit_before_deg: float = 12.0
     """``edge="fit"``: the window fitted starts this far before the rise the pieces show ..."""
     fit_after_deg: float = 15.0
@@ -228,5 +233,6 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
                           k.backlash_recovery_lag_deg, BacklashReference.of(k))
         # the product's knee (tsmd datasheet) where the sheet turns it on
         one = replace(one, backlash_knee=True) if k.backlash_knee else one
+        one = replace(one, edge_curve=True) if k.edge_curve else one
         chosen.append(replace(one, reading_offset=k.reading_offset, unit_part=UnitPart.of(k)))
     return chosen[0], chosen[1]

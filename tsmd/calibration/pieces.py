@@ -116,6 +116,7 @@ def fitted_edge(grid: FloatArray, yg: FloatArray, plateau_start: int, rise_k: in
     b = min(yg.size, rise_k + round(opts.fit_after_deg / step))
     fit = fit_edge(grid[a:b], yg[a:b], noise, knee_slope_ratio=opts.knee_slope_ratio,
                    max_knee_deg=opts.max_knee_deg, penalty_k=opts.penalty_k,
+                   curve_check=opts.edge_curve,
                    search_step_deg=step)
     if fit is None:
         return rise_k

@@ -95,7 +95,7 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_recovery_lag_deg", "backlash_bend_gain", "backlash_release_rule",
-                      "backlash_knee")
+                      "backlash_knee", "edge_curve")
 _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
 _SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
@@ -198,6 +198,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_bend_gain=optional("backlash_bend_gain"),
             backlash_release_rule=_release_rule(r, k, key),
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
+            edge_curve=_knee(r, k.get("edge_curve"), f"{key}.edge_curve"),
             reference_rule_backlash_gain=optional("reference_rule_backlash_gain"),
             reference_tip_backlash_gain=optional("reference_tip_backlash_gain"),
             reference_tip_line_backlash_gain=optional("reference_tip_line_backlash_gain"),

@@ -139,6 +139,10 @@ class DeviceKnob:
     what its reference backlash scaled by the current's swing there predicts, relative to the
     same at the other knob's 0 (:func:`tsmd.calibration.recovery.bend_gain`); the rule
     "recovery" scales a backlash the current does not show by it (1 without it)."""
+    edge_curve: bool | None = None
+    """Optional, the product's choice of the curved-hinge check on the dead-zone edge
+    (:mod:`tsmd.calibration.curved_ramp`): a knee in the loaded current must also beat a
+    smoothly bending ramp (``true``; jawcrimp) or is taken as before (absent)."""
     backlash_knee: bool | None = None
     """Optional, the product's choice of the knee (:mod:`tsmd.calibration.knee`): a fraction
     rule's backlash end beyond the point where the current's rise falls below its own scatter

@@ -17,8 +17,8 @@ plant (session 13) is held out now, the nitinol plant (session 14, written blind
 now, the helixbelt plant (session 15, written blind) is held out now, the ratestate plant
 (session 16, written blind) is held out now, the warmgear plant (session 18, written blind) is
 held out now, the archwave plant (session 19, written blind) is held out now (tuned on its
-development units in session 20), the jawcrimp plant (session 20, written blind) is the blind one
-(``PLANT_ROLE``).
+development units in session 20), the jawcrimp plant (session 20, written blind, run untuned, then
+tuned on its development units in the same session's second round) is held out (``PLANT_ROLE``).
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -68,7 +68,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
-              "jawcrimp": "blind"}
+              "jawcrimp": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

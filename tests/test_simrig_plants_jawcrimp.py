@@ -1,4 +1,4 @@
-"""The jawcrimp plant (blind in session 20): laws, behaviours, registration, refusals."""
+"""The jawcrimp plant (blind, then held out, in session 20): laws, registration, refusals."""
 
 from __future__ import annotations
 
@@ -180,9 +180,9 @@ def test_unknown_reshapes_are_refused() -> None:
         make_jawcrimp_plant().reshape(sheath_curvature_deg=-5.0)
 
 
-def test_jawcrimp_is_registered_last_and_blind() -> None:
+def test_jawcrimp_is_registered_last_and_held_out() -> None:
     assert list(PLANT_SPECS)[-1] == "jawcrimp"
-    assert PLANT_ROLE["jawcrimp"] == "blind"
+    assert PLANT_ROLE["jawcrimp"] == "held-out"
     assert isinstance(family_member("jawcrimp", 101).build(), JawCrimpPlant)
     assert set(SCATTER["jawcrimp"]) <= set(family_member("jawcrimp", 0).params["knobs"][0])
 

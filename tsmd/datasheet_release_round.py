@@ -30,7 +30,7 @@ from tsmd.calibration.identify import split_half_cycles
 from tsmd.calibration.run import run_calibration
 from tsmd.calibration.signal import lowpass
 from tsmd.compensation.release_round import reference_backlash_deg
-from tsmd.compensation.tension_play import BETA_RANGE, TensionPlayParams
+from tsmd.compensation.tension_play import TensionPlayParams, release_slope
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.errors import TsmdError
 from tsmd.profile import DeviceModel
@@ -70,7 +70,6 @@ def fit_release_round(pos_deg: FloatArray, tip_deg: FloatArray, sample_rate_hz: 
     x = np.asarray(pos_deg, float)
     sq = np.zeros((len(SHIFT_GRID), len(ROUND_GRID)))
     n = 0
-    lo, hi = BETA_RANGE
     for direction, a, b, _ in split_half_cycles(x, _MIN_REVERSAL_DEG):
         side = -direction  # the side released: falling from +A is direction -1
         if a == 0 or b - a < 50:
@@ -79,7 +78,7 @@ def fit_release_round(pos_deg: FloatArray, tip_deg: FloatArray, sample_rate_hz: 
                     else (tension.backlash_gain_neg[i], tension.zero_load_neg_deg[i]))
         backlash = abs(beta * (x[a] - x0))
         b_ref = reference_backlash_deg(beta, x0, side)
-        slope = tension.omega / (1.0 - min(max(beta, lo), hi))
+        slope = release_slope(tension.omega, beta)
         xs, ts = x[a:b], tip[a:b]
         keep = side * xs >= WINDOW_END_DEG
         travel = side * (x[a] - xs)

@@ -17,7 +17,7 @@ from typing import Any
 
 from simrig.plant import Plant, load_plant
 from tsmd import __version__
-from tsmd.commands.datasheet_sample import int_list, sample_units, update, with_sample
+from tsmd.commands.datasheet_sample import sample_units, update, with_sample
 from tsmd.config import DEFAULT_CONFIG_PATH, TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import (
     ANALYSED_CYCLES,
@@ -158,7 +158,14 @@ def _from_recordings(paths: list[str]) -> list[KnobConstants]:
 def _rule_seeds(text: str) -> list[int]:
     if text.strip().lower() == "none":
         return []
-    return int_list(text, "--rule-seeds", "seed", "'none'")
+    try:
+        seeds = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise DatasheetError("--rule-seeds: not a comma-separated list of integers or 'none': "
+                             f"{text!r}") from None
+    if not seeds:
+        raise DatasheetError("--rule-seeds: give at least one seed, or 'none'")
+    return seeds
 
 
 def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,

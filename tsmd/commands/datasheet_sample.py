@@ -35,20 +35,6 @@ MEASURING_OPTIONS = ("from_recording", "device_model", "loaded_shape", "tip_back
 """Options that measure a sheet anew: not with ``--update``."""
 
 
-def int_list(text: str, option: str, what: str, alternative: str = "") -> list[int]:
-    """``text`` as a non-empty comma-separated list of integers, or a one-line error naming
-    ``option``."""
-    try:
-        values = [int(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise DatasheetError(f"{option}: not a comma-separated list of integers"
-                             f"{' or ' + alternative if alternative else ''}: {text!r}") from None
-    if not values:
-        raise DatasheetError(f"{option}: give at least one {what}"
-                             f"{', or ' + alternative if alternative else ''}")
-    return values
-
-
 def sample_units(text: str, own_unit: object) -> list[int]:
     """``--unit-sample``: units and ranges (``201-208``), none scored, none twice, not the
     sheet's own unit (``own_unit``, always in the sample)."""

@@ -16,7 +16,7 @@ from tsmd.compensation.knee_map import moved_grid, moved_knee
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid, curved, steepest_slope
 from tsmd.compensation.release_round import reference_backlash_deg, shifted_zero_load_deg
 from tsmd.compensation.shaped_play import model_branches
-from tsmd.compensation.tension_play import BETA_RANGE, Branches, TensionPlayParams
+from tsmd.compensation.tension_play import Branches, TensionPlayParams, release_slope
 
 OURS_COLUMNS: tuple[str, ...] = ("dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_gain_pos",
                                  "backlash_gain_neg", "zero_load_pos_deg", "zero_load_neg_deg")
@@ -95,9 +95,8 @@ class OursKnob:
                            *self.shapes_at(other_deg))
         if self.release_round == 0.0:
             return b
-        lo, hi = BETA_RANGE
         k_pos, k_neg = (self.release_round * reference_backlash_deg(beta, x0, side)
-                        * w / (1.0 - min(max(beta, lo), hi))
+                        * release_slope(w, beta)
                         for beta, x0, side in ((r[2], r[4], 1), (r[3], r[5], -1)))
         return dataclasses.replace(b, round_pos_deg=k_pos, round_neg_deg=k_neg)
 

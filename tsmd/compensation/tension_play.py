@@ -287,8 +287,14 @@ def release_line(omega: float, height_deg: float, dead_zone_deg: float, beta: fl
     the ends lie on ``y = H + omega ((x - beta x0) / (1 - beta) - D)``.
     """
     b = min(max(beta, BETA_RANGE[0]), BETA_RANGE[1])
-    slope = omega / (1.0 - b)
+    slope = release_slope(omega, beta)
     return slope, height_deg - omega * dead_zone_deg - slope * b * zero_load_deg
+
+
+def release_slope(omega: float, beta: float) -> float:
+    """The release line's slope, tip per knob degree: ``omega / (1 - beta)``, beta clamped to
+    :data:`BETA_RANGE`."""
+    return omega / (1.0 - min(max(beta, BETA_RANGE[0]), BETA_RANGE[1]))
 
 
 def branches(omega: float, height_pos_deg: float, height_neg_deg: float, d_pos: float,

@@ -117,14 +117,18 @@ def without_offset(device: DeviceModel) -> DeviceModel:
 
 
 def with_reading_offset(device: DeviceModel, config: TsmdConfig, truth: Truth,
-                        noise_seeds: Sequence[int]) -> tuple[DeviceModel, list[ProtocolRun]]:
+                        noise_seeds: Sequence[int],
+                        truth_points: Sequence[GridPoint] | None = None
+                        ) -> tuple[DeviceModel, list[ProtocolRun]]:
     """The sheet with each knob's reading offset, from fast calibrations of its own unit
     (``config.sim``) with the sheet as chosen (no offset applied while measuring it); a knob's
     dead-zone edge gets none where the tip's reading of it is bound to the tracker's noise
-    (:func:`noise_bound_edges`, on the sweeps the truth is read from)."""
+    (:func:`noise_bound_edges`, on the sweeps the truth is read from: ``truth_points``, or
+    swept again when not given)."""
     plain = without_offset(device)
     runs = [play_protocol(config, plain, fast_protocol(), seed) for seed in noise_seeds]
-    unsure = noise_bound_edges(truth_sweeps(config), config.sim.tracker_noise_deg)
+    points = truth_sweeps(config) if truth_points is None else truth_points
+    unsure = noise_bound_edges(points, config.sim.tracker_noise_deg)
     offsets = reading_offsets(offset_readings(runs, truth, unsure=unsure))
     knobs = tuple(dataclasses.replace(k, reading_offset=o)
                   for k, o in zip(plain.knobs, offsets, strict=True))

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.calibration.tension_play_fit import fit_sweep_sides, sweeps_from_points
 from tsmd.config import TsmdConfig
@@ -110,9 +111,11 @@ def knob_errors(errors: Sequence[float], knob: int) -> np.ndarray:
 Truth = dict[tuple[int, float], dict[str, float]]
 
 
-def sheet_truth(config: TsmdConfig) -> Truth:
-    """The sheet unit's tracked D and B on the paper's grid (the plant alone)."""
-    return {(p.knob, p.other_deg): tip_truth(p) for p in truth_sweeps(config)}
+def sheet_truth(config: TsmdConfig, sweeps: Sequence[GridPoint] | None = None) -> Truth:
+    """The sheet unit's tracked D and B on the paper's grid (the plant alone), from its
+    ``sweeps`` when the caller has them (:func:`tsmd.tracked_calibration.truth_sweeps`)."""
+    points = truth_sweeps(config) if sweeps is None else sweeps
+    return {(p.knob, p.other_deg): tip_truth(p) for p in points}
 
 
 def scored(config: TsmdConfig, candidate: DeviceModel, label: str, truth: Truth,

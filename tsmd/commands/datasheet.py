@@ -51,6 +51,7 @@ from tsmd.datasheet_shape_grid import measure_shape_grids
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.profile.reading_offset import ReadingOffset
 from tsmd.recording import read_recording
+from tsmd.tracked_calibration import truth_sweeps
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -175,7 +176,8 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
     (``recovery``: "recovery" offered too, its constants measured first), and the product's
     reading offset measured with that rule."""
     unit = config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=params))
-    truth = sheet_truth(unit)
+    sweeps = truth_sweeps(unit)
+    truth = sheet_truth(unit, sweeps)
     if recovery:
         t0 = time.monotonic()
         device, _ = with_recovery_constants(device, unit, truth, seeds)
@@ -196,7 +198,7 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
               f"{k.backlash_release_rule}, knee {'on' if k.backlash_knee else 'off'}")
     print(f"  rule choice: {time.monotonic() - t0:.0f} s")
     t0 = time.monotonic()
-    chosen, _ = with_reading_offset(chosen, unit, truth, seeds)
+    chosen, _ = with_reading_offset(chosen, unit, truth, seeds, sweeps)
     for name, k in zip(("phi1", "phi2"), chosen.knobs, strict=True):
         print(f"{name} reading offset (current minus tip, deg, at the other knob's "
               f"{_angles(k.reading_offset)}): {_offsets(k.reading_offset)}")

@@ -8,10 +8,7 @@ reason, before anything touches a drive. Every key is documented in docs/configu
 from __future__ import annotations
 
 import dataclasses
-import math
-import types
 import typing
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -23,6 +20,7 @@ from drivers.drive import DriveError
 from drivers.units import DriveConfig, MasterTimeouts
 from tsmd.compensation.safety import DEFAULT_MAX_ACCEL_DEG_S2, DEFAULT_MAX_VELOCITY_DEG_S
 from tsmd.errors import TsmdError
+from tsmd.strict_dataclass import SchemaError, build_dataclass
 from tsmd.yamlfile import read_yaml
 
 DEFAULT_CONFIG_PATH = Path("/etc/tsmd/tsmd.yaml")
@@ -196,128 +194,6 @@ class TsmdConfig:
         return dataclasses.replace(self, **changes)
 
 
-# --- strict loading -------------------------------------------------------------------------
-
-
-def _type_name(tp: Any) -> str:
-    origin = typing.get_origin(tp)
-    if origin is Literal:
-        return " | ".join(repr(a) for a in typing.get_args(tp))
-    if origin in (typing.Union, types.UnionType):
-        return " or ".join(_type_name(a) for a in typing.get_args(tp))
-    if tp is type(None):
-        return "null"
-    if dataclasses.is_dataclass(tp):
-        return "mapping"
-    if origin is not None:
-        return getattr(origin, "__name__", str(origin))
-    return getattr(tp, "__name__", str(tp))
-
-
-def _convert(tp: Any, value: Any, path: str) -> Any:
-    origin = typing.get_origin(tp)
-    if tp is Any:
-        return value
-    if origin in (typing.Union, types.UnionType):
-        args = typing.get_args(tp)
-        if value is None:
-            if type(None) in args:
-                return None
-            raise ConfigError(f"{path}: must not be null")
-        errors = []
-        for arg in args:
-            if arg is type(None):
-                continue
-            try:
-                return _convert(arg, value, path)
-            except ConfigError as exc:
-                errors.append(exc)
-        raise errors[0]
-    if origin is Literal:
-        allowed = typing.get_args(tp)
-        if value not in allowed or isinstance(value, bool):
-            raise ConfigError(
-                f"{path}: {value!r} is not one of {', '.join(repr(a) for a in allowed)}")
-        return value
-    if dataclasses.is_dataclass(tp):
-        return _build(tp, value, path)  # type: ignore[arg-type]
-    if origin is list:
-        (item_tp,) = typing.get_args(tp)
-        if not isinstance(value, list):
-            raise ConfigError(f"{path}: expected a list, got {type(value).__name__}")
-        return [_convert(item_tp, v, f"{path}[{i}]") for i, v in enumerate(value)]
-    if origin is dict:
-        _key_tp, val_tp = typing.get_args(tp)
-        if not isinstance(value, Mapping):
-            raise ConfigError(f"{path}: expected a mapping, got {type(value).__name__}")
-        out = {}
-        for k, v in value.items():
-            if not isinstance(k, str):
-                raise ConfigError(f"{path}: key {k!r} must be a string")
-            out[k] = _convert(val_tp, v, f"{path}.{k}")
-        return out
-    if value is None:
-        raise ConfigError(f"{path}: must not be null (expected {_type_name(tp)})")
-    if tp is bool:
-        if not isinstance(value, bool):
-            raise ConfigError(f"{path}: expected true or false, got {value!r}")
-        return value
-    if tp is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{path}: expected an integer, got {value!r}")
-        return value
-    if tp is float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise ConfigError(f"{path}: expected a number, got {value!r}")
-        if not math.isfinite(value):
-            raise ConfigError(f"{path}: must be a finite number, got {value!r}")
-        return float(value)
-    if tp is str:
-        if not isinstance(value, str):
-            raise ConfigError(f"{path}: expected a string, got {value!r}")
-        return value
-    raise ConfigError(f"{path}: unsupported type {_type_name(tp)}")
-
-
-def _check_range(value: Any, f: dataclasses.Field[Any], path: str) -> None:
-    bounds = f.metadata.get("range")
-    if bounds is None or value is None:
-        return
-    lo, hi = bounds
-    if (lo is not None and value < lo) or (hi is not None and value > hi):
-        raise ConfigError(f"{path}: {value!r} is out of range [{lo}, {hi}]")
-
-
-def _build(cls: type[Any], data: Any, path: str) -> Any:
-    """Build dataclass ``cls`` from a mapping, refusing unknown keys and wrong types."""
-    if data is None:
-        data = {}
-    if not isinstance(data, Mapping):
-        where = path or "top level"
-        raise ConfigError(f"{where}: expected a mapping, got {type(data).__name__}")
-    hints = typing.get_type_hints(cls)
-    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
-    prefix = f"{path}." if path else ""
-    for key in data:
-        if key not in fields:
-            known = ", ".join(sorted(fields))
-            raise ConfigError(f"{prefix}{key}: unknown key (known keys: {known})")
-    kwargs = {}
-    for name, f in fields.items():
-        key_path = f"{prefix}{name}"
-        if name not in data:
-            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
-                raise ConfigError(f"{key_path}: missing (required)")
-            continue
-        value = _convert(hints[name], data[name], key_path)
-        _check_range(value, f, key_path)
-        kwargs[name] = value
-    try:
-        return cls(**kwargs)
-    except (TypeError, ValueError) as exc:
-        raise ConfigError(f"{path or 'top level'}: {exc}") from None
-
-
 def _validate(config: TsmdConfig) -> None:
     for name, knob in (("phi1", config.limits.phi1), ("phi2", config.limits.phi2)):
         if knob.min_deg >= knob.max_deg:
@@ -343,9 +219,9 @@ def _validate(config: TsmdConfig) -> None:
 def parse_config(data: Any, source: str = "<config>") -> TsmdConfig:
     """Validate an already-parsed YAML document."""
     try:
-        config = _build(TsmdConfig, data, "")
+        config = build_dataclass(TsmdConfig, data, "")
         _validate(config)
-    except ConfigError as exc:
+    except (ConfigError, SchemaError) as exc:
         raise ConfigError(f"{source}: {exc}") from None
     return typing.cast(TsmdConfig, config)
 

@@ -44,6 +44,7 @@ class ReferenceReadings:
     n_between: int
     n_widened: int
     n_steeper: int
+    n_flatter_own: int
     n_reread: int
     odd_speed: bool
     ramp_change: float
@@ -85,11 +86,17 @@ class ReferenceReadings:
         softer catheter: twistshaft warming in the patient, its tip's edge in place)."""
         raw = self._crossing(ramp, edge_deg, slope)
         assert self.slope_ref_A_per_deg is not None
-        if not (self.options.flatter_reads_between and slope < self.slope_ref_A_per_deg):
-            return raw
-        self.n_between += 1
-        return nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
-                               self.estimate_deg + self.bins.bias_deg(ramp.other_deg))
+        target = self.estimate_deg + self.bins.bias_deg(ramp.other_deg)
+        if self.options.flatter_reads_between and slope < self.slope_ref_A_per_deg:
+            self.n_between += 1
+            raw = nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
+                                  target)
+        if (self.options.flatter_ramp_within_gate_reads_own
+                and ramp.slope_A_per_deg < slope and abs(raw - target) <= self.options.gate_deg):
+            self.n_flatter_own += 1
+            raw = nearest_between(raw, self._crossing(ramp, edge_deg, ramp.slope_A_per_deg),
+                                  target)
+        return raw
 
     def _widening_read(self, ramp: LoadedRamp, edge_deg: float, slope: float,
                        partner: ReferenceReadings | None = None) -> float | None:

@@ -44,7 +44,7 @@ class ReferenceReadings:
     n_between: int
     n_widened: int
     n_steeper: int
-    n_flatter_own: int
+    n_own_between: int
     n_reread: int
     odd_speed: bool
     ramp_change: float
@@ -83,7 +83,9 @@ class ReferenceReadings:
         """The crossing with the slope in use; on a ramp flatter than the reference (with
         ``flatter_reads_between``) the point between it and the reference slope's crossing
         nearest the estimate: the slope turned about a point the current does not show (a
-        softer catheter: twistshaft warming in the patient, its tip's edge in place)."""
+        softer catheter: twistshaft warming in the patient, its tip's edge in place). Within
+        the gate (with ``within_gate_reads_own``) then the point between that and the ramp's
+        own slope's crossing nearest the estimate: which slope is right nothing says there."""
         raw = self._crossing(ramp, edge_deg, slope)
         assert self.slope_ref_A_per_deg is not None
         target = self.estimate_deg + self.bins.bias_deg(ramp.other_deg)
@@ -91,9 +93,9 @@ class ReferenceReadings:
             self.n_between += 1
             raw = nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
                                   target)
-        if (self.options.flatter_ramp_within_gate_reads_own
-                and ramp.slope_A_per_deg < slope and abs(raw - target) <= self.options.gate_deg):
-            self.n_flatter_own += 1
+        if (self.options.within_gate_reads_own and ramp.slope_A_per_deg != slope
+                and abs(raw - target) <= self.options.gate_deg):
+            self.n_own_between += 1
             raw = nearest_between(raw, self._crossing(ramp, edge_deg, ramp.slope_A_per_deg),
                                   target)
         return raw

@@ -99,8 +99,8 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """The last ramp's own slope against the reference, minus 1, whatever its speed."""
     n_steeper: int = 0
     """Of those, steeper ramps read with their own slope (``steeper_knob_reads_own``)."""
-    n_flatter_own: int = 0
-    """Flatter ramps read towards their own slope (``flatter_ramp_within_gate_reads_own``)."""
+    n_own_between: int = 0
+    """Crossings within the gate read towards the ramp's own slope (``within_gate_reads_own``)."""
     n_odd_knee: int = 0
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_odd_crossing: int = 0
@@ -392,4 +392,4 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                 "reference_relearned": self.reference.relearned,
                 "reread_ramps": self.n_reread, "partner_held": self.n_partner_held,
                 "between_ramps": self.n_between, "widened_ramps": self.n_widened,
-                "steeper_ramps": self.n_steeper, "flatter_own_ramps": self.n_flatter_own}
+                "steeper_ramps": self.n_steeper, "own_slope_ramps": self.n_own_between}

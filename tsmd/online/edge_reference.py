@@ -44,6 +44,7 @@ class ReferenceReadings:
     n_between: int
     n_widened: int
     n_steeper: int
+    n_own_between: int
     n_reread: int
     odd_speed: bool
     ramp_change: float
@@ -82,14 +83,22 @@ class ReferenceReadings:
         """The crossing with the slope in use; on a ramp flatter than the reference (with
         ``flatter_reads_between``) the point between it and the reference slope's crossing
         nearest the estimate: the slope turned about a point the current does not show (a
-        softer catheter: twistshaft warming in the patient, its tip's edge in place)."""
+        softer catheter: twistshaft warming in the patient, its tip's edge in place). Within
+        the gate (with ``within_gate_reads_own``) then the point between that and the ramp's
+        own slope's crossing nearest the estimate: which slope is right nothing says there."""
         raw = self._crossing(ramp, edge_deg, slope)
         assert self.slope_ref_A_per_deg is not None
-        if not (self.options.flatter_reads_between and slope < self.slope_ref_A_per_deg):
-            return raw
-        self.n_between += 1
-        return nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
-                               self.estimate_deg + self.bins.bias_deg(ramp.other_deg))
+        target = self.estimate_deg + self.bins.bias_deg(ramp.other_deg)
+        if self.options.flatter_reads_between and slope < self.slope_ref_A_per_deg:
+            self.n_between += 1
+            raw = nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
+                                  target)
+        if (self.options.within_gate_reads_own and ramp.slope_A_per_deg != slope
+                and abs(raw - target) <= self.options.gate_deg):
+            self.n_own_between += 1
+            raw = nearest_between(raw, self._crossing(ramp, edge_deg, ramp.slope_A_per_deg),
+                                  target)
+        return raw
 
     def _widening_read(self, ramp: LoadedRamp, edge_deg: float, slope: float,
                        partner: ReferenceReadings | None = None) -> float | None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 from statistics import median
 
 from tsmd.online.estimator_options import EstimatorOptions
+from tsmd.online.features import LoadedRamp
 from tsmd.online.slopes import common_change, pooled_change, shrunk_ratio
 
 
@@ -25,6 +26,16 @@ class SlopeReadings:
     knob_change: float
     level_deg: float
     partner: SlopeReadings | None
+
+    def plausible(self, ramp: LoadedRamp | object) -> bool:
+        """A ramp whose slope is within ``slope_ratio_max`` of the reference (True while
+        learning); anything else (a rejected stroke) is not."""
+        if not isinstance(ramp, LoadedRamp):
+            return False
+        if self.slope_ref_A_per_deg is None:
+            return True
+        ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
+        return 1.0 / self.options.slope_ratio_max <= ratio <= self.options.slope_ratio_max
 
     @property
     def knob_followed(self) -> bool:

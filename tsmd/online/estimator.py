@@ -99,6 +99,8 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """The last ramp's own slope against the reference, minus 1, whatever its speed."""
     n_steeper: int = 0
     """Of those, steeper ramps read with their own slope (``steeper_knob_reads_own``)."""
+    n_own_between: int = 0
+    """Crossings within the gate read towards the ramp's own slope (``within_gate_reads_own``)."""
     n_odd_knee: int = 0
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_odd_crossing: int = 0
@@ -159,16 +161,6 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                               else ramps)
         self.frozen_reason = reason
         self.suspects.clear()
-
-    def plausible(self, ramp: LoadedRamp | object) -> bool:
-        """A ramp whose slope is within ``slope_ratio_max`` of the reference (True while
-        learning); anything else (a rejected stroke) is not."""
-        if not isinstance(ramp, LoadedRamp):
-            return False
-        if self.slope_ref_A_per_deg is None:
-            return True
-        ratio = ramp.slope_A_per_deg / self.slope_ref_A_per_deg
-        return 1.0 / self.options.slope_ratio_max <= ratio <= self.options.slope_ratio_max
 
     def update(self, ramp: LoadedRamp, profile_edge_deg: float,
                partner: EdgeTracker | None = None) -> list[tuple[str, str, dict[str, Any]]]:
@@ -400,4 +392,4 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                 "reference_relearned": self.reference.relearned,
                 "reread_ramps": self.n_reread, "partner_held": self.n_partner_held,
                 "between_ramps": self.n_between, "widened_ramps": self.n_widened,
-                "steeper_ramps": self.n_steeper}
+                "steeper_ramps": self.n_steeper, "own_slope_ramps": self.n_own_between}

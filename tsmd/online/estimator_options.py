@@ -104,6 +104,18 @@ class EstimatorOptions:
     crossings -0.6..-1.8 deg with the slope in use, +0.5..+0.8 with the reference's, while
     the tip's edge stayed within +-0.3 deg; followed, phi2 tracked 0.3-1.6 deg worse than
     with online off). Off: the slope in use alone (until session 17)."""
+    within_gate_reads_own: bool = True
+    """A crossing within the gate of a ramp whose slope differs from the slope in use reads
+    the point between it and the ramp's own slope's crossing nearest the estimate: the slope
+    in use is shrunk towards the reference (``slope_in_use_tolerance``) and the line runs
+    through the window's centre ~15 deg out, so a ramp flatter than it reads outward and a
+    steeper one inward, and under a softening catheter the readings creep (twistshaft 3
+    without a change, 600 s: ramps 0.83-0.96 x, crossings +1.0..+1.8 deg with the
+    reference's slope, -1.6..+0.9 with their own; phi1 left the dead band to +0.46/+0.79 deg
+    and tracked worse than with online off). Both ways, not only flatter ramps: those alone
+    leave the steeper ramps' inward readings, and coilpipe 1 without a change ended at
+    -0.45 deg instead of -0.03. Beyond the gate nothing changes (a change's suspects). Off:
+    the slope in use alone (until session 20)."""
     odd_slopes_read_widening: bool = True
     """A ramp whose slope disagrees with the slope in use beyond ``same_slope_tolerance``
     (measuring nothing otherwise) is a suspect when its crossings with the reference's slope

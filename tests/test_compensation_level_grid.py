@@ -8,7 +8,9 @@ import dataclasses
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_compensation_tension_play_fit import DEVICE_KNOB, synthetic_sweep
 
+from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.compensation.level_grid import LevelGrid, level_grid_from_mapping, level_grid_to_mapping
 from tsmd.compensation.ours_table import OursKnob
 from tsmd.compensation.safety import KnobLimits
@@ -131,3 +133,11 @@ def test_the_data_sheet_round_trips_the_level_grid() -> None:
     again = device_model_from_mapping(device_model_to_mapping(sheet))
     assert again.knobs[0].loaded_level_grid == GRID
     assert again.knobs[1].loaded_level_grid is None
+
+
+def test_calibration_copies_the_sheets_level_grid_into_the_profile() -> None:
+    sweeps = [synthetic_sweep(g) for g in (-90.0, 0.0, 90.0)]
+    plain = fit_tension_play(sweeps, DEVICE_KNOB)
+    with_grid = fit_tension_play(sweeps, dataclasses.replace(DEVICE_KNOB, loaded_level_grid=GRID))
+    assert plain.level_grid is None
+    assert with_grid == dataclasses.replace(plain, level_grid=GRID)

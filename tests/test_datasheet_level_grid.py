@@ -59,3 +59,12 @@ def test_without_a_sweep_at_the_other_knobs_zero_there_is_no_grid() -> None:
     sweeps = [s for s in sweeps_of(dataclasses.replace(tension(), level_grid=shifted))
               if s[0] != 0.0]
     assert level_grid(sweeps, tension()) is None
+
+
+def test_an_angle_where_the_profile_is_mis_read_is_left_out() -> None:
+    shifted = LevelGrid(ANGLES, (-2.0, 0.0, -3.0), (2.5, 0.0, 1.5))
+    misread = dataclasses.replace(tension(), dead_zone_pos_deg=(1.0, 20.0, 20.0))
+    found = level_grid(sweeps_of(dataclasses.replace(tension(), level_grid=shifted)), misread)
+    assert found is not None
+    assert found.other_knob_deg == (0.0, 60.0)
+    assert found.pos_deg == pytest.approx((0.0, -3.0), abs=0.3)

@@ -26,9 +26,9 @@ LEVEL_SHIFT_RANGE_DEG: tuple[float, float] = (-30.0, 30.0)
 
 @dataclass(frozen=True)
 class LevelGrid:
-    """Each side's shift of its plateau height (tip deg, outward positive on neither: the
-    positive side's H gets ``pos_deg``, the negative side's ``neg_deg``) over the other knob's
-    angle; linear between the angles, the end ones held."""
+    """Each side's shift of its plateau height over the other knob's angle (tip deg: the
+    positive side's H gets ``pos_deg``, the negative side's ``neg_deg``); linear between the
+    angles, the end ones held."""
 
     other_knob_deg: tuple[float, ...]
     pos_deg: tuple[float, ...]

@@ -290,7 +290,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         sheet_loaded_knee_deg=(None if ks_pos is None or ks_neg is None
                                else (float(ks_pos), float(ks_neg))),
         release_round=float(getattr(k, "release_round", None) or 0.0),
-        release_shift=float(getattr(k, "release_shift", None) or 0.0))
+        release_shift=float(getattr(k, "release_shift", None) or 0.0),
+        level_grid=getattr(k, "loaded_level_grid", None))
 
 
 def clamped_gain(beta: float) -> float:

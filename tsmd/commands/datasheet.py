@@ -36,6 +36,7 @@ from tsmd.datasheet import (
 from tsmd.datasheet_amplitude import measure_tip_backlash_gains
 from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
 from tsmd.datasheet_coupling import measure_other_tip_gains
+from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_offset import with_reading_offset
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
 from tsmd.datasheet_release_end import measure_release_end_offsets
@@ -94,6 +95,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --plant: also calibrate the unit once more, tracked, and fit "
                              "the tip's rounded start after a reversal (release_round, "
                              "release_shift; opt-in per product, docs/model.md Session 20)")
+    parser.add_argument("--level-grid", action="store_true",
+                        help="with --plant: also calibrate the unit once more, tracked, and read "
+                             "how far each side's loaded level moves with the other knob's angle "
+                             "(loaded_level_grid; opt-in per product, docs/model.md Session 21)")
     parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "
@@ -357,6 +362,8 @@ def main(args: argparse.Namespace) -> int:
         device = _with_release_end_offset(device, config, factory, args.seed)
     if args.plant is not None and args.release_round:
         device = with_release_round(device, config, factory, args.seed)
+    if args.plant is not None and args.level_grid:
+        device = with_level_grid(device, config, factory, args.seed)
     if args.plant is not None and sample:
         device = with_sample(device, config, args.plant, params, args.unit_key, sample,
                              seeds[0] if seeds else 0)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from tsmd.compensation.fresh_play import fresh_branches
 from tsmd.compensation.grid import ParameterField
 from tsmd.compensation.knee_map import moved_grid, moved_knee
+from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid, curved, steepest_slope
 from tsmd.compensation.release_round import reference_backlash_deg, shifted_zero_load_deg
 from tsmd.compensation.shaped_play import model_branches
@@ -58,6 +59,10 @@ class OursKnob:
     backlashes at a 90 deg reversal; 0: the sharp corner (fresh tables stay sharp)."""
     release_shift: float = 0.0
     """How much later the release lines lie, in the same backlashes."""
+    level_grid: LevelGrid | None = None
+    """The product's shift of each side's plateau height over the other knob's angle
+    (:mod:`tsmd.compensation.level_grid`); None: the heights at every angle (fresh tables
+    keep them)."""
     _table: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
     _fresh: tuple[tuple[Branches, ...], ...] = dataclasses.field(init=False, repr=False,
                                                                  compare=False)
@@ -87,6 +92,9 @@ class OursKnob:
     def _row_branches(self, r: list[float], other_deg: float) -> Branches:
         """One table row's branches, the release rounded and shifted where the product says."""
         w, h_pos, h_neg = self.omega, self.height_pos_deg, self.height_neg_deg
+        if self.level_grid is not None:
+            shift_pos, shift_neg = self.level_grid.at(other_deg)
+            h_pos, h_neg = h_pos + shift_pos, h_neg + shift_neg
         x0_pos, x0_neg = r[4], r[5]
         if self.release_shift != 0.0:
             x0_pos = shifted_zero_load_deg(r[2], r[4], self.release_shift, 1)
@@ -115,7 +123,7 @@ class OursKnob:
                    # the profile's fresh numbers come together from one first sweep
                    p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None,
                    curved(shape_pos), curved(shape_neg), p.other_tip_gain, grid,
-                   p.release_round, p.release_shift)
+                   p.release_round, p.release_shift, p.level_grid)
 
     def shapes_at(self, other_deg: float) -> tuple[LoadedShape | None, LoadedShape | None]:
         """The templates (positive, negative side) at the other knob's angle."""

@@ -30,6 +30,11 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.compensation.level_grid import (
+    LevelGrid,
+    level_grid_from_mapping,
+    level_grid_to_mapping,
+)
 from tsmd.compensation.loaded_shape import (
     LoadedShape,
     ShapeGrid,
@@ -81,6 +86,8 @@ class TensionPlayParams:
     (:mod:`tsmd.compensation.knee_map`); otherwise the templates as they are.
     ``release_round`` / ``release_shift``: the product's rounded release (data sheet,
     :mod:`tsmd.compensation.release_round`), in backlashes at a 90 deg reversal; 0: sharp.
+    ``level_grid``: the product's shift of each side's plateau height over the other knob's
+    angle (data sheet, :mod:`tsmd.compensation.level_grid`); None: H at every angle.
     """
 
     omega: float
@@ -105,6 +112,7 @@ class TensionPlayParams:
     sheet_loaded_knee_deg: tuple[float, float] | None = None
     release_round: float = 0.0
     release_shift: float = 0.0
+    level_grid: LevelGrid | None = None
 
     def columns(self) -> NDArray[np.float64]:
         """(n, 6): D_pos, D_neg, beta_pos, beta_neg, x0_pos, x0_neg per grid point."""
@@ -130,6 +138,7 @@ _WRITTEN_IF_SET = {"fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain", "
                    "release_shift"}
 _SHAPES = {"loaded_shape_pos": "shape_pos", "loaded_shape_neg": "shape_neg"}
 _SHAPE_GRID = "loaded_shape_grid"
+_LEVEL_GRID = "loaded_level_grid"
 _KNEES = ("loaded_knee_deg", "loaded_knee_u95_deg", "sheet_loaded_knee_deg")
 """Optional pairs (positive, negative side), written only when set."""
 
@@ -155,11 +164,11 @@ def _numbers(values: Any, name: str, n: int | None, lo: float, hi: float) -> tup
 
 def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
     """Validate a profile's ``tension_play`` block (ValueError naming the key)."""
-    known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES, _SHAPE_GRID, *_KNEES}
+    known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES, _SHAPE_GRID, _LEVEL_GRID, *_KNEES}
     for key in m:
         if key not in known:
             raise ValueError(f"{key}: unknown key")
-    for key in known - _OPTIONAL - set(_SHAPES) - {_SHAPE_GRID} - set(_KNEES):
+    for key in known - _OPTIONAL - set(_SHAPES) - {_SHAPE_GRID, _LEVEL_GRID} - set(_KNEES):
         if key not in m:
             raise ValueError(f"{key}: missing key")
     grid = _numbers(m["other_knob_deg"], "other_knob_deg", None, -180.0, 180.0)
@@ -177,7 +186,9 @@ def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
         s["fresh_edge_delay_deg"], pos_shape, neg_shape, other_tip_gain=s["other_tip_gain"],
         shape_grid=(shape_grid_from_mapping(m[_SHAPE_GRID], _SHAPE_GRID)
                     if m.get(_SHAPE_GRID) is not None else None),
-        release_round=s["release_round"], release_shift=s["release_shift"], **knees)
+        release_round=s["release_round"], release_shift=s["release_shift"],
+        level_grid=(level_grid_from_mapping(m[_LEVEL_GRID], _LEVEL_GRID)
+                    if m.get(_LEVEL_GRID) is not None else None), **knees)
 
 
 def _knee_pair(values: Any, name: str) -> tuple[float, float]:
@@ -196,6 +207,8 @@ def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
             out[key] = shape_to_mapping(shape)
     if p.shape_grid is not None:
         out[_SHAPE_GRID] = shape_grid_to_mapping(*p.shape_grid)
+    if p.level_grid is not None:
+        out[_LEVEL_GRID] = level_grid_to_mapping(p.level_grid)
     for key in _KNEES:
         pair = getattr(p, key)
         if pair is not None:

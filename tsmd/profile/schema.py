@@ -11,6 +11,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from tsmd.compensation.grid import INTERPOLATION_METHODS
+from tsmd.compensation.level_grid import level_grid_from_mapping, level_grid_to_mapping
 from tsmd.compensation.loaded_shape import (
     shape_from_mapping,
     shape_grid_from_mapping,
@@ -216,7 +217,9 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)
                for name in _SHAPE_KEYS},
             loaded_shape_grid=_nested(r, k.get("loaded_shape_grid"),
-                                      f"{key}.loaded_shape_grid", shape_grid_from_mapping)))
+                                      f"{key}.loaded_shape_grid", shape_grid_from_mapping),
+            loaded_level_grid=_nested(r, k.get("loaded_level_grid"),
+                                      f"{key}.loaded_level_grid", level_grid_from_mapping)))
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version, *bend)
@@ -264,6 +267,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
                 knobs[name][key] = shape_to_mapping(shape)
         if k.loaded_shape_grid is not None:
             knobs[name]["loaded_shape_grid"] = shape_grid_to_mapping(*k.loaded_shape_grid)
+        if k.loaded_level_grid is not None:
+            knobs[name]["loaded_level_grid"] = level_grid_to_mapping(k.loaded_level_grid)
         for key in _RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS + _ROUND_KEYS:
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tsmd.compensation.grid import CALIBRATION_GRID_DEG
+from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.safety import KnobLimits
@@ -224,6 +225,12 @@ class DeviceKnob:
     release_shift: float | None = None
     """Optional, with ``release_round``: how much later the tip's release line lies than the
     current's backlash end, in the same backlashes. None: 0."""
+    loaded_level_grid: LevelGrid | None = None
+    """Optional, tracked on the data-sheet unit (``tsmd datasheet --level-grid``, session 21):
+    each side's shift of its plateau height over the other knob's angle, where the other
+    plane's bend moves the tip's flats and loaded branches inward (a spine both planes share;
+    :mod:`tsmd.compensation.level_grid`); calibration copies it into each unit's profile.
+    None: the heights at every angle."""
 
 
 @dataclass(frozen=True)

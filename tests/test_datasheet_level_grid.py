@@ -1,0 +1,70 @@
+"""The product's loaded level over the other knob's angle, read on the sheet's unit
+(tsmd.datasheet_level_grid)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from tsmd.bench.error_split import model_parts
+from tsmd.compensation.level_grid import LevelGrid
+from tsmd.compensation.tension_play import TensionPlayParams
+from tsmd.datasheet_level_grid import MIN_LEVEL_SHIFT_DEG, TrackedSweep, level_grid
+
+ANGLES = (-60.0, 0.0, 60.0)
+
+
+def tension() -> TensionPlayParams:
+    return TensionPlayParams(1.3, -2.0, 2.0, ANGLES, (20.0,) * 3, (-20.0,) * 3, (0.1,) * 3,
+                             (0.1,) * 3, (-60.0,) * 3, (60.0,) * 3)
+
+
+def sweeps_of(truth: TensionPlayParams) -> list[tuple[float, TrackedSweep]]:
+    """Two +-90 deg sweeps per angle, the other knob held there, the tip as ``truth`` says."""
+    t = np.arange(0.0, 50.0, 0.02)
+    x = -90.0 * np.cos(2 * np.pi * 0.04 * t)
+    out = []
+    for other in ANGLES:
+        held = np.full_like(x, other)
+        tip, _ = model_parts(x, held, truth, 0.0)
+        out += [(other, TrackedSweep(x, held, tip))] * 2
+    return out
+
+
+def test_the_grid_finds_the_level_the_tip_stands_at() -> None:
+    shifted = LevelGrid(ANGLES, (-2.0, 0.0, -3.0), (2.5, 0.0, 1.5))
+    found = level_grid(sweeps_of(dataclasses.replace(tension(), level_grid=shifted)), tension())
+    assert found is not None
+    assert found.other_knob_deg == ANGLES
+    assert found.pos_deg == pytest.approx(shifted.pos_deg, abs=0.3)
+    assert found.neg_deg == pytest.approx(shifted.neg_deg, abs=0.3)
+
+
+def test_a_tip_on_the_model_gives_no_grid() -> None:
+    assert level_grid(sweeps_of(tension()), tension()) is None
+
+
+def test_a_shift_below_the_threshold_is_none() -> None:
+    small = 0.5 * MIN_LEVEL_SHIFT_DEG
+    shifted = LevelGrid(ANGLES, (-small, 0.0, -3.0), (small, 0.0, 1.5))
+    found = level_grid(sweeps_of(dataclasses.replace(tension(), level_grid=shifted)), tension())
+    assert found is not None
+    assert (found.pos_deg[0], found.neg_deg[0]) == (0.0, 0.0)
+
+
+def test_without_a_sweep_at_the_other_knobs_zero_there_is_no_grid() -> None:
+    shifted = LevelGrid(ANGLES, (-2.0, 0.0, -3.0), (2.5, 0.0, 1.5))
+    sweeps = [s for s in sweeps_of(dataclasses.replace(tension(), level_grid=shifted))
+              if s[0] != 0.0]
+    assert level_grid(sweeps, tension()) is None
+
+
+def test_an_angle_where_the_profile_is_mis_read_is_left_out() -> None:
+    shifted = LevelGrid(ANGLES, (-2.0, 0.0, -3.0), (2.5, 0.0, 1.5))
+    misread = dataclasses.replace(tension(), dead_zone_pos_deg=(1.0, 20.0, 20.0))
+    found = level_grid(sweeps_of(dataclasses.replace(tension(), level_grid=shifted)), misread)
+    assert found is not None
+    assert found.other_knob_deg == (0.0, 60.0)
+    assert found.pos_deg == pytest.approx((0.0, -3.0), abs=0.3)

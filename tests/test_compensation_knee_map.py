@@ -16,7 +16,7 @@ from tsmd.calibration.loaded_knee import read_loaded_knee
 from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.compensation.knee_map import KNEE_RATIO_RANGE, moved_knee
 from tsmd.compensation.loaded_shape import LoadedShape
-from tsmd.compensation.tension_play import tension_play_from_mapping, tension_play_to_mapping
+from tsmd.compensation.tension_play_params import tension_play_from_mapping, tension_play_to_mapping
 from tsmd.profile import load_device_model, save_device_model
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 from tsmd.profile.types import DeviceModel

@@ -14,12 +14,10 @@ from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.compensation.level_grid import LevelGrid, level_grid_from_mapping, level_grid_to_mapping
 from tsmd.compensation.ours_table import OursKnob
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import (
+from tsmd.compensation.tension_play import inverse_step, model_step, rest_state
+from tsmd.compensation.tension_play_params import (
     BETA_RANGE,
     TensionPlayParams,
-    inverse_step,
-    model_step,
-    rest_state,
     tension_play_from_mapping,
     tension_play_to_mapping,
 )

@@ -21,13 +21,10 @@ from tsmd.compensation.ours import OursCompensator
 from tsmd.compensation.ours_table import ours_knobs
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.shaped_play import shaped_branches
-from tsmd.compensation.tension_play import (
+from tsmd.compensation.tension_play import Branches, PlayState, inverse_step, model_step
+from tsmd.compensation.tension_play_params import (
     BETA_RANGE,
-    Branches,
-    PlayState,
     TensionPlayParams,
-    inverse_step,
-    model_step,
     tension_play_from_mapping,
     tension_play_to_mapping,
 )

@@ -15,16 +15,15 @@ from tsmd.compensation.ours import OursCompensator
 from tsmd.compensation.ours_table import MOVES_WITH_EDGE, OursKnob, ours_knobs
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
-    BETA_RANGE,
     Branches,
     PlayState,
-    TensionPlayParams,
     branches,
     inverse_step,
     model_step,
     release_line,
     rest_state,
 )
+from tsmd.compensation.tension_play_params import BETA_RANGE, TensionPlayParams
 
 PERIOD_S = 0.004
 LIMITS = KnobLimits(-90.0, 90.0, 120.0, 2000.0)

@@ -13,7 +13,7 @@ from support.profiles import DEVICE
 
 from tsmd.compensation.ours import OursCompensator
 from tsmd.compensation.ours_table import ours_knobs
-from tsmd.compensation.tension_play import (
+from tsmd.compensation.tension_play_params import (
     TensionPlayParams,
     tension_play_from_mapping,
     tension_play_to_mapping,

@@ -15,7 +15,7 @@ from tsmd.compensation.ours import OursCompensator
 from tsmd.compensation.ours_knob import KnobCommand, motion
 from tsmd.compensation.ours_table import ours_knobs
 from tsmd.compensation.safety import MAX_TICK_PERIODS, KnobLimiter, KnobLimits, tick_time_s
-from tsmd.compensation.tension_play import TensionPlayParams
+from tsmd.compensation.tension_play_params import TensionPlayParams
 
 
 def commands_at_times(q_of_t: object, late_every: int, duration_s: float,

@@ -12,11 +12,9 @@ from tsmd.compensation.fresh_play import fresh_branches
 from tsmd.compensation.ours import OursCompensator
 from tsmd.compensation.ours_table import ours_knobs
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import (
-    PlayState,
+from tsmd.compensation.tension_play import PlayState, branches, model_step
+from tsmd.compensation.tension_play_params import (
     TensionPlayParams,
-    branches,
-    model_step,
     tension_play_from_mapping,
     tension_play_to_mapping,
 )

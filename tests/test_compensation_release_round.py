@@ -15,14 +15,10 @@ from tsmd.compensation.release_round import (
     rounded_drop_deg,
     rounded_gap_deg,
 )
-from tsmd.compensation.tension_play import (
+from tsmd.compensation.tension_play import Branches, PlayState, inverse_step, model_step, rest_state
+from tsmd.compensation.tension_play_params import (
     BETA_RANGE,
-    Branches,
-    PlayState,
     TensionPlayParams,
-    inverse_step,
-    model_step,
-    rest_state,
     tension_play_from_mapping,
     tension_play_to_mapping,
 )

@@ -14,7 +14,7 @@ from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid, shape_grid_from_mapping
 from tsmd.compensation.ours import OursCompensator
 from tsmd.compensation.ours_table import ours_knobs
-from tsmd.compensation.tension_play import (
+from tsmd.compensation.tension_play_params import (
     TensionPlayParams,
     tension_play_from_mapping,
     tension_play_to_mapping,

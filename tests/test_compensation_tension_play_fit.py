@@ -24,10 +24,10 @@ from tsmd.calibration.unit_slope import unit_omega
 from tsmd.compensation import CompensationError, build_compensator
 from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import (
+from tsmd.compensation.tension_play import release_line
+from tsmd.compensation.tension_play_params import (
     BETA_RANGE,
     TensionPlayParams,
-    release_line,
     tension_play_from_mapping,
     tension_play_to_mapping,
 )

@@ -10,7 +10,7 @@ import pytest
 
 from tsmd.bench.error_split import model_parts
 from tsmd.compensation.level_grid import LevelGrid
-from tsmd.compensation.tension_play import TensionPlayParams
+from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.datasheet_level_grid import MIN_LEVEL_SHIFT_DEG, TrackedSweep, level_grid
 
 ANGLES = (-60.0, 0.0, 60.0)

@@ -7,7 +7,7 @@ import pytest
 
 from tsmd.calibration.identify import split_half_cycles
 from tsmd.compensation.release_round import reference_backlash_deg
-from tsmd.compensation.tension_play import TensionPlayParams
+from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.datasheet_release_round import fit_release_round, release_drop_deg, worth_a_field
 
 RATE_HZ = 50.0

@@ -29,7 +29,7 @@ from tsmd.bench.error_split import model_parts
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.run import run_calibration
 from tsmd.compensation.level_grid import LevelGrid
-from tsmd.compensation.tension_play import TensionPlayParams
+from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.errors import TsmdError
 from tsmd.profile import DeviceModel

@@ -30,7 +30,8 @@ from tsmd.calibration.identify import split_half_cycles
 from tsmd.calibration.run import run_calibration
 from tsmd.calibration.signal import lowpass
 from tsmd.compensation.release_round import reference_backlash_deg
-from tsmd.compensation.tension_play import TensionPlayParams, release_slope
+from tsmd.compensation.tension_play import release_slope
+from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.errors import TsmdError
 from tsmd.profile import DeviceModel

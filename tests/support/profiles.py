@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from tsmd.compensation.tension_play import TensionPlayParams
+from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.profile import (
     CatheterProfile,
     KnobProfile,

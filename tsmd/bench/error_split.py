@@ -25,7 +25,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from tsmd.compensation.ours_table import ours_knobs
-from tsmd.compensation.tension_play import PlayState, TensionPlayParams, model_step
+from tsmd.compensation.tension_play import PlayState, model_step
+from tsmd.compensation.tension_play_params import TensionPlayParams
 
 FloatArray = NDArray[np.float64]
 PARTS: tuple[str, ...] = ("loaded", "release", "plateau", "backlash")

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from tsmd.compensation.tension_play import BETA_RANGE
+from tsmd.compensation.tension_play_params import BETA_RANGE
 
 FAR_ZERO_LOAD_DEG = 89.0
 """A moved zero-load point stays within +-this (the profile keeps x0 within +-90 deg)."""

@@ -63,7 +63,7 @@ from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.unit_slope import GainReading, gain_scatter, weighed_omega
 from tsmd.compensation.loaded_shape import curved, shaped_height
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
-from tsmd.compensation.tension_play import BETA_RANGE, TensionPlayParams
+from tsmd.compensation.tension_play_params import BETA_RANGE, TensionPlayParams
 
 FloatArray = NDArray[np.float64]
 RAMP_START_DEG = 10.0

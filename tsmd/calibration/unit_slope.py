@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tsmd.compensation.tension_play import OMEGA_RANGE
+from tsmd.compensation.tension_play_params import OMEGA_RANGE
 
 PRODUCT_SLOPE_SCATTER = 0.10
 """A unit's loaded slope against the data sheet's, relative: about this much (tip chords of the

@@ -17,7 +17,8 @@ from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid, curved, steepest_slope
 from tsmd.compensation.release_round import reference_backlash_deg, shifted_zero_load_deg
 from tsmd.compensation.shaped_play import model_branches
-from tsmd.compensation.tension_play import Branches, TensionPlayParams, release_slope
+from tsmd.compensation.tension_play import Branches, release_slope
+from tsmd.compensation.tension_play_params import TensionPlayParams
 
 OURS_COLUMNS: tuple[str, ...] = ("dead_zone_pos_deg", "dead_zone_neg_deg", "backlash_gain_pos",
                                  "backlash_gain_neg", "zero_load_pos_deg", "zero_load_neg_deg")

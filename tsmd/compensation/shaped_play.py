@@ -8,13 +8,8 @@
 from __future__ import annotations
 
 from tsmd.compensation.loaded_shape import LoadedShape, curved
-from tsmd.compensation.tension_play import (
-    _FAR_DEG,
-    BETA_RANGE,
-    Branches,
-    branches,
-    envelopes,
-)
+from tsmd.compensation.tension_play import _FAR_DEG, Branches, branches, envelopes
+from tsmd.compensation.tension_play_params import BETA_RANGE
 
 _STRAIGHT = LoadedShape((0.0, 1.0), (0.0, 1.0))
 

@@ -19,7 +19,7 @@ import numpy as np
 from tsmd.calibration.unit_slope import unit_omega
 from tsmd.compensation.ours_table import MOVES_WITH_EDGE, OursKnob
 from tsmd.compensation.paper import PaperKnob
-from tsmd.compensation.tension_play import BETA_RANGE
+from tsmd.compensation.tension_play_params import BETA_RANGE
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, KnobProfile, ReferencePoint, save_profile
 

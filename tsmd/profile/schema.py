@@ -20,7 +20,7 @@ from tsmd.compensation.loaded_shape import (
 )
 from tsmd.compensation.release_round import RELEASE_ROUND_RANGE, RELEASE_SHIFT_RANGE
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import (
+from tsmd.compensation.tension_play_params import (
     OTHER_TIP_GAIN_RANGE,
     tension_play_from_mapping,
     tension_play_to_mapping,

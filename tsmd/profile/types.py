@@ -14,7 +14,7 @@ from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import TensionPlayParams
+from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.errors import TsmdError
 from tsmd.profile.reading_offset import ReadingOffset
 

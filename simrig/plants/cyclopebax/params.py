@@ -46,8 +46,8 @@ class CycloPebaxKnob:
     """Knob turns per drum turn (a single-stage cycloidal reducer: ratio = lobes / (lobes - 1)
     is usually 10-80; the adapter's is a low-ratio two-disc stage, design constant)."""
     lost_motion_deg: float = 5.0
-    """Knob-side lost motion of the reducer (pin-roller clearance: cycloidal drives are sold at
-    1-3 arcmin output, moulded adapter stages at 0.5-1.5 deg output)."""
+    """Knob-side lost motion of the reducer (pin-roller clearance: machined cycloidal drives are
+    sold at 1-3 arcmin output, moulded adapter stages at 0.5-2 deg output; 5 deg here is 1.7)."""
     mesh_twist_deg: float = 0.8
     """Knob-side twist of the pin contacts at ``mesh_ref_torque_Nm`` (Hertzian: twist ~ T^2/3)."""
     mesh_ref_torque_Nm: float = 0.2
@@ -56,7 +56,7 @@ class CycloPebaxKnob:
     while back-driven (cycloidal efficiency 0.8-0.9 at low ratio, lower back-driving)."""
     mesh_presliding_deg: float = 0.3
     drum_radius_mm: float = 21.0
-    """Tendon drum on the reducer's output (effective radius at the knob: 6 mm)."""
+    """Tendon drum on the reducer's output (effective radius at the knob: 7 mm)."""
     drum_friction_Nmm: float = 5.0
     """Drum bushing: holds the drum inside the reducer's clearance when no tendon pulls."""
     handle_friction_Nm: float = 0.02
@@ -65,14 +65,16 @@ class CycloPebaxKnob:
     slack_pos_mm: float = 3.0
     slack_neg_mm: float = 3.0
     tendon_stiffness_N: float = 9000.0
-    """EA of a 0.45 mm 7x7 steel rope (about 0.1 mm^2 metallic area x 190 GPa x lay factor)."""
+    """EA of a 0.36 mm 7x7 steel rope (about 0.065 mm^2 metallic area x 190 GPa x lay
+    factor 0.75)."""
     free_length_m: float = 0.12
     sheath_length_m: float = 1.0
     bend_length_mm: float = 70.0
     sheath_wrap_deg: float = 150.0
     """Accumulated curvature of the shaft's path to the heart (a TEE/ICE route: 90-270 deg)."""
     sheath_friction: float = 0.28
-    """Mean of the two sliding directions (steel rope on a PTFE-lined coil: 0.05-0.15)."""
+    """Mean of the two sliding directions (steel rope in a bare steel coil with little
+    lubricant: 0.2-0.35; a PTFE-lined lumen would be 0.05-0.15)."""
     lay_asymmetry: float = 0.25
     """Friction is (1 + a) x the mean when the rope is drawn in against its lay, (1 - a) x when
     it pays out (a right-hand-lay rope in a right-hand coil: the strands ride the coil's turns
@@ -84,8 +86,8 @@ class CycloPebaxKnob:
     bend_stiffness_Nmm_per_rad: float = 30.0
     """Small-bend stiffness of the whole section (three zones in series)."""
     yield_tension_N: float = 15.0
-    """Tension at which the rope starts to take a permanent set (its crimp seats, strands bed
-    in: wire ropes set 0.1-0.5 % of length at 30-60 % of break, 0.45 mm 7x7 breaks at ~180 N)."""
+    """Tension at which the rope starts to take a permanent set (the crimp seats on the rope,
+    the strands bed in: from 10-20 % of break; a 0.36 mm 7x7 rope breaks at ~110 N)."""
     set_hardening_N_per_mm: float = 40.0
     """Rise of that tension per mm of set already taken (the rope beds in, then holds)."""
 

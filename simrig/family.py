@@ -18,7 +18,8 @@ now, the helixbelt plant (session 15, written blind) is held out now, the ratest
 (session 16, written blind) is held out now, the warmgear plant (session 18, written blind) is
 held out now, the archwave plant (session 19, written blind) is held out now (tuned on its
 development units in session 20), the jawcrimp plant (session 20, written blind, run untuned, then
-tuned on its development units in the same session's second round) is held out (``PLANT_ROLE``).
+tuned on its development units in the same session's second round) is held out, the cyclopebax
+plant (session 21, written blind, run untuned) is the blind plant (``PLANT_ROLE``).
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -37,6 +38,7 @@ from simrig.plant import Plant, PlantLoadError, load_plant
 from simrig.plants.archwave import NOMINAL_KNOBS as ARCHWAVE_KNOBS
 from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
 from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
+from simrig.plants.cyclopebax import NOMINAL_KNOBS as CYCLOPEBAX_KNOBS
 from simrig.plants.helixbelt import NOMINAL_KNOBS as HELIXBELT_KNOBS
 from simrig.plants.jawcrimp import NOMINAL_KNOBS as JAWCRIMP_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
@@ -62,13 +64,14 @@ PLANT_SPECS: dict[str, str] = {
     "ratestate": "simrig.plants.ratestate:make_ratestate_plant",
     "warmgear": "simrig.plants.warmgear:make_warmgear_plant",
     "archwave": "simrig.plants.archwave:make_archwave_plant",
-    "jawcrimp": "simrig.plants.jawcrimp:make_jawcrimp_plant",  # last: the others' seeds hold
+    "jawcrimp": "simrig.plants.jawcrimp:make_jawcrimp_plant",
+    "cyclopebax": "simrig.plants.cyclopebax:make_cyclopebax_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
-              "jawcrimp": "held-out"}
+              "jawcrimp": "held-out", "cyclopebax": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -85,7 +88,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "ratestate": RATESTATE_KNOBS,
                                         "warmgear": WARMGEAR_KNOBS,
                                         "archwave": ARCHWAVE_KNOBS,
-                                        "jawcrimp": JAWCRIMP_KNOBS}
+                                        "jawcrimp": JAWCRIMP_KNOBS,
+                                        "cyclopebax": CYCLOPEBAX_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -152,6 +156,8 @@ VARIANTS: dict[str, Variant] = {
                          "handle_friction_Nm": 1.5, "wave_drag_Nm": 1.5},
             "jawcrimp": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                          "handle_friction_Nm": 1.5, "idler_friction": 1.5},
+            "cyclopebax": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                           "handle_friction_Nm": 1.5, "mesh_friction": 1.3},
         },
     ),
     "steel-tendon": Variant(
@@ -178,7 +184,8 @@ VARIANTS: dict[str, Variant] = {
                  "ratestate": {"tendon_stiffness_N": 0.4},
                  "warmgear": {"tendon_stiffness_N": 0.4},
                  "archwave": {"tendon_stiffness_N": 0.4},
-                 "jawcrimp": {"tendon_stiffness_N": 0.4}},
+                 "jawcrimp": {"tendon_stiffness_N": 0.4},
+                 "cyclopebax": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

@@ -14,7 +14,7 @@ contrast a small effect model fitted on the other configuration removes.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -22,7 +22,14 @@ from scipy import stats
 
 from tsmd.gap.compliance import sheet_from_units
 from tsmd.gap.data import GapSeries
-from tsmd.gap.dwell import CREEP_CHANNELS, Drift, drift_shrink, drift_size, drift_stat, dwell_slope
+from tsmd.gap.dwell import (
+    CREEP_CHANNELS,
+    RELAX_CHANNELS,
+    Drift,
+    creep_reading,
+    dwell_slope,
+    tip_relaxation,
+)
 from tsmd.gap.loops import (
     Loops,
     Triple,
@@ -64,7 +71,7 @@ they are still scored and shown, but not named."""
 CONDITIONS: dict[str, str] = {
     "rate": "the same loops at two speeds (matched segments)",
     "coupling": "the same loop with the other knob held at -, 0, + (matched segments)",
-    "creep": "current drift in loaded against unloaded dwells",
+    "creep": "current drift and tip relaxing in loaded against unloaded dwells",
     "curvature": "the same loops in two sheath configurations (matched segments)",
 }
 
@@ -82,6 +89,8 @@ class TestData:
     dwells: dict[tuple[str, int], tuple[FloatArray, FloatArray]]
     currents: dict[tuple[str, int], list[Triple | None]]
     """The same loops' currents (knob, residual, measured current)."""
+    dwell_sign: dict[tuple[str, int], tuple[float, float]] = field(default_factory=dict)
+    """Per dwell the sign of each knob's mean angle (the side a loaded dwell loads)."""
 
 
 def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray],
@@ -107,6 +116,7 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
     out = []
     crit = family_alpha / max(n_tried, 1)
     for test, name in DECIDES.items():
+        tip_size = float("nan")
         if test == "curvature":
             loops = [lp for lp in (_across_configs([d[t] for d in by_config.values() if t in d])
                                    for t in ("rate", "coupling")) if lp is not None]
@@ -121,10 +131,9 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
                                   for c in by_config if test in by_config[c]) if d.diff.size]
             if not drifts:
                 continue
-            _, _, p = drift_stat(drifts)
-            shrinks = [drift_shrink(drifts[:i] + drifts[i + 1:], drifts[i])
-                       for i in range(len(drifts))]
-            size = drift_size(drifts)
+            creep = creep_reading(drifts, current_noise_A, tip_noise_deg, crit)
+            p, shrinks = creep.p, creep.shrinks
+            size, tip_size = creep.current_size_A, creep.tip_size_deg
         else:
             ref = reference.loops.get(test) if reference is not None else None
             found = [_loops_beyond(by_config[c][test], meas_config.get(c, {}).get(test), ref)
@@ -141,11 +150,13 @@ def contrast_scores(series: Sequence[GapSeries], residuals: Sequence[FloatArray]
         lo_hi = (min(finite), max(finite)) if finite else (float("nan"), float("nan"))
         title, _ = SIGNATURES[name]
         noise = current_noise_A if test == "creep" else tip_noise_deg
-        material = not (np.isfinite(size) and noise is not None) or size >= noise
+        material = (creep.material if test == "creep"
+                    else not (np.isfinite(size) and noise is not None) or size >= noise)
         sig = bool(p < crit and finite and share >= min_share and material)
         condition = CONDITIONS[test]
         if np.isfinite(size) and test == "creep":
-            condition += f"; {1e3 * size:.1f} mA over a loaded dwell above the slopes' noise"
+            condition += (f"; {1e3 * size:.1f} mA and {tip_size:.3f} deg over a loaded dwell "
+                          "above the slopes' noise")
         elif np.isfinite(size):
             condition += f"; contrast {size:.3f} deg above the repeats' noise"
         score = SignatureScore(name, title, condition, share, lo_hi, sig, share, 0.0, _z(p),
@@ -329,6 +340,8 @@ def _collect(s: GapSeries, res: FloatArray, tests: dict[str, TestData]) -> None:
         key = (seg.level, seg.rep)
         if seg.test == "creep":
             data.dwells[key] = (s.t_s[rows], res[rows])
+            sides = np.sign(s.knob_deg[rows].mean(axis=0))
+            data.dwell_sign[key] = (float(sides[0]), float(sides[1]))
             continue
         knobs = (0, 1) if seg.knob < 0 else (seg.knob,)
         windows: list[Triple | None] = [(s.knob_deg[rows, j], res[rows, j], s.tip_deg[rows, j])
@@ -343,7 +356,8 @@ def _collect(s: GapSeries, res: FloatArray, tests: dict[str, TestData]) -> None:
 
 
 def _drift(data: TestData) -> Drift:
-    """Loaded-minus-unloaded dwell slopes per repeat and current channel."""
+    """Loaded-minus-unloaded dwell slopes per repeat and current channel, then each tip's
+    relaxation toward its unloaded position (:func:`tsmd.gap.dwell.tip_relaxation`)."""
     diffs, vars_, spans = [], [], []
     for rep in sorted({r for _, r in data.dwells}):
         loaded, unloaded = data.dwells.get(("loaded", rep)), data.dwells.get(("unloaded", rep))
@@ -356,6 +370,11 @@ def _drift(data: TestData) -> Drift:
             su, vu = dwell_slope(tu, yu[:, ch])
             row_d.append(sl - su)
             row_v.append(vl + vu)
+        signs = data.dwell_sign.get(("loaded", rep), (0.0, 0.0))
+        for ch, sign in zip(RELAX_CHANNELS, signs, strict=True):
+            relax, var = tip_relaxation(tl, yl[:, ch], tu, yu[:, ch], sign)
+            row_d.append(relax)
+            row_v.append(var)
         diffs.append(row_d)
         vars_.append(row_v)
         spans.append(float(tl[-1] - tl[0]))

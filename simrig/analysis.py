@@ -5,7 +5,8 @@ plant parameters, so they measure what a catheter actually does. Definitions fol
 piecewise-linear model (see ``docs/plant.md``):
 
 - ``dead_zone_pos_deg`` (``D_pos``): on a rising pass, the knob angle at which the tip leaves the
-  dead-zone plateau upwards (rises more than ``threshold_deg`` above the plateau level).
+  dead-zone plateau upwards (rises more than ``threshold_deg`` above the line the plateau
+  follows: flat on a still plateau, sloped on one the tip creeps along).
 - ``dead_zone_neg_deg`` (``D_neg``, signed, normally negative): the same on a falling pass.
 - ``backlash_pos_deg`` (``B_pos``): knob travel after a reversal at the positive extreme before the
   tip has moved back by ``threshold_deg``.
@@ -73,9 +74,8 @@ def _rising_pass_measures(q: FloatArray, tip: FloatArray, thr: float) -> tuple[f
     i_left = int(left[0])
     backlash = float(q[i_left] - q[0])
     # Dead-zone plateau: the stretch from which the knob must travel farthest before the tip
-    # rises by the threshold. Its level is the median tip over the middle of that stretch (so a
-    # start just below the plateau cannot bias it); the dead zone ends where the tip rises the
-    # threshold above that level.
+    # rises by the threshold. The dead zone ends where the tip has risen the threshold above
+    # the line the plateau follows (see _plateau_line), searched from the stretch's middle.
     qs = q[i_left:]
     cm = rising_max[i_left:]
     ts = tip[i_left:]
@@ -85,14 +85,32 @@ def _rising_pass_measures(q: FloatArray, tip: FloatArray, thr: float) -> tuple[f
         return backlash, float("nan")
     travel = np.where(valid, qs[np.minimum(j, qs.size - 1)] - qs, -np.inf)
     i_best = int(np.argmax(travel))
-    q_a, q_b = qs[i_best], qs[j[i_best]]
-    middle = (qs >= q_a + 0.25 * (q_b - q_a)) & (qs <= q_a + 0.75 * (q_b - q_a))
-    level = float(np.median(ts[middle])) if np.any(middle) else float(ts[i_best])
+    q_a, q_b = float(qs[i_best]), float(qs[j[i_best]])
+    slope, level = _plateau_line(qs, ts, q_a, q_b)
     mid = int(np.searchsorted(qs, 0.5 * (q_a + q_b)))
-    above = np.flatnonzero(cm[mid:] > level + thr)
+    off_line = ts[mid:] - (level + slope * (qs[mid:] - 0.5 * (q_a + q_b)))
+    above = np.flatnonzero(off_line > thr)
     if above.size == 0:
         return backlash, float("nan")
     return backlash, float(qs[mid + above[0]])
+
+
+def _plateau_line(qs: FloatArray, ts: FloatArray, q_a: float, q_b: float) -> tuple[float, float]:
+    """(slope, level at the stretch's middle) of the line the tip follows along the plateau
+    stretch ``q_a..q_b``: a least-squares line over the stretch's middle half (so neither a
+    start just below the plateau nor the rise at its end biases it). The tip "starts to move"
+    where it leaves this line: a tip creeping along its plateau (a coil settling, a sheath
+    sliding) is not yet pulled by the tendon, and measured against a flat median level it would
+    cross the threshold mid-plateau (session 20: 10-17 deg early beyond ~0.07 deg/deg). A flat
+    plateau gives a flat line, so its reading is the median level's. Too few samples: flat, at
+    the median of the stretch."""
+    middle = (qs >= q_a + 0.25 * (q_b - q_a)) & (qs <= q_a + 0.75 * (q_b - q_a))
+    q_mid = 0.5 * (q_a + q_b)
+    if np.count_nonzero(middle) >= 3 and np.ptp(qs[middle]) > 0.0:
+        slope, level = np.polyfit(qs[middle] - q_mid, ts[middle], 1)
+        return float(slope), float(level)
+    stretch = (qs >= q_a) & (qs <= q_b)
+    return 0.0, float(np.median(ts[stretch]))
 
 
 def measure_dead_zone_backlash(

@@ -129,13 +129,59 @@ def test_lines_read_the_corners_of_the_paper_lines_where_release_and_load_differ
     assert m.backlash_neg_deg == pytest.approx(16.0, abs=0.3)
 
 
-def test_a_tip_creeping_along_the_plateau_moves_the_threshold_edge_but_not_the_lines() -> None:
+def test_a_tip_creeping_along_the_plateau_is_read_where_it_leaves_the_plateau() -> None:
+    # 2.5 deg of creep over a ~50 deg plateau (0.05 deg/deg): against the plateau's median
+    # level the 1 deg threshold fired > 3 deg early; against its line it fires where the tip
+    # has risen 1 deg off the plateau's line (1 / 1.1 deg of knob past the corner).
     q, tip = paper_lines_sweep(backlash_deg=16.0, dead_deg=18.0, release=1.6, loaded=1.1,
                                plateau_creep_deg=2.5)
     by_threshold = measure_dead_zone_backlash(q, tip, threshold_deg=1.0)
-    by_lines = measure_by_lines(q, tip)
-    assert abs(by_threshold.dead_zone_pos_deg - 18.0) > 3.0
-    assert by_lines.dead_zone_pos_deg == pytest.approx(18.0, abs=0.3)
+    assert by_threshold.dead_zone_pos_deg == pytest.approx(18.0 + 1.0 / 1.1, abs=0.3)
+    assert by_threshold.dead_zone_neg_deg == pytest.approx(-18.0 - 1.0 / 1.1, abs=0.3)
+
+
+def creeping_plateau_sweep(creep_deg_per_deg: float, dead_deg: float = 12.0,
+                           slope: float = 1.35) -> tuple[np.ndarray, np.ndarray]:
+    """Two +-90 deg cycles, symmetric: the release line down to a plateau along which the tip
+    creeps at ``creep_deg_per_deg`` (tip per knob degree), the loaded line from ``dead_deg``."""
+    up = np.linspace(-90.0, 90.0, 4501)
+    plateau = -14.0 + creep_deg_per_deg * up
+    loaded = -14.0 + creep_deg_per_deg * dead_deg + slope * (up - dead_deg)
+    release = -loaded[-1] + slope * np.maximum(0.0, up + 74.0)
+    y_up = np.maximum(np.minimum(release, plateau), loaded)
+    return (np.r_[up, -up[1:], up[1:], -up[1:]], np.r_[y_up, -y_up[1:], y_up[1:], -y_up[1:]])
+
+
+@pytest.mark.parametrize("creep", [0.03, 0.07, 0.1, -0.03])
+def test_the_edge_of_a_creeping_plateau_does_not_move_with_its_creep(creep: float) -> None:
+    q, tip = creeping_plateau_sweep(creep)
+    still = measure_dead_zone_backlash(*creeping_plateau_sweep(0.0))
+    m = measure_dead_zone_backlash(q, tip)
+    assert m.dead_zone_pos_deg == pytest.approx(still.dead_zone_pos_deg, abs=0.15)
+    assert m.dead_zone_neg_deg == pytest.approx(still.dead_zone_neg_deg, abs=0.15)
+
+
+def test_a_still_plateau_is_read_at_its_level_plus_the_threshold() -> None:
+    m = measure_dead_zone_backlash(*creeping_plateau_sweep(0.0))
+    assert m.dead_zone_pos_deg == pytest.approx(12.0 + 1.0 / 1.35, abs=0.05)
+    assert m.dead_zone_neg_deg == pytest.approx(-12.0 - 1.0 / 1.35, abs=0.05)
+
+
+def test_a_creeping_plateau_survives_tracker_noise() -> None:
+    q, tip = creeping_plateau_sweep(0.07)
+    noisy = tip + np.random.default_rng(1).normal(0.0, 0.2, tip.size)
+    m = measure_dead_zone_backlash(q, noisy)
+    assert m.dead_zone_pos_deg == pytest.approx(12.0 + 1.0 / 1.35, abs=0.5)
+    assert m.dead_zone_neg_deg == pytest.approx(-12.0 - 1.0 / 1.35, abs=0.5)
+
+
+@pytest.mark.parametrize("creep", [0.0, 0.05])
+def test_a_tip_that_never_leaves_its_plateau_has_no_dead_zone_edge(creep: float) -> None:
+    up = np.linspace(-90.0, 90.0, 4501)
+    y_up = np.minimum(1.35 * (up + 60.0), creep * (up + 60.0))
+    q, tip = np.r_[up, -up[1:], up[1:], -up[1:]], np.r_[y_up, -y_up[1:], y_up[1:], -y_up[1:]]
+    m = measure_dead_zone_backlash(q, tip)
+    assert np.isnan(m.dead_zone_pos_deg) and np.isnan(m.dead_zone_neg_deg)
 
 
 def test_lines_give_nan_where_the_tip_shows_no_plateau() -> None:

@@ -22,9 +22,10 @@ TIP_THRESHOLD_DEG = 1.0
 """How far the tip must move off its plateau for an edge or a backlash end (deg)."""
 
 TRUTHS = {"threshold": measure_dead_zone_backlash, "lines": measure_by_lines}
-"""The two readings of the tip: where it has moved 1 deg, and the corners of the paper's lines
-(fitted over whole branches; the plateau with its own slope). They differ by up to ~3 deg on a
-curved branch, so a score names its truth."""
+"""The two readings of the tip: where it has moved 1 deg (a dead-zone edge: 1 deg off the line
+its plateau follows, so a creeping plateau is not read mid-plateau; session 21), and the
+corners of the paper's lines (fitted over whole branches; the plateau with its own slope). They
+differ by up to ~3 deg on a curved branch, so a score names its truth."""
 
 
 def tip_truth(point: GridPoint, by: str = "threshold", tip_noise_deg: float = 0.0,

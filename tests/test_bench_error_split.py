@@ -10,7 +10,8 @@ import pytest
 
 from tsmd.bench import family_accuracy
 from tsmd.bench.accuracy_scenarios import Scenario, scenarios
-from tsmd.bench.error_split import delayed, model_parts, split_error, split_run
+from tsmd.bench.error_split import delayed, split_error, split_run
+from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.config import resolve_data_path
 from tsmd.profile import load_profile

@@ -8,8 +8,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from tsmd.bench.error_split import model_parts
 from tsmd.compensation.level_grid import LevelGrid
+from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.datasheet_level_grid import MIN_LEVEL_SHIFT_DEG, TrackedSweep, level_grid
 

@@ -25,10 +25,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.plant import Plant
-from tsmd.bench.error_split import model_parts
 from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.run import run_calibration
 from tsmd.compensation.level_grid import LevelGrid
+from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.errors import TsmdError

@@ -36,6 +36,7 @@ from tsmd.datasheet import (
 from tsmd.datasheet_amplitude import measure_tip_backlash_gains
 from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
 from tsmd.datasheet_coupling import measure_other_tip_gains
+from tsmd.datasheet_edge_curve import choose_edge_curve
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_offset import with_reading_offset
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
@@ -104,7 +105,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --plant: noise seeds of the unit's fast calibrations under "
                              "each backlash rule; the better rule per knob goes into the sheet "
                              "(docs/calibration.md, session 11), then the unit calibrated with "
-                             "it once per seed gives the product's reading offset (session 14; "
+                             "it once per seed chooses each knob's curved-hinge check "
+                             "(edge_curve, session 21), and once more the product's reading "
+                             "offset (session 14; "
                              "'none': no choice and no offset, the sheet keeps the rule its "
                              "shares imply)")
     parser.add_argument("--recovery-rule", action="store_true",
@@ -178,8 +181,9 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
                  params: dict[str, Any], seeds: list[int], recovery: bool = False
                  ) -> DeviceModel:
     """The sheet with each knob's backlash rule, chosen on its own unit's calibrations
-    (``recovery``: "recovery" offered too, its constants measured first), and the product's
-    reading offset measured with that rule."""
+    (``recovery``: "recovery" offered too, its constants measured first), each knob's
+    curved-hinge check (:mod:`tsmd.datasheet_edge_curve`) and the product's reading offset
+    measured with both."""
     unit = config.replace(sim=dataclasses.replace(config.sim, plant=plant, params=params))
     sweeps = truth_sweeps(unit)
     truth = sheet_truth(unit, sweeps)
@@ -202,6 +206,11 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
               f"{','.join(map(str, seeds))}: {mine}; with the knee: {knee[knob].text()} -> "
               f"{k.backlash_release_rule}, knee {'on' if k.backlash_knee else 'off'}")
     print(f"  rule choice: {time.monotonic() - t0:.0f} s")
+    t0 = time.monotonic()
+    chosen, curve = choose_edge_curve(unit, chosen, truth, seeds)
+    for name, c in zip(("phi1", "phi2"), curve, strict=True):
+        print(f"{name} curved-hinge check on the sheet's unit, fast protocol: {c.text()}")
+    print(f"  edge-curve choice: {time.monotonic() - t0:.0f} s")
     t0 = time.monotonic()
     chosen, _ = with_reading_offset(chosen, unit, truth, seeds, sweeps)
     for name, k in zip(("phi1", "phi2"), chosen.knobs, strict=True):

@@ -28,6 +28,7 @@ from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.calibration.tension_play_fit import fit_sweep_sides, sweeps_from_points
 from tsmd.config import TsmdConfig
+from tsmd.datasheet_rule_halves import placed, points_half_cycle_errors
 from tsmd.profile import DeviceKnob, DeviceModel
 from tsmd.profile.types import RELEASE_RULES
 from tsmd.tip_truth import tip_truth
@@ -52,18 +53,31 @@ class RuleScore:
     backlash_gain: float | None = None
     """The unit's backlash gain at the other knob's 0 with B by this candidate (mean over the
     runs): the sheet's ``reference_rule_backlash_gain`` where this candidate is chosen."""
+    half_placed: int = 0
+    """Half-cycles after a reversal whose B lies within the target of the tip's in the same
+    sweep (:mod:`tsmd.datasheet_rule_halves`), over the runs."""
+    half_cycles: int = 0
 
     def key(self) -> tuple[int, int]:
-        """Better first: more values within the target, then more runs accepted (a refused
-        healthy unit is the worse failure: coilpipe unit 0's phi2 placed 56/56 under both
-        "swing" and "local", "swing" with one of two runs refused). The mean error is reported,
-        not compared: on lumped unit 0 two rules placed 56/56 with means 0.06 deg apart."""
+        """Better first: more readings within the target, a grid value and one half-cycle's B
+        counting one each (session 21: the grid's medians hid warmgear's "line" misreading 5
+        of 12 half-cycles by 20-25 deg on unit 0 and then whole grid points on development
+        units), then more runs accepted (a refused healthy unit is the worse failure: coilpipe
+        unit 0's phi2 placed 56/56 under both "swing" and "local", "swing" with one of two runs
+        refused). The mean error is reported, not compared: on lumped unit 0 two rules placed
+        56/56 with means 0.06 deg apart."""
+        return (-(self.within + self.half_placed), -self.accepted)
+
+    def grid_key(self) -> tuple[int, int]:
+        """:meth:`key` on the grid values alone (the knee's choice, unchanged since session
+        12)."""
         return (-self.within, -self.accepted)
 
     def text(self) -> str:
         return (f"{self.rule} {self.within}/{self.values} within {TARGET_DEG:g} deg (mean "
                 f"{self.mean_abs_deg:.2f}, max {self.max_deg:.2f} deg, accepted "
-                f"{self.accepted}/{self.runs})")
+                f"{self.accepted}/{self.runs}; B per half-cycle {self.half_placed}/"
+                f"{self.half_cycles})")
 
 
 def with_rule(device: DeviceModel, rule: str) -> DeviceModel:
@@ -130,12 +144,13 @@ def scored(config: TsmdConfig, candidate: DeviceModel, label: str, truth: Truth,
         e = np.concatenate([knob_errors(r.errors, knob) for r in runs])
         finite = e[np.isfinite(e)]
         gains = [g for g in (rule_backlash_gain(r.points, knob) for r in runs) if g is not None]
+        halves = [h for r in runs for h in points_half_cycle_errors(r.points, knob)]
         out.append(RuleScore(
             label, knob, int(np.sum(finite <= TARGET_DEG)), e.size,
             float(np.mean(finite)) if finite.size else math.nan,
             float(np.max(finite)) if finite.size else math.nan,
             sum(r.accepted for r in runs), len(runs),
-            float(np.mean(gains)) if gains else None))
+            float(np.mean(gains)) if gains else None, placed(halves), len(halves)))
     return out
 
 
@@ -176,7 +191,7 @@ def knee_choice(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
     for knob, k in enumerate(chosen.knobs):
         plain = [s for s in rule_scores_ if s.knob == knob and s.rule == k.backlash_release_rule]
         knee = [s for s in knee_scores if s.knob == knob]
-        on.append(bool(plain and knee) and knee[0].key() <= plain[0].key())
+        on.append(bool(plain and knee) and knee[0].grid_key() <= plain[0].grid_key())
     return with_rule_gains(with_knee(chosen, (on[0], on[1])), rule_scores_, knee_scores)
 
 
@@ -195,8 +210,8 @@ def with_rule_gains(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
 
 
 def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceModel:
-    """Each knob gets the rule that placed the most values within the target (then: the
-    most runs accepted); a tie keeps
+    """Each knob gets the rule that placed the most readings within the target, grid values
+    and half-cycles (:meth:`RuleScore.key`; then: the most runs accepted); a tie keeps
     the earlier of :data:`RELEASE_RULES` ("line": the rule of a sheet with a line share and no
     choice, chosen on the development units of lumped and segments); a rule needs its share."""
     knobs = []

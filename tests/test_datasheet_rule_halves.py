@@ -1,6 +1,6 @@
 """The backlash rules scored half-cycle by half-cycle on the sheet's unit (session 21,
 tsmd.datasheet_rule_halves): a half-cycle's B against the tip tracked in the same sweep, and a
-rule whose grid medians hide misread half-cycles loses the choice."""
+rule that misreads more half-cycles loses whatever its grid medians placed."""
 
 from __future__ import annotations
 
@@ -12,8 +12,8 @@ from support.profiles import DEVICE
 
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.sweep_result import HalfCycle, SweepResult
-from tsmd.datasheet_rule import RuleScore, choose_rules, knee_choice
-from tsmd.datasheet_rule_halves import half_cycle_errors, placed, tip_backlash_deg
+from tsmd.datasheet_rule import RuleScore, choose_rules
+from tsmd.datasheet_rule_halves import HalfRead, half_cycle_reads, tip_backlash_deg
 from tsmd.profile import DeviceModel, load_device_model
 
 RATE_HZ = 100.0
@@ -45,17 +45,24 @@ def test_the_tips_backlash_is_the_travel_until_it_moves_the_threshold() -> None:
     assert abs(found - (PLAY_DEG + 1.0 / 0.8)) <= 0.5
 
 
-def test_a_half_cycles_error_is_its_b_minus_the_tips() -> None:
+def test_each_half_cycle_after_a_reversal_pairs_the_rules_b_with_the_tips() -> None:
     result, t, tip = result_with(PLAY_DEG + 6.0)
-    errors = half_cycle_errors(result, t, tip, 0.25)
-    assert len(errors) == 1  # the first half-cycle starts at no reversal
-    assert abs(errors[0] - (6.0 - 1.0 / 0.8)) <= 0.5
+    reads = half_cycle_reads(result, t, tip, 0.25)
+    assert len(reads) == 1  # the first half-cycle starts at no reversal
+    assert reads[0].backlash_deg == PLAY_DEG + 6.0
+    assert abs(reads[0].tip_deg - (PLAY_DEG + 1.0 / 0.8)) <= 0.5
 
 
-def test_a_half_cycle_without_b_is_a_miss() -> None:
+def test_a_b_off_by_more_than_the_tips_own_is_a_misread_not_a_near_miss() -> None:
+    assert HalfRead(37.0, 12.0).misread and not HalfRead(37.0, 12.0).placed
+    assert not HalfRead(19.0, 12.0).misread and not HalfRead(19.0, 12.0).placed
+    assert HalfRead(13.5, 12.0).placed
+
+
+def test_a_missing_b_is_neither_placed_nor_misread() -> None:
     result, t, tip = result_with(math.nan)
-    errors = half_cycle_errors(result, t, tip, 0.25)
-    assert len(errors) == 1 and placed(errors) == 0
+    (read,) = half_cycle_reads(result, t, tip, 0.25)
+    assert not read.placed and not read.misread
 
 
 def sheet() -> DeviceModel:
@@ -67,22 +74,19 @@ def sheet() -> DeviceModel:
     return dataclasses.replace(base, knobs=(knobs[0], knobs[1]))
 
 
-def scored(rule: str, knob: int, within: int, half_placed: int) -> RuleScore:
-    return RuleScore(rule, knob, within, 56, 1.0, 3.0, 2, 2, None, half_placed, 24)
+def scored(rule: str, knob: int, within: int, misread: int) -> RuleScore:
+    return RuleScore(rule, knob, within, 56, 1.0, 3.0, 2, 2, None, 24 - misread, misread, 24)
 
 
-def test_a_rule_whose_half_cycles_miss_loses_despite_one_more_grid_value() -> None:
-    scores = [scored("line", 0, 44, 14), scored("local", 0, 43, 24),
-              scored("line", 1, 50, 24), scored("local", 1, 43, 24)]
+def test_a_rule_that_misreads_more_half_cycles_loses_despite_more_values() -> None:
+    scores = [scored("swing", 0, 49, 2), scored("local", 0, 43, 0),
+              scored("swing", 1, 34, 0), scored("local", 1, 27, 0)]
+    chosen = choose_rules(sheet(), scores)
+    assert [k.backlash_release_rule for k in chosen.knobs] == ["local", "swing"]
+
+
+def test_among_rules_misreading_equally_the_values_decide() -> None:
+    scores = [scored("line", k, 44, 3) for k in (0, 1)] + [
+        scored("local", 0, 46, 3), scored("local", 1, 43, 3)]
     chosen = choose_rules(sheet(), scores)
     assert [k.backlash_release_rule for k in chosen.knobs] == ["local", "line"]
-
-
-def test_the_knee_is_still_chosen_on_the_grid_values_alone() -> None:
-    rules = [scored("local", 0, 50, 10), scored("local", 1, 50, 24)]
-    knee = [scored("knee", 0, 50, 24), scored("knee", 1, 50, 10)]
-    base = sheet()
-    local = [dataclasses.replace(k, backlash_release_rule="local") for k in base.knobs]
-    with_local = dataclasses.replace(base, knobs=(local[0], local[1]))
-    chosen = knee_choice(with_local, rules, knee)
-    assert [k.backlash_knee for k in chosen.knobs] == [True, True]

@@ -9,13 +9,17 @@ within 2 deg against "local" 43/56, while per half-cycle (plant alone, other kno
 placed 10/10 and 9/10 of B within 2 deg, "line" 2/10 and 0/10 (docs/calibration.md, session
 20), and development units 1-2 under "line" were refused. So each rule is also scored on every
 half-cycle after a reversal of its own calibration runs, against the tip tracked in the same
-sweep: a reading that carries across the unit's half-cycles is what carries to other units.
+sweep, and the rules that misread the fewest (:attr:`HalfRead.misread`: B off by more than
+the tip's own, another feature of the current taken for the release) are the candidates: in
+the fast protocol a grid point's B per side is the median of two half-cycles, so one such
+misread on a unit moves the value by half of it.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -43,11 +47,30 @@ def tip_backlash_deg(pos_deg: NDArray[np.float64], tip_deg: NDArray[np.float64],
     return float(grid[moved[0]] - grid[0]) if moved.size else math.nan
 
 
-def half_cycle_errors(result: SweepResult, t_s: NDArray[np.float64],
-                      tip_deg: NDArray[np.float64], step_deg: float) -> list[float]:
-    """Identified minus tip B on each of the sweep's own half-cycles after a reversal (the tip
-    as recorded at ``t_s``, low-passed as the truth reads it); NaN where the rule gave no B
-    (a miss) and left out where the tip shows no B (nothing to score)."""
+class HalfRead(NamedTuple):
+    """One half-cycle after a reversal: B as the rule read it and as the tip shows it (deg)."""
+
+    backlash_deg: float
+    tip_deg: float
+
+    @property
+    def placed(self) -> bool:
+        """Within :data:`HALF_TARGET_DEG` of the tip (a missing B is not)."""
+        return abs(self.backlash_deg - self.tip_deg) <= HALF_TARGET_DEG
+
+    @property
+    def misread(self) -> bool:
+        """Off by more than the tip's own B: the rule ended the backlash at another feature of
+        the current (a gear's loaded step, 36-50 deg on warmgear), not near the release. A
+        missing B is no misread: it leaves the grid point's median to the other half-cycles."""
+        return abs(self.backlash_deg - self.tip_deg) > self.tip_deg
+
+
+def half_cycle_reads(result: SweepResult, t_s: NDArray[np.float64],
+                     tip_deg: NDArray[np.float64], step_deg: float) -> list[HalfRead]:
+    """B by the rule and by the tip on each of the sweep's own half-cycles after a reversal
+    (the tip as recorded at ``t_s``, low-passed as the truth reads it); half-cycles where the
+    tip shows no B are left out (nothing to score)."""
     data = result.data
     tip_f, _ = lowpass(np.asarray(tip_deg, float), 1.0 / float(np.median(np.diff(t_s))))
     tip = np.interp(data.t_s, np.asarray(t_s, float), tip_f)
@@ -58,24 +81,19 @@ def half_cycle_errors(result: SweepResult, t_s: NDArray[np.float64],
         truth = tip_backlash_deg(data.pos_deg[h.start:h.stop], tip[h.start:h.stop],
                                  h.direction, step_deg)
         if math.isfinite(truth):
-            out.append(h.backlash_deg - truth)
+            out.append(HalfRead(h.backlash_deg, truth))
     return out
 
 
-def points_half_cycle_errors(points: Sequence[GridPoint], knob: int,
-                             step_deg: float = IdentifyOptions().grid_step_deg) -> list[float]:
-    """:func:`half_cycle_errors` over ``knob``'s grid points whose recording tracked the tip."""
-    out: list[float] = []
+def points_half_cycle_reads(points: Sequence[GridPoint], knob: int,
+                            step_deg: float = IdentifyOptions().grid_step_deg
+                            ) -> list[HalfRead]:
+    """:func:`half_cycle_reads` over ``knob``'s grid points whose recording tracked the tip."""
+    out: list[HalfRead] = []
     for p in points:
         rec = p.recording
         if p.knob != knob or rec is None or not rec.has_tip:
             continue
-        out += half_cycle_errors(p.result, np.asarray(rec["t"], float),
-                                 np.asarray(rec[f"tip{knob + 1}"], float), step_deg)
+        out += half_cycle_reads(p.result, np.asarray(rec["t"], float),
+                                np.asarray(rec[f"tip{knob + 1}"], float), step_deg)
     return out
-
-
-def placed(errors: Sequence[float]) -> int:
-    """How many half-cycles' B lie within :data:`HALF_TARGET_DEG` of the tip (a NaN is not)."""
-    e = np.asarray(errors, dtype=float)
-    return int(np.sum(np.abs(e[np.isfinite(e)]) <= HALF_TARGET_DEG))

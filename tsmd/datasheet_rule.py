@@ -28,6 +28,7 @@ from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.calibration.tension_play_fit import fit_sweep_sides, sweeps_from_points
 from tsmd.config import TsmdConfig
+from tsmd.datasheet_rule_halves import points_half_cycle_reads
 from tsmd.profile import DeviceKnob, DeviceModel
 from tsmd.profile.types import RELEASE_RULES
 from tsmd.tip_truth import tip_truth
@@ -35,6 +36,7 @@ from tsmd.tracked_calibration import TARGET_DEG, play_protocol, score, truth_swe
 
 RULE_NOISE_SEEDS = (0, 1)
 """Noise seeds of the sheet unit's calibrations per rule: one run per seed and rule."""
+
 
 
 @dataclass(frozen=True)
@@ -52,6 +54,12 @@ class RuleScore:
     backlash_gain: float | None = None
     """The unit's backlash gain at the other knob's 0 with B by this candidate (mean over the
     runs): the sheet's ``reference_rule_backlash_gain`` where this candidate is chosen."""
+    half_placed: int = 0
+    """Half-cycles after a reversal whose B lies within the target of the tip's in the same
+    sweep (:mod:`tsmd.datasheet_rule_halves`), over the runs."""
+    half_misread: int = 0
+    """Half-cycles whose B is off by more than the tip's own (:attr:`HalfRead.misread`)."""
+    half_cycles: int = 0
 
     def key(self) -> tuple[int, int]:
         """Better first: more values within the target, then more runs accepted (a refused
@@ -63,7 +71,8 @@ class RuleScore:
     def text(self) -> str:
         return (f"{self.rule} {self.within}/{self.values} within {TARGET_DEG:g} deg (mean "
                 f"{self.mean_abs_deg:.2f}, max {self.max_deg:.2f} deg, accepted "
-                f"{self.accepted}/{self.runs})")
+                f"{self.accepted}/{self.runs}; B per half-cycle {self.half_placed}/"
+                f"{self.half_cycles} within {TARGET_DEG:g} deg, {self.half_misread} misread)")
 
 
 def with_rule(device: DeviceModel, rule: str) -> DeviceModel:
@@ -130,12 +139,14 @@ def scored(config: TsmdConfig, candidate: DeviceModel, label: str, truth: Truth,
         e = np.concatenate([knob_errors(r.errors, knob) for r in runs])
         finite = e[np.isfinite(e)]
         gains = [g for g in (rule_backlash_gain(r.points, knob) for r in runs) if g is not None]
+        halves = [h for r in runs for h in points_half_cycle_reads(r.points, knob)]
         out.append(RuleScore(
             label, knob, int(np.sum(finite <= TARGET_DEG)), e.size,
             float(np.mean(finite)) if finite.size else math.nan,
             float(np.max(finite)) if finite.size else math.nan,
             sum(r.accepted for r in runs), len(runs),
-            float(np.mean(gains)) if gains else None))
+            float(np.mean(gains)) if gains else None, sum(h.placed for h in halves),
+            sum(h.misread for h in halves), len(halves)))
     return out
 
 
@@ -195,17 +206,22 @@ def with_rule_gains(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
 
 
 def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceModel:
-    """Each knob gets the rule that placed the most values within the target (then: the
-    most runs accepted); a tie keeps
-    the earlier of :data:`RELEASE_RULES` ("line": the rule of a sheet with a line share and no
-    choice, chosen on the development units of lumped and segments); a rule needs its share."""
+    """Each knob gets, among the rules that misread the fewest of the unit's half-cycles
+    (:attr:`tsmd.datasheet_rule_halves.HalfRead.misread`; session 21: warmgear unit 0's phi1
+    "swing" placed 49/56 grid values against "local" 43/56 while ending 2 of 24 half-cycles at
+    a loaded gear step 36-38 deg off, and on development unit 1 it did so at two of three grid
+    points), the rule that placed the most values within the target (then: the most runs
+    accepted); a tie keeps the earlier of :data:`RELEASE_RULES` ("line": the rule of a sheet
+    with a line share and no choice, chosen on the development units of lumped and segments);
+    a rule needs its share."""
     knobs = []
     for knob, k in enumerate(device.knobs):
         mine = [s for s in scores if s.knob == knob and usable(k, s.rule)]
         if not mine:
             knobs.append(k)
             continue
+        fewest = min(s.half_misread for s in mine)
+        mine = [s for s in mine if s.half_misread == fewest]
         best = min(mine, key=lambda s: (s.key(), RELEASE_RULES.index(s.rule)))
         knobs.append(dataclasses.replace(k, backlash_release_rule=best.rule))
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
-

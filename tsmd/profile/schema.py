@@ -17,6 +17,7 @@ from tsmd.compensation.loaded_shape import (
     shape_grid_to_mapping,
     shape_to_mapping,
 )
+from tsmd.compensation.release_ratio import release_ratio_problem
 from tsmd.compensation.release_round import RELEASE_ROUND_RANGE, RELEASE_SHIFT_RANGE
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import (
@@ -168,9 +169,9 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
         _check_references(r, key, pos, neg)
         release = k.get("release_omega")
         b_pos, b_neg = k.get("reference_backlash_pos_deg"), k.get("reference_backlash_neg_deg")
-        if len({release is None, b_pos is None, b_neg is None}) > 1:
-            raise r.fail(key, "release_omega, reference_backlash_pos_deg and "
-                         "reference_backlash_neg_deg go together (all or none)")
+        if (b_pos is None) != (b_neg is None) or (release is not None and b_pos is None):
+            raise r.fail(key, "reference_backlash_pos_deg and reference_backlash_neg_deg go "
+                         "together, and release_omega needs them")
 
         def optional(name: str, k: Mapping[str, Any] = k, key: str = key) -> float | None:
             lo, hi, unit = OPTIONAL_KNOB_RANGES[name]
@@ -217,6 +218,10 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
                for name in _SHAPE_KEYS},
             loaded_shape_grid=_nested(r, k.get("loaded_shape_grid"),
                                       f"{key}.loaded_shape_grid", shape_grid_from_mapping)))
+    for knob_name, knob in zip(KNOB_NAMES, knobs, strict=True):
+        problem = release_ratio_problem(knob)
+        if problem is not None:  # a sheet error, shown when it is read, not on a patient's unit
+            raise r.fail(f"knobs.{knob_name}.release_omega", problem)
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version, *bend)
@@ -247,6 +252,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         }
         if k.release_omega is not None:
             knobs[name]["release_omega"] = k.release_omega
+        if k.reference_backlash_pos_deg is not None:
             knobs[name]["reference_backlash_pos_deg"] = k.reference_backlash_pos_deg
             knobs[name]["reference_backlash_neg_deg"] = k.reference_backlash_neg_deg
         if k.dead_zone_offset_deg is not None:

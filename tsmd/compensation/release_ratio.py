@@ -24,9 +24,14 @@ def ratio_gain(device_knob: Any) -> float | None:
     Where the sheet also has the growth read at the corners of the paper's lines
     (``reference_tip_line_backlash_gain``, session 17), the choice is made against it: the
     model's backlash is the knob travel to its release line, which a tip with rounded
-    corners reaches after the 1 deg threshold has fired."""
+    corners reaches after the 1 deg threshold has fired. A sheet's ``release_ratio_gain``
+    ("settle" or "rule") overrides the choice."""
     settle = getattr(device_knob, "reference_backlash_gain", None)
     rule = getattr(device_knob, "reference_rule_backlash_gain", None)
+    chosen = getattr(device_knob, "release_ratio_gain", None)
+    if chosen is not None:  # the product's choice on its sheet unit's tracking (session 21)
+        picked = settle if chosen == "settle" else rule
+        return None if picked is None else float(picked)
     tip = getattr(device_knob, "reference_tip_line_backlash_gain", None)
     if tip is None:
         tip = getattr(device_knob, "reference_tip_backlash_gain", None)

@@ -36,6 +36,7 @@ from tsmd.profile.types import (
     ID_PATTERN,
     KNOB_NAMES,
     PROFILE_SCHEMA_VERSION,
+    RATIO_GAINS,
     RELEASE_RULES,
     CatheterProfile,
     DeviceKnob,
@@ -96,7 +97,7 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_recovery_lag_deg", "backlash_bend_gain", "backlash_release_rule",
-                      "backlash_knee", "edge_curve")
+                      "backlash_knee", "edge_curve", "release_ratio_gain")
 _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
 _SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
@@ -117,6 +118,20 @@ def _nested(r: Reader, value: Any, where: str,
         return parse(value, where)
     except ValueError as exc:
         raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
+
+
+def _ratio_gain(r: Reader, k: Mapping[str, Any], key: str) -> str | None:
+    value = k.get("release_ratio_gain")
+    if value is None:
+        return None
+    gain = r.text(value, f"{key}.release_ratio_gain")
+    if gain not in RATIO_GAINS:
+        raise r.fail(f"{key}.release_ratio_gain",
+                     f"{gain!r} is not one of {', '.join(RATIO_GAINS)}")
+    needs = "reference_backlash_gain" if gain == "settle" else "reference_rule_backlash_gain"
+    if k.get(needs) is None:
+        raise r.fail(f"{key}.release_ratio_gain", f"'{gain}' needs {needs}")
+    return gain
 
 
 def _release_rule(r: Reader, k: Mapping[str, Any], key: str) -> str | None:
@@ -200,6 +215,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_release_rule=_release_rule(r, k, key),
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
             edge_curve=_knee(r, k.get("edge_curve"), f"{key}.edge_curve"),
+            release_ratio_gain=_ratio_gain(r, k, key),
             reference_rule_backlash_gain=optional("reference_rule_backlash_gain"),
             reference_tip_backlash_gain=optional("reference_tip_backlash_gain"),
             reference_tip_line_backlash_gain=optional("reference_tip_line_backlash_gain"),

@@ -7,14 +7,18 @@ import dataclasses
 import math
 
 import pytest
-from support.profiles import assert_sheet_knob_field_round_trips
+from support.profiles import DEVICE, assert_sheet_knob_field_round_trips
 
-from tsmd.calibration.release_path import ratio_gain, release_slope_ratio
+from tsmd.compensation.release_ratio import ratio_gain, release_slope_ratio
 from tsmd.compensation.safety import KnobLimits
 from tsmd.datasheet_amplitude import backlash_growth
 from tsmd.profile import (
     DeviceKnob,
+    ProfileError,
     ReferencePoint,
+    device_model_from_mapping,
+    device_model_to_mapping,
+    load_device_model,
 )
 
 SETTLE, RULE, OMEGA, RELEASE = 0.2, 0.16, 1.32, 1.51
@@ -76,3 +80,31 @@ def test_a_line_read_tip_gain_alone_chooses_the_gain() -> None:
 
 def test_the_line_read_tip_gain_round_trips_and_is_range_checked() -> None:
     assert_sheet_knob_field_round_trips("reference_tip_line_backlash_gain", 1, 0.173, 0.9)
+
+
+def test_the_sheets_ratio_gain_choice_overrides_the_tip_gains() -> None:
+    near_settle = moved_gain(SETTLE) - 0.005
+    knob = dataclasses.replace(KNOB, reference_tip_backlash_gain=near_settle,
+                               release_ratio_gain="rule")
+    assert ratio_gain(knob) == RULE
+    assert ratio_gain(dataclasses.replace(knob, release_ratio_gain="settle")) == SETTLE
+
+
+def test_the_ratio_gain_choice_round_trips_and_an_unknown_one_is_refused() -> None:
+    data = device_model_to_mapping(load_device_model(DEVICE))
+    data["knobs"]["phi2"]["release_ratio_gain"] = "settle"
+    device = device_model_from_mapping(data)
+    assert device.knobs[1].release_ratio_gain == "settle"
+    assert device.knobs[0].release_ratio_gain is None
+    assert device_model_to_mapping(device)["knobs"]["phi2"]["release_ratio_gain"] == "settle"
+    data["knobs"]["phi2"]["release_ratio_gain"] = "tip"
+    with pytest.raises(ProfileError, match="knobs.phi2.release_ratio_gain: 'tip'"):
+        device_model_from_mapping(data)
+
+
+def test_a_ratio_gain_choice_without_its_gain_is_refused() -> None:
+    data = device_model_to_mapping(load_device_model(DEVICE))
+    data["knobs"]["phi1"].pop("reference_rule_backlash_gain", None)
+    data["knobs"]["phi1"]["release_ratio_gain"] = "rule"
+    with pytest.raises(ProfileError, match="needs reference_rule_backlash_gain"):
+        device_model_from_mapping(data)

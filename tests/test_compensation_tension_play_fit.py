@@ -11,7 +11,7 @@ import pytest
 import yaml
 from support.profiles import assert_sheet_knob_field_round_trips, make_profile
 
-from tsmd.calibration.release_path import release_slope_ratio, release_through_amplitude
+from tsmd.calibration.release_path import release_through_amplitude
 from tsmd.calibration.tension_play_fit import (
     SweepCurrent,
     fit_side,
@@ -23,6 +23,7 @@ from tsmd.calibration.tension_play_fit import (
 from tsmd.calibration.unit_slope import unit_omega
 from tsmd.compensation import CompensationError, build_compensator
 from tsmd.compensation.loaded_shape import LoadedShape
+from tsmd.compensation.release_ratio import release_slope_ratio
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play import release_line
 from tsmd.compensation.tension_play_params import (

@@ -14,6 +14,7 @@ from support.profiles import DEVICE
 
 from simrig.plants.capstan.tendon_sheath import make_tendon_sheath_plant
 from tsmd.cli import main
+from tsmd.compensation.release_ratio import RELEASE_RATIO_RANGE
 from tsmd.datasheet import (
     CONDITIONING_CYCLES,
     RELEASE_READ_CYCLES,
@@ -254,6 +255,26 @@ def test_a_measured_read_the_schema_refuses_is_left_out_and_named() -> None:
     assert sheet.knobs[1].backlash_release_local_share == 0.98
     assert sheet.knobs[0] == measured.knobs[0]
     assert len(dropped) == 1 and "knobs.phi2.backlash_release_line_share" in dropped[0]
+
+
+def test_a_tracked_release_the_calibration_could_not_use_is_left_out_and_named() -> None:
+    device = load_device_model(DEVICE)
+    knob = device.knobs[1]
+    assert knob.reference_backlash_gain is not None
+    release = (RELEASE_RATIO_RANGE[0] - 0.05) * knob.omega / (1.0 - knob.reference_backlash_gain)
+    sheet, dropped = readable(_with_phi2(device, release_omega=release))
+    assert sheet.knobs[1].release_omega is None
+    assert sheet.knobs[1].reference_backlash_pos_deg == knob.reference_backlash_pos_deg
+    assert sheet.knobs[0] == device.knobs[0]
+    assert len(dropped) == 1 and "knobs.phi2.release_omega" in dropped[0]
+
+
+def test_a_sheet_without_the_tracked_release_writes_its_reference_backlash(tmp_path: Path) -> None:
+    device = load_device_model(DEVICE)
+    save_device_model(_with_phi2(device, release_omega=None), tmp_path / "sheet.yaml")
+    knob = load_device_model(tmp_path / "sheet.yaml").knobs[1]
+    assert knob.release_omega is None
+    assert knob.reference_backlash_pos_deg == device.knobs[1].reference_backlash_pos_deg
 
 
 def test_a_measured_sheet_invalid_beyond_its_optional_reads_is_one_error() -> None:

@@ -12,6 +12,7 @@ import pytest
 import yaml
 from support.profiles import DEVICE, ROOT, make_profile
 
+from tsmd.compensation.release_ratio import RELEASE_RATIO_RANGE
 from tsmd.profile import (
     DEFAULT_HANDLE_SLIP_DEG,
     ProfileError,
@@ -210,6 +211,27 @@ def test_bad_device_model_is_refused(tmp_path: Path) -> None:
         load_device_model(path)
 
 
+def _release_at_ratio(knob: dict[str, Any], ratio: float) -> float:
+    """The tracked release_omega that gives ``ratio`` against the knob's settle-rule gain."""
+    return ratio * knob["omega"] / (1.0 - knob["reference_backlash_gain"])
+
+
+def test_a_sheet_whose_release_ratio_the_calibration_cannot_use_is_refused_naming_it() -> None:
+    data = yaml.safe_load(DEVICE.read_text())
+    phi2 = data["knobs"]["phi2"]
+    phi2["release_omega"] = _release_at_ratio(phi2, RELEASE_RATIO_RANGE[0] - 0.05)
+    with pytest.raises(ProfileError, match=r"knobs.phi2.release_omega: .*outside"):
+        device_model_from_mapping(data)
+
+
+def test_a_sheet_keeps_its_reference_backlash_without_the_tracked_release() -> None:
+    data = yaml.safe_load(DEVICE.read_text())
+    data["knobs"]["phi2"].pop("release_omega")
+    knob = device_model_from_mapping(data).knobs[1]
+    assert knob.release_omega is None
+    assert knob.reference_backlash_pos_deg == data["knobs"]["phi2"]["reference_backlash_pos_deg"]
+
+
 def test_device_model_round_trip_keeps_our_optional_constants(tmp_path: Path) -> None:
     device = load_device_model(DEVICE)
     assert device.knobs[0].release_omega is not None
@@ -244,7 +266,7 @@ def test_device_release_constants_go_together(tmp_path: Path) -> None:
     del data["knobs"]["phi1"]["reference_backlash_neg_deg"]
     path = tmp_path / "dev.yaml"
     path.write_text(yaml.safe_dump(data))
-    with pytest.raises(ProfileError, match="knobs.phi1: release_omega, reference_backlash"):
+    with pytest.raises(ProfileError, match="knobs.phi1: reference_backlash_pos_deg and"):
         load_device_model(path)
 
 

@@ -28,6 +28,7 @@ from tsmd.calibration.identify import identify_sweep
 from tsmd.calibration.loaded_knee import read_loaded_knee
 from tsmd.calibration.tension_play_fit import fit_sweep_sides
 from tsmd.compensation.loaded_shape import LoadedShape
+from tsmd.compensation.release_ratio import release_ratio_problem
 from tsmd.compensation.safety import KnobLimits
 from tsmd.config import TsmdConfig, default_sim_config
 from tsmd.datasheet_release import median_ratio, median_share, release_reads
@@ -346,7 +347,10 @@ def readable(device: DeviceModel) -> tuple[DeviceModel, list[str]]:
     """The sheet as the schema will read it back: a measured optional value outside the
     schema's range for it (:data:`tsmd.profile.schema.OPTIONAL_KNOB_RANGES`) is left out and
     named, so the rules that need it are no candidates, instead of the whole measurement being
-    lost when the file is written. A refusal of anything else is an error."""
+    lost when the file is written. So is a tracked ``release_omega`` whose release-path ratio
+    (:func:`tsmd.compensation.release_ratio.release_slope_ratio`) the loader would refuse
+    (session 21, cyclopebax: 0.69 refused every unit's calibration). A refusal of anything else
+    is an error."""
     dropped: list[str] = []
     knobs = list(device.knobs)
     for i, knob in enumerate(device.knobs):
@@ -359,6 +363,11 @@ def readable(device: DeviceModel) -> tuple[DeviceModel, list[str]]:
             dropped.append(f"knobs.{KNOB_NAMES[i]}.{name}: {value} {unit} is outside the "
                            f"plausible range [{lo}, {hi}]: left out of the sheet"
                            .replace("  ", " "))
+        problem = release_ratio_problem(knobs[i])
+        if problem is not None:  # the calibration could not use it on any unit
+            knobs[i] = dataclasses.replace(knobs[i], release_omega=None)
+            dropped.append(f"knobs.{KNOB_NAMES[i]}.release_omega: {problem}: left out of the "
+                           "sheet (the release line keeps the backlash-end locus slope)")
     device = dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
     try:
         device_model_from_mapping(plain_values(device_model_to_mapping(device)), "sheet")

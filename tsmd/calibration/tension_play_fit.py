@@ -18,7 +18,7 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   lumped catheter's is 7 % shallower; the current cannot see it: a released tendon's current is
   friction only), the data sheet's tracked ``release_omega`` gives the product's ratio
   ``release_omega (1 - beta_sheet) / omega_sheet``
-  (:func:`tsmd.calibration.release_path.release_slope_ratio`); the unit's
+  (:func:`tsmd.compensation.release_ratio.release_slope_ratio`); the unit's
   release line then has that ratio times its own locus slope and still passes through its own
   backlash end at the calibration amplitude (:func:`~tsmd.calibration.release_path.
   release_through_amplitude`);
@@ -54,15 +54,12 @@ from tsmd.calibration.lag import estimate_lag_s
 from tsmd.calibration.loaded_knee import sweep_knees
 from tsmd.calibration.reading_offset import offset_at, reference_edge_deg
 from tsmd.calibration.release_end import plateau_moved, side_ratios
-from tsmd.calibration.release_path import (
-    RELEASE_RATIO_RANGE,
-    release_slope_ratio,
-    release_through_amplitude,
-)
+from tsmd.calibration.release_path import release_through_amplitude
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.unit_slope import GainReading, gain_scatter, weighed_omega
 from tsmd.compensation.loaded_shape import curved, shaped_height
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
+from tsmd.compensation.release_ratio import RELEASE_RATIO_RANGE, release_slope_ratio
 from tsmd.compensation.tension_play_params import BETA_RANGE, TensionPlayParams
 
 FloatArray = NDArray[np.float64]

@@ -376,6 +376,10 @@ def main(args: argparse.Namespace) -> int:
     if args.plant is not None and sample:
         device = with_sample(device, config, args.plant, params, args.unit_key, sample,
                              seeds[0] if seeds else 0)
+    if args.plant is not None:  # the gains read since may move the ratio out of its range
+        device, dropped = readable(device)
+        for line in dropped:
+            print(f"warning: {line}")
     comment = (f"Data sheet of {args.device_model}, measured by tsmd {__version__} "
                f"(tsmd datasheet) on {source}:\n"
                f"each knob swept +-{SWEEP_AMPLITUDE_DEG:g} deg at {SWEEP_HZ:g} Hz, other knob "

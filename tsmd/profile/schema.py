@@ -18,6 +18,7 @@ from tsmd.compensation.loaded_shape import (
     shape_grid_to_mapping,
     shape_to_mapping,
 )
+from tsmd.compensation.release_ratio import release_ratio_problem
 from tsmd.compensation.release_round import RELEASE_ROUND_RANGE, RELEASE_SHIFT_RANGE
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play_params import (
@@ -36,6 +37,7 @@ from tsmd.profile.types import (
     ID_PATTERN,
     KNOB_NAMES,
     PROFILE_SCHEMA_VERSION,
+    RATIO_GAINS,
     RELEASE_RULES,
     CatheterProfile,
     DeviceKnob,
@@ -96,7 +98,7 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_recovery_lag_deg", "backlash_bend_gain", "backlash_release_rule",
-                      "backlash_knee", "edge_curve")
+                      "backlash_knee", "edge_curve", "release_ratio_gain")
 _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
 _SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
@@ -117,6 +119,20 @@ def _nested(r: Reader, value: Any, where: str,
         return parse(value, where)
     except ValueError as exc:
         raise r.fail(where, str(exc).removeprefix(where + ": ")) from None
+
+
+def _ratio_gain(r: Reader, k: Mapping[str, Any], key: str) -> str | None:
+    value = k.get("release_ratio_gain")
+    if value is None:
+        return None
+    gain = r.text(value, f"{key}.release_ratio_gain")
+    if gain not in RATIO_GAINS:
+        raise r.fail(f"{key}.release_ratio_gain",
+                     f"{gain!r} is not one of {', '.join(RATIO_GAINS)}")
+    needs = "reference_backlash_gain" if gain == "settle" else "reference_rule_backlash_gain"
+    if k.get(needs) is None:
+        raise r.fail(f"{key}.release_ratio_gain", f"'{gain}' needs {needs}")
+    return gain
 
 
 def _release_rule(r: Reader, k: Mapping[str, Any], key: str) -> str | None:
@@ -169,9 +185,9 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
         _check_references(r, key, pos, neg)
         release = k.get("release_omega")
         b_pos, b_neg = k.get("reference_backlash_pos_deg"), k.get("reference_backlash_neg_deg")
-        if len({release is None, b_pos is None, b_neg is None}) > 1:
-            raise r.fail(key, "release_omega, reference_backlash_pos_deg and "
-                         "reference_backlash_neg_deg go together (all or none)")
+        if (b_pos is None) != (b_neg is None) or (release is not None and b_pos is None):
+            raise r.fail(key, "reference_backlash_pos_deg and reference_backlash_neg_deg go "
+                         "together, and release_omega needs them")
 
         def optional(name: str, k: Mapping[str, Any] = k, key: str = key) -> float | None:
             lo, hi, unit = OPTIONAL_KNOB_RANGES[name]
@@ -200,6 +216,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_release_rule=_release_rule(r, k, key),
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
             edge_curve=_knee(r, k.get("edge_curve"), f"{key}.edge_curve"),
+            release_ratio_gain=_ratio_gain(r, k, key),
             reference_rule_backlash_gain=optional("reference_rule_backlash_gain"),
             reference_tip_backlash_gain=optional("reference_tip_backlash_gain"),
             reference_tip_line_backlash_gain=optional("reference_tip_line_backlash_gain"),
@@ -220,6 +237,10 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
                                       f"{key}.loaded_shape_grid", shape_grid_from_mapping),
             loaded_level_grid=_nested(r, k.get("loaded_level_grid"),
                                       f"{key}.loaded_level_grid", level_grid_from_mapping)))
+    for knob_name, knob in zip(KNOB_NAMES, knobs, strict=True):
+        problem = release_ratio_problem(knob)
+        if problem is not None:  # a sheet error, shown when it is read, not on a patient's unit
+            raise r.fail(f"knobs.{knob_name}.release_omega", problem)
     desc = m.get("description", "")
     bend = _bend_relation(r, m.get("bend_relation"))
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version, *bend)
@@ -250,6 +271,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         }
         if k.release_omega is not None:
             knobs[name]["release_omega"] = k.release_omega
+        if k.reference_backlash_pos_deg is not None:
             knobs[name]["reference_backlash_pos_deg"] = k.reference_backlash_pos_deg
             knobs[name]["reference_backlash_neg_deg"] = k.reference_backlash_neg_deg
         if k.dead_zone_offset_deg is not None:

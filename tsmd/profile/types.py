@@ -22,6 +22,9 @@ PROFILE_SCHEMA_VERSION = 1
 DEVICE_SCHEMA_VERSION = 1
 RELEASE_RULES = ("line", "swing", "local", "recovery")
 """The backlash rules a data sheet can name (``DeviceKnob.backlash_release_rule``)."""
+RATIO_GAINS = ("settle", "rule")
+"""The gains a data sheet can take its release-path ratio against
+(``DeviceKnob.release_ratio_gain``)."""
 KNOB_NAMES: tuple[str, str] = ("phi1", "phi2")
 ANGLE_RANGE_DEG = 360.0
 """Every angle in a profile (knob or tip) must lie within +-ANGLE_RANGE_DEG: a larger value is
@@ -161,13 +164,19 @@ class DeviceKnob:
     session 16): how much the tip's backlash grows per degree of reversal amplitude (reversals
     at 60 and 90 deg, :mod:`tsmd.datasheet_amplitude`). Method ours takes its release-path
     ratio against the gain reading that brings the sheet unit's moved gain nearer it
-    (:func:`tsmd.calibration.release_path.ratio_gain`); None: the settle rule's."""
+    (:func:`tsmd.compensation.release_ratio.ratio_gain`); None: the settle rule's."""
+    release_ratio_gain: str | None = None
+    """Optional, the product's choice of the gain its release-path ratio is taken against:
+    "settle" (``reference_backlash_gain``) or "rule" (``reference_rule_backlash_gain``, the
+    reading every unit's beta is fitted with); it overrides the choice by the tip gains
+    (:func:`tsmd.compensation.release_ratio.ratio_gain`). Set by hand on the sheet's unit's
+    tracking (session 21, cyclopebax phi2); None: chosen as before."""
     reference_tip_line_backlash_gain: float | None = None
     """Optional, tracked on the data-sheet unit (``tsmd datasheet --tip-line-backlash-gain``,
     opt-in, session 17): the same growth with the tip's backlash read at the corners of the
     paper's lines (where the release line meets the reversal's level) instead of at the 1 deg
     threshold, which a tip that starts back gradually after a reversal (rounded corners) reaches
-    early. Where given, :func:`~tsmd.calibration.release_path.ratio_gain` chooses against it
+    early. Where given, :func:`~tsmd.compensation.release_ratio.ratio_gain` chooses against it
     instead of ``reference_tip_backlash_gain``."""
     reference_release_end_offset_deg: float | None = None
     """Optional, tracked on the data-sheet unit (``tsmd datasheet --release-end-offset``,

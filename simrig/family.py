@@ -19,7 +19,9 @@ now, the helixbelt plant (session 15, written blind) is held out now, the ratest
 held out now, the archwave plant (session 19, written blind) is held out now (tuned on its
 development units in session 20), the jawcrimp plant (session 20, written blind, run untuned, then
 tuned on its development units in the same session's second round) is held out, the cyclopebax
-plant (session 21, written blind, run untuned) is the blind plant (``PLANT_ROLE``).
+plant (session 21, written blind, run untuned, then its sheet constant tuned on its development
+units in the same session's second round) is held out (``PLANT_ROLE``); the next blind plant
+is registered after it.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -71,7 +73,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
-              "jawcrimp": "held-out", "cyclopebax": "blind"}
+              "jawcrimp": "held-out", "cyclopebax": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

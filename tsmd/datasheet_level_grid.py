@@ -25,15 +25,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.plant import Plant
-from tsmd.calibration.errors import CalibrationError
-from tsmd.calibration.run import run_calibration
 from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.tension_play_params import TensionPlayParams
-from tsmd.config import TsmdConfig, default_sim_config
+from tsmd.config import TsmdConfig
+from tsmd.datasheet_unit_run import calibrate_sheet_unit
 from tsmd.errors import TsmdError
 from tsmd.profile import DeviceModel
-from tsmd.replay import LockstepRunner
 
 FloatArray = NDArray[np.float64]
 
@@ -105,12 +103,7 @@ def measure_level_grids(plant_factory: Callable[[], Plant], device: DeviceModel,
                         seed: int = 2000, config: TsmdConfig | None = None
                         ) -> tuple[LevelGrid | None, LevelGrid | None]:
     """Both knobs' grids, from one tracked calibration of the sheet's unit with ``device``."""
-    cfg = config if config is not None else default_sim_config()
-    try:
-        with LockstepRunner(cfg, None, "none", seed, plant_factory()) as runner:
-            result = run_calibration(runner, "datasheet-level-grid", device)
-    except CalibrationError as exc:
-        raise TsmdError(f"level grid: the sheet's unit did not calibrate: {exc}") from None
+    result = calibrate_sheet_unit(plant_factory, device, "level grid", seed, config)
     grids: list[LevelGrid | None] = []
     for knob in (0, 1):
         tension = result.profile.knobs[knob].tension_play

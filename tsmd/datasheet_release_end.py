@@ -24,14 +24,12 @@ import numpy as np
 
 from simrig.plant import Plant
 from tsmd.calibration.assemble import GridPoint
-from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.release_end import read_release_end
-from tsmd.calibration.run import run_calibration
 from tsmd.calibration.tension_play_fit import SweepCurrent, sweeps_from_points
-from tsmd.config import TsmdConfig, default_sim_config
+from tsmd.config import TsmdConfig
+from tsmd.datasheet_unit_run import calibrate_sheet_unit
 from tsmd.errors import TsmdError
 from tsmd.profile import DeviceModel
-from tsmd.replay import LockstepRunner
 
 
 def tip_sweeps(points: Sequence[GridPoint], knob: int) -> tuple[list[SweepCurrent],
@@ -72,11 +70,6 @@ def measure_release_end_offsets(plant_factory: Callable[[], Plant], device: Devi
                                 ) -> tuple[tuple[float, float] | None, tuple[float, float] | None]:
     """Both knobs' (offset, plateau), from one calibration of the sheet's unit with ``device``
     (the sheet as measured so far: its backlash rule sets the window the end is read in)."""
-    cfg = config if config is not None else default_sim_config()
-    try:
-        with LockstepRunner(cfg, None, "none", seed, plant_factory()) as runner:
-            points = run_calibration(runner, "datasheet-release-end", device).points
-    except CalibrationError as exc:
-        raise TsmdError(f"release end: the sheet's unit did not calibrate: {exc}") from None
+    points = calibrate_sheet_unit(plant_factory, device, "release end", seed, config).points
     first, second = (offset_deg(*tip_sweeps(points, k)) for k in (0, 1))
     return first, second

@@ -25,17 +25,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.plant import Plant
-from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.identify import split_half_cycles
-from tsmd.calibration.run import run_calibration
 from tsmd.calibration.signal import lowpass
 from tsmd.compensation.release_round import reference_backlash_deg
 from tsmd.compensation.tension_play import release_slope
 from tsmd.compensation.tension_play_params import TensionPlayParams
-from tsmd.config import TsmdConfig, default_sim_config
+from tsmd.config import TsmdConfig
+from tsmd.datasheet_unit_run import calibrate_sheet_unit
 from tsmd.errors import TsmdError
 from tsmd.profile import DeviceModel
-from tsmd.replay import LockstepRunner
 
 FloatArray = NDArray[np.float64]
 
@@ -102,12 +100,7 @@ def measure_release_round(plant_factory: Callable[[], Plant], device: DeviceMode
                           seed: int = 2000, config: TsmdConfig | None = None
                           ) -> tuple[tuple[float, float, float, float] | None, ...]:
     """Both knobs' fit, from one tracked calibration of the sheet's unit with ``device``."""
-    cfg = config if config is not None else default_sim_config()
-    try:
-        with LockstepRunner(cfg, None, "none", seed, plant_factory()) as runner:
-            result = run_calibration(runner, "datasheet-release-round", device)
-    except CalibrationError as exc:
-        raise TsmdError(f"release round: the sheet's unit did not calibrate: {exc}") from None
+    result = calibrate_sheet_unit(plant_factory, device, "release round", seed, config)
     fits: list[tuple[float, float, float, float] | None] = []
     for knob in (0, 1):
         tension = result.profile.knobs[knob].tension_play

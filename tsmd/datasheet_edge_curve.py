@@ -37,7 +37,7 @@ from tsmd.calibration.protocol import fast_protocol
 from tsmd.calibration.run import device_options
 from tsmd.config import TsmdConfig
 from tsmd.profile import DeviceModel
-from tsmd.tracked_calibration import play_protocol
+from tsmd.tracked_calibration import ProtocolRun, play_protocol
 
 Truth = dict[tuple[int, float], dict[str, float]]
 
@@ -148,15 +148,15 @@ def edge_curve_scores(reads: Sequence[EdgeRead]) -> list[EdgeCurveScore]:
 
 
 def choose_edge_curve(config: TsmdConfig, device: DeviceModel, truth: Truth,
-                      noise_seeds: Sequence[int]) -> tuple[DeviceModel, list[EdgeCurveScore]]:
+                      noise_seeds: Sequence[int]
+                      ) -> tuple[DeviceModel, list[EdgeCurveScore], list[ProtocolRun]]:
     """The sheet's unit (``config.sim``) calibrated with the fast protocol under ``device``
     without the check, once per noise seed, and each knob's check chosen on its edges.
-    (sheet, scores)"""
+    (sheet, scores, the runs: made with ``with_edge_curve(device, (False, False))``, so the
+    reading offset re-uses them where no knob takes the check)"""
     plain = with_edge_curve(device, (False, False))
     options = device_options(None, plain)
-    pairs = []
-    for seed in noise_seeds:
-        run = play_protocol(config, plain, fast_protocol(), seed)
-        pairs += edge_pairs(run.points, options, truth)
-    scores = edge_curve_scores(pairs)
-    return with_edge_curve(device, (scores[0].chosen, scores[1].chosen)), scores
+    runs = [play_protocol(config, plain, fast_protocol(), seed) for seed in noise_seeds]
+    scores = edge_curve_scores([pair for run in runs
+                                for pair in edge_pairs(run.points, options, truth)])
+    return with_edge_curve(device, (scores[0].chosen, scores[1].chosen)), scores, runs

@@ -118,15 +118,21 @@ def without_offset(device: DeviceModel) -> DeviceModel:
 
 def with_reading_offset(device: DeviceModel, config: TsmdConfig, truth: Truth,
                         noise_seeds: Sequence[int],
-                        truth_points: Sequence[GridPoint] | None = None
+                        truth_points: Sequence[GridPoint] | None = None,
+                        made: tuple[DeviceModel, Sequence[ProtocolRun]] | None = None
                         ) -> tuple[DeviceModel, list[ProtocolRun]]:
     """The sheet with each knob's reading offset, from fast calibrations of its own unit
     (``config.sim``) with the sheet as chosen (no offset applied while measuring it); a knob's
     dead-zone edge gets none where the tip's reading of it is bound to the tracker's noise
     (:func:`noise_bound_edges`, on the sweeps the truth is read from: ``truth_points``, or
-    swept again when not given)."""
+    swept again when not given). ``made``: a sheet and its unit's fast calibrations already run
+    with it, one per noise seed (the edge-curve choice's), re-used where that sheet is the one
+    measured here."""
     plain = without_offset(device)
-    runs = [play_protocol(config, plain, fast_protocol(), seed) for seed in noise_seeds]
+    if made is not None and made[0] == plain and len(made[1]) == len(noise_seeds):
+        runs = list(made[1])
+    else:
+        runs = [play_protocol(config, plain, fast_protocol(), seed) for seed in noise_seeds]
     points = truth_sweeps(config) if truth_points is None else truth_points
     unsure = noise_bound_edges(points, config.sim.tracker_noise_deg)
     offsets = reading_offsets(offset_readings(runs, truth, unsure=unsure))

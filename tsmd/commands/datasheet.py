@@ -36,7 +36,7 @@ from tsmd.datasheet import (
 from tsmd.datasheet_amplitude import measure_tip_backlash_gains
 from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
 from tsmd.datasheet_coupling import measure_other_tip_gains
-from tsmd.datasheet_edge_curve import choose_edge_curve
+from tsmd.datasheet_edge_curve import choose_edge_curve, with_edge_curve
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_offset import with_reading_offset
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
@@ -207,12 +207,15 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
               f"{k.backlash_release_rule}, knee {'on' if k.backlash_knee else 'off'}")
     print(f"  rule choice: {time.monotonic() - t0:.0f} s")
     t0 = time.monotonic()
-    chosen, curve = choose_edge_curve(unit, chosen, truth, seeds)
+    before = chosen
+    chosen, curve, curve_runs = choose_edge_curve(unit, before, truth, seeds)
     for name, c in zip(("phi1", "phi2"), curve, strict=True):
         print(f"{name} curved-hinge check on the sheet's unit, fast protocol: {c.text()}")
     print(f"  edge-curve choice: {time.monotonic() - t0:.0f} s")
     t0 = time.monotonic()
-    chosen, _ = with_reading_offset(chosen, unit, truth, seeds, sweeps)
+    # where no knob took the check, the edge-curve runs are the reading offset's own
+    made = (with_edge_curve(before, (False, False)), curve_runs)
+    chosen, _ = with_reading_offset(chosen, unit, truth, seeds, sweeps, made)
     for name, k in zip(("phi1", "phi2"), chosen.knobs, strict=True):
         print(f"{name} reading offset (current minus tip, deg, at the other knob's "
               f"{_angles(k.reading_offset)}): {_offsets(k.reading_offset)}")

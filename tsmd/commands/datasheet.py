@@ -106,8 +106,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "each backlash rule; the better rule per knob goes into the sheet "
                              "(docs/calibration.md, session 11), then the unit calibrated with "
                              "it once per seed chooses each knob's curved-hinge check "
-                             "(edge_curve, session 21), and once more the product's reading "
-                             "offset (session 14; "
+                             "(edge_curve, session 21) and, with the check where taken, the "
+                             "product's reading offset (session 14; "
                              "'none': no choice and no offset, the sheet keeps the rule its "
                              "shares imply)")
     parser.add_argument("--recovery-rule", action="store_true",

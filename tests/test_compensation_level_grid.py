@@ -8,13 +8,14 @@ import dataclasses
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.play import assert_model_of_inverse_follows
 from test_compensation_tension_play_fit import DEVICE_KNOB, synthetic_sweep
 
 from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.compensation.level_grid import LevelGrid, level_grid_from_mapping, level_grid_to_mapping
 from tsmd.compensation.ours_table import OursKnob
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import inverse_step, model_step, rest_state
+from tsmd.compensation.tension_play import model_step, rest_state
 from tsmd.compensation.tension_play_params import (
     BETA_RANGE,
     TensionPlayParams,
@@ -97,12 +98,7 @@ def test_a_shifted_row_stays_continuous_and_between_its_branches(
 def test_the_model_of_a_shifted_rows_inverse_gives_the_desired_output(
         p: TensionPlayParams, other: float, path: list[float]) -> None:
     b = OursKnob.from_params(p).at(other)
-    inv = rest_state(0.0, b)
-    fwd = inv
-    for y in path:
-        inv = inverse_step(inv, y, b)
-        fwd = model_step(fwd, inv.x_deg, b)
-        assert fwd.y_deg == pytest.approx(y, abs=1e-6 * max(1.0, abs(y)))
+    assert_model_of_inverse_follows(b, path)
 
 
 def test_the_profile_block_round_trips_the_level_grid() -> None:

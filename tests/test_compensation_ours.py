@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.play import assert_model_of_inverse_follows
 
 from tsmd.compensation.ours import OursCompensator
 from tsmd.compensation.ours_table import MOVES_WITH_EDGE, OursKnob, ours_knobs
@@ -107,12 +108,7 @@ def test_rising_branch_never_above_falling_branch(p: TensionPlayParams, x: float
 def test_model_of_the_inverse_gives_the_desired_output(p: TensionPlayParams,
                                                       path: list[float]) -> None:
     b = knob_branches(p)
-    inv = rest_state(0.0, b)
-    fwd = inv
-    for y in path:
-        inv = inverse_step(inv, y, b)
-        fwd = model_step(fwd, inv.x_deg, b)
-        assert fwd.y_deg == pytest.approx(y, abs=1e-6 * max(1.0, abs(y)))
+    assert_model_of_inverse_follows(b, path)
 
 
 @given(random_params, st.floats(-100.0, 100.0), st.floats(-100.0, 100.0))

@@ -7,6 +7,7 @@ import dataclasses
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.play import assert_model_of_inverse_follows
 
 from tsmd.compensation.ours_table import OursKnob
 from tsmd.compensation.release_round import (
@@ -15,7 +16,7 @@ from tsmd.compensation.release_round import (
     rounded_drop_deg,
     rounded_gap_deg,
 )
-from tsmd.compensation.tension_play import Branches, PlayState, inverse_step, model_step, rest_state
+from tsmd.compensation.tension_play import Branches, PlayState, model_step, rest_state
 from tsmd.compensation.tension_play_params import (
     BETA_RANGE,
     TensionPlayParams,
@@ -122,12 +123,7 @@ def test_rounded_output_is_continuous_and_between_the_branches(p: TensionPlayPar
 def test_model_of_the_rounded_inverse_gives_the_desired_output(p: TensionPlayParams,
                                                               path: list[float]) -> None:
     b = knob(p)
-    inv = rest_state(0.0, b)
-    fwd = inv
-    for y in path:
-        inv = inverse_step(inv, y, b)
-        fwd = model_step(fwd, inv.x_deg, b)
-        assert fwd.y_deg == pytest.approx(y, abs=1e-6 * max(1.0, abs(y)))
+    assert_model_of_inverse_follows(b, path)
 
 
 def test_a_reversal_inside_the_dead_zone_keeps_the_output_on_its_hold() -> None:

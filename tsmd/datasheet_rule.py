@@ -38,7 +38,6 @@ RULE_NOISE_SEEDS = (0, 1)
 """Noise seeds of the sheet unit's calibrations per rule: one run per seed and rule."""
 
 
-
 @dataclass(frozen=True)
 class RuleScore:
     """One rule on one knob of the sheet's unit, over the noise seeds."""

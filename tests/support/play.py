@@ -1,0 +1,19 @@
+"""The tension-play model's exactness check shared by the property tests of its variants."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import pytest
+
+from tsmd.compensation.tension_play import Branches, inverse_step, model_step, rest_state
+
+
+def assert_model_of_inverse_follows(b: Branches, path: Sequence[float]) -> None:
+    """From rest at 0, the model fed the inverse's knob angles gives each desired output."""
+    inv = rest_state(0.0, b)
+    fwd = inv
+    for y in path:
+        inv = inverse_step(inv, y, b)
+        fwd = model_step(fwd, inv.x_deg, b)
+        assert fwd.y_deg == pytest.approx(y, abs=1e-6 * max(1.0, abs(y)))

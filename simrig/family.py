@@ -20,8 +20,9 @@ held out now, the archwave plant (session 19, written blind) is held out now (tu
 development units in session 20), the jawcrimp plant (session 20, written blind, run untuned, then
 tuned on its development units in the same session's second round) is held out, the cyclopebax
 plant (session 21, written blind, run untuned, then its sheet constant tuned on its development
-units in the same session's second round) is held out (``PLANT_ROLE``); the next blind plant
-is registered after it.
+units in the same session's second round) is held out, the snakedent plant (session 22, written
+blind: rolling vertebrae, detented knobs) is the blind plant (``PLANT_ROLE``); the next blind
+plant is registered after it.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -48,6 +49,7 @@ from simrig.plants.nitinol import NOMINAL_KNOBS as NITINOL_KNOBS
 from simrig.plants.ratestate import NOMINAL_KNOBS as RATESTATE_KNOBS
 from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
+from simrig.plants.snakedent import NOMINAL_KNOBS as SNAKEDENT_KNOBS
 from simrig.plants.stickslip import NOMINAL_KNOBS as STICKSLIP_KNOBS
 from simrig.plants.twistshaft import NOMINAL_KNOBS as TWISTSHAFT_KNOBS
 from simrig.plants.warmgear import NOMINAL_KNOBS as WARMGEAR_KNOBS
@@ -67,13 +69,14 @@ PLANT_SPECS: dict[str, str] = {
     "warmgear": "simrig.plants.warmgear:make_warmgear_plant",
     "archwave": "simrig.plants.archwave:make_archwave_plant",
     "jawcrimp": "simrig.plants.jawcrimp:make_jawcrimp_plant",
-    "cyclopebax": "simrig.plants.cyclopebax:make_cyclopebax_plant",  # last: the others' seeds hold
+    "cyclopebax": "simrig.plants.cyclopebax:make_cyclopebax_plant",
+    "snakedent": "simrig.plants.snakedent:make_snakedent_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
-              "jawcrimp": "held-out", "cyclopebax": "held-out"}
+              "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -91,7 +94,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "warmgear": WARMGEAR_KNOBS,
                                         "archwave": ARCHWAVE_KNOBS,
                                         "jawcrimp": JAWCRIMP_KNOBS,
-                                        "cyclopebax": CYCLOPEBAX_KNOBS}
+                                        "cyclopebax": CYCLOPEBAX_KNOBS,
+                                        "snakedent": SNAKEDENT_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -160,6 +164,8 @@ VARIANTS: dict[str, Variant] = {
                          "handle_friction_Nm": 1.5, "idler_friction": 1.5},
             "cyclopebax": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                            "handle_friction_Nm": 1.5, "mesh_friction": 1.3},
+            "snakedent": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                          "handle_friction_Nm": 1.5, "joint_friction_mm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -187,7 +193,8 @@ VARIANTS: dict[str, Variant] = {
                  "warmgear": {"tendon_stiffness_N": 0.4},
                  "archwave": {"tendon_stiffness_N": 0.4},
                  "jawcrimp": {"tendon_stiffness_N": 0.4},
-                 "cyclopebax": {"tendon_stiffness_N": 0.4}},
+                 "cyclopebax": {"tendon_stiffness_N": 0.4},
+                 "snakedent": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

@@ -127,8 +127,9 @@ def test_a_unit_is_the_same_catheter_for_the_same_seed() -> None:
     assert not np.array_equal(tip_a, drive_knob(c, 0, path)[0])
 
 
-def test_cyclopebax_is_registered_last_and_held_out() -> None:
-    assert list(PLANT_SPECS)[-1] == "cyclopebax"
+def test_cyclopebax_is_registered_after_jawcrimp_and_held_out() -> None:
+    names = list(PLANT_SPECS)
+    assert names.index("cyclopebax") == names.index("jawcrimp") + 1
     assert PLANT_ROLE["cyclopebax"] == "held-out"
     assert isinstance(family_member("cyclopebax", 101).build(), CycloPebaxPlant)
     assert set(SCATTER["cyclopebax"]) <= set(family_member("cyclopebax", 0).params["knobs"][0])

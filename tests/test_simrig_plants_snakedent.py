@@ -65,10 +65,11 @@ def test_the_detent_does_no_net_work_over_a_notch() -> None:
 
 
 def test_dead_zone_and_backlash_are_those_of_a_probe() -> None:
+    """Dead zone up to 28 deg: the paper's uncompensated PTPE (58-69 deg) needs 23-26 here."""
     for knob in (0, 1):
         rec = run_sweep(make_snakedent_plant(), knob)
         m = measure_dead_zone_backlash(rec.knob_deg, rec.tip_deg)
-        assert 10.0 <= m.dead_zone_pos_deg <= 25.0 and 10.0 <= -m.dead_zone_neg_deg <= 25.0
+        assert 10.0 <= m.dead_zone_pos_deg <= 28.0 and 10.0 <= -m.dead_zone_neg_deg <= 28.0
         assert 5.0 <= m.backlash_pos_deg <= 20.0 and 5.0 <= m.backlash_neg_deg <= 20.0
 
 

@@ -22,17 +22,18 @@ class SnakeDentKnob:
 
     drum_radius_mm: float = 3.5
     """Rope drum on the knob shaft (TEE handles: 3-5 mm)."""
-    slack_pos_mm: float = 0.95
-    """Rope slack at assembly (hand crimped: about 1 mm, i.e. 15 deg of a 3.5 mm drum)."""
-    slack_neg_mm: float = 1.0
+    slack_pos_mm: float = 1.62
+    """Rope slack at assembly (hand crimped: 1.6 mm, i.e. 27 deg of a 3.5 mm drum; enough for
+    the paper's uncompensated errors, PTPE 58-69 deg)."""
+    slack_neg_mm: float = 1.67
     tendon_stiffness_N: float = 45000.0
     """Rope EA: a 7x19 steel rope of 0.75 mm (metallic area ~0.24 mm^2 x ~190 GPa)."""
     sheath_length_m: float = 1.0
     """Insertion tube (TEE: ~1 m)."""
     free_length_m: float = 0.15
     """Rope in the handle and the section."""
-    sheath_friction: float = 0.17
-    """Steel rope on a PTFE-lined coil (boundary, lubricated: 0.1-0.2)."""
+    sheath_friction: float = 0.20
+    """Steel rope on a PTFE-lined coil (boundary, lubricated: 0.1-0.25)."""
     sheath_wrap_deg: float = 270.0
     """Total curve of the shaft: pharynx bend plus the oesophagus and the handle's exit."""
     sheath_drag_N: float = 0.5
@@ -41,14 +42,14 @@ class SnakeDentKnob:
     """Rope hole's distance from the vertebra axis in its plane (d)."""
     roll_radius_mm: float = 3.2
     """Radius of the vertebrae's rolling faces (R)."""
-    hole_depth_mm: float = 2.5
+    hole_depth_mm: float = 1.9
     """Depth of the rope hole's exit below the rolling face's apex (h); R - h sets how much
     the rope path lengthens on both sides as a joint rolls."""
     joints: float = 6.0
     """Rolling joints of this plane (the stack alternates the two planes' joints)."""
     bend_stiffness_Nmm_per_rad: float = 140.0
     """Per joint: the central spring spine and the polymer jacket over the stack."""
-    joint_friction_mm: float = 0.05
+    joint_friction_mm: float = 0.12
     """Per joint: friction torque per newton of stack compression (sliding at the pins'
     guides, rolling resistance of the faces): mu x lever."""
     joint_preload_N: float = 10.0
@@ -61,7 +62,7 @@ class SnakeDentKnob:
     """Angle between detent notches (24 per turn)."""
 
 
-NOMINAL_KNOBS = (SnakeDentKnob(), SnakeDentKnob(slack_pos_mm=1.05, slack_neg_mm=0.9,
+NOMINAL_KNOBS = (SnakeDentKnob(), SnakeDentKnob(slack_pos_mm=1.72, slack_neg_mm=1.57,
                                                  bend_stiffness_Nmm_per_rad=120.0,
                                                  tendon_offset_mm=2.1))
 """phi1 (anterior-posterior) and phi2 (right-left); the right-left stack is softer."""

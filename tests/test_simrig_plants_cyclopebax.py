@@ -97,6 +97,20 @@ def test_the_other_plane_bent_narrows_this_planes_dead_zone() -> None:
     assert threshold(80.0) < threshold(0.0) - 0.5
 
 
+def test_the_coupling_keyword_takes_up_this_plane_more_with_the_other_bent() -> None:
+    def tip_at_30(coupling: float) -> float:
+        plant = make_cyclopebax_plant(coupling=coupling)
+        drive_knob(plant, 1, ramp_deg(0.0, 80.0))
+        return float(drive_knob(plant, 0, ramp_deg(0.0, 30.0), 80.0)[0][-1])
+
+    def tip_straight(coupling: float) -> float:
+        plant = make_cyclopebax_plant(coupling=coupling)
+        return float(drive_knob(plant, 0, ramp_deg(0.0, 30.0))[0][-1])
+
+    assert tip_at_30(3.0) > tip_at_30(0.0) + 0.5
+    assert tip_straight(3.0) == tip_straight(0.0)  # the other plane straight: no change
+
+
 def test_an_overload_leaves_a_set_that_stops_growing() -> None:
     plant = make_cyclopebax_plant(knobs=[{"yield_tension_N": 8.0}, {}])
     drive_knob(plant, 0, _cycle(90.0))
@@ -146,6 +160,7 @@ def test_cyclopebax_is_registered_after_jawcrimp_and_held_out() -> None:
         ({"knobs": [{"lay_asymmetry": 1.0}, {}]}, "lay_asymmetry must be < 1"),
         ({"knobs": [{"mesh_friction": 0.6}, {}]}, "mesh_friction must be < 0.5"),
         ({"sheath_curvature_deg": -10.0}, "sheath_curvature_deg must be >= 0"),
+        ({"coupling": -1.0}, "coupling must be >= 0"),
     ],
 )
 def test_bad_constants_are_refused_with_one_clear_line(kwargs: dict[str, object],

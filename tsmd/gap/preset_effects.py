@@ -271,3 +271,31 @@ JAWCRIMP_MAX_STEP_S = 0.004
 """The nominal-scatter unit's tip lies 0.045 deg RMS (0.61 max) from 1 ms steps at 20 ms steps,
 0.008 (0.17) at 4 ms (unit 1, 120 s of the experiment motion): the crimps' creep and the node's
 stick are integrated per step; as data it is stepped at 4 ms, the plant's own step."""
+
+
+CYCLOPEBAX_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"coupling": 3.0},
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The cyclopebax plant's effect keywords, sized before any diagnosis (tip RMSE effect on minus
+off, units 1 / 2, noise-free, 120 s of the experiment motion at 50 Hz): the other plane's
+neutral-axis take-up on every rope four times the section's own (``coupling`` 3.0, the plant's
+keyword added for this preset; x2 0.49 / 0.49, x3 0.97 / 0.93, x6 2.99 / 2.85), 1.52 / 1.44 deg
+(the others' coupling 1.5 deg); a 120 deg sheath bend (added to the coil lumen's wrap), 3.99 /
+4.73 deg (60 deg 1.85 / 2.31), inside the others' 1.1-12.8 deg. Its laws read the knob angle
+only (the reducer's and the brake's presliding are in angle, the lumen friction is Coulomb and
+no law takes the step's time) and nothing moves at a held knob (the ropes' set follows the
+tension, not time): rate and creep are not run. "None" is the nominal physics as written
+(docs/gap.md "Session 22")."""
+
+CYCLOPEBAX_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Compliance on cyclopebax as a factor on the unit's knob constants, sized before any
+diagnosis (same criterion): the steel rope's EA halved, 4.19 / 4.31 deg (units 1 / 2)."""
+
+CYCLOPEBAX_MAX_STEP_S = 0.0
+"""No finer stepping: the nominal-scatter unit's tip lies 0.19 deg RMS from 0.25 ms steps at 20
+ms, and no closer at 4 ms (0.17), 1 ms (0.16) or 0.5 ms (0.12; unit 1, 120 s of the experiment
+motion): its rope contacts slip in events whose timing moves with the step, as a real catheter's
+would with the drive's own timing; a finer step buys nothing."""

@@ -23,6 +23,9 @@ from tsmd.gap.preset_effects import (
     COILPIPE_BASE,
     COILPIPE_EFFECTS,
     COILPIPE_KNOB_EFFECTS,
+    CYCLOPEBAX_EFFECTS,
+    CYCLOPEBAX_KNOB_EFFECTS,
+    CYCLOPEBAX_MAX_STEP_S,
     HELIXBELT_EFFECTS,
     HELIXBELT_KNOB_EFFECTS,
     JAWCRIMP_EFFECTS,
@@ -155,6 +158,10 @@ PRESETS: dict[str, PlantSpec] = {
     "jawcrimp": PlantSpec(PLANT_SPECS["jawcrimp"], {}, (), "jawcrimp", family="jawcrimp",
                           effects=JAWCRIMP_EFFECTS, knob_effects=JAWCRIMP_KNOB_EFFECTS,
                           max_step_s=JAWCRIMP_MAX_STEP_S),
+    "cyclopebax": PlantSpec(PLANT_SPECS["cyclopebax"], {}, (), "cyclopebax",
+                            family="cyclopebax", effects=CYCLOPEBAX_EFFECTS,
+                            knob_effects=CYCLOPEBAX_KNOB_EFFECTS,
+                            max_step_s=CYCLOPEBAX_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

@@ -51,14 +51,19 @@ class CycloPebaxPlant:
     """Two knobs of the cyclopebax catheter (see the module docstring)."""
 
     def __init__(self, knobs: Sequence[CycloPebaxKnob],
-                 sheath_curvature_deg: float = 0.0) -> None:
+                 sheath_curvature_deg: float = 0.0, coupling: float = 0.0) -> None:
         if len(knobs) != 2:
             raise PlantLoadError(f"cyclopebax takes 2 knobs, got {len(knobs)}")
         if not (math.isfinite(sheath_curvature_deg) and sheath_curvature_deg >= 0.0):
             raise PlantLoadError(f"cyclopebax sheath_curvature_deg must be >= 0, got "
                                  f"{sheath_curvature_deg!r}")
+        if not (math.isfinite(coupling) and coupling >= 0.0):
+            raise PlantLoadError(f"cyclopebax coupling must be >= 0, got {coupling!r}")
         self.knobs = tuple(knobs)
         self.sheath_curvature_deg = float(sheath_curvature_deg)
+        # the other plane's neutral-axis take-up on this plane's ropes, as a share of what the
+        # section as written takes (``coupling`` adds to it: lumens set off their plane)
+        self.cross_takeup_share = 1.0 + float(coupling)
         self.slack_delta_mm = [[0.0, 0.0], [0.0, 0.0]]
         self._tables: list[SectionTable] = [section_table(k.bend_stiffness_Nmm_per_rad)
                                             for k in self.knobs]
@@ -104,7 +109,8 @@ class CycloPebaxPlant:
         torque = [0.0, 0.0]
         for j in (0, 1):
             other = 1 - j
-            takeup_other = section_at(self._tables[other], bends[other])[2]
+            takeup_other = (self.cross_takeup_share
+                            * section_at(self._tables[other], bends[other])[2])
             torque[j] = self._step_knob(j, q[j], total, takeup_other)
         tip = np.array([self.bend_rad[0] / _DEG, self.bend_rad[1] / _DEG])
         return PlantStep(tip, np.array(torque))
@@ -200,11 +206,13 @@ class CycloPebaxPlant:
 
 
 def make_cyclopebax_plant(knobs: Sequence[dict[str, Any] | CycloPebaxKnob] | None = None,
-                          sheath_curvature_deg: float = 0.0) -> CycloPebaxPlant:
-    """A cyclopebax catheter: ``knobs=[{...}, {...}]`` overrides the nominal constants."""
+                          sheath_curvature_deg: float = 0.0,
+                          coupling: float = 0.0) -> CycloPebaxPlant:
+    """A cyclopebax catheter: ``knobs=[{...}, {...}]`` overrides the nominal constants;
+    ``coupling`` adds that many times the other plane's take-up to every rope (0: as written)."""
     if knobs is None:
         knobs = NOMINAL_KNOBS
     if len(knobs) != 2:
         raise PlantLoadError(f"cyclopebax takes 2 knobs, got {len(knobs)}")
     return CycloPebaxPlant([knob_from(v, n) for v, n in zip(knobs, NOMINAL_KNOBS, strict=True)],
-                           sheath_curvature_deg)
+                           sheath_curvature_deg, coupling)

@@ -31,11 +31,10 @@ from tsmd.config import TsmdConfig
 from tsmd.datasheet_rule_halves import points_half_cycle_reads
 from tsmd.datasheet_rule_settled import (
     CANDIDATES,
-    SETTLED_SHARE,
+    SWING_KNEE,
     as_candidate,
-    candidate_of,
-    settled_swing,
-    with_settled_share,
+    offered,
+    with_swing_knee,
 )
 from tsmd.profile import DeviceKnob, DeviceModel
 from tsmd.profile.types import RELEASE_RULES
@@ -96,9 +95,9 @@ def with_rule(device: DeviceModel, rule: str) -> DeviceModel:
 def usable(knob: DeviceKnob, rule: str) -> bool:
     """Whether the knob's sheet has the share ``rule`` needs (the lag for "recovery", which
     ``tsmd datasheet --recovery-rule`` measures first, :mod:`tsmd.datasheet_recovery`; a
-    settled swing share for :data:`~tsmd.datasheet_rule_settled.SETTLED_SHARE`)."""
-    if rule == SETTLED_SHARE:
-        return settled_swing(knob)
+    knob a rule reads by the settle rule for :data:`~tsmd.datasheet_rule_settled.SWING_KNEE`)."""
+    if rule == SWING_KNEE:
+        return offered(knob)
     share = {"line": knob.backlash_release_line_share,
              "local": knob.backlash_release_local_share,
              "recovery": knob.backlash_recovery_lag_deg}.get(rule, 1.0)
@@ -164,15 +163,15 @@ def scored(config: TsmdConfig, candidate: DeviceModel, label: str, truth: Truth,
 def rule_scores(config: TsmdConfig, device: DeviceModel,
                 noise_seeds: Sequence[int] = RULE_NOISE_SEEDS,
                 truth: Truth | None = None) -> list[RuleScore]:
-    """Each rule on the sheet's unit (``config.sim``), scored per knob; where a knob's share is
-    settled, "swing" read at that share too (:mod:`tsmd.datasheet_rule_settled`), scored on
-    those knobs only."""
+    """Each rule on the sheet's unit (``config.sim``), scored per knob; where a rule reads a
+    knob by the settle rule, "swing" read at its share with the knee too
+    (:mod:`tsmd.datasheet_rule_settled`), scored on those knobs only."""
     truth = sheet_truth(config) if truth is None else truth
     out = [one for rule in RELEASE_RULES if any(usable(k, rule) for k in device.knobs)
            for one in scored(config, with_rule(device, rule), rule, truth, noise_seeds)]
-    if any(settled_swing(k) for k in device.knobs):
-        out += [s for s in scored(config, with_settled_share(device), SETTLED_SHARE, truth,
-                                  noise_seeds) if settled_swing(device.knobs[s.knob])]
+    if any(offered(k) for k in device.knobs):
+        out += [s for s in scored(config, with_swing_knee(device), SWING_KNEE, truth,
+                                  noise_seeds) if offered(device.knobs[s.knob])]
     return out
 
 
@@ -202,10 +201,10 @@ def knee_choice(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
     31 and 45 of 56 with it, 56/56 without)."""
     on = []
     for knob, k in enumerate(chosen.knobs):
-        plain = [s for s in rule_scores_ if s.knob == knob and s.rule == candidate_of(k)]
+        plain = [s for s in rule_scores_ if s.knob == knob and s.rule == k.backlash_release_rule]
         knee = [s for s in knee_scores if s.knob == knob]
-        # the settled share's candidate was scored with the knee: it has no other
-        on.append(bool(k.backlash_settled_share)
+        # a candidate chosen with its knee (SWING_KNEE) was scored with it: it has no other
+        on.append(bool(k.backlash_knee)
                   or (bool(plain and knee) and knee[0].key() <= plain[0].key()))
     return with_rule_gains(with_knee(chosen, (on[0], on[1])), rule_scores_, knee_scores)
 
@@ -217,7 +216,7 @@ def with_rule_gains(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
     knobs = []
     for knob, k in enumerate(chosen.knobs):
         pool = knee_scores if k.backlash_knee else [
-            s for s in rule_scores_ if s.rule == candidate_of(k)]
+            s for s in rule_scores_ if s.rule == k.backlash_release_rule]
         gains = [s.backlash_gain for s in pool if s.knob == knob and s.backlash_gain is not None]
         gain = round(gains[0], 3) if gains else None
         knobs.append(dataclasses.replace(k, reference_rule_backlash_gain=gain))
@@ -232,8 +231,8 @@ def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceMode
     points), the rule that placed the most values within the target (then: the most runs
     accepted); a tie keeps the earlier of :data:`RELEASE_RULES` ("line": the rule of a sheet
     with a line share and no choice, chosen on the development units of lumped and segments;
-    the settled share's candidate last, so a tie keeps the settle rule); a rule needs its
-    share."""
+    :data:`~tsmd.datasheet_rule_settled.SWING_KNEE` last, so a tie keeps the rule of before);
+    a rule needs its share."""
     knobs = []
     for knob, k in enumerate(device.knobs):
         mine = [s for s in scores if s.knob == knob and usable(k, s.rule)]

@@ -32,8 +32,13 @@ def test_a_mean_between_two_features_is_written_as_zero() -> None:
     assert grid.mean_deg == (0.0,) and grid.u95_deg == (1.8,)
 
 
-def test_an_offset_whose_gain_is_within_its_half_width_is_written_as_zero() -> None:
+def test_a_steady_offset_is_written_however_wide_its_half_width() -> None:
     kept = helpful_offset(offset(-1.5, 1.6), 0, {(0, 0.0): {"backlash_pos_deg": STEADY}})
+    assert kept is not None and kept.grid("backlash_pos_deg").mean_deg == (-1.5,)
+
+
+def test_an_offset_without_its_readings_is_written_as_zero() -> None:
+    kept = helpful_offset(offset(-1.5, 0.3), 0, {})
     assert kept is not None and kept.grid("backlash_pos_deg").mean_deg == (0.0,)
 
 

@@ -128,8 +128,8 @@ def with_reading_offset(device: DeviceModel, config: TsmdConfig, truth: Truth,
     (:func:`noise_bound_edges`, on the sweeps the truth is read from: ``truth_points``, or
     swept again when not given). ``made``: a sheet and its unit's fast calibrations already run
     with it, one per noise seed (the edge-curve choice's), re-used where that sheet is the one
-    measured here. A backlash offset is written where it helps those readings by more than its
-    own half-width, else 0 (:mod:`tsmd.datasheet_offset_help`)."""
+    measured here. A backlash offset is written where it lowers those readings' mean absolute
+    error, else 0 (:mod:`tsmd.datasheet_offset_help`)."""
     plain = without_offset(device)
     if made is not None and made[0] == plain and len(made[1]) == len(noise_seeds):
         runs = list(made[1])

@@ -8,8 +8,12 @@ sweep's first one 5-10 deg late) the mean lies between them and subtracting it m
 readings off by as much as it moves the late ones on: the mean +3.0 +- 1.8 deg at the other
 knob's -90 put development unit 1's right readings 3.6 deg short (docs/calibration.md, session
 21). So each B offset is tested on the readings it was measured from: the mean absolute error
-with it taken out must be smaller than without by more than the offset's own 95 % half-width;
-else the sheet writes 0 there (its half-width and half-cycles kept: what was measured).
+with it taken out must be smaller than without; else the sheet writes 0 there (its half-width
+and half-cycles kept: what was measured). Not "smaller by more than its 95 % half-width": on
+screwrod that dropped phi2's B_neg offset at the other knob's -90 deg (-1.69 +- 1.20, gain 0.79)
+and development units 1-2 lost 3 of 112 values (104 -> 101, max 3.27 -> 3.78; session 22).
+Whether an offset is then applied stays the calibration's decision
+(:mod:`tsmd.calibration.reading_offset`).
 """
 
 from __future__ import annotations
@@ -38,9 +42,9 @@ def offset_gain_deg(errors: Sequence[float], offset_deg: float) -> float:
 
 def helpful_grid(grid: OffsetGrid, errors: Sequence[Sequence[float]]) -> OffsetGrid:
     """``grid`` with its mean set to 0 at each angle where it does not lower the mean absolute
-    error of that angle's ``errors`` by more than its own 95 % half-width."""
-    means = tuple(m if offset_gain_deg(e, m) > u else 0.0
-                  for m, u, e in zip(grid.mean_deg, grid.u95_deg, errors, strict=True))
+    error of that angle's ``errors``."""
+    means = tuple(m if offset_gain_deg(e, m) > 0.0 else 0.0
+                  for m, e in zip(grid.mean_deg, errors, strict=True))
     return dataclasses.replace(grid, mean_deg=means)
 
 

@@ -30,6 +30,7 @@ from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.calibration.sweep_result import PARAMETERS, SweepResult
 from tsmd.config import TsmdConfig
+from tsmd.datasheet_offset_help import helpful_offset
 from tsmd.datasheet_rule import Truth
 from tsmd.profile import DeviceModel
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
@@ -127,7 +128,8 @@ def with_reading_offset(device: DeviceModel, config: TsmdConfig, truth: Truth,
     (:func:`noise_bound_edges`, on the sweeps the truth is read from: ``truth_points``, or
     swept again when not given). ``made``: a sheet and its unit's fast calibrations already run
     with it, one per noise seed (the edge-curve choice's), re-used where that sheet is the one
-    measured here."""
+    measured here. A backlash offset is written where it lowers those readings' mean absolute
+    error, else 0 (:mod:`tsmd.datasheet_offset_help`)."""
     plain = without_offset(device)
     if made is not None and made[0] == plain and len(made[1]) == len(noise_seeds):
         runs = list(made[1])
@@ -135,7 +137,9 @@ def with_reading_offset(device: DeviceModel, config: TsmdConfig, truth: Truth,
         runs = [play_protocol(config, plain, fast_protocol(), seed) for seed in noise_seeds]
     points = truth_sweeps(config) if truth_points is None else truth_points
     unsure = noise_bound_edges(points, config.sim.tracker_noise_deg)
-    offsets = reading_offsets(offset_readings(runs, truth, unsure=unsure))
-    knobs = tuple(dataclasses.replace(k, reading_offset=o)
-                  for k, o in zip(plain.knobs, offsets, strict=True))
+    readings = offset_readings(runs, truth, unsure=unsure)
+    offsets = reading_offsets(readings)
+    # a backlash offset only where it helps the readings it came from (session 22)
+    knobs = tuple(dataclasses.replace(k, reading_offset=helpful_offset(o, knob, readings))
+                  for knob, (k, o) in enumerate(zip(plain.knobs, offsets, strict=True)))
     return dataclasses.replace(plain, knobs=(knobs[0], knobs[1])), runs

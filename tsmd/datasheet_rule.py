@@ -29,6 +29,13 @@ from tsmd.calibration.protocol import fast_protocol
 from tsmd.calibration.tension_play_fit import fit_sweep_sides, sweeps_from_points
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_rule_halves import points_half_cycle_reads
+from tsmd.datasheet_rule_settled import (
+    CANDIDATES,
+    SWING_KNEE,
+    as_candidate,
+    offered,
+    with_swing_knee,
+)
 from tsmd.profile import DeviceKnob, DeviceModel
 from tsmd.profile.types import RELEASE_RULES
 from tsmd.tip_truth import tip_truth
@@ -79,14 +86,18 @@ def with_rule(device: DeviceModel, rule: str) -> DeviceModel:
     that share)."""
     if rule not in RELEASE_RULES:
         raise ValueError(f"unknown backlash rule {rule!r}")
-    knobs = tuple(dataclasses.replace(k, backlash_release_rule=rule if usable(k, rule) else None)
+    knobs = tuple(dataclasses.replace(k, backlash_release_rule=rule if usable(k, rule) else None,
+                                      backlash_settled_share=None)
                   for k in device.knobs)
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
 def usable(knob: DeviceKnob, rule: str) -> bool:
     """Whether the knob's sheet has the share ``rule`` needs (the lag for "recovery", which
-    ``tsmd datasheet --recovery-rule`` measures first, :mod:`tsmd.datasheet_recovery`)."""
+    ``tsmd datasheet --recovery-rule`` measures first, :mod:`tsmd.datasheet_recovery`; a
+    knob a rule reads by the settle rule for :data:`~tsmd.datasheet_rule_settled.SWING_KNEE`)."""
+    if rule == SWING_KNEE:
+        return offered(knob)
     share = {"line": knob.backlash_release_line_share,
              "local": knob.backlash_release_local_share,
              "recovery": knob.backlash_recovery_lag_deg}.get(rule, 1.0)
@@ -152,10 +163,16 @@ def scored(config: TsmdConfig, candidate: DeviceModel, label: str, truth: Truth,
 def rule_scores(config: TsmdConfig, device: DeviceModel,
                 noise_seeds: Sequence[int] = RULE_NOISE_SEEDS,
                 truth: Truth | None = None) -> list[RuleScore]:
-    """Each rule on the sheet's unit (``config.sim``), scored per knob."""
+    """Each rule on the sheet's unit (``config.sim``), scored per knob; where a rule reads a
+    knob by the settle rule, "swing" read at its share with the knee too
+    (:mod:`tsmd.datasheet_rule_settled`), scored on those knobs only."""
     truth = sheet_truth(config) if truth is None else truth
-    return [one for rule in RELEASE_RULES if any(usable(k, rule) for k in device.knobs)
-            for one in scored(config, with_rule(device, rule), rule, truth, noise_seeds)]
+    out = [one for rule in RELEASE_RULES if any(usable(k, rule) for k in device.knobs)
+           for one in scored(config, with_rule(device, rule), rule, truth, noise_seeds)]
+    if any(offered(k) for k in device.knobs):
+        out += [s for s in scored(config, with_swing_knee(device), SWING_KNEE, truth,
+                                  noise_seeds) if offered(device.knobs[s.knob])]
+    return out
 
 
 def with_knee(device: DeviceModel, on: tuple[bool, bool]) -> DeviceModel:
@@ -186,7 +203,9 @@ def knee_choice(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
     for knob, k in enumerate(chosen.knobs):
         plain = [s for s in rule_scores_ if s.knob == knob and s.rule == k.backlash_release_rule]
         knee = [s for s in knee_scores if s.knob == knob]
-        on.append(bool(plain and knee) and knee[0].key() <= plain[0].key())
+        # a candidate chosen with its knee (SWING_KNEE) was scored with it: it has no other
+        on.append(bool(k.backlash_knee)
+                  or (bool(plain and knee) and knee[0].key() <= plain[0].key()))
     return with_rule_gains(with_knee(chosen, (on[0], on[1])), rule_scores_, knee_scores)
 
 
@@ -211,7 +230,8 @@ def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceMode
     a loaded gear step 36-38 deg off, and on development unit 1 it did so at two of three grid
     points), the rule that placed the most values within the target (then: the most runs
     accepted); a tie keeps the earlier of :data:`RELEASE_RULES` ("line": the rule of a sheet
-    with a line share and no choice, chosen on the development units of lumped and segments);
+    with a line share and no choice, chosen on the development units of lumped and segments;
+    :data:`~tsmd.datasheet_rule_settled.SWING_KNEE` last, so a tie keeps the rule of before);
     a rule needs its share."""
     knobs = []
     for knob, k in enumerate(device.knobs):
@@ -221,6 +241,6 @@ def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceMode
             continue
         fewest = min(s.half_misread for s in mine)
         mine = [s for s in mine if s.half_misread == fewest]
-        best = min(mine, key=lambda s: (s.key(), RELEASE_RULES.index(s.rule)))
-        knobs.append(dataclasses.replace(k, backlash_release_rule=best.rule))
+        best = min(mine, key=lambda s: (s.key(), CANDIDATES.index(s.rule)))
+        knobs.append(as_candidate(k, best.rule))
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))

@@ -181,7 +181,8 @@ def for_product(options: IdentifyOptions, settle_fraction: float | None,
                 rule: str | None = None,
                 local_share: float | None = None,
                 recovery_lag_deg: float | None = None,
-                reference: BacklashReference | None = None) -> IdentifyOptions:
+                reference: BacklashReference | None = None,
+                settled_share: bool = False) -> IdentifyOptions:
     """The identification for one knob of a product whose data sheet measured how far the
     current has come back when the tip starts to move: below :data:`SETTLED_FRACTION` the
     backlash ends at that share of the current's swing ("fraction"), moved per sweep by the
@@ -192,7 +193,9 @@ def for_product(options: IdentifyOptions, settle_fraction: float | None,
     "swing" (``DeviceKnob.backlash_release_rule``: the product keeps the share of the swing)
     or "local" (the share ``local_share`` of the gap to the branch just beyond the end), or
     "recovery" (the end of the current's recovery from its overshoot plus
-    ``recovery_lag_deg``, the sheet's ``reference`` where no half-cycle shows it)."""
+    ``recovery_lag_deg``, the sheet's ``reference`` where no half-cycle shows it).
+    ``settled_share`` (the sheet's ``backlash_settled_share``, session 22): "swing" reads its
+    share even at or above :data:`SETTLED_FRACTION`."""
     if options.backlash != "settle":
         return options
     if rule == "recovery" and recovery_lag_deg is not None:
@@ -210,7 +213,8 @@ def for_product(options: IdentifyOptions, settle_fraction: float | None,
             return line
         return replace(line, backlash_reference_slope_ratio=slope_ratio,
                        backlash_share_per_slope_ratio=LINE_SHARE_PER_SLOPE_RATIO)
-    if settle_fraction is None or settle_fraction >= SETTLED_FRACTION:
+    settles = not (settled_share and rule == "swing")
+    if settle_fraction is None or (settles and settle_fraction >= SETTLED_FRACTION):
         if settle_lag_deg is None or settle_fraction is None:
             return options
         return replace(options, backlash_settle_lag_deg=settle_lag_deg)
@@ -230,7 +234,8 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
         one = for_product(base, k.backlash_settle_fraction, k.backlash_release_slope_ratio,
                           k.backlash_settle_lag_deg, k.backlash_release_line_share,
                           k.backlash_release_rule, k.backlash_release_local_share,
-                          k.backlash_recovery_lag_deg, BacklashReference.of(k))
+                          k.backlash_recovery_lag_deg, BacklashReference.of(k),
+                          bool(k.backlash_settled_share))
         # the product's knee (tsmd datasheet) where the sheet turns it on
         one = replace(one, backlash_knee=True) if k.backlash_knee else one
         one = replace(one, edge_curve=True) if k.edge_curve else one

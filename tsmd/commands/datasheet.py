@@ -49,6 +49,7 @@ from tsmd.datasheet_rule import (
     rule_scores,
     sheet_truth,
 )
+from tsmd.datasheet_rule_settled import rule_text
 from tsmd.datasheet_shape_grid import measure_shape_grids
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.profile.reading_offset import ReadingOffset
@@ -204,7 +205,7 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
         k = chosen.knobs[knob]
         print(f"{name} backlash rule on the sheet's unit, fast protocol, noise seeds "
               f"{','.join(map(str, seeds))}: {mine}; with the knee: {knee[knob].text()} -> "
-              f"{k.backlash_release_rule}, knee {'on' if k.backlash_knee else 'off'}")
+              f"{rule_text(k)}, knee {'on' if k.backlash_knee else 'off'}")
     print(f"  rule choice: {time.monotonic() - t0:.0f} s")
     t0 = time.monotonic()
     before = chosen

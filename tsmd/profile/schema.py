@@ -98,7 +98,7 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
 """Optional data-sheet numbers written only when measured (the backlash rules' constants)."""
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_recovery_lag_deg", "backlash_bend_gain", "backlash_release_rule",
-                      "backlash_knee", "edge_curve", "release_ratio_gain")
+                      "backlash_settled_share", "backlash_knee", "edge_curve", "release_ratio_gain")
 _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
 _SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
@@ -149,6 +149,14 @@ def _release_rule(r: Reader, k: Mapping[str, Any], key: str) -> str | None:
         if rule == needs and k.get(share) is None:
             raise r.fail(f"{key}.backlash_release_rule", f"'{needs}' needs {share}")
     return rule
+
+
+def _settled_share(r: Reader, k: Mapping[str, Any], key: str) -> bool | None:
+    """``backlash_settled_share``: a flag, and only with the rule whose share it reads."""
+    value = _knee(r, k.get("backlash_settled_share"), f"{key}.backlash_settled_share")
+    if value and k.get("backlash_release_rule") != "swing":
+        raise r.fail(f"{key}.backlash_settled_share", "needs backlash_release_rule: swing")
+    return value
 
 
 def _knee(r: Reader, value: Any, where: str) -> bool | None:
@@ -214,6 +222,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_recovery_lag_deg=optional("backlash_recovery_lag_deg"),
             backlash_bend_gain=optional("backlash_bend_gain"),
             backlash_release_rule=_release_rule(r, k, key),
+            backlash_settled_share=_settled_share(r, k, key),
             backlash_knee=_knee(r, k.get("backlash_knee"), f"{key}.backlash_knee"),
             edge_curve=_knee(r, k.get("edge_curve"), f"{key}.edge_curve"),
             release_ratio_gain=_ratio_gain(r, k, key),

@@ -133,6 +133,12 @@ class DeviceKnob:
     the one whose calibration of the sheet's own unit best reproduces its tracked tip (session
     11); without it a sheet keeps the rule its fields imply (line where the line share is
     given)."""
+    backlash_settled_share: bool | None = None
+    """Optional, the product's choice (``tsmd datasheet``, session 22): ``true`` where the
+    knob's rule ("swing") reads its share even though the share is settled (at or above
+    :data:`tsmd.calibration.options.SETTLED_FRACTION`), with the knee where chosen, instead of
+    the paper's settle rule (jawcrimp phi1: the current still moves when the tip lets go, and
+    the settle point comes late on some half-cycles). Absent: the settle rule, as before."""
     backlash_recovery_lag_deg: float | None = None
     """Optional, on the data-sheet unit: knob travel from the end of the current's recovery
     from its overshoot after a reversal (:func:`tsmd.calibration.recovery.recovery_end`) to

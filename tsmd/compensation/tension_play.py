@@ -249,8 +249,9 @@ def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
             x = interp_linear(y_deg, b.falling_deg, b.knots)
         if x > x_prev:
             x = x_prev
-    if turned and x == x_prev and (k > 0.0 or state.round_deg > 0.0):
-        # the knob does not move, so the catheter sees no reversal: a rounded release goes on
+    if turned and x == x_prev:
+        # the knob does not move, so the catheter sees no reversal: a rounded release goes on,
+        # and none starts later from a turn the model never made
         return PlayState(x, y_deg, state.direction, state.held_deg, state.round_deg)
     return PlayState(x, y_deg, direction, held, k)
 

@@ -4,10 +4,12 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tsmd.cli import main
 from tsmd.compensation.loaded_shape import LoadedShape, shaped_height
 from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.paper import plateau_heights
@@ -94,3 +96,16 @@ def test_a_knob_left_straight_loses_its_templates_and_knees() -> None:
     assert (plain.loaded_shape_pos, plain.loaded_shape_neg, plain.loaded_knee_pos_deg,
             plain.loaded_knee_neg_deg) == (None, None, None, None)
     assert plain.omega == knob.omega
+
+
+@pytest.mark.parametrize("extra", [["--loaded-shape"], []])
+def test_the_choice_without_a_plant_or_with_loaded_shape_is_refused_in_one_line(
+        extra: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    source = (["--plant", "simrig.plants.capstan:make_tendon_sheath_plant"] if extra
+              else ["--from-recording", str(tmp_path / "a.csv"), str(tmp_path / "b.csv")])
+    code = main(["datasheet", *source, *extra, "--choose-loaded-shape", "--device-model", "x",
+                 "--out", str(tmp_path / "d.yaml")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert "--choose-loaded-shape" in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "d.yaml").exists()

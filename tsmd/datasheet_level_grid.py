@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.plant import Plant
+from tsmd.calibration.run import Calibration
 from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.tension_play_params import TensionPlayParams
@@ -99,6 +100,25 @@ def level_grid(sweeps: Sequence[tuple[float, TrackedSweep]], tension: TensionPla
                      tuple(round(v, 2) for v in neg))
 
 
+def tracked_sweeps(result: Calibration, knob: int, stage: str
+                   ) -> list[tuple[float, TrackedSweep]]:
+    """``(other knob's grid angle, sweep)`` of one knob from a tracked calibration of the sheet's
+    unit; TsmdError naming ``stage`` where the knob has no tracked sweep."""
+    mine = [p for p in result.points if p.knob == knob and p.recording is not None]
+    if not mine:
+        raise TsmdError(f"{stage}: no tracked sweep of knob {knob + 1}")
+    sweeps = []
+    for point in mine:
+        rec = point.recording
+        assert rec is not None
+        if not rec.has_tip:
+            raise TsmdError(f"{stage}: {point.name} has no tracked tip")
+        sweeps.append((float(point.other_deg), TrackedSweep(
+            np.asarray(rec[f"pos{knob + 1}"], float), np.asarray(rec[f"pos{2 - knob}"], float),
+            np.asarray(rec[f"tip{knob + 1}"], float))))
+    return sweeps
+
+
 def measure_level_grids(plant_factory: Callable[[], Plant], device: DeviceModel,
                         seed: int = 2000, config: TsmdConfig | None = None
                         ) -> tuple[LevelGrid | None, LevelGrid | None]:
@@ -107,19 +127,9 @@ def measure_level_grids(plant_factory: Callable[[], Plant], device: DeviceModel,
     grids: list[LevelGrid | None] = []
     for knob in (0, 1):
         tension = result.profile.knobs[knob].tension_play
-        mine = [p for p in result.points if p.knob == knob and p.recording is not None]
-        if tension is None or not mine:
+        if tension is None:
             raise TsmdError(f"level grid: no tracked sweep of knob {knob + 1}")
-        sweeps = []
-        for point in mine:
-            rec = point.recording
-            assert rec is not None
-            if not rec.has_tip:
-                raise TsmdError(f"level grid: {point.name} has no tracked tip")
-            sweeps.append((float(point.other_deg), TrackedSweep(
-                np.asarray(rec[f"pos{knob + 1}"], float), np.asarray(rec[f"pos{2 - knob}"], float),
-                np.asarray(rec[f"tip{knob + 1}"], float))))
-        grids.append(level_grid(sweeps, tension))
+        grids.append(level_grid(tracked_sweeps(result, knob, "level grid"), tension))
     return grids[0], grids[1]
 
 

@@ -50,6 +50,7 @@ from tsmd.datasheet_rule import (
     sheet_truth,
 )
 from tsmd.datasheet_rule_settled import rule_text
+from tsmd.datasheet_shape_choice import with_shape_choice
 from tsmd.datasheet_shape_grid import measure_shape_grids
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.profile.reading_offset import ReadingOffset
@@ -78,6 +79,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "loaded lines by it; off by default, docs/model.md Session 10) and, "
                              "with --plant, its templates over the other knob's angle (the "
                              "calibration grid, 14 more sweeps; Session 15)")
+    parser.add_argument("--choose-loaded-shape", action="store_true",
+                        help="with --plant and without --loaded-shape: measure each knob's "
+                             "loaded-branch template and keep it where the sheet's unit, "
+                             "calibrated once more and tracked, shows the bent line nearer its "
+                             "tip (one more calibration; docs/model.md Session 22)")
     parser.add_argument("--tip-backlash-gain", action="store_true",
                         help="with --plant: also track the tip's backlash after reversals at "
                              "+-60 and +-90 deg (2 sweeps more per knob); method ours then takes "
@@ -322,6 +328,9 @@ def _or_none(value: float | None, decimals: int) -> str:
 def main(args: argparse.Namespace) -> int:
     if args.params is not None and args.plant is None:
         raise DatasheetError("--params goes with --plant")
+    if args.choose_loaded_shape and (args.plant is None or args.loaded_shape):
+        raise DatasheetError("--choose-loaded-shape goes with --plant and without --loaded-shape "
+                             "(which keeps the templates and their grid unchosen)")
     if args.bend_relation and args.plant is None:
         raise DatasheetError("--bend-relation goes with --plant (the unit is calibrated bent on "
                              "the simulated rig)")
@@ -355,7 +364,7 @@ def main(args: argparse.Namespace) -> int:
         config = load_config(args.config if args.config is not None else DEFAULT_CONFIG_PATH)
         source = "recordings " + ", ".join(Path(p).name for p in args.from_recording)
     device = device_model(args.device_model, constants, config, args.description,
-                          loaded_shape=args.loaded_shape)
+                          loaded_shape=args.loaded_shape or args.choose_loaded_shape)
     device, dropped = readable(device)
     for line in dropped:
         print(f"warning: {line}")
@@ -369,6 +378,8 @@ def main(args: argparse.Namespace) -> int:
         device = _with_shape_grid(device, config, factory, args.seed)
     if args.plant is not None and seeds:
         device = _choose_rule(device, config, args.plant, params, seeds, args.recovery_rule)
+    if args.plant is not None and args.choose_loaded_shape:  # under the sheet's rules
+        device = with_shape_choice(device, config, factory, args.seed)
     if args.plant is not None and args.bend_relation:
         device = _with_bend(device, config, factory)
     if args.plant is not None and args.release_end_offset:
@@ -404,7 +415,7 @@ def main(args: argparse.Namespace) -> int:
               f"{c.release_reversals} reversals")
         for side, shape in (("+", c.loaded_shape_pos), ("-", c.loaded_shape_neg)):
             # tip travel past the plateau over knob travel past the edge
-            if args.loaded_shape and shape is not None:
+            if (args.loaded_shape or args.choose_loaded_shape) and shape is not None:
                 print(f"  loaded shape {side}: T(u)/u " + " ".join(
                     f"{u:g}:{t / u:.3f}" for u, t in zip(shape.travel_deg[1:],
                                                          shape.shaped_deg[1:], strict=True)))

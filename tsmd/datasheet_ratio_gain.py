@@ -26,15 +26,17 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from simrig.plant import Plant
-from tsmd.bench.accuracy import run_scenario
-from tsmd.bench.accuracy_scenarios import Scenario, scenarios
 from tsmd.compensation.release_ratio import ratio_gain, release_ratio_problem
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_unit_run import SHEET_UNIT_SEED, calibrate_sheet_unit
-from tsmd.profile import DeviceKnob, DeviceModel
+from tsmd.profile import CatheterProfile, DeviceKnob, DeviceModel
+from tsmd.replay import run_trajectory
+from tsmd.tracking_scenarios import Scenario, conditioned, scenarios, tracking_errors
 
 GAINS: tuple[str, str] = ("settle", "rule")
 """The two readings of the sheet unit's backlash gain the ratio can be taken against."""
+TRACK_SEED = 0
+"""Noise seed of the tracking runs (the accuracy bench's); the calibration takes the sheet's."""
 SHEET = "sheet"
 """The option of a knob as the sheet stands (its default gain, or no tracked release)."""
 MIN_RMSE_GAIN = 0.05
@@ -89,13 +91,24 @@ def knob_rows(knob: int, quick: Sequence[Scenario]) -> list[Scenario]:
     return [s for s in quick if s.group.startswith("1-DOF") and s.knobs == (knob,)]
 
 
+def track_rmse_deg(s: Scenario, profile: CatheterProfile, factory: Callable[[], Plant],
+                   config: TsmdConfig | None, seed: int = TRACK_SEED) -> float:
+    """Method ours' tracking RMSE (deg) of the scenario's knob on the sheet's unit, after one
+    conditioning cycle (as the accuracy bench runs it)."""
+    tt, qq, skip = conditioned(s.t_s, s.q_deg, True)
+    rec = run_trajectory(tt, qq, config=config, profile=profile, method="ours", seed=seed,
+                         plant=factory())
+    k = s.knobs[0]
+    return tracking_errors(np.asarray(rec[f"tip{k + 1}"])[skip:], qq[skip:, k])[1]
+
+
 def track_gain(factory: Callable[[], Plant], device: DeviceModel, config: TsmdConfig | None,
                seed: int, knobs: Sequence[int]) -> dict[int, float]:
     """Mean tracking RMSE (deg) of method ours per knob in ``knobs`` on the sheet's unit,
     calibrated under ``device`` by the paper protocol."""
     profile = calibrate_sheet_unit(factory, device, "ratio gain", seed, config).profile
     quick = scenarios(quick=True)
-    return {k: float(np.mean([run_scenario(s, "ours", 0, profile, factory, True).rmse_deg
+    return {k: float(np.mean([track_rmse_deg(s, profile, factory, config)
                               for s in knob_rows(k, quick)])) for k in knobs}
 
 

@@ -11,6 +11,7 @@ from tsmd.compensation.release_ratio import ratio_gain
 from tsmd.compensation.safety import KnobLimits
 from tsmd.datasheet_ratio_gain import (
     MIN_RMSE_GAIN,
+    NO_RELEASE,
     SHEET,
     alternatives,
     candidate,
@@ -38,6 +39,14 @@ def test_the_default_gain_is_the_one_the_sheet_takes_without_the_field() -> None
 def test_a_knob_is_offered_the_gain_it_does_not_take() -> None:
     assert alternatives(KNOB, None) == ["rule"]
     assert alternatives(dataclasses.replace(KNOB, reference_rule_backlash_gain=None), None) == []
+
+
+def test_no_tracked_release_is_offered_only_when_asked_and_drops_the_release() -> None:
+    assert NO_RELEASE not in alternatives(KNOB, None)
+    assert alternatives(KNOB, None, offer_none=True) == ["rule", NO_RELEASE]
+    bare = candidate(dataclasses.replace(KNOB, release_ratio_gain="rule"), NO_RELEASE, None)
+    assert bare is not None and bare.release_omega is None and bare.release_ratio_gain is None
+    assert alternatives(DROPPED, 1.59, offer_none=True) == ["rule"]  # it has none already
 
 
 def test_a_left_out_release_comes_back_only_against_a_gain_that_makes_it_usable() -> None:

@@ -37,6 +37,9 @@ GAINS: tuple[str, str] = ("settle", "rule")
 """The two readings of the sheet unit's backlash gain the ratio can be taken against."""
 TRACK_SEED = 0
 """Noise seed of the tracking runs (the accuracy bench's); the calibration takes the sheet's."""
+NO_RELEASE = "none"
+"""The option of no tracked release on the knob (ratio 1: each unit's release line is the locus
+its own current's beta and x0 give); offered only with ``offer_none`` (``--ratio-gain-none``)."""
 SHEET = "sheet"
 """The option of a knob as the sheet stands (its default gain, or no tracked release)."""
 MIN_RMSE_GAIN = 0.05
@@ -57,7 +60,11 @@ def default_gain(knob: DeviceKnob) -> str | None:
 def candidate(knob: DeviceKnob, gain: str, dropped_release_omega: float | None
               ) -> DeviceKnob | None:
     """The knob with its ratio taken against ``gain`` (its left-out tracked release restored
-    where that makes the ratio usable); None where the knob cannot take ``gain``."""
+    where that makes the ratio usable), or without its tracked release for
+    :data:`NO_RELEASE`; None where the knob cannot take ``gain``."""
+    if gain == NO_RELEASE:
+        return (None if knob.release_omega is None
+                else dataclasses.replace(knob, release_omega=None, release_ratio_gain=None))
     if knob.reference_rule_backlash_gain is None or knob.reference_backlash_gain is None:
         return None
     release = knob.release_omega if knob.release_omega is not None else dropped_release_omega
@@ -67,10 +74,13 @@ def candidate(knob: DeviceKnob, gain: str, dropped_release_omega: float | None
     return None if release_ratio_problem(out) is not None else out
 
 
-def alternatives(knob: DeviceKnob, dropped_release_omega: float | None) -> list[str]:
-    """The gains the knob could take other than the one it takes as the sheet stands."""
+def alternatives(knob: DeviceKnob, dropped_release_omega: float | None,
+                 offer_none: bool = False) -> list[str]:
+    """The gains the knob could take other than the one it takes as the sheet stands (and,
+    with ``offer_none``, no tracked release)."""
     default = default_gain(knob)
-    return [g for g in GAINS
+    options = (*GAINS, NO_RELEASE) if offer_none else GAINS
+    return [g for g in options
             if g != default and candidate(knob, g, dropped_release_omega) is not None]
 
 
@@ -115,15 +125,16 @@ def track_gain(factory: Callable[[], Plant], device: DeviceModel, config: TsmdCo
 def measure_gain_scores(factory: Callable[[], Plant], device: DeviceModel,
                         dropped_release_omega: Sequence[float | None] = (None, None),
                         config: TsmdConfig | None = None, seed: int = SHEET_UNIT_SEED,
-                        track: Callable[..., dict[int, float]] = track_gain
-                        ) -> tuple[dict[str, float], dict[str, float]]:
+                        track: Callable[..., dict[int, float]] = track_gain,
+                        offer_none: bool = False) -> tuple[dict[str, float], dict[str, float]]:
     """Each knob's mean RMSE per option: the sheet as it stands (without a
     ``release_ratio_gain``), then each other usable gain
     (one calibration and run set per option round, both knobs switched together); empty for a
     knob with no other gain."""
     bare = [dataclasses.replace(k, release_ratio_gain=None) for k in device.knobs]
     device = dataclasses.replace(device, knobs=(bare[0], bare[1]))
-    alt = [alternatives(k, d) for k, d in zip(device.knobs, dropped_release_omega, strict=True)]
+    alt = [alternatives(k, d, offer_none)
+           for k, d in zip(device.knobs, dropped_release_omega, strict=True)]
     knobs = [i for i in (0, 1) if alt[i]]
     out: tuple[dict[str, float], dict[str, float]] = ({}, {})
     if not knobs:
@@ -143,12 +154,14 @@ def measure_gain_scores(factory: Callable[[], Plant], device: DeviceModel,
 
 def with_ratio_gain(device: DeviceModel, config: TsmdConfig, factory: Callable[[], Plant],
                     dropped_release_omega: Sequence[float | None] = (None, None),
-                    seed: int = SHEET_UNIT_SEED) -> DeviceModel:
+                    seed: int = SHEET_UNIT_SEED, offer_none: bool = False) -> DeviceModel:
     """The sheet with each knob's ``release_ratio_gain`` where tracking on its unit chose one
     other than the one it takes as it stands (and the knob's left-out tracked release back
-    where that gain uses it); printed per knob."""
+    where that gain uses it; with ``offer_none`` its tracked release left out where that
+    tracks better); printed per knob."""
     t0 = time.monotonic()
-    scores = measure_gain_scores(factory, device, dropped_release_omega, config, seed)
+    scores = measure_gain_scores(factory, device, dropped_release_omega, config, seed,
+                                 offer_none=offer_none)
     knobs = list(device.knobs)
     parts = []
     for i, (name, score) in enumerate(zip(("phi1", "phi2"), scores, strict=True)):

@@ -115,6 +115,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --plant: skip the choice of the gain each knob's release "
                              "ratio is taken against (release_ratio_gain; by default the unit "
                              "is calibrated and tracked under each, docs/model.md Session 22)")
+    parser.add_argument("--ratio-gain-none", action="store_true",
+                        help="with --plant: the ratio-gain choice also offers each knob no "
+                             "tracked release (release_omega left out: every unit's release line "
+                             "the locus its own current gives; opt-in per product, docs/model.md "
+                             "Session 22)")
     parser.add_argument("--recovery-rule", action="store_true",
                         help="with --plant: also offer the backlash rule 'recovery' (a "
                              "self-locking handle): its lag and bend gain measured on the unit's "
@@ -375,7 +380,8 @@ def main(args: argparse.Namespace) -> int:
         device = _choose_rule(device, config, args.plant, params, seeds, args.recovery_rule)
     if args.plant is not None and not args.no_ratio_gain:
         device = with_ratio_gain(device, config, factory,
-                                 [round(c.release_omega, 2) for c in constants], args.seed)
+                                 [round(c.release_omega, 2) for c in constants], args.seed,
+                                 args.ratio_gain_none)
     if args.plant is not None and args.bend_relation:
         device = _with_bend(device, config, factory)
     if args.plant is not None and args.release_end_offset:

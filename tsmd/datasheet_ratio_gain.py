@@ -13,7 +13,10 @@ it differs from what the sheet chooses without the field by more than :data:`MIN
 
 A knob whose tracked release the sheet left out (its ratio against the default gain outside the
 range) is offered it back against the other gain where that ratio is in range (cyclopebax phi1:
-0.69 against the settle gain, 0.94 against the rule's).
+0.69 against the settle gain, 0.94 against the rule's). With ``offer_none`` (opt-in per product,
+``--ratio-gain-none``) a knob is also offered no tracked release at all (ratio 1): cyclopebax
+phi2 takes it on unit 0 (2.02 deg against 3.38 with the rule's gain); nitinol and segments do not
+(docs/model.md "Session 22").
 """
 
 from __future__ import annotations
@@ -44,8 +47,9 @@ SHEET = "sheet"
 """The option of a knob as the sheet stands (its default gain, or no tracked release)."""
 MIN_RMSE_GAIN = 0.05
 """The other gain must track with a mean RMSE this fraction lower than the sheet's default to be
-written (session 21's two products differ by 35-45 %; gains a few thousandths apart, as on
-archwave or twistshaft, by the noise of one run)."""
+written: above the noise of one run (cyclopebax unit 0's phi1 tracked 1.88 and 1.93 deg in two
+runs that differed only in phi2's sheet); the choices made on unit 0 in session 22 differ by
+16-70 %."""
 
 
 def default_gain(knob: DeviceKnob) -> str | None:

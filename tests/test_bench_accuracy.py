@@ -12,11 +12,10 @@ import pytest
 from simrig.family import PLANT_SPECS
 from tsmd import cli
 from tsmd.bench import accuracy, family_accuracy
-from tsmd.bench.accuracy import tracking_errors
-from tsmd.bench.accuracy_scenarios import PERIOD_S, conditioned, scenarios
 from tsmd.compensation.ours import OursCompensator
 from tsmd.config import resolve_data_path
 from tsmd.profile import load_device_model, load_profile
+from tsmd.tracking_scenarios import PERIOD_S, conditioned, scenarios, tracking_errors
 
 
 def test_protocol_has_the_papers_scenarios() -> None:

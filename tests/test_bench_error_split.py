@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from tsmd.bench import family_accuracy
-from tsmd.bench.accuracy_scenarios import Scenario, scenarios
 from tsmd.bench.error_split import delayed, split_error, split_run
 from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.config import resolve_data_path
 from tsmd.profile import load_profile
+from tsmd.tracking_scenarios import Scenario, scenarios
 
 OMEGA, H_POS, H_NEG, D_POS, D_NEG = 1.4, -4.0, 4.0, 20.0, -20.0
 

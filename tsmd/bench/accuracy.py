@@ -31,7 +31,6 @@ from tsmd.bench.accuracy_report import (
     plot_runs,
     summarise,
 )
-from tsmd.bench.accuracy_scenarios import PERIOD_S, Scenario, conditioned, scenarios
 from tsmd.calibration import calibrate
 from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
 from tsmd.compensation import LimitedCompensator, build_compensator
@@ -47,17 +46,13 @@ from tsmd.profile import (
     save_profile,
 )
 from tsmd.replay import LockstepRunner, run_trajectory
-
-
-def tracking_errors(tip_deg: NDArray[np.float64], q_deg: NDArray[np.float64]
-                    ) -> tuple[float, float]:
-    """(PTPE, RMSE) of tip against desired: peak-to-peak of the error and its RMS."""
-    e = np.asarray(tip_deg, float) - np.asarray(q_deg, float)
-    e = e[np.isfinite(e)]
-    if e.size == 0:
-        return math.nan, math.nan
-    return float(e.max() - e.min()), float(np.sqrt(np.mean(e * e)))
-
+from tsmd.tracking_scenarios import (
+    PERIOD_S,
+    Scenario,
+    conditioned,
+    scenarios,
+    tracking_errors,
+)
 
 # ----------------------------------------------------------------------------------------------
 # Profiles

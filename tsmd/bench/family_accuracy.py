@@ -28,12 +28,12 @@ from simrig.family import PLANT_ROLE, PLANT_SPECS, family_member
 from simrig.plant import PlantLoadError, load_plant
 from tsmd.bench.accuracy import calibrated_profile, compute_time_us, run_scenario
 from tsmd.bench.accuracy_report import plot_runs
-from tsmd.bench.accuracy_scenarios import PERIOD_S, Scenario, scenarios
 from tsmd.bench.error_split import split_run
 from tsmd.calibration.errors import CalibrationError
 from tsmd.config import resolve_data_path
 from tsmd.errors import TsmdError
 from tsmd.profile import CatheterProfile, load_device_model, load_profile, save_profile
+from tsmd.tracking_scenarios import PERIOD_S, Scenario, scenarios
 
 FloatArray = NDArray[np.float64]
 DEFAULT_PLANT = "simrig.plants.capstan.tendon_sheath:make_tendon_sheath_plant"

@@ -5,7 +5,7 @@ checks, on the plant alone with the knob at the commanded angle (at 0.04 Hz the 
 within a fraction of a degree: the full stack gives the same errors to 0.2 deg):
 
 * uncompensated errors on the paper's tracking protocol
-  (``tsmd.bench.accuracy_scenarios.scenarios``, after one conditioning cycle): RMSE 17-24
+  (``tsmd.tracking_scenarios.scenarios``, after one conditioning cycle): RMSE 17-24
   deg, PTPE 58-69 deg (the paper's uncompensated runs);
 * the loaded slope of both knobs: 1.2-1.6 (the paper's catheters, omega 1.32 +- 0.12 and more);
 * the release/loaded slope ratio of both knobs: 0.6-1.1. The paper's model has one slope for both
@@ -44,13 +44,12 @@ from simrig.analysis import (
 from simrig.current_sensor import CurrentSensor
 from simrig.family import PLANT_ROLE, PLANT_SPECS, FamilyMember, family
 from simrig.report import run_sweep
-from tsmd.bench.accuracy import tracking_errors
-from tsmd.bench.accuracy_scenarios import PERIOD_S, Scenario, scenarios
 from tsmd.bench.realism_tee import release_load_ratio, tee_comparison
 from tsmd.config import default_sim_config, resolve_data_path
 from tsmd.datasheet import device_model, measure_device_constants
 from tsmd.errors import TsmdError
 from tsmd.profile import load_device_model
+from tsmd.tracking_scenarios import PERIOD_S, Scenario, scenarios, tracking_errors
 
 FloatArray = NDArray[np.float64]
 

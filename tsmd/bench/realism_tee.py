@@ -18,9 +18,9 @@ from scipy.signal import medfilt
 
 from simrig.analysis import SweepAnalysisError, loaded_slope, releasing_slope
 from simrig.plant import as_plant_step, load_plant
-from tsmd.bench.accuracy_scenarios import PERIOD_S
 from tsmd.errors import TsmdError
 from tsmd.tee import DEFAULT_SAMPLE_PERIOD_S, knob_from_filename, load_tee_acquisition
+from tsmd.tracking_scenarios import PERIOD_S
 
 FloatArray = NDArray[np.float64]
 

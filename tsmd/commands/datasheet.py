@@ -39,6 +39,7 @@ from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_edge_curve import choose_edge_curve, with_edge_curve
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_offset import with_reading_offset
+from tsmd.datasheet_ratio_gain import with_ratio_gain
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
 from tsmd.datasheet_release_end import measure_release_end_offsets
 from tsmd.datasheet_release_round import with_release_round
@@ -117,6 +118,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "product's reading offset (session 14; "
                              "'none': no choice and no offset, the sheet keeps the rule its "
                              "shares imply)")
+    parser.add_argument("--no-ratio-gain", action="store_true",
+                        help="with --plant: skip the choice of the gain each knob's release "
+                             "ratio is taken against (release_ratio_gain; by default the unit "
+                             "is calibrated and tracked under each, docs/model.md Session 22)")
+    parser.add_argument("--ratio-gain-none", action="store_true",
+                        help="with --plant: the ratio-gain choice also offers each knob no "
+                             "tracked release (release_omega left out: every unit's release line "
+                             "the locus its own current gives; opt-in per product, docs/model.md "
+                             "Session 22)")
     parser.add_argument("--recovery-rule", action="store_true",
                         help="with --plant: also offer the backlash rule 'recovery' (a "
                              "self-locking handle): its lag and bend gain measured on the unit's "
@@ -380,6 +390,10 @@ def main(args: argparse.Namespace) -> int:
         device = _choose_rule(device, config, args.plant, params, seeds, args.recovery_rule)
     if args.plant is not None and args.choose_loaded_shape:  # under the sheet's rules
         device = with_shape_choice(device, config, factory, args.seed)
+    if args.plant is not None and not args.no_ratio_gain:
+        device = with_ratio_gain(device, config, factory,
+                                 [round(c.release_omega, 2) for c in constants], args.seed,
+                                 args.ratio_gain_none)
     if args.plant is not None and args.bend_relation:
         device = _with_bend(device, config, factory)
     if args.plant is not None and args.release_end_offset:

@@ -1,7 +1,11 @@
-"""The accuracy benchmark's protocol: the paper's tracking scenarios and the conditioned start.
+"""The paper's tracking scenarios, the conditioned start and the tracking errors.
 
-What is run (:func:`scenarios`, :func:`conditioned`); :mod:`tsmd.bench.accuracy` runs them
-through the full stack and scores them, :mod:`tsmd.bench.family_accuracy` per catheter unit.
+What is run (:func:`scenarios`, :func:`conditioned`) and how it is scored
+(:func:`tracking_errors`); :mod:`tsmd.bench.accuracy` runs them through the full stack,
+:mod:`tsmd.bench.family_accuracy` per catheter unit, and the data sheet's release-ratio gain
+choice (:mod:`tsmd.datasheet_ratio_gain`) on the sheet's unit: outside :mod:`tsmd.bench`
+(moved from ``tsmd/bench/accuracy_scenarios.py`` in session 22), because the daemon's modules
+do not import the benchmarks.
 """
 
 from __future__ import annotations
@@ -82,3 +86,13 @@ def scenarios(quick: bool = False) -> list[Scenario]:
     out.append(Scenario("2-DOF non-periodic", "phi1 0.02+0.035 Hz, phi2 twice", t_np, q2n,
                         (0, 1)))
     return out
+
+
+def tracking_errors(tip_deg: NDArray[np.float64], q_deg: NDArray[np.float64]
+                    ) -> tuple[float, float]:
+    """(PTPE, RMSE) of tip against desired: peak-to-peak of the error and its RMS."""
+    e = np.asarray(tip_deg, float) - np.asarray(q_deg, float)
+    e = e[np.isfinite(e)]
+    if e.size == 0:
+        return math.nan, math.nan
+    return float(e.max() - e.min()), float(np.sqrt(np.mean(e * e)))

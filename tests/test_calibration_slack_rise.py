@@ -52,3 +52,16 @@ def test_a_gentle_rise_between_slack_levels_is_not_the_rise() -> None:
     # the release branch climbing at a third of the loaded slope for 20 deg
     pieces, flat, yg = _current([(30.0, 0.0), (20.0, 1e-3), (10.0, 0.0), (30.0, 3e-3)])
     assert before_sustained_rise(pieces, flat, STEP, OPTS, yg, pieces[2]) == pieces[2]
+
+
+def test_a_rise_a_little_less_steep_than_the_loaded_average_is_the_rise() -> None:
+    # the loaded branch from the edge to the first tooth flat measures 0.97-1.09 times the last
+    # quarter's slope on warmgear (session 22); here 0.95 times: still the load, not a release
+    pieces, flat, yg = _current([(40.0, 0.0), (30.0, 2.85e-3), (8.0, 0.0), (30.0, 3e-3)])
+    assert before_sustained_rise(pieces, flat, STEP, OPTS, yg, pieces[2]) == pieces[0]
+
+
+def test_a_release_rise_at_half_the_loaded_slope_is_not_the_rise() -> None:
+    # the release branch's long rises reach at most 0.42 of the loaded slope (warmgear)
+    pieces, flat, yg = _current([(30.0, 0.0), (12.0, 1.5e-3), (8.0, 0.0), (30.0, 3e-3)])
+    assert before_sustained_rise(pieces, flat, STEP, OPTS, yg, pieces[2]) == pieces[2]

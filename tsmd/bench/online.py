@@ -284,7 +284,9 @@ def main(args: argparse.Namespace) -> int:
                   else "unit 0, bends 30/60/90 deg")
         print(f"bend relation ({source}): release line "
               f"{args.bend.release_per_edge:.3f} deg per edge deg, beta x (1 + "
-              f"{args.bend.gain_per_release_deg:.4f} per release deg)")
+              f"{args.bend.gain_per_release_deg:.4f} per release deg); without an edge move "
+              f"beta x (1 + {args.bend.gain_per_slope:.3f} per slope rise), omega per gain "
+              f"{args.bend.omega_per_gain}")
     med, p99, top = hot_path_us()
     print(f"hot path (loop-side observe, two knobs): median {med:.2f} us, p99 {p99:.2f} us, "
           f"max {top:.1f} us")

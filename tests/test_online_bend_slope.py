@@ -9,11 +9,19 @@ from typing import Any
 
 import pytest
 from support.profiles import DEVICE
-from test_online_estimator import EDGE_DEG, SLOPE, learned, ramp_with_edge
+from test_online_estimator import (
+    EDGE_DEG,
+    SLOPE,
+    learned,
+    learned_knob,
+    ramp_with_edge,
+    ramp_with_knee,
+)
 
 from tsmd.compensation import build_compensator
 from tsmd.datasheet_bend import bend_relation
-from tsmd.online import OnlineError
+from tsmd.loop import ROW_COLUMNS
+from tsmd.online import OnlineError, OnlineWorker
 from tsmd.online.apply import bent_omega, shifted_knob
 from tsmd.online.bend import (
     BendRelation,
@@ -23,6 +31,7 @@ from tsmd.online.bend import (
     slope_rise,
     with_bend_relation,
 )
+from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.profile import (
     device_model_from_mapping,
     device_model_to_mapping,
@@ -142,3 +151,20 @@ def test_the_sheet_unit_reads_each_bends_slope_rise_under_its_straight_calibrati
     assert all(profile is straight for profile, _ in asked)
     assert relation.gain_per_slope == pytest.approx(0.8)
     assert relation.omega_per_gain == pytest.approx(-0.2)
+
+
+def test_where_bends_move_no_edge_a_knee_in_knee_mode_measures_nothing() -> None:
+    pos, neg = learned_knob(EstimatorOptions(knee_places_edge=False))
+    for _ in range(3):  # both ramps 1.25 x steeper, knees 2 deg further out
+        pos.update(ramp_with_knee(EDGE_DEG + 2.0, 1.25 * SLOPE), EDGE_DEG, neg)
+        neg.update(ramp_with_knee(EDGE_DEG + 2.0, 1.25 * SLOPE), EDGE_DEG, pos)
+    assert pos.knee_mode and not pos.suspects and pos.applied_deg == 0.0
+    assert pos.status()["odd_knee_ramps"] >= 1
+
+
+def test_a_worker_whose_products_bends_move_no_edge_leaves_the_knee_out() -> None:
+    comp = build_compensator(load_profile(PROFILE), "ours", 0.004)
+    worker = OnlineWorker(comp, 0.004, ROW_COLUMNS, bend=BendRelation(1.0, 0.0, 1.07))
+    assert not worker.trackers[(0, 1)].options.knee_places_edge
+    plain = OnlineWorker(comp, 0.004, ROW_COLUMNS, bend=BendRelation(1.2, 0.06))
+    assert plain.trackers[(0, 1)].options.knee_places_edge

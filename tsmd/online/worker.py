@@ -83,11 +83,14 @@ class OnlineWorker:
                                 for x in slip)
         self.fault_reason = fault_reason
         self.bend = bend
-        self.trackers = {(knob, side): EdgeTracker(knob, side, estimator or EstimatorOptions())
+        options = estimator or EstimatorOptions()
+        if bend is not None and bend.gain_per_slope > 0.0:  # its bends move no edge
+            options = replace(options, knee_places_edge=False)
+        self.trackers = {(knob, side): EdgeTracker(knob, side, options)
                          for knob in (0, 1) for side in (1, -1)}
         for (knob, side), tr in self.trackers.items():
             tr.partner = self.trackers[(knob, -side)]
-        if (estimator or EstimatorOptions()).other_knob_confirms:
+        if options.other_knob_confirms:
             for (knob, _), tr in self.trackers.items():
                 tr.other_knob_shows = partial(self._knob_shows, 1 - knob)
         self.rate_deg_s = rate_deg_s

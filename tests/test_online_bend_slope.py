@@ -87,6 +87,12 @@ def test_slopes_within_the_same_slope_tolerance_read_no_rise() -> None:
     assert slope_rise(pos) == 0.0
 
 
+def test_a_pooled_rise_beyond_the_tolerance_reads_while_one_tendon_sits_at_it() -> None:
+    pos = SimpleNamespace(knob_change=0.19, knee_direction=0,
+                          options=EstimatorOptions(same_slope_tolerance=0.15))
+    assert slope_rise(pos) == pytest.approx(0.19)
+
+
 def _gains(relation: BendRelation, ratio: float) -> Any:
     pos, neg = _knob_steeper(ratio)
     other_pos, other_neg = learned(), learned()

@@ -174,9 +174,13 @@ def zero_load_move_deg(edge_deg: float, zero_load_deg: float, gain: float, edge_
 def slope_rise(tracker: Any) -> float:
     """The knob's loaded-slope rise a bend shows: the pooled change of both tendons' last
     ramps (:attr:`EdgeTracker.knob_change`) while both got steeper beyond the same-slope
-    tolerance (:attr:`EdgeTracker.knee_direction`), else 0 (without a change the medians stay
-    within 0.09 over 600 s on ratestate and coilpipe 1, session 21's no-change runs)."""
-    return max(float(tracker.knob_change), 0.0) if tracker.knee_direction > 0 else 0.0
+    tolerance (:attr:`EdgeTracker.knee_direction`) or the pooled change itself is beyond it
+    (one tendon's median at the tolerance's edge made the rise flicker off on ratestate
+    development 2, session 22), else 0 (without a change each tendon's median stays within
+    0.09 over 600 s on ratestate and coilpipe 1, session 21's no-change runs)."""
+    change = float(tracker.knob_change)
+    steeper = tracker.knee_direction > 0 or change > tracker.options.same_slope_tolerance
+    return max(change, 0.0) if steeper else 0.0
 
 
 def bend_targets(bend: BendRelation, trackers: Mapping[tuple[int, int], Any],

@@ -18,8 +18,8 @@ from typing import Any
 
 from simrig.plant import Plant
 from simrig.scenario import ShapeChange, ShapeChangePlant
-from tsmd.bench.online import mixed_motion, run
 from tsmd.datasheet_bend import BEND_SEED, ReadSlopes
+from tsmd.online.rig_run import mixed_motion, run
 from tsmd.profile import CatheterProfile, DeviceModel
 
 BEND_AT_S = 80.0

@@ -300,7 +300,9 @@ def test_the_worker_takes_the_bend_relation_from_the_data_sheet(tmp_path: Path) 
         worker = running_worker(daemon)
         assert worker.bend == BendRelation(0.61, 0.064)
         assert worker.status()["bend_relation"] == {"release_per_edge": 0.61,
-                                                     "gain_per_release_deg": 0.064}
+                                                     "gain_per_release_deg": 0.064,
+                                                     "gain_per_slope": 0.0,
+                                                     "omega_per_gain": None}
     finally:
         daemon.stop()
 

@@ -36,35 +36,50 @@ CalibrateBent = Callable[[float], CatheterProfile]
 """A unit's calibration with its sheath bent by the given angle (0: straight)."""
 
 
+ReadSlopes = Callable[[CatheterProfile, float], tuple[float, float]]
+"""Each knob's loaded-slope rise a bend of the given angle shows online under the straight
+profile (:func:`tsmd.datasheet_bend_slope.rig_slope_reader`)."""
+
+
 def bend_relation(calibrate_bent: CalibrateBent,
-                  bends_deg: Sequence[float] = BENDS_DEG) -> BendRelation:
+                  bends_deg: Sequence[float] = BENDS_DEG,
+                  read_slopes: ReadSlopes | None = None) -> BendRelation:
     """The relation from one unit calibrated straight and at ``bends_deg``; a bend whose
-    calibration is refused is left out (an OnlineError in one line when none is left)."""
+    calibration is refused is left out (an OnlineError in one line when none is left). With
+    ``read_slopes``, each bend's slope rise too (the release move per slope rise of a bend
+    that moves no edge)."""
     straight = calibrate_bent(0.0)
-    bent = []
+    bent, rises = [], []
     for deg in bends_deg:
         try:
             bent.append(calibrate_bent(deg))
         except CalibrationRefusedError:
             continue
-    return measure_bend_relation(straight, bent)
+        if read_slopes is not None:
+            rises.append(read_slopes(straight, deg))
+    return measure_bend_relation(straight, bent, rises if read_slopes is not None else None)
 
 
 def sheet_with_bend(device: DeviceModel, calibrate_bent: CalibrateBent,
-                    bends_deg: Sequence[float] = BENDS_DEG) -> tuple[DeviceModel, str]:
+                    bends_deg: Sequence[float] = BENDS_DEG,
+                    read_slopes: ReadSlopes | None = None) -> tuple[DeviceModel, str]:
     """The sheet with the product's relation and a line saying what it is; a product whose
     bends move no edge (stickslip unit 0, session 13: 0.5 deg nowhere) has none, and the sheet
     measured before it is kept without one rather than lost (the daemon then moves x0 with
     the edge, as for any sheet without a relation)."""
     try:
-        bend = bend_relation(calibrate_bent, bends_deg)
+        bend = bend_relation(calibrate_bent, bends_deg, read_slopes)
     except OnlineError as exc:
         return device, f"no bend relation on the sheet: {exc}"
     return with_bend_relation(device, bend), (
         f"bend relation on the sheet's unit (straight and "
         f"{'/'.join(f'{b:g}' for b in bends_deg)} deg): release line "
         f"{bend.release_per_edge:.3f} deg per edge deg, beta x (1 + "
-        f"{bend.gain_per_release_deg:.4f} per release deg)")
+        f"{bend.gain_per_release_deg:.4f} per release deg)"
+        + ("" if not bend.gain_per_slope else
+           f"; without an edge move beta x (1 + {bend.gain_per_slope:.3f} per slope rise)")
+        + ("" if bend.omega_per_gain is None else
+           f", omega x (1 + {bend.omega_per_gain:.3f} per relative beta change)"))
 
 
 def rig_calibration(factory: Callable[[], Plant], device: DeviceModel, config: TsmdConfig,
@@ -84,5 +99,5 @@ def rig_calibration(factory: Callable[[], Plant], device: DeviceModel, config: T
     return run
 
 
-__all__ = ["BENDS_DEG", "BEND_SEED", "CalibrateBent", "bend_relation", "rig_calibration",
-           "sheet_with_bend"]
+__all__ = ["BENDS_DEG", "BEND_SEED", "CalibrateBent", "ReadSlopes", "bend_relation",
+           "rig_calibration", "sheet_with_bend"]

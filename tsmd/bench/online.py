@@ -46,53 +46,17 @@ from tsmd.bench.online_bend import product_bend_relation
 from tsmd.bench.online_units import calibrated, device_for, make_unit, shape_change
 from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.compensation import build_compensator
-from tsmd.daemon import make_compensator
 from tsmd.errors import TsmdError
 from tsmd.loop import ROW_COLUMNS
 from tsmd.online import OnlineWorker
 from tsmd.online.bend import sheet_bend_relation
+from tsmd.online.rig_run import PERIOD_S, mixed_motion, run
 from tsmd.profile import load_device_model, load_profile
-from tsmd.replay import LockstepRunner
 
 Array = NDArray[np.float64]
-PERIOD_S = 0.004
-DRAIN_EVERY = 25
 REVERSALS = 10
 CALIBRATION_UNCERTAINTY_DEG = 0.5
 """One half-cycle's knee edge against the tip's, standard deviation (docs/calibration.md)."""
-
-
-def mixed_motion(duration_s: float, seed: int) -> tuple[Array, Array]:
-    """Both knobs, each a slow large sine plus a faster smaller one (phases from ``seed``)."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(0.0, duration_s, PERIOD_S)
-    ph = rng.uniform(0.0, 2 * math.pi, 4)
-    q1 = 45.0 * np.sin(2 * math.pi * 0.06 * t + ph[0]) + 12.0 * np.sin(2 * math.pi * 0.17 * t
-                                                                        + ph[1])
-    q2 = 42.0 * np.sin(2 * math.pi * 0.05 * t + ph[2]) + 12.0 * np.sin(2 * math.pi * 0.14 * t
-                                                                        + ph[3])
-    ramp = np.clip(t / 2.0, 0.0, 1.0)  # start from rest
-    return t, np.column_stack([q1 * ramp, q2 * ramp])
-
-
-def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int,
-        device: Any = None, bend: Any = None) -> tuple[Any, Any]:
-    """One lockstep run with our compensator; returns (recording, worker or None). The
-    worker takes each knob's handle slip from ``device``'s data sheet and the product's bend
-    relation ``bend`` (None: none)."""
-    with LockstepRunner(None, profile, "ours", seed, plant) as runner:
-        comp = make_compensator(profile, "ours", runner.config)
-        runner.loop.execute("set_compensator", compensator=comp, label="ours")
-        worker = None
-        if online:
-            slip = None if device is None else (device.knobs[0].handle_slip_deg,
-                                                 device.knobs[1].handle_slip_deg)
-            worker = OnlineWorker(comp, runner.loop.period_s, ROW_COLUMNS,
-                                  handle_slip_deg=slip, drain_every=DRAIN_EVERY,
-                                  fault_reason=lambda: runner.loop.fault_reason, bend=bend)
-            runner.loop.observer = worker.observe
-        rec = runner.run(t, q, compensate=True)
-    return rec, worker
 
 
 def reversal_times(t: Array, q: Array, after_s: float) -> Array:
@@ -284,7 +248,9 @@ def main(args: argparse.Namespace) -> int:
                   else "unit 0, bends 30/60/90 deg")
         print(f"bend relation ({source}): release line "
               f"{args.bend.release_per_edge:.3f} deg per edge deg, beta x (1 + "
-              f"{args.bend.gain_per_release_deg:.4f} per release deg)")
+              f"{args.bend.gain_per_release_deg:.4f} per release deg); without an edge move "
+              f"beta x (1 + {args.bend.gain_per_slope:.3f} per slope rise), omega per gain "
+              f"{args.bend.omega_per_gain}")
     med, p99, top = hot_path_us()
     print(f"hot path (loop-side observe, two knobs): median {med:.2f} us, p99 {p99:.2f} us, "
           f"max {top:.1f} us")

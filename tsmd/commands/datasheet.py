@@ -35,6 +35,7 @@ from tsmd.datasheet import (
 )
 from tsmd.datasheet_amplitude import measure_tip_backlash_gains
 from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
+from tsmd.datasheet_bend_slope import rig_slope_reader
 from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_edge_curve import choose_edge_curve, with_edge_curve
 from tsmd.datasheet_level_grid import with_level_grid
@@ -150,6 +151,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --plant: also calibrate the unit straight and with its sheath "
                              "bent 30/60/90 deg and write the product's bend relation for online "
                              "re-estimation (four fast calibrations, minutes; docs/online.md)")
+    parser.add_argument("--bend-slopes", action="store_true",
+                        help="with --bend-relation: also drive the unit under its straight "
+                             "calibration through each bend (the online bench's mixed motion) "
+                             "and read the loaded ramps' slope rise, for a product whose bends "
+                             "move no edge (gain_per_slope, omega_per_gain; docs/online.md "
+                             "Session 22)")
 
 
 def _params(text: str | None) -> dict[str, Any]:
@@ -322,11 +329,13 @@ def _offsets(offset: ReadingOffset | None) -> str:
 
 
 def _with_bend(device: DeviceModel, config: TsmdConfig,
-               factory: Callable[[], Plant]) -> DeviceModel:
+               factory: Callable[[], Plant], slopes: bool) -> DeviceModel:
     """The sheet with the product's bend relation, from its unit calibrated straight and bent
     (without one, said in one line, when no bend moved an edge)."""
     t0 = time.monotonic()
-    device, line = sheet_with_bend(device, rig_calibration(factory, device, config))
+    device, line = sheet_with_bend(device, rig_calibration(factory, device, config),
+                                   read_slopes=(rig_slope_reader(factory, device)
+                                                if slopes else None))
     print(f"{line}; {time.monotonic() - t0:.0f} s")
     return device
 
@@ -341,6 +350,8 @@ def main(args: argparse.Namespace) -> int:
     if args.choose_loaded_shape and (args.plant is None or args.loaded_shape):
         raise DatasheetError("--choose-loaded-shape goes with --plant and without --loaded-shape "
                              "(which keeps the templates and their grid unchosen)")
+    if args.bend_slopes and not args.bend_relation:
+        raise DatasheetError("--bend-slopes goes with --bend-relation")
     if args.bend_relation and args.plant is None:
         raise DatasheetError("--bend-relation goes with --plant (the unit is calibrated bent on "
                              "the simulated rig)")
@@ -395,7 +406,7 @@ def main(args: argparse.Namespace) -> int:
                                  [round(c.release_omega, 2) for c in constants], args.seed,
                                  args.ratio_gain_none)
     if args.plant is not None and args.bend_relation:
-        device = _with_bend(device, config, factory)
+        device = _with_bend(device, config, factory, args.bend_slopes)
     if args.plant is not None and args.release_end_offset:
         device = _with_release_end_offset(device, config, factory, args.seed)
     if args.plant is not None and args.release_round:

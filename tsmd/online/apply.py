@@ -46,9 +46,21 @@ class OnlineError(TsmdError):
     """Online estimates cannot be applied or saved as asked."""
 
 
+def bent_omega(omega: float, gain_before: float, gain_after: float,
+               omega_per_gain: float | None = None) -> float:
+    """The tension play's omega after the knob's mean backlash gain moved: by the
+    release-slope relation (:func:`unit_omega`), or with a product's bend relation that says
+    otherwise by ``omega_per_gain`` per relative gain change
+    (:attr:`tsmd.online.bend.BendRelation.omega_per_gain`)."""
+    if omega_per_gain is None or gain_before <= 0:
+        return unit_omega(omega, gain_before, gain_after)
+    return omega * (1.0 + omega_per_gain * (gain_after / gain_before - 1.0))
+
+
 def shifted_knob(knob: Any, offset: tuple[float, float],
                  gain_ratio: tuple[float, float] = (1.0, 1.0),
-                 zero_load: tuple[float, float] | None = None) -> Any:
+                 zero_load: tuple[float, float] | None = None,
+                 omega_per_gain: float | None = None) -> Any:
     """A copy of a compensator knob (ours or the paper's) with its edges moved outward.
 
     Ours: each tendon's zero-load point moves outward by ``zero_load`` (pos, neg; None: with
@@ -56,7 +68,8 @@ def shifted_knob(knob: Any, offset: tuple[float, float],
     edge and keeps x0, :attr:`EdgeTracker.zero_load_deg`); ``gain_ratio`` (pos, neg)
     multiplies each tendon's backlash gain beta (a sheath bend: the backlash grows with the
     tension per knob degree, :attr:`EdgeTracker.gain_ratio`), and omega follows the
-    calibration's relation (the release slope ``omega / (1 - beta)`` is the product's).
+    calibration's relation (the release slope ``omega / (1 - beta)`` is the product's), or the
+    bend relation's ``omega_per_gain`` (:func:`bent_omega`).
     """
     off_pos, off_neg = offset
     moves = {"dead_zone_pos_deg": off_pos, "dead_zone_neg_deg": -off_neg}
@@ -69,7 +82,8 @@ def shifted_knob(knob: Any, offset: tuple[float, float],
             return replace(knob, field=field)
         field = field.scaled({"backlash_gain_pos": gain_ratio[0],
                               "backlash_gain_neg": gain_ratio[1]}, BETA_RANGE)
-        omega = unit_omega(knob.omega, _beta_at_zero(knob.field), _beta_at_zero(field))
+        omega = bent_omega(knob.omega, _beta_at_zero(knob.field), _beta_at_zero(field),
+                           omega_per_gain)
         return replace(knob, field=field, omega=omega)
     if not isinstance(knob, PaperKnob):
         raise OnlineError(f"online re-estimation cannot shift a {type(knob).__name__}")
@@ -101,7 +115,8 @@ def apply_knobs(compensator: Any, knobs: tuple[Any, Any]) -> None:
 
 def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str = "",
                          gains: Offsets = ((1.0, 1.0), (1.0, 1.0)),
-                         zero_loads: Offsets | None = None) -> CatheterProfile:
+                         zero_loads: Offsets | None = None,
+                         omega_per_gain: float | None = None) -> CatheterProfile:
     """The profile with its edges moved by ``offsets``, its tension play's zero-load points
     by ``zero_loads`` (None: with the edges) and its backlash gains multiplied by ``gains``
     (same catheter, a new version; omega as :func:`shifted_knob`).
@@ -130,9 +145,9 @@ def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str =
                 zero_load_pos_deg=tuple(v + x0_pos for v in ours.zero_load_pos_deg),
                 zero_load_neg_deg=tuple(v - x0_neg for v in ours.zero_load_neg_deg),
                 backlash_gain_pos=beta_pos, backlash_gain_neg=beta_neg,
-                omega=unit_omega(ours.omega, at_zero(ours.backlash_gain_pos,
+                omega=bent_omega(ours.omega, at_zero(ours.backlash_gain_pos,
                                                      ours.backlash_gain_neg),
-                                 at_zero(beta_pos, beta_neg)))
+                                 at_zero(beta_pos, beta_neg), omega_per_gain))
         knobs.append(KnobProfile(
             k.omega, ReferencePoint(k.reference_pos.knob_deg + off_pos, k.reference_pos.tip_deg),
             ReferencePoint(k.reference_neg.knob_deg - off_neg, k.reference_neg.tip_deg),
@@ -159,7 +174,8 @@ def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str =
 def save_online_version(profile: CatheterProfile, offsets: Offsets,
                         directory: str | os.PathLike[str], note: str = "",
                         gains: Offsets = ((1.0, 1.0), (1.0, 1.0)),
-                        zero_loads: Offsets | None = None) -> Path:
+                        zero_loads: Offsets | None = None,
+                        omega_per_gain: float | None = None) -> Path:
     """Save the online estimates as ``<dir>/<catheter_id>.online-<UTC time>.yaml``.
 
     Never overwrites: not the calibrated ``<catheter_id>.yaml``, not an earlier version.
@@ -174,5 +190,6 @@ def save_online_version(profile: CatheterProfile, offsets: Offsets,
     while path.exists():
         n += 1
         path = Path(directory) / f"{profile.catheter_id}.online-{stamp}-{n}.yaml"
-    save_profile(profile_with_offsets(profile, offsets, note, gains, zero_loads), path)
+    save_profile(profile_with_offsets(profile, offsets, note, gains, zero_loads,
+                                      omega_per_gain), path)
     return path

@@ -92,7 +92,8 @@ class OnlineAttachment:
         if profile is None:
             raise OnlineError("online_save: no catheter profile is loaded")
         return save_online_version(profile, worker.offsets(), directory,
-                                   gains=worker.gains, zero_loads=worker.zero_loads)
+                                   gains=worker.gains, zero_loads=worker.zero_loads,
+                                   omega_per_gain=worker.omega_per_gain)
 
     def offsets_row(self) -> tuple[float, ...]:
         """The offsets in force, in :data:`tsmd.online.RECORDING_COLUMNS` order (0: none)."""

@@ -225,7 +225,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             # knee scatters three times as much: it is resolved to the samples' spacing at
             # full speed, ~0.5 deg, and on the lumped plant's gradual toe by +-3 deg).
             self.last_feature = "knee"
-            if direction * (knee_m - self.estimate_deg) < -o.gate_deg:
+            if not o.knee_places_edge or direction * (knee_m - self.estimate_deg) < -o.gate_deg:
                 # More friction (steeper ramps) widens the dead zone, less narrows it; a
                 # knee that says the opposite beyond the gate is the toe's shape, not the
                 # edge (lumped 104, 60 deg bend: ramps 1.15-1.22 x, knees 2.5-6.25 deg

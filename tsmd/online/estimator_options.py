@@ -184,6 +184,12 @@ class EstimatorOptions:
     slopes (what sessions 7-9 settled on for the capstan bend: the knee reads the edge
     0.5-1.5 deg short, and with the relation on it capstan 1, 2 tracked worse after a 60 deg
     bend, on / fresh mean 1.99 against 1.70; docs/online.md, Session 11)."""
+    knee_places_edge: bool = True
+    """Off: in knee mode no ramp measures (counted in ``odd_knee_ramps``). The worker turns it
+    off for a product whose bend relation says its bends move no edge
+    (:attr:`tsmd.online.bend.BendRelation.gain_per_slope`): there the knee is the grown
+    engagement, not the edge (ratestate unit 0 at 60 deg, edges -0.38..-0.12 deg, knees read
+    -1.5..+2.0 deg and followed phi2 to +1.75; development 1 to +2.0; session 22)."""
     keep_zero_load_in_bend: bool = False
     """On: a change the knee placed moves the edge, not the zero-load point (what a bend does
     on the capstan plant). Off by default: with the knee's edges (~1 deg short of a fresh

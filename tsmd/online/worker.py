@@ -11,14 +11,11 @@ simulation and tests, called synchronously every ``drain_every`` ticks.
 from __future__ import annotations
 
 import collections
-import math
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from functools import partial
 from typing import Any
-
-import numpy as np
 
 from tsmd.online.apply import (
     GAIN_STEP,
@@ -35,16 +32,9 @@ from tsmd.online.bend import BendRelation, bend_targets
 from tsmd.online.cross_knob import knob_shows
 from tsmd.online.estimator import EdgeTracker
 from tsmd.online.estimator_options import EstimatorOptions
-from tsmd.online.features import (
-    LoadedRamp,
-    RampOptions,
-    Rejected,
-    Stroke,
-    find_knee_deg,
-    loaded_ramp,
-    relocated_edge_deg,
-)
+from tsmd.online.features import LoadedRamp, RampOptions, Rejected, Stroke
 from tsmd.online.segment import StrokeSegmenter
+from tsmd.online.stroke_ramp import referred_stroke, stroke_ramp
 
 RECORDING_COLUMNS: tuple[str, ...] = ("dz_off_pos1", "dz_off_neg1", "dz_off_pos2", "dz_off_neg2")
 """Recording columns for the applied offsets (deg, outward), one value per tick."""
@@ -93,11 +83,14 @@ class OnlineWorker:
                                 for x in slip)
         self.fault_reason = fault_reason
         self.bend = bend
-        self.trackers = {(knob, side): EdgeTracker(knob, side, estimator or EstimatorOptions())
+        options = estimator or EstimatorOptions()
+        if bend is not None and bend.gain_per_slope > 0.0:  # its bends move no edge
+            options = replace(options, knee_places_edge=False)
+        self.trackers = {(knob, side): EdgeTracker(knob, side, options)
                          for knob in (0, 1) for side in (1, -1)}
         for (knob, side), tr in self.trackers.items():
             tr.partner = self.trackers[(knob, -side)]
-        if (estimator or EstimatorOptions()).other_knob_confirms:
+        if options.other_knob_confirms:
             for (knob, _), tr in self.trackers.items():
                 tr.other_knob_shows = partial(self._knob_shows, 1 - knob)
         self.rate_deg_s = rate_deg_s
@@ -219,43 +212,14 @@ class OnlineWorker:
     def _stroke(self, stroke: Stroke) -> None:
         knob, side = stroke.knob, stroke.direction
         tracker = self.trackers[(knob, side)]
-        stroke, edge = self._referred(stroke)
-        expected = edge + side * tracker.applied_deg
-        knee = find_knee_deg(stroke, expected, self._knob_ramp[knob])
-        if math.isfinite(knee[0]) and tracker.knee_mode:
-            expected = knee[0]  # the window starts past the engagement this stroke shows
-        elif tracker.level_A is not None and tracker.slope_ref_A_per_deg is not None:
-            expected = relocated_edge_deg(stroke, expected, tracker.level_A,
-                                          tracker.slope_ref_A_per_deg, self._knob_ramp[knob])
-        ramp = loaded_ramp(stroke, expected, self._knob_ramp[knob], knee)
-        if math.isfinite(knee[0]) and expected != knee[0] and not tracker.plausible(ramp):
-            # The reference ramp's relocation assumes an unchanged ramp: after a bend it can
-            # put the window inside the dead zone (a flat "ramp"); past the knee it is not.
-            at_knee = loaded_ramp(stroke, knee[0], self._knob_ramp[knob], knee)
-            ramp = at_knee if isinstance(at_knee, LoadedRamp) else ramp
+        stroke, edge = referred_stroke(stroke, self.base_knobs[knob])
+        ramp = stroke_ramp(stroke, edge, tracker, self._knob_ramp[knob])
         if isinstance(ramp, Rejected):
             if ramp.stall:
                 tracker.freeze(ramp.reason)
                 self._emit("warning", "online estimate frozen", knob=knob, reason=ramp.reason)
             return
         self._ramp(tracker, ramp)
-
-    def _referred(self, stroke: Stroke) -> tuple[Stroke, float]:
-        """The stroke with the profile's own edge motion taken out, and that edge.
-
-        The profile says how the edge moves with the other knob's angle; over one stroke the
-        other knob may move far. Each sample's angle is moved by the profile edge's change
-        from the stroke's middle, so the ramp's foot stays put unless the catheter changed.
-        """
-        f = self.base_knobs[stroke.knob].field
-        column = 0 if stroke.direction > 0 else 1
-        grid = np.asarray(f.grid_deg, dtype=float)
-        values = np.asarray(f.values, dtype=float)[:, column]
-        mid = float(np.median(stroke.other_deg))
-        edge = float(f.at(mid)[column])
-        moved = np.interp(stroke.other_deg, grid, values) - float(np.interp(mid, grid, values))
-        return replace(stroke, cmd_deg=stroke.cmd_deg - moved, pos_deg=stroke.pos_deg - moved,
-                       other_deg=np.full_like(stroke.other_deg, mid)), edge
 
     def _ramp(self, tracker: EdgeTracker, ramp: LoadedRamp) -> None:
         d_pos, d_neg = edges_at(self.base_knobs[ramp.knob], ramp.other_deg)
@@ -354,7 +318,8 @@ class OnlineWorker:
         knobs = tuple(  # a knob whose values did not move is kept (a rebuild costs ~65 ms)
             old_knobs[k] if (new[k], gains[k], zero_loads[k]) == (
                 current[k], self.gains[k], self.zero_loads[k])
-            else shifted_knob(self.base_knobs[k], new[k], gains[k], zero_loads[k])
+            else shifted_knob(self.base_knobs[k], new[k], gains[k], zero_loads[k],
+                              self.omega_per_gain)
             for k in (0, 1))
         self.gains = gains
         self.zero_loads = zero_loads
@@ -373,6 +338,12 @@ class OnlineWorker:
                 self.published = (version + 1, ZERO_OFFSETS, self.base_knobs)
         self._emit("info", "online re-estimation", enabled=enabled)
 
+    @property
+    def omega_per_gain(self) -> float | None:
+        """How the published knobs' omega moves with beta: the bend relation's
+        (:attr:`BendRelation.omega_per_gain`), None: the release-slope relation."""
+        return None if self.bend is None else self.bend.omega_per_gain
+
     def offsets(self) -> Offsets:
         """The offsets in force (published to the loop)."""
         return self.published[1]
@@ -386,7 +357,9 @@ class OnlineWorker:
                 "zero_load_offsets_deg": [list(self.zero_loads[0]), list(self.zero_loads[1])],
                 "bend_relation": None if self.bend is None else {
                     "release_per_edge": self.bend.release_per_edge,
-                    "gain_per_release_deg": self.bend.gain_per_release_deg},
+                    "gain_per_release_deg": self.bend.gain_per_release_deg,
+                    "gain_per_slope": self.bend.gain_per_slope,
+                    "omega_per_gain": self.bend.omega_per_gain},
                 "edges": {f"phi{k + 1}_{'pos' if s > 0 else 'neg'}": tr.status()
                           for (k, s), tr in self.trackers.items()},
                 "events": list(self.events)[-5:]}

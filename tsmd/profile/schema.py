@@ -31,6 +31,8 @@ from tsmd.profile.reading_offset import offset_from_mapping, offset_to_mapping
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
     BEND_GAIN_PER_RELEASE_RANGE,
+    BEND_GAIN_PER_SLOPE_RANGE,
+    BEND_OMEGA_PER_GAIN_RANGE,
     BEND_RELEASE_PER_EDGE_RANGE,
     DEFAULT_HANDLE_SLIP_DEG,
     DEVICE_SCHEMA_VERSION,
@@ -255,16 +257,22 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
     return DeviceModel(name, (knobs[0], knobs[1]), str(desc), version, *bend)
 
 
-def _bend_relation(r: Reader, raw: Any) -> tuple[float | None, float | None]:
-    """The sheet's optional bend relation (both numbers or the key absent)."""
+def _bend_relation(r: Reader, raw: Any) -> tuple[Any, ...]:
+    """The sheet's optional bend relation (both numbers or the key absent; the slope terms
+    optional within it)."""
     if raw is None:
-        return None, None
+        return None, None, None, None
     m = r.mapping(raw, "bend_relation")
+    slope, omega = m.get("gain_per_slope"), m.get("omega_per_gain")
     return (r.number(r.get(m, "release_per_edge", "bend_relation."),
                      "bend_relation.release_per_edge", *BEND_RELEASE_PER_EDGE_RANGE, ""),
             r.number(r.get(m, "gain_per_release_deg", "bend_relation."),
                      "bend_relation.gain_per_release_deg", *BEND_GAIN_PER_RELEASE_RANGE,
-                     "per deg"))
+                     "per deg"),
+            None if slope is None else r.number(slope, "bend_relation.gain_per_slope",
+                                                *BEND_GAIN_PER_SLOPE_RANGE, ""),
+            None if omega is None else r.number(omega, "bend_relation.omega_per_gain",
+                                                *BEND_OMEGA_PER_GAIN_RANGE, ""))
 
 
 def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
@@ -311,6 +319,9 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
     if device.bend_release_per_edge is not None:
         out["bend_relation"] = {"release_per_edge": device.bend_release_per_edge,
                                 "gain_per_release_deg": device.bend_gain_per_release_deg}
+        for key in ("gain_per_slope", "omega_per_gain"):
+            if getattr(device, f"bend_{key}") is not None:
+                out["bend_relation"][key] = getattr(device, f"bend_{key}")
     return out
 
 

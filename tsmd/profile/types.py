@@ -37,7 +37,11 @@ BEND_RELEASE_PER_EDGE_RANGE: tuple[float, float] = (0.2, 5.0)
 0.55-1.26 on the simulated products, docs/online.md session 11)."""
 BEND_GAIN_PER_RELEASE_RANGE: tuple[float, float] = (-0.5, 0.5)
 """Plausible relative backlash-gain growth per degree of release-line move (measured ~0.06)."""
-
+BEND_GAIN_PER_SLOPE_RANGE: tuple[float, float] = (0.0, 10.0)
+"""Plausible relative beta growths per unit of loaded-slope rise in a bend that moves no edge
+(session 22)."""
+BEND_OMEGA_PER_GAIN_RANGE: tuple[float, float] = (-2.0, 2.0)
+"""Plausible relative omega changes per relative beta change in a bend (session 22)."""
 
 class ProfileError(TsmdError, ValueError):
     """A profile or device model is missing, malformed or implausible; the message says why."""
@@ -264,6 +268,13 @@ class DeviceModel:
     bend_gain_per_release_deg: float | None = None
     """Optional, with the field above: the backlash gain's relative growth per degree of
     release-line move in a bend."""
+    bend_gain_per_slope: float | None = None
+    """Optional, with the bend relation: beta's relative growth per unit of the loaded ramps'
+    slope rise in a bend that moves no edge, x0 kept (measured on the data-sheet unit with the
+    online estimator's slope reading, `--bend-slopes`, session 22). None: 0."""
+    bend_omega_per_gain: float | None = None
+    """Optional, with the bend relation: omega's relative change per relative change of the
+    knob's mean beta in a bend. None: omega follows the release-slope relation."""
 
     @property
     def limits(self) -> tuple[KnobLimits, KnobLimits]:

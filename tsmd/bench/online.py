@@ -17,10 +17,11 @@ estimator sees only commanded and actual position and current. Per unit:
   knobs) online on and off: each edge's largest offset against the calibration's uncertainty,
   and the tracking of both runs.
 
-``--bend-relation sheet``: the worker gets the product's bend relation from the data sheet, as
-the daemon's does; a sheet without one gets it measured on unit 0 as ``tsmd datasheet
---bend-relation`` would (:mod:`tsmd.bench.online_bend`; ``unit0``, session 11's name, is the
-same). ``--sheet FILE``: the product's data sheet to use instead. The data sheet of the lumped
+``--bend-relation daemon`` (the default): the worker gets the data sheet's bend relation when
+the sheet carries one and none otherwise, as the daemon's does. ``sheet``: a sheet without one
+gets it measured on unit 0 as ``tsmd datasheet --bend-relation`` would
+(:mod:`tsmd.bench.online_bend`; ``unit0``, session 11's name, is the same); ``off``: none even
+where the sheet has one (the default until session 22). ``--sheet FILE``: the product's data sheet to use instead. The data sheet of the lumped
 family is measured once on its nominal unit (tracker on the tip, ``tsmd.datasheet``); capstan
 units use ``profiles/devices/sim-catheter.yaml``. Data sheets and
 calibrated profiles are cached in ``--cache``, in a subdirectory keyed by the code that made them
@@ -225,10 +226,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sheet", metavar="FILE",
                         help="the product's data sheet (default: capstan's built-in one, "
                              "other plants' measured on unit 0 and cached)")
-    parser.add_argument("--bend-relation", choices=("sheet", "unit0", "off"), default="off",
-                        help="sheet (or unit0): the data sheet's bend relation, measured on "
-                             "unit 0 when the sheet has none (release "
-                        "line and beta move with the edges); off: x0 moves with the edges")
+    parser.add_argument("--bend-relation", choices=("daemon", "sheet", "unit0", "off"),
+                        default="daemon",
+                        help="daemon (default): the data sheet's bend relation where it has one, "
+                             "as the daemon runs; sheet (or unit0): measured on unit 0 when the "
+                             "sheet has none (release line and beta move with the edges); off: "
+                             "none, x0 moves with the edges")
 
 
 def main(args: argparse.Namespace) -> int:
@@ -242,8 +245,11 @@ def main(args: argparse.Namespace) -> int:
     device = (device_for(args.plant, Path(args.cache)) if args.sheet is None
               else load_device_model(args.sheet))
     args.bend = None
-    if args.bend_relation != "off":
+    if args.bend_relation == "daemon":
+        args.bend = sheet_bend_relation(device)
+    elif args.bend_relation != "off":
         args.bend = product_bend_relation(args.plant, device, Path(args.cache))
+    if args.bend is not None:
         source = ("the data sheet" if sheet_bend_relation(device) is not None
                   else "unit 0, bends 30/60/90 deg")
         print(f"bend relation ({source}): release line "

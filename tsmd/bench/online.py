@@ -21,11 +21,12 @@ estimator sees only commanded and actual position and current. Per unit:
 the sheet carries one and none otherwise, as the daemon's does. ``sheet``: a sheet without one
 gets it measured on unit 0 as ``tsmd datasheet --bend-relation`` would
 (:mod:`tsmd.bench.online_bend`; ``unit0``, session 11's name, is the same); ``off``: none even
-where the sheet has one (the default until session 22). ``--sheet FILE``: the product's data sheet to use instead. The data sheet of the lumped
-family is measured once on its nominal unit (tracker on the tip, ``tsmd.datasheet``); capstan
-units use ``profiles/devices/sim-catheter.yaml``. Data sheets and
-calibrated profiles are cached in ``--cache``, in a subdirectory keyed by the code that made them
-(:mod:`tsmd.bench.cache_key`), by plant, unit and shape, so reruns are cheap.
+where the sheet has one (the default until session 22). ``--sheet FILE``: the product's data
+sheet to use instead. The data sheet of the lumped family is measured once on its nominal unit
+(tracker on the tip, ``tsmd.datasheet``); capstan units use
+``profiles/devices/sim-catheter.yaml``. Data sheets and calibrated profiles are cached in
+``--cache``, in a subdirectory keyed by the code that made them (:mod:`tsmd.bench.cache_key`),
+by plant, unit and shape, so reruns are cheap.
 """
 
 from __future__ import annotations

@@ -1,0 +1,114 @@
+"""`tsmd datasheet`'s options: what each stage measures and what it costs on the rig.
+
+Kept apart from the command's stages (:mod:`tsmd.commands.datasheet`) because the option list
+grows with every product constant a session adds.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from tsmd.config import DEFAULT_CONFIG_PATH
+from tsmd.datasheet_rule import RULE_NOISE_SEEDS
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    source = parser.add_mutually_exclusive_group(required=True)
+    source.add_argument("--plant", metavar="MODULE:FACTORY",
+                        help="measure on the simulated rig with this plant")
+    source.add_argument("--from-recording", nargs="+", metavar="FILE",
+                        help="a tracked real unit's sweep recordings, one per knob")
+    parser.add_argument("--params", metavar="JSON", help="the plant factory's keyword parameters")
+    parser.add_argument("--device-model", metavar="NAME",
+                        help="the catheter type's name in the data sheet (required unless "
+                             "--update)")
+    parser.add_argument("--description", default="", help="one line describing the device")
+    parser.add_argument("--out", required=True, metavar="FILE", help="device YAML to write")
+    parser.add_argument("--config", metavar="FILE",
+                        help=f"configuration whose limits go into the data sheet (default: "
+                             f"packaged sim config with --plant, else {DEFAULT_CONFIG_PATH})")
+    parser.add_argument("--seed", type=int, default=2000, help="simulated rig's noise seed")
+    parser.add_argument("--loaded-shape", action="store_true",
+                        help="also write each knob's loaded-branch template (ours then bends its "
+                             "loaded lines by it; off by default, docs/model.md Session 10) and, "
+                             "with --plant, its templates over the other knob's angle (the "
+                             "calibration grid, 14 more sweeps; Session 15)")
+    parser.add_argument("--choose-loaded-shape", action="store_true",
+                        help="with --plant and without --loaded-shape: measure each knob's "
+                             "loaded-branch template and keep it where the sheet's unit, "
+                             "calibrated once more and tracked, shows the bent line nearer its "
+                             "tip (one more calibration; docs/model.md Session 22)")
+    parser.add_argument("--tip-backlash-gain", action="store_true",
+                        help="with --plant: also track the tip's backlash after reversals at "
+                             "+-60 and +-90 deg (2 sweeps more per knob); method ours then takes "
+                             "the release-path ratio against the gain reading nearer it (opt-in "
+                             "per product, docs/model.md Session 16)")
+    parser.add_argument("--tip-line-backlash-gain", action="store_true",
+                        help="with --plant: the same sweeps with the tip's backlash read at the "
+                             "corners of the paper's lines instead of at the 1 deg threshold; "
+                             "the ratio's gain is then chosen against it (a tip with rounded "
+                             "corners; opt-in per product, docs/model.md Session 17)")
+    parser.add_argument("--release-end-offset", action="store_true",
+                        help="with --plant: also calibrate the unit once more, tracked, and read "
+                             "where the release ends in the current and on the tip; method ours "
+                             "then draws each unit's release line to the end its current shows "
+                             "(opt-in per product, docs/model.md Session 18)")
+    parser.add_argument("--release-round", action="store_true",
+                        help="with --plant: also calibrate the unit once more, tracked, and fit "
+                             "the tip's rounded start after a reversal (release_round, "
+                             "release_shift; opt-in per product, docs/model.md Session 20)")
+    parser.add_argument("--level-grid", action="store_true",
+                        help="with --plant: also calibrate the unit once more, tracked, and read "
+                             "how far each side's loaded level moves with the other knob's angle "
+                             "(loaded_level_grid; opt-in per product, docs/model.md Session 21)")
+    parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
+                        metavar="LIST",
+                        help="with --plant: noise seeds of the unit's fast calibrations under "
+                             "each backlash rule; the better rule per knob goes into the sheet "
+                             "(docs/calibration.md, session 11), then the unit calibrated with "
+                             "it once per seed chooses each knob's curved-hinge check "
+                             "(edge_curve, session 21) and, with the check where taken, the "
+                             "product's reading offset (session 14; "
+                             "'none': no choice and no offset, the sheet keeps the rule its "
+                             "shares imply)")
+    parser.add_argument("--no-ratio-gain", action="store_true",
+                        help="with --plant: skip the choice of the gain each knob's release "
+                             "ratio is taken against (release_ratio_gain; by default the unit "
+                             "is calibrated and tracked under each, docs/model.md Session 22)")
+    parser.add_argument("--ratio-gain-none", action="store_true",
+                        help="with --plant: the ratio-gain choice also offers each knob no "
+                             "tracked release (release_omega left out: every unit's release line "
+                             "the locus its own current gives; opt-in per product, docs/model.md "
+                             "Session 22)")
+    parser.add_argument("--recovery-rule", action="store_true",
+                        help="with --plant: also offer the backlash rule 'recovery' (a "
+                             "self-locking handle): its lag and bend gain measured on the unit's "
+                             "fast calibrations under it (one more run per rule seed), kept on a "
+                             "knob that chooses it (docs/calibration.md, session 16)")
+    parser.add_argument("--unit-sample", metavar="LIST",
+                        help="with --plant: also calibrate the sheet's unit and these declared "
+                             "sample units (values of --unit-key, e.g. 201,202,203; never units "
+                             "scored elsewhere) with the fast protocol, noise seed the first "
+                             "rule seed, against their tracked tips, and write each knob's "
+                             "dead_zone_unit_u95_deg and backlash_unit_u95_deg "
+                             "(docs/calibration.md, session 19)")
+    parser.add_argument("--update", metavar="FILE",
+                        help="with --plant/--params of the sheet's unit and --unit-sample: add "
+                             "the sample's part to this existing sheet, calibrating the sample "
+                             "under it, and write it to --out with no other field changed (its "
+                             "header records the command; docs/calibration.md, session 20)")
+    parser.add_argument("--unit-key", default="unit",
+                        help="--unit-sample: the plant factory's parameter naming a unit")
+    parser.add_argument("--bend-relation", action="store_true",
+                        help="with --plant: also calibrate the unit straight and with its sheath "
+                             "bent 30/60/90 deg and write the product's bend relation for online "
+                             "re-estimation (four fast calibrations, minutes; docs/online.md)")
+    parser.add_argument("--bend-slopes", action="store_true",
+                        help="with --bend-relation: also drive the unit under its straight "
+                             "calibration through each bend (the online bench's mixed motion) "
+                             "and read the loaded ramps' slope rise, for a product whose bends "
+                             "move no edge (gain_per_slope, omega_per_gain; docs/online.md "
+                             "Session 22)")
+
+
+__all__ = ["add_arguments"]

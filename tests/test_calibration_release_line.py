@@ -22,7 +22,7 @@ from tsmd.calibration.release import (
 )
 from tsmd.calibration.signal import Conditioned
 from tsmd.profile import load_device_model
-from tsmd.profile.schema import device_model_from_mapping, device_model_to_mapping
+from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
 
 DEVICE = "profiles/devices/sim-catheter.yaml"
 

@@ -12,7 +12,7 @@ from tsmd.calibration.run import device_options
 from tsmd.datasheet_rule import RuleScore, choose_rules, knee_choice, with_rule
 from tsmd.datasheet_rule_settled import SWING_KNEE, offered
 from tsmd.profile import DeviceModel, ProfileError, load_device_model
-from tsmd.profile.schema import device_model_from_mapping, device_model_to_mapping
+from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
 
 SETTLED = 0.99
 

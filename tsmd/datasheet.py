@@ -44,7 +44,8 @@ from tsmd.profile import (
     device_model_from_mapping,
     device_model_to_mapping,
 )
-from tsmd.profile.schema import OPTIONAL_KNOB_RANGES, plain_values
+from tsmd.profile.schema import plain_values
+from tsmd.profile.sheet_schema import OPTIONAL_KNOB_RANGES
 from tsmd.recording import Recording
 from tsmd.replay import run_trajectory
 from tsmd.stack import knob_limits
@@ -345,7 +346,7 @@ def device_model(name: str, constants: Sequence[KnobConstants], config: TsmdConf
 
 def readable(device: DeviceModel) -> tuple[DeviceModel, list[str]]:
     """The sheet as the schema will read it back: a measured optional value outside the
-    schema's range for it (:data:`tsmd.profile.schema.OPTIONAL_KNOB_RANGES`) is left out and
+    schema's range for it (:data:`tsmd.profile.sheet_schema.OPTIONAL_KNOB_RANGES`) is left out and
     named, so the rules that need it are no candidates, instead of the whole measurement being
     lost when the file is written. So is a tracked ``release_omega`` whose release-path ratio
     (:func:`tsmd.compensation.release_ratio.release_slope_ratio`) the loader would refuse

@@ -27,7 +27,7 @@ from tsmd.config import TsmdConfig
 from tsmd.datasheet_offset import offset_readings
 from tsmd.datasheet_rule import Truth
 from tsmd.profile import DeviceKnob, DeviceModel
-from tsmd.profile.schema import OPTIONAL_KNOB_RANGES
+from tsmd.profile.sheet_schema import OPTIONAL_KNOB_RANGES
 from tsmd.tracked_calibration import ProtocolRun, play_protocol
 
 BACKLASHES = ("backlash_pos_deg", "backlash_neg_deg")

@@ -21,12 +21,8 @@ from tsmd.profile.files import (
     save_device_model,
     save_profile,
 )
-from tsmd.profile.schema import (
-    device_model_from_mapping,
-    device_model_to_mapping,
-    profile_from_mapping,
-    profile_to_mapping,
-)
+from tsmd.profile.schema import profile_from_mapping, profile_to_mapping
+from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
     DEFAULT_HANDLE_SLIP_DEG,

@@ -11,12 +11,11 @@ import pytest
 import yaml
 from support.profiles import assert_sheet_knob_field_round_trips, make_profile
 
+from tsmd.calibration.load_ramp import fit_side, friction_current_A
 from tsmd.calibration.release_path import release_through_amplitude
 from tsmd.calibration.tension_play_fit import (
     SweepCurrent,
-    fit_side,
     fit_tension_play,
-    friction_current_A,
     median_of_three,
     smooth_over_grid,
 )

@@ -169,8 +169,8 @@ def test_the_backlash_gain_uses_the_settle_rule_whatever_the_products_rule() -> 
     where the release has settled), so the sheet's gain must too: one estimator."""
     from simrig.plants.lumped import make_lumped_plant
     from tsmd.calibration.identify import identify_sweep, settle_rule_backlash
+    from tsmd.calibration.load_ramp import fit_sweep_sides
     from tsmd.calibration.options import IdentifyOptions, for_product
-    from tsmd.calibration.tension_play_fit import fit_sweep_sides
 
     runner = LockstepPlantRunner(make_lumped_plant(), PERIOD_S, seed=0)
     t, q, skip = settle(*tip_sweep(0, 0.0, PERIOD_S), PERIOD_S)

@@ -25,8 +25,8 @@ from numpy.typing import NDArray
 from simrig.analysis import measure_dead_zone_backlash, split_passes
 from simrig.plant import Plant
 from tsmd.calibration.identify import identify_sweep
+from tsmd.calibration.load_ramp import fit_sweep_sides
 from tsmd.calibration.loaded_knee import read_loaded_knee
-from tsmd.calibration.tension_play_fit import fit_sweep_sides
 from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.release_ratio import release_ratio_problem
 from tsmd.compensation.safety import KnobLimits

@@ -25,8 +25,9 @@ from typing import Any
 import numpy as np
 
 from tsmd.calibration.assemble import GridPoint
+from tsmd.calibration.load_ramp import fit_sweep_sides
 from tsmd.calibration.protocol import fast_protocol
-from tsmd.calibration.tension_play_fit import fit_sweep_sides, sweeps_from_points
+from tsmd.calibration.tension_play_fit import sweeps_from_points
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_rule_halves import points_half_cycle_reads
 from tsmd.datasheet_rule_settled import (

@@ -51,6 +51,7 @@ from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.fresh_hold import with_fresh_hold
 from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
+from tsmd.calibration.load_ramp import SideFit, fit_sweep_sides
 from tsmd.calibration.loaded_knee import sweep_knees
 from tsmd.calibration.reading_offset import offset_at, reference_edge_deg
 from tsmd.calibration.release_end import plateau_moved, side_ratios
@@ -63,14 +64,6 @@ from tsmd.compensation.release_ratio import RELEASE_RATIO_RANGE, release_slope_r
 from tsmd.compensation.tension_play_params import BETA_RANGE, TensionPlayParams
 
 FloatArray = NDArray[np.float64]
-RAMP_START_DEG = 10.0
-"""The loaded ramp is fitted from this far past the dead-zone edge (the knee is curved) ..."""
-RAMP_END_DEG = 5.0
-"""... to this far before the turn (the current lags and the drive slows there)."""
-PLATEAU_MARGIN_DEG = 5.0
-MIN_RAMP_SAMPLES = 50
-
-
 @dataclass(frozen=True)
 class SweepCurrent:
     """One sweep's arrays (uncompensated) and the current analysis' D and B (deg)."""
@@ -92,70 +85,6 @@ class SweepCurrent:
     """The settle rule's (B_pos, B_neg) where the B above is another rule's: a sheet whose gain
     was read with the settle rule scales omega by a unit gain read the same way. None: the B
     above is the settle rule's."""
-
-
-@dataclass(frozen=True)
-class SideFit:
-    """What one side of one sweep gave."""
-
-    dead_zone_deg: float
-    backlash_deg: float
-    amplitude_deg: float
-    zero_load_deg: float
-    backlash_gain: float
-
-
-def friction_current_A(pos_deg: FloatArray, current_A: FloatArray, d_pos: float, d_neg: float,
-                       direction: int) -> float:
-    """The current moving through the dead zone in ``direction``: no tendon is loaded, only the
-    knob's and the motor's friction act (and any offset of the sensor). The loaded ramp of the
-    same direction carries the same friction, so tension = current minus this."""
-    v = np.gradient(pos_deg)
-    inside = (pos_deg > d_neg + PLATEAU_MARGIN_DEG) & (pos_deg < d_pos - PLATEAU_MARGIN_DEG)
-    moving = current_A[inside & (direction * v > 0)]
-    if moving.size < 10:
-        raise ValueError("the sweep does not cross the dead zone both ways")
-    return float(np.median(moving))
-
-
-def fit_side(pos_deg: FloatArray, current_A: FloatArray, sign: int, dead_zone_deg: float,
-             backlash_deg: float, zero_A: float) -> SideFit:
-    """x0 and beta of one side (``sign`` +1: positive side, loaded while moving up)."""
-    v = np.gradient(pos_deg)
-    amplitude = float(np.max(sign * pos_deg)) * sign
-    x = sign * pos_deg
-    sel = ((sign * v > 0) & (x > sign * dead_zone_deg + RAMP_START_DEG)
-           & (x < sign * amplitude - RAMP_END_DEG))
-    if np.count_nonzero(sel) < MIN_RAMP_SAMPLES:
-        raise ValueError(f"too few samples on the loaded ramp of the {'+' if sign > 0 else '-'} "
-                         "side (amplitude too small for the dead zone)")
-    slope, intercept = np.polyfit(pos_deg[sel], current_A[sel] - zero_A, 1)
-    if not slope > 0:  # the current grows with the position on both sides (sign of load)
-        raise ValueError("the loaded current does not grow with the load")
-    x0 = float(-intercept / slope)
-    run = sign * (amplitude - x0)
-    if not run > backlash_deg > 0:
-        raise ValueError(f"backlash {backlash_deg:.1f} deg does not fit a load ramp of "
-                         f"{run:.1f} deg")
-    beta = min(max(backlash_deg / run, BETA_RANGE[0]), BETA_RANGE[1])
-    return SideFit(dead_zone_deg, backlash_deg, amplitude, x0, beta)
-
-
-def fit_sweep_sides(pos_deg: FloatArray, current_A: FloatArray, dead_zone_pos_deg: float,
-                    dead_zone_neg_deg: float, backlash_pos_deg: float, backlash_neg_deg: float
-                    ) -> tuple[SideFit, SideFit]:
-    """Both sides of one sweep (+, -); samples with a non-finite value are dropped. The data
-    sheet's ``reference_backlash_gain`` comes from the same function (one estimator)."""
-    pos = np.asarray(pos_deg, float)
-    cur = np.asarray(current_A, float)
-    ok = np.isfinite(pos) & np.isfinite(cur)
-    pos, cur = pos[ok], cur[ok]
-    fits = []
-    for sign, d, b in ((1, dead_zone_pos_deg, backlash_pos_deg),
-                       (-1, dead_zone_neg_deg, backlash_neg_deg)):
-        zero = friction_current_A(pos, cur, dead_zone_pos_deg, dead_zone_neg_deg, sign)
-        fits.append(fit_side(pos, cur, sign, float(d), float(b), zero))
-    return fits[0], fits[1]
 
 
 def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list[float]:

@@ -72,6 +72,12 @@ class IdentifyOptions:
     fit_after_deg: float = 15.0
     """... and ends this far after it (the loaded ramp)."""
     max_knee_deg: float = 15.0
+    torque_ripple_period_deg: float | None = None
+    """``edge="fit"``: the knob angle over which the handle's torque ripples (a detent's notch
+    spacing, cogging), or None. The fitted window is averaged over one period first, which
+    removes a periodic ripple of any shape and leaves a line's slope as it is: a notch's
+    steep-then-shallow stretch on the loaded ramp otherwise reads as a knee one period late
+    (:func:`tsmd.calibration.pieces.fitted_edge`)."""
     settle_hold_deg: float = 1.0
     """The current must stay on the constant level this long to count as settled."""
     backlash_tangent_deg: float = 3.0
@@ -239,5 +245,6 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
         # the product's knee (tsmd datasheet) where the sheet turns it on
         one = replace(one, backlash_knee=True) if k.backlash_knee else one
         one = replace(one, edge_curve=True) if k.edge_curve else one
+        one = replace(one, torque_ripple_period_deg=k.torque_ripple_period_deg)
         chosen.append(replace(one, reading_offset=k.reading_offset, unit_part=UnitPart.of(k)))
     return chosen[0], chosen[1]

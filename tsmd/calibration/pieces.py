@@ -114,13 +114,32 @@ def fitted_edge(grid: FloatArray, yg: FloatArray, plateau_start: int, rise_k: in
     step = float(grid[1] - grid[0])
     a = max(plateau_start, rise_k - round(opts.fit_before_deg / step))
     b = min(yg.size, rise_k + round(opts.fit_after_deg / step))
-    fit = fit_edge(grid[a:b], yg[a:b], noise, knee_slope_ratio=opts.knee_slope_ratio,
+    x, y = grid[a:b], yg[a:b]
+    if opts.torque_ripple_period_deg:
+        x, y = period_mean(grid, yg, a, b, opts.torque_ripple_period_deg)
+    fit = fit_edge(x, y, noise, knee_slope_ratio=opts.knee_slope_ratio,
                    max_knee_deg=opts.max_knee_deg, penalty_k=opts.penalty_k,
                    curve_check=opts.edge_curve,
                    search_step_deg=step)
     if fit is None:
         return rise_k
     return min(int(np.searchsorted(grid, fit.edge_deg)), yg.size - 1)
+
+
+def period_mean(grid: FloatArray, yg: FloatArray, a: int, b: int,
+                period_deg: float) -> tuple[FloatArray, FloatArray]:
+    """``grid[a:b]`` and the current there averaged over one ripple period centred on each
+    sample (a periodic ripple averages out, a straight line stays; the whole half-cycle
+    supplies the samples either side), trimmed where the period runs off the half-cycle."""
+    step = float(grid[1] - grid[0])
+    half = max(1, round(0.5 * period_deg / step))
+    lo, hi = max(a, half), min(b, yg.size - half)
+    if hi - lo < 8:
+        return grid[a:b], yg[a:b]
+    sums = np.concatenate([[0.0], np.cumsum(yg)])
+    k = np.arange(lo, hi)
+    mean = (sums[k + half + 1] - sums[k - half]) / (2 * half + 1)
+    return grid[lo:hi], mean
 
 
 def smooth_crossing(grid: FloatArray, yg: FloatArray, k: int, target: float,

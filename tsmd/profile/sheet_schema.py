@@ -66,6 +66,7 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "backlash_unit_u95_deg": (0.0, 20.0, "deg"),
     "release_round": (*RELEASE_ROUND_RANGE, ""),
     "release_shift": (*RELEASE_SHIFT_RANGE, ""),
+    "torque_ripple_period_deg": (1.0, 90.0, "deg"),
 }
 """The data sheet's optional measured numbers per knob and their plausible ranges: the schema
 reads them with these, and ``tsmd datasheet`` leaves out a measured one outside its range
@@ -87,6 +88,8 @@ _SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
 """Optional data-sheet numbers measured on the product's sample, written only when measured."""
 _ROUND_KEYS = ("release_round", "release_shift")
 """Optional data-sheet numbers of the rounded release (session 20), written only when set."""
+_HANDLE_KEYS = ("torque_ripple_period_deg",)
+"""Optional numbers of the handle's own make (session 22), written only when set."""
 
 
 _Block = TypeVar("_Block")
@@ -220,6 +223,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_unit_u95_deg=optional("backlash_unit_u95_deg"),
             release_round=optional("release_round"),
             release_shift=optional("release_shift"),
+            torque_ripple_period_deg=optional("torque_ripple_period_deg"),
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)
@@ -288,7 +292,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             knobs[name]["loaded_shape_grid"] = shape_grid_to_mapping(*k.loaded_shape_grid)
         if k.loaded_level_grid is not None:
             knobs[name]["loaded_level_grid"] = level_grid_to_mapping(k.loaded_level_grid)
-        for key in _RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS + _ROUND_KEYS:
+        for key in (_RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS + _ROUND_KEYS
+                    + _HANDLE_KEYS):
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         if k.reading_offset is not None:

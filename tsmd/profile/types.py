@@ -244,6 +244,10 @@ class DeviceKnob:
     release_shift: float | None = None
     """Optional, with ``release_round``: how much later the tip's release line lies than the
     current's backlash end, in the same backlashes. None: 0."""
+    torque_ripple_period_deg: float | None = None
+    """Optional, the handle's: the knob angle over which its torque ripples (a detent's notch
+    spacing, a cogging period); the dead-zone edge fit averages the current over it
+    (:func:`tsmd.calibration.pieces.period_mean`). None: no ripple."""
     loaded_level_grid: LevelGrid | None = None
     """Optional, tracked on the data-sheet unit (``tsmd datasheet --level-grid``, session 21):
     each side's shift of its plateau height over the other knob's angle, where the other

@@ -27,6 +27,7 @@ from simrig.plant import Plant
 from tsmd.calibration.identify import identify_sweep
 from tsmd.calibration.load_ramp import fit_sweep_sides
 from tsmd.calibration.loaded_knee import read_loaded_knee
+from tsmd.calibration.options import IdentifyOptions
 from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.release_ratio import release_ratio_problem
 from tsmd.compensation.safety import KnobLimits
@@ -207,15 +208,18 @@ def swept_knob(rec: Recording) -> int:
     return int(np.argmax(spans))
 
 
-def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None = None
-                   ) -> KnobConstants:
+def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None = None,
+                   ripple_period_deg: float | None = None) -> KnobConstants:
     """The data-sheet constants of ``knob`` from a tracked sweep, analysed from row ``start``:
     the whole-pass constants up to row ``stop`` (None: the end), the reversal reads (release
-    share and slope ratio, reference backlash) over every reversal to the end."""
+    share and slope ratio, reference backlash) over every reversal to the end.
+    ``ripple_period_deg``: the handle's torque ripple period (a design constant), which every
+    unit's edge fit averages over, so the sheet unit's current edges are read the same way."""
     if stop is not None:
         whole = knob_constants(Recording({k: v[:stop] for k, v in rec.columns.items()},
-                                         rec.metadata), knob, start)
-        ends = knob_constants(rec, knob, start)
+                                         rec.metadata), knob, start,
+                               ripple_period_deg=ripple_period_deg)
+        ends = knob_constants(rec, knob, start, ripple_period_deg=ripple_period_deg)
         return dataclasses.replace(
             whole, reference_backlash_pos_deg=ends.reference_backlash_pos_deg,
             reference_backlash_neg_deg=ends.reference_backlash_neg_deg,
@@ -242,7 +246,8 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
     # on the raw tip: the dead-zone offset is what the compensators were built against
     tip_b = tip_reading(t, rec[f"cmd{knob + 1}"][start:], pos, tip)
     # where the calibration's current analysis puts the edges on the same sweep
-    cur = identify_sweep(t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:])
+    cur = identify_sweep(t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:],
+                         IdentifyOptions(torque_ripple_period_deg=ripple_period_deg))
     dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
                        + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
     # The backlash gain exactly as the tension-play fit measures every unit's: by the settle
@@ -308,7 +313,8 @@ def _finite_or_none(value: float) -> float | None:
 
 
 def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 2000,
-                             config: TsmdConfig | None = None) -> list[KnobConstants]:
+                             config: TsmdConfig | None = None,
+                             ripple_period_deg: float | None = None) -> list[KnobConstants]:
     """Both knobs' constants on the simulated rig: each knob swept through the full stack
     (uncompensated, other knob at 0) for ``RELEASE_READ_CYCLES``, analysed after
     ``CONDITIONING_CYCLES`` (:func:`knob_constants`: the whole-pass constants on the first
@@ -322,7 +328,8 @@ def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 200
                              plant=plant_factory())
         # the run is causal: up to the short sweep's last sample it is the short sweep's
         stop = skip + tip_sweep(knob, 0.0, period_s)[0].size
-        out.append(knob_constants(rec, knob, analysed_from(skip, period_s), stop))
+        out.append(knob_constants(rec, knob, analysed_from(skip, period_s), stop,
+                                  ripple_period_deg))
     return out
 
 

@@ -56,6 +56,7 @@ from tsmd.datasheet_shape_choice import with_shape_choice
 from tsmd.datasheet_shape_grid import measure_shape_grids
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.profile.reading_offset import ReadingOffset
+from tsmd.profile.sheet_schema import OPTIONAL_KNOB_RANGES
 from tsmd.recording import read_recording
 from tsmd.tracked_calibration import truth_sweeps
 
@@ -72,7 +73,7 @@ def _params(text: str | None) -> dict[str, Any]:
     return params
 
 
-def _from_recordings(paths: list[str]) -> list[KnobConstants]:
+def _from_recordings(paths: list[str], ripple_period_deg: float | None) -> list[KnobConstants]:
     by_knob: dict[int, KnobConstants] = {}
     for path in paths:
         rec = read_recording(path)
@@ -80,13 +81,21 @@ def _from_recordings(paths: list[str]) -> list[KnobConstants]:
         if knob in by_knob:
             raise DatasheetError(f"{path}: a second sweep of knob {knob + 1}; give one per knob")
         try:
-            by_knob[knob] = knob_constants(rec, knob)
+            by_knob[knob] = knob_constants(rec, knob, ripple_period_deg=ripple_period_deg)
         except DatasheetError as exc:
             raise DatasheetError(f"{path}: {exc}") from None
     missing = [k + 1 for k in (0, 1) if k not in by_knob]
     if missing:
         raise DatasheetError(f"no sweep of knob {missing[0]} among the recordings")
     return [by_knob[0], by_knob[1]]
+
+
+def _ripple_period(value: float | None) -> float | None:
+    low, high, _ = OPTIONAL_KNOB_RANGES["torque_ripple_period_deg"]
+    if value is not None and not low <= value <= high:
+        raise DatasheetError(f"--torque-ripple-period-deg {value:g}: outside [{low:g}, {high:g}] "
+                             "deg")
+    return value
 
 
 def _rule_seeds(text: str) -> list[int]:
@@ -262,6 +271,7 @@ def main(args: argparse.Namespace) -> int:
     if args.device_model is None:
         raise DatasheetError("--device-model is required (or --update FILE)")
     params = _params(args.params)
+    ripple = _ripple_period(args.torque_ripple_period_deg)
     sample = (sample_units(args.unit_sample, params.get(args.unit_key))
               if args.unit_sample is not None else [])
     if sample and args.plant is None:
@@ -277,16 +287,21 @@ def main(args: argparse.Namespace) -> int:
         def factory() -> Plant:
             return load_plant(args.plant, params)
 
-        constants = measure_device_constants(factory, args.seed, config)
+        constants = measure_device_constants(factory, args.seed, config, ripple)
         source = (f"the simulated rig, plant {args.plant} with {json.dumps(params)}, seed "
                   f"{args.seed}, {RELEASE_READ_CYCLES:g} cycles per knob (whole passes: the "
                   f"first {ANALYSED_CYCLES:g})")
     else:
-        constants = _from_recordings(args.from_recording)
+        constants = _from_recordings(args.from_recording, ripple)
         config = load_config(args.config if args.config is not None else DEFAULT_CONFIG_PATH)
         source = "recordings " + ", ".join(Path(p).name for p in args.from_recording)
     device = device_model(args.device_model, constants, config, args.description,
                           loaded_shape=args.loaded_shape or args.choose_loaded_shape)
+    if ripple is not None:
+        source += f"; the handle's torque ripple period {ripple:g} deg given (a design constant)"
+        phi1, phi2 = (dataclasses.replace(k, torque_ripple_period_deg=ripple)
+                      for k in device.knobs)
+        device = dataclasses.replace(device, knobs=(phi1, phi2))
     device, dropped = readable(device)
     for line in dropped:
         print(f"warning: {line}")

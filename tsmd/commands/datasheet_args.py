@@ -28,6 +28,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"configuration whose limits go into the data sheet (default: "
                              f"packaged sim config with --plant, else {DEFAULT_CONFIG_PATH})")
     parser.add_argument("--seed", type=int, default=2000, help="simulated rig's noise seed")
+    parser.add_argument("--torque-ripple-period-deg", type=float, metavar="DEG",
+                        help="the handle's torque ripple period (a detent's notch spacing, "
+                             "cogging), a design constant of the product: every edge fit, the "
+                             "sheet unit's included, averages the current over it; written to "
+                             "both knobs (docs/calibration.md Session 22: a ripple in the knob's "
+                             "torque)")
     parser.add_argument("--loaded-shape", action="store_true",
                         help="also write each knob's loaded-branch template (ours then bends its "
                              "loaded lines by it; off by default, docs/model.md Session 10) and, "

@@ -3,6 +3,7 @@ over one ripple period (tsmd.calibration.pieces.period_mean) before the edge is 
 
 from __future__ import annotations
 
+import argparse
 from dataclasses import replace
 from pathlib import Path
 
@@ -11,9 +12,12 @@ import pytest
 
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.pieces import fitted_edge, period_mean
+from tsmd.commands import datasheet as datasheet_command
+from tsmd.commands.datasheet_args import add_arguments
+from tsmd.datasheet import DatasheetError
 from tsmd.errors import TsmdError
 from tsmd.profile.files import load_device_model
-from tsmd.profile.schema import device_model_from_mapping, device_model_to_mapping
+from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
 
 NOISE_A = 0.0005
 PERIOD_DEG = 15.0
@@ -70,3 +74,20 @@ def test_a_ripple_period_out_of_range_is_refused() -> None:
     data["knobs"]["phi1"]["torque_ripple_period_deg"] = 0.1
     with pytest.raises(TsmdError, match="torque_ripple_period_deg"):
         device_model_from_mapping(data)
+
+
+def test_datasheet_takes_the_ripple_period_as_a_design_constant() -> None:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    args = parser.parse_args(["--plant", "m:f", "--out", "x.yaml",
+                              "--torque-ripple-period-deg", "15"])
+    assert args.torque_ripple_period_deg == 15.0
+
+
+@pytest.mark.parametrize("period_deg", [0.5, 120.0])
+def test_datasheet_refuses_a_ripple_period_outside_its_range_by_name(period_deg: float) -> None:
+    with pytest.raises(DatasheetError, match="--torque-ripple-period-deg"):
+        datasheet_command.main(argparse.Namespace(
+            params=None, plant="simrig.family:make_family_plant", choose_loaded_shape=False,
+            loaded_shape=False, bend_slopes=False, bend_relation=False, rule_seeds="0,1",
+            update=None, device_model="x", torque_ripple_period_deg=period_deg))

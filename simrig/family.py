@@ -21,8 +21,9 @@ development units in session 20), the jawcrimp plant (session 20, written blind,
 tuned on its development units in the same session's second round) is held out, the cyclopebax
 plant (session 21, written blind, run untuned, then its sheet constant tuned on its development
 units in the same session's second round) is held out, the snakedent plant (session 22, written
-blind: rolling vertebrae, detented knobs) is the blind plant (``PLANT_ROLE``); the next blind
-plant is registered after it.
+blind: rolling vertebrae, detented knobs, run untuned, then its edge reading tuned on its
+development units in the same session's second round) is held out (``PLANT_ROLE``); the next
+blind plant is registered after it.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -76,7 +77,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
-              "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "blind"}
+              "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

@@ -138,9 +138,9 @@ def test_a_unit_is_the_same_catheter_for_the_same_seed() -> None:
     assert not np.array_equal(tip_a, drive_knob(c, 0, path)[0])
 
 
-def test_snakedent_is_registered_last_and_blind() -> None:
+def test_snakedent_is_registered_last_and_held_out() -> None:
     assert list(PLANT_SPECS)[-1] == "snakedent"
-    assert PLANT_ROLE["snakedent"] == "blind"
+    assert PLANT_ROLE["snakedent"] == "held-out"
     assert isinstance(family_member("snakedent", 101).build(), SnakeDentPlant)
     assert set(SCATTER["snakedent"]) <= set(family_member("snakedent", 0).params["knobs"][0])
     assert isinstance(load_plant(SPEC), SnakeDentPlant)

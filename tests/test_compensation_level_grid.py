@@ -8,14 +8,13 @@ import dataclasses
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support.play import assert_model_of_inverse_follows
+from support.play import assert_model_continuous_between_branches, assert_model_of_inverse_follows
 from test_compensation_tension_play_fit import DEVICE_KNOB, synthetic_sweep
 
 from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.compensation.level_grid import LevelGrid, level_grid_from_mapping, level_grid_to_mapping
 from tsmd.compensation.ours_table import OursKnob
 from tsmd.compensation.safety import KnobLimits
-from tsmd.compensation.tension_play import model_step, rest_state
 from tsmd.compensation.tension_play_params import (
     BETA_RANGE,
     TensionPlayParams,
@@ -84,12 +83,7 @@ def test_a_shifted_row_stays_continuous_and_between_its_branches(
         p: TensionPlayParams, other: float, xs: list[float]) -> None:
     b = OursKnob.from_params(p).at(other)
     steepest = p.omega / (1.0 - BETA_RANGE[1]) * (1.0 + 1e-6) + 1e-9
-    state = rest_state(0.0, b)
-    for x in xs:
-        nxt = model_step(state, x, b)
-        assert abs(nxt.y_deg - state.y_deg) <= steepest * abs(x - state.x_deg) + 1e-9
-        assert b.rising(x) - 1e-9 <= nxt.y_deg <= b.falling(x) + 1e-9
-        state = nxt
+    assert_model_continuous_between_branches(b, xs, steepest)
 
 
 @given(random_params, st.floats(-90.0, 90.0),

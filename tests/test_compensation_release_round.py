@@ -7,7 +7,7 @@ import dataclasses
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support.play import assert_model_of_inverse_follows
+from support.play import assert_model_continuous_between_branches, assert_model_of_inverse_follows
 
 from tsmd.compensation.ours_table import OursKnob
 from tsmd.compensation.release_round import (
@@ -110,12 +110,7 @@ def test_rounded_output_is_continuous_and_between_the_branches(p: TensionPlayPar
                                                               xs: list[float]) -> None:
     b = knob(p)
     steepest = p.omega / (1.0 - BETA_RANGE[1]) * (1.0 + 1e-6) + 1e-9
-    state = rest_state(0.0, b)
-    for x in xs:
-        nxt = model_step(state, x, b)
-        assert abs(nxt.y_deg - state.y_deg) <= steepest * abs(x - state.x_deg) + 1e-9
-        assert b.rising(x) - 1e-9 <= nxt.y_deg <= b.falling(x) + 1e-9
-        state = nxt
+    assert_model_continuous_between_branches(b, xs, steepest)
 
 
 @given(random_params, st.lists(st.floats(-100.0, 100.0), min_size=1, max_size=60))

@@ -6,13 +6,12 @@ from __future__ import annotations
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support.play import assert_model_of_inverse_follows
+from support.play import assert_model_continuous_between_branches, assert_model_of_inverse_follows
 from test_compensation_loaded_shape import shapes
 
 from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.loaded_shape import LoadedShape, steepest_slope
 from tsmd.compensation.ours_table import OursKnob
-from tsmd.compensation.tension_play import model_step, rest_state
 from tsmd.compensation.tension_play_params import BETA_RANGE, TensionPlayParams
 
 ANGLES = (-90.0, 0.0, 60.0, 90.0)
@@ -54,9 +53,4 @@ def test_a_bent_shifted_row_stays_continuous_and_between_its_branches(
     # a moved knee squeezes a piece by at most the knee ratio's lower bound (0.8)
     steepest = (p.omega * steepest_slope(p.shape_pos, p.shape_neg) / 0.8
                 / (1.0 - BETA_RANGE[1]) * (1.0 + 1e-6) + 1e-9)
-    state = rest_state(0.0, b)
-    for x in xs:
-        nxt = model_step(state, x, b)
-        assert abs(nxt.y_deg - state.y_deg) <= steepest * abs(x - state.x_deg) + 1e-6
-        assert b.rising(x) - 1e-9 <= nxt.y_deg <= b.falling(x) + 1e-9
-        state = nxt
+    assert_model_continuous_between_branches(b, xs, steepest, tol=1e-6)

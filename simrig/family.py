@@ -22,8 +22,9 @@ tuned on its development units in the same session's second round) is held out, 
 plant (session 21, written blind, run untuned, then its sheet constant tuned on its development
 units in the same session's second round) is held out, the snakedent plant (session 22, written
 blind: rolling vertebrae, detented knobs, run untuned, then its edge reading tuned on its
-development units in the same session's second round) is held out (``PLANT_ROLE``); the next
-blind plant is registered after it.
+development units in the same session's second round) is held out (``PLANT_ROLE``); the
+planetwist plant (session 23, written blind: a planetary handle stage, twist-coupled strands in
+swivel crimps, blood flow on the tip; run untuned) is the blind plant, registered last.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -47,6 +48,7 @@ from simrig.plants.helixbelt import NOMINAL_KNOBS as HELIXBELT_KNOBS
 from simrig.plants.jawcrimp import NOMINAL_KNOBS as JAWCRIMP_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
 from simrig.plants.nitinol import NOMINAL_KNOBS as NITINOL_KNOBS
+from simrig.plants.planetwist import NOMINAL_KNOBS as PLANETWIST_KNOBS
 from simrig.plants.ratestate import NOMINAL_KNOBS as RATESTATE_KNOBS
 from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
@@ -71,13 +73,15 @@ PLANT_SPECS: dict[str, str] = {
     "archwave": "simrig.plants.archwave:make_archwave_plant",
     "jawcrimp": "simrig.plants.jawcrimp:make_jawcrimp_plant",
     "cyclopebax": "simrig.plants.cyclopebax:make_cyclopebax_plant",
-    "snakedent": "simrig.plants.snakedent:make_snakedent_plant",  # last: the others' seeds hold
+    "snakedent": "simrig.plants.snakedent:make_snakedent_plant",
+    "planetwist": "simrig.plants.planetwist:make_planetwist_plant",  # last: the others' seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
-              "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out"}
+              "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
+              "planetwist": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -96,7 +100,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "archwave": ARCHWAVE_KNOBS,
                                         "jawcrimp": JAWCRIMP_KNOBS,
                                         "cyclopebax": CYCLOPEBAX_KNOBS,
-                                        "snakedent": SNAKEDENT_KNOBS}
+                                        "snakedent": SNAKEDENT_KNOBS,
+                                        "planetwist": PLANETWIST_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -167,6 +172,9 @@ VARIANTS: dict[str, Variant] = {
                            "handle_friction_Nm": 1.5, "mesh_friction": 1.3},
             "snakedent": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                           "handle_friction_Nm": 1.5, "joint_friction_mm": 1.5},
+            "planetwist": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                           "handle_friction_Nm": 1.5, "swivel_friction_Nmm": 1.5,
+                           "carrier_play_deg": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -195,7 +203,8 @@ VARIANTS: dict[str, Variant] = {
                  "archwave": {"tendon_stiffness_N": 0.4},
                  "jawcrimp": {"tendon_stiffness_N": 0.4},
                  "cyclopebax": {"tendon_stiffness_N": 0.4},
-                 "snakedent": {"tendon_stiffness_N": 0.4}},
+                 "snakedent": {"tendon_stiffness_N": 0.4},
+                 "planetwist": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

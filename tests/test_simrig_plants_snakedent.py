@@ -138,8 +138,9 @@ def test_a_unit_is_the_same_catheter_for_the_same_seed() -> None:
     assert not np.array_equal(tip_a, drive_knob(c, 0, path)[0])
 
 
-def test_snakedent_is_registered_last_and_held_out() -> None:
-    assert list(PLANT_SPECS)[-1] == "snakedent"
+def test_snakedent_is_registered_after_cyclopebax_and_held_out() -> None:
+    names = list(PLANT_SPECS)
+    assert names.index("snakedent") == names.index("cyclopebax") + 1
     assert PLANT_ROLE["snakedent"] == "held-out"
     assert isinstance(family_member("snakedent", 101).build(), SnakeDentPlant)
     assert set(SCATTER["snakedent"]) <= set(family_member("snakedent", 0).params["knobs"][0])

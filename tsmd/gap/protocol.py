@@ -49,11 +49,8 @@ class ProtocolDesign:
     slow_deg_s: float = 20.0
     fast_deg_s: float = 80.0
     coupling_deg_s: float = 40.0
-    other_deg: float = 75.0
-    """Where the other knob is held in the coupling test (0, +, -). 50 deg before session 23:
-    a catheter with a 25 deg dead zone has its other plane bent only about 28 deg there, and a
-    coupling that grows with the other bend squared (the rope take-up of rolling joints) hid
-    inside its model's units' spread (snakedent, docs/gap.md "Session 23")."""
+    other_deg: float = 50.0
+    """Where the other knob is held in the coupling test (0, +, -)."""
     dwell_amp_deg: float = 60.0
     dwell_s: float = 20.0
     rest_s: float = 10.0

@@ -99,6 +99,21 @@ def test_the_other_plane_bent_narrows_this_planes_dead_zone() -> None:
     assert threshold(80.0) < threshold(0.0) - 0.5
 
 
+def test_the_coupling_keyword_takes_up_this_plane_more_with_the_other_bent() -> None:
+    def tip_at_30(coupling: float) -> float:
+        plant = make_snakedent_plant(coupling=coupling)
+        drive_knob(plant, 1, ramp_deg(0.0, 80.0))
+        return float(drive_knob(plant, 0, ramp_deg(0.0, 30.0), 80.0)[0][-1])
+
+    def tip_straight(coupling: float) -> float:
+        plant = make_snakedent_plant(coupling=coupling)
+        return float(drive_knob(plant, 0, ramp_deg(0.0, 30.0))[0][-1])
+
+    assert tip_at_30(4.5) > tip_at_30(0.0) + 0.5
+    # the other knob at 0: its plane stays all but straight, so next to no change
+    assert tip_straight(4.5) == pytest.approx(tip_straight(0.0), abs=0.05)
+
+
 def test_the_backlash_grows_with_the_load_at_the_reversal() -> None:
     def travel_back(top_deg: float) -> float:
         plant = make_snakedent_plant()
@@ -157,6 +172,7 @@ def test_snakedent_is_registered_after_cyclopebax_and_held_out() -> None:
         ({"knobs": [{"hole_depth_mm": 4.0}, {}]}, "hole_depth_mm must be <= roll_radius_mm"),
         ({"knobs": [{"tendon_offset_mm": 3.5}, {}]}, "tendon_offset_mm must be < roll_radius"),
         ({"sheath_curvature_deg": -10.0}, "sheath_curvature_deg must be >= 0"),
+        ({"coupling": -1.0}, "coupling must be >= 0"),
     ],
 )
 def test_bad_constants_are_refused_with_one_clear_line(kwargs: dict[str, object],

@@ -299,3 +299,30 @@ CYCLOPEBAX_MAX_STEP_S = 0.0
 ms, and no closer at 4 ms (0.17), 1 ms (0.16) or 0.5 ms (0.12; unit 1, 120 s of the experiment
 motion): its rope contacts slip in events whose timing moves with the step, as a real catheter's
 would with the drive's own timing; a finer step buys nothing."""
+
+
+SNAKEDENT_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"coupling": 4.5},
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The snakedent plant's effect keywords, sized before any diagnosis (tip RMSE effect on minus
+off, units 1 / 2, noise-free, 120 s of the experiment motion at 50 Hz): the other plane's
+take-up on every rope 5.5 times the vertebrae's own (``coupling`` 4.5, the plant's keyword
+added for this preset: rope holes set off their plane; x3 0.64 / 0.87, x5 1.21 / 1.50, x6 1.48
+/ 1.87, the take-up removed altogether 0.31 / 0.57), 1.34 / 1.68 deg (the others' coupling 1.5
+deg); a 120 deg sheath bend (added to every lumen contact's wrap), 1.52 / 1.32 deg (60 deg 0.70
+/ 0.61), inside the others' 1.1-12.8 deg. Its laws read the knob angle only (the lumen
+contacts and the joints' friction band are Coulomb, the knob seal's tanh saturates at 2 deg/s
+and acts on the motor: x3 moves the tip 0.000 deg, the current 7-8 mA RMS) and nothing moves
+at a held knob: rate and creep are not run. The detent and the load-grown joint friction are
+base physics; "none" is the nominal physics as written (docs/gap.md "Session 23")."""
+
+SNAKEDENT_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Compliance on snakedent as a factor on the unit's knob constants, sized before any diagnosis
+(same criterion): the steel rope's EA halved, 3.61 / 3.44 deg (units 1 / 2)."""
+
+SNAKEDENT_MAX_STEP_S = 0.0
+"""No finer stepping: the nominal-scatter unit's tip lies 0.014 deg RMS (0.32 max) from 0.25 ms
+steps at 20 ms, 0.011 (0.07) at 4 ms (unit 1, 120 s of the experiment motion): quasi-static."""

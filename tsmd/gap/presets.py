@@ -43,6 +43,9 @@ from tsmd.gap.preset_effects import (
     SEGMENTS_BASE,
     SEGMENTS_EFFECTS,
     SEGMENTS_KNOB_EFFECTS,
+    SNAKEDENT_EFFECTS,
+    SNAKEDENT_KNOB_EFFECTS,
+    SNAKEDENT_MAX_STEP_S,
     STICKSLIP_EFFECTS,
     STICKSLIP_KNOB_EFFECTS,
     TWISTSHAFT_EFFECTS,
@@ -162,6 +165,9 @@ PRESETS: dict[str, PlantSpec] = {
                             family="cyclopebax", effects=CYCLOPEBAX_EFFECTS,
                             knob_effects=CYCLOPEBAX_KNOB_EFFECTS,
                             max_step_s=CYCLOPEBAX_MAX_STEP_S),
+    "snakedent": PlantSpec(PLANT_SPECS["snakedent"], {}, (), "snakedent", family="snakedent",
+                           effects=SNAKEDENT_EFFECTS, knob_effects=SNAKEDENT_KNOB_EFFECTS,
+                           max_step_s=SNAKEDENT_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

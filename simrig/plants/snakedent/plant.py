@@ -34,10 +34,13 @@ _MAX_ITER = 12
 class SnakeDentPlant:
     """Two planes of rolling vertebrae, each pulled by a pair of ropes off a detented knob."""
 
-    def __init__(self, knobs: Sequence[SnakeDentKnob], sheath_curvature_deg: float = 0.0
-                 ) -> None:
+    def __init__(self, knobs: Sequence[SnakeDentKnob], sheath_curvature_deg: float = 0.0,
+                 coupling: float = 0.0) -> None:
         self.knobs = tuple(knobs)
         self.sheath_curvature_deg = sheath_curvature_deg
+        # the other plane's take-up on this plane's ropes as a share of what the vertebrae's
+        # geometry gives (``coupling`` adds to it: rope holes set off their plane)
+        self.cross_takeup_share = 1.0 + coupling
         self._slack_extra = [[0.0, 0.0], [0.0, 0.0]]
         self._constants()
         self.reset()
@@ -80,7 +83,8 @@ class SnakeDentPlant:
         friction not included), its stiffness, and both ropes' contact answers."""
         k, o = self.knobs[i], self.knobs[1 - i]
         c, c_o = self._depth[i], self._depth[1 - i]
-        take_up = o.joints * rope_lengthening_mm(self.theta_rad[1 - i], 0.0, c_o)
+        take_up = self.cross_takeup_share * o.joints * rope_lengthening_mm(
+            self.theta_rad[1 - i], 0.0, c_o)
         draw = math.radians(q_deg) * k.drum_radius_mm
         slack = (k.slack_pos_mm + self._slack_extra[i][0],
                  k.slack_neg_mm + self._slack_extra[i][1])
@@ -156,14 +160,18 @@ class SnakeDentPlant:
 
 
 def make_snakedent_plant(knobs: Sequence[Mapping[str, Any]] | None = None,
-                         sheath_curvature_deg: float = 0.0) -> SnakeDentPlant:
-    """The snakedent plant; ``knobs`` are two dicts of :class:`SnakeDentKnob` overrides."""
+                         sheath_curvature_deg: float = 0.0,
+                         coupling: float = 0.0) -> SnakeDentPlant:
+    """The snakedent plant; ``knobs`` are two dicts of :class:`SnakeDentKnob` overrides;
+    ``coupling`` adds that many times the other plane's take-up to every rope (0: as written)."""
     given = list(knobs) if knobs is not None else [{}, {}]
     if len(given) != 2:
         raise PlantLoadError(f"snakedent takes 2 knobs, got {len(given)}")
     if not (math.isfinite(sheath_curvature_deg) and sheath_curvature_deg >= 0.0):
         raise PlantLoadError(f"snakedent sheath_curvature_deg must be >= 0, got "
                              f"{sheath_curvature_deg!r}")
+    if not (math.isfinite(coupling) and coupling >= 0.0):
+        raise PlantLoadError(f"snakedent coupling must be >= 0, got {coupling!r}")
     return SnakeDentPlant([knob_from(v, base) for v, base in zip(given, NOMINAL_KNOBS,
                                                                   strict=True)],
-                          float(sheath_curvature_deg))
+                          float(sheath_curvature_deg), float(coupling))

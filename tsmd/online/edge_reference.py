@@ -136,8 +136,9 @@ class ReferenceReadings:
         ``leaning_steeper_reads_own``; :attr:`EstimatorOptions.leaning_steeper_reads_own`),
         else None. A bend steepens both tendons' first ramps after it by 5-15 % and widens
         the dead zone; the slope in use, shrunk towards the reference and two ramps per edge
-        late, reads a third of the widening inside the gate, while without a change the
-        crossing with the slope in use stays within half the gate of the estimate."""
+        late, reads a third of the widening inside the gate (lumped 1 phi2: +0.96..+1.33 deg,
+        fresh +2.9/+3.1). The lean keeps a steeper ramp whose crossing stays in place (its
+        slope's scatter, read outward by its own slope) from becoming a suspect."""
         o = self.options
         tol = o.slope_in_use_tolerance
         if not (o.leaning_steeper_reads_own and not self.odd_speed and partner is not None

@@ -45,6 +45,7 @@ class ReferenceReadings:
     n_widened: int
     n_steeper: int
     n_own_between: int
+    n_leaning_steeper: int
     n_reread: int
     odd_speed: bool
     ramp_change: float
@@ -127,6 +128,30 @@ class ReferenceReadings:
         self.n_widened += 1
         self.n_steeper += steeper
         return reading
+
+    def _leaning_steeper_read(self, ramp: LoadedRamp, edge_deg: float, slope: float,
+                              partner: ReferenceReadings | None) -> float | None:
+        """The ramp's own slope's crossing when the knob's friction shows a rise the slope in
+        use has not followed yet and the crossing leans outward with either slope (with
+        ``leaning_steeper_reads_own``; :attr:`EstimatorOptions.leaning_steeper_reads_own`),
+        else None. A bend steepens both tendons' first ramps after it by 5-15 % and widens
+        the dead zone; the slope in use, shrunk towards the reference and two ramps per edge
+        late, reads a third of the widening inside the gate (lumped 1 phi2: +0.96..+1.33 deg,
+        fresh +2.9/+3.1). The lean keeps a steeper ramp whose crossing stays in place (its
+        slope's scatter, read outward by its own slope) from becoming a suspect."""
+        o = self.options
+        tol = o.slope_in_use_tolerance
+        if not (o.leaning_steeper_reads_own and not self.odd_speed and partner is not None
+                and partner.ramp_change > tol and ramp.slope_A_per_deg / slope - 1.0 > tol):
+            return None
+        bias = self.bins.bias_deg(ramp.other_deg) + self.estimate_deg
+        if self._crossing(ramp, edge_deg, slope) - bias < o.partner_lean * o.gate_deg:
+            return None
+        own = self._crossing(ramp, edge_deg, ramp.slope_A_per_deg)
+        if own - bias <= o.gate_deg:
+            return None
+        self.n_leaning_steeper += 1
+        return own
 
     def _knob_steeper(self, ramp: LoadedRamp, slope: float,
                       partner: ReferenceReadings | None) -> bool:

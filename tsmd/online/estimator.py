@@ -32,6 +32,7 @@ from typing import Any
 
 from tsmd.online.edge_reference import ORDER, ReferenceReadings
 from tsmd.online.edge_slopes import SlopeReadings
+from tsmd.online.edge_status import edge_status
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
@@ -101,6 +102,9 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """Of those, steeper ramps read with their own slope (``steeper_knob_reads_own``)."""
     n_own_between: int = 0
     """Crossings within the gate read towards the ramp's own slope (``within_gate_reads_own``)."""
+    n_leaning_steeper: int = 0
+    """Crossings of steeper ramps read as suspects with their own slope
+    (``leaning_steeper_reads_own``)."""
     n_odd_knee: int = 0
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_odd_crossing: int = 0
@@ -259,7 +263,8 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             self._measured(widened, ramp.other_deg, events)
             return events
         self.last_feature = "crossing"
-        raw = self._crossing_read(ramp, profile_edge_deg, slope)
+        leaning = self._leaning_steeper_read(ramp, profile_edge_deg, slope, partner)
+        raw = self._crossing_read(ramp, profile_edge_deg, slope) if leaning is None else leaning
         rose = change > tol or ramp.slope_A_per_deg / slope - 1.0 > tol
         if o.refuse_inward_on_steeper and rose and raw - self.estimate_deg < -o.gate_deg:
             # More friction along the tendon (the knob's ramps, or this one, steeper beyond
@@ -376,20 +381,4 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             self.zero_load_deg = self.applied_deg
 
     def status(self) -> dict[str, Any]:
-        state = ("learning" if self.learning else "frozen" if self.frozen_for > 0
-                 else "tracking" if self.reference.settled else "settling")
-        return {"state": state, "offset_deg": round(self.applied_deg, 3),
-                "zero_load_offset_deg": round(self.zero_load_deg, 3),
-                "estimate_deg": round(self.estimate_deg, 3),
-                "confidence": round(self.confidence, 2), "ramps": self.n_ramps,
-                "odd_slope_ramps": self.n_odd_slope, "odd_knee_ramps": self.n_odd_knee,
-                "odd_crossing_ramps": self.n_odd_crossing, "refused_ramps": self.n_refused,
-                "odd_speed_ramps": self.n_odd_speed,
-                "feature": self.last_feature or None,
-                "backlash_gain_ratio": round(self.gain_ratio, 3),
-                "other_knob_bins_deg": self.bins.biases_deg(),
-                "frozen_reason": self.frozen_reason if self.frozen_for > 0 else None,
-                "reference_relearned": self.reference.relearned,
-                "reread_ramps": self.n_reread, "partner_held": self.n_partner_held,
-                "between_ramps": self.n_between, "widened_ramps": self.n_widened,
-                "steeper_ramps": self.n_steeper, "own_slope_ramps": self.n_own_between}
+        return edge_status(self)

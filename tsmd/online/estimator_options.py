@@ -131,6 +131,17 @@ class EstimatorOptions:
     the gate): both tendons' friction rose, a bend, and the slope in use lags it (coilpipe 1,
     60 deg bend: phi1 ramps 1.16-1.34 x passed over for 40 s, on / fresh 2.13 x). Off: such a
     ramp is read as any odd slope (``odd_slopes_read_widening``; until session 19)."""
+    leaning_steeper_reads_own: bool = True
+    """A crossing of a ramp steeper than the slope in use beyond ``slope_in_use_tolerance``,
+    at the reference's speed, while the knob's other tendon's last ramp was steeper than its
+    reference by as much, that leans outward by ``partner_lean`` of the gate with the slope in
+    use and lies outward beyond the gate with its own slope, is a suspect at its own slope's
+    crossing (:meth:`EdgeTracker._leaning_steeper_read`): the first ramps after a bend are
+    5-15 % steeper, the slope in use follows two ramps per edge late and reads a third of the
+    widening inside the gate (lumped 1, 60 deg bend: phi2 +0.96/+1.33/+1.00 deg on ramps
+    1.08-1.15 x, the fresh edges +2.9/+3.1; followed 52 s after the bend, 19 s into the
+    scoring). Both edges' suspects must agree (or two in a row) as for any change. Off: such
+    a crossing reads inside the gate (until session 22)."""
     reread_on_slope_change: bool = False
     """The last crossing ramp is read again when the slope in use has moved beyond
     ``slope_in_use_tolerance`` since it was read; outward beyond the gate it becomes a

@@ -27,6 +27,15 @@ class EdgeView(Protocol):
     last_reading_deg: float
 
 
+class SuspectView(Protocol):
+    """What :func:`holds_agreeing_suspect` reads of an edge tracker."""
+
+    frozen_for: int
+    suspects: list[float]
+    suspect_order: int
+    accepted_order: int
+
+
 def partner_shows_change(partner: EdgeView | None, lean_deg: float) -> bool:
     """The knob's other edge followed a change, or its latest reading lies ``lean_deg`` or
     more from its estimate (either way: a widening or a shift). True without a partner."""
@@ -44,4 +53,18 @@ def partner_left_band(partner: EdgeView | None, deadband_deg: float) -> bool:
     return abs(partner.estimate_deg) > deadband_deg
 
 
-__all__ = ["EdgeView", "partner_left_band", "partner_shows_change"]
+def holds_agreeing_suspect(partner: SuspectView, value_deg: float, spread_deg: float) -> bool:
+    """The knob's other edge, not frozen, last read a suspect (nothing within its gate since)
+    within ``spread_deg`` of ``value_deg``, the change this edge just followed on its own
+    suspects: both edges of the knob agree, so the other follows too. Without it, an edge that
+    followed on two suspects of its own took its partner's agreeing suspect with it (both
+    cleared) and the partner stayed where it was (coilpipe 1, 60 deg bend: phi2 neg followed
+    to +2.78 deg on two suspects, pos held +2.42 and stayed at 0; phi2 tracked worse than
+    with online off)."""
+    return (partner.frozen_for == 0 and bool(partner.suspects)
+            and partner.suspect_order > partner.accepted_order
+            and abs(partner.suspects[-1] - value_deg) <= spread_deg)
+
+
+__all__ = ["EdgeView", "SuspectView", "holds_agreeing_suspect", "partner_left_band",
+           "partner_shows_change"]

@@ -33,6 +33,7 @@ from tsmd.online.cross_knob import knob_shows
 from tsmd.online.estimator import EdgeTracker
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp, RampOptions, Rejected, Stroke
+from tsmd.online.partner import holds_agreeing_suspect
 from tsmd.online.segment import StrokeSegmenter
 from tsmd.online.stroke_ramp import referred_stroke, stroke_ramp
 
@@ -223,9 +224,13 @@ class OnlineWorker:
 
     def _ramp(self, tracker: EdgeTracker, ramp: LoadedRamp) -> None:
         d_pos, d_neg = edges_at(self.base_knobs[ramp.knob], ramp.other_deg)
-        before = tracker.applied_deg
+        before, level_before = tracker.applied_deg, tracker.level_deg
         other = self.trackers[(ramp.knob, -ramp.side)]
         events = tracker.update(ramp, d_pos if ramp.side > 0 else d_neg, other)
+        if tracker.level_deg != level_before and holds_agreeing_suspect(
+                other, tracker.level_deg, tracker.options.confirm_spread_deg):
+            events += self._follow_other(other, other.suspects[-1],
+                                         "both edges of the knob agree", "")
         bend = (tracker.bend_suspect and tracker.options.follow_bend_at_once
                 and other.frozen_for == 0)
         if bend or self._knob_agrees(tracker, other):

@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.calibration.edge_level import edge_level_grid
 from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.fresh_hold import with_fresh_hold
 from tsmd.calibration.identify import settle_rule_backlash
@@ -58,6 +59,7 @@ from tsmd.calibration.release_end import plateau_moved, side_ratios
 from tsmd.calibration.release_path import release_through_amplitude
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.unit_slope import GainReading, gain_scatter, weighed_omega
+from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.loaded_shape import curved, shaped_height
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
 from tsmd.compensation.release_ratio import RELEASE_RATIO_RANGE, release_slope_ratio
@@ -217,7 +219,18 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                                else (float(ks_pos), float(ks_neg))),
         release_round=float(getattr(k, "release_round", None) or 0.0),
         release_shift=float(getattr(k, "release_shift", None) or 0.0),
-        level_grid=getattr(k, "loaded_level_grid", None))
+        level_grid=unit_level_grid(k, omega, grid, d_pos, d_neg))
+
+
+def unit_level_grid(knob: Any, omega: float, grid: Sequence[float],
+                    d_pos: Sequence[float], d_neg: Sequence[float]) -> LevelGrid | None:
+    """The unit's level grid: the sheet's ``loaded_level_grid`` as it is, or with the sheet's
+    ``edge_level_share`` the shift this unit's own edges call for added to it (session 23)."""
+    product = getattr(knob, "loaded_level_grid", None)
+    share = getattr(knob, "edge_level_share", None)
+    if share is None:
+        return product
+    return edge_level_grid(float(share), omega, grid, d_pos, d_neg, product)
 
 
 def clamped_gain(beta: float) -> float:

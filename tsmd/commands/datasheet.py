@@ -39,6 +39,7 @@ from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
 from tsmd.datasheet_bend_slope import rig_slope_reader
 from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_edge_curve import choose_edge_curve, with_edge_curve
+from tsmd.datasheet_edge_level import with_edge_level_share
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_offset import with_reading_offset
 from tsmd.datasheet_ratio_gain import with_ratio_gain
@@ -327,6 +328,8 @@ def main(args: argparse.Namespace) -> int:
         device = _with_release_end_offset(device, config, factory, args.seed)
     if args.plant is not None and args.release_round:
         device = with_release_round(device, config, factory, args.seed)
+    if args.plant is not None and args.edge_level_share:  # the level grid reads what is left
+        device = with_edge_level_share(device, config, factory, args.seed)
     if args.plant is not None and args.level_grid:
         device = with_level_grid(device, config, factory, args.seed)
     if args.plant is not None and sample:

@@ -67,6 +67,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "how far each side's loaded level moves with the other knob's angle "
                              "(loaded_level_grid; opt-in per product, docs/model.md Session 21)")
+    parser.add_argument("--edge-level-share", action="store_true",
+                        help="with --plant: also calibrate the unit once more, tracked, and read "
+                             "the share of the current's edge movement over the other knob's "
+                             "angle the tip's loaded level does not follow (edge_level_share; "
+                             "opt-in per product, docs/model.md Session 23)")
     parser.add_argument("--rule-seeds", default=",".join(map(str, RULE_NOISE_SEEDS)),
                         metavar="LIST",
                         help="with --plant: noise seeds of the unit's fast calibrations under "

@@ -22,6 +22,10 @@ import numpy as np
 
 LEVEL_SHIFT_RANGE_DEG: tuple[float, float] = (-30.0, 30.0)
 """A shift beyond this is not a level but a mis-read (bad input)."""
+EDGE_LEVEL_SHARE_RANGE: tuple[float, float] = (0.0, 1.5)
+"""Plausible shares of the current's edge movement the tip's level does not follow (data
+sheet's ``edge_level_share``, :mod:`tsmd.calibration.edge_level`): 0 the tip follows the edge,
+1 it keeps its level at the other knob's 0; beyond 1.5 no edge explains the miss."""
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,11 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any, TypeVar
 
-from tsmd.compensation.level_grid import level_grid_from_mapping, level_grid_to_mapping
+from tsmd.compensation.level_grid import (
+    EDGE_LEVEL_SHARE_RANGE,
+    level_grid_from_mapping,
+    level_grid_to_mapping,
+)
 from tsmd.compensation.loaded_shape import (
     shape_from_mapping,
     shape_grid_from_mapping,
@@ -67,6 +71,7 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "release_round": (*RELEASE_ROUND_RANGE, ""),
     "release_shift": (*RELEASE_SHIFT_RANGE, ""),
     "torque_ripple_period_deg": (1.0, 90.0, "deg"),
+    "edge_level_share": (*EDGE_LEVEL_SHARE_RANGE, ""),
 }
 """The data sheet's optional measured numbers per knob and their plausible ranges: the schema
 reads them with these, and ``tsmd datasheet`` leaves out a measured one outside its range
@@ -82,7 +87,8 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_recovery_lag_deg", "backlash_bend_gain", "backlash_release_rule",
                       "backlash_settled_share", "backlash_knee", "edge_curve", "release_ratio_gain")
-_COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg")
+_COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg",
+                  "edge_level_share")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
 _SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
 """Optional data-sheet numbers measured on the product's sample, written only when measured."""
@@ -224,6 +230,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             release_round=optional("release_round"),
             release_shift=optional("release_shift"),
             torque_ripple_period_deg=optional("torque_ripple_period_deg"),
+            edge_level_share=optional("edge_level_share"),
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)

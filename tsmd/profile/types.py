@@ -254,6 +254,11 @@ class DeviceKnob:
     plane's bend moves the tip's flats and loaded branches inward (a spine both planes share;
     :mod:`tsmd.compensation.level_grid`); calibration copies it into each unit's profile.
     None: the heights at every angle."""
+    edge_level_share: float | None = None
+    """Optional, tracked on the data-sheet unit (``tsmd datasheet --edge-level-share``, session
+    23): the share of the current's edge movement over the other knob's angle that the tip's
+    loaded level does not follow (:mod:`tsmd.calibration.edge_level`); calibration turns it and
+    the unit's own edges into the unit's level grid. None: the tip follows the edge."""
 
 
 @dataclass(frozen=True)

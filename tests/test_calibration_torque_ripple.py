@@ -1,5 +1,6 @@
-"""The dead-zone edge fit over a handle's torque ripple (a detent, cogging): the current averaged
-over one ripple period (tsmd.calibration.pieces.period_mean) before the edge is fitted."""
+"""The dead-zone edge fit over a handle's torque ripple (a detent, cogging): the ripple taken out
+of the current (tsmd.calibration.pieces.ripple_removed, folded on its period around the
+one-period mean, tsmd.calibration.pieces.period_mean) before the edge is fitted."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 from tsmd.calibration.options import IdentifyOptions
-from tsmd.calibration.pieces import fitted_edge, period_mean
+from tsmd.calibration.pieces import fitted_edge, period_mean, ripple_removed
 from tsmd.commands import datasheet as datasheet_command
 from tsmd.commands.datasheet_args import add_arguments
 from tsmd.datasheet import DatasheetError
@@ -31,6 +32,40 @@ def _rippled_hinge(x: np.ndarray, phase_deg: float) -> np.ndarray:
     ramp = 0.02 + 0.0022 * np.maximum(x - EDGE_DEG, 0.0)
     ripple = 0.004 * np.sin(2.0 * np.pi * (x - phase_deg) / PERIOD_DEG)
     return ramp + ripple + np.random.default_rng(1).normal(0.0, NOISE_A, x.size)
+
+
+STRETCH_START_DEG = 16.0
+
+
+def _stretch_then_ramp(x: np.ndarray) -> np.ndarray:
+    """The rope stretching while the tip is held (6 mA/deg from ``STRETCH_START_DEG``), then the
+    loaded ramp (2.2 mA/deg) from ``EDGE_DEG``, where the tip lets go."""
+    return (0.02 + 0.006 * np.clip(x - STRETCH_START_DEG, 0.0, EDGE_DEG - STRETCH_START_DEG)
+            + 0.0022 * np.maximum(x - EDGE_DEG, 0.0))
+
+
+def _ripple(x: np.ndarray, phase_deg: float) -> np.ndarray:
+    return 0.004 * np.sin(2.0 * np.pi * (x - phase_deg) / PERIOD_DEG)
+
+
+@pytest.mark.parametrize("phase_deg", [0.0, 5.0, 10.0])
+def test_the_ripple_taken_out_leaves_the_current_it_rode_on(phase_deg: float) -> None:
+    x = np.arange(-90.0, 90.0, 0.25)
+    clean = _stretch_then_ramp(x)
+    cleaned = ripple_removed(x, clean + _ripple(x, phase_deg), PERIOD_DEG)
+    assert np.max(np.abs((cleaned - clean) - np.mean(cleaned - clean))) < 4e-4  # of 4 mA
+
+
+@pytest.mark.parametrize("phase_deg", [0.0, 2.5, 5.0, 7.5, 10.0, 12.5])
+def test_a_rope_stretch_under_the_ripple_reads_at_its_end_whatever_the_notch_phase(
+        phase_deg: float) -> None:
+    x = np.arange(-90.0, 90.0, 0.25)
+    y = (_stretch_then_ramp(x) + _ripple(x, phase_deg)
+         + np.random.default_rng(2).normal(0.0, NOISE_A, x.size))
+    k = int(np.searchsorted(x, STRETCH_START_DEG))
+    opts = replace(IdentifyOptions(edge="fit", edge_curve=True),
+                   torque_ripple_period_deg=PERIOD_DEG)
+    assert abs(x[fitted_edge(x, y, 0, k, NOISE_A, opts)] - EDGE_DEG) < 1.0
 
 
 def test_one_period_mean_removes_the_ripple_and_keeps_a_line() -> None:

@@ -211,7 +211,9 @@ class Daemon:
             config.online, self.loop, on_event=self.events.emit,
             handle_slip_deg=None if sheet is None else (sheet.knobs[0].handle_slip_deg,
                                                         sheet.knobs[1].handle_slip_deg),
-            bend=sheet_bend_relation(sheet))
+            bend=sheet_bend_relation(sheet),
+            ripple_period_deg=None if sheet is None else (
+                sheet.knobs[0].torque_ripple_period_deg, sheet.knobs[1].torque_ripple_period_deg))
         if self.recorder is not None and config.online.enabled:
             self.loop.recorder = self.online.recording(self.recorder)
         self.online.attach(compensator)

@@ -74,9 +74,11 @@ class IdentifyOptions:
     max_knee_deg: float = 15.0
     torque_ripple_period_deg: float | None = None
     """``edge="fit"``: the knob angle over which the handle's torque ripples (a detent's notch
-    spacing, cogging), or None. The fitted window is averaged over one period first, which
-    removes a periodic ripple of any shape and leaves a line's slope as it is: a notch's
-    steep-then-shallow stretch on the loaded ramp otherwise reads as a knee one period late
+    spacing, cogging), or None. The ripple of that period is taken out of the half-cycle's
+    current first (its departure from the one-period mean, folded on the period:
+    :func:`tsmd.calibration.pieces.ripple_removed`), which removes a periodic ripple of any
+    shape and leaves the engagement's corner as it is: a notch's steep-then-shallow stretch on
+    the loaded ramp otherwise reads as a knee one period late
     (:func:`tsmd.calibration.pieces.fitted_edge`)."""
     settle_hold_deg: float = 1.0
     """The current must stay on the constant level this long to count as settled."""

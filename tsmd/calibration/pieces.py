@@ -116,7 +116,7 @@ def fitted_edge(grid: FloatArray, yg: FloatArray, plateau_start: int, rise_k: in
     b = min(yg.size, rise_k + round(opts.fit_after_deg / step))
     x, y = grid[a:b], yg[a:b]
     if opts.torque_ripple_period_deg:
-        x, y = period_mean(grid, yg, a, b, opts.torque_ripple_period_deg)
+        y = ripple_removed(grid, yg, opts.torque_ripple_period_deg)[a:b]
     fit = fit_edge(x, y, noise, knee_slope_ratio=opts.knee_slope_ratio,
                    max_knee_deg=opts.max_knee_deg, penalty_k=opts.penalty_k,
                    curve_check=opts.edge_curve,
@@ -140,6 +140,27 @@ def period_mean(grid: FloatArray, yg: FloatArray, a: int, b: int,
     k = np.arange(lo, hi)
     mean = (sums[k + half + 1] - sums[k - half]) / (2 * half + 1)
     return grid[lo:hi], mean
+
+
+def ripple_removed(grid: FloatArray, yg: FloatArray, period_deg: float) -> FloatArray:
+    """``yg`` less the ripple it carries with ``period_deg`` (a detent's notches): the current's
+    departure from its one-period mean (:func:`period_mean`) folded on the period over the
+    whole half-cycle, its median per phase. Averaging alone spreads the engagement's corner
+    over a period (snakedent: edges read 1.6-2.1 deg inward on a detent-free unit, varying
+    with where the notches lie); the departure near that corner is the corner's own, one or
+    two periods of the half-cycle's dozen, which the median leaves out."""
+    step = float(grid[1] - grid[0])
+    x, smooth = period_mean(grid, yg, 0, yg.size, period_deg)
+    if x.size == yg.size:  # too short a half-cycle for one period either side
+        return yg
+    start = round((float(x[0]) - float(grid[0])) / step)
+    departure = yg[start:start + x.size] - smooth
+    bins = max(1, round(period_deg / step))
+    phase = np.floor(np.mod(x, period_deg) / step + 1e-9).astype(int) % bins
+    template = np.array([float(np.median(departure[phase == b])) if np.any(phase == b)
+                         else 0.0 for b in range(bins)])
+    template -= template.mean()
+    return yg - template[np.floor(np.mod(grid, period_deg) / step + 1e-9).astype(int) % bins]
 
 
 def smooth_crossing(grid: FloatArray, yg: FloatArray, k: int, target: float,

@@ -35,18 +35,21 @@ class OnlineAttachment:
     """Owns the loop's online worker; ``wanted`` survives compensator changes.
 
     ``on_event(level, event, **fields)`` receives the worker's events (the daemon's log).
-    ``handle_slip_deg`` per knob comes from the data sheet (None: the estimator's default),
-    and so does the product's ``bend`` relation (None: the sheet has none).
+    ``handle_slip_deg`` and ``ripple_period_deg`` per knob come from the data sheet (None: the
+    estimator's default), and so does the product's ``bend`` relation (None: the sheet has
+    none).
     """
 
     def __init__(self, config: OnlineConfig, loop: Observed,
                  on_event: Callable[..., None] | None = None,
                  handle_slip_deg: tuple[float, float] | None = None,
-                 bend: BendRelation | None = None) -> None:
+                 bend: BendRelation | None = None,
+                 ripple_period_deg: tuple[float | None, float | None] | None = None) -> None:
         self.config = config
         self.loop = loop
         self.on_event = on_event
         self.handle_slip_deg = handle_slip_deg
+        self.ripple_period_deg = ripple_period_deg
         self.bend = bend
         self.wanted = config.enabled
         self.worker: OnlineWorker | None = None
@@ -126,7 +129,8 @@ class OnlineAttachment:
                 estimator=EstimatorOptions(gate_deg=c.gate_deg, max_offset_deg=c.max_offset_deg,
                                            deadband_deg=c.deadband_deg),
                 rate_deg_s=c.rate_deg_s, on_event=self.on_event,
-                handle_slip_deg=self.handle_slip_deg, fault_reason=self._fault_reason,
+                handle_slip_deg=self.handle_slip_deg, ripple_period_deg=self.ripple_period_deg,
+                fault_reason=self._fault_reason,
                 bend=self.bend)
         except OnlineError as exc:
             self._why_not = str(exc)

@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.calibration.pieces import period_mean
+
 Array = NDArray[np.float64]
 
 
@@ -67,6 +69,12 @@ class RampOptions:
     knee_step_deg: float = 0.25
     knee_min_side: int = 10
     """Samples needed on each side of a knee candidate."""
+    torque_ripple_period_deg: float | None = None
+    """The handle's torque ripple period (a detent's notch spacing; the data sheet's
+    :attr:`tsmd.profile.DeviceKnob.torque_ripple_period_deg`): the loaded window's current is
+    averaged over it before the line is fitted. None: no ripple, the samples are fitted."""
+    ripple_grid_step_deg: float = 0.25
+    """The uniform knob-angle grid the current is averaged on (bin means of the samples)."""
 
 
 @dataclass(frozen=True)
@@ -118,6 +126,11 @@ class Rejected:
     stall: bool = False
 
 
+RIPPLE_MIN_SPAN_DEG = 4.0
+"""Knob travel the ripple-averaged points must span: each already averages a whole period, so
+the line needs fewer degrees than the samples' fit (0.6 of the window)."""
+
+
 def _line(x: Array, y: Array, stick: Array) -> tuple[float, float, Array]:
     """(value at mean x, slope, residuals) of the least-squares line plus a fading stick term
     (``stick`` = exp(-slip / handle_slip), left out when it does not vary in the window)."""
@@ -128,6 +141,43 @@ def _line(x: Array, y: Array, stick: Array) -> tuple[float, float, Array]:
     a_mat = np.column_stack(columns)
     coef, *_ = np.linalg.lstsq(a_mat, y, rcond=None)
     return float(coef[0]), float(coef[1]), y - a_mat @ coef
+
+
+def _ripple_averaged(u: Array, y: Array, slip_deg: Array, start: float, o: RampOptions
+                     ) -> tuple[Array, Array, Array] | None:
+    """(angle, current, stick term) from ``start`` outward over the window, each averaged over
+    one period of the handle's torque ripple (:func:`tsmd.calibration.pieces.period_mean`) on
+    a uniform grid of knob angle: a periodic ripple of any shape averages out, the line stays.
+    Each averaged point takes half a period of samples either side (inward of the window too),
+    so the points end half a period before the stroke does; None where the stroke leaves
+    fewer than 8 points or gaps (a restart) in a fifth of the grid."""
+    period = float(o.torque_ripple_period_deg or 0.0)
+    step = o.ripple_grid_step_deg
+    half = max(1, round(0.5 * period / step))
+    ok = slip_deg >= o.restart_skip_deg
+    if not ok.any():
+        return None
+    lo = start - half * step
+    hi = min(float(u[ok].max()), start + o.width_deg + half * step)
+    n = math.floor((hi - lo) / step) + 1
+    if n < 2 * half + 8:
+        return None
+    take = ok & (u >= lo - 0.5 * step) & (u < lo + (n - 0.5) * step)
+    k = np.rint((u[take] - lo) / step).astype(int)
+    counts = np.bincount(k, minlength=n)
+    have = counts > 0
+    if np.count_nonzero(have) < 0.8 * n:
+        return None
+    grid = lo + step * np.arange(n, dtype=np.float64)
+
+    def binned(v: Array) -> Array:
+        means = np.bincount(k, weights=v, minlength=n)[have] / counts[have]
+        return np.interp(grid, grid[have], means)
+
+    stick = np.exp(-slip_deg[take] / o.handle_slip_deg)
+    x, y_mean = period_mean(grid, binned(y[take]), half, n - half, period)
+    _, stick_mean = period_mean(grid, binned(stick), half, n - half, period)
+    return x, y_mean, stick_mean
 
 
 def _window(u: Array, slip_deg: Array, start: float, width: float, o: RampOptions,
@@ -257,6 +307,13 @@ def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
     stick = np.exp(-stroke.slip_deg[sel] / o.handle_slip_deg)
     span_s = float(stroke.t_s[sel][-1] - stroke.t_s[sel][0])
     speed = float(x.max() - x.min()) / span_s if span_s > 0 else math.nan
+    if o.torque_ripple_period_deg:
+        averaged = _ripple_averaged(u, side * stroke.current_A, stroke.slip_deg,
+                                    float(x.min()), o)
+        if averaged is None or float(averaged[0][-1] - averaged[0][0]) < RIPPLE_MIN_SPAN_DEG:
+            return Rejected(stroke.knob, "the stroke turns back within half a torque ripple "
+                                         "period of the loaded window")
+        x, y, stick = averaged
     a, b, r = _line(x, y, stick)
     sigma = 1.4826 * float(np.median(np.abs(r - np.median(r))))
     if sigma > 0:

@@ -40,8 +40,8 @@ def mixed_motion(duration_s: float, seed: int) -> tuple[Array, Array]:
 def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int,
         device: Any = None, bend: Any = None) -> tuple[Any, Any]:
     """One lockstep run with our compensator; returns (recording, worker or None). The
-    worker takes each knob's handle slip from ``device``'s data sheet and the product's bend
-    relation ``bend`` (None: none)."""
+    worker takes each knob's handle slip and torque ripple period from ``device``'s data
+    sheet and the product's bend relation ``bend`` (None: none)."""
     with LockstepRunner(None, profile, "ours", seed, plant) as runner:
         comp = make_compensator(profile, "ours", runner.config)
         runner.loop.execute("set_compensator", compensator=comp, label="ours")
@@ -49,8 +49,11 @@ def run(profile: Any, plant: Any, t: Array, q: Array, online: bool, seed: int,
         if online:
             slip = None if device is None else (device.knobs[0].handle_slip_deg,
                                                  device.knobs[1].handle_slip_deg)
+            ripple = None if device is None else (device.knobs[0].torque_ripple_period_deg,
+                                                   device.knobs[1].torque_ripple_period_deg)
             worker = OnlineWorker(comp, runner.loop.period_s, ROW_COLUMNS,
-                                  handle_slip_deg=slip, drain_every=DRAIN_EVERY,
+                                  handle_slip_deg=slip, ripple_period_deg=ripple,
+                                  drain_every=DRAIN_EVERY,
                                   fault_reason=lambda: runner.loop.fault_reason, bend=bend)
             runner.loop.observer = worker.observe
         rec = runner.run(t, q, compensate=True)

@@ -50,6 +50,9 @@ class OnlineWorker:
     ``cmd1/2``, ``pos1/2``, ``cur1/2``. ``on_event(level, event, **fields)`` as the loop's.
     ``handle_slip_deg``: each knob's handle slip from the data sheet
     (:attr:`tsmd.profile.DeviceKnob.handle_slip_deg`); None keeps ``ramp``'s.
+    ``ripple_period_deg``: each knob's handle torque ripple period from the data sheet
+    (:attr:`tsmd.profile.DeviceKnob.torque_ripple_period_deg`, None for a knob without one):
+    the loaded ramps are fitted to the current averaged over it; None keeps ``ramp``'s.
     ``fault_reason``: the loop's fault (``lambda: loop.fault_reason``); when the loop leaves
     ENABLED with a fault the freeze is a warning, otherwise (stop, disable, not yet enabled)
     the estimate pauses silently. ``bend``: the product's bend relation (data sheet's unit);
@@ -61,6 +64,7 @@ class OnlineWorker:
     def __init__(self, compensator: Any, period_s: float, columns: Sequence[str], *,
                  estimator: EstimatorOptions | None = None, ramp: RampOptions | None = None,
                  handle_slip_deg: tuple[float, float] | None = None,
+                 ripple_period_deg: tuple[float | None, float | None] | None = None,
                  rate_deg_s: float = 4.0, gain_rate_per_s: float = 0.5,
                  queue_len: int = 8192, drain_every: int = 0,
                  on_event: EventSink | None = None,
@@ -80,8 +84,12 @@ class OnlineWorker:
         slip = handle_slip_deg or (self.ramp_options.handle_slip_deg,) * 2
         if not all(x > 0.0 for x in slip):  # also refuses NaN
             raise OnlineError(f"handle_slip_deg must be > 0 deg, got {slip}")
-        self._knob_ramp = tuple(replace(self.ramp_options, handle_slip_deg=float(x))
-                                for x in slip)
+        ripple = ripple_period_deg or (self.ramp_options.torque_ripple_period_deg,) * 2
+        if not all(p is None or p > 0.0 for p in ripple):
+            raise OnlineError(f"ripple_period_deg must be > 0 deg or None, got {ripple}")
+        self._knob_ramp = tuple(replace(self.ramp_options, handle_slip_deg=float(x),
+                                        torque_ripple_period_deg=p)
+                                for x, p in zip(slip, ripple, strict=True))
         self.fault_reason = fault_reason
         self.bend = bend
         options = estimator or EstimatorOptions()

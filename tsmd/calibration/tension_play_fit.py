@@ -217,7 +217,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                                else (float(ks_pos), float(ks_neg))),
         release_round=float(getattr(k, "release_round", None) or 0.0),
         release_shift=float(getattr(k, "release_shift", None) or 0.0),
-        level_grid=getattr(k, "loaded_level_grid", None))
+        level_grid=getattr(k, "loaded_level_grid", None),
+        release_end=getattr(k, "release_end_shape", None))
 
 
 def clamped_gain(beta: float) -> float:

@@ -45,6 +45,7 @@ from tsmd.datasheet_ratio_gain import with_ratio_gain
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
 from tsmd.datasheet_release_end import measure_release_end_offsets
 from tsmd.datasheet_release_round import with_release_round
+from tsmd.datasheet_reversal_release import with_release_end
 from tsmd.datasheet_rule import (
     choose_knee,
     choose_rules,
@@ -327,6 +328,8 @@ def main(args: argparse.Namespace) -> int:
         device = _with_release_end_offset(device, config, factory, args.seed)
     if args.plant is not None and args.release_round:
         device = with_release_round(device, config, factory, args.seed)
+    if args.plant is not None and args.release_end_shape:
+        device = with_release_end(device, config, factory, args.seed)
     if args.plant is not None and args.level_grid:
         device = with_level_grid(device, config, factory, args.seed)
     if args.plant is not None and sample:

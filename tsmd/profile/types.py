@@ -13,6 +13,7 @@ from tsmd.compensation.grid import CALIBRATION_GRID_DEG
 from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
+from tsmd.compensation.reversal_release import ReleaseEndShape
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.errors import TsmdError
@@ -254,6 +255,12 @@ class DeviceKnob:
     plane's bend moves the tip's flats and loaded branches inward (a spine both planes share;
     :mod:`tsmd.compensation.level_grid`); calibration copies it into each unit's profile.
     None: the heights at every angle."""
+    release_end_shape: ReleaseEndShape | None = None
+    """Optional, read from the data-sheet unit's tip (session 23, ``tsmd datasheet
+    --release-end-shape``): where the tip's release ends after a reversal at a fraction of
+    90 deg, as a ratio of where it ends after 90 (:mod:`tsmd.compensation.reversal_release`);
+    calibration copies it into each unit's profile and method ours draws a release line per
+    reversal to that end. None: the static release lines."""
 
 
 @dataclass(frozen=True)

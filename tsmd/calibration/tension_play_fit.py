@@ -219,7 +219,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                                else (float(ks_pos), float(ks_neg))),
         release_round=float(getattr(k, "release_round", None) or 0.0),
         release_shift=float(getattr(k, "release_shift", None) or 0.0),
-        level_grid=unit_level_grid(k, omega, grid, d_pos, d_neg))
+        level_grid=unit_level_grid(k, omega, grid, d_pos, d_neg),
+        release_end=getattr(k, "release_end_shape", None))
 
 
 def unit_level_grid(knob: Any, omega: float, grid: Sequence[float],

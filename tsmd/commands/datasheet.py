@@ -46,6 +46,7 @@ from tsmd.datasheet_ratio_gain import with_ratio_gain
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
 from tsmd.datasheet_release_end import measure_release_end_offsets
 from tsmd.datasheet_release_round import with_release_round
+from tsmd.datasheet_reversal_release import with_release_end
 from tsmd.datasheet_rule import (
     choose_knee,
     choose_rules,
@@ -330,6 +331,8 @@ def main(args: argparse.Namespace) -> int:
         device = with_release_round(device, config, factory, args.seed)
     if args.plant is not None and args.edge_level_share:  # the level grid reads what is left
         device = with_edge_level_share(device, config, factory, args.seed)
+    if args.plant is not None and args.release_end_shape:
+        device = with_release_end(device, config, factory, args.seed)
     if args.plant is not None and args.level_grid:
         device = with_level_grid(device, config, factory, args.seed)
     if args.plant is not None and sample:

@@ -63,6 +63,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --plant: also calibrate the unit once more, tracked, and fit "
                              "the tip's rounded start after a reversal (release_round, "
                              "release_shift; opt-in per product, docs/model.md Session 20)")
+    parser.add_argument("--release-end-shape", action="store_true",
+                        help="with --plant: also sweep the unit at 45-90 deg, read where the "
+                             "tip's release ends after each reversal, and keep that shape on a "
+                             "knob where the unit, calibrated once, tracks better with a release "
+                             "line per reversal (release_end_shape; opt-in per product, "
+                             "docs/model.md Session 23)")
     parser.add_argument("--level-grid", action="store_true",
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "how far each side's loaded level moves with the other knob's angle "

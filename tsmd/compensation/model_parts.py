@@ -38,7 +38,8 @@ def model_parts(x_deg: FloatArray, other_deg: FloatArray, params: TensionPlayPar
         y[i] = state.y_deg
         branch = b.rising(float(x)) if state.direction > 0 else b.falling(float(x))
         flat = params.height_pos_deg if state.direction > 0 else params.height_neg_deg
-        if abs(branch - state.y_deg) > 1e-9:
+        on_line = state.line_slope > 0.0 and state.y_deg != state.held_deg  # a reversal's line
+        if abs(branch - state.y_deg) > 1e-9 and not on_line:
             parts.append("backlash")
         elif abs(state.y_deg - flat) <= FLAT_TOLERANCE_DEG:
             parts.append("plateau")

@@ -16,6 +16,7 @@ from tsmd.compensation.knee_map import moved_grid, moved_knee
 from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid, curved, steepest_slope
 from tsmd.compensation.release_round import reference_backlash_deg, shifted_zero_load_deg
+from tsmd.compensation.reversal_release import ReleaseEndShape
 from tsmd.compensation.shaped_play import model_branches
 from tsmd.compensation.tension_play import Branches, release_slope
 from tsmd.compensation.tension_play_params import TensionPlayParams
@@ -64,6 +65,9 @@ class OursKnob:
     """The product's shift of each side's plateau height over the other knob's angle
     (:mod:`tsmd.compensation.level_grid`); None: the heights at every angle (fresh tables
     keep them)."""
+    release_end: ReleaseEndShape | None = None
+    """The product's release end per reversal (:mod:`tsmd.compensation.reversal_release`);
+    None: the static release lines (fresh tables keep them)."""
     _table: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
     _fresh: tuple[tuple[Branches, ...], ...] = dataclasses.field(init=False, repr=False,
                                                                  compare=False)
@@ -102,6 +106,8 @@ class OursKnob:
             x0_neg = shifted_zero_load_deg(r[3], r[5], self.release_shift, -1)
         b = model_branches(w, h_pos, h_neg, r[0], r[1], r[2], r[3], x0_pos, x0_neg,
                            *self.shapes_at(other_deg))
+        if self.release_end is not None:
+            b = dataclasses.replace(b, release_end=self.release_end)
         if self.release_round == 0.0:
             return b
         k_pos, k_neg = (self.release_round * reference_backlash_deg(beta, x0, side)
@@ -124,7 +130,7 @@ class OursKnob:
                    # the profile's fresh numbers come together from one first sweep
                    p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None,
                    curved(shape_pos), curved(shape_neg), p.other_tip_gain, grid,
-                   p.release_round, p.release_shift, p.level_grid)
+                   p.release_round, p.release_shift, p.level_grid, p.release_end)
 
     def shapes_at(self, other_deg: float) -> tuple[LoadedShape | None, LoadedShape | None]:
         """The templates (positive, negative side) at the other knob's angle."""

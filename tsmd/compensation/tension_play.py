@@ -31,6 +31,7 @@ from tsmd.compensation.release_round import (
     rounded_drop_deg,
     rounded_gap_deg,
 )
+from tsmd.compensation.reversal_release import ReleaseEndShape, reversal_line
 from tsmd.compensation.tension_play_params import BETA_RANGE
 
 _FLAT_SLOPE = 1e-6  # makes the envelopes strictly increasing so that they can be inverted
@@ -76,7 +77,9 @@ def widest_flat(knots: Sequence[float], ys: Sequence[float], omega: float) -> Fl
 class Branches:
     """Rising (lower) and falling (upper) branch of one knob, piecewise linear on ``knots``;
     ``round_pos_deg`` / ``round_neg_deg``: the rounded release's half-width (output deg) after
-    a reversal from the positive / negative side (:mod:`tsmd.compensation.release_round`)."""
+    a reversal from the positive / negative side (:mod:`tsmd.compensation.release_round`);
+    ``release_end``: the product's release end per reversal (:mod:`tsmd.compensation.
+    reversal_release`), None: the static release lines."""
 
     knots: tuple[float, ...]
     rising_deg: tuple[float, ...]
@@ -85,6 +88,7 @@ class Branches:
     falling_flat: Flat | None = None
     round_pos_deg: float = 0.0
     round_neg_deg: float = 0.0
+    release_end: ReleaseEndShape | None = None
 
     def rising(self, x_deg: float) -> float:
         return interp_linear(x_deg, self.knots, self.rising_deg)
@@ -178,13 +182,79 @@ def envelopes(kinks: set[float], rising: Callable[[float], float],
 
 class PlayState(NamedTuple):
     """Command x, model output y, direction of motion, output held since the last reversal,
-    the rounded release's half-width since then (0: a sharp corner)."""
+    the rounded release's half-width since then (0: a sharp corner), the release line drawn at
+    that reversal (:mod:`tsmd.compensation.reversal_release`: its end on the plateau and slope;
+    slope 0: the static branches)."""
 
     x_deg: float
     y_deg: float
     direction: int
     held_deg: float
     round_deg: float = 0.0
+    line_x_deg: float = 0.0
+    line_y_deg: float = 0.0
+    line_slope: float = 0.0
+
+
+def reversal_release_line(b: Branches, x_deg: float, held_deg: float, direction: int
+                          ) -> tuple[float, float, float]:
+    """The release line after a reversal at ``x_deg`` holding ``held_deg`` (end knob deg, end
+    output deg, slope; slope 0: none): from the static branch's backlash end to the product's
+    end on the far plateau, where it meets the branch it hands over to."""
+    if b.release_end is None:
+        return 0.0, 0.0, 0.0
+    if direction < 0:
+        flat = b.falling_flat
+        if flat is None:
+            return 0.0, 0.0, 0.0
+        xf = flat.hi_deg
+        return reversal_line(b.release_end, x_deg, held_deg, b.falling_inverse(held_deg), xf,
+                             lambda x: b.falling(x if x < xf else xf), -1)
+    flat = b.rising_flat
+    if flat is None:
+        return 0.0, 0.0, 0.0
+    xl = flat.lo_deg
+    return reversal_line(b.release_end, x_deg, held_deg, b.rising_inverse(held_deg), xl,
+                         lambda x: b.rising(x if x > xl else xl), 1)
+
+
+def line_output(b: Branches, x_deg: float, s: PlayState) -> float:
+    """The output on a reversal's release line ``L`` (up to its end): moving down
+    ``min(held, max(L, F(min(x, x_flat)), R))`` (the falling branch beyond its flat's end held
+    at the flat), mirrored moving up."""
+    if s.direction < 0:
+        flat = b.falling_flat
+        f = b.falling(x_deg if flat is None or x_deg < flat.hi_deg else flat.hi_deg)
+        if x_deg > s.line_x_deg:
+            f = max(f, s.line_y_deg + s.line_slope * (x_deg - s.line_x_deg))
+        f = max(f, b.rising(x_deg))
+        return s.held_deg if f > s.held_deg else f
+    flat = b.rising_flat
+    f = b.rising(x_deg if flat is None or x_deg > flat.lo_deg else flat.lo_deg)
+    if x_deg < s.line_x_deg:
+        f = min(f, s.line_y_deg + s.line_slope * (x_deg - s.line_x_deg))
+    f = min(f, b.falling(x_deg))
+    return s.held_deg if f < s.held_deg else f
+
+
+def line_input(b: Branches, y_deg: float, s: PlayState) -> float:
+    """The input :func:`line_output` turns into ``y_deg`` (exact: every piece is increasing,
+    so the first piece to reach ``y_deg`` sets it)."""
+    if s.direction < 0:
+        x = b.rising_inverse(y_deg)
+        if y_deg > s.line_y_deg:
+            x = min(x, s.line_x_deg + (y_deg - s.line_y_deg) / s.line_slope)
+        flat = b.falling_flat
+        if flat is None or y_deg <= b.falling(flat.hi_deg):
+            x = min(x, b.falling_inverse(y_deg))
+        return x
+    x = b.falling_inverse(y_deg)
+    if y_deg < s.line_y_deg:
+        x = max(x, s.line_x_deg + (y_deg - s.line_y_deg) / s.line_slope)
+    flat = b.rising_flat
+    if flat is None or y_deg >= b.rising(flat.lo_deg):
+        x = max(x, b.rising_inverse(y_deg))
+    return x
 
 
 def reversal_round(b: Branches, x_deg: float, held_deg: float, direction: int) -> float:
@@ -202,9 +272,14 @@ def model_step(state: PlayState, x_deg: float, b: Branches) -> PlayState:
     direction = state.direction if dx == 0.0 else (1 if dx > 0.0 else -1)
     if direction == state.direction:
         held, k = state.held_deg, state.round_deg
+        lx, ly, slope = state.line_x_deg, state.line_y_deg, state.line_slope
     else:
         held = state.y_deg
-        k = reversal_round(b, state.x_deg, held, direction)
+        lx, ly, slope = reversal_release_line(b, state.x_deg, held, direction)
+        k = 0.0 if slope > 0.0 else reversal_round(b, state.x_deg, held, direction)
+    if slope > 0.0:
+        nxt = PlayState(x_deg, held, direction, held, 0.0, lx, ly, slope)
+        return nxt._replace(y_deg=line_output(b, x_deg, nxt))
     if k > 0.0:  # rounded, and never beyond the other branch (a hold on its flat part)
         if direction > 0:
             y = min(held + rounded_drop_deg(b.rising(x_deg) - held, k), b.falling(x_deg))
@@ -223,7 +298,7 @@ def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
     """
     if y_deg - y_deg != 0.0:  # not finite
         return state
-    x_prev, y_prev, direction, held, k = state
+    x_prev, y_prev, direction, held, k, lx, ly, slope = state
     turned = False
     if y_deg == y_prev:
         if y_prev == held:
@@ -232,7 +307,16 @@ def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
         turn = 1 if y_deg > y_prev else -1
         if turn != direction:
             direction, held, turned = turn, y_prev, True
-            k = reversal_round(b, x_prev, held, direction)
+            lx, ly, slope = reversal_release_line(b, x_prev, held, direction)
+            k = 0.0 if slope > 0.0 else reversal_round(b, x_prev, held, direction)
+    if slope > 0.0:
+        line = PlayState(x_prev, y_deg, direction, held, 0.0, lx, ly, slope)
+        x = line_input(b, y_deg, line)
+        if (x - x_prev) * direction < 0.0:
+            x = x_prev
+        if turned and x == x_prev:
+            return state._replace(x_deg=x, y_deg=y_deg)
+        return line._replace(x_deg=x)
     if direction > 0:
         if k > 0.0 and held < y_deg < held + k:  # on the rounded corner, or the other branch
             x = max(interp_linear(held + rounded_gap_deg(y_deg - held, k), b.rising_deg,
@@ -252,7 +336,7 @@ def inverse_step(state: PlayState, y_deg: float, b: Branches) -> PlayState:
     if turned and x == x_prev:
         # the knob does not move, so the catheter sees no reversal: a rounded release goes on,
         # and none starts later from a turn the model never made
-        return PlayState(x, y_deg, state.direction, state.held_deg, state.round_deg)
+        return state._replace(x_deg=x, y_deg=y_deg)
     return PlayState(x, y_deg, direction, held, k)
 
 

@@ -31,6 +31,11 @@ from tsmd.compensation.loaded_shape import (
     shape_to_mapping,
 )
 from tsmd.compensation.release_round import RELEASE_ROUND_RANGE, RELEASE_SHIFT_RANGE
+from tsmd.compensation.reversal_release import (
+    ReleaseEndShape,
+    release_end_shape_from_mapping,
+    release_end_shape_to_mapping,
+)
 
 BETA_RANGE: tuple[float, float] = (0.0, 0.8)
 """Backlash per knob degree of load: 0 = no backlash; 0.8 = release slope 5 omega."""
@@ -67,6 +72,8 @@ class TensionPlayParams:
     :mod:`tsmd.compensation.release_round`), in backlashes at a 90 deg reversal; 0: sharp.
     ``level_grid``: the product's shift of each side's plateau height over the other knob's
     angle (data sheet, :mod:`tsmd.compensation.level_grid`); None: H at every angle.
+    ``release_end``: the product's release end per reversal (data sheet ``release_end_shape``,
+    :mod:`tsmd.compensation.reversal_release`); None: the static release lines.
     """
 
     omega: float
@@ -92,6 +99,7 @@ class TensionPlayParams:
     release_round: float = 0.0
     release_shift: float = 0.0
     level_grid: LevelGrid | None = None
+    release_end: ReleaseEndShape | None = None
 
     def columns(self) -> NDArray[np.float64]:
         """(n, 6): D_pos, D_neg, beta_pos, beta_neg, x0_pos, x0_neg per grid point."""
@@ -118,6 +126,7 @@ _WRITTEN_IF_SET = {"fresh_hold_deg", "fresh_edge_delay_deg", "other_tip_gain", "
 _SHAPES = {"loaded_shape_pos": "shape_pos", "loaded_shape_neg": "shape_neg"}
 _SHAPE_GRID = "loaded_shape_grid"
 _LEVEL_GRID = "loaded_level_grid"
+_RELEASE_END = "release_end_shape"
 _KNEES = ("loaded_knee_deg", "loaded_knee_u95_deg", "sheet_loaded_knee_deg")
 """Optional pairs (positive, negative side), written only when set."""
 
@@ -143,11 +152,13 @@ def _numbers(values: Any, name: str, n: int | None, lo: float, hi: float) -> tup
 
 def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
     """Validate a profile's ``tension_play`` block (ValueError naming the key)."""
-    known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES, _SHAPE_GRID, _LEVEL_GRID, *_KNEES}
+    known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES, _SHAPE_GRID, _LEVEL_GRID, *_KNEES,
+             _RELEASE_END}
     for key in m:
         if key not in known:
             raise ValueError(f"{key}: unknown key")
-    for key in known - _OPTIONAL - set(_SHAPES) - {_SHAPE_GRID, _LEVEL_GRID} - set(_KNEES):
+    for key in (known - _OPTIONAL - set(_SHAPES) - {_SHAPE_GRID, _LEVEL_GRID, _RELEASE_END}
+                - set(_KNEES)):
         if key not in m:
             raise ValueError(f"{key}: missing key")
     grid = _numbers(m["other_knob_deg"], "other_knob_deg", None, -180.0, 180.0)
@@ -167,7 +178,9 @@ def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
                     if m.get(_SHAPE_GRID) is not None else None),
         release_round=s["release_round"], release_shift=s["release_shift"],
         level_grid=(level_grid_from_mapping(m[_LEVEL_GRID], _LEVEL_GRID)
-                    if m.get(_LEVEL_GRID) is not None else None), **knees)
+                    if m.get(_LEVEL_GRID) is not None else None),
+        release_end=(release_end_shape_from_mapping(m[_RELEASE_END], _RELEASE_END)
+                     if m.get(_RELEASE_END) is not None else None), **knees)
 
 
 def _knee_pair(values: Any, name: str) -> tuple[float, float]:
@@ -188,6 +201,8 @@ def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
         out[_SHAPE_GRID] = shape_grid_to_mapping(*p.shape_grid)
     if p.level_grid is not None:
         out[_LEVEL_GRID] = level_grid_to_mapping(p.level_grid)
+    if p.release_end is not None:
+        out[_RELEASE_END] = release_end_shape_to_mapping(p.release_end)
     for key in _KNEES:
         pair = getattr(p, key)
         if pair is not None:

@@ -20,6 +20,10 @@ from tsmd.compensation.loaded_shape import (
 )
 from tsmd.compensation.release_ratio import release_ratio_problem
 from tsmd.compensation.release_round import RELEASE_ROUND_RANGE, RELEASE_SHIFT_RANGE
+from tsmd.compensation.reversal_release import (
+    release_end_shape_from_mapping,
+    release_end_shape_to_mapping,
+)
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play_params import (
     OTHER_TIP_GAIN_RANGE,
@@ -238,7 +242,10 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             loaded_shape_grid=_nested(r, k.get("loaded_shape_grid"),
                                       f"{key}.loaded_shape_grid", shape_grid_from_mapping),
             loaded_level_grid=_nested(r, k.get("loaded_level_grid"),
-                                      f"{key}.loaded_level_grid", level_grid_from_mapping)))
+                                      f"{key}.loaded_level_grid", level_grid_from_mapping),
+            release_end_shape=_nested(r, k.get("release_end_shape"),
+                                      f"{key}.release_end_shape",
+                                      release_end_shape_from_mapping)))
     for knob_name, knob in zip(KNOB_NAMES, knobs, strict=True):
         problem = release_ratio_problem(knob)
         if problem is not None:  # a sheet error, shown when it is read, not on a patient's unit
@@ -299,6 +306,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
             knobs[name]["loaded_shape_grid"] = shape_grid_to_mapping(*k.loaded_shape_grid)
         if k.loaded_level_grid is not None:
             knobs[name]["loaded_level_grid"] = level_grid_to_mapping(k.loaded_level_grid)
+        if k.release_end_shape is not None:
+            knobs[name]["release_end_shape"] = release_end_shape_to_mapping(k.release_end_shape)
         for key in (_RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS + _ROUND_KEYS
                     + _HANDLE_KEYS):
             if getattr(k, key) is not None:

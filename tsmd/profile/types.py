@@ -13,6 +13,7 @@ from tsmd.compensation.grid import CALIBRATION_GRID_DEG
 from tsmd.compensation.level_grid import LevelGrid
 from tsmd.compensation.loaded_shape import LoadedShape, ShapeGrid
 from tsmd.compensation.paper import at_other_knob_zero, plateau_heights
+from tsmd.compensation.reversal_release import ReleaseEndShape
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.errors import TsmdError
@@ -259,6 +260,12 @@ class DeviceKnob:
     23): the share of the current's edge movement over the other knob's angle that the tip's
     loaded level does not follow (:mod:`tsmd.calibration.edge_level`); calibration turns it and
     the unit's own edges into the unit's level grid. None: the tip follows the edge."""
+    release_end_shape: ReleaseEndShape | None = None
+    """Optional, read from the data-sheet unit's tip (session 23, ``tsmd datasheet
+    --release-end-shape``): where the tip's release ends after a reversal at a fraction of
+    90 deg, as a ratio of where it ends after 90 (:mod:`tsmd.compensation.reversal_release`);
+    calibration copies it into each unit's profile and method ours draws a release line per
+    reversal to that end. None: the static release lines."""
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,13 @@ from support.profiles import DEVICE
 from tsmd.calibration.options import IdentifyOptions, for_product
 from tsmd.calibration.run import device_options
 from tsmd.cli import main
-from tsmd.datasheet_rule import RuleScore, choose_rules, knee_choice, with_rule
+from tsmd.datasheet_rule import (
+    RuleScore,
+    backlash_errors,
+    choose_rules,
+    knee_choice,
+    with_rule,
+)
 from tsmd.profile import DeviceModel, ProfileError, load_device_model
 from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
 
@@ -142,6 +148,19 @@ def test_a_tie_keeps_the_knee() -> None:
     knee = [scored("knee", 0, 56, mean=1.5), scored("knee", 1, 56)]
     chosen = knee_choice(sheet(rule="line"), rules, knee)
     assert [k.backlash_knee for k in chosen.knobs] == [True, True]
+
+
+def test_the_knee_is_chosen_on_the_backlash_values_it_moves_not_on_the_edges() -> None:
+    rules = [dataclasses.replace(scored("line", k, 34), backlash_within=25) for k in (0, 1)]
+    knee = [dataclasses.replace(scored("knee", 0, 30), backlash_within=28),
+            dataclasses.replace(scored("knee", 1, 40), backlash_within=22)]
+    chosen = knee_choice(sheet(rule="line"), rules, knee)
+    assert [k.backlash_knee for k in chosen.knobs] == [True, None]
+
+
+def test_the_backlash_errors_are_the_knobs_b_rows() -> None:
+    errors = [float(i) for i in range(56)]
+    assert list(backlash_errors(errors, 1)) == [float(i) for i in range(42, 56)]
 
 
 def test_the_knee_that_costs_an_accepted_run_stays_off() -> None:

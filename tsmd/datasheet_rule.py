@@ -27,6 +27,7 @@ import numpy as np
 from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.load_ramp import fit_sweep_sides
 from tsmd.calibration.protocol import fast_protocol
+from tsmd.calibration.sweep_result import PARAMETERS
 from tsmd.calibration.tension_play_fit import sweeps_from_points
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_rule_halves import points_half_cycle_reads
@@ -67,6 +68,9 @@ class RuleScore:
     half_misread: int = 0
     """Half-cycles whose B is off by more than the tip's own (:attr:`HalfRead.misread`)."""
     half_cycles: int = 0
+    backlash_within: int | None = None
+    """The knob's B values (both sides, every grid point and run) within the target: what the
+    knee can change (:func:`knee_choice`); None where not counted apart."""
 
     def key(self) -> tuple[int, int]:
         """Better first: more values within the target, then more runs accepted (a refused
@@ -75,11 +79,20 @@ class RuleScore:
         not compared: on lumped unit 0 two rules placed 56/56 with means 0.06 deg apart."""
         return (-self.within, -self.accepted)
 
+    def backlash_key(self) -> tuple[int, int]:
+        """As :meth:`key` on the B values alone (all values where B was not counted apart)."""
+        within = self.within if self.backlash_within is None else self.backlash_within
+        return (-within, -self.accepted)
+
     def text(self) -> str:
         return (f"{self.rule} {self.within}/{self.values} within {TARGET_DEG:g} deg (mean "
                 f"{self.mean_abs_deg:.2f}, max {self.max_deg:.2f} deg, accepted "
-                f"{self.accepted}/{self.runs}; B per half-cycle {self.half_placed}/"
+                f"{self.accepted}/{self.runs}; B {self._backlash_text()}; B per half-cycle "
+                f"{self.half_placed}/"
                 f"{self.half_cycles} within {TARGET_DEG:g} deg, {self.half_misread} misread)")
+
+    def _backlash_text(self) -> str:
+        return "-" if self.backlash_within is None else f"{self.backlash_within}/{self.values // 2}"
 
 
 def with_rule(device: DeviceModel, rule: str) -> DeviceModel:
@@ -128,6 +141,15 @@ def knob_errors(errors: Sequence[float], knob: int) -> np.ndarray:
     return np.asarray(errors[knob * n:(knob + 1) * n], dtype=float)
 
 
+def backlash_errors(errors: Sequence[float], knob: int) -> np.ndarray:
+    """One knob's B values of :func:`score`'s (its parameters in
+    :data:`~tsmd.calibration.sweep_result.PARAMETERS` order, each over the grid)."""
+    mine = knob_errors(errors, knob)
+    per = mine.size // len(PARAMETERS)
+    keep = [i for i, name in enumerate(PARAMETERS) if name.startswith("backlash")]
+    return np.concatenate([mine[i * per:(i + 1) * per] for i in keep])
+
+
 Truth = dict[tuple[int, float], dict[str, float]]
 
 
@@ -149,6 +171,7 @@ def scored(config: TsmdConfig, candidate: DeviceModel, label: str, truth: Truth,
     for knob in (0, 1):
         e = np.concatenate([knob_errors(r.errors, knob) for r in runs])
         finite = e[np.isfinite(e)]
+        b = np.concatenate([backlash_errors(r.errors, knob) for r in runs])
         gains = [g for g in (rule_backlash_gain(r.points, knob) for r in runs) if g is not None]
         halves = [h for r in runs for h in points_half_cycle_reads(r.points, knob)]
         out.append(RuleScore(
@@ -157,7 +180,8 @@ def scored(config: TsmdConfig, candidate: DeviceModel, label: str, truth: Truth,
             float(np.max(finite)) if finite.size else math.nan,
             sum(r.accepted for r in runs), len(runs),
             float(np.mean(gains)) if gains else None, sum(h.placed for h in halves),
-            sum(h.misread for h in halves), len(halves)))
+            sum(h.misread for h in halves), len(halves),
+            int(np.sum(np.abs(b[np.isfinite(b)]) <= TARGET_DEG))))
     return out
 
 
@@ -194,19 +218,23 @@ def choose_knee(config: TsmdConfig, chosen: DeviceModel, rule_scores_: Sequence[
 
 def knee_choice(chosen: DeviceModel, rule_scores_: Sequence[RuleScore],
                 knee_scores: Sequence[RuleScore]) -> DeviceModel:
-    """Each knob keeps the knee unless it placed fewer values (then: fewer runs accepted) than
-    the knob's rule without it. A tie keeps it: the knee only stops a rule from reading B where
-    the current no longer says anything, and a unit that the rule alone already places fully
-    cannot show that (stickslip unit 0: 56/56 either way, while held-out units of that product
-    were refused without it); the products it harms show it on their own unit (lumped unit 0:
-    31 and 45 of 56 with it, 56/56 without)."""
+    """Each knob keeps the knee unless it placed fewer B values (then: fewer runs accepted)
+    than the knob's rule without it. A tie keeps it: the knee only stops a rule from reading B
+    where the current no longer says anything, and a unit that the rule alone already places
+    fully cannot show that (stickslip unit 0: 56/56 either way, while held-out units of that
+    product were refused without it); the products it harms show it on their own unit (lumped
+    unit 0: 31 and 45 of 56 with it, 56/56 without). B alone (session 23): the knee moves no
+    edge, and the edges these runs read carry no reading offset yet, so their count moved
+    with the re-sweeps' order and decided warmgear's phi2 (34 against 30 of 56 values, while
+    B per half-cycle was 21/24 without the knee and 24/24 with it)."""
     on = []
     for knob, k in enumerate(chosen.knobs):
         plain = [s for s in rule_scores_ if s.knob == knob and s.rule == k.backlash_release_rule]
         knee = [s for s in knee_scores if s.knob == knob]
         # a candidate chosen with its knee (SWING_KNEE) was scored with it: it has no other
         on.append(bool(k.backlash_knee)
-                  or (bool(plain and knee) and knee[0].key() <= plain[0].key()))
+                  or (bool(plain and knee)
+                      and knee[0].backlash_key() <= plain[0].backlash_key()))
     return with_rule_gains(with_knee(chosen, (on[0], on[1])), rule_scores_, knee_scores)
 
 

@@ -16,9 +16,11 @@ from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 GRID = (-90.0, 0.0, 90.0)
 
 
-def offset_knob(shift_deg: float, **fields: float) -> object:
-    """The test's sheet knob whose B reads ``shift_deg`` off the tip on both sides."""
-    grid = OffsetGrid((shift_deg,) * 3, (0.3,) * 3, (4,) * 3)
+def offset_knob(shift_deg: float, ends_deg: float | None = None, **fields: float) -> object:
+    """The test's sheet knob whose B reads ``shift_deg`` off the tip on both sides (at the
+    other knob's ends ``ends_deg`` where given)."""
+    end = shift_deg if ends_deg is None else ends_deg
+    grid = OffsetGrid((end, shift_deg, end), (0.3,) * 3, (4,) * 3)
     offset = ReadingOffset(GRID, (("backlash_pos_deg", grid), ("backlash_neg_deg", grid)))
     return dataclasses.replace(DEVICE_KNOB, reading_offset=offset, **fields)
 
@@ -30,11 +32,16 @@ def test_the_offset_the_calibration_subtracted_is_added_back() -> None:
 
 def test_an_unseen_backlash_has_nothing_added_back() -> None:
     knob = offset_knob(-10.0)
-    assert subtracted_backlash_deg(knob, 0.0, (True, False)) == (0.0, -10.0)
+    assert subtracted_backlash_deg(knob, (True, False)) == (0.0, -10.0)
 
 
 def test_without_a_reading_offset_nothing_is_added_back() -> None:
-    assert subtracted_backlash_deg(DEVICE_KNOB, 0.0, (False, False)) == (0.0, 0.0)
+    assert subtracted_backlash_deg(DEVICE_KNOB, (False, False)) == (0.0, 0.0)
+
+
+def test_the_offset_added_back_is_the_one_where_the_sheet_read_its_gains() -> None:
+    # only at the other knob's ends: the sheet's gains (other knob at 0) never saw it
+    assert subtracted_backlash_deg(offset_knob(0.0, ends_deg=-2.0), (False, False)) == (0.0, 0.0)
 
 
 def test_a_unit_that_reads_like_the_sheets_unit_keeps_the_sheets_omega() -> None:

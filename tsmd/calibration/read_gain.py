@@ -25,14 +25,16 @@ from tsmd.calibration.reading_offset import offset_at
 BACKLASH_NAMES = ("backlash_pos_deg", "backlash_neg_deg")
 
 
-def subtracted_backlash_deg(device_knob: Any, other_knob_deg: float,
-                            unseen: tuple[bool, bool]) -> tuple[float, float]:
-    """(+, -) offset the calibration subtracted from this sweep's B (0 where none applied or
-    the backlash was unseen)."""
+def subtracted_backlash_deg(device_knob: Any, unseen: tuple[bool, bool]
+                            ) -> tuple[float, float]:
+    """(+, -) offset the calibration subtracts from B with the other knob at 0, where the
+    sheet read its gains (0 where none is applied or the backlash was unseen). Taken at 0 for
+    every grid angle: the sheet's gains never saw what the offset does at the other knob's
+    ends (nitinol's -2 deg at +-90 only), and the unit's own trend over the grid is kept."""
     offset = getattr(device_knob, "reading_offset", None)
     if offset is None:
         return 0.0, 0.0
-    shift = [0.0 if hidden else offset_at(offset, name, other_knob_deg)[0]
+    shift = [0.0 if hidden else offset_at(offset, name, 0.0)[0]
              for name, hidden in zip(BACKLASH_NAMES, unseen, strict=True)]
     return shift[0], shift[1]
 
@@ -51,8 +53,8 @@ def read_gains(device_knob: Any, grid: Sequence[float], unseen: Sequence[tuple[b
                ) -> tuple[list[float], list[float]]:
     """Per side and sweep, the play's gain with its B as read (before the reading offset)."""
     pos, neg = [], []
-    for other, hidden, fp, fn in zip(grid, unseen, pos_fits, neg_fits, strict=True):
-        s_pos, s_neg = subtracted_backlash_deg(device_knob, other, hidden)
+    for _, hidden, fp, fn in zip(grid, unseen, pos_fits, neg_fits, strict=True):
+        s_pos, s_neg = subtracted_backlash_deg(device_knob, hidden)
         pos.append(read_gain(fp, s_pos))
         neg.append(read_gain(fn, s_neg))
     return pos, neg

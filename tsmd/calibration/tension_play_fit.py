@@ -54,6 +54,7 @@ from tsmd.calibration.identify import settle_rule_backlash
 from tsmd.calibration.lag import estimate_lag_s
 from tsmd.calibration.load_ramp import SideFit, fit_sweep_sides
 from tsmd.calibration.loaded_knee import sweep_knees
+from tsmd.calibration.read_gain import BACKLASH_NAMES, read_gains, read_side_ratio
 from tsmd.calibration.reading_offset import offset_at, reference_edge_deg
 from tsmd.calibration.release_end import plateau_moved, side_ratios
 from tsmd.calibration.release_path import release_through_amplitude
@@ -87,6 +88,9 @@ class SweepCurrent:
     """The settle rule's (B_pos, B_neg) where the B above is another rule's: a sheet whose gain
     was read with the settle rule scales omega by a unit gain read the same way. None: the B
     above is the settle rule's."""
+    backlash_unseen: tuple[bool, bool] = (False, False)
+    """(+, -): the current did not show that backlash (the B is the sheet's, no reading offset
+    was subtracted from it)."""
 
 
 def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list[float]:
@@ -191,7 +195,10 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
                            if s.lag_s is None else s.lag_s for s in order]))
     beta_pos = smoothed_gains(grid, [f.backlash_gain for f in pos_fits])
     beta_neg = smoothed_gains(grid, [f.backlash_gain for f in neg_fits])
-    omega = loaded_slope(k, grid, order, pos_fits, neg_fits)
+    # the unit's gains with B as the current read it, as the sheet's were (session 23)
+    read = read_gains(k, grid, [s.backlash_unseen for s in order], pos_fits, neg_fits)
+    omega = loaded_slope(k, grid, order, pos_fits, neg_fits, read)  # scatter: per sweep
+    raw_pos, raw_neg = (smoothed_gains(grid, g) for g in read)
     ratio = release_slope_ratio(k)
     x0_pos, x0_neg = (smooth_over_grid(grid, [f.zero_load_deg for f in fits])
                       for fits in (pos_fits, neg_fits))
@@ -202,10 +209,12 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
         ratios = side_ratios(order, k, omega, (h_pos, h_neg), (d_pos, d_neg),
                              (beta_pos, beta_neg), (x0_pos, x0_neg), ratio, RELEASE_RATIO_RANGE)
     sides = []
-    for betas, x0s, fits, side_ratio in ((beta_pos, x0_pos, pos_fits, ratios[0]),
-                                         (beta_neg, x0_neg, neg_fits, ratios[1])):
-        moved = [release_through_amplitude(b, x0, f.amplitude_deg, side_ratio)
-                 for b, x0, f in zip(betas, x0s, fits, strict=True)]
+    for betas, reads, x0s, fits, side_ratio in (
+            (beta_pos, raw_pos, x0_pos, pos_fits, ratios[0]),
+            (beta_neg, raw_neg, x0_neg, neg_fits, ratios[1])):
+        moved = [release_through_amplitude(b, x0, f.amplitude_deg,
+                                           read_side_ratio(side_ratio, b, r))
+                 for b, r, x0, f in zip(betas, reads, x0s, fits, strict=True)]
         sides.append((tuple(m[0] for m in moved), tuple(m[1] for m in moved)))
     return TensionPlayParams(
         omega=omega, height_pos_deg=float(h_pos), height_neg_deg=float(h_neg),
@@ -268,11 +277,13 @@ def settle_rule_gains(sweeps: Sequence[SweepCurrent], pos_fits: Sequence[SideFit
 
 
 def loaded_slope(device_knob: Any, grid: Sequence[float], sweeps: Sequence[SweepCurrent],
-                 pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit]) -> float:
+                 pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit],
+                 read: tuple[Sequence[float], Sequence[float]] | None = None) -> float:
     """The unit's omega (:mod:`tsmd.calibration.unit_slope`): each backlash gain the sheet
     holds (the settle rule's, the product rule's) read on this unit with the same rule, the
     readings weighed by their scatter against the sheet's omega; a sheet without a gain keeps
-    its omega."""
+    its omega. ``read``: the play's (+, -) gains with B as the current read it, before the
+    reading offset, as the sheet's product-rule gain was read (the play's own without)."""
     readings = []
     settle_gain = getattr(device_knob, "reference_backlash_gain", None)
     if settle_gain is not None:
@@ -280,8 +291,9 @@ def loaded_slope(device_knob: Any, grid: Sequence[float], sweeps: Sequence[Sweep
                                      *settle_rule_gains(sweeps, pos_fits, neg_fits)))
     rule_gain = getattr(device_knob, "reference_rule_backlash_gain", None)
     if rule_gain is not None:
-        readings.append(gain_reading(float(rule_gain), grid, [f.backlash_gain for f in pos_fits],
-                                     [f.backlash_gain for f in neg_fits]))
+        pos, neg = (([f.backlash_gain for f in pos_fits], [f.backlash_gain for f in neg_fits])
+                    if read is None else read)
+        readings.append(gain_reading(float(rule_gain), grid, pos, neg))
     return weighed_omega(float(device_knob.omega), readings)
 
 
@@ -335,7 +347,9 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
                                 est("backlash_neg_deg"), pre.lag_s,
                                 (u["dead_zone_pos_deg"].u95_deg,
                                  u["dead_zone_neg_deg"].u95_deg),
-                                (pre.backlash_pos_deg, pre.backlash_neg_deg)))
+                                (pre.backlash_pos_deg, pre.backlash_neg_deg),
+                                (BACKLASH_NAMES[0] in p.result.unseen,
+                                 BACKLASH_NAMES[1] in p.result.unseen)))
     return out
 
 

@@ -24,7 +24,8 @@ units in the same session's second round) is held out, the snakedent plant (sess
 blind: rolling vertebrae, detented knobs, run untuned, then its edge reading tuned on its
 development units in the same session's second round) is held out (``PLANT_ROLE``); the
 planetwist plant (session 23, written blind: a planetary handle stage, twist-coupled strands in
-swivel crimps, blood flow on the tip; run untuned) is the blind plant, registered last.
+swivel crimps, blood flow on the tip; run untuned, then ours' gain reading made consistent on its
+development units in the same session's second round) is held out, registered last.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -81,7 +82,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
-              "planetwist": "blind"}
+              "planetwist": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

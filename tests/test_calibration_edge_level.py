@@ -9,12 +9,12 @@ import dataclasses
 import numpy as np
 import pytest
 from support.profiles import assert_sheet_knob_field_round_trips
+from support.tracked import tracked_sweeps
 from test_compensation_tension_play_fit import DEVICE_KNOB, synthetic_sweep
 
 from tsmd.calibration.edge_level import edge_level_grid, edge_level_shifts
 from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.compensation.level_grid import LEVEL_SHIFT_RANGE_DEG, LevelGrid
-from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.datasheet_edge_level import MIN_EDGE_LEVEL_GAIN_DEG, edge_share, fit_share
 from tsmd.datasheet_level_grid import TrackedSweep
@@ -81,15 +81,8 @@ def tension() -> TensionPlayParams:
 
 
 def sweeps_of(truth: TensionPlayParams) -> list[tuple[float, TrackedSweep]]:
-    """One +-90 deg sweep per angle, the other knob held there, the tip as ``truth`` says."""
-    t = np.arange(0.0, 50.0, 0.02)
-    x = -90.0 * np.cos(2 * np.pi * 0.04 * t)
-    out = []
-    for other in ANGLES:
-        held = np.full_like(x, other)
-        tip, _ = model_parts(x, held, truth, 0.0)
-        out.append((other, TrackedSweep(x, held, tip)))
-    return out
+    """One sweep per angle, the other knob held there."""
+    return tracked_sweeps(truth, ANGLES)
 
 
 def test_the_sheet_units_share_is_read_from_its_tip_against_its_edges() -> None:

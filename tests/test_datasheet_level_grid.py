@@ -5,11 +5,10 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
 import pytest
+from support.tracked import tracked_sweeps
 
 from tsmd.compensation.level_grid import LevelGrid
-from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.datasheet_level_grid import MIN_LEVEL_SHIFT_DEG, TrackedSweep, level_grid
 
@@ -22,15 +21,8 @@ def tension() -> TensionPlayParams:
 
 
 def sweeps_of(truth: TensionPlayParams) -> list[tuple[float, TrackedSweep]]:
-    """Two +-90 deg sweeps per angle, the other knob held there, the tip as ``truth`` says."""
-    t = np.arange(0.0, 50.0, 0.02)
-    x = -90.0 * np.cos(2 * np.pi * 0.04 * t)
-    out = []
-    for other in ANGLES:
-        held = np.full_like(x, other)
-        tip, _ = model_parts(x, held, truth, 0.0)
-        out += [(other, TrackedSweep(x, held, tip))] * 2
-    return out
+    """Two sweeps per angle, the other knob held there."""
+    return tracked_sweeps(truth, ANGLES, repeats=2)
 
 
 def test_the_grid_finds_the_level_the_tip_stands_at() -> None:

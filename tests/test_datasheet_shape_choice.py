@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from support.tracked import tracked_sweeps
 
 from tsmd.cli import main
 from tsmd.compensation.loaded_shape import LoadedShape, shaped_height
-from tsmd.compensation.model_parts import model_parts
 from tsmd.compensation.paper import plateau_heights
 from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play_params import TensionPlayParams
@@ -46,15 +46,8 @@ def bent(shape: LoadedShape = SOFT_START) -> TensionPlayParams:
 
 
 def sweeps_of(truth: TensionPlayParams) -> list[TrackedSweep]:
-    """One +-90 deg sweep per angle, the other knob held there, the tip as ``truth`` says."""
-    t = np.arange(0.0, 50.0, 0.02)
-    x = -90.0 * np.cos(2 * np.pi * 0.04 * t)
-    out = []
-    for other in ANGLES:
-        held = np.full_like(x, other)
-        tip, _ = model_parts(x, held, truth, 0.0)
-        out.append(TrackedSweep(x, held, tip))
-    return out
+    """One sweep per angle, the other knob held there."""
+    return [sweep for _, sweep in tracked_sweeps(truth, ANGLES)]
 
 
 def test_the_straight_counterpart_draws_its_lines_through_the_reference_points() -> None:

@@ -48,12 +48,12 @@ def read_gain(fit: SideFit, subtracted_deg: float) -> float:
     return fit.backlash_gain if not (run > 0 and b > 0) else b / run
 
 
-def read_gains(device_knob: Any, grid: Sequence[float], unseen: Sequence[tuple[bool, bool]],
+def read_gains(device_knob: Any, unseen: Sequence[tuple[bool, bool]],
                pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit]
                ) -> tuple[list[float], list[float]]:
     """Per side and sweep, the play's gain with its B as read (before the reading offset)."""
     pos, neg = [], []
-    for _, hidden, fp, fn in zip(grid, unseen, pos_fits, neg_fits, strict=True):
+    for hidden, fp, fn in zip(unseen, pos_fits, neg_fits, strict=True):
         s_pos, s_neg = subtracted_backlash_deg(device_knob, hidden)
         pos.append(read_gain(fp, s_pos))
         neg.append(read_gain(fn, s_neg))

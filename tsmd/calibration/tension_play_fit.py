@@ -196,7 +196,7 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     beta_pos = smoothed_gains(grid, [f.backlash_gain for f in pos_fits])
     beta_neg = smoothed_gains(grid, [f.backlash_gain for f in neg_fits])
     # the unit's gains with B as the current read it, as the sheet's were (session 23)
-    read = read_gains(k, grid, [s.backlash_unseen for s in order], pos_fits, neg_fits)
+    read = read_gains(k, [s.backlash_unseen for s in order], pos_fits, neg_fits)
     omega = loaded_slope(k, grid, order, pos_fits, neg_fits, read)  # scatter: per sweep
     raw_pos, raw_neg = (smoothed_gains(grid, g) for g in read)
     ratio = release_slope_ratio(k)

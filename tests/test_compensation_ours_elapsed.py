@@ -85,6 +85,44 @@ def test_a_staircase_of_late_ticks_gives_no_acceleration() -> None:
     assert max(abs(a) for a in accel) == 0.0
 
 
+def client_staircase(jitter_s: float, seed: int, duration_s: float) -> list[float]:
+    """The desired angle each on-time tick sees from a 50 Hz client's 0.1 Hz, 60 deg sine whose
+    values arrive up to ``jitter_s`` late (the client thread delayed): now and then two of them
+    land on consecutive ticks, the staircase catching up."""
+    rng = np.random.default_rng(seed)
+    sent = np.arange(0.0, duration_s, 0.02)
+    arrive = sent + rng.uniform(0.0, jitter_s, sent.size)
+    arrive = np.maximum.accumulate(arrive)  # one socket: values arrive in order
+    values = 60.0 * np.sin(2 * np.pi * 0.1 * sent)
+    ticks = np.arange(PERIOD_S, duration_s, PERIOD_S)
+    seen = np.searchsorted(arrive, ticks, side="right") - 1
+    return [float(values[i]) if i >= 0 else 0.0 for i in seen]
+
+
+def test_a_staircase_catching_up_on_consecutive_ticks_gives_no_acceleration() -> None:
+    kc = KnobCommand(LIMITS)
+    kc.jump_deg_s = 5.0 * 1.5 * 120.0
+    accel = []
+    for q in client_staircase(0.05, 2, 10.0):
+        motion(kc, q, PERIOD_S, PERIOD_S)
+        accel.append(kc.accel)
+    # the sine's own acceleration is at most 60 (2 pi 0.1)^2 = 24 deg/s^2
+    assert max(abs(a) for a in accel) < 30.0
+
+
+def test_a_jittered_client_staircase_is_commanded_like_an_even_one() -> None:
+    # the daemon's demo on a loaded machine: values landing on consecutive ticks read as an
+    # acceleration started the jump across the dead zone ~0.8 s early and held it there
+    commands = []
+    for jitter_s in (0.0, 0.05):
+        comp = OursCompensator(ours_knobs((params(), params())), PERIOD_S, (LIMITS, LIMITS))
+        comp.reset(np.zeros(2))
+        commands.append(np.array([comp.command(np.array([q, 0.0]), PERIOD_S)[0]
+                                  for q in client_staircase(jitter_s, 2, 10.0)]))
+    even, jittered = commands
+    assert np.max(np.abs(jittered - even)) < 8.0
+
+
 def test_the_limiter_counts_a_late_tick_up_to_its_longest() -> None:
     limiter = KnobLimiter([LIMITS, LIMITS], PERIOD_S)
     limiter.reset(np.zeros(2))

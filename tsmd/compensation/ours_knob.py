@@ -48,7 +48,7 @@ class KnobCommand:
                  "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan",
                  "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "rest_q",
                  "stand_s", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
-                 "window")
+                 "v_raw_known", "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
@@ -75,6 +75,9 @@ class KnobCommand:
         self.accel = 0.0
         self.q_raw = q_deg
         self.v_raw = 0.0
+        self.v_raw_known = True
+        """``v_raw`` is a velocity the next change may be compared with (the desired angle
+        stood at rest, or changed every period): only then is a change an acceleration."""
         self.held_s = 0.0
         self.target = q_deg
         self.out = state.x_deg
@@ -148,16 +151,27 @@ def motion(kc: KnobCommand, q_raw: float, dt_s: float, period_s: float
     # daemon's demo: RMSE 11.4 / 6.8 deg with it, 3.0 / 3.0 without). "Every tick" is every
     # period, in time: ticks late by a period or more let that client's staircase change at
     # nearly every tick, and its acceleration then was noise up to the knob's limit again.
+    # A held value is zero velocity only when the angle stood at rest: after a staircase's
+    # short hold (or a late tick) the next change in the very next period is the staircase
+    # catching up, not the hand speeding up from zero. Read as one (the demo under load: two
+    # of the client's values landing on consecutive ticks), it gave ~1600 deg/s^2, the early
+    # jump crossed the dead zone ~0.8 s ahead and held there: phi1 RMSE 8-11 deg in one run
+    # of ten. Such a change starts the velocity afresh, with no acceleration.
     dq_raw = q_raw - kc.q_raw
     kc.held_s += dt_s
     if dq_raw != 0.0:
         kc.q_raw = q_raw
         if abs(dq_raw) > jump_deg or kc.held_s > 1.5 * period_s:
             kc.v_raw = kc.accel = 0.0  # a step, a staircase, or a start after a pause
-        else:
+            kc.v_raw_known = abs(dq_raw) <= jump_deg and kc.held_s >= REST_S
+        elif kc.v_raw_known:
             v_raw = keep_v * kc.v_raw + gain_v * dq_raw / dt_s
             kc.accel = keep_a * kc.accel + gain_a * (v_raw - kc.v_raw) / dt_s
             kc.v_raw = v_raw
+        else:
+            kc.v_raw = dq_raw / dt_s
+            kc.accel = 0.0
+            kc.v_raw_known = True
         kc.held_s = 0.0
     elif kc.held_s > 1.5 * period_s:
         kc.v_raw = kc.accel = 0.0  # standing: the next move starts from rest

@@ -26,7 +26,6 @@ from numpy.typing import NDArray
 
 from tsmd.compensation.ours_knob import (
     PLATEAU_MARGIN_DEG,
-    STAIRCASE_MEMORY_S,
     KnobCommand,
     fresh_progress,
     motion,
@@ -257,11 +256,7 @@ class OursCompensator:
         kc.target = target
         state = inverse_step(state, target, b)
         kc.state = state
-        if planned:
-            kc.out = state.x_deg
-        else:  # a client's staircase: timed with its averaged velocity (ours_knob)
-            v_jump = kc.v_stair if kc.stair_s < STAIRCASE_MEMORY_S else v
-            kc.out = self._early_jump(kc, state, target, v_jump, b)
+        kc.out = state.x_deg if planned else self._early_jump(kc, state, target, v, b)
 
     def _centre(self, kc: KnobCommand, b: Branches) -> bool:
         """During a dwell: the knob to the middle of the play holding the model's output (the

@@ -38,13 +38,6 @@ from rest (point-to-point), which speeds up along a planned profile. A continuou
 turning points stand within the reversal deadband for 0.2-1.2 s (the multisine): not rests."""
 SETTLED_DEG = 1e-3
 """The sent command has arrived when the output filter is this close to it."""
-STAIRCASE_VELOCITY_S = 0.08
-"""The time constant of the velocity a staircase's early jump is timed with: several of a 50 Hz
-client's values, so that a burst of them after the client was held up (values landing on
-consecutive ticks) reads as the client's velocity, not as a fast move."""
-STAIRCASE_MEMORY_S = 0.2
-"""A desired angle that changed after a hold (1.5 periods to :data:`REST_S`) this recently is a
-client's staircase: its early jump is timed with :attr:`KnobCommand.v_stair`."""
 
 
 class KnobCommand:
@@ -54,8 +47,8 @@ class KnobCommand:
                  "fresh_lo_deg", "held_s", "hold", "jump_deg_s", "lim_deg",
                  "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan",
                  "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "rest_q",
-                 "stair_s", "stand_s", "state", "still_q", "still_s", "sum", "target", "v",
-                 "v_raw", "v_raw_known", "v_stair", "window")
+                 "stand_s", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
+                 "v_raw_known", "window")
 
     def __init__(self, limits: KnobLimits) -> None:
         self.limits = limits
@@ -86,10 +79,6 @@ class KnobCommand:
         """``v_raw`` is a velocity the next change may be compared with (the desired angle
         stood at rest, or changed every period): only then is a change an acceleration."""
         self.held_s = 0.0
-        self.v_stair = 0.0
-        """The desired angle's velocity averaged over :data:`STAIRCASE_VELOCITY_S`."""
-        self.stair_s = math.inf
-        """Time since the desired angle last changed after a staircase's hold."""
         self.target = q_deg
         self.out = state.x_deg
         self.hold = 0
@@ -149,9 +138,6 @@ def motion(kc: KnobCommand, q_raw: float, dt_s: float, period_s: float
         kc.q_dir = -kc.q_dir
     dq = qi - q_prev
     kc.q_prev = qi
-    keep_s = math.exp(-dt_s / STAIRCASE_VELOCITY_S)
-    kc.v_stair = keep_s * kc.v_stair + (1.0 - keep_s) * dq / dt_s
-    kc.stair_s += dt_s
     v = keep_v * kc.v + gain_v * dq / dt_s
     jump_deg = kc.jump_deg_s * dt_s
     if abs(dq) > jump_deg:  # a step, not a motion: nothing to predict from it
@@ -178,8 +164,6 @@ def motion(kc: KnobCommand, q_raw: float, dt_s: float, period_s: float
         if abs(dq_raw) > jump_deg or kc.held_s > 1.5 * period_s:
             kc.v_raw = kc.accel = 0.0  # a step, a staircase, or a start after a pause
             kc.v_raw_known = abs(dq_raw) <= jump_deg and kc.held_s >= REST_S
-            if kc.held_s < REST_S:
-                kc.stair_s = 0.0
         elif kc.v_raw_known:
             v_raw = keep_v * kc.v_raw + gain_v * dq_raw / dt_s
             kc.accel = keep_a * kc.accel + gain_a * (v_raw - kc.v_raw) / dt_s

@@ -44,6 +44,16 @@ class EstimatorOptions:
     the reference's speed steepen too (lumped 1, 60 deg: 1.13-1.18 x) and the slow ones then
     count (with none of them counting, phi1 followed 30 s later, 0.87 -> 1.38 x fresh). Off:
     every ramp's slope counts (until session 17)."""
+    odd_speed_slopes_need_both: bool = True
+    """With ``slopes_at_reference_speed``: a ramp at an odd speed feeds the slopes only once
+    both tendons' last ramps at the reference's speed changed slope its way (a sheath's
+    friction changes both alike). Off: either tendon's (until session 24)."""
+    odd_speed_not_refused: bool = True
+    """A ramp beyond ``slope_ratio_max`` of the reference run at a knob speed beyond
+    ``speed_ratio_max`` of the reference's measures nothing (``odd_speed_ramps``) instead of
+    being refused with a warning: at such speeds the slope is the drive's, not the catheter's
+    (planetwist 1 without a change: a ramp at 113 deg/s, 0.3 x). Off: refused (until session
+    24)."""
     window: int = 5
     gate_deg: float = 1.5
     other_knob_confirms: bool = False

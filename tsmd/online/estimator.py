@@ -208,8 +208,8 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                      and 1.0 / o.shared_slope_ratio_max <= ratio <= o.shared_slope_ratio_max)
         in_bounds = 1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max or shared_ok
         if not in_bounds and self.odd_speed and o.odd_speed_not_refused:
-            # the knob far off the reference's speed (120 deg/s through the window: the
-            # drive's own dynamics in the current); a stuck knob shows as a lagging motor
+            # the knob far off the reference's speed: its slope is not the reference's
+            # friction (planetwist 1: 0.3 x at 113 deg/s); a stuck knob lags its command
             self.n_odd_speed += 1
             self.last_measurement_deg = math.nan
             return events

@@ -189,9 +189,10 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         self.odd_speed = not self._speed_matches(ramp)
         if not self.odd_speed:
             self.speed_ref_change = ratio - 1.0
-        slope_counts = not (self.odd_speed and o.slopes_at_reference_speed) or any(
-            c * (ratio - 1.0) > 0.0 and abs(c) > o.same_slope_tolerance
-            for c in (self.speed_ref_change, partner.speed_ref_change if partner else 0.0))
+        confirming = (self.speed_ref_change, partner.speed_ref_change if partner else 0.0)
+        slope_counts = not (self.odd_speed and o.slopes_at_reference_speed) or (
+            all if o.odd_speed_slopes_need_both else any)(
+            c * (ratio - 1.0) > 0.0 and abs(c) > o.same_slope_tolerance for c in confirming)
         if slope_counts:
             self.recent_slopes = [*self.recent_slopes, ramp.slope_A_per_deg][-o.slope_window:]
         shared = 0.0 if partner is None else common_change(
@@ -205,7 +206,14 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         self.partner_knee_change = 0.0 if partner is None else partner.knee_slope_change
         shared_ok = (abs(shared) >= 2.0 * o.same_slope_tolerance
                      and 1.0 / o.shared_slope_ratio_max <= ratio <= o.shared_slope_ratio_max)
-        if not (1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max or shared_ok):
+        in_bounds = 1.0 / o.slope_ratio_max <= ratio <= o.slope_ratio_max or shared_ok
+        if not in_bounds and self.odd_speed and o.odd_speed_not_refused:
+            # the knob far off the reference's speed: its slope is not the reference's
+            # friction (planetwist 1: 0.3 x at 113 deg/s); a stuck knob lags its command
+            self.n_odd_speed += 1
+            self.last_measurement_deg = math.nan
+            return events
+        if not in_bounds:
             # A stuck knob or a blocked tip (one tendon's ramp), or a stroke across a shape
             # change: this ramp is refused and the suspects before it are void, but the ramps
             # after it measure (freezing them delayed a slack change by two ramps per side). A

@@ -44,6 +44,20 @@ class EstimatorOptions:
     the reference's speed steepen too (lumped 1, 60 deg: 1.13-1.18 x) and the slow ones then
     count (with none of them counting, phi1 followed 30 s later, 0.87 -> 1.38 x fresh). Off:
     every ramp's slope counts (until session 17)."""
+    odd_speed_slopes_need_both: bool = True
+    """With ``slopes_at_reference_speed``: a ramp at an odd speed feeds the slopes only once
+    both tendons' last ramps at the reference's speed changed slope its way beyond
+    ``same_slope_tolerance`` (a sheath's friction changes both alike). With either tendon's,
+    one ramp at the edge of the speed band (planetwist 1 without a change: 1.35 x at 33 deg/s,
+    the reference's ~19; coilpipe 1: 1.17 x at 11 deg/s) let slow ramps at 1.26-2.02 x into
+    the slope in use, which rose 9-10 %, and ordinary ramps then read +1.6..+2.5 deg: phi1
+    followed without a change on both. Off: either tendon's (until session 24)."""
+    odd_speed_not_refused: bool = True
+    """A ramp beyond ``slope_ratio_max`` of the reference run at a knob speed beyond
+    ``speed_ratio_max`` of the reference's measures nothing (``odd_speed_ramps``) instead of
+    being refused with a warning: its slope is not the reference's friction (planetwist 1
+    without a change: a ramp at 113 deg/s, 0.3 x), and a stuck knob lags its command and
+    freezes the edge anyway. Off: refused (until session 24)."""
     window: int = 5
     gate_deg: float = 1.5
     other_knob_confirms: bool = False

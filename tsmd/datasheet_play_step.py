@@ -60,6 +60,8 @@ class PlayStepScore:
                 and self.step_mae_deg < self.rule_mae_deg)
 
     def text(self) -> str:
+        if self.found == 0:
+            return f"step in 0/{self.half_cycles} half-cycles -> rule"
         return (f"step in {self.found}/{self.half_cycles} half-cycles, {self.within} within "
                 f"{TARGET_DEG:g} deg of the tip, mean |error| {self.step_mae_deg:.2f} deg "
                 f"against the rule's {self.rule_mae_deg:.2f} -> "

@@ -10,7 +10,7 @@ import math
 from support.play_step import PLAY_DEG, sweep
 from support.profiles import DEVICE
 
-from tsmd.calibration.assemble import GridPoint
+from tsmd.calibration.assemble import GridPoint, QualityReport, cross_check_device
 from tsmd.calibration.identify import identify_sweep
 from tsmd.calibration.options import IdentifyOptions
 from tsmd.calibration.run import device_options
@@ -64,3 +64,20 @@ def test_the_choice_is_written_per_knob_and_off_is_absent() -> None:
     assert (device.knobs[0].backlash_play_step, device.knobs[1].backlash_play_step) == (True, None)
     phi1, phi2 = device_options(None, device)
     assert phi1.backlash_play_step and not phi2.backlash_play_step
+
+
+def play_warnings(on: bool) -> list[str]:
+    scores = tuple(PlayStepScore(k, 10, 10 if on else 0, 10 if on else 0, 0.5, 9.0)
+                   for k in (0, 1))
+    device = with_play_step(load_device_model(DEVICE), scores)
+    report = QualityReport()
+    cross_check_device(run_with_step(-0.010).points, device, report)
+    return [w for w in report.warnings if "play closes" in w]
+
+
+def test_a_calibration_under_the_play_step_warns_that_the_tip_may_let_go_earlier() -> None:
+    assert len(play_warnings(True)) == 1
+
+
+def test_without_the_play_step_no_such_warning() -> None:
+    assert play_warnings(False) == []

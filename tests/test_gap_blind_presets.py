@@ -1,22 +1,45 @@
-"""The blind plants whose physics has no time law (cyclopebax, session 21; snakedent, session
-22) as the data of the cross-plant self-test: their presets."""
+"""The blind plants whose physics has no time law at the tip (cyclopebax, session 21;
+snakedent, session 22; planetwist, session 23) as the data of the cross-plant self-test: their
+presets."""
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 import pytest
 
 from simrig.plants.cyclopebax import CycloPebaxPlant
 from simrig.plants.cyclopebax.params import CycloPebaxKnob
+from simrig.plants.planetwist import PlanetTwistKnob, PlanetTwistPlant
 from simrig.plants.snakedent import SnakeDentKnob, SnakeDentPlant
 from tsmd.gap.presets import PRESETS, parse_plant_spec
 from tsmd.gap.selftest import drive_plant, trajectory
 
 BLIND = [("cyclopebax", CycloPebaxPlant, CycloPebaxKnob),
-         ("snakedent", SnakeDentPlant, SnakeDentKnob)]
+         ("snakedent", SnakeDentPlant, SnakeDentKnob),
+         ("planetwist", PlanetTwistPlant, PlanetTwistKnob)]
 NAMES = [name for name, _plant, _knob in BLIND]
+
+
+def _share_keyword(plant: Any) -> list[float]:
+    return [plant.cross_takeup_share] * 2
+
+
+def _takeup_constant(plant: Any) -> list[float]:
+    return [knob.cross_takeup for knob in plant.knobs]
+
+
+TAKEUP: dict[str, tuple[Callable[[Any], list[float]], set[str]]] = {
+    "cyclopebax": (_share_keyword, set()),
+    "snakedent": (_share_keyword, set()),
+    "planetwist": (_takeup_constant, {"cross_takeup"}),
+}
+"""How strongly the other plane's bend takes up a plane's ropes, per plant, and which knob
+constants the coupling case may change (a keyword on cyclopebax and snakedent, planetwist's own
+knob constant)."""
 
 
 @pytest.mark.parametrize(("name", "plant_type", "_knob"), BLIND)
@@ -38,20 +61,30 @@ def test_case_factors_name_constants_of_the_plants_knobs(name: str, _plant: type
 
 
 @pytest.mark.parametrize("name", NAMES)
-def test_cases_couple_the_planes_halve_the_rope_and_bend_the_sheath(name: str) -> None:
+def test_cases_halve_the_rope_and_bend_the_sheath(name: str) -> None:
     preset = PRESETS[name]
     none = preset.build_unit(102, 0.1)
-    coupled = preset.build_unit(102, 0.1, "coupling", **preset.case_effects("coupling"))
     soft = preset.build_unit(102, 0.1, "compliance", **preset.case_effects("compliance"))
     bent = preset.build_unit(102, 0.1, "curvature", **preset.case_effects("curvature"))
     for k in (0, 1):
         assert soft.knobs[k].tendon_stiffness_N == pytest.approx(
             0.5 * none.knobs[k].tendon_stiffness_N)
-        assert bent.knobs[k] == none.knobs[k] == coupled.knobs[k]
-    assert none.cross_takeup_share == 1.0
-    assert coupled.cross_takeup_share > 1.0
+        assert bent.knobs[k] == none.knobs[k]
     assert none.sheath_curvature_deg == 0.0
     assert bent.sheath_curvature_deg == pytest.approx(120.0)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_coupling_case_only_raises_the_other_planes_takeup(name: str) -> None:
+    preset = PRESETS[name]
+    takeup, constants = TAKEUP[name]
+    none = preset.build_unit(102, 0.1)
+    coupled = preset.build_unit(102, 0.1, "coupling", **preset.case_effects("coupling"))
+    for k in (0, 1):
+        assert takeup(coupled)[k] > 1.5 * takeup(none)[k]
+        kept = {c: getattr(none.knobs[k], c) for c in constants}
+        assert dataclasses.replace(coupled.knobs[k], **kept) == none.knobs[k]
+    assert coupled.sheath_curvature_deg == none.sheath_curvature_deg
 
 
 @pytest.mark.parametrize("name", NAMES)

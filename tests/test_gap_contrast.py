@@ -12,6 +12,7 @@ import pytest
 from numpy.typing import NDArray
 
 from tsmd import cli
+from tsmd.gap import contrast
 from tsmd.gap.contrast import collect_tests, contrast_scores, product_reference
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.errors import GapError
@@ -181,6 +182,25 @@ def test_a_loop_with_a_lower_gain_in_one_configuration_is_explained_as_curvature
     scores = _scores(flatter, looped_only=True)
     assert _named(scores) == {"curvature"}
     assert scores["curvature"].share > 0.9
+
+
+def _other_knob_bend_looped(t: Arr, q: Arr) -> Arr:
+    """A looped sheath whose plane loses gain with the other plane bent beyond the rate loops'
+    amplitude: seen only where the other knob is held far out (the coupling test's levels)."""
+    out = np.zeros((len(t), 4))
+    for j in range(2):
+        out[:, j] = -0.02 * q[:, j] * np.maximum(np.abs(q[:, 1 - j]) - 45.0, 0.0)
+    return out
+
+
+def test_the_curvature_test_on_couplings_level_0_loops_ignores_the_held_levels(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    everything = _scores(_other_knob_bend_looped, looped_only=True)["curvature"]
+    monkeypatch.setattr(contrast, "CURVATURE_LEVELS", {"rate": None, "coupling": ("+0",)})
+    level_0 = _scores(_other_knob_bend_looped, looped_only=True)["curvature"]
+    assert everything.z > 5.0
+    assert not level_0.significant
+    assert level_0.z < 3.0
 
 
 def _creep(t: Arr, q: Arr) -> Arr:

@@ -326,3 +326,35 @@ SNAKEDENT_KNOB_EFFECTS: dict[str, dict[str, float]] = {
 SNAKEDENT_MAX_STEP_S = 0.0
 """No finer stepping: the nominal-scatter unit's tip lies 0.014 deg RMS (0.32 max) from 0.25 ms
 steps at 20 ms, 0.011 (0.07) at 4 ms (unit 1, 120 s of the experiment motion): quasi-static."""
+
+
+PLANETWIST_EFFECTS: dict[str, dict[str, float]] = {
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The planetwist plant's one effect keyword: a 120 deg sheath bend (added to every lumped lumen
+contact's wrap), 1.84 / 1.73 deg of tip (tip RMSE effect on minus off, units 1 / 2, noise-free,
+120 s of the experiment motion at 50 Hz; 60 deg 0.62 / 0.61), inside the others' 1.1-12.8 deg.
+Its laws read the knob angle only at the tip (the stage's driving/back-driven loss and the
+handle's friction turn round with the knob speed but act on the motor: the same path 8 times as
+fast moves the tip 0.000 deg, flow off; handle friction x3 moves the current 10-11 mA RMS, the
+tip 0.000) and nothing drifts at a held knob (75 deg held 60 s: the tip's five-beat mean moves
+0.003 deg, the heart's pulse 0.03 deg peak to peak): rate and creep are not run. The stage's
+play, the planets' load sharing, the swivel crimps, the section's stiffening with the total bend
+and the pulsing flow are base physics; "none" is the nominal physics as written (docs/gap.md
+"Session 24")."""
+
+PLANETWIST_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"cross_takeup": 6.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Planetwist effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion, units 1 / 2): the other plane's bend taking up six times the unit's share of both
+ropes (``cross_takeup``, the plant's constant that reads the other plane only: rope lumens set
+off their plane), 1.67 / 1.28 deg (x5 1.38 / 1.06, x5.5 1.52 / 1.17, x6.5 1.81 / 1.38, x7 1.94 /
+1.48; the take-up removed altogether 0.41 / 0.31; the others' coupling 1.5 deg); the strand's EA
+halved (its twist coupling and torsion scale with it), 5.06 / 5.41 deg."""
+
+PLANETWIST_MAX_STEP_S = 0.0
+"""No finer stepping: the nominal-scatter unit's tip lies 0.039 deg RMS (0.12 max) from 0.25 ms
+steps at 20 ms, 0.007 (0.02) at 4 ms (unit 1; unit 2 0.024 / 0.005): quasi-static, the flow's
+pulse sampled."""

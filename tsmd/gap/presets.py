@@ -34,6 +34,9 @@ from tsmd.gap.preset_effects import (
     LUMPED_EFFECTS,
     NITINOL_EFFECTS,
     NITINOL_KNOB_EFFECTS,
+    PLANETWIST_EFFECTS,
+    PLANETWIST_KNOB_EFFECTS,
+    PLANETWIST_MAX_STEP_S,
     RATESTATE_EFFECTS,
     RATESTATE_KNOB_EFFECTS,
     RATESTATE_MAX_STEP_S,
@@ -168,6 +171,10 @@ PRESETS: dict[str, PlantSpec] = {
     "snakedent": PlantSpec(PLANT_SPECS["snakedent"], {}, (), "snakedent", family="snakedent",
                            effects=SNAKEDENT_EFFECTS, knob_effects=SNAKEDENT_KNOB_EFFECTS,
                            max_step_s=SNAKEDENT_MAX_STEP_S),
+    "planetwist": PlantSpec(PLANT_SPECS["planetwist"], {}, (), "planetwist",
+                            family="planetwist", effects=PLANETWIST_EFFECTS,
+                            knob_effects=PLANETWIST_KNOB_EFFECTS,
+                            max_step_s=PLANETWIST_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

@@ -25,7 +25,10 @@ blind: rolling vertebrae, detented knobs, run untuned, then its edge reading tun
 development units in the same session's second round) is held out (``PLANT_ROLE``); the
 planetwist plant (session 23, written blind: a planetary handle stage, twist-coupled strands in
 swivel crimps, blood flow on the tip; run untuned, then ours' gain reading made consistent on its
-development units in the same session's second round) is held out, registered last.
+development units in the same session's second round) is held out; the notchclutch plant
+(session 24, written blind: a slip clutch in the handle, aramid tendons on a soaking hydrophilic
+liner, a notched steel section, a tip rubbing on the wall; run untuned) is the blind plant,
+registered last.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -49,6 +52,7 @@ from simrig.plants.helixbelt import NOMINAL_KNOBS as HELIXBELT_KNOBS
 from simrig.plants.jawcrimp import NOMINAL_KNOBS as JAWCRIMP_KNOBS
 from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
 from simrig.plants.nitinol import NOMINAL_KNOBS as NITINOL_KNOBS
+from simrig.plants.notchclutch import NOMINAL_KNOBS as NOTCHCLUTCH_KNOBS
 from simrig.plants.planetwist import NOMINAL_KNOBS as PLANETWIST_KNOBS
 from simrig.plants.ratestate import NOMINAL_KNOBS as RATESTATE_KNOBS
 from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
@@ -75,14 +79,15 @@ PLANT_SPECS: dict[str, str] = {
     "jawcrimp": "simrig.plants.jawcrimp:make_jawcrimp_plant",
     "cyclopebax": "simrig.plants.cyclopebax:make_cyclopebax_plant",
     "snakedent": "simrig.plants.snakedent:make_snakedent_plant",
-    "planetwist": "simrig.plants.planetwist:make_planetwist_plant",  # last: the others' seeds hold
+    "planetwist": "simrig.plants.planetwist:make_planetwist_plant",
+    "notchclutch": "simrig.plants.notchclutch:make_notchclutch_plant",  # last: seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
-              "planetwist": "held-out"}
+              "planetwist": "held-out", "notchclutch": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -102,7 +107,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "jawcrimp": JAWCRIMP_KNOBS,
                                         "cyclopebax": CYCLOPEBAX_KNOBS,
                                         "snakedent": SNAKEDENT_KNOBS,
-                                        "planetwist": PLANETWIST_KNOBS}
+                                        "planetwist": PLANETWIST_KNOBS,
+                                        "notchclutch": NOTCHCLUTCH_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -176,6 +182,8 @@ VARIANTS: dict[str, Variant] = {
             "planetwist": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                            "handle_friction_Nm": 1.5, "swivel_friction_Nmm": 1.5,
                            "carrier_play_deg": 1.5},
+            "notchclutch": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                            "handle_friction_Nm": 1.5, "tissue_friction_Nmm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -205,7 +213,8 @@ VARIANTS: dict[str, Variant] = {
                  "jawcrimp": {"tendon_stiffness_N": 0.4},
                  "cyclopebax": {"tendon_stiffness_N": 0.4},
                  "snakedent": {"tendon_stiffness_N": 0.4},
-                 "planetwist": {"tendon_stiffness_N": 0.4}},
+                 "planetwist": {"tendon_stiffness_N": 0.4},
+                 "notchclutch": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

@@ -380,5 +380,27 @@ SCATTER: dict[str, dict[str, float]] = {
         "handle_friction_Nm": 0.25,  # knob seal
         "flow_moment_Nmm": 0.40,  # where in the chamber the tip sits (not the catheter's part)
     },
+    "notchclutch": {
+        "drum_radius_mm": 0.02,  # moulded drum
+        "clutch_capacity_Nmm": 0.15,  # wave-spring preload and facing friction of the clutch
+        "clutch_kinetic_ratio": 0.05,
+        "handle_friction_Nm": 0.20,  # knob seal
+        "slack_pos_mm": 0.15,  # braid cut and knotted by hand
+        "slack_neg_mm": 0.15,
+        "toe_mm": 0.20,  # braid crimp of the lot
+        "tendon_stiffness_N": 0.10,  # aramid lot
+        "rate_stiffening": 0.20,
+        "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+        "sheath_friction": 0.15,  # coating thickness and cure
+        "dry_friction_ratio": 0.10,
+        "soak_time_s": 0.30,  # coating thickness
+        "stribeck_rise": 0.20,
+        "sheath_wrap_deg": 0.10,  # routing in the handle
+        "sheath_drag_N": 0.20,  # lumen fit
+        "bend_stiffness_Nmm_per_rad": 0.15,  # laser cut, cover durometer
+        "notch_close_deg": 0.05,  # notch width of the cut
+        "tissue_friction_Nmm": 0.25,  # the patient's mucosa, the probe's position
+        "tissue_friction_ratio": 0.25,
+    },
 }
 """Relative half-range of the uniform unit-to-unit scatter of every constant, per knob."""

@@ -104,6 +104,21 @@ def test_each_knob_gets_the_rule_that_reproduced_the_tip_better() -> None:
     assert [k.backlash_release_rule for k in chosen.knobs] == ["swing", "line"]
 
 
+def test_the_rule_is_chosen_on_the_backlash_values_it_ends_not_on_the_edges() -> None:
+    scores = [dataclasses.replace(scored("line", k, 54), backlash_within=26) for k in (0, 1)]
+    scores += [dataclasses.replace(scored("swing", 0, 50), backlash_within=28),
+               dataclasses.replace(scored("swing", 1, 56), backlash_within=25)]
+    chosen = choose_rules(sheet(), scores)
+    assert [k.backlash_release_rule for k in chosen.knobs] == ["swing", "line"]
+
+
+def test_a_tie_in_backlash_values_keeps_line_whatever_the_edges() -> None:
+    scores = [dataclasses.replace(scored("line", k, 50), backlash_within=27) for k in (0, 1)]
+    scores += [dataclasses.replace(scored("swing", k, 56), backlash_within=27) for k in (0, 1)]
+    chosen = choose_rules(sheet(), scores)
+    assert [k.backlash_release_rule for k in chosen.knobs] == ["line", "line"]
+
+
 def test_a_tie_in_count_keeps_line_whatever_the_mean_errors() -> None:
     scores = [scored("line", 0, 50, mean=1.2), scored("swing", 0, 50, mean=0.9),
               scored("line", 1, 50), scored("swing", 1, 49, mean=0.5)]

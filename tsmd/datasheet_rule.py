@@ -8,10 +8,11 @@ other-knob angles separate them per product (coilpipe unit 0: 64 against 103 of 
 within 2 deg; docs/calibration.md, session 10 lead), and no one of them holds on every plant.
 So the manufacturer, who tracks the tip of this unit anyway, calibrates it with the fast
 protocol under each rule (current only, as every unit is calibrated) and writes the rule whose
-D and B come closest to the tip into the sheet: a per-product constant measured where the
-other ones are. The knee (:mod:`tsmd.calibration.knee`) is chosen the same way, after the
-rule: the chosen rules calibrated once more with it on, kept per knob unless that placed fewer
-of the unit's values (lumped unit 0 loses with it).
+B comes closest to the tip into the sheet (the rule ends B and moves no edge; session 24): a
+per-product constant measured where the other ones are. The knee
+(:mod:`tsmd.calibration.knee`) is chosen the same way, after the rule: the chosen rules
+calibrated once more with it on, kept per knob unless that placed fewer of the unit's B values
+(lumped unit 0 loses with it).
 """
 
 from __future__ import annotations
@@ -257,11 +258,15 @@ def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceMode
     (:attr:`tsmd.datasheet_rule_halves.HalfRead.misread`; session 21: warmgear unit 0's phi1
     "swing" placed 49/56 grid values against "local" 43/56 while ending 2 of 24 half-cycles at
     a loaded gear step 36-38 deg off, and on development unit 1 it did so at two of three grid
-    points), the rule that placed the most values within the target (then: the most runs
-    accepted); a tie keeps the earlier of :data:`RELEASE_RULES` ("line": the rule of a sheet
-    with a line share and no choice, chosen on the development units of lumped and segments;
+    points), the rule that placed the most B values within the target (then: the most runs
+    accepted; :meth:`RuleScore.backlash_key`); a tie keeps the earlier of
+    :data:`RELEASE_RULES` ("line": the rule of a sheet with a line share and no choice, chosen
+    on the development units of lumped and segments;
     :data:`~tsmd.datasheet_rule_settled.SWING_KNEE` last, so a tie keeps the rule of before);
-    a rule needs its share."""
+    a rule needs its share. B alone (session 24), as for the knee (:func:`knee_choice`): a
+    half-cycle's edge is fitted from its constant stretch on, whatever ends its backlash
+    (:func:`tsmd.calibration.identify.identify_sweep`), so a rule moves an edge only through
+    the re-sweeps its B's half-width asks for (docs/calibration.md, session 24)."""
     knobs = []
     for knob, k in enumerate(device.knobs):
         mine = [s for s in scores if s.knob == knob and usable(k, s.rule)]
@@ -270,6 +275,6 @@ def choose_rules(device: DeviceModel, scores: Sequence[RuleScore]) -> DeviceMode
             continue
         fewest = min(s.half_misread for s in mine)
         mine = [s for s in mine if s.half_misread == fewest]
-        best = min(mine, key=lambda s: (s.key(), CANDIDATES.index(s.rule)))
+        best = min(mine, key=lambda s: (s.backlash_key(), CANDIDATES.index(s.rule)))
         knobs.append(as_candidate(k, best.rule))
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))

@@ -203,14 +203,6 @@ def cross_check_device(points: Sequence[GridPoint], device: DeviceModel,
         if not zero:
             continue
         label = KNOB_LABELS[knob]
-        if sheet.backlash_play_step:
-            # session 24: planetwist's section gives way while the play opens on some units
-            report.warnings.append(
-                f"{label}: the backlash is read where the handle's play closes (data sheet: "
-                "backlash_play_step); on a unit whose section gives way while the play opens "
-                "the tip lets go where the current's swing ends, up to the play earlier, and "
-                "the current cannot tell the two apart (the reported half-width does not "
-                "cover it)")
         for side, reference in (("pos", sheet.reference_backlash_pos_deg),
                                 ("neg", sheet.reference_backlash_neg_deg)):
             name = f"backlash_{side}_deg"

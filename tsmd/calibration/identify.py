@@ -44,7 +44,6 @@ from tsmd.calibration.pieces import (
     knee_edge,
     linear_pieces,
 )
-from tsmd.calibration.play_step import find_play_step
 from tsmd.calibration.recovery import recovery_end
 from tsmd.calibration.release import (
     EDGE_CLEARANCE_DEG,
@@ -277,41 +276,6 @@ def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
     return tuple(out)
 
 
-def play_step_at(data: Conditioned, h: HalfCycle, opts: IdentifyOptions
-                 ) -> tuple[FloatArray, FloatArray, int | None]:
-    """One after-reversal half-cycle's knob position, its angle grid and the grid index of its
-    play step (:func:`tsmd.calibration.play_step.find_play_step`; None: no step shows),
-    searched up to its dead-zone edge less the clearance."""
-    step = opts.grid_step_deg
-    pos = data.pos_deg[h.start:h.stop]
-    grid, yg = resample_on_angle(
-        pos, h.direction * data.current_filtered_A[h.start:h.stop], h.direction, step)
-    end = yg.size - round(opts.edge_margin_deg / step)
-    stop = end if not math.isfinite(h.edge_deg) else int(
-        np.searchsorted(grid, h.direction * h.edge_deg)) - round(EDGE_CLEARANCE_DEG / step)
-    found = find_play_step(yg[:end], step, stop)
-    return pos, grid, None if found is None else found.index
-
-
-def play_step_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
-                       opts: IdentifyOptions) -> tuple[HalfCycle, ...]:
-    """``halves`` with each after-reversal backlash moved to its half-cycle's play step
-    (:mod:`tsmd.calibration.play_step`), none where the current shows no step; unchanged
-    unless the product's sheet chose the step (``opts.backlash_play_step``)."""
-    if not opts.backlash_play_step:
-        return halves
-    out = list(halves)
-    for i, h in enumerate(halves):
-        if not h.after_reversal:
-            continue
-        pos, grid, k = play_step_at(data, h, opts)
-        out[i] = replace(h, backlash_deg=math.nan if k is None else float(grid[k] - grid[0]),
-                         backlash_end_index=None if k is None else _index_at(
-                             pos, h.direction, grid, k, h.start),
-                         share_u95_deg=math.nan)
-    return tuple(out)
-
-
 def _share_u95_deg(grid: FloatArray, yg: FloatArray, k: int, share: float,
                    opts: IdentifyOptions, stop: int | None) -> float:
     """The 95 % half-width of one release end that the share's unit part gives: the knob
@@ -355,9 +319,8 @@ def identify_sweep(t_s: NDArray[np.floating], cmd_deg: NDArray[np.floating],
     if not stretches:
         raise CalibrationError(
             f"the command never moves more than {opts.min_reversal_deg:g} deg: nothing to identify")
-    halves = play_step_backlash(data, unit_share_backlash(
-        data, tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches),
-        opts), opts)
+    halves = unit_share_backlash(
+        data, tuple(analyse_half_cycle(data, d, a, b, r, opts) for d, a, b, r in stretches), opts)
     check_signal(data, [(h.direction, h.start, h.stop, h.snr) for h in halves], opts.min_snr)
     check_slips([h.slip for h in halves if h.snr >= opts.min_snr])
     values: dict[str, list[float]] = {name: [] for name in PARAMETERS}

@@ -126,11 +126,6 @@ class IdentifyOptions:
     value of held-out stickslip and coilpipe but moved lumped's ends before the tip's release
     (0/8 accepted, 291/448; docs/calibration.md, session 12), so it is not a rule for every
     product; False: the rule's end as is."""
-    backlash_play_step: bool = False
-    """After every other rule: each backlash ends at the lone step of the flat current where the
-    handle's play closes (:mod:`tsmd.calibration.play_step`, session 24), none where no step
-    shows. The product's choice (data-sheet ``backlash_play_step``, planetwist); off: the
-    rule's end as is."""
     release_fit_half_deg: float = 4.0
     """"fraction": the share's crossing is read off a quadratic fitted to the current over this
     much knob travel either side of it (noise averaged; narrow enough for a quadratic to follow
@@ -252,7 +247,6 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
         # the product's knee (tsmd datasheet) where the sheet turns it on
         one = replace(one, backlash_knee=True) if k.backlash_knee else one
         one = replace(one, edge_curve=True) if k.edge_curve else one
-        one = replace(one, backlash_play_step=True) if k.backlash_play_step else one
         one = replace(one, torque_ripple_period_deg=k.torque_ripple_period_deg)
         chosen.append(replace(one, reading_offset=k.reading_offset, unit_part=UnitPart.of(k)))
     return chosen[0], chosen[1]

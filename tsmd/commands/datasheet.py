@@ -18,7 +18,6 @@ from typing import Any
 from simrig.plant import Plant, load_plant
 from tsmd import __version__
 from tsmd.commands.datasheet_args import add_arguments
-from tsmd.commands.datasheet_play_step import play_step_update
 from tsmd.commands.datasheet_sample import sample_units, update, with_sample
 from tsmd.config import DEFAULT_CONFIG_PATH, TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import (
@@ -269,8 +268,6 @@ def main(args: argparse.Namespace) -> int:
         raise DatasheetError("--bend-relation goes with --plant (the unit is calibrated bent on "
                              "the simulated rig)")
     seeds = _rule_seeds(args.rule_seeds)
-    if args.update is not None and args.play_step:
-        return play_step_update(args, _params(args.params), seeds)
     if args.update is not None:
         return update(args, _params(args.params), seeds[0] if seeds else 0)
     if args.device_model is None:

@@ -114,13 +114,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "the sample's part to this existing sheet, calibrating the sample "
                              "under it, and write it to --out with no other field changed (its "
                              "header records the command; docs/calibration.md, session 20)")
-    parser.add_argument("--play-step", action="store_true",
-                        help="with --update FILE, --plant/--params of the sheet's unit: choose "
-                             "per knob whether each backlash ends at the step the flat current "
-                             "makes where the handle's play closes (backlash_play_step, the "
-                             "sheet's unit calibrated once per rule seed and tracked) and, where "
-                             "chosen, measure the reading offset again under it "
-                             "(docs/calibration.md, session 24)")
     parser.add_argument("--unit-key", default="unit",
                         help="--unit-sample: the plant factory's parameter naming a unit")
     parser.add_argument("--bend-relation", action="store_true",

@@ -158,11 +158,6 @@ class DeviceKnob:
     """Optional, the product's choice of the curved-hinge check on the dead-zone edge
     (:mod:`tsmd.calibration.curved_ramp`): a knee in the loaded current must also beat a
     smoothly bending ramp (``true``; jawcrimp) or is taken as before (absent)."""
-    backlash_play_step: bool | None = None
-    """Optional, the product's choice of the play step (:mod:`tsmd.calibration.play_step`):
-    every backlash ends where the flat current after the release steps as the handle's play
-    closes (``true``, planetwist; ``tsmd datasheet --play-step``, session 24). None or False:
-    the release rule's end."""
     backlash_knee: bool | None = None
     """Optional, the product's choice of the knee (:mod:`tsmd.calibration.knee`): a fraction
     rule's backlash end beyond the point where the current's rise falls below its own scatter

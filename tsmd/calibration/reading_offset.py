@@ -16,6 +16,7 @@ import dataclasses
 
 import numpy as np
 
+from tsmd.calibration.play_engage import engaged
 from tsmd.calibration.sweep_result import SweepResult
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 
@@ -68,11 +69,17 @@ def corrected(result: SweepResult, offset: ReadingOffset | None,
     # A backlash the current does not show is the sheet's, not a reading: no offset, and its
     # own half-width goes to the gate in the offset's place.
     u95: dict[str, float] = dict(result.unseen)
+    shifts: dict[str, float] = {}
     for name, v in result.values.items():
         shift, u = (0.0, 0.0) if offset is None else offset_at(offset, name, other_deg)
         if shift != 0.0 and name not in result.unseen:
             values[name] = tuple(x - shift for x in v)
             u95[name] = u
+            shifts[name] = shift
     if not u95:
         return result
+    # a handle's play whose end the current shows: the unit's own reading (session 24)
+    plays = {name: offset_at(offset, name, 0.0)[0] for name in shifts
+             if name.startswith("backlash")} if offset is not None else {}
+    values.update(engaged(result, shifts, plays)[0])
     return dataclasses.replace(result, values=values, offset_u95_deg=u95)

@@ -89,6 +89,7 @@ def test_the_calibrations_correction_takes_the_step_instead_of_the_sheets_offset
     r = corrected(falling_sweep(16.0), sheet_offset(-10.0), 0.0)
     assert r.values["backlash_pos_deg"][0] == pytest.approx(16.0, abs=0.3)
     assert r.offset_u95_deg["backlash_pos_deg"] == pytest.approx(0.5)
+    assert r.own_offset_deg["backlash_pos_deg"] == pytest.approx(LINE_END_DEG - 16.0, abs=0.3)
 
 
 def test_the_step_is_found_on_the_grid_between_samples() -> None:

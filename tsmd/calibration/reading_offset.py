@@ -81,5 +81,6 @@ def corrected(result: SweepResult, offset: ReadingOffset | None,
     # a handle's play whose end the current shows: the unit's own reading (session 24)
     plays = {name: offset_at(offset, name, 0.0)[0] for name in shifts
              if name.startswith("backlash")} if offset is not None else {}
-    values.update(engaged(result, shifts, plays)[0])
-    return dataclasses.replace(result, values=values, offset_u95_deg=u95)
+    read, own = engaged(result, shifts, plays)
+    values.update(read)
+    return dataclasses.replace(result, values=values, offset_u95_deg=u95, own_offset_deg=own)

@@ -7,11 +7,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tsmd.calibration.play_engage import MIN_PLAY_DEG, engage_travel_deg, engaged
+from tsmd.calibration.play_engage import (
+    MIN_PLAY_DEG,
+    TIP_MOVE_DEG,
+    engage_lag_deg,
+    engage_travel_deg,
+    engaged,
+)
 from tsmd.calibration.reading_offset import corrected
 from tsmd.calibration.signal import Conditioned
 from tsmd.calibration.sweep_result import HalfCycle, SweepResult
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
+from tsmd.tip_truth import TIP_THRESHOLD_DEG
 
 LEVEL_A = 0.026
 PULL_A = 0.011
@@ -97,3 +104,14 @@ def test_the_step_is_found_on_the_grid_between_samples() -> None:
     travel = engage_travel_deg(grid, release_y(grid, 12.1), round(LINE_END_DEG / 0.25),
                                NOISE_A, (5.0, 20.0))
     assert travel == pytest.approx(12.1, abs=0.2)
+
+
+def test_the_step_is_moved_to_where_the_tip_has_moved_the_sheets_one_degree() -> None:
+    r = corrected(falling_sweep(16.0), sheet_offset(-10.0), 0.0, release_slope=1.25)
+    assert r.values["backlash_pos_deg"][0] == pytest.approx(16.0 + 1.0 / 1.25, abs=0.3)
+    assert r.own_offset_deg["backlash_pos_deg"] == pytest.approx(LINE_END_DEG - 16.8, abs=0.3)
+    assert engage_lag_deg(None) == 0.0
+
+
+def test_the_tips_move_is_the_truths_threshold() -> None:
+    assert TIP_MOVE_DEG == TIP_THRESHOLD_DEG

@@ -41,6 +41,17 @@ ENGAGE_HOLD_DEG = 1.0
 ENGAGE_WINDOW: tuple[float, float] = (0.5, 2.0)
 """The step is taken between these multiples of the sheet's offset past the line end."""
 GRID_STEP_DEG = 0.25
+TIP_MOVE_DEG = 1.0
+"""How far the tip has moved where a backlash ends by the data sheet's definition (its
+reference B and reading offset are read where the tip has left its plateau by 1 deg,
+``tsmd.tip_truth.TIP_THRESHOLD_DEG``); the step is where the tip *starts*, so B at the step is
+moved by this over the release slope (unit 0: 13.6 -> 14.35 deg, its tip 14.22; dev unit 4:
+15.7 -> 16.45, its tip 16.47)."""
+
+
+def engage_lag_deg(release_slope: float | None) -> float:
+    """Knob travel from the play's end to the tip's 1 deg (0 without a slope)."""
+    return TIP_MOVE_DEG / release_slope if release_slope and release_slope > 0 else 0.0
 
 
 def engage_travel_deg(grid: FloatArray, yg: FloatArray, line_k: int, noise_A: float,
@@ -70,13 +81,13 @@ def engage_travel_deg(grid: FloatArray, yg: FloatArray, line_k: int, noise_A: fl
     return None
 
 
-def engaged(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[str, float]
-            ) -> tuple[dict[str, tuple[float, ...]], dict[str, float]]:
+def engaged(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[str, float],
+            lag_deg: float = 0.0) -> tuple[dict[str, tuple[float, ...]], dict[str, float]]:
     """Per backlash whose sheet offset at the other knob's 0 is at least :data:`MIN_PLAY_DEG`
     (``play_at_zero``, current minus tip: negative): each half-cycle's B at the play's end
     where its current shows the step, else ``B - shift`` (``shifts``: the offset at this grid
     point), and the mean offset the unit's own steps gave (line end minus step; only where
-    every half-cycle showed one)."""
+    every half-cycle showed one); ``lag_deg`` added to each step (:func:`engage_lag_deg`)."""
     values: dict[str, tuple[float, ...]] = {}
     own: dict[str, float] = {}
     data = result.data
@@ -98,8 +109,8 @@ def engaged(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[st
             if travel is None:
                 out.append(h.backlash_deg - shift)
             else:
-                out.append(travel)
-                diffs.append(h.backlash_deg - travel)
+                out.append(travel + lag_deg)
+                diffs.append(h.backlash_deg - travel - lag_deg)
         if out and len(out) == len(result.values.get(name, ())):
             values[name] = tuple(out)
             if len(diffs) == len(out):
@@ -107,4 +118,4 @@ def engaged(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[st
     return values, own
 
 
-__all__ = ["engage_travel_deg", "engaged"]
+__all__ = ["engage_lag_deg", "engage_travel_deg", "engaged"]

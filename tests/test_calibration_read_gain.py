@@ -62,3 +62,15 @@ def test_the_release_line_has_the_ratio_times_the_read_gains_locus() -> None:
 def test_the_ratio_is_unchanged_where_the_gains_agree_or_there_is_no_ratio() -> None:
     assert read_side_ratio(0.95, 0.2, 0.2) == 0.95
     assert read_side_ratio(1.0, 0.3, 0.1) == 1.0
+
+
+def test_a_unit_that_read_its_own_play_has_its_own_offset_added_back() -> None:
+    # B 28 deg read at the play's end its current showed, 10 deg as the line rule read it:
+    # the unit reads like the sheet's unit (own offset -18), whatever the sheet's offset says
+    raw = 10.0 / (90.0 - X0_POS)
+    knob = offset_knob(-15.0, reference_rule_backlash_gain=raw)
+    sweeps = [dataclasses.replace(synthetic_sweep(g, backlash_deg=28.0),
+                                  own_offset_deg=(-18.0, -18.0)) for g in GRID]
+    assert fit_tension_play(sweeps, knob).omega == pytest.approx(1.5, rel=0.01)
+    with_sheets = [synthetic_sweep(g, backlash_deg=28.0) for g in GRID]
+    assert fit_tension_play(with_sheets, knob).omega < 1.48

@@ -137,6 +137,10 @@ class IdentifyOptions:
     reading_offset: ReadingOffset | None = None
     """The product's reading offset from the data sheet, subtracted from this knob's values
     where sure (:mod:`tsmd.calibration.reading_offset`); None: the values as read."""
+    release_slope: float | None = None
+    """The product's release slope (data sheet ``release_omega``, else ``omega``): a B read at
+    the play's end (:mod:`tsmd.calibration.play_engage`) is moved by the knob travel the tip
+    needs to move the sheet's 1 deg; None: not moved."""
     unit_part: UnitPart | None = None
     """The product's part of the error that no sweep narrows, from the data sheet's sample
     (:mod:`tsmd.calibration.unit_part`), reported with each value; None: the share's part."""
@@ -248,5 +252,8 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
         one = replace(one, backlash_knee=True) if k.backlash_knee else one
         one = replace(one, edge_curve=True) if k.edge_curve else one
         one = replace(one, torque_ripple_period_deg=k.torque_ripple_period_deg)
-        chosen.append(replace(one, reading_offset=k.reading_offset, unit_part=UnitPart.of(k)))
+        # the release slope only serves a B read at a play's end, which needs an offset
+        slope = (getattr(k, "release_omega", None) or k.omega) if k.reading_offset else None
+        chosen.append(replace(one, reading_offset=k.reading_offset, unit_part=UnitPart.of(k),
+                              release_slope=None if slope is None else float(slope)))
     return chosen[0], chosen[1]

@@ -49,14 +49,18 @@ def read_gain(fit: SideFit, subtracted_deg: float) -> float:
 
 
 def read_gains(device_knob: Any, unseen: Sequence[tuple[bool, bool]],
-               pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit]
+               pos_fits: Sequence[SideFit], neg_fits: Sequence[SideFit],
+               own: Sequence[tuple[float | None, float | None]] | None = None
                ) -> tuple[list[float], list[float]]:
-    """Per side and sweep, the play's gain with its B as read (before the reading offset)."""
+    """Per side and sweep, the play's gain with its B as read (before the reading offset);
+    where the unit read its own offset (``own``, the play's end its current showed:
+    :mod:`tsmd.calibration.play_engage`), that one is added back instead of the sheet's."""
     pos, neg = [], []
-    for hidden, fp, fn in zip(unseen, pos_fits, neg_fits, strict=True):
+    owns = own if own is not None else [(None, None)] * len(pos_fits)
+    for hidden, fp, fn, mine in zip(unseen, pos_fits, neg_fits, owns, strict=True):
         s_pos, s_neg = subtracted_backlash_deg(device_knob, hidden)
-        pos.append(read_gain(fp, s_pos))
-        neg.append(read_gain(fn, s_neg))
+        pos.append(read_gain(fp, s_pos if mine[0] is None else mine[0]))
+        neg.append(read_gain(fn, s_neg if mine[1] is None else mine[1]))
     return pos, neg
 
 

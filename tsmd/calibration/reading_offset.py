@@ -16,6 +16,7 @@ import dataclasses
 
 import numpy as np
 
+from tsmd.calibration.play_engage import engage_lag_deg, engaged
 from tsmd.calibration.sweep_result import SweepResult
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 
@@ -60,7 +61,7 @@ def reference_edge_deg(offset: ReadingOffset | None, name: str,
 
 
 def corrected(result: SweepResult, offset: ReadingOffset | None,
-              other_deg: float) -> SweepResult:
+              other_deg: float, release_slope: float | None = None) -> SweepResult:
     """``result`` with every half-cycle's value moved by the product's offset at this grid
     point, and the offsets' half-widths kept for the gate (unchanged without an offset), the
     half-widths of the backlashes the current does not show (``result.unseen``) with them."""
@@ -68,11 +69,18 @@ def corrected(result: SweepResult, offset: ReadingOffset | None,
     # A backlash the current does not show is the sheet's, not a reading: no offset, and its
     # own half-width goes to the gate in the offset's place.
     u95: dict[str, float] = dict(result.unseen)
+    shifts: dict[str, float] = {}
     for name, v in result.values.items():
         shift, u = (0.0, 0.0) if offset is None else offset_at(offset, name, other_deg)
         if shift != 0.0 and name not in result.unseen:
             values[name] = tuple(x - shift for x in v)
             u95[name] = u
+            shifts[name] = shift
     if not u95:
         return result
-    return dataclasses.replace(result, values=values, offset_u95_deg=u95)
+    # a handle's play whose end the current shows: the unit's own reading (session 24)
+    plays = {name: offset_at(offset, name, 0.0)[0] for name in shifts
+             if name.startswith("backlash")} if offset is not None else {}
+    read, own = engaged(result, shifts, plays, engage_lag_deg(release_slope))
+    values.update(read)
+    return dataclasses.replace(result, values=values, offset_u95_deg=u95, own_offset_deg=own)

@@ -132,7 +132,7 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
     except CalibrationError as exc:
         raise CalibrationError(f"{source} ({KNOB_LABELS[knob]} sweep): {exc}") from None
     found = corrected(with_unseen(result, opts, other), opts.reading_offset if opts else None,
-                      other)
+                      other, opts.release_slope if opts else None)
     return GridPoint(knob, other, with_unit_part(found, opts.unit_part if opts else None), rec)
 
 

@@ -81,6 +81,10 @@ class SweepResult:
     product_u95_deg: dict[str, float] = field(default_factory=dict)
     """Per parameter, the 95 % half-width of what the product's sample measured that no sweep
     narrows (:mod:`tsmd.calibration.unit_part`); absent: the share's part, if any."""
+    own_offset_deg: dict[str, float] = field(default_factory=dict)
+    """Per backlash read at the end of the handle's play its current showed
+    (:mod:`tsmd.calibration.play_engage`), the unit's own reading offset that replaced the
+    sheet's (line end minus the play's end, mean over the half-cycles); absent: the sheet's."""
 
     @property
     def data_half_cycles(self) -> tuple[HalfCycle, ...]:
@@ -114,7 +118,8 @@ class SweepResult:
                   for name in PARAMETERS}
         return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
                            self.resweeps + 1, len(self.data_half_cycles), self.offset_u95_deg,
-                           {**self.unseen, **other.unseen}, self.product_u95_deg)
+                           {**self.unseen, **other.unseen}, self.product_u95_deg,
+                           self.own_offset_deg)
 
     @property
     def snr(self) -> float:

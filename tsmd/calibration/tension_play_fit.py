@@ -91,6 +91,9 @@ class SweepCurrent:
     backlash_unseen: tuple[bool, bool] = (False, False)
     """(+, -): the current did not show that backlash (the B is the sheet's, no reading offset
     was subtracted from it)."""
+    own_offset_deg: tuple[float | None, float | None] = (None, None)
+    """(+, -): the unit's own reading offset where its current showed the play's end
+    (:mod:`tsmd.calibration.play_engage`); None: the sheet's was subtracted."""
 
 
 def smooth_over_grid(grid_deg: Sequence[float], values: Sequence[float]) -> list[float]:
@@ -196,7 +199,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     beta_pos = smoothed_gains(grid, [f.backlash_gain for f in pos_fits])
     beta_neg = smoothed_gains(grid, [f.backlash_gain for f in neg_fits])
     # the unit's gains with B as the current read it, as the sheet's were (session 23)
-    read = read_gains(k, [s.backlash_unseen for s in order], pos_fits, neg_fits)
+    read = read_gains(k, [s.backlash_unseen for s in order], pos_fits, neg_fits,
+                      [s.own_offset_deg for s in order])
     omega = loaded_slope(k, grid, order, pos_fits, neg_fits, read)  # scatter: per sweep
     raw_pos, raw_neg = (smoothed_gains(grid, g) for g in read)
     ratio = release_slope_ratio(k)
@@ -349,7 +353,9 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
                                  u["dead_zone_neg_deg"].u95_deg),
                                 (pre.backlash_pos_deg, pre.backlash_neg_deg),
                                 (BACKLASH_NAMES[0] in p.result.unseen,
-                                 BACKLASH_NAMES[1] in p.result.unseen)))
+                                 BACKLASH_NAMES[1] in p.result.unseen),
+                                (p.result.own_offset_deg.get(BACKLASH_NAMES[0]),
+                                 p.result.own_offset_deg.get(BACKLASH_NAMES[1]))))
     return out
 
 

@@ -27,8 +27,8 @@ planetwist plant (session 23, written blind: a planetary handle stage, twist-cou
 swivel crimps, blood flow on the tip; run untuned, then ours' gain reading made consistent on its
 development units in the same session's second round) is held out; the notchclutch plant
 (session 24, written blind: a slip clutch in the handle, aramid tendons on a soaking hydrophilic
-liner, a notched steel section, a tip rubbing on the wall; run untuned) is the blind plant,
-registered last.
+liner, a notched steel section, a tip rubbing on the wall; run untuned, then traced on its
+development units in the same session's second round) is held out, registered last.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -87,7 +87,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
-              "planetwist": "held-out", "notchclutch": "blind"}
+              "planetwist": "held-out", "notchclutch": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

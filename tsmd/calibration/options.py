@@ -253,7 +253,7 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
         one = replace(one, edge_curve=True) if k.edge_curve else one
         one = replace(one, torque_ripple_period_deg=k.torque_ripple_period_deg)
         # the release slope only serves a B read at a play's end, which needs an offset
-        slope = (getattr(k, "release_omega", None) or k.omega) if k.reading_offset else None
+        slope = (k.release_omega or k.omega) if k.reading_offset else None
         chosen.append(replace(one, reading_offset=k.reading_offset, unit_part=UnitPart.of(k),
                               release_slope=None if slope is None else float(slope)))
     return chosen[0], chosen[1]

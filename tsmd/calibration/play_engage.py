@@ -23,6 +23,7 @@ misses at least :data:`MIN_PLAY_DEG`, and a step is taken only within
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -81,8 +82,18 @@ def engage_travel_deg(grid: FloatArray, yg: FloatArray, line_k: int, noise_A: fl
     return None
 
 
-def engaged(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[str, float],
-            lag_deg: float = 0.0) -> tuple[dict[str, tuple[float, ...]], dict[str, float]]:
+@dataclass(frozen=True)
+class Engaged:
+    """What :func:`engage` read: the backlashes' new values, the unit's own offsets, and per
+    backlash each half-cycle's play end (its B at the step; NaN where no step showed)."""
+
+    values: dict[str, tuple[float, ...]]
+    own: dict[str, float]
+    ends: dict[str, tuple[float, ...]]
+
+
+def engage(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[str, float],
+           lag_deg: float = 0.0) -> Engaged:
     """Per backlash whose sheet offset at the other knob's 0 is at least :data:`MIN_PLAY_DEG`
     (``play_at_zero``, current minus tip: negative): each half-cycle's B at the play's end
     where its current shows the step, else ``B - shift`` (``shifts``: the offset at this grid
@@ -90,12 +101,13 @@ def engaged(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[st
     every half-cycle showed one); ``lag_deg`` added to each step (:func:`engage_lag_deg`)."""
     values: dict[str, tuple[float, ...]] = {}
     own: dict[str, float] = {}
+    ends: dict[str, tuple[float, ...]] = {}
     data = result.data
     for name, play in play_at_zero.items():
         if play > -MIN_PLAY_DEG:
             continue
         shift = shifts.get(name, 0.0)
-        out, diffs = [], []
+        out, diffs, found = [], [], []
         for h in result.data_half_cycles:
             if h.backlash_name != name or not math.isfinite(h.backlash_deg):
                 continue
@@ -108,14 +120,24 @@ def engaged(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[st
                       else engage_travel_deg(grid, yg, line_k, data.filtered_noise_A, window))
             if travel is None:
                 out.append(h.backlash_deg - shift)
+                found.append(math.nan)
             else:
                 out.append(travel + lag_deg)
+                found.append(travel + lag_deg)
                 diffs.append(h.backlash_deg - travel - lag_deg)
         if out and len(out) == len(result.values.get(name, ())):
             values[name] = tuple(out)
+            ends[name] = tuple(found)
             if len(diffs) == len(out):
                 own[name] = float(np.mean(diffs))
-    return values, own
+    return Engaged(values, own, ends)
 
 
-__all__ = ["engage_lag_deg", "engage_travel_deg", "engaged"]
+def engaged(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[str, float],
+            lag_deg: float = 0.0) -> tuple[dict[str, tuple[float, ...]], dict[str, float]]:
+    """:func:`engage`'s values and own offsets."""
+    read = engage(result, shifts, play_at_zero, lag_deg)
+    return read.values, read.own
+
+
+__all__ = ["Engaged", "engage", "engage_lag_deg", "engage_travel_deg", "engaged"]

@@ -16,7 +16,7 @@ import dataclasses
 
 import numpy as np
 
-from tsmd.calibration.play_engage import engage_lag_deg, engaged
+from tsmd.calibration.play_engage import engage, engage_lag_deg
 from tsmd.calibration.sweep_result import SweepResult
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 
@@ -81,6 +81,7 @@ def corrected(result: SweepResult, offset: ReadingOffset | None,
     # a handle's play whose end the current shows: the unit's own reading (session 24)
     plays = {name: offset_at(offset, name, 0.0)[0] for name in shifts
              if name.startswith("backlash")} if offset is not None else {}
-    read, own = engaged(result, shifts, plays, engage_lag_deg(release_slope))
-    values.update(read)
-    return dataclasses.replace(result, values=values, offset_u95_deg=u95, own_offset_deg=own)
+    read = engage(result, shifts, plays, engage_lag_deg(release_slope))
+    values.update(read.values)
+    return dataclasses.replace(result, values=values, offset_u95_deg=u95,
+                               own_offset_deg=read.own, play_ends_deg=read.ends)

@@ -38,6 +38,7 @@ from tsmd.calibration.errors import (
 from tsmd.calibration.estimate import EstimateOptions
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
 from tsmd.calibration.options import device_options
+from tsmd.calibration.play_creep import check_play_creep
 from tsmd.calibration.player import (
     Player,
     Progress,
@@ -146,6 +147,8 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
     # Before refusing: a backlash far below the data sheet's often explains cycles that disagree.
     cross_check_device(points, device, report,
                        (limits or QualityLimits()).estimate.max_tip_error_deg)
+    # A play whose end moves over the grid: the tip crept while it opened (B widened in points).
+    check_play_creep(points, report)
     try:
         report.raise_if_bad()
     except CalibrationError as exc:

@@ -85,6 +85,10 @@ class SweepResult:
     """Per backlash read at the end of the handle's play its current showed
     (:mod:`tsmd.calibration.play_engage`), the unit's own reading offset that replaced the
     sheet's (line end minus the play's end, mean over the half-cycles); absent: the sheet's."""
+    play_ends_deg: dict[str, tuple[float, ...]] = field(default_factory=dict)
+    """Per backlash read where the data sheet announces a handle's play, each half-cycle's
+    play end (NaN where its current showed no step); re-sweeps' appended
+    (:mod:`tsmd.calibration.play_creep` judges whether the play is rigid)."""
 
     @property
     def data_half_cycles(self) -> tuple[HalfCycle, ...]:
@@ -116,10 +120,12 @@ class SweepResult:
         """This sweep's half-cycles pooled with a re-sweep's (the first sweep's signals kept)."""
         values = {name: self.values.get(name, ()) + other.values.get(name, ())
                   for name in PARAMETERS}
+        ends = {name: self.play_ends_deg.get(name, ()) + other.play_ends_deg.get(name, ())
+                for name in {*self.play_ends_deg, *other.play_ends_deg}}
         return SweepResult(self.data, self.half_cycles + other.half_cycles, values,
                            self.resweeps + 1, len(self.data_half_cycles), self.offset_u95_deg,
                            {**self.unseen, **other.unseen}, self.product_u95_deg,
-                           self.own_offset_deg)
+                           self.own_offset_deg, ends)
 
     @property
     def snr(self) -> float:

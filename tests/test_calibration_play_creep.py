@@ -1,0 +1,141 @@
+"""A tip that creeps while the handle's play opens: the rope the drum paid out is wound back
+before the far flanks meet, so the play closes later where the tip crept more. A rigid play
+closes at one travel after every reversal; where a knob's play ends move over its grid, its B
+is flagged: a one-line warning naming the knob, and B's reported half-width reaching back to
+the line rule's end."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tsmd.calibration.assemble import GridPoint, QualityReport
+from tsmd.calibration.play_creep import (
+    CREEP_SPREAD_DEG,
+    check_play_creep,
+    play_creep,
+)
+from tsmd.calibration.reading_offset import corrected
+from tsmd.calibration.resweep import point_estimates
+from tsmd.calibration.signal import Conditioned
+from tsmd.calibration.sweep_result import HalfCycle, SweepResult
+from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
+
+LEVEL_A = 0.026
+PULL_A = 0.011
+NOISE_A = 0.001
+LINE_END_DEG = 3.0
+SHEET_PLAY_DEG = -10.0
+OTHER_DEG = (-90.0, 0.0, 90.0)
+
+
+def falling_sweep(play_end_deg: float, seed: int) -> SweepResult:
+    """One half-cycle down from +90 deg: the tension unloads over the line rule's 3 deg, the
+    current rests at the friction level over the play and steps down by the released rope's
+    pull where the play closes (``play_end_deg`` after the reversal)."""
+    pos = np.linspace(90.0, -60.0, 1501)
+    travel = 90.0 - pos
+    y = np.full_like(travel, LEVEL_A)
+    unload = travel < LINE_END_DEG
+    y[unload] = -0.08 + (LEVEL_A + 0.08) * travel[unload] / LINE_END_DEG
+    s = travel - play_end_deg
+    pulled = (s >= 0.0) & (s < 50.0)
+    y[pulled] = LEVEL_A - PULL_A * (1.0 - s[pulled] / 50.0)
+    y = y + np.random.default_rng(seed).normal(0.0, NOISE_A / 4, pos.size)
+    current = -y  # direction -1
+    t = np.arange(pos.size) * 0.02
+    data = Conditioned(t, pos, pos, current, current, 50.0, NOISE_A, NOISE_A, ())
+    half = HalfCycle(direction=-1, start=0, stop=pos.size, after_reversal=True,
+                     backlash_deg=LINE_END_DEG)
+    return SweepResult(data, (half,), {"backlash_pos_deg": (LINE_END_DEG,)})
+
+
+def sheet(play_deg: float = SHEET_PLAY_DEG) -> ReadingOffset:
+    grid = OffsetGrid((play_deg,) * 3, (0.5,) * 3, (4, 4, 4))
+    return ReadingOffset(OTHER_DEG, (("backlash_pos_deg", grid),))
+
+
+def knob_points(play_ends_deg: tuple[float, ...], knob: int = 0,
+                play_deg: float = SHEET_PLAY_DEG) -> list[GridPoint]:
+    """One sweep per other-knob angle, read through the sheet's offset (the play-end reading
+    where the sheet announces a play)."""
+    return [GridPoint(knob, other, corrected(falling_sweep(end, seed), sheet(play_deg), other))
+            for seed, (other, end) in enumerate(zip(OTHER_DEG, play_ends_deg, strict=True))]
+
+
+RIGID = (15.0, 15.2, 14.9)
+CREEPING = (15.0, 17.5, 19.0)
+
+
+def test_a_rigid_play_closes_at_one_travel_over_the_grid() -> None:
+    creep = play_creep(knob_points(RIGID), 0)
+    assert creep is not None
+    assert creep.spread_deg < CREEP_SPREAD_DEG
+
+
+def test_a_play_end_moving_over_the_grid_shows_its_spread() -> None:
+    creep = play_creep(knob_points(CREEPING), 0)
+    assert creep is not None
+    assert creep.spread_deg == pytest.approx(4.0, abs=0.4)
+
+
+def test_a_rigid_play_gives_no_warning_and_keeps_the_half_widths() -> None:
+    points = knob_points(RIGID)
+    before = [e["backlash_pos_deg"].reported_u95_deg for e in point_estimates(points)]
+    report = QualityReport()
+    check_play_creep(points, report)
+    assert report.warnings == []
+    after = [e["backlash_pos_deg"].reported_u95_deg for e in point_estimates(points)]
+    assert after == before
+
+
+def test_a_creeping_knob_is_warned_about_in_one_line_naming_it() -> None:
+    report = QualityReport()
+    check_play_creep(knob_points(CREEPING, knob=1), report)
+    assert len(report.warnings) == 1
+    warning = report.warnings[0]
+    assert "\n" not in warning
+    assert warning.startswith("phi2: backlash unsure")
+    assert "creep" in warning and "play" in warning
+
+
+def test_a_creeping_knobs_half_width_reaches_back_to_the_line_end() -> None:
+    points = knob_points(CREEPING)
+    check_play_creep(points, QualityReport())
+    for e in point_estimates(points):
+        b = e["backlash_pos_deg"]
+        assert b.value - b.reported_u95_deg <= LINE_END_DEG + 0.5
+
+
+def test_a_creeping_knob_keeps_its_values_at_the_plays_end() -> None:
+    points = knob_points(CREEPING)
+    values = [p.result.values for p in points]
+    check_play_creep(points, QualityReport())
+    assert [p.result.values for p in points] == values
+
+
+def test_a_play_closing_beyond_the_sheets_window_in_most_half_cycles_is_flagged() -> None:
+    # 30 deg after the reversal: past the line end plus twice the sheet's 10 deg play.
+    points = knob_points((15.0, 30.0, 30.0))
+    creep = play_creep(points, 0)
+    assert creep is not None and creep.missing == 2
+    report = QualityReport()
+    check_play_creep(points, report)
+    assert len(report.warnings) == 1
+    assert "no step where the play should close in 2 of 3 half-cycles" in report.warnings[0]
+
+
+def test_a_backlash_not_read_at_a_plays_end_is_never_flagged() -> None:
+    # The line rule's values (every other product: no play end read), however they spread.
+    points = [GridPoint(0, other, SweepResult(falling_sweep(15.0, 0).data, (),
+                                              {"backlash_pos_deg": (value,)}))
+              for other, value in zip(OTHER_DEG, (5.0, 9.0, 13.0), strict=True)]
+    report = QualityReport()
+    check_play_creep(points, report)
+    assert play_creep(points, 0) is None
+    assert report.warnings == []
+
+
+def test_a_sheet_announcing_no_play_reads_no_play_end() -> None:
+    points = knob_points(CREEPING, play_deg=-1.5)
+    assert all(not p.result.own_offset_deg for p in points)

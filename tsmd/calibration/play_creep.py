@@ -1,0 +1,146 @@
+"""A tip that creeps while a handle's play opens, as the play's end shows it (session 25).
+
+Where the backlash is read at the end of the handle's play (:mod:`tsmd.calibration.play_engage`),
+the reading assumes the tip holds until the far flanks meet. On some units it does not: the
+rope, held on the drum only by the drum's bearing while the play opens, pays out as the
+section's bend gives way, and the tip creeps back by a degree or more long before the play
+closes (planetwist development units 1, 6, 7; sample units 201, 202, 207). The current shows
+nothing of the creep itself (the drum floats: no torque reaches the knob), but the rope the drum
+paid out must be wound back before the far flanks meet, so the play closes *later* than a rigid
+tooth clearance would, by as much as the tip crept, and the creep depends on the rope's load
+(the other knob's angle, the side). A rigid play closes at one knob travel after every
+reversal; on a creeping unit the end moves over the grid, or lies beyond where the sheet's play
+should close (no step found there). So where a knob's play ends spread more than
+:data:`CREEP_SPREAD_DEG` over its grid points and sides, or more than :data:`MISSING_SHARE` of
+its half-cycles show no step, the knob's B is flagged: its values stay the play's end (what the
+paper's lines' corner follows), its reported 95 % half-width grows to reach back to the swing's
+end (where a creeping tip has already started back), and a one-line warning names the knob.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from tsmd.calibration.assemble import KNOB_LABELS, GridPoint, QualityReport
+from tsmd.calibration.signal import FloatArray
+from tsmd.calibration.sweep_result import SweepResult
+
+BACKLASHES = ("backlash_pos_deg", "backlash_neg_deg")
+CREEP_SPREAD_DEG = 1.5
+"""Largest spread of a knob's play ends (per grid point and side, median over the
+half-cycles) a rigid play shows. Measured on planetwist (fast protocol, noise seed 0):
+holding knobs 0.06-0.65 deg over development units 1-7, 201, 207; creeping knobs 2.1-4.8."""
+MISSING_SHARE = 0.25
+"""A knob where more than this share of the half-cycles show no step where the sheet's play
+should close (within :data:`tsmd.calibration.play_engage.ENGAGE_WINDOW` of it) is flagged as
+well: its play closed later than the window (development unit 6's phi2: 9 of 14)."""
+REACH_MARGIN_DEG = 2.0
+"""The widened half-width reaches this far before the swing's end (the line rule's earliest
+end at the grid point): a creeping tip starts back at the reversal, so its 1 deg threshold
+can fall before the line end (development units 1, 6, 7: up to 1.2 deg)."""
+
+
+@dataclass(frozen=True)
+class PlayCreep:
+    """One knob's play ends over its grid: their spread, and how many half-cycles showed none."""
+
+    knob: int
+    low_deg: float
+    high_deg: float
+    missing: int
+    half_cycles: int
+
+    @property
+    def spread_deg(self) -> float:
+        return self.high_deg - self.low_deg if self.high_deg >= self.low_deg else 0.0
+
+    def rigid(self, spread_limit_deg: float = CREEP_SPREAD_DEG) -> bool:
+        """Whether the play closed at one travel in (nearly) every half-cycle."""
+        return (self.spread_deg <= spread_limit_deg
+                and self.missing <= MISSING_SHARE * self.half_cycles)
+
+
+def _finite(values: Sequence[float]) -> FloatArray:
+    v = np.asarray(values, dtype=float)
+    return v[np.isfinite(v)]
+
+
+def play_creep(points: Sequence[GridPoint], knob: int) -> PlayCreep | None:
+    """``knob``'s play ends over its grid points and sides; None where its backlash was not
+    read at a play's end (the sheet announces none)."""
+    medians, missing, total = [], 0, 0
+    for p in points:
+        if p.knob != knob:
+            continue
+        for ends in p.result.play_ends_deg.values():
+            found = _finite(ends)
+            total += len(ends)
+            missing += len(ends) - found.size
+            if found.size:
+                medians.append(float(np.median(found)))
+    if total == 0:
+        return None
+    low, high = (min(medians), max(medians)) if medians else (math.nan, math.nan)
+    return PlayCreep(knob, low, high, missing, total)
+
+
+def reach_deg(result: SweepResult, name: str) -> float:
+    """How far before ``name``'s value the tip may let go on a creeping unit: down to the
+    earliest line-rule end of its half-cycles (the swing's end) less
+    :data:`REACH_MARGIN_DEG`; 0 without a value or a line end."""
+    value = _finite(result.values.get(name, ()))
+    lines = _finite([h.backlash_deg for h in result.half_cycles if h.backlash_name == name])
+    if not value.size or not lines.size:
+        return 0.0
+    return max(0.0, float(np.median(value)) - float(lines.min()) + REACH_MARGIN_DEG)
+
+
+def widened(result: SweepResult) -> SweepResult:
+    """``result`` with each play-end backlash's reported half-width at least its
+    :func:`reach_deg` (:attr:`SweepResult.product_u95_deg`, which the gate does not judge)."""
+    more = {name: max(result.unit_u95_deg(name), reach_deg(result, name))
+            for name in result.play_ends_deg}
+    if not more:
+        return result
+    return dataclasses.replace(result, product_u95_deg={**result.product_u95_deg, **more})
+
+
+def check_play_creep(points: list[GridPoint], report: QualityReport,
+                     spread_limit_deg: float = CREEP_SPREAD_DEG) -> None:
+    """Per knob whose play did not close at one travel: a one-line warning, and (in
+    ``points``, in place) B's reported half-width widened to reach back to the swing's end;
+    each knob's spread in ``report.figures``."""
+    for knob in (0, 1):
+        creep = play_creep(points, knob)
+        if creep is None:
+            continue
+        label = KNOB_LABELS[knob]
+        report.figures[f"{label}_play_end_spread_deg"] = creep.spread_deg
+        if creep.rigid(spread_limit_deg):
+            continue
+        reach = 0.0
+        for i, p in enumerate(points):
+            if p.knob == knob:
+                points[i] = dataclasses.replace(p, result=widened(p.result))
+                reach = max([reach, *(reach_deg(p.result, n) for n in p.result.play_ends_deg)])
+        where = (f"the play closes {creep.low_deg:.1f}-{creep.high_deg:.1f} deg after a reversal "
+                 f"over the grid (spread {creep.spread_deg:.1f} deg; a rigid play closes at one "
+                 "travel)" if math.isfinite(creep.spread_deg) and creep.high_deg > creep.low_deg
+                 else "")
+        if creep.missing > MISSING_SHARE * creep.half_cycles:
+            where += ("; " if where else "") + (
+                f"no step where the play should close in {creep.missing} of "
+                f"{creep.half_cycles} half-cycles")
+        report.warnings.append(
+            f"{label}: backlash unsure, the tip may creep while the handle's play opens: "
+            f"{where}; the tip may let go up to {reach:.1f} deg before B says, B's 95 % "
+            "half-width widened to cover it")
+
+
+__all__ = ["CREEP_SPREAD_DEG", "MISSING_SHARE", "REACH_MARGIN_DEG", "PlayCreep",
+           "check_play_creep", "play_creep", "reach_deg", "widened"]

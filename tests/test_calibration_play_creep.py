@@ -81,12 +81,11 @@ def test_a_play_end_moving_over_the_grid_shows_its_spread() -> None:
 
 def test_a_rigid_play_gives_no_warning_and_keeps_the_half_widths() -> None:
     points = knob_points(RIGID)
-    before = [e["backlash_pos_deg"].reported_u95_deg for e in point_estimates(points)]
+    before = [p.result.unit_u95_deg("backlash_pos_deg") for p in points]
     report = QualityReport()
     check_play_creep(points, report)
     assert report.warnings == []
-    after = [e["backlash_pos_deg"].reported_u95_deg for e in point_estimates(points)]
-    assert after == before
+    assert [p.result.unit_u95_deg("backlash_pos_deg") for p in points] == before
 
 
 def test_a_creeping_knob_is_warned_about_in_one_line_naming_it() -> None:
@@ -102,9 +101,10 @@ def test_a_creeping_knob_is_warned_about_in_one_line_naming_it() -> None:
 def test_a_creeping_knobs_half_width_reaches_back_to_the_line_end() -> None:
     points = knob_points(CREEPING)
     check_play_creep(points, QualityReport())
-    for e in point_estimates(points):
-        b = e["backlash_pos_deg"]
-        assert b.value - b.reported_u95_deg <= LINE_END_DEG + 0.5
+    for p, e in zip(points, point_estimates(points), strict=True):
+        # the part no sweep narrows (one half-cycle: the gate's own part is unbounded here)
+        assert e["backlash_pos_deg"].value - p.result.unit_u95_deg("backlash_pos_deg") \
+            <= LINE_END_DEG - 1.0
 
 
 def test_a_creeping_knob_keeps_its_values_at_the_plays_end() -> None:
@@ -139,3 +139,10 @@ def test_a_backlash_not_read_at_a_plays_end_is_never_flagged() -> None:
 def test_a_sheet_announcing_no_play_reads_no_play_end() -> None:
     points = knob_points(CREEPING, play_deg=-1.5)
     assert all(not p.result.own_offset_deg for p in points)
+
+
+def test_a_resweeps_play_ends_are_pooled_with_the_first_sweeps() -> None:
+    first, again = knob_points((15.0, 19.0, 15.0))[:2]
+    pooled = first.result.merged(again.result)
+    assert len(pooled.play_ends_deg["backlash_pos_deg"]) == 2
+    assert pooled.play_ends_deg["backlash_pos_deg"][1] == pytest.approx(19.0, abs=0.3)

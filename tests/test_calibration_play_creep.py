@@ -6,6 +6,8 @@ the line rule's end."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -146,3 +148,16 @@ def test_a_resweeps_play_ends_are_pooled_with_the_first_sweeps() -> None:
     pooled = first.result.merged(again.result)
     assert len(pooled.play_ends_deg["backlash_pos_deg"]) == 2
     assert pooled.play_ends_deg["backlash_pos_deg"][1] == pytest.approx(19.0, abs=0.3)
+
+
+def test_one_half_cycles_late_line_end_does_not_narrow_the_half_width() -> None:
+    # The swing's end is the drive train's: the knob's earliest line end counts everywhere.
+    points = knob_points(CREEPING)
+    late = points[2].result
+    half = dataclasses.replace(late.half_cycles[0], backlash_deg=8.0)
+    points[2] = dataclasses.replace(points[2], result=dataclasses.replace(late,
+                                                                           half_cycles=(half,)))
+    check_play_creep(points, QualityReport())
+    b = points[2].result
+    assert b.estimate("backlash_pos_deg") - b.unit_u95_deg("backlash_pos_deg") \
+        <= LINE_END_DEG - 1.0

@@ -41,8 +41,9 @@ should close (within :data:`tsmd.calibration.play_engage.ENGAGE_WINDOW` of it) i
 well: its play closed later than the window (development unit 6's phi2: 9 of 14)."""
 REACH_MARGIN_DEG = 2.0
 """The widened half-width reaches this far before the swing's end (the line rule's earliest
-end at the grid point): a creeping tip starts back at the reversal, so its 1 deg threshold
-can fall before the line end (development units 1, 6, 7: up to 1.2 deg)."""
+end over the knob's grid, :func:`earliest_line_end_deg`): a creeping tip starts back at the
+reversal, so its 1 deg threshold can fall before that end (development units 1, 6, 7: up to
+1.2 deg before the grid point's own earliest line end)."""
 
 
 @dataclass(frozen=True)
@@ -89,21 +90,28 @@ def play_creep(points: Sequence[GridPoint], knob: int) -> PlayCreep | None:
     return PlayCreep(knob, low, high, missing, total)
 
 
-def reach_deg(result: SweepResult, name: str) -> float:
+def earliest_line_end_deg(points: Sequence[GridPoint], knob: int) -> float:
+    """The earliest line-rule end of ``knob``'s play-end backlashes over its whole grid (the
+    swing's end: the drive train's, the same at every grid point, while one half-cycle's line
+    end scatters by a few degrees: sample unit 201 phi1 2.75-8.0); NaN without one."""
+    lines = _finite([h.backlash_deg for p in points if p.knob == knob
+                     for h in p.result.half_cycles if h.backlash_name in p.result.play_ends_deg])
+    return float(lines.min()) if lines.size else math.nan
+
+
+def reach_deg(result: SweepResult, name: str, line_end_deg: float) -> float:
     """How far before ``name``'s value the tip may let go on a creeping unit: down to the
-    earliest line-rule end of its half-cycles (the swing's end) less
-    :data:`REACH_MARGIN_DEG`; 0 without a value or a line end."""
+    swing's end ``line_end_deg`` less :data:`REACH_MARGIN_DEG`; 0 without a value or line end."""
     value = _finite(result.values.get(name, ()))
-    lines = _finite([h.backlash_deg for h in result.half_cycles if h.backlash_name == name])
-    if not value.size or not lines.size:
+    if not value.size or not math.isfinite(line_end_deg):
         return 0.0
-    return max(0.0, float(np.median(value)) - float(lines.min()) + REACH_MARGIN_DEG)
+    return max(0.0, float(np.median(value)) - line_end_deg + REACH_MARGIN_DEG)
 
 
-def widened(result: SweepResult) -> SweepResult:
+def widened(result: SweepResult, line_end_deg: float) -> SweepResult:
     """``result`` with each play-end backlash's reported half-width at least its
     :func:`reach_deg` (:attr:`SweepResult.product_u95_deg`, which the gate does not judge)."""
-    more = {name: max(result.unit_u95_deg(name), reach_deg(result, name))
+    more = {name: max(result.unit_u95_deg(name), reach_deg(result, name, line_end_deg))
             for name in result.play_ends_deg}
     if not more:
         return result
@@ -123,11 +131,13 @@ def check_play_creep(points: list[GridPoint], report: QualityReport,
         report.figures[f"{label}_play_end_spread_deg"] = creep.spread_deg
         if creep.rigid(spread_limit_deg):
             continue
+        line = earliest_line_end_deg(points, knob)
         reach = 0.0
         for i, p in enumerate(points):
             if p.knob == knob:
-                points[i] = dataclasses.replace(p, result=widened(p.result))
-                reach = max([reach, *(reach_deg(p.result, n) for n in p.result.play_ends_deg)])
+                points[i] = dataclasses.replace(p, result=widened(p.result, line))
+                reach = max([reach, *(reach_deg(p.result, n, line)
+                                      for n in p.result.play_ends_deg)])
         where = (f"the play closes {creep.low_deg:.1f}-{creep.high_deg:.1f} deg after a reversal "
                  f"over the grid (spread {creep.spread_deg:.1f} deg; a rigid play closes at one "
                  "travel)" if math.isfinite(creep.spread_deg) and creep.high_deg > creep.low_deg
@@ -143,4 +153,4 @@ def check_play_creep(points: list[GridPoint], report: QualityReport,
 
 
 __all__ = ["CREEP_SPREAD_DEG", "MISSING_SHARE", "REACH_MARGIN_DEG", "PlayCreep",
-           "check_play_creep", "play_creep", "reach_deg", "widened"]
+           "check_play_creep", "earliest_line_end_deg", "play_creep", "reach_deg", "widened"]

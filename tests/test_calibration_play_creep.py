@@ -161,3 +161,15 @@ def test_one_half_cycles_late_line_end_does_not_narrow_the_half_width() -> None:
     b = points[2].result
     assert b.estimate("backlash_pos_deg") - b.unit_u95_deg("backlash_pos_deg") \
         <= LINE_END_DEG - 1.0
+
+
+def test_one_early_play_end_does_not_flag_a_rigid_play() -> None:
+    # A play not yet fully open at a sweep's first reversal closes early once; a rigid play
+    # never closes later than its swing and clearance, and only a creep delays it.
+    points = knob_points(RIGID)
+    first = points[0].result
+    points[0] = dataclasses.replace(points[0], result=dataclasses.replace(
+        first, play_ends_deg={"backlash_pos_deg": (11.0, 15.0)}))
+    report = QualityReport()
+    check_play_creep(points, report)
+    assert report.warnings == []

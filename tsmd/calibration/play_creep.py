@@ -11,10 +11,11 @@ tooth clearance would, by as much as the tip crept, and the creep depends on the
 (the other knob's angle, the side). A rigid play closes at one knob travel after every
 reversal; on a creeping unit the end moves over the grid, or lies beyond where the sheet's play
 should close (no step found there). So where a knob's play ends spread more than
-:data:`CREEP_SPREAD_DEG` over its grid points and sides, or more than :data:`MISSING_SHARE` of
-its half-cycles show no step, the knob's B is flagged: its values stay the play's end (what the
-paper's lines' corner follows), its reported 95 % half-width grows to reach back to the swing's
-end (where a creeping tip has already started back), and a one-line warning names the knob.
+:data:`CREEP_SPREAD_DEG` over its grid points and sides (the latest end of each), or more
+than :data:`MISSING_SHARE` of its half-cycles show no step, the knob's B is flagged: its values
+stay the play's end (what the paper's lines' corner follows), its reported 95 % half-width grows
+to reach back to the swing's end (where a creeping tip has already started back), and a one-line
+warning names the knob.
 """
 
 from __future__ import annotations
@@ -32,9 +33,13 @@ from tsmd.calibration.sweep_result import SweepResult
 
 BACKLASHES = ("backlash_pos_deg", "backlash_neg_deg")
 CREEP_SPREAD_DEG = 1.5
-"""Largest spread of a knob's play ends (per grid point and side, median over the
-half-cycles) a rigid play shows. Measured on planetwist (fast protocol, noise seed 0):
-holding knobs 0.06-0.65 deg over development units 1-7, 201, 207; creeping knobs 2.1-4.8."""
+"""Largest spread of a knob's play ends (per grid point and side the latest of its half-cycles)
+a rigid play shows. Planetwist, noise seed 0: holding knobs 0.10-0.59 deg (fast protocol,
+development 1-8, held out 101-104, sample 201-208; paper protocol, development 2: 0.24 / 0.31),
+creeping knobs 2.15-4.88. The latest, not the median: a rigid play can close early in one
+half-cycle (not yet fully open at a sweep's first reversal: development 2, paper protocol, phi2
+at phi1 +90 10.35 against 12.55 deg, its median over two half-cycles pulling the spread to 1.10),
+never later than the swing and the clearance; a creep only delays it."""
 MISSING_SHARE = 0.25
 """A knob where more than this share of the half-cycles show no step where the sheet's play
 should close (within :data:`tsmd.calibration.play_engage.ENGAGE_WINDOW` of it) is flagged as
@@ -72,9 +77,9 @@ def _finite(values: Sequence[float]) -> FloatArray:
 
 
 def play_creep(points: Sequence[GridPoint], knob: int) -> PlayCreep | None:
-    """``knob``'s play ends over its grid points and sides; None where its backlash was not
-    read at a play's end (the sheet announces none)."""
-    medians, missing, total = [], 0, 0
+    """``knob``'s play ends over its grid points and sides (the latest per grid point and side);
+    None where its backlash was not read at a play's end (the sheet announces none)."""
+    latest, missing, total = [], 0, 0
     for p in points:
         if p.knob != knob:
             continue
@@ -83,10 +88,10 @@ def play_creep(points: Sequence[GridPoint], knob: int) -> PlayCreep | None:
             total += len(ends)
             missing += len(ends) - found.size
             if found.size:
-                medians.append(float(np.median(found)))
+                latest.append(float(found.max()))
     if total == 0:
         return None
-    low, high = (min(medians), max(medians)) if medians else (math.nan, math.nan)
+    low, high = (min(latest), max(latest)) if latest else (math.nan, math.nan)
     return PlayCreep(knob, low, high, missing, total)
 
 

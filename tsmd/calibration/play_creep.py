@@ -31,7 +31,6 @@ from tsmd.calibration.assemble import KNOB_LABELS, GridPoint, QualityReport
 from tsmd.calibration.signal import FloatArray
 from tsmd.calibration.sweep_result import SweepResult
 
-BACKLASHES = ("backlash_pos_deg", "backlash_neg_deg")
 CREEP_SPREAD_DEG = 1.5
 """Largest spread of a knob's play ends (per grid point and side the latest of its half-cycles)
 a rigid play shows. Planetwist, noise seed 0: holding knobs 0.10-0.59 deg (fast protocol,
@@ -43,7 +42,7 @@ never later than the swing and the clearance; a creep only delays it."""
 MISSING_SHARE = 0.25
 """A knob where more than this share of the half-cycles show no step where the sheet's play
 should close (within :data:`tsmd.calibration.play_engage.ENGAGE_WINDOW` of it) is flagged as
-well: its play closed later than the window (development unit 6's phi2: 9 of 14)."""
+well: its play closed later than the window (development unit 6's phi2: 11 of 16)."""
 REACH_MARGIN_DEG = 2.0
 """The widened half-width reaches this far before the swing's end (the line rule's earliest
 end over the knob's grid, :func:`earliest_line_end_deg`): a creeping tip starts back at the

@@ -1,6 +1,6 @@
-"""The blind plants whose physics has no time law at the tip (cyclopebax, session 21;
-snakedent, session 22; planetwist, session 23) as the data of the cross-plant self-test: their
-presets."""
+"""The blind plants as the data of the cross-plant self-test: their presets (cyclopebax, session
+21; snakedent, session 22; planetwist, session 23, none with a time law at the tip; notchclutch,
+session 24, whose braid stiffens with strain rate and whose liner soaks)."""
 
 from __future__ import annotations
 
@@ -13,6 +13,8 @@ import pytest
 
 from simrig.plants.cyclopebax import CycloPebaxPlant
 from simrig.plants.cyclopebax.params import CycloPebaxKnob
+from simrig.plants.notchclutch.params import NotchClutchKnob
+from simrig.plants.notchclutch.plant import NotchClutchPlant
 from simrig.plants.planetwist import PlanetTwistKnob, PlanetTwistPlant
 from simrig.plants.snakedent import SnakeDentKnob, SnakeDentPlant
 from tsmd.gap.presets import PRESETS, parse_plant_spec
@@ -20,12 +22,19 @@ from tsmd.gap.selftest import drive_plant, trajectory
 
 BLIND = [("cyclopebax", CycloPebaxPlant, CycloPebaxKnob),
          ("snakedent", SnakeDentPlant, SnakeDentKnob),
-         ("planetwist", PlanetTwistPlant, PlanetTwistKnob)]
+         ("planetwist", PlanetTwistPlant, PlanetTwistKnob),
+         ("notchclutch", NotchClutchPlant, NotchClutchKnob)]
 NAMES = [name for name, _plant, _knob in BLIND]
+TIMELESS = ["cyclopebax", "snakedent", "planetwist"]
+"""The blind plants with no law of speed or time at the tip."""
 
 
 def _share_keyword(plant: Any) -> list[float]:
     return [plant.cross_takeup_share] * 2
+
+
+def _takeup_keyword(plant: Any) -> list[float]:
+    return [plant.coupling] * 2
 
 
 def _takeup_constant(plant: Any) -> list[float]:
@@ -36,6 +45,7 @@ TAKEUP: dict[str, tuple[Callable[[Any], list[float]], set[str]]] = {
     "cyclopebax": (_share_keyword, set()),
     "snakedent": (_share_keyword, set()),
     "planetwist": (_takeup_constant, {"cross_takeup"}),
+    "notchclutch": (_takeup_keyword, set()),
 }
 """How strongly the other plane's bend takes up a plane's ropes, per plant, and which knob
 constants the coupling case may change (a keyword on cyclopebax and snakedent, planetwist's own
@@ -87,7 +97,7 @@ def test_coupling_case_only_raises_the_other_planes_takeup(name: str) -> None:
     assert coupled.sheath_curvature_deg == none.sheath_curvature_deg
 
 
-@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("name", TIMELESS)
 def test_rate_and_creep_are_not_run(name: str) -> None:
     preset = PRESETS[name]
     for case in ("rate", "creep"):
@@ -96,8 +106,22 @@ def test_rate_and_creep_are_not_run(name: str) -> None:
         assert preset.supports(case)
 
 
-@pytest.mark.parametrize("name", NAMES)
-@pytest.mark.parametrize("case", ["coupling", "compliance", "curvature"])
+def test_notchclutchs_rate_stiffens_the_braid_and_its_creep_soaks_the_liner_slower() -> None:
+    preset = PRESETS["notchclutch"]
+    none = preset.build_unit(102, 0.1)
+    for case, constant in (("rate", "rate_stiffening"), ("creep", "soak_time_s")):
+        assert preset.supports(case)
+        changed = preset.build_unit(102, 0.1, case, **preset.case_effects(case))
+        for k in (0, 1):
+            assert getattr(changed.knobs[k], constant) > 4.0 * getattr(none.knobs[k], constant)
+            kept = {constant: getattr(none.knobs[k], constant)}
+            assert dataclasses.replace(changed.knobs[k], **kept) == none.knobs[k]
+        assert changed.coupling == none.coupling == 0.0
+
+
+@pytest.mark.parametrize(("name", "case"),
+                         [(n, c) for n in NAMES for c in ("coupling", "compliance", "curvature")]
+                         + [("notchclutch", "rate"), ("notchclutch", "creep")])
 def test_each_case_moves_the_tip_beyond_the_trackers_noise(name: str, case: str) -> None:
     preset = PRESETS[name]
     _t, q = trajectory(30.0, 50.0)

@@ -124,6 +124,16 @@ def test_a_knob_whose_tip_never_returns_leaves_the_figure_to_the_other_knob() ->
     assert score is not None and score.significant
 
 
+def test_the_protocols_slow_reversals_fill_both_loads_on_both_sides_of_each_knob() -> None:
+    # the figure's loads follow the protocol's design: a moved dwell must still be read
+    for knob in (0, 1):
+        at = compliance.reversals(_protocol_series(5, "none"), knob).at_deg
+        for level in compliance.LEVELS_DEG:
+            for side in (1.0, -1.0):
+                near = np.abs(at - side * level) <= compliance.LEVEL_BAND_DEG
+                assert int(near.sum()) >= compliance.MIN_PER_LEVEL
+
+
 def test_recordings_without_the_protocol_give_no_figure() -> None:
     plain = [GapSeries(s.name, s.t_s, s.knob_deg, s.current_A, s.tip_deg, s.knob_source)
              for s in _protocol_series(5, "none")]

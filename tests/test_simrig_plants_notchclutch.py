@@ -140,6 +140,20 @@ def test_the_other_planes_bend_changes_this_planes_loop() -> None:
     assert abs(coupled[-1] - alone[-1]) > 2.0
 
 
+def test_the_coupling_keyword_takes_up_the_tendons_by_the_other_planes_bend_only() -> None:
+    path = ramp_deg(0.0, 60.0)
+    plain, _ = drive_knob(make_notchclutch_plant(), 0, path)
+    keyed, _ = drive_knob(make_notchclutch_plant(coupling=0.2), 0, path)
+    np.testing.assert_array_equal(keyed, plain)  # the other plane straight: nothing to take up
+    loops = []
+    for coupling in (0.0, 0.2):
+        plant = make_notchclutch_plant(coupling=coupling)
+        drive_knob(plant, 1, ramp_deg(0.0, 60.0))
+        tip, _ = drive_knob(plant, 0, path, other_deg=60.0)
+        loops.append(tip)
+    assert loops[1][-1] - loops[0][-1] > 2.0  # taken-up slack: the tip bends further
+
+
 def test_a_unit_is_the_same_every_time_and_differs_from_another() -> None:
     path = np.concatenate([ramp_deg(0.0, 70.0), ramp_deg(70.0, -30.0)])
     a, _ = drive_knob(family_member("notchclutch", 101).build(), 0, path)
@@ -166,6 +180,7 @@ def test_notchclutch_is_registered_last_and_held_out() -> None:
         ({"knobs": [{}, {"sheath_friction": -0.1}]}, "sheath_friction must be >= 0"),
         ({"knobs": [{"clutch_kinetic_ratio": 1.2}, {}]}, "clutch_kinetic_ratio must be in"),
         ({"sheath_curvature_deg": math.inf}, "sheath_curvature_deg must be finite"),
+        ({"coupling": -0.1}, "coupling must be >= 0"),
     ],
 )
 def test_bad_constants_are_refused_with_one_clear_line(kwargs: dict[str, object],

@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from scipy import stats
 
 from tsmd.gap.data import GapSeries
+from tsmd.gap.protocol import ProtocolDesign
 from tsmd.gap.reversal import TRAVEL_GRID_DEG, Reversals, reversals
 from tsmd.gap.signature import SIGNATURES, SignatureScore
 from tsmd.gap.stats import unit_spread
@@ -53,9 +54,10 @@ TOLERANCE = 0.25
 """The smallest excess named: a unit is named more compliant only when its ratio to the data
 sheet is at least 1 + this; from a sheet of one unit (spread unknown) its lower confidence
 bound must exceed it too (:func:`compliance_score`)."""
-LEVELS_DEG = (40.0, 60.0)
+LEVELS_DEG = (ProtocolDesign.amp_deg, ProtocolDesign.dwell_amp_deg)
 """The two loads compared: reversals at the protocol's loop and dwell amplitudes (the
-constant part of the lost motion, slack and the joints' presliding, cancels)."""
+constant part of the lost motion, slack and the joints' presliding, cancels); taken from the
+protocol's design, so that moving its dwells moves the figure's heavier load with them."""
 LEVEL_BAND_DEG = 2.0
 MIN_PER_LEVEL = 3
 """Repeats at each load and side for a figure (the jackknife needs a few)."""

@@ -75,8 +75,9 @@ rate loops (both knobs together) do not predict: with the other knob held at +-7
 curvature model fitted on one motion misses the other (cyclopebax development unit 1 66 -> 36
 %, docs/gap.md "Session 23"). Coupling's level-0 loops only, ``("+0",)``, keep curvature's
 share there at +-75 (59 %; snakedent 3 / 4 72 / 67 %) and leave it at +-50 (67 %, 72 / 60 %):
-measured on development units in session 24, not yet the default (the full cross-plant
-self-test with it and the +-75 level is not run; docs/gap.md "Session 24")."""
+measured on development units in session 24, not the default: in session 25 (docs/gap.md
+"Session 25") the +-75 level with it cost warmgear development unit 1 its compliance case and
+planetwist's coupling share fell to 57 %."""
 
 CONDITIONS: dict[str, str] = {
     "rate": "the same loops at two speeds (matched segments)",

@@ -358,3 +358,38 @@ PLANETWIST_MAX_STEP_S = 0.0
 """No finer stepping: the nominal-scatter unit's tip lies 0.039 deg RMS (0.12 max) from 0.25 ms
 steps at 20 ms, 0.007 (0.02) at 4 ms (unit 1; unit 2 0.024 / 0.005): quasi-static, the flow's
 pulse sampled."""
+
+
+NOTCHCLUTCH_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"coupling": 0.2},
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The notchclutch plant's effect keywords, sized before any diagnosis (tip RMSE effect on minus
+off, units 1 / 2, noise-free, 120 s of the experiment motion at 50 Hz): the other plane's bend
+taking up both tendons (``coupling`` 0.2, the plant's keyword added for this preset: lumens set
+off their plane, 0.2 x offset x other^2 / 2 mm), 1.66 / 1.13 deg (0.1 0.78 / 0.54, 0.25 2.16 /
+1.47, 0.4 3.99 / 2.75; the others' coupling 1.5 deg); a 120 deg sheath bend (added to every lumen
+contact's wrap), 4.31 / 0.78 deg (60 deg 0.47 / 0.36), inside the others' 1.1-12.8 deg on unit 1.
+The slip clutch, the braid's toe, the liner's soak and Stribeck rise, the notches' closure and
+the tip's friction on the wall are base physics; "none" is the nominal physics as written
+(docs/gap.md "Session 25")."""
+
+NOTCHCLUTCH_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "rate": {"rate_stiffening": 20.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+    "creep": {"soak_time_s": 5.0},
+}
+"""Notchclutch effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion, units 1 / 2): rate is the braid's stiffening with strain rate twenty times the
+unit's (its one speed law that reaches the tip; the liner's Stribeck rise x4 moves it 0.17 /
+0.14 deg), 1.67 / 1.49 deg (x10 1.17 / 1.01, x15 1.48 / 1.30; the others' rate 1.1-1.9 deg);
+the braid's EA halved, 4.57 / 4.41 deg; creep (read as drift: time in the run) is the liner
+soaking five times as slowly (40 -> 200 s, a coating that hydrates late: its friction and drag
+move through the whole run instead of its first minute), 0.37 / 0.26 deg (x10 0.47 / 0.32; the
+others' creep 0.35-0.43 deg). Nothing else at the tip moves at a held knob."""
+
+NOTCHCLUTCH_MAX_STEP_S = 0.0
+"""No finer stepping: unit 1's tip lies 0.22 deg RMS (2.3 max) from 0.25 ms steps at 20 ms and
+0.17 (2.1) at 4 ms (unit 2 0.20 / 0.16; 120 s of the experiment motion): the rate laws use the
+previous step's strain rate and film speed and the wall's hold sticks where the step leaves it,
+so a finer step buys little, as on cyclopebax."""

@@ -34,6 +34,9 @@ from tsmd.gap.preset_effects import (
     LUMPED_EFFECTS,
     NITINOL_EFFECTS,
     NITINOL_KNOB_EFFECTS,
+    NOTCHCLUTCH_EFFECTS,
+    NOTCHCLUTCH_KNOB_EFFECTS,
+    NOTCHCLUTCH_MAX_STEP_S,
     PLANETWIST_EFFECTS,
     PLANETWIST_KNOB_EFFECTS,
     PLANETWIST_MAX_STEP_S,
@@ -175,6 +178,10 @@ PRESETS: dict[str, PlantSpec] = {
                             family="planetwist", effects=PLANETWIST_EFFECTS,
                             knob_effects=PLANETWIST_KNOB_EFFECTS,
                             max_step_s=PLANETWIST_MAX_STEP_S),
+    "notchclutch": PlantSpec(PLANT_SPECS["notchclutch"], {}, (), "notchclutch",
+                             family="notchclutch", effects=NOTCHCLUTCH_EFFECTS,
+                             knob_effects=NOTCHCLUTCH_KNOB_EFFECTS,
+                             max_step_s=NOTCHCLUTCH_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

@@ -10,7 +10,8 @@ clutch's capacity the clutch slips: the drum angle is searched so that the torqu
 slipping capacity. Rate-dependent terms (the braid's stiffening with strain rate, the liner's
 Stribeck rise with film speed) use the previous step's rates: they change slowly next to the
 250 Hz step. The bending planes couple through the notch closure and the wrap (both set by the
-total bend) and through the wall's friction (it grows with the total bend).
+total bend) and through the wall's friction (it grows with the total bend); ``coupling`` adds a
+take-up of both tendons by the other plane's bend alone (0: as written).
 """
 
 from __future__ import annotations
@@ -64,10 +65,13 @@ class NotchClutchPlant:
     """Two knobs, each through a slip clutch to a drum pulling a pair of aramid tendons."""
 
     def __init__(self, knobs: tuple[NotchClutchKnob, NotchClutchKnob],
-                 sheath_curvature_deg: float = 0.0) -> None:
+                 sheath_curvature_deg: float = 0.0, coupling: float = 0.0) -> None:
         self.knobs = knobs
         self.planes = (_Plane(knobs[0]), _Plane(knobs[1]))
         self.sheath_curvature_deg = float(sheath_curvature_deg)
+        self.coupling = float(coupling)
+        """Take-up of both tendons by the other plane's bend, ``coupling x offset x
+        other^2 / 2`` mm (lumens set off their plane; 0: as written)."""
         self.slack_delta_mm = ((0.0, 0.0), (0.0, 0.0))
         self.t_s = 0.0
 
@@ -115,8 +119,9 @@ class NotchClutchPlant:
             p.film_mm_s[j], k.stribeck_speed_mm_s)) for j in (0, 1)]
         k1s = [p.k1 * (1.0 + k.rate_stiffening * math.log1p(
             p.strain_rate[j] / k.reference_strain_rate_per_s)) for j in (0, 1)]
-        slacks = (k.slack_pos_mm + self.slack_delta_mm[i][0],
-                  k.slack_neg_mm + self.slack_delta_mm[i][1])
+        takeup_mm = self.coupling * k.tendon_offset_mm * other_rad * other_rad / 2.0
+        slacks = (k.slack_pos_mm + self.slack_delta_mm[i][0] - takeup_mm,
+                  k.slack_neg_mm + self.slack_delta_mm[i][1] - takeup_mm)
         hold_Nmm = k.tissue_friction_Nmm + k.tissue_friction_ratio * (
             k.bend_stiffness_Nmm_per_rad * total_old)
         drag = liner_drag_N(k.sheath_drag_N, k.dry_drag_ratio, k.soak_time_s, self.t_s)
@@ -239,8 +244,12 @@ class NotchClutchPlant:
 
 
 def make_notchclutch_plant(knobs: Sequence[Mapping[str, Any] | NotchClutchKnob] | None = None,
-                           sheath_curvature_deg: float = 0.0) -> NotchClutchPlant:
-    """The notchclutch plant (``simrig.plants.notchclutch:make_notchclutch_plant``)."""
+                           sheath_curvature_deg: float = 0.0,
+                           coupling: float = 0.0) -> NotchClutchPlant:
+    """The notchclutch plant (``simrig.plants.notchclutch:make_notchclutch_plant``);
+    ``coupling`` takes up both tendons by the other plane's bend (0: as written)."""
     if not math.isfinite(float(sheath_curvature_deg)):
         raise PlantLoadError("notchclutch: sheath_curvature_deg must be finite")
-    return NotchClutchPlant(knobs_from(knobs), sheath_curvature_deg)
+    if not (math.isfinite(float(coupling)) and float(coupling) >= 0.0):
+        raise PlantLoadError(f"notchclutch: coupling must be >= 0, got {coupling!r}")
+    return NotchClutchPlant(knobs_from(knobs), sheath_curvature_deg, float(coupling))

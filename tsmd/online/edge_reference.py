@@ -45,6 +45,7 @@ class ReferenceReadings:
     n_widened: int
     n_steeper: int
     n_own_between: int
+    n_own_held: int
     n_leaning_steeper: int
     n_reread: int
     odd_speed: bool
@@ -86,7 +87,9 @@ class ReferenceReadings:
         nearest the estimate: the slope turned about a point the current does not show (a
         softer catheter: twistshaft warming in the patient, its tip's edge in place). Within
         the gate (with ``within_gate_reads_own``) then the point between that and the ramp's
-        own slope's crossing nearest the estimate: which slope is right nothing says there."""
+        own slope's crossing nearest the estimate: which slope is right nothing says there.
+        Beyond the gate (with ``suspect_needs_own_slope``) the same when the ramp's own slope
+        puts the crossing within the gate: a suspect must lie beyond it with both slopes."""
         raw = self._crossing(ramp, edge_deg, slope)
         assert self.slope_ref_A_per_deg is not None
         target = self.estimate_deg + self.bins.bias_deg(ramp.other_deg)
@@ -94,11 +97,21 @@ class ReferenceReadings:
             self.n_between += 1
             raw = nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
                                   target)
-        if (self.options.within_gate_reads_own and ramp.slope_A_per_deg != slope
-                and abs(raw - target) <= self.options.gate_deg):
+        o = self.options
+        if ramp.slope_A_per_deg == slope:
+            return raw
+        own = self._crossing(ramp, edge_deg, ramp.slope_A_per_deg)
+        if o.within_gate_reads_own and abs(raw - target) <= o.gate_deg:
             self.n_own_between += 1
-            raw = nearest_between(raw, self._crossing(ramp, edge_deg, ramp.slope_A_per_deg),
-                                  target)
+            return nearest_between(raw, own, target)
+        if (o.suspect_needs_own_slope and abs(raw - target) > o.gate_deg
+                and (own - target) * math.copysign(1.0, raw - target) <= o.gate_deg):
+            # beyond the gate with the slope in use, within it (or beyond it the other way)
+            # with the ramp's own: nothing says which slope is right, and a change shows with
+            # both (planetwist 101 without a change: slow ramps 0.91-0.93 x read +1.82/+2.13
+            # with the slope in use, +0.40/+1.11 with their own, and were followed)
+            self.n_own_held += 1
+            return nearest_between(raw, own, target)
         return raw
 
     def _widening_read(self, ramp: LoadedRamp, edge_deg: float, slope: float,

@@ -1,7 +1,9 @@
 """A crossing beyond the gate with the slope in use is a suspect only when the ramp's own slope
 puts it beyond the gate too (EstimatorOptions.suspect_needs_own_slope): a ramp a few per cent
 flatter than the slope in use reads ~15 deg x its slope's error outward with the slope in use
-(planetwist 101 without a change), while a shift of the edge shows with either slope."""
+(planetwist 101 without a change), while a shift of the edge shows with either slope. Such a
+reading still confirms a suspect the knob's other edge holds the same way (a slack's first
+ramps)."""
 
 from __future__ import annotations
 
@@ -28,13 +30,17 @@ def ramp(shift_deg: float = 0.0, slope_ratio: float = 1.0) -> LoadedRamp:
                       0.0, 0.0, 200, 0.003)
 
 
-def after_reference(options: EstimatorOptions, shift_deg: float) -> EdgeTracker:
-    """One edge: the reference learned on the profile's ramp, then one ramp ``FLATTER`` x as
-    steep whose own slope puts its edge ``shift_deg`` outward."""
+def after_reference(options: EstimatorOptions, shift_deg: float,
+                    partner_shift_deg: float | None = None) -> EdgeTracker:
+    """The positive edge of a knob: the references learned on the profile's ramp, the negative
+    edge then given one ramp moved ``partner_shift_deg`` (None: none), then the positive edge
+    one ramp ``FLATTER`` x as steep whose own slope puts its edge ``shift_deg`` outward."""
     pos, neg = EdgeTracker(0, 1, options), EdgeTracker(0, -1, options)
     for _ in range(options.baseline_ramps):
         pos.update(ramp(), EDGE_DEG, neg)
         neg.update(ramp(), EDGE_DEG, pos)
+    if partner_shift_deg is not None:
+        neg.update(ramp(partner_shift_deg), EDGE_DEG, pos)
     pos.update(ramp(shift_deg, FLATTER), EDGE_DEG, neg)
     return pos
 
@@ -61,3 +67,14 @@ def test_a_widening_both_slopes_read_beyond_the_gate_stays_a_suspect_at_the_slop
     on = after_reference(EstimatorOptions(), 3.0)
     off = after_reference(EstimatorOptions(suspect_needs_own_slope=False), 3.0)
     assert on.suspects == off.suspects == [pytest.approx(slope_in_use_reading(3.0), abs=0.01)]
+
+
+def test_the_same_ramp_confirms_a_suspect_the_other_edge_holds_outward() -> None:
+    edge = after_reference(EstimatorOptions(), 0.5, partner_shift_deg=3.0)
+    assert edge.suspects == [pytest.approx(slope_in_use_reading(0.5), abs=0.01)]
+    assert edge.status()["own_slope_held_ramps"] == 0
+
+
+def test_an_inward_suspect_of_the_other_edge_does_not_confirm_an_outward_reading() -> None:
+    edge = after_reference(EstimatorOptions(), 0.5, partner_shift_deg=-3.0)
+    assert edge.suspects == []

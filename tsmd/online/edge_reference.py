@@ -51,6 +51,7 @@ class ReferenceReadings:
     odd_speed: bool
     ramp_change: float
     held: tuple[LoadedRamp, float, float] | None
+    partner: ReferenceReadings | None
 
     def _speed_matches(self, ramp: LoadedRamp) -> bool:
         """The ramp ran at a knob speed within ``speed_ratio_max`` of the reference's (True
@@ -104,8 +105,9 @@ class ReferenceReadings:
         if o.within_gate_reads_own and abs(raw - target) <= o.gate_deg:
             self.n_own_between += 1
             return nearest_between(raw, own, target)
+        way = math.copysign(1.0, raw - target)
         if (o.suspect_needs_own_slope and abs(raw - target) > o.gate_deg
-                and (own - target) * math.copysign(1.0, raw - target) <= o.gate_deg):
+                and (own - target) * way <= o.gate_deg and not self._partner_suspects(way)):
             # beyond the gate with the slope in use, within it (or beyond it the other way)
             # with the ramp's own: nothing says which slope is right, and a change shows with
             # both (planetwist 101 without a change: slow ramps 0.91-0.93 x read +1.82/+2.13
@@ -113,6 +115,15 @@ class ReferenceReadings:
             self.n_own_held += 1
             return nearest_between(raw, own, target)
         return raw
+
+    def _partner_suspects(self, way: float) -> bool:
+        """The knob's other edge holds a suspect beyond the gate ``way`` (+1 outward): then a
+        reading only the slope in use puts beyond the gate confirms it (a slack's first ramps:
+        coilpipe 1, +0.5 mm, phi1's positive edge +2.79 with the slope in use, +1.25 with its
+        own, after the negative edge's +3.90)."""
+        partner = self.partner
+        return (partner is not None and bool(partner.suspects)
+                and (partner.suspects[-1] - partner.estimate_deg) * way > self.options.gate_deg)
 
     def _widening_read(self, ramp: LoadedRamp, edge_deg: float, slope: float,
                        partner: ReferenceReadings | None = None) -> float | None:

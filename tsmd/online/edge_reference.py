@@ -89,8 +89,9 @@ class ReferenceReadings:
         softer catheter: twistshaft warming in the patient, its tip's edge in place). Within
         the gate (with ``within_gate_reads_own``) then the point between that and the ramp's
         own slope's crossing nearest the estimate: which slope is right nothing says there.
-        Beyond the gate (with ``suspect_needs_own_slope``) the same when the ramp's own slope
-        puts the crossing within the gate: a suspect must lie beyond it with both slopes."""
+        Outward beyond the gate (with ``suspect_needs_own_slope``) the same when the ramp's own
+        slope does not put the crossing beyond the gate too, unless the knob's other edge holds
+        an outward suspect: a widening must show with both slopes."""
         raw = self._crossing(ramp, edge_deg, slope)
         assert self.slope_ref_A_per_deg is not None
         target = self.estimate_deg + self.bins.bias_deg(ramp.other_deg)
@@ -105,13 +106,13 @@ class ReferenceReadings:
         if o.within_gate_reads_own and abs(raw - target) <= o.gate_deg:
             self.n_own_between += 1
             return nearest_between(raw, own, target)
-        way = math.copysign(1.0, raw - target)
-        if (o.suspect_needs_own_slope and abs(raw - target) > o.gate_deg
-                and (own - target) * way <= o.gate_deg and not self._partner_suspects(way)):
-            # beyond the gate with the slope in use, within it (or beyond it the other way)
-            # with the ramp's own: nothing says which slope is right, and a change shows with
-            # both (planetwist 101 without a change: slow ramps 0.91-0.93 x read +1.82/+2.13
-            # with the slope in use, +0.40/+1.11 with their own, and were followed)
+        if (o.suspect_needs_own_slope and raw - target > o.gate_deg
+                and own - target <= o.gate_deg and not self._partner_suspects(1.0)):
+            # outward beyond the gate with the slope in use, not with the ramp's own: nothing
+            # says which slope is right, and a widening shows with both (planetwist 101
+            # without a change: slow ramps 0.91-0.93 x read +1.82/+2.13 with the slope in
+            # use, +0.40/+1.11 with their own, and were followed). Inward, a steeper ramp's
+            # crossing is refused when the friction rose (``refuse_inward_on_steeper``).
             self.n_own_held += 1
             return nearest_between(raw, own, target)
         return raw

@@ -45,11 +45,13 @@ class ReferenceReadings:
     n_widened: int
     n_steeper: int
     n_own_between: int
+    n_own_held: int
     n_leaning_steeper: int
     n_reread: int
     odd_speed: bool
     ramp_change: float
     held: tuple[LoadedRamp, float, float] | None
+    partner: ReferenceReadings | None
 
     def _speed_matches(self, ramp: LoadedRamp) -> bool:
         """The ramp ran at a knob speed within ``speed_ratio_max`` of the reference's (True
@@ -86,7 +88,10 @@ class ReferenceReadings:
         nearest the estimate: the slope turned about a point the current does not show (a
         softer catheter: twistshaft warming in the patient, its tip's edge in place). Within
         the gate (with ``within_gate_reads_own``) then the point between that and the ramp's
-        own slope's crossing nearest the estimate: which slope is right nothing says there."""
+        own slope's crossing nearest the estimate: which slope is right nothing says there.
+        Outward beyond the gate (with ``suspect_needs_own_slope``) the same when the ramp's own
+        slope does not put the crossing beyond the gate too, unless the knob's other edge holds
+        an outward suspect: a widening must show with both slopes."""
         raw = self._crossing(ramp, edge_deg, slope)
         assert self.slope_ref_A_per_deg is not None
         target = self.estimate_deg + self.bins.bias_deg(ramp.other_deg)
@@ -94,12 +99,32 @@ class ReferenceReadings:
             self.n_between += 1
             raw = nearest_between(raw, self._crossing(ramp, edge_deg, self.slope_ref_A_per_deg),
                                   target)
-        if (self.options.within_gate_reads_own and ramp.slope_A_per_deg != slope
-                and abs(raw - target) <= self.options.gate_deg):
+        o = self.options
+        if ramp.slope_A_per_deg == slope:
+            return raw
+        own = self._crossing(ramp, edge_deg, ramp.slope_A_per_deg)
+        if o.within_gate_reads_own and abs(raw - target) <= o.gate_deg:
             self.n_own_between += 1
-            raw = nearest_between(raw, self._crossing(ramp, edge_deg, ramp.slope_A_per_deg),
-                                  target)
+            return nearest_between(raw, own, target)
+        if (o.suspect_needs_own_slope and raw - target > o.gate_deg
+                and own - target <= o.gate_deg and not self._partner_suspects(1.0)):
+            # outward beyond the gate with the slope in use, not with the ramp's own: nothing
+            # says which slope is right, and a widening shows with both (planetwist 101
+            # without a change: slow ramps 0.91-0.93 x read +1.82/+2.13 with the slope in
+            # use, +0.40/+1.11 with their own, and were followed). Inward, a steeper ramp's
+            # crossing is refused when the friction rose (``refuse_inward_on_steeper``).
+            self.n_own_held += 1
+            return nearest_between(raw, own, target)
         return raw
+
+    def _partner_suspects(self, way: float) -> bool:
+        """The knob's other edge holds a suspect beyond the gate ``way`` (+1 outward): then a
+        reading only the slope in use puts beyond the gate confirms it (a slack's first ramps:
+        coilpipe 1, +0.5 mm, phi1's positive edge +2.79 with the slope in use, +1.25 with its
+        own, after the negative edge's +3.90)."""
+        partner = self.partner
+        return (partner is not None and bool(partner.suspects)
+                and (partner.suspects[-1] - partner.estimate_deg) * way > self.options.gate_deg)
 
     def _widening_read(self, ramp: LoadedRamp, edge_deg: float, slope: float,
                        partner: ReferenceReadings | None = None) -> float | None:

@@ -102,6 +102,9 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     """Of those, steeper ramps read with their own slope (``steeper_knob_reads_own``)."""
     n_own_between: int = 0
     """Crossings within the gate read towards the ramp's own slope (``within_gate_reads_own``)."""
+    n_own_held: int = 0
+    """Crossings beyond the gate with the slope in use read within it towards the ramp's own
+    slope (``suspect_needs_own_slope``)."""
     n_leaning_steeper: int = 0
     """Crossings of steeper ramps read as suspects with their own slope
     (``leaning_steeper_reads_own``)."""

@@ -130,6 +130,17 @@ class EstimatorOptions:
     leave the steeper ramps' inward readings, and coilpipe 1 without a change ended at
     -0.45 deg instead of -0.03. Beyond the gate nothing changes (a change's suspects). Off:
     the slope in use alone (until session 20)."""
+    suspect_needs_own_slope: bool = True
+    """A crossing outward beyond the gate with the slope in use that the ramp's own slope
+    (within ``same_slope_tolerance`` of it) does not put outward beyond the gate reads the
+    point between the two nearest the estimate, as within the gate (``within_gate_reads_own``),
+    unless the knob's other edge holds an outward suspect (then it confirms it, a slack's first
+    ramps: coilpipe 1): a widening moves the crossing whatever the slope, while a ramp
+    a few per cent off the slope in use moves the slope-in-use crossing by ~15 deg x its
+    slope's error (planetwist 101 without a change, 600 s: phi2's negative ramps at 0.91-0.93
+    x read +1.82/+2.13 deg with the slope in use, +0.40/+1.11 with their own, became two
+    suspects and phi2 was followed to +1.9/+2.1 deg). Off: the slope in use's crossing (until
+    session 25)."""
     odd_slopes_read_widening: bool = True
     """A ramp whose slope disagrees with the slope in use beyond ``same_slope_tolerance``
     (measuring nothing otherwise) is a suspect when its crossings with the reference's slope

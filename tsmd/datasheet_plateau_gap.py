@@ -4,7 +4,8 @@ Each unit's calibration reads its plateau gap from the loop's motor current
 (:mod:`tsmd.calibration.dead_zone_loop`); what a degree of gap is worth in tip flats is the
 product's, measured here once on the sheet's unit with the tracker: the same loop move, read
 from the current the way every unit's is (the sheet's own identification options), and the
-tip's flats where each way in ends at 0 (the tip resting on that side's plateau). The sheet
+tip's flats where each way in ends at 0 (the tip resting on that side's plateau), the move
+played :data:`SHEET_REPEATS` times and pooled. The sheet
 gets ``plateau_gap_deg`` (the gap) and ``plateau_gap_factor`` (both sides' flats, summed, over
 the gap); their presence turns the loop on for the product. A knob whose loop shows no edge on
 either side, or whose flats do not lie on both sides of 0, gets neither (and says so).
@@ -22,7 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from simrig.plant import Plant
-from tsmd.calibration.dead_zone_loop import loop_move, read_loop_edges
+from tsmd.calibration.dead_zone_loop import LoopEdges, loop_move, read_loop_edges
 from tsmd.calibration.identify import split_half_cycles
 from tsmd.calibration.options import device_options
 from tsmd.config import TsmdConfig, default_sim_config
@@ -32,6 +33,10 @@ from tsmd.replay import LockstepRunner
 
 FloatArray = NDArray[np.float64]
 
+SHEET_REPEATS = 3
+"""The sheet's unit plays each knob's loop move this many times, pooled: its gap is every
+unit's reference, so its reading scatter would be every unit's bias (one move on snakedent's
+unit 0 read phi2's gap 8.75 and 9.37 deg at two noise seeds)."""
 LOOP_KEYS = ("plateau_gap_deg", "plateau_gap_factor")
 """The sheet's fields this stage writes (per knob); nothing else of the sheet depends on it."""
 
@@ -76,15 +81,21 @@ def measure_sheet_loops(plant_factory: Callable[[], Plant], device: DeviceModel,
     out = []
     with LockstepRunner(cfg, None, "none", seed, plant_factory()) as runner:
         for knob in (0, 1):
-            move = loop_move(knob, runner.period_s)
-            rec = runner.run(move.t_s, move.q_deg, False)
-            k = knob + 1
-            cmd = np.asarray(rec[f"cmd{k}"], float)
-            edges = read_loop_edges(np.asarray(rec["t"], float), cmd,
-                                    np.asarray(rec[f"pos{k}"], float),
-                                    np.asarray(rec[f"cur{k}"], float), options[knob])
-            pos, neg = tracked_flats(cmd, np.asarray(rec[f"tip{k}"], float))
-            out.append(SheetLoop(edges.gap_deg, pos, neg))
+            edges, cmds, tips = [], [], []
+            for _ in range(SHEET_REPEATS):
+                move = loop_move(knob, runner.period_s)
+                rec = runner.run(move.t_s, move.q_deg, False)
+                k = knob + 1
+                cmd = np.asarray(rec[f"cmd{k}"], float)
+                edges.append(read_loop_edges(np.asarray(rec["t"], float), cmd,
+                                             np.asarray(rec[f"pos{k}"], float),
+                                             np.asarray(rec[f"cur{k}"], float), options[knob]))
+                cmds.append(cmd)
+                tips.append(np.asarray(rec[f"tip{k}"], float))
+            pooled = LoopEdges(*(tuple(v for e in edges for v in getattr(e, f.name))
+                                 for f in dataclasses.fields(LoopEdges)))
+            pos, neg = tracked_flats(np.concatenate(cmds), np.concatenate(tips))
+            out.append(SheetLoop(pooled.gap_deg, pos, neg))
     return out[0], out[1]
 
 

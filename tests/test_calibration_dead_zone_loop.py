@@ -17,12 +17,15 @@ from tsmd.calibration.dead_zone_loop import (
     loop_move,
     loop_points,
     plateau_shift_deg,
+    play_loops,
     read_loop_edges,
     wants_loop,
 )
+from tsmd.calibration.errors import CalibrationError
 from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.datasheet_plateau_gap import SheetLoop, tracked_flats
 from tsmd.profile import DeviceModel
+from tsmd.recording import Recording
 
 PERIOD_S = 0.004
 FULL_EDGE_DEG = 20.0
@@ -142,3 +145,44 @@ def test_the_sheets_factor_is_both_flats_over_the_gap() -> None:
 def test_the_sheets_loop_numbers_round_trip_and_are_range_checked() -> None:
     assert_sheet_knob_field_round_trips("plateau_gap_deg", 1, 8.6, 60.0)
     assert_sheet_knob_field_round_trips("plateau_gap_factor", 0, 1.35, 20.0)
+
+
+class _SyntheticRig:
+    """A runner whose swept knob shows :func:`synthetic_loop`'s current (the other knob's is
+    friction-free and flat); ``stop_after`` ticks: it stops there as a faulted run would."""
+
+    period_s = PERIOD_S
+
+    def __init__(self, stop_after: int | None = None) -> None:
+        self.stop_after = stop_after
+        self.runs: list[np.ndarray] = []
+
+    def run(self, t_s: np.ndarray, q_deg: np.ndarray, compensate: bool,
+            cancel: object = None, progress: object = None) -> Recording:
+        q = np.asarray(q_deg, float)
+        self.runs.append(q)
+        n = len(q) if self.stop_after is None else min(self.stop_after, len(q))
+        knob = int(np.argmax(np.ptp(q, axis=0))) if np.ptp(q) > 0 else 0
+        columns = {"t": np.asarray(t_s, float)[:n]}
+        for k in (0, 1):
+            cur = (synthetic_loop()[3] if k == knob and len(q) == len(loop_move(0, PERIOD_S).q_deg)
+                   else np.zeros(len(q)))
+            columns.update({f"cmd{k + 1}": q[:n, k], f"pos{k + 1}": q[:n, k],
+                            f"cur{k + 1}": cur[:n]})
+        return Recording(columns)
+
+
+def test_the_calibration_plays_the_loop_of_an_opted_in_knob_only_and_reads_its_gap() -> None:
+    rig = _SyntheticRig()
+    run = play_loops(rig, DeviceModel("x", (DEVICE_KNOB, SHEET_KNOB)), None)  # type: ignore[arg-type]
+    assert run.gaps_deg[0] is None
+    assert run.gaps_deg[1] == pytest.approx(LOOP_EDGE_DEG - FULL_EDGE_DEG, abs=0.5)
+    assert len(rig.runs) == 1 and np.all(rig.runs[0][:, 0] == 0.0)
+    assert "phi2: plateau gap" in run.notes[0]
+
+
+def test_a_loop_cut_short_is_refused_with_the_knobs_sent_back_to_zero() -> None:
+    rig = _SyntheticRig(stop_after=1000)
+    with pytest.raises(CalibrationError, match="dead-zone loop phi1: the runner stopped"):
+        play_loops(rig, DeviceModel("x", (SHEET_KNOB, DEVICE_KNOB)), None)  # type: ignore[arg-type]
+    assert rig.runs[-1][-1] == pytest.approx([0.0, 0.0])

@@ -26,7 +26,10 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   the edges the current showed on the data-sheet unit (``reference_dead_zone_*_deg``), so that
   each unit's loaded line moves with its own edges (more slack: the tip reaches less at +-90).
   Without those data-sheet keys, the paper's assumption: the line through the reference point
-  and this unit's own edge at 0 deg.
+  and this unit's own edge at 0 deg. Where the sheet opts in to the dead-zone loop
+  (``plateau_gap_deg``, ``plateau_gap_factor``), each unit's own plateau moves them apart by
+  ``factor (gap - sheet's gap) / 2``, the gap read from its loop's current
+  (:mod:`tsmd.calibration.dead_zone_loop`, session 25).
 
 ``beta`` and ``x0`` scatter from sweep to sweep (``B_A`` by about 1 deg); over the grid they are
 smoothed by a least-squares polynomial in the other knob's angle (degree 2; on three grid points

@@ -85,6 +85,11 @@ def test_one_loops_outlying_edge_does_not_move_the_gap() -> None:
     assert edges.gap_deg == pytest.approx(8.0)
 
 
+def test_a_side_whose_loops_lie_inside_its_full_cycles_edge_is_no_reading() -> None:
+    edges = LoopEdges((31.25, 31.0), (-31.5, -31.5), (19.5,), (-38.5,))
+    assert edges.gap_deg == pytest.approx(11.625)
+
+
 def test_no_edge_read_gives_no_gap() -> None:
     assert math.isnan(LoopEdges((math.nan,), (), (20.0,), ()).gap_deg)
 

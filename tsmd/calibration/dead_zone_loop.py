@@ -113,11 +113,15 @@ class LoopEdges:
     @property
     def loop_gaps_deg(self) -> tuple[float, ...]:
         """Each loop's gap: its edge against its side's full-cycle edge (a side without a
-        full-cycle edge, or a loop without an edge, gives none)."""
+        full-cycle edge, or a loop without an edge, gives none). A gap that is not positive is
+        no reading: with the tip on its own side's plateau the rope takes load farther out
+        than with it on the other side's, so an edge inside the full cycle's is a mis-read
+        (snakedent development 4 phi2: the full cycle's negative edge fitted at -38.5 deg on a
+        later knee, its loops at -31.5, gap -7 on that side against +11.6 on the other)."""
         full_pos, full_neg = _mean(self.full_pos_deg), _mean(self.full_neg_deg)
         gaps = [e - full_pos for e in self.loop_pos_deg] + [full_neg - e
                                                            for e in self.loop_neg_deg]
-        return tuple(g for g in gaps if math.isfinite(g))
+        return tuple(g for g in gaps if math.isfinite(g) and g > 0.0)
 
     @property
     def gap_deg(self) -> float:

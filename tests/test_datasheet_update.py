@@ -132,3 +132,21 @@ def test_a_sample_of_another_product_is_refused(tmp_path: Path,
                  '{"plant":"coilpipe","unit":0}', "--update", str(LUMPED), "--unit-sample",
                  "201", "--out", str(tmp_path / "d.yaml")]) == 2
     assert "its sample must be units of its product" in capsys.readouterr().err
+
+
+def test_update_with_the_plateau_gap_writes_only_the_loops_fields(
+        bare: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    def fake(device: DeviceModel, config: object, factory: object, seed: int) -> DeviceModel:
+        knobs = tuple(dataclasses.replace(k, plateau_gap_deg=8.5 + i, plateau_gap_factor=1.3)
+                      for i, k in enumerate(device.knobs))
+        return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_plateau_gap", fake)
+    out = tmp_path / "new.yaml"
+    assert main(["datasheet", "--update", str(bare), *PLANT, "--plateau-gap",
+                 "--out", str(out)]) == 0
+    changed = _changed(bare, out)
+    assert [line for line in changed if not line.startswith("+#")] == [
+        "+    plateau_gap_deg: 8.5", "+    plateau_gap_factor: 1.3",
+        "+    plateau_gap_deg: 9.5", "+    plateau_gap_factor: 1.3"]
+    assert any("--plateau-gap" in line for line in changed)

@@ -30,6 +30,7 @@ from tsmd.calibration.assemble import (
     check_quality,
     cross_check_device,
 )
+from tsmd.calibration.dead_zone_loop import play_loops, wants_loop
 from tsmd.calibration.errors import (
     CalibrationCancelledError,
     CalibrationError,
@@ -55,7 +56,7 @@ from tsmd.calibration.resweep import (
     pooled,
     uncertain_points,
 )
-from tsmd.calibration.tension_play_fit import with_prefit, with_tension_play
+from tsmd.calibration.tension_play_fit import PlateauGaps, with_prefit, with_tension_play
 from tsmd.calibration.unit_part import with_unit_part
 from tsmd.profile import CatheterProfile, DeviceModel
 from tsmd.recording import Recording
@@ -139,9 +140,10 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
 
 def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
            limits: QualityLimits | None = None, amplitude_deg: float = 90.0,
-           source: str = "calibration from motor current") -> tuple[CatheterProfile,
-                                                                   QualityReport]:
-    """Quality checks, our compensator's fit and the profile (CalibrationError if refused)."""
+           source: str = "calibration from motor current",
+           plateau_gaps: PlateauGaps = None) -> tuple[CatheterProfile, QualityReport]:
+    """Quality checks, our compensator's fit and the profile (CalibrationError if refused);
+    ``plateau_gaps``: each knob's dead-zone loop gap where one was played."""
     report = check_quality(points, limits, amplitude_deg,
                            omegas=tuple(k.omega for k in device.knobs))
     # Before refusing: a backlash far below the data sheet's often explains cycles that disagree.
@@ -156,7 +158,7 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
     profile = build_profile(catheter_id, device, points, quality=report,
                             software_version=__version__, source=source)
     try:
-        profile = with_tension_play(profile, points, device)
+        profile = with_tension_play(profile, points, device, plateau_gaps)
     except (ValueError, ArithmeticError) as exc:
         raise CalibrationError(f"our compensator's fit (tension play) failed: {exc}") from None
     return profile, report
@@ -194,17 +196,24 @@ def run_calibration(runner: TrajectoryRunner, catheter_id: str, device: DeviceMo
     proto.validate(tuple((k.limits.min_deg, k.limits.max_deg)  # type: ignore[arg-type]
                          for k in device.knobs))
     omegas = tuple(k.omega for k in device.knobs)
+    per_knob = device_options(options, device)
     runs = run_sweeps(runner, proto, progress=progress, cancel=cancel,
-                      options=device_options(options, device), isolate=isolate,
+                      options=per_knob, isolate=isolate,
                       live_loop=live_loop, omegas=omegas,
                       estimate=(limits or QualityLimits()).estimate,
                       refuse_tip_error_deg=(limits or QualityLimits()).refuse_tip_error_deg)
+    # the dead-zone loop after the sweeps, on a product whose sheet opts in (session 25)
+    loops = play_loops(runner, device, per_knob, cancel, progress) if wants_loop(device) else None
     profile, report = finish(catheter_id, device, runs.points, limits=limits,
-                             amplitude_deg=max(s.amplitude_deg for s in proto.sweeps))
+                             amplitude_deg=max(s.amplitude_deg for s in proto.sweeps),
+                             plateau_gaps=None if loops is None else loops.gaps_deg)
     calibration = Calibration(profile, runs.points, report, proto.name,
-                              proto.sweep_time_s + runs.resweep_time_s, runs.motion_time_s,
+                              proto.sweep_time_s + runs.resweep_time_s,
+                              runs.motion_time_s + (0.0 if loops is None else loops.motion_s),
                               runs.wall_time_s)
     calibration.notes.extend(runs.resweeps)
+    if loops is not None:
+        calibration.notes.extend(loops.notes)
     if runs.budget_note:
         calibration.notes.append(runs.budget_note)
     return calibration

@@ -26,7 +26,10 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   the edges the current showed on the data-sheet unit (``reference_dead_zone_*_deg``), so that
   each unit's loaded line moves with its own edges (more slack: the tip reaches less at +-90).
   Without those data-sheet keys, the paper's assumption: the line through the reference point
-  and this unit's own edge at 0 deg.
+  and this unit's own edge at 0 deg. Where the sheet opts in to the dead-zone loop
+  (``plateau_gap_deg``, ``plateau_gap_factor``), each unit's own plateau moves them apart by
+  ``factor (gap - sheet's gap) / 2``, the gap read from its loop's current
+  (:mod:`tsmd.calibration.dead_zone_loop`, session 25).
 
 ``beta`` and ``x0`` scatter from sweep to sweep (``B_A`` by about 1 deg); over the grid they are
 smoothed by a least-squares polynomial in the other knob's angle (degree 2; on three grid points
@@ -47,6 +50,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from tsmd.calibration.dead_zone_loop import plateau_shift_deg
 from tsmd.calibration.edge_level import edge_level_grid
 from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.fresh_hold import with_fresh_hold
@@ -128,11 +132,15 @@ def median_of_three(values: Sequence[float], u95_deg: Sequence[float] | None = N
     return out
 
 
-def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> TensionPlayParams:
+def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any,
+                     plateau_gap_deg: float | None = None) -> TensionPlayParams:
     """One knob's parameters from all its sweeps (ValueError naming the sweep that fails).
 
     ``device_knob``: the data sheet's knob (``omega``, ``reference_pos``/``_neg`` and optionally
     ``reference_dead_zone_*_deg``), measured once per product on another unit.
+    ``plateau_gap_deg``: this unit's dead-zone loop gap (:mod:`tsmd.calibration.dead_zone_loop`);
+    with the sheet's ``plateau_gap_deg`` and ``plateau_gap_factor`` it moves the plateau heights
+    apart by ``factor (gap - sheet's) / 2`` each (None, or a sheet without them: unchanged).
     """
     if len(sweeps) < 2:
         raise ValueError("needs sweeps at >= 2 other-knob angles")
@@ -183,6 +191,11 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any) -> Tensio
     if shape_neg is not None:
         h_neg = shaped_height(k.reference_neg.knob_deg, k.reference_neg.tip_deg, edge_neg,
                               float(k.omega), shape_neg)
+    # the unit's own plateau, from its dead-zone loop against the sheet unit's (session 25)
+    shift = plateau_shift_deg(plateau_gap_deg, getattr(k, "plateau_gap_deg", None),
+                              getattr(k, "plateau_gap_factor", None))
+    if shift != 0.0:
+        h_pos, h_neg = h_pos - shift, h_neg + shift
     # the knee past the edge as the current read it (the sheet's is read so): the product's
     # reading offset the calibration subtracted from the edges added back
     near_zero = min(order, key=lambda w: abs(w.other_knob_deg))  # where the sheet reads its own
@@ -359,15 +372,25 @@ def sweeps_from_points(points: Sequence[Any], knob: int) -> list[SweepCurrent]:
     return out
 
 
-def fit_from_points(points: Sequence[Any], device: Any) -> tuple[TensionPlayParams, ...]:
+PlateauGaps = tuple[float | None, float | None] | None
+"""Each knob's dead-zone loop gap (deg; None: not read), or None: no loop played."""
+
+
+def fit_from_points(points: Sequence[Any], device: Any,
+                    plateau_gaps: PlateauGaps = None) -> tuple[TensionPlayParams, ...]:
     """Both knobs' parameters from the calibration's grid points and the data sheet (the
-    first sweep's knob also with its fresh hold, :mod:`tsmd.calibration.fresh_hold`)."""
-    params = [fit_tension_play(sweeps_from_points(points, k), device.knobs[k]) for k in (0, 1)]
+    first sweep's knob also with its fresh hold, :mod:`tsmd.calibration.fresh_hold`), each
+    knob's heights moved by its dead-zone loop's gap where one was read."""
+    gaps = plateau_gaps or (None, None)
+    params = [fit_tension_play(sweeps_from_points(points, k), device.knobs[k], gaps[k])
+              for k in (0, 1)]
     return with_fresh_hold(params, points)
 
 
-def with_tension_play(profile: Any, points: Sequence[Any], device: Any) -> Any:
-    """``profile`` with each knob's ``tension_play`` parameters fitted from ``points``."""
-    params = fit_from_points(points, device)
+def with_tension_play(profile: Any, points: Sequence[Any], device: Any,
+                      plateau_gaps: PlateauGaps = None) -> Any:
+    """``profile`` with each knob's ``tension_play`` parameters fitted from ``points`` (and
+    the dead-zone loop's ``plateau_gaps`` where played)."""
+    params = fit_from_points(points, device, plateau_gaps)
     knobs = tuple(replace(k, tension_play=p) for k, p in zip(profile.knobs, params, strict=True))
     return replace(profile, knobs=knobs)

@@ -42,6 +42,7 @@ from tsmd.datasheet_edge_curve import choose_edge_curve, with_edge_curve
 from tsmd.datasheet_edge_level import with_edge_level_share
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_offset import with_reading_offset
+from tsmd.datasheet_plateau_gap import with_plateau_gap
 from tsmd.datasheet_ratio_gain import with_ratio_gain
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
 from tsmd.datasheet_release_end import measure_release_end_offsets
@@ -335,6 +336,8 @@ def main(args: argparse.Namespace) -> int:
         device = with_release_end(device, config, factory, args.seed)
     if args.plant is not None and args.level_grid:
         device = with_level_grid(device, config, factory, args.seed)
+    if args.plant is not None and args.plateau_gap:
+        device = with_plateau_gap(device, config, factory, args.seed)
     if args.plant is not None and sample:
         device = with_sample(device, config, args.plant, params, args.unit_key, sample,
                              seeds[0] if seeds else 0)

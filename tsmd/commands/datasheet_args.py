@@ -73,6 +73,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "how far each side's loaded level moves with the other knob's angle "
                              "(loaded_level_grid; opt-in per product, docs/model.md Session 21)")
+    parser.add_argument("--plateau-gap", action="store_true",
+                        help="with --plant: also play the dead-zone loop on the sheet's unit and "
+                             "write its plateau gap and flats per gap degree (plateau_gap_deg, "
+                             "plateau_gap_factor; opt-in per product: each unit's calibration "
+                             "then plays the loop, ~2 min, and moves its plateau heights; "
+                             "with --update adds only those; docs/model.md Session 25)")
     parser.add_argument("--edge-level-share", action="store_true",
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "the share of the current's edge movement over the other knob's "

@@ -23,6 +23,7 @@ from simrig.plant import load_plant
 from tsmd import __version__
 from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
+from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
 from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
 from tsmd.profile import DeviceModel, load_device_model, save_device_fields
 
@@ -85,32 +86,46 @@ def with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: dic
 
 
 def update(args: argparse.Namespace, params: dict[str, Any], seed: int) -> int:
-    """``--update FILE``: the sheet with its sample's part, written to ``--out``; nothing else
-    of it changes (checked before writing)."""
+    """``--update FILE``: the sheet with its sample's part and/or its dead-zone loop's numbers
+    (``--plateau-gap``), written to ``--out``; nothing else of it changes (checked before
+    writing)."""
     for name in MEASURING_OPTIONS:
         if getattr(args, name) not in (None, False):
             raise DatasheetError(f"--{name.replace('_', '-')} measures a sheet anew: not with "
-                                 "--update (which adds only the sample's part)")
+                                 "--update (which adds only the sample's part or the loop's)")
     if args.plant is None:
         raise DatasheetError("--update needs --plant (and --params) of the sheet's unit: the "
                              "sample is tracked on the simulated rig")
-    if args.unit_sample is None:
-        raise DatasheetError("--update adds the sample's part: give --unit-sample")
+    loop = bool(getattr(args, "plateau_gap", False))
+    if args.unit_sample is None and not loop:
+        raise DatasheetError("--update adds the sample's part or the loop's: give --unit-sample "
+                             "or --plateau-gap")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
-    units = sample_units(args.unit_sample, params.get(args.unit_key))
     config = load_config(args.config) if args.config is not None else default_sim_config()
     load_plant(args.plant, params)  # fail early, with the loader's message
-    updated = with_sample(device, config, args.plant, params, args.unit_key, units, seed)
+    keys: tuple[str, ...] = ()
     command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
-               f"'{json.dumps(params)}' --unit-key {args.unit_key} --unit-sample "
-               f"{args.unit_sample} --out FILE")
-    save_device_fields(source, updated, SAMPLE_KEYS, args.out,
-                       f"{', '.join(SAMPLE_KEYS)} added by tsmd {__version__}:\n  {command}\n"
-                       f"  ({len(units) + 1} units, fast protocol, noise seed {seed}; no other "
-                       "field changed)")
-    print(f"tsmd datasheet: wrote {args.out} ({source} with its sample's part)")
+               f"'{json.dumps(params)}'")
+    what: list[str] = []
+    updated = device
+    if args.unit_sample is not None:
+        units = sample_units(args.unit_sample, params.get(args.unit_key))
+        updated = with_sample(updated, config, args.plant, params, args.unit_key, units, seed)
+        keys += SAMPLE_KEYS
+        command += f" --unit-key {args.unit_key} --unit-sample {args.unit_sample}"
+        what.append(f"{len(units) + 1} units, fast protocol, noise seed {seed}")
+    if loop:
+        updated = with_plateau_gap(updated, config, lambda: load_plant(args.plant, params),
+                                   args.seed)
+        keys += LOOP_KEYS
+        command += " --plateau-gap"
+        what.append(f"the sheet's unit's dead-zone loop, noise seed {args.seed}")
+    save_device_fields(source, updated, keys, args.out,
+                       f"{', '.join(keys)} added by tsmd {__version__}:\n  {command} --out FILE\n"
+                       f"  ({'; '.join(what)}; no other field changed)")
+    print(f"tsmd datasheet: wrote {args.out} ({source} with {', '.join(keys)})")
     return 0
 
 

@@ -76,6 +76,8 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "release_shift": (*RELEASE_SHIFT_RANGE, ""),
     "torque_ripple_period_deg": (1.0, 90.0, "deg"),
     "edge_level_share": (*EDGE_LEVEL_SHARE_RANGE, ""),
+    "plateau_gap_deg": (0.0, 45.0, "deg"),
+    "plateau_gap_factor": (0.1, 10.0, ""),
 }
 """The data sheet's optional measured numbers per knob and their plausible ranges: the schema
 reads them with these, and ``tsmd datasheet`` leaves out a measured one outside its range
@@ -100,6 +102,8 @@ _ROUND_KEYS = ("release_round", "release_shift")
 """Optional data-sheet numbers of the rounded release (session 20), written only when set."""
 _HANDLE_KEYS = ("torque_ripple_period_deg",)
 """Optional numbers of the handle's own make (session 22), written only when set."""
+_LOOP_KEYS = ("plateau_gap_deg", "plateau_gap_factor")
+"""Optional numbers of the dead-zone loop (session 25), written only when measured."""
 
 
 _Block = TypeVar("_Block")
@@ -235,6 +239,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             release_shift=optional("release_shift"),
             torque_ripple_period_deg=optional("torque_ripple_period_deg"),
             edge_level_share=optional("edge_level_share"),
+            plateau_gap_deg=optional("plateau_gap_deg"),
+            plateau_gap_factor=optional("plateau_gap_factor"),
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)
@@ -309,7 +315,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         if k.release_end_shape is not None:
             knobs[name]["release_end_shape"] = release_end_shape_to_mapping(k.release_end_shape)
         for key in (_RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS + _ROUND_KEYS
-                    + _HANDLE_KEYS):
+                    + _HANDLE_KEYS + _LOOP_KEYS):
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         if k.reading_offset is not None:

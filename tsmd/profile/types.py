@@ -266,6 +266,16 @@ class DeviceKnob:
     90 deg, as a ratio of where it ends after 90 (:mod:`tsmd.compensation.reversal_release`);
     calibration copies it into each unit's profile and method ours draws a release line per
     reversal to that end. None: the static release lines."""
+    plateau_gap_deg: float | None = None
+    """Optional, read on the data-sheet unit (``tsmd datasheet --plateau-gap``, session 25):
+    the dead-zone loop's plateau gap from its motor current, knob deg
+    (:mod:`tsmd.calibration.dead_zone_loop`). Where given with ``plateau_gap_factor``, the
+    calibration plays the loop on each unit and moves its plateau heights apart by ``factor
+    (gap - this) / 2`` (the opt-in; None: no loop, the heights as before)."""
+    plateau_gap_factor: float | None = None
+    """Optional, with ``plateau_gap_deg``: the sheet unit's tracked flats (both sides' plateau
+    heights, summed) over that gap."""
+
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,9 @@ swivel crimps, blood flow on the tip; run untuned, then ours' gain reading made 
 development units in the same session's second round) is held out; the notchclutch plant
 (session 24, written blind: a slip clutch in the handle, aramid tendons on a soaking hydrophilic
 liner, a notched steel section, a tip rubbing on the wall; run untuned, then traced on its
-development units in the same session's second round) is held out, registered last.
+development units in the same session's second round) is held out; the pronyring plant (session
+25, written blind: a viscoelastic Pebax section, a pull ring on a compliant bond, PTFE-lined ropes
+along a breathing path; run untuned) is the blind plant, registered last.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -54,6 +56,7 @@ from simrig.plants.lumped import NOMINAL_KNOBS as LUMPED_KNOBS
 from simrig.plants.nitinol import NOMINAL_KNOBS as NITINOL_KNOBS
 from simrig.plants.notchclutch import NOMINAL_KNOBS as NOTCHCLUTCH_KNOBS
 from simrig.plants.planetwist import NOMINAL_KNOBS as PLANETWIST_KNOBS
+from simrig.plants.pronyring import NOMINAL_KNOBS as PRONYRING_KNOBS
 from simrig.plants.ratestate import NOMINAL_KNOBS as RATESTATE_KNOBS
 from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
@@ -80,14 +83,16 @@ PLANT_SPECS: dict[str, str] = {
     "cyclopebax": "simrig.plants.cyclopebax:make_cyclopebax_plant",
     "snakedent": "simrig.plants.snakedent:make_snakedent_plant",
     "planetwist": "simrig.plants.planetwist:make_planetwist_plant",
-    "notchclutch": "simrig.plants.notchclutch:make_notchclutch_plant",  # last: seeds hold
+    "notchclutch": "simrig.plants.notchclutch:make_notchclutch_plant",
+    "pronyring": "simrig.plants.pronyring:make_pronyring_plant",  # last: seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
               "screwrod": "held-out", "nitinol": "held-out", "helixbelt": "held-out",
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
-              "planetwist": "held-out", "notchclutch": "held-out"}
+              "planetwist": "held-out", "notchclutch": "held-out",
+              "pronyring": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -108,7 +113,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "cyclopebax": CYCLOPEBAX_KNOBS,
                                         "snakedent": SNAKEDENT_KNOBS,
                                         "planetwist": PLANETWIST_KNOBS,
-                                        "notchclutch": NOTCHCLUTCH_KNOBS}
+                                        "notchclutch": NOTCHCLUTCH_KNOBS,
+                                        "pronyring": PRONYRING_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -184,6 +190,8 @@ VARIANTS: dict[str, Variant] = {
                            "carrier_play_deg": 1.5},
             "notchclutch": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                             "handle_friction_Nm": 1.5, "tissue_friction_Nmm": 1.5},
+            "pronyring": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                          "handle_friction_Nm": 1.5, "ring_tilt_Nmm_per_rad": 1.0 / 1.3},
         },
     ),
     "steel-tendon": Variant(
@@ -214,7 +222,8 @@ VARIANTS: dict[str, Variant] = {
                  "cyclopebax": {"tendon_stiffness_N": 0.4},
                  "snakedent": {"tendon_stiffness_N": 0.4},
                  "planetwist": {"tendon_stiffness_N": 0.4},
-                 "notchclutch": {"tendon_stiffness_N": 0.4}},
+                 "notchclutch": {"tendon_stiffness_N": 0.4},
+                 "pronyring": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

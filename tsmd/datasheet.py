@@ -209,17 +209,21 @@ def swept_knob(rec: Recording) -> int:
 
 
 def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None = None,
-                   ripple_period_deg: float | None = None) -> KnobConstants:
+                   ripple_period_deg: float | None = None,
+                   edge_rise: bool = False) -> KnobConstants:
     """The data-sheet constants of ``knob`` from a tracked sweep, analysed from row ``start``:
     the whole-pass constants up to row ``stop`` (None: the end), the reversal reads (release
     share and slope ratio, reference backlash) over every reversal to the end.
     ``ripple_period_deg``: the handle's torque ripple period (a design constant), which every
-    unit's edge fit averages over, so the sheet unit's current edges are read the same way."""
+    unit's edge fit averages over, so the sheet unit's current edges are read the same way;
+    ``edge_rise``: the product reads its edges where the current starts to rise
+    (``DeviceKnob.edge_rise``), the sheet unit's too."""
     if stop is not None:
         whole = knob_constants(Recording({k: v[:stop] for k, v in rec.columns.items()},
                                          rec.metadata), knob, start,
-                               ripple_period_deg=ripple_period_deg)
-        ends = knob_constants(rec, knob, start, ripple_period_deg=ripple_period_deg)
+                               ripple_period_deg=ripple_period_deg, edge_rise=edge_rise)
+        ends = knob_constants(rec, knob, start, ripple_period_deg=ripple_period_deg,
+                              edge_rise=edge_rise)
         return dataclasses.replace(
             whole, reference_backlash_pos_deg=ends.reference_backlash_pos_deg,
             reference_backlash_neg_deg=ends.reference_backlash_neg_deg,
@@ -247,7 +251,8 @@ def knob_constants(rec: Recording, knob: int, start: int = 0, stop: int | None =
     tip_b = tip_reading(t, rec[f"cmd{knob + 1}"][start:], pos, tip)
     # where the calibration's current analysis puts the edges on the same sweep
     cur = identify_sweep(t, rec[f"cmd{knob + 1}"][start:], pos, rec[f"cur{knob + 1}"][start:],
-                         IdentifyOptions(torque_ripple_period_deg=ripple_period_deg))
+                         IdentifyOptions(torque_ripple_period_deg=ripple_period_deg,
+                                         edge="rise" if edge_rise else "fit"))
     dz_offset = 0.5 * ((dz.dead_zone_pos_deg - cur.estimate("dead_zone_pos_deg"))
                        + (cur.estimate("dead_zone_neg_deg") - dz.dead_zone_neg_deg))
     # The backlash gain exactly as the tension-play fit measures every unit's: by the settle
@@ -314,7 +319,8 @@ def _finite_or_none(value: float) -> float | None:
 
 def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 2000,
                              config: TsmdConfig | None = None,
-                             ripple_period_deg: float | None = None) -> list[KnobConstants]:
+                             ripple_period_deg: float | None = None,
+                             edge_rise: bool = False) -> list[KnobConstants]:
     """Both knobs' constants on the simulated rig: each knob swept through the full stack
     (uncompensated, other knob at 0) for ``RELEASE_READ_CYCLES``, analysed after
     ``CONDITIONING_CYCLES`` (:func:`knob_constants`: the whole-pass constants on the first
@@ -329,7 +335,7 @@ def measure_device_constants(plant_factory: Callable[[], Plant], seed: int = 200
         # the run is causal: up to the short sweep's last sample it is the short sweep's
         stop = skip + tip_sweep(knob, 0.0, period_s)[0].size
         out.append(knob_constants(rec, knob, analysed_from(skip, period_s), stop,
-                                  ripple_period_deg))
+                                  ripple_period_deg, edge_rise))
     return out
 
 

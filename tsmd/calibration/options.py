@@ -251,6 +251,8 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
         # the product's knee (tsmd datasheet) where the sheet turns it on
         one = replace(one, backlash_knee=True) if k.backlash_knee else one
         one = replace(one, edge_curve=True) if k.edge_curve else one
+        # the product's edge reader: where the current starts to rise (session 25, warmgear)
+        one = replace(one, edge="rise") if k.edge_rise else one
         one = replace(one, torque_ripple_period_deg=k.torque_ripple_period_deg)
         # the release slope only serves a B read at a play's end, which needs an offset
         slope = (k.release_omega or k.omega) if k.reading_offset else None

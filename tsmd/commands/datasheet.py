@@ -76,7 +76,8 @@ def _params(text: str | None) -> dict[str, Any]:
     return params
 
 
-def _from_recordings(paths: list[str], ripple_period_deg: float | None) -> list[KnobConstants]:
+def _from_recordings(paths: list[str], ripple_period_deg: float | None,
+                     edge_rise: bool = False) -> list[KnobConstants]:
     by_knob: dict[int, KnobConstants] = {}
     for path in paths:
         rec = read_recording(path)
@@ -84,7 +85,8 @@ def _from_recordings(paths: list[str], ripple_period_deg: float | None) -> list[
         if knob in by_knob:
             raise DatasheetError(f"{path}: a second sweep of knob {knob + 1}; give one per knob")
         try:
-            by_knob[knob] = knob_constants(rec, knob, ripple_period_deg=ripple_period_deg)
+            by_knob[knob] = knob_constants(rec, knob, ripple_period_deg=ripple_period_deg,
+                                           edge_rise=edge_rise)
         except DatasheetError as exc:
             raise DatasheetError(f"{path}: {exc}") from None
     missing = [k + 1 for k in (0, 1) if k not in by_knob]
@@ -290,12 +292,12 @@ def main(args: argparse.Namespace) -> int:
         def factory() -> Plant:
             return load_plant(args.plant, params)
 
-        constants = measure_device_constants(factory, args.seed, config, ripple)
+        constants = measure_device_constants(factory, args.seed, config, ripple, args.edge_rise)
         source = (f"the simulated rig, plant {args.plant} with {json.dumps(params)}, seed "
                   f"{args.seed}, {RELEASE_READ_CYCLES:g} cycles per knob (whole passes: the "
                   f"first {ANALYSED_CYCLES:g})")
     else:
-        constants = _from_recordings(args.from_recording, ripple)
+        constants = _from_recordings(args.from_recording, ripple, args.edge_rise)
         config = load_config(args.config if args.config is not None else DEFAULT_CONFIG_PATH)
         source = "recordings " + ", ".join(Path(p).name for p in args.from_recording)
     device = device_model(args.device_model, constants, config, args.description,
@@ -304,6 +306,10 @@ def main(args: argparse.Namespace) -> int:
         source += f"; the handle's torque ripple period {ripple:g} deg given (a design constant)"
         phi1, phi2 = (dataclasses.replace(k, torque_ripple_period_deg=ripple)
                       for k in device.knobs)
+        device = dataclasses.replace(device, knobs=(phi1, phi2))
+    if args.edge_rise:
+        source += "; edges read where the current starts to rise (the product's reader)"
+        phi1, phi2 = (dataclasses.replace(k, edge_rise=True) for k in device.knobs)
         device = dataclasses.replace(device, knobs=(phi1, phi2))
     device, dropped = readable(device)
     for line in dropped:

@@ -34,6 +34,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "sheet unit's included, averages the current over it; written to "
                              "both knobs (docs/calibration.md Session 22: a ripple in the knob's "
                              "torque)")
+    parser.add_argument("--edge-rise", action="store_true",
+                        help="the product reads its dead-zone edges where the current starts "
+                             "to rise, the sheet unit's included (a handle whose current steps "
+                             "up at the take-up, then climbs a rippled ramp); written to both "
+                             "knobs as edge_rise (docs/calibration.md Session 25)")
     parser.add_argument("--loaded-shape", action="store_true",
                         help="also write each knob's loaded-branch template (ours then bends its "
                              "loaded lines by it; off by default, docs/model.md Session 10) and, "

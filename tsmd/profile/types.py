@@ -158,6 +158,13 @@ class DeviceKnob:
     """Optional, the product's choice of the curved-hinge check on the dead-zone edge
     (:mod:`tsmd.calibration.curved_ramp`): a knee in the loaded current must also beat a
     smoothly bending ramp (``true``; jawcrimp) or is taken as before (absent)."""
+    edge_rise: bool | None = None
+    """Optional, the product's dead-zone edge reader (``tsmd datasheet --edge-rise``): ``true``
+    reads each edge where the current starts to rise (``IdentifyOptions.edge = "rise"``) instead
+    of fitting a hinge or knee to it. For a handle whose current steps up where the tendon
+    takes up and then climbs a rippled ramp (warmgear's spur gear): there the fit flips between
+    hinge and knee from one unit to the next while the step's start keeps the same lag to the
+    tip, which the product's reading offset takes out (docs/calibration.md, session 25)."""
     backlash_knee: bool | None = None
     """Optional, the product's choice of the knee (:mod:`tsmd.calibration.knee`): a fraction
     rule's backlash end beyond the point where the current's rise falls below its own scatter

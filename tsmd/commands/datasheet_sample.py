@@ -21,10 +21,15 @@ from typing import Any
 from simrig.family import DEVELOPMENT_UNITS, HELD_OUT_UNITS
 from simrig.plant import load_plant
 from tsmd import __version__
+from tsmd.commands.datasheet_stick import (
+    source_header,
+    with_settle_gain_check,
+    with_stick_choice,
+)
 from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
-from tsmd.profile import DeviceModel, load_device_model, save_device_fields
+from tsmd.profile import DeviceModel, load_device_model, save_device_fields, save_device_model
 
 SCORED_UNITS = frozenset(DEVELOPMENT_UNITS + HELD_OUT_UNITS)
 """Units a figure is scored on (development and held out): never in a product's sample."""
@@ -84,9 +89,12 @@ def with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: dic
     return device
 
 
-def update(args: argparse.Namespace, params: dict[str, Any], seed: int) -> int:
+def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -> int:
     """``--update FILE``: the sheet with its sample's part, written to ``--out``; nothing else
-    of it changes (checked before writing)."""
+    of it changes (checked before writing). With ``--stick-end`` the stick-end choice and the
+    reading offset measured under it first (the sample then calibrated under that), the sheet
+    written whole."""
+    seed = seeds[0] if seeds else 0
     for name in MEASURING_OPTIONS:
         if getattr(args, name) not in (None, False):
             raise DatasheetError(f"--{name.replace('_', '-')} measures a sheet anew: not with "
@@ -94,18 +102,38 @@ def update(args: argparse.Namespace, params: dict[str, Any], seed: int) -> int:
     if args.plant is None:
         raise DatasheetError("--update needs --plant (and --params) of the sheet's unit: the "
                              "sample is tracked on the simulated rig")
-    if args.unit_sample is None:
-        raise DatasheetError("--update adds the sample's part: give --unit-sample")
+    whole = args.stick_end or args.settle_gain_check  # nested or new fields: written whole
+    if args.unit_sample is None and not whole:
+        raise DatasheetError("--update adds the sample's part (or the stick end, the settle-gain "
+                             "check): give --unit-sample (or --stick-end, --settle-gain-check)")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
-    units = sample_units(args.unit_sample, params.get(args.unit_key))
+    units = ([] if args.unit_sample is None
+             else sample_units(args.unit_sample, params.get(args.unit_key)))
     config = load_config(args.config) if args.config is not None else default_sim_config()
     load_plant(args.plant, params)  # fail early, with the loader's message
-    updated = with_sample(device, config, args.plant, params, args.unit_key, units, seed)
+    if args.stick_end:
+        device = with_stick_choice(device, config, args.plant, params, seeds)
+    if args.settle_gain_check:
+        device = with_settle_gain_check(device, config, args.plant, params, seeds)
+    updated = (with_sample(device, config, args.plant, params, args.unit_key, units, seed)
+               if units else device)
     command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
-               f"'{json.dumps(params)}' --unit-key {args.unit_key} --unit-sample "
-               f"{args.unit_sample} --out FILE")
+               f"'{json.dumps(params)}' --unit-key {args.unit_key}"
+               + (f" --unit-sample {args.unit_sample}" if units else "")
+               + (" --stick-end" if args.stick_end else "")
+               + (" --settle-gain-check" if args.settle_gain_check else "")
+               + (f" --rule-seeds {','.join(map(str, seeds))}" if whole else "") + " --out FILE")
+    if whole:
+        fields = ((["backlash_stick_end", "reading_offset"] if args.stick_end else [])
+                  + (["settle_gain_read"] if args.settle_gain_check else [])
+                  + (list(SAMPLE_KEYS) if units else []))
+        save_device_model(updated, args.out, source_header(source) + (
+            f"\n{', '.join(fields)} measured by tsmd {__version__} (no other field changed):"
+            f"\n  {command}"))
+        print(f"tsmd datasheet: wrote {args.out} ({source} with {', '.join(fields)})")
+        return 0
     save_device_fields(source, updated, SAMPLE_KEYS, args.out,
                        f"{', '.join(SAMPLE_KEYS)} added by tsmd {__version__}:\n  {command}\n"
                        f"  ({len(units) + 1} units, fast protocol, noise seed {seed}; no other "

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from support.profiles import DEVICE, assert_sheet_knob_field_round_trips
 
+import tsmd.datasheet_stick_end as stick_end
 from tsmd.calibration.identify import unit_share_backlash
 from tsmd.calibration.options import IdentifyOptions, device_options
 from tsmd.calibration.stick_end import STICK_SLOPE_SHARE, stick_end_index
@@ -102,3 +103,14 @@ def test_the_stick_end_is_chosen_only_where_it_scatters_less() -> None:
     assert not stick_choice((0.3, 24), (0.3, 24))
     assert not stick_choice((0.3, 24), (1.0, 24))
     assert not stick_choice((1.7, 24), (math.nan, 0))
+
+
+def test_the_rule_gain_is_read_again_only_where_the_stick_end_is_on(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(stick_end, "rule_backlash_gain", lambda points, knob: 0.09 + knob)
+    base = load_device_model(DEVICE)
+    knobs = tuple(dataclasses.replace(k, reference_rule_backlash_gain=0.117) for k in base.knobs)
+    device = dataclasses.replace(base, knobs=knobs)
+    runs = [SimpleNamespace(points=[])]
+    out = stick_end.with_rule_gain(device, runs, (True, False))  # type: ignore[arg-type]
+    assert [k.reference_rule_backlash_gain for k in out.knobs] == [0.09, 0.117]

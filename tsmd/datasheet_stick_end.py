@@ -7,8 +7,8 @@ which the sheet measures on the same unit and every unit subtracts
 (:mod:`tsmd.datasheet_offset`). So the sheet's unit is calibrated with the fast protocol with
 the sheet's rule as it stands and with the stick end, and each knob takes the stick end where
 its backlash values scatter less about their own grid point's median distance to the tracked
-tip (:func:`half_scatter_deg`); the reading offset is then measured again under what was chosen
-(session 25: notchclutch unit 0, docs/calibration.md).
+tip (:func:`half_scatter_deg`); the reading offset and the rule's backlash gain are then
+measured again under what was chosen (session 25: notchclutch unit 0, docs/calibration.md).
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from tsmd.calibration.assemble import GridPoint
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_offset import offset_readings, with_reading_offset, without_offset
-from tsmd.datasheet_rule import Truth
+from tsmd.datasheet_rule import Truth, rule_backlash_gain
 from tsmd.profile import DeviceModel
 from tsmd.tracked_calibration import ProtocolRun, play_protocol
 
@@ -94,7 +94,22 @@ def choose_stick_end(config: TsmdConfig, device: DeviceModel, truth: Truth,
     on = (choices[0].chosen, choices[1].chosen)
     if not any(on):
         return device, (choices[0], choices[1])
-    chosen = with_stick_end(device, on)
-    made = (stick, stick_runs) if all(on) else None
+    chosen = with_rule_gain(with_stick_end(device, on), stick_runs, on)
+    # the rule gain moves no D or B value, so the stick-end runs are the offset's own
+    made = (without_offset(chosen), stick_runs) if all(on) else None
     chosen, _ = with_reading_offset(chosen, config, truth, noise_seeds, truth_points, made)
     return chosen, (choices[0], choices[1])
+
+
+def with_rule_gain(device: DeviceModel, runs: Sequence[ProtocolRun], on: tuple[bool, bool]
+                   ) -> DeviceModel:
+    """``reference_rule_backlash_gain`` read again where the stick end is on (each unit reads
+    its own gain with B as the stick end reads it: the sheet's, read under the rule before,
+    would move every unit's omega by the two readings' difference; mean over ``runs``, made
+    under the stick end without an offset)."""
+    knobs = []
+    for knob, (k, o) in enumerate(zip(device.knobs, on, strict=True)):
+        gains = [g for g in (rule_backlash_gain(r.points, knob) for r in runs) if g is not None]
+        knobs.append(dataclasses.replace(k, reference_rule_backlash_gain=round(
+            float(np.mean(gains)), 3)) if o and gains else k)
+    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))

@@ -40,12 +40,16 @@ class SettleCheck:
     sd: float
     readings: int
     kept: bool
+    per_run: tuple[float, ...] = ()
+    """Each run's slope ratio (printed: the runs of one unit differ by more than ``sd`` on
+    notchclutch, docs/model.md session 25)."""
 
     def text(self) -> str:
         if not self.readings:
             return "no settle reading on the sheet's unit -> kept"
         return (f"settle gain read as a unit reads it: slope ratio {self.ratio:.3f} +- "
-                f"{Z95 * self.sd:.3f} (95 %) over {self.readings} run(s) -> "
+                f"{Z95 * self.sd:.3f} (95 %) over {self.readings} run(s) ("
+                f"{', '.join(f'{r:.3f}' for r in self.per_run)}) -> "
                 f"{'kept' if self.kept else 'not read by the units'}")
 
 
@@ -73,7 +77,8 @@ def settle_check(runs: Sequence[ProtocolRun], knob: int, sheet_gain: float) -> S
         return SettleCheck(math.nan, math.nan, 0, True)
     ratio = float(np.mean([r.ratio() for r in found]))
     sd = float(np.mean([r.ratio_sd() for r in found]))
-    return SettleCheck(ratio, sd, len(found), bool(abs(ratio - 1.0) <= Z95 * sd))
+    return SettleCheck(ratio, sd, len(found), bool(abs(ratio - 1.0) <= Z95 * sd),
+                       tuple(r.ratio() for r in found))
 
 
 def with_settle_check(device: DeviceModel, runs: Sequence[ProtocolRun]

@@ -98,9 +98,11 @@ def test_the_scatter_is_about_each_grid_points_own_offset() -> None:
     assert n == 4 and rms == pytest.approx(math.sqrt(2.0 / 4.0))
 
 
-def test_the_stick_end_is_chosen_only_where_it_scatters_less() -> None:
+def test_the_stick_end_is_chosen_only_where_it_scatters_less_by_more_than_the_angle_grid(
+        ) -> None:
     assert stick_choice((1.7, 24), (0.3, 24))
     assert not stick_choice((0.3, 24), (0.3, 24))
+    assert not stick_choice((0.14, 12), (0.10, 12))
     assert not stick_choice((0.3, 24), (1.0, 24))
     assert not stick_choice((1.7, 24), (math.nan, 0))
 

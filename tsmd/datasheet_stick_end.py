@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tsmd.calibration.assemble import GridPoint
+from tsmd.calibration.estimate import RESOLUTION_DEG
 from tsmd.calibration.protocol import fast_protocol
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_offset import offset_readings, with_reading_offset, without_offset
@@ -29,6 +30,11 @@ from tsmd.profile import DeviceModel
 from tsmd.tracked_calibration import ProtocolRun, play_protocol
 
 BACKLASHES = ("backlash_pos_deg", "backlash_neg_deg")
+MIN_SCATTER_GAIN_DEG = RESOLUTION_DEG
+"""The stick end must lower the scatter by more than the identification's angle grid (a smaller
+difference is below what one half-cycle's value resolves): notchclutch unit 0 1.40 -> 0.21 and
+1.35 -> 0.14 deg; offline on one fast calibration of jawcrimp unit 0, phi2 0.14 -> 0.10 (kept
+on its rule), lumped unit 0 0.36 -> 0.71 and 0.57 -> 1.09 (session 25)."""
 
 
 @dataclass(frozen=True)
@@ -71,9 +77,9 @@ def half_scatter_deg(runs: Sequence[ProtocolRun], truth: Truth, knob: int) -> tu
 
 
 def stick_choice(rule: tuple[float, int], stick: tuple[float, int]) -> bool:
-    """The stick end where its scatter is the smaller (a tie or a knob without readings keeps
-    the rule)."""
-    return bool(stick[1] and rule[1] and stick[0] < rule[0])
+    """The stick end where its scatter is smaller by more than :data:`MIN_SCATTER_GAIN_DEG`
+    (a closer call or a knob without readings keeps the rule)."""
+    return bool(stick[1] and rule[1] and stick[0] < rule[0] - MIN_SCATTER_GAIN_DEG)
 
 
 def choose_stick_end(config: TsmdConfig, device: DeviceModel, truth: Truth,

@@ -54,6 +54,7 @@ from tsmd.calibration.release import (
 )
 from tsmd.calibration.signal import Conditioned, FloatArray, condition
 from tsmd.calibration.slack_rise import before_sustained_rise
+from tsmd.calibration.stick_end import stick_end_index
 from tsmd.calibration.sweep_result import PARAMETERS, HalfCycle, SweepResult
 
 SHARE_STEP = 0.01
@@ -170,6 +171,8 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
                                        branch_stop))
         if found is not None and opts.backlash == "fraction" and opts.backlash_knee:
             found = resolvable_end(grid[:end], yg[:end], found, branch_stop)
+        stick = stick_end_index(grid[:end], yg[:end]) if opts.backlash_stick_end else None
+        found = found if stick is None else stick
         if found is None:
             # No value rather than a guess: the quality checks then name this reason.
             problems.append(f"{where}: the current never becomes constant after the reversal")
@@ -177,8 +180,9 @@ def analyse_half_cycle(data: Conditioned, direction: int, start: int, stop: int,
             settle = found
             # The backlash counts from the reversal (the model's X_ref); by the settle rule
             # it ends where the data sheet's unit let go after its current settled.
-            lag_deg = {"settle": opts.backlash_settle_lag_deg,
-                       "recovery": opts.backlash_recovery_lag_deg}.get(opts.backlash, 0.0)
+            lag_deg = 0.0 if stick is not None else {
+                "settle": opts.backlash_settle_lag_deg,
+                "recovery": opts.backlash_recovery_lag_deg}.get(opts.backlash, 0.0)
             lagged = min(max(settle + round(lag_deg / step), 0), end - 1)
             backlash_deg = float(grid[lagged] - grid[0])
             swing = release_swing(grid[:end], yg[:end], settle)
@@ -237,10 +241,12 @@ def unit_share_backlash(data: Conditioned, halves: tuple[HalfCycle, ...],
     0.939-0.971 against one sheet's 0.957), and so does the release-to-loaded slope ratio that
     follows the sheath's friction-wrap product; the sweep's mean ratio (one half-cycle's is
     too noisy) moves the sheet's share by ``backlash_share_per_slope_ratio`` per unit of ratio
-    away from the sheet unit's. Without a reference ratio the halves are returned as they are.
+    away from the sheet unit's. Without a reference ratio (or with the
+    stick end, :mod:`tsmd.calibration.stick_end`, which takes no share) the halves are returned
+    as they are.
     """
     ref = opts.backlash_reference_slope_ratio
-    if opts.backlash != "fraction" or ref is None:
+    if opts.backlash != "fraction" or ref is None or opts.backlash_stick_end:
         return halves
     step = opts.grid_step_deg
     curves: dict[int, tuple[FloatArray, FloatArray, FloatArray, int]] = {}

@@ -126,6 +126,11 @@ class IdentifyOptions:
     value of held-out stickslip and coilpipe but moved lumped's ends before the tip's release
     (0/8 accepted, 291/448; docs/calibration.md, session 12), so it is not a rule for every
     product; False: the rule's end as is."""
+    backlash_stick_end: bool = False
+    """The backlash ends where the current's steep fall after the reversal (the stick phase)
+    ends, whatever the rule (:mod:`tsmd.calibration.stick_end`, session 25; the data sheet's
+    ``backlash_stick_end``): the rule's end is kept only where the current shows no such fall.
+    False: the rule's end."""
     release_fit_half_deg: float = 4.0
     """"fraction": the share's crossing is read off a quadratic fitted to the current over this
     much knob travel either side of it (noise averaged; narrow enough for a quadratic to follow
@@ -250,6 +255,7 @@ def device_options(options: IdentifyOptions | None, device: DeviceModel
                           bool(k.backlash_settled_share))
         # the product's knee (tsmd datasheet) where the sheet turns it on
         one = replace(one, backlash_knee=True) if k.backlash_knee else one
+        one = replace(one, backlash_stick_end=True) if k.backlash_stick_end else one
         one = replace(one, edge_curve=True) if k.edge_curve else one
         # the product's edge reader: where the current starts to rise (session 25, warmgear)
         one = replace(one, edge="rise") if k.edge_rise else one

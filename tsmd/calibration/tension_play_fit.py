@@ -303,7 +303,8 @@ def loaded_slope(device_knob: Any, grid: Sequence[float], sweeps: Sequence[Sweep
     reading offset, as the sheet's product-rule gain was read (the play's own without)."""
     readings = []
     settle_gain = getattr(device_knob, "reference_backlash_gain", None)
-    if settle_gain is not None:
+    # a sheet whose own unit does not read its settle gain so (session 25) takes no reading
+    if settle_gain is not None and getattr(device_knob, "settle_gain_read", None) is not False:
         readings.append(gain_reading(float(settle_gain), grid,
                                      *settle_rule_gains(sweeps, pos_fits, neg_fits)))
     rule_gain = getattr(device_knob, "reference_rule_backlash_gain", None)

@@ -19,6 +19,7 @@ from simrig.plant import Plant, load_plant
 from tsmd import __version__
 from tsmd.commands.datasheet_args import add_arguments
 from tsmd.commands.datasheet_sample import sample_units, update, with_sample
+from tsmd.commands.datasheet_stick import with_settle_gain_check, with_stick_choice
 from tsmd.config import DEFAULT_CONFIG_PATH, TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import (
     ANALYSED_CYCLES,
@@ -272,7 +273,7 @@ def main(args: argparse.Namespace) -> int:
                              "the simulated rig)")
     seeds = _rule_seeds(args.rule_seeds)
     if args.update is not None:
-        return update(args, _params(args.params), seeds[0] if seeds else 0)
+        return update(args, _params(args.params), seeds)
     if args.device_model is None:
         raise DatasheetError("--device-model is required (or --update FILE)")
     params = _params(args.params)
@@ -324,6 +325,10 @@ def main(args: argparse.Namespace) -> int:
         device = _with_shape_grid(device, config, factory, args.seed)
     if args.plant is not None and seeds:
         device = _choose_rule(device, config, args.plant, params, seeds, args.recovery_rule)
+    if args.plant is not None and args.stick_end:  # after the rule: its offset measured again
+        device = with_stick_choice(device, config, args.plant, params, seeds)
+    if args.plant is not None and args.settle_gain_check:
+        device = with_settle_gain_check(device, config, args.plant, params, seeds)
     if args.plant is not None and args.choose_loaded_shape:  # under the sheet's rules
         device = with_shape_choice(device, config, factory, args.seed)
     if args.plant is not None and not args.no_ratio_gain:

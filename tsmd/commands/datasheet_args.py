@@ -125,6 +125,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "the sample's part to this existing sheet, calibrating the sample "
                              "under it, and write it to --out with no other field changed (its "
                              "header records the command; docs/calibration.md, session 20)")
+    parser.add_argument("--stick-end", action="store_true",
+                        help="with --plant and rule seeds: also calibrate the sheet's unit with "
+                             "each backlash ended where the current's steep fall after the "
+                             "reversal levels off (the stick phase), keep it on a knob whose B "
+                             "values then scatter less about the tip, and measure the reading "
+                             "offset again under it (backlash_stick_end; opt-in per product; "
+                             "with --update: added to that sheet, docs/calibration.md, "
+                             "session 25)")
+    parser.add_argument("--settle-gain-check", action="store_true",
+                        help="with --plant and rule seeds: also calibrate the sheet's unit as "
+                             "every unit is and read its settle-rule backlash gain the units' "
+                             "way; where the slope ratio that gives is not 1 within its 95 %% "
+                             "half-width, the units' omega takes no settle reading "
+                             "(settle_gain_read: false; with --update: added to that sheet, "
+                             "docs/model.md, session 25)")
     parser.add_argument("--unit-key", default="unit",
                         help="--unit-sample: the plant factory's parameter naming a unit")
     parser.add_argument("--bend-relation", action="store_true",

@@ -21,11 +21,16 @@ from typing import Any
 from simrig.family import DEVELOPMENT_UNITS, HELD_OUT_UNITS
 from simrig.plant import load_plant
 from tsmd import __version__
+from tsmd.commands.datasheet_stick import (
+    source_header,
+    with_settle_gain_check,
+    with_stick_choice,
+)
 from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
 from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
-from tsmd.profile import DeviceModel, load_device_model, save_device_fields
+from tsmd.profile import DeviceModel, load_device_model, save_device_fields, save_device_model
 
 SCORED_UNITS = frozenset(DEVELOPMENT_UNITS + HELD_OUT_UNITS)
 """Units a figure is scored on (development and held out): never in a product's sample."""
@@ -85,45 +90,63 @@ def with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: dic
     return device
 
 
-def update(args: argparse.Namespace, params: dict[str, Any], seed: int) -> int:
+def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -> int:
     """``--update FILE``: the sheet with its sample's part and/or its dead-zone loop's numbers
     (``--plateau-gap``), written to ``--out``; nothing else of it changes (checked before
-    writing)."""
+    writing). With ``--stick-end`` / ``--settle-gain-check`` those choices (and the reading
+    offset under the stick end) are measured first, the sample then calibrated under them, and
+    the sheet is written whole."""
+    seed = seeds[0] if seeds else 0
     for name in MEASURING_OPTIONS:
         if getattr(args, name) not in (None, False):
             raise DatasheetError(f"--{name.replace('_', '-')} measures a sheet anew: not with "
-                                 "--update (which adds only the sample's part or the loop's)")
+                                 "--update")
     if args.plant is None:
         raise DatasheetError("--update needs --plant (and --params) of the sheet's unit: the "
                              "sample is tracked on the simulated rig")
     loop = bool(getattr(args, "plateau_gap", False))
-    if args.unit_sample is None and not loop:
-        raise DatasheetError("--update adds the sample's part or the loop's: give --unit-sample "
-                             "or --plateau-gap")
+    whole = args.stick_end or args.settle_gain_check  # nested or new fields: written whole
+    if args.unit_sample is None and not loop and not whole:
+        raise DatasheetError("--update adds the sample's part, the loop's, the stick end or the "
+                             "settle-gain check: give --unit-sample, --plateau-gap, --stick-end "
+                             "or --settle-gain-check")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
+    units = ([] if args.unit_sample is None
+             else sample_units(args.unit_sample, params.get(args.unit_key)))
     config = load_config(args.config) if args.config is not None else default_sim_config()
     load_plant(args.plant, params)  # fail early, with the loader's message
-    keys: tuple[str, ...] = ()
-    command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
-               f"'{json.dumps(params)}'")
-    what: list[str] = []
-    updated = device
-    if args.unit_sample is not None:
-        units = sample_units(args.unit_sample, params.get(args.unit_key))
-        updated = with_sample(updated, config, args.plant, params, args.unit_key, units, seed)
-        keys += SAMPLE_KEYS
-        command += f" --unit-key {args.unit_key} --unit-sample {args.unit_sample}"
-        what.append(f"{len(units) + 1} units, fast protocol, noise seed {seed}")
+    if args.stick_end:
+        device = with_stick_choice(device, config, args.plant, params, seeds)
+    if args.settle_gain_check:
+        device = with_settle_gain_check(device, config, args.plant, params, seeds)
+    updated = (with_sample(device, config, args.plant, params, args.unit_key, units, seed)
+               if units else device)
+    keys: tuple[str, ...] = SAMPLE_KEYS if units else ()
+    what = [f"{len(units) + 1} units, fast protocol, noise seed {seed}"] if units else []
     if loop:
         updated = with_plateau_gap(updated, config, lambda: load_plant(args.plant, params),
                                    args.seed)
         keys += LOOP_KEYS
-        command += " --plateau-gap"
         what.append(f"the sheet's unit's dead-zone loop, noise seed {args.seed}")
+    command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
+               f"'{json.dumps(params)}' --unit-key {args.unit_key}"
+               + (f" --unit-sample {args.unit_sample}" if units else "")
+               + (" --plateau-gap" if loop else "")
+               + (" --stick-end" if args.stick_end else "")
+               + (" --settle-gain-check" if args.settle_gain_check else "")
+               + (f" --rule-seeds {','.join(map(str, seeds))}" if whole else "") + " --out FILE")
+    if whole:
+        fields = ((["backlash_stick_end", "reading_offset"] if args.stick_end else [])
+                  + (["settle_gain_read"] if args.settle_gain_check else []) + list(keys))
+        save_device_model(updated, args.out, source_header(source) + (
+            f"\n{', '.join(fields)} measured by tsmd {__version__} (no other field changed):"
+            f"\n  {command}"))
+        print(f"tsmd datasheet: wrote {args.out} ({source} with {', '.join(fields)})")
+        return 0
     save_device_fields(source, updated, keys, args.out,
-                       f"{', '.join(keys)} added by tsmd {__version__}:\n  {command} --out FILE\n"
+                       f"{', '.join(keys)} added by tsmd {__version__}:\n  {command}\n"
                        f"  ({'; '.join(what)}; no other field changed)")
     print(f"tsmd datasheet: wrote {args.out} ({source} with {', '.join(keys)})")
     return 0

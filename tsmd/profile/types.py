@@ -172,6 +172,17 @@ class DeviceKnob:
     release (stickslip, coilpipe) and too early where the current slows gradually (lumped), so
     ``tsmd datasheet`` turns it on only where it calibrates the sheet's own unit closer to its
     tracked tip (session 12). None or False: off."""
+    settle_gain_read: bool | None = None
+    """Optional: ``false`` where the sheet's unit, calibrated as every unit is, does not read
+    its own ``reference_backlash_gain`` (the slope ratio that reading gives is off 1 by more
+    than its 95 % half-width, :mod:`tsmd.datasheet_settle_gain`): each unit's omega then takes
+    no settle-rule reading (session 25). None or True: read."""
+    backlash_stick_end: bool | None = None
+    """Optional, the product's choice of the stick phase's end (:mod:`tsmd.calibration.stick_end`):
+    every half-cycle's backlash ends where the current's steep fall after the reversal levels
+    off, not where the rule ends it (session 25: notchclutch, whose current creeps on for 10-20
+    deg after the tip is let go). ``tsmd datasheet --stick-end`` turns it on where it reads the
+    sheet unit's backlash with less scatter about its tip; None or False: off."""
     reference_rule_backlash_gain: float | None = None
     """Optional: the data-sheet unit's backlash gain as ``reference_backlash_gain`` but with B
     by the product's chosen rule and knee (fast calibrations of that unit, ``tsmd

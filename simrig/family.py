@@ -30,7 +30,7 @@ development units in the same session's second round) is held out; the notchclut
 liner, a notched steel section, a tip rubbing on the wall; run untuned, then traced on its
 development units in the same session's second round) is held out; the pronyring plant (session
 25, written blind: a viscoelastic Pebax section, a pull ring on a compliant bond, PTFE-lined ropes
-along a breathing path; run untuned) is the blind plant, registered last.
+along a breathing path; run untuned) is held out from the end of session 25, registered last.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -92,7 +92,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
               "planetwist": "held-out", "notchclutch": "held-out",
-              "pronyring": "blind"}
+              "pronyring": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

@@ -141,6 +141,14 @@ class EstimatorOptions:
     x read +1.82/+2.13 deg with the slope in use, +0.40/+1.11 with their own, became two
     suspects and phi2 was followed to +1.9/+2.1 deg). Off: the slope in use's crossing (until
     session 25)."""
+    flatter_suspect_reads_own: bool = True
+    """A crossing outward beyond the gate with the slope in use whose ramp is flatter than
+    the slope in use and whose own slope's crossing lies outward beyond the gate too reads at
+    its own slope's crossing (the nearer): both slopes see the widening, and a friction that
+    fell flattens the ramp about its foot, so the slope in use puts the foot too far out
+    (notchclutch 1, +0.5 mm slack while its liner still soaks: ramps 0.76-0.92 x, crossings
+    with the slope in use +4.8..+5.3 deg, with their own +3.5..+4.4, the edges' true move
+    +3.58). Off: the slope in use's crossing (until session 25)."""
     odd_slopes_read_widening: bool = True
     """A ramp whose slope disagrees with the slope in use beyond ``same_slope_tolerance``
     (measuring nothing otherwise) is a suspect when its crossings with the reference's slope

@@ -47,6 +47,7 @@ class ReferenceReadings:
     n_own_between: int
     n_own_held: int
     n_flatter_own: int
+    knob_change: float
     n_leaning_steeper: int
     n_reread: int
     odd_speed: bool
@@ -117,7 +118,8 @@ class ReferenceReadings:
             self.n_own_held += 1
             return nearest_between(raw, own, target)
         if (o.flatter_suspect_reads_own and raw - target > o.gate_deg
-                and own - target > o.gate_deg and ramp.slope_A_per_deg < slope):
+                and own - target > o.gate_deg and ramp.slope_A_per_deg < slope
+                and self.knob_change < -o.slope_in_use_tolerance):
             # outward beyond the gate with both slopes on a ramp flatter than the slope in
             # use: the widening is real, its size is the nearer crossing. A friction that
             # falls flattens the ramp about its foot (notchclutch's liner soaking after

@@ -64,8 +64,10 @@ def test_without_the_rule_the_same_ramp_is_a_suspect_beyond_the_gate() -> None:
 
 
 def test_a_widening_both_slopes_read_beyond_the_gate_stays_a_suspect_at_the_slope_in_use() -> None:
-    on = after_reference(EstimatorOptions(), 3.0)
-    off = after_reference(EstimatorOptions(suspect_needs_own_slope=False), 3.0)
+    # without flatter_suspect_reads_own (session 25, round 2), which reads it at its own slope
+    on = after_reference(EstimatorOptions(flatter_suspect_reads_own=False), 3.0)
+    off = after_reference(EstimatorOptions(suspect_needs_own_slope=False,
+                                           flatter_suspect_reads_own=False), 3.0)
     assert on.suspects == off.suspects == [pytest.approx(slope_in_use_reading(3.0), abs=0.01)]
 
 

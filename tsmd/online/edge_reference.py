@@ -46,6 +46,8 @@ class ReferenceReadings:
     n_steeper: int
     n_own_between: int
     n_own_held: int
+    n_flatter_own: int
+    knob_change: float
     n_leaning_steeper: int
     n_reread: int
     odd_speed: bool
@@ -115,6 +117,16 @@ class ReferenceReadings:
             # crossing is refused when the friction rose (``refuse_inward_on_steeper``).
             self.n_own_held += 1
             return nearest_between(raw, own, target)
+        if (o.flatter_suspect_reads_own and raw - target > o.gate_deg
+                and own - target > o.gate_deg and ramp.slope_A_per_deg < slope
+                and self.knob_change < -o.slope_in_use_tolerance):
+            # outward beyond the gate with both slopes on a ramp flatter than the slope in
+            # use: the widening is real, its size is the nearer crossing. A friction that
+            # falls flattens the ramp about its foot (notchclutch's liner soaking after
+            # insertion: ramps 0.76-0.92 x, a +0.5 mm slack read +4.8..+5.3 deg with the
+            # slope in use, +3.5..+4.4 with their own, true +3.58).
+            self.n_flatter_own += 1
+            return own
         return raw
 
     def _partner_suspects(self, way: float) -> bool:

@@ -28,7 +28,7 @@ def edge_status(edge: Any) -> dict[str, Any]:
             "reread_ramps": edge.n_reread, "partner_held": edge.n_partner_held,
             "between_ramps": edge.n_between, "widened_ramps": edge.n_widened,
             "steeper_ramps": edge.n_steeper, "own_slope_ramps": edge.n_own_between,
-            "own_slope_held_ramps": edge.n_own_held,
+            "own_slope_held_ramps": edge.n_own_held, "flatter_own_ramps": edge.n_flatter_own,
             "leaning_steeper_ramps": edge.n_leaning_steeper}
 
 

@@ -105,6 +105,9 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     n_own_held: int = 0
     """Crossings beyond the gate with the slope in use read within it towards the ramp's own
     slope (``suspect_needs_own_slope``)."""
+    n_flatter_own: int = 0
+    """Crossings outward beyond the gate with both slopes on a flatter ramp, read at its own
+    slope (``flatter_suspect_reads_own``)."""
     n_leaning_steeper: int = 0
     """Crossings of steeper ramps read as suspects with their own slope
     (``leaning_steeper_reads_own``)."""

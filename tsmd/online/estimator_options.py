@@ -141,6 +141,18 @@ class EstimatorOptions:
     x read +1.82/+2.13 deg with the slope in use, +0.40/+1.11 with their own, became two
     suspects and phi2 was followed to +1.9/+2.1 deg). Off: the slope in use's crossing (until
     session 25)."""
+    flatter_suspect_reads_own: bool = False
+    """A crossing outward beyond the gate with the slope in use, on a ramp flatter than the
+    slope in use while the knob's pooled slope change is below -``slope_in_use_tolerance`` (a
+    friction that fell on both tendons), whose own slope's crossing lies outward beyond the
+    gate too, reads at its own slope's crossing (the nearer): such a fall flattens the ramp
+    about its foot, and the slope in use puts the foot too far out (notchclutch 1, +0.5 mm
+    slack while its liner still soaks: ramps 0.76-0.92 x, crossings with the slope in use
+    +4.8..+5.3 deg, with their own +3.5..+4.4, the edges' true move +3.58). Off (session 25,
+    docs/online.md "Session 25, round 2"): closed loop on notchclutch 1 phi1 got worse (a
+    knee-mode follow back came inside the RMSE window) and coilpipe 1's slack (phi1 negative
+    edge, one noisy 0.89 x ramp) read 2.19 deg instead of 3.90 in replay; notchclutch's miss
+    is mostly the bench's run starting on a dry liner after the calibration."""
     odd_slopes_read_widening: bool = True
     """A ramp whose slope disagrees with the slope in use beyond ``same_slope_tolerance``
     (measuring nothing otherwise) is a suspect when its crossings with the reference's slope

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
 import pytest
+from support.handle_play import LINE_END_DEG, OTHER_DEG, falling_sweep, play_offset
 
 from tsmd.calibration.assemble import GridPoint, QualityReport
 from tsmd.calibration.play_creep import (
@@ -19,49 +19,17 @@ from tsmd.calibration.play_creep import (
 )
 from tsmd.calibration.reading_offset import corrected
 from tsmd.calibration.resweep import point_estimates
-from tsmd.calibration.signal import Conditioned
-from tsmd.calibration.sweep_result import HalfCycle, SweepResult
-from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
+from tsmd.calibration.sweep_result import SweepResult
 
-LEVEL_A = 0.026
-PULL_A = 0.011
-NOISE_A = 0.001
-LINE_END_DEG = 3.0
 SHEET_PLAY_DEG = -10.0
-OTHER_DEG = (-90.0, 0.0, 90.0)
-
-
-def falling_sweep(play_end_deg: float, seed: int) -> SweepResult:
-    """One half-cycle down from +90 deg: the tension unloads over the line rule's 3 deg, the
-    current rests at the friction level over the play and steps down by the released rope's
-    pull where the play closes (``play_end_deg`` after the reversal)."""
-    pos = np.linspace(90.0, -60.0, 1501)
-    travel = 90.0 - pos
-    y = np.full_like(travel, LEVEL_A)
-    unload = travel < LINE_END_DEG
-    y[unload] = -0.08 + (LEVEL_A + 0.08) * travel[unload] / LINE_END_DEG
-    s = travel - play_end_deg
-    pulled = (s >= 0.0) & (s < 50.0)
-    y[pulled] = LEVEL_A - PULL_A * (1.0 - s[pulled] / 50.0)
-    y = y + np.random.default_rng(seed).normal(0.0, NOISE_A / 4, pos.size)
-    current = -y  # direction -1
-    t = np.arange(pos.size) * 0.02
-    data = Conditioned(t, pos, pos, current, current, 50.0, NOISE_A, NOISE_A, ())
-    half = HalfCycle(direction=-1, start=0, stop=pos.size, after_reversal=True,
-                     backlash_deg=LINE_END_DEG)
-    return SweepResult(data, (half,), {"backlash_pos_deg": (LINE_END_DEG,)})
-
-
-def sheet(play_deg: float = SHEET_PLAY_DEG) -> ReadingOffset:
-    grid = OffsetGrid((play_deg,) * 3, (0.5,) * 3, (4, 4, 4))
-    return ReadingOffset(OTHER_DEG, (("backlash_pos_deg", grid),))
 
 
 def knob_points(play_ends_deg: tuple[float, ...], knob: int = 0,
                 play_deg: float = SHEET_PLAY_DEG) -> list[GridPoint]:
     """One sweep per other-knob angle, read through the sheet's offset (the play-end reading
     where the sheet announces a play)."""
-    return [GridPoint(knob, other, corrected(falling_sweep(end, seed), sheet(play_deg), other))
+    offset = play_offset(play_deg)
+    return [GridPoint(knob, other, corrected(falling_sweep(end, seed), offset, other))
             for seed, (other, end) in enumerate(zip(OTHER_DEG, play_ends_deg, strict=True))]
 
 

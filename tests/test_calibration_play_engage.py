@@ -6,6 +6,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from support.handle_play import (
+    LINE_END_DEG,
+    NOISE_A,
+    falling_sweep,
+    play_offset,
+    release_y,
+)
 
 from tsmd.calibration.play_engage import (
     MIN_PLAY_DEG,
@@ -15,48 +22,7 @@ from tsmd.calibration.play_engage import (
     engaged,
 )
 from tsmd.calibration.reading_offset import corrected
-from tsmd.calibration.signal import Conditioned
-from tsmd.calibration.sweep_result import HalfCycle, SweepResult
-from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 from tsmd.tip_truth import TIP_THRESHOLD_DEG
-
-LEVEL_A = 0.026
-PULL_A = 0.011
-NOISE_A = 0.001
-LINE_END_DEG = 3.0
-
-
-def release_y(travel_deg: np.ndarray, play_end_deg: float | None) -> np.ndarray:
-    """Direction-signed current after a reversal: the tension unloads over the line rule's
-    3 deg, the current rests at the level over the play, then the released rope's pull lowers
-    it by PULL_A, fading over 50 deg (None: no step, the level to the end)."""
-    y = np.full_like(travel_deg, LEVEL_A)
-    unload = travel_deg < LINE_END_DEG
-    y[unload] = -0.08 + (LEVEL_A + 0.08) * travel_deg[unload] / LINE_END_DEG
-    if play_end_deg is not None:
-        s = travel_deg - play_end_deg
-        pulled = (s >= 0.0) & (s < 50.0)
-        y[pulled] = LEVEL_A - PULL_A * (1.0 - s[pulled] / 50.0)
-    return y
-
-
-def falling_sweep(play_end_deg: float | None, seed: int = 0) -> SweepResult:
-    """One half-cycle down from +90 deg (the + side's backlash) with the line rule's B."""
-    pos = np.linspace(90.0, -60.0, 1501)
-    travel = 90.0 - pos
-    y = release_y(travel, play_end_deg) + np.random.default_rng(seed).normal(0, NOISE_A / 4,
-                                                                            pos.size)
-    current = -y  # direction -1
-    t = np.arange(pos.size) * 0.02
-    data = Conditioned(t, pos, pos, current, current, 50.0, NOISE_A, NOISE_A, ())
-    half = HalfCycle(direction=-1, start=0, stop=pos.size, after_reversal=True,
-                     backlash_deg=LINE_END_DEG)
-    return SweepResult(data, (half,), {"backlash_pos_deg": (LINE_END_DEG,)})
-
-
-def sheet_offset(at_zero_deg: float) -> ReadingOffset:
-    grid = OffsetGrid((at_zero_deg,) * 3, (0.5,) * 3, (4, 4, 4))
-    return ReadingOffset((-90.0, 0.0, 90.0), (("backlash_pos_deg", grid),))
 
 
 def test_the_backlash_ends_where_the_current_steps_off_the_plays_level() -> None:
@@ -93,7 +59,7 @@ def test_no_play_is_searched_where_the_sheets_offset_is_small() -> None:
 
 
 def test_the_calibrations_correction_takes_the_step_instead_of_the_sheets_offset() -> None:
-    r = corrected(falling_sweep(16.0), sheet_offset(-10.0), 0.0)
+    r = corrected(falling_sweep(16.0), play_offset(-10.0), 0.0)
     assert r.values["backlash_pos_deg"][0] == pytest.approx(16.0, abs=0.3)
     assert r.offset_u95_deg["backlash_pos_deg"] == pytest.approx(0.5)
     assert r.own_offset_deg["backlash_pos_deg"] == pytest.approx(LINE_END_DEG - 16.0, abs=0.3)
@@ -107,7 +73,7 @@ def test_the_step_is_found_on_the_grid_between_samples() -> None:
 
 
 def test_the_step_is_moved_to_where_the_tip_has_moved_the_sheets_one_degree() -> None:
-    r = corrected(falling_sweep(16.0), sheet_offset(-10.0), 0.0, release_slope=1.25)
+    r = corrected(falling_sweep(16.0), play_offset(-10.0), 0.0, release_slope=1.25)
     assert r.values["backlash_pos_deg"][0] == pytest.approx(16.0 + 1.0 / 1.25, abs=0.3)
     assert r.own_offset_deg["backlash_pos_deg"] == pytest.approx(LINE_END_DEG - 16.8, abs=0.3)
     assert engage_lag_deg(None) == 0.0

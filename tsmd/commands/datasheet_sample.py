@@ -104,7 +104,7 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
     if args.plant is None:
         raise DatasheetError("--update needs --plant (and --params) of the sheet's unit: the "
                              "sample is tracked on the simulated rig")
-    loop = bool(getattr(args, "plateau_gap", False))
+    loop = bool(args.plateau_gap)
     whole = args.stick_end or args.settle_gain_check  # nested or new fields: written whole
     if args.unit_sample is None and not loop and not whole:
         raise DatasheetError("--update adds the sample's part, the loop's, the stick end or the "

@@ -17,44 +17,44 @@ from support.handle_play import (
 from tsmd.calibration.play_engage import (
     MIN_PLAY_DEG,
     TIP_MOVE_DEG,
+    engage,
     engage_lag_deg,
     engage_travel_deg,
-    engaged,
 )
 from tsmd.calibration.reading_offset import corrected
 from tsmd.tip_truth import TIP_THRESHOLD_DEG
 
 
 def test_the_backlash_ends_where_the_current_steps_off_the_plays_level() -> None:
-    values, own = engaged(falling_sweep(15.0), {"backlash_pos_deg": -10.0},
-                          {"backlash_pos_deg": -10.0})
+    read = engage(falling_sweep(15.0), {"backlash_pos_deg": -10.0}, {"backlash_pos_deg": -10.0})
+    values, own = read.values, read.own
     assert values["backlash_pos_deg"][0] == pytest.approx(15.0, abs=0.3)
     assert own["backlash_pos_deg"] == pytest.approx(LINE_END_DEG - 15.0, abs=0.3)
 
 
 def test_a_unit_with_more_play_than_the_sheets_reads_its_own() -> None:
-    values, _ = engaged(falling_sweep(18.0), {"backlash_pos_deg": -10.0},
-                        {"backlash_pos_deg": -10.0})
+    values = engage(falling_sweep(18.0), {"backlash_pos_deg": -10.0},
+                    {"backlash_pos_deg": -10.0}).values
     assert values["backlash_pos_deg"][0] == pytest.approx(18.0, abs=0.3)
 
 
 def test_a_current_that_never_leaves_its_level_keeps_the_sheets_offset() -> None:
-    values, own = engaged(falling_sweep(None), {"backlash_pos_deg": -10.0},
-                          {"backlash_pos_deg": -10.0})
+    read = engage(falling_sweep(None), {"backlash_pos_deg": -10.0}, {"backlash_pos_deg": -10.0})
+    values, own = read.values, read.own
     assert values["backlash_pos_deg"] == pytest.approx((LINE_END_DEG + 10.0,))
     assert own == {}
 
 
 def test_a_step_far_beyond_what_the_sheet_announces_is_not_taken() -> None:
-    values, _ = engaged(falling_sweep(LINE_END_DEG + 25.0), {"backlash_pos_deg": -10.0},
-                        {"backlash_pos_deg": -10.0})
+    values = engage(falling_sweep(LINE_END_DEG + 25.0), {"backlash_pos_deg": -10.0},
+                    {"backlash_pos_deg": -10.0}).values
     assert values["backlash_pos_deg"] == pytest.approx((LINE_END_DEG + 10.0,))
 
 
 def test_no_play_is_searched_where_the_sheets_offset_is_small() -> None:
     small = -(MIN_PLAY_DEG - 0.5)
-    values, _ = engaged(falling_sweep(LINE_END_DEG + 2.0), {"backlash_pos_deg": small},
-                        {"backlash_pos_deg": small})
+    values = engage(falling_sweep(LINE_END_DEG + 2.0), {"backlash_pos_deg": small},
+                    {"backlash_pos_deg": small}).values
     assert values == {}
 
 

@@ -133,11 +133,4 @@ def engage(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[str
     return Engaged(values, own, ends)
 
 
-def engaged(result: SweepResult, shifts: dict[str, float], play_at_zero: dict[str, float],
-            lag_deg: float = 0.0) -> tuple[dict[str, tuple[float, ...]], dict[str, float]]:
-    """:func:`engage`'s values and own offsets."""
-    read = engage(result, shifts, play_at_zero, lag_deg)
-    return read.values, read.own
-
-
-__all__ = ["Engaged", "engage", "engage_lag_deg", "engage_travel_deg", "engaged"]
+__all__ = ["Engaged", "engage", "engage_lag_deg", "engage_travel_deg"]

@@ -17,6 +17,7 @@ from statistics import median
 from tsmd.online.estimator_options import EstimatorOptions
 from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
+from tsmd.online.partner import holds_outward_suspect
 from tsmd.online.reference import SettlingReference
 from tsmd.online.slopes import nearest_between
 
@@ -109,7 +110,8 @@ class ReferenceReadings:
             self.n_own_between += 1
             return nearest_between(raw, own, target)
         if (o.suspect_needs_own_slope and raw - target > o.gate_deg
-                and own - target <= o.gate_deg and not self._partner_suspects(1.0)):
+                and own - target <= o.gate_deg
+                and not holds_outward_suspect(self.partner, o.gate_deg)):
             # outward beyond the gate with the slope in use, not with the ramp's own: nothing
             # says which slope is right, and a widening shows with both (planetwist 101
             # without a change: slow ramps 0.91-0.93 x read +1.82/+2.13 with the slope in
@@ -128,15 +130,6 @@ class ReferenceReadings:
             self.n_flatter_own += 1
             return own
         return raw
-
-    def _partner_suspects(self, way: float) -> bool:
-        """The knob's other edge holds a suspect beyond the gate ``way`` (+1 outward): then a
-        reading only the slope in use puts beyond the gate confirms it (a slack's first ramps:
-        coilpipe 1, +0.5 mm, phi1's positive edge +2.79 with the slope in use, +1.25 with its
-        own, after the negative edge's +3.90)."""
-        partner = self.partner
-        return (partner is not None and bool(partner.suspects)
-                and (partner.suspects[-1] - partner.estimate_deg) * way > self.options.gate_deg)
 
     def _widening_read(self, ramp: LoadedRamp, edge_deg: float, slope: float,
                        partner: ReferenceReadings | None = None) -> float | None:

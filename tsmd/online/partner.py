@@ -36,6 +36,13 @@ class SuspectView(Protocol):
     accepted_order: int
 
 
+class OutwardView(Protocol):
+    """What :func:`holds_outward_suspect` reads of an edge tracker."""
+
+    estimate_deg: float
+    suspects: list[float]
+
+
 def partner_shows_change(partner: EdgeView | None, lean_deg: float) -> bool:
     """The knob's other edge followed a change, or its latest reading lies ``lean_deg`` or
     more from its estimate (either way: a widening or a shift). True without a partner."""
@@ -53,6 +60,15 @@ def partner_left_band(partner: EdgeView | None, deadband_deg: float) -> bool:
     return abs(partner.estimate_deg) > deadband_deg
 
 
+def holds_outward_suspect(partner: OutwardView | None, gate_deg: float) -> bool:
+    """The knob's other edge last read a suspect outward beyond the gate: then a reading of
+    this edge that only the slope in use puts beyond the gate confirms it (a slack's first
+    ramps: coilpipe 1, +0.5 mm, phi1's positive edge +2.79 with the slope in use, +1.25 with
+    its own, after the negative edge's +3.90)."""
+    return (partner is not None and bool(partner.suspects)
+            and partner.suspects[-1] - partner.estimate_deg > gate_deg)
+
+
 def holds_agreeing_suspect(partner: SuspectView, value_deg: float, spread_deg: float) -> bool:
     """The knob's other edge, not frozen, last read a suspect (nothing within its gate since)
     within ``spread_deg`` of ``value_deg``, the change this edge just followed on its own
@@ -66,5 +82,5 @@ def holds_agreeing_suspect(partner: SuspectView, value_deg: float, spread_deg: f
             and abs(partner.suspects[-1] - value_deg) <= spread_deg)
 
 
-__all__ = ["EdgeView", "SuspectView", "holds_agreeing_suspect", "partner_left_band",
-           "partner_shows_change"]
+__all__ = ["EdgeView", "OutwardView", "SuspectView", "holds_agreeing_suspect",
+           "holds_outward_suspect", "partner_left_band", "partner_shows_change"]

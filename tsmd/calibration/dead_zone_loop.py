@@ -10,11 +10,7 @@ is where the same rope takes load with the tip on the *other* side's plateau. Th
 minus the full cycle's is the plateau gap: twice the plateau over the release's kinematic
 slope. A unit whose gap is the data-sheet unit's has the sheet's plateau; each degree more moves
 its plateaus out by the sheet's ``plateau_gap_factor / 2`` (tracked flats over gap on the
-sheet's unit, :mod:`tsmd.datasheet_plateau_gap`). The plateau moves alone (session 26): each
-edge slides along its loaded line, which stays where the product's heights put it. Moving the
-lines with the plateau (session 25) shifted each loaded and release line by ~0.93 of the move;
-on snakedent the lines' own offset is the unit's loaded slope (tip slope against the unit's
-omega, +-4 %), not its plateau, so that shift helped some units and cost others.
+sheet's unit, :mod:`tsmd.datasheet_plateau_gap`).
 
 The move (per knob, the other at 0): 0 -> -A, then ``LOOPS_PER_SIDE`` times -A -> 0 -> -A
 (the negative loops), -A -> +A (the full cycle's positive edge), ``LOOPS_PER_SIDE`` times
@@ -30,7 +26,7 @@ from __future__ import annotations
 import itertools
 import math
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -179,17 +175,6 @@ def plateau_shift_deg(gap_deg: float | None, sheet_gap_deg: float | None,
     return 0.5 * float(factor) * (float(gap_deg) - float(sheet_gap_deg))
 
 
-def edges_along_lines(d_pos: Sequence[float], d_neg: Sequence[float], shift_deg: float,
-                      omega: float) -> tuple[list[float], list[float]]:
-    """The edges under plateaus moved out by ``shift_deg`` with the loaded lines kept: the
-    rising line ``H_pos + omega (x - D_pos)`` is unchanged when ``H_pos`` falls by the shift and
-    ``D_pos`` by ``shift / omega`` (the falling side mirrored); no shift: the edges as given."""
-    if shift_deg == 0.0:
-        return list(d_pos), list(d_neg)
-    step = shift_deg / omega
-    return [d - step for d in d_pos], [d + step for d in d_neg]
-
-
 def wants_loop(device: Any) -> bool:
     """Whether the product's sheet opts in: a knob with both loop numbers."""
     return any(getattr(k, "plateau_gap_deg", None) is not None
@@ -250,8 +235,8 @@ def play_loops(runner: TrajectoryRunner, device: Any, options: Any,
             gaps[knob] = gap
             notes.append(f"dead-zone loop {name}: plateau gap {gap:.2f} deg (sides "
                          f"{edges.gap_pos_deg:.2f} / {edges.gap_neg_deg:.2f}; the sheet's "
-                         f"{sheet.plateau_gap_deg:.2f}): plateaus moved out by {shift:+.2f} deg "
-                         "along the loaded lines")
+                         f"{sheet.plateau_gap_deg:.2f}): plateau heights moved out by "
+                         f"{shift:+.2f} deg")
         else:
             notes.append(f"dead-zone loop {name}: no edge read on either side; the sheet's "
                          "plateau heights kept")

@@ -29,9 +29,7 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   and this unit's own edge at 0 deg. Where the sheet opts in to the dead-zone loop
   (``plateau_gap_deg``, ``plateau_gap_factor``), each unit's own plateau moves them apart by
   ``factor (gap - sheet's gap) / 2``, the gap read from its loop's current
-  (:mod:`tsmd.calibration.dead_zone_loop`, session 25), and each edge slides along its loaded
-  line so that the lines stay where the product's heights put them (session 26: the lines'
-  own offset on snakedent is the unit's slope, which the plateau does not show).
+  (:mod:`tsmd.calibration.dead_zone_loop`, session 25).
 
 ``beta`` and ``x0`` scatter from sweep to sweep (``B_A`` by about 1 deg); over the grid they are
 smoothed by a least-squares polynomial in the other knob's angle (degree 2; on three grid points
@@ -52,7 +50,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tsmd.calibration.dead_zone_loop import edges_along_lines, plateau_shift_deg
+from tsmd.calibration.dead_zone_loop import plateau_shift_deg
 from tsmd.calibration.edge_level import edge_level_grid
 from tsmd.calibration.estimate import point_estimates
 from tsmd.calibration.fresh_hold import with_fresh_hold
@@ -217,8 +215,6 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any,
     read = read_gains(k, [s.backlash_unseen for s in order], pos_fits, neg_fits,
                       [s.own_offset_deg for s in order])
     omega = loaded_slope(k, grid, order, pos_fits, neg_fits, read)  # scatter: per sweep
-    # the loop moves the plateau alone: each edge slides along its loaded line (session 26)
-    d_pos, d_neg = edges_along_lines(d_pos, d_neg, shift, omega)
     raw_pos, raw_neg = (smoothed_gains(grid, g) for g in read)
     ratio = release_slope_ratio(k)
     x0_pos, x0_neg = (smooth_over_grid(grid, [f.zero_load_deg for f in fits])

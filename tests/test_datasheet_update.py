@@ -13,6 +13,7 @@ from support.profiles import ROOT
 
 from tsmd.cli import main
 from tsmd.commands.datasheet_sample import sample_units
+from tsmd.compensation.level_grid import LevelGrid
 from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_sample import SAMPLE_KEYS, Readings
 from tsmd.profile import DeviceModel, ProfileError, load_device_model, save_device_fields
@@ -150,3 +151,23 @@ def test_update_with_the_plateau_gap_writes_only_the_loops_fields(
         "+    plateau_gap_deg: 8.5", "+    plateau_gap_factor: 1.3",
         "+    plateau_gap_deg: 9.5", "+    plateau_gap_factor: 1.3"]
     assert any("--plateau-gap" in line for line in changed)
+
+
+def test_update_with_the_level_grid_adds_the_grid_read_under_the_sheet(
+        bare: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    seen: list[DeviceModel] = []
+
+    def fake(device: DeviceModel, config: object, factory: object, seed: int) -> DeviceModel:
+        seen.append(device)
+        grid = LevelGrid((0.0, 60.0), (0.0, -6.5), (0.0, 5.0))
+        knobs = tuple(dataclasses.replace(k, loaded_level_grid=grid) for k in device.knobs)
+        return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_level_grid", fake)
+    out = tmp_path / "new.yaml"
+    assert main(["datasheet", "--update", str(bare), *PLANT, "--level-grid",
+                 "--out", str(out)]) == 0
+    before, after = load_device_model(bare), load_device_model(out)
+    assert seen == [before]
+    assert after == fake(before, None, None, 0)
+    assert "--level-grid" in out.read_text().split("schema_version")[0]

@@ -8,9 +8,11 @@ protocol (the tracker recording the tip alongside); on each sweep, its profile's
 the tip where the model is on a side's loaded branch or its flat, the mean miss per side; per
 other-knob angle the mean over its sweeps, less the miss at the other knob's 0 (where the sheet
 read H). A shift below :data:`MIN_LEVEL_SHIFT_DEG` is taken as none (noise of one unit); a
-product with none at any angle gets no field. An angle where the unit's own profile misses by
-more than :data:`MAX_LEVEL_MISS_DEG` is left out: there the calibration mis-read the unit (an
-edge off by tens of degrees), which is no level of the product.
+product with none at any angle gets no field. An angle whose miss departs by more than
+:data:`MAX_LEVEL_MISS_DEG` from what its neighbours on the grid say is left out: there the
+calibration mis-read the unit (an edge off by tens of degrees), which is no level of the
+product. A level that grows smoothly with the other knob's angle is kept however large
+(pronyring's pull ring, session 26: 11-17 deg at the other knob's +-90, every angle read right).
 """
 
 from __future__ import annotations
@@ -41,8 +43,9 @@ MIN_LEVEL_SHIFT_DEG = 1.0
 applied: two calibrations of nitinol's sheet unit (noise seeds 0 and 2000) read the same shift
 0.4-0.7 deg apart, and lumped's unit 0 reads at most 0.77."""
 MAX_LEVEL_MISS_DEG = 10.0
-"""A side's miss beyond this at an angle is a mis-read profile there, not a level: the angle is
-left out of the grid (the shifts interpolate across it)."""
+"""A side's miss this far from its neighbours' (:func:`misread_angles`) is a mis-read profile
+there, not a level: the angle is left out of the grid (the shifts interpolate across it). With
+fewer than three angles there are no neighbours to go by and the miss itself is held to it."""
 SETTLE_FRACTION = 0.3
 """The first part of each sweep is left out: the knob's first loading from rest."""
 NEAR_SIDE_DEG = 5.0
@@ -75,6 +78,37 @@ def side_misses(sweep: TrackedSweep, tension: TensionPlayParams) -> tuple[float,
     return out[0], out[1]
 
 
+def misread_angles(misses: dict[float, FloatArray]) -> set[float]:
+    """Grid angles whose (positive, negative side) miss departs by more than
+    :data:`MAX_LEVEL_MISS_DEG` from the median of itself and its two neighbours on the grid; an
+    end, judged after the inner angles, from the median of itself, the nearest inner angle kept
+    and the line through the nearest two kept, carried out to it. A level the other plane's
+    load sets grows smoothly over the angles, so the median follows it; one angle's mis-read
+    edge stands alone. With fewer than three angles: those whose miss itself exceeds the
+    limit."""
+    angles = sorted(misses)
+    m = np.asarray([misses[a] for a in angles], dtype=float).reshape(len(angles), -1)
+    if len(angles) < 3:
+        return {a for a, row in zip(angles, m, strict=True)
+                if np.max(np.abs(row)) > MAX_LEVEL_MISS_DEG}
+
+    def off(i: int, trio: FloatArray) -> bool:
+        return bool(np.max(np.abs(m[i] - np.median(trio, axis=0))) > MAX_LEVEL_MISS_DEG)
+
+    last = len(angles) - 1
+    out = {i for i in range(1, last) if off(i, m[i - 1:i + 2])}
+    x = np.asarray(angles, dtype=float)
+    for i, inner in ((0, range(1, last + 1)), (last, range(last - 1, -1, -1))):
+        kept = [j for j in inner if j not in out][:2]
+        if len(kept) < 2:
+            continue
+        j, k = kept
+        line = m[j] + (m[j] - m[k]) * (x[i] - x[j]) / (x[j] - x[k])
+        if off(i, np.stack([m[i], m[j], line])):
+            out.add(i)
+    return {angles[i] for i in out}
+
+
 def level_grid(sweeps: Sequence[tuple[float, TrackedSweep]], tension: TensionPlayParams
                ) -> LevelGrid | None:
     """The product's shifts from the sheet unit's tracked sweeps ``(other knob's grid angle,
@@ -84,8 +118,9 @@ def level_grid(sweeps: Sequence[tuple[float, TrackedSweep]], tension: TensionPla
     for other, sweep in sweeps:
         by_angle[float(other)].append(side_misses(sweep, tension))
     mean = {a: np.nanmean(np.asarray(m), axis=0) for a, m in by_angle.items()}
-    mean = {a: m for a, m in mean.items()
-            if np.all(np.isfinite(m)) and np.max(np.abs(m)) <= MAX_LEVEL_MISS_DEG}
+    mean = {a: m for a, m in mean.items() if np.all(np.isfinite(m))}
+    misread = misread_angles(mean)
+    mean = {a: m for a, m in mean.items() if a not in misread}
     if 0.0 not in mean or len(mean) < 2:
         return None
     angles = sorted(mean)

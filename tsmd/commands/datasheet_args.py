@@ -77,7 +77,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--level-grid", action="store_true",
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "how far each side's loaded level moves with the other knob's angle "
-                             "(loaded_level_grid; opt-in per product, docs/model.md Session 21)")
+                             "(loaded_level_grid; opt-in per product, docs/model.md Session 21; "
+                             "with --update: added to that sheet, measured under it, session 26)")
     parser.add_argument("--plateau-gap", action="store_true",
                         help="with --plant: also play the dead-zone loop on the sheet's unit and "
                              "write its plateau gap and flats per gap degree (plateau_gap_deg, "

@@ -28,6 +28,7 @@ from tsmd.commands.datasheet_stick import (
 )
 from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
+from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
 from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
 from tsmd.profile import DeviceModel, load_device_model, save_device_fields, save_device_model
@@ -105,11 +106,12 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         raise DatasheetError("--update needs --plant (and --params) of the sheet's unit: the "
                              "sample is tracked on the simulated rig")
     loop = bool(args.plateau_gap)
-    whole = args.stick_end or args.settle_gain_check  # nested or new fields: written whole
+    # nested or new fields: written whole
+    whole = args.stick_end or args.settle_gain_check or args.level_grid
     if args.unit_sample is None and not loop and not whole:
-        raise DatasheetError("--update adds the sample's part, the loop's, the stick end or the "
-                             "settle-gain check: give --unit-sample, --plateau-gap, --stick-end "
-                             "or --settle-gain-check")
+        raise DatasheetError("--update adds the sample's part, the loop's, the stick end, the "
+                             "settle-gain check or the level grid: give --unit-sample, "
+                             "--plateau-gap, --stick-end, --settle-gain-check or --level-grid")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
@@ -121,6 +123,9 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         device = with_stick_choice(device, config, args.plant, params, seeds)
     if args.settle_gain_check:
         device = with_settle_gain_check(device, config, args.plant, params, seeds)
+    if args.level_grid:  # read under the sheet's own choices, as every unit is calibrated
+        device = with_level_grid(device, config, lambda: load_plant(args.plant, params),
+                                 args.seed)
     updated = (with_sample(device, config, args.plant, params, args.unit_key, units, seed)
                if units else device)
     keys: tuple[str, ...] = SAMPLE_KEYS if units else ()
@@ -136,10 +141,13 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                + (" --plateau-gap" if loop else "")
                + (" --stick-end" if args.stick_end else "")
                + (" --settle-gain-check" if args.settle_gain_check else "")
-               + (f" --rule-seeds {','.join(map(str, seeds))}" if whole else "") + " --out FILE")
+               + (f" --level-grid --seed {args.seed}" if args.level_grid else "")
+               + (f" --rule-seeds {','.join(map(str, seeds))}"
+                  if args.stick_end or args.settle_gain_check else "") + " --out FILE")
     if whole:
         fields = ((["backlash_stick_end", "reading_offset"] if args.stick_end else [])
-                  + (["settle_gain_read"] if args.settle_gain_check else []) + list(keys))
+                  + (["settle_gain_read"] if args.settle_gain_check else [])
+                  + (["loaded_level_grid"] if args.level_grid else []) + list(keys))
         save_device_model(updated, args.out, source_header(source) + (
             f"\n{', '.join(fields)} measured by tsmd {__version__} (no other field changed):"
             f"\n  {command}"))

@@ -52,6 +52,10 @@ class ProtocolDesign:
     other_deg: float = 50.0
     """Where the other knob is held in the coupling test (0, +, -)."""
     dwell_amp_deg: float = 60.0
+    heavy_amp_deg: float = 0.0
+    """When above 0, the warm-up ends with two cycles of both knobs at this amplitude: slow
+    reversals at a third, heavier load, for a compliance figure from loads further apart while
+    the light pair keeps testing its premise (docs/gap.md "Session 26"; 0: no such cycles)."""
     dwell_s: float = 20.0
     rest_s: float = 10.0
     settle_s: float = 1.0
@@ -127,9 +131,10 @@ def protocol(rate_hz: float, design: ProtocolDesign | None = None) -> tuple[
     b = _Builder(rate_hz)
     amp = lattice_amp(p.amp_deg, (p.fast_deg_s,), rate_hz)
     # warm-up: the start from a straight catheter is a state no later motion returns to
-    for _ in range(2):
-        b.ramp((p.dwell_amp_deg, p.dwell_amp_deg), p.coupling_deg_s)
-        b.ramp((-p.dwell_amp_deg, -p.dwell_amp_deg), p.coupling_deg_s)
+    for amp_warm in (p.dwell_amp_deg, p.heavy_amp_deg):
+        for _ in range(2 if amp_warm > 0.0 else 0):
+            b.ramp((amp_warm, amp_warm), p.coupling_deg_s)
+            b.ramp((-amp_warm, -amp_warm), p.coupling_deg_s)
     b.ramp((0.0, 0.0), p.coupling_deg_s)
     for rep, name in enumerate(("slow", "fast", "fast", "slow")):
         speed = p.slow_deg_s if name == "slow" else p.fast_deg_s

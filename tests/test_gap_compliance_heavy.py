@@ -75,3 +75,10 @@ def test_a_played_light_load_still_sends_the_sheet_to_the_release(
     monkeypatch.setattr(compliance, "CONTRAST_LEVELS_DEG", (40.0, 75.0))
     sheet = compliance.sheet_from_units(units)
     assert sheet is not None and sheet.figure == "release"
+
+
+def test_the_heavy_cycles_leave_every_earlier_sample_as_it_was() -> None:
+    default, heavy = protocol(RATE_HZ), protocol(RATE_HZ, HEAVY)
+    n = len(default[0])
+    np.testing.assert_array_equal(heavy[1][:n], default[1])
+    np.testing.assert_array_equal(heavy[2][:n], default[2])

@@ -1,6 +1,7 @@
 """The blind plants as the data of the cross-plant self-test: their presets (cyclopebax, session
 21; snakedent, session 22; planetwist, session 23, none with a time law at the tip; notchclutch,
-session 24, whose braid stiffens with strain rate and whose liner soaks)."""
+session 24, whose braid stiffens with strain rate and whose liner soaks; pronyring, session 25,
+whose Pebax section relaxes with a Prony spectrum)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,8 @@ from simrig.plants.cyclopebax.params import CycloPebaxKnob
 from simrig.plants.notchclutch.params import NotchClutchKnob
 from simrig.plants.notchclutch.plant import NotchClutchPlant
 from simrig.plants.planetwist import PlanetTwistKnob, PlanetTwistPlant
+from simrig.plants.pronyring.params import KnobConstants as PronyRingKnob
+from simrig.plants.pronyring.plant import PronyRingPlant
 from simrig.plants.snakedent import SnakeDentKnob, SnakeDentPlant
 from tsmd.gap.presets import PRESETS, parse_plant_spec
 from tsmd.gap.selftest import drive_plant, trajectory
@@ -23,7 +26,8 @@ from tsmd.gap.selftest import drive_plant, trajectory
 BLIND = [("cyclopebax", CycloPebaxPlant, CycloPebaxKnob),
          ("snakedent", SnakeDentPlant, SnakeDentKnob),
          ("planetwist", PlanetTwistPlant, PlanetTwistKnob),
-         ("notchclutch", NotchClutchPlant, NotchClutchKnob)]
+         ("notchclutch", NotchClutchPlant, NotchClutchKnob),
+         ("pronyring", PronyRingPlant, PronyRingKnob)]
 NAMES = [name for name, _plant, _knob in BLIND]
 TIMELESS = ["cyclopebax", "snakedent", "planetwist"]
 """The blind plants with no law of speed or time at the tip."""
@@ -46,6 +50,7 @@ TAKEUP: dict[str, tuple[Callable[[Any], list[float]], set[str]]] = {
     "snakedent": (_share_keyword, set()),
     "planetwist": (_takeup_constant, {"cross_takeup"}),
     "notchclutch": (_takeup_keyword, set()),
+    "pronyring": (_takeup_keyword, set()),
 }
 """How strongly the other plane's bend takes up a plane's ropes, per plant, and which knob
 constants the coupling case may change (a keyword on cyclopebax and snakedent, planetwist's own
@@ -106,14 +111,22 @@ def test_rate_and_creep_are_not_run(name: str) -> None:
         assert preset.supports(case)
 
 
-def test_notchclutchs_rate_stiffens_the_braid_and_its_creep_soaks_the_liner_slower() -> None:
-    preset = PRESETS["notchclutch"]
+TIME_LAWS = {"notchclutch": (("rate", "rate_stiffening", 4.0), ("creep", "soak_time_s", 4.0)),
+             "pronyring": (("rate", "prony_fast_Nmm_per_rad", 2.0),
+                           ("creep", "prony_slow_Nmm_per_rad", 1.5))}
+"""The blind plants with a law of speed or time at the tip: per case the one knob constant it
+scales, and the least factor."""
+
+
+@pytest.mark.parametrize("name", sorted(TIME_LAWS))
+def test_rate_and_creep_each_scale_one_law_of_speed_or_time(name: str) -> None:
+    preset = PRESETS[name]
     none = preset.build_unit(102, 0.1)
-    for case, constant in (("rate", "rate_stiffening"), ("creep", "soak_time_s")):
+    for case, constant, least in TIME_LAWS[name]:
         assert preset.supports(case)
         changed = preset.build_unit(102, 0.1, case, **preset.case_effects(case))
         for k in (0, 1):
-            assert getattr(changed.knobs[k], constant) > 4.0 * getattr(none.knobs[k], constant)
+            assert getattr(changed.knobs[k], constant) > least * getattr(none.knobs[k], constant)
             kept = {constant: getattr(none.knobs[k], constant)}
             assert dataclasses.replace(changed.knobs[k], **kept) == none.knobs[k]
         assert changed.coupling == none.coupling == 0.0
@@ -121,7 +134,7 @@ def test_notchclutchs_rate_stiffens_the_braid_and_its_creep_soaks_the_liner_slow
 
 @pytest.mark.parametrize(("name", "case"),
                          [(n, c) for n in NAMES for c in ("coupling", "compliance", "curvature")]
-                         + [("notchclutch", "rate"), ("notchclutch", "creep")])
+                         + [(n, c) for n in sorted(TIME_LAWS) for c in ("rate", "creep")])
 def test_each_case_moves_the_tip_beyond_the_trackers_noise(name: str, case: str) -> None:
     preset = PRESETS[name]
     _t, q = trajectory(30.0, 50.0)

@@ -2,22 +2,19 @@
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 
 import numpy as np
 import pytest
+from support.gap_play import play_at_light_load
 
 from tsmd.gap import compliance
 from tsmd.gap.crosstest import make_session
 from tsmd.gap.data import GapSeries, series_from_recording
 from tsmd.gap.presets import PRESETS
-from tsmd.gap.reversal import TRAVEL_GRID_DEG, Reversals, _after, _reversal_pairs
+from tsmd.gap.reversal import TRAVEL_GRID_DEG, Reversals
 
 RATE_HZ = 50.0
-PLAY_DEG = 5.0
-"""A geared handle's play crossed before the tip returns from the light load only (warmgear:
-4.3 deg of knob, more than its lost motion grows from 40 to 60 deg)."""
 
 
 @functools.cache
@@ -28,25 +25,8 @@ def _series(unit: int, case: str = "none") -> tuple[GapSeries, ...]:
                  for i, r in enumerate(recs) if "segments" in r.metadata)
 
 
-def _play_at_light_load(series: tuple[GapSeries, ...]) -> list[GapSeries]:
-    """Knob 1's tip returns from its + side's 40 deg reversals only after the knob has crossed
-    :data:`PLAY_DEG` more (the drum held by its friction while the pinion crosses the play);
-    the delay fades out between 20 and 30 deg of travel, before the next reversal."""
-    out = []
-    for s in series:
-        x, tip = s.knob_deg[:, 0], s.tip_deg.copy()
-        for a, b in _reversal_pairs(x):
-            if abs(x[a] - 40.0) > compliance.LEVEL_BAND_DEG:
-                continue
-            travel, end = _after(x, a, b)
-            delay = PLAY_DEG * np.clip((30.0 - travel) / 10.0, 0.0, 1.0)
-            tip[a:end, 0] = np.interp(travel - delay, travel, s.tip_deg[a:end, 0])
-        out.append(dataclasses.replace(s, tip_deg=tip))
-    return out
-
-
 def _units(with_play: bool) -> list[list[GapSeries]]:
-    five = _play_at_light_load(_series(5)) if with_play else list(_series(5))
+    five = play_at_light_load(_series(5)) if with_play else list(_series(5))
     return [list(_series(0)), five, list(_series(6))]
 
 

@@ -169,6 +169,21 @@ def test_pronyring_is_registered_last_and_held_out() -> None:
     assert isinstance(load_plant(SPEC), PronyRingPlant)
 
 
+def test_the_coupling_keyword_takes_up_the_ropes_by_the_other_planes_bend() -> None:
+    path = ramp_deg(0.0, 80.0)
+    plain, _ = drive_knob(make_pronyring_plant(), 0, path)
+    keyed, _ = drive_knob(make_pronyring_plant(coupling=0.6), 0, path)
+    # the other knob at 0: its ropes, taken up by this plane's bend, only load the ring's seat
+    np.testing.assert_allclose(keyed, plain, atol=0.3)
+    loops = []
+    for coupling in (0.0, 0.6):
+        plant = make_pronyring_plant(coupling=coupling)
+        drive_knob(plant, 1, ramp_deg(0.0, 80.0))
+        tip, _ = drive_knob(plant, 0, path, other_deg=80.0)
+        loops.append(tip)
+    assert loops[1][-1] - loops[0][-1] > 2.0  # taken-up slack: the tip bends further
+
+
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
@@ -179,6 +194,8 @@ def test_pronyring_is_registered_last_and_held_out() -> None:
         ({"knobs": [{"contact_fraction": 1.0}, {}]}, "contact_fraction must be in"),
         ({"knobs": [{"prony_mid_s": math.nan}, {}]}, "prony_mid_s must be finite"),
         ({"sheath_curvature_deg": math.inf}, "sheath_curvature_deg must be finite"),
+        ({"coupling": -0.1}, "coupling must be >= 0"),
+        ({"coupling": math.nan}, "coupling must be finite"),
     ],
 )
 def test_bad_constants_are_refused_with_one_clear_line(kwargs: dict[str, object],

@@ -58,6 +58,12 @@ LEVELS_DEG = (ProtocolDesign.amp_deg, ProtocolDesign.dwell_amp_deg)
 """The two loads compared: reversals at the protocol's loop and dwell amplitudes (the
 constant part of the lost motion, slack and the joints' presliding, cancels); taken from the
 protocol's design, so that moving its dwells moves the figure's heavier load with them."""
+CONTRAST_LEVELS_DEG = LEVELS_DEG
+"""The two loads of the load contrast. :data:`LEVELS_DEG` unless the protocol adds a heavier
+load (``ProtocolDesign.heavy_amp_deg``): then the light load against it, while the premise
+(:func:`load_growth`) and the release stay on :data:`LEVELS_DEG`, where a geared handle's play
+shows (with the heavy load alone the premise no longer fires on warmgear, and its release at 75
+deg scatters more: docs/gap.md "Session 26"). Off by default: (40, 60)."""
 LEVEL_BAND_DEG = 2.0
 MIN_PER_LEVEL = 3
 """Repeats at each load and side for a figure (the jackknife needs a few)."""
@@ -176,9 +182,10 @@ def _contrast(r: Reversals, rows: NDArray[np.int64], with_var: bool = False,
     side = np.sign(r.at_deg[rows])
     total = np.zeros(4)
     found = False
+    levels = LEVELS_DEG if figure == "release" else CONTRAST_LEVELS_DEG
     for s in (1.0, -1.0):
         groups = [rows[(np.abs(amp - level) <= LEVEL_BAND_DEG) & (side == s)]
-                  for level in LEVELS_DEG]
+                  for level in levels]
         if min(len(g) for g in groups) < min_per_group:
             continue
         if figure == "release":

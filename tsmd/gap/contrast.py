@@ -381,7 +381,7 @@ def _collect(s: GapSeries, res: FloatArray, tests: dict[str, TestData]) -> None:
 def _drift(data: TestData) -> Drift:
     """Loaded-minus-unloaded dwell slopes per repeat and current channel, then each tip's
     relaxation toward its unloaded position (:func:`tsmd.gap.dwell.tip_relaxation`)."""
-    diffs, vars_, spans = [], [], []
+    diffs, vars_, spans, sides = [], [], [], []
     for rep in sorted({r for _, r in data.dwells}):
         loaded, unloaded = data.dwells.get(("loaded", rep)), data.dwells.get(("unloaded", rep))
         if loaded is None or unloaded is None:
@@ -401,9 +401,10 @@ def _drift(data: TestData) -> Drift:
         diffs.append(row_d)
         vars_.append(row_v)
         spans.append(float(tl[-1] - tl[0]))
+        sides.append(signs)
     return Drift(np.array(diffs, dtype=float).reshape(len(diffs), -1),
                  np.array(vars_, dtype=float).reshape(len(vars_), -1),
-                 np.array(spans, dtype=float))
+                 np.array(spans, dtype=float), np.array(sides, dtype=float).reshape(-1, 2))
 
 
 def segments_present(series: Sequence[GapSeries]) -> bool:

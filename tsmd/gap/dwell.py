@@ -31,6 +31,8 @@ class Drift:
     diff: FloatArray  # (pairs, channels) loaded minus unloaded slope
     var: FloatArray
     span_s: FloatArray  # (pairs,) how long each loaded dwell is compared
+    load_sign: FloatArray | None = None
+    """(pairs, 2): the side each knob's loaded dwell loads (the sign of its knob angle)."""
 
     def columns(self, part: slice) -> Drift:
         """The same pairs, only the channels in ``part``."""

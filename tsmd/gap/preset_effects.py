@@ -393,3 +393,36 @@ NOTCHCLUTCH_MAX_STEP_S = 0.0
 0.17 (2.1) at 4 ms (unit 2 0.20 / 0.16; 120 s of the experiment motion): the rate laws use the
 previous step's strain rate and film speed and the wall's hold sticks where the step leaves it,
 so a finer step buys little, as on cyclopebax."""
+
+
+PRONYRING_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"coupling": 0.6},
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The pronyring plant's effect keywords, sized before any diagnosis (tip RMSE effect on minus
+off, units 1 / 2, noise-free, 120 s of the experiment motion at 50 Hz): the other plane's bend
+taking up both ropes (``coupling`` 0.6, the plant's keyword added for this preset: rope lumens
+set off their plane at the ring, 0.6 x offset x other^2 / 2 mm), 1.13 / 1.64 deg (0.4 0.72 /
+1.01, 0.7 1.36 / 2.02; the others' coupling 1.5 deg; the ring's anchor clocking x8 gives 1.09 /
+0.76 deg but turns the ring's own tilt as well, 0.24-0.29 deg with the other knob held at 0); a
+120 deg sheath bend (the shaft's anterior-posterior bend and every rope's wrap), 5.76 / 5.96 deg
+(60 deg 2.99 / 3.05), inside the others' 1.1-12.8 deg. The section's Prony relaxation, the
+ring's tilt, set-back and seat friction, the liner's load-dependent friction and the breathing
+are base physics; "none" is the nominal physics as written (docs/gap.md "Session 26")."""
+
+PRONYRING_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "rate": {"prony_fast_Nmm_per_rad": 2.5},
+    "compliance": {"tendon_stiffness_N": 0.5},
+    "creep": {"prony_slow_Nmm_per_rad": 1.75},
+}
+"""Pronyring effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion, units 1 / 2): rate is the section's fast Prony branch (3 s) 2.5 times as stiff (the
+section stiffer the faster it is bent), 1.34 / 1.76 deg (x2 0.93 / 1.22, x3 1.73 / 2.27; the
+others' rate 1.1-1.9 deg); the rope's EA halved, 5.59 / 6.49 deg; creep (read as drift: time in
+the run) is the slow branch (400 s) 1.75 times as stiff, 0.37 / 0.45 deg (x1.5 0.25 / 0.30, x2
+0.49 / 0.60; the others' creep 0.35-0.43 deg)."""
+
+PRONYRING_MAX_STEP_S = 0.0
+"""No finer stepping: unit 1's tip lies 0.059 deg RMS (0.39 max) from 0.25 ms steps at 20 ms,
+0.012 (0.08) at 4 ms (unit 2 0.064 (0.52) / 0.012): the Prony branches are advanced implicitly
+and the rope contacts in closed form."""

@@ -40,6 +40,9 @@ from tsmd.gap.preset_effects import (
     PLANETWIST_EFFECTS,
     PLANETWIST_KNOB_EFFECTS,
     PLANETWIST_MAX_STEP_S,
+    PRONYRING_EFFECTS,
+    PRONYRING_KNOB_EFFECTS,
+    PRONYRING_MAX_STEP_S,
     RATESTATE_EFFECTS,
     RATESTATE_KNOB_EFFECTS,
     RATESTATE_MAX_STEP_S,
@@ -182,6 +185,9 @@ PRESETS: dict[str, PlantSpec] = {
                              family="notchclutch", effects=NOTCHCLUTCH_EFFECTS,
                              knob_effects=NOTCHCLUTCH_KNOB_EFFECTS,
                              max_step_s=NOTCHCLUTCH_MAX_STEP_S),
+    "pronyring": PlantSpec(PLANT_SPECS["pronyring"], {}, (), "pronyring", family="pronyring",
+                           effects=PRONYRING_EFFECTS, knob_effects=PRONYRING_KNOB_EFFECTS,
+                           max_step_s=PRONYRING_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

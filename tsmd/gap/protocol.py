@@ -52,6 +52,12 @@ class ProtocolDesign:
     other_deg: float = 50.0
     """Where the other knob is held in the coupling test (0, +, -)."""
     dwell_amp_deg: float = 60.0
+    heavy_amp_deg: float = 0.0
+    """When above 0, the protocol ends with two cycles of both knobs at this amplitude: slow
+    reversals at a third, heavier load, for a compliance figure from loads further apart while
+    the usual pair keeps testing its premise; appended, so every earlier sample is as without
+    them (in the warm-up they changed the 60 deg reversals' history and warmgear's release
+    spread; docs/gap.md "Session 26"). 0: no such cycles."""
     dwell_s: float = 20.0
     rest_s: float = 10.0
     settle_s: float = 1.0
@@ -149,6 +155,11 @@ def protocol(rate_hz: float, design: ProtocolDesign | None = None) -> tuple[
         b.dwell(p.dwell_s, b.segment(Segment("creep", "loaded", rep, -1)), p.settle_s)
         b.ramp((0.0, 0.0), p.coupling_deg_s)
         b.dwell(p.rest_s, b.segment(Segment("creep", "unloaded", rep, -1)), p.settle_s)
+    if p.heavy_amp_deg > 0.0:  # appended: every earlier sample stays as it was
+        for _ in range(2):
+            b.ramp((p.heavy_amp_deg, p.heavy_amp_deg), p.coupling_deg_s)
+            b.ramp((-p.heavy_amp_deg, -p.heavy_amp_deg), p.coupling_deg_s)
+        b.ramp((0.0, 0.0), p.coupling_deg_s)
     q = np.vstack(b.q)
     t = np.arange(len(q), dtype=float) * b.dt
     return t, q, np.concatenate(b.label), b.table

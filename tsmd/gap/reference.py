@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from tsmd.gap.compliance import ComplianceSheet
 from tsmd.gap.data import GapSeries
-from tsmd.gap.dwell import Drift
+from tsmd.gap.dwell import CURRENT_COLUMNS, Drift
 from tsmd.gap.loops import Loops, contrast_of
 
 FloatArray = NDArray[np.float64]
@@ -131,13 +131,26 @@ def own_scale(measured: FloatArray, own: FloatArray) -> float:
     return float(np.clip((measured * own).sum() / norm, 0.0, 1.0))
 
 
+ONE_SIDED_CREEP = False
+"""When True, the currents' drift beyond the model's own is read one-sided, as the tips' is
+(:func:`tsmd.gap.dwell.tip_relaxation`): only a held knob's current relaxing *faster* than the
+model's units' is creep. A unit whose current relaxes more slowly (a softer rope in front of a
+section that relaxes: the blind pronyring plant's compliance case, docs/gap.md "Session 26")
+does not creep more. Off by default until the cross-plant self-test has run with it."""
+
+
 def drift_beyond_reference(res: Drift, meas: Drift,
                            creep: tuple[FloatArray, FloatArray] | None) -> Drift:
     """The residual's dwell slopes less the model's own: the measured slopes minus the
-    reference's, pair by pair, their variances added. Unchanged without a reference or when
+    reference's, pair by pair, their variances added (with :data:`ONE_SIDED_CREEP`, the
+    currents' part toward a smaller load only, else 0). Unchanged without a reference or when
     the dwells differ."""
     if creep is None or not (meas.diff.shape == res.diff.shape == creep[0].shape):
         return res
     own, own_var = creep
-    return Drift(meas.diff - own, res.var + own_var, res.span_s)
+    beyond = meas.diff - own
+    if ONE_SIDED_CREEP and meas.load_sign is not None:
+        currents = beyond[:, CURRENT_COLUMNS]
+        beyond[:, CURRENT_COLUMNS] = np.maximum(-meas.load_sign * currents, 0.0)
+    return Drift(beyond, res.var + own_var, res.span_s)
 

@@ -14,7 +14,9 @@ its bracket finds it in a few steps. The ring rides in the section's lumen: its 
 bend until the imbalance exceeds a friction moment proportional to the ring's axial load. The
 planes couple through the shared pull ring (the other plane's moment, one step old, tilts the
 ring by the anchors' clocking; all four distal tensions, one step old, push the ring back and
-take up every rope, and press its seat).
+take up every rope, and press its seat). ``coupling`` (0: as written) adds a take-up of both
+ropes of a plane by the other plane's bend, ``coupling x offset x other^2 / 2`` (rope lumens set
+off their plane: the self-test's coupling case).
 """
 
 from __future__ import annotations
@@ -74,9 +76,12 @@ class _Plane:
 class PronyRingPlant:
     """A TEE-sized probe: Pebax section with creep, tilting pull ring, PTFE ropes (see module)."""
 
-    def __init__(self, knobs: Sequence[KnobConstants], sheath_curvature_deg: float = 0.0) -> None:
+    def __init__(self, knobs: Sequence[KnobConstants], sheath_curvature_deg: float = 0.0,
+                 coupling: float = 0.0) -> None:
         self.knobs = tuple(knobs)
         self.sheath_curvature_deg = sheath_curvature_deg
+        self.coupling = coupling
+        """Take-up of both ropes by the other plane's bend (mm per mm of offset per rad^2 / 2)."""
         self.slack_delta_mm = [[0.0, 0.0], [0.0, 0.0]]
         self.planes = [_Plane(k) for k in self.knobs]
         self.t_s = 0.0
@@ -106,23 +111,26 @@ class PronyRingPlant:
         breath_rad = math.sin(2.0 * math.pi * BREATHING_HZ * self.t_s) * _DEG
         cross = (-p0.tilt_sin * p1.moment_Nmm / p1.k.ring_tilt_Nmm_per_rad,
                  p1.tilt_sin * p0.moment_Nmm / p0.k.ring_tilt_Nmm_per_rad)
+        other_rad = (p1.theta, p0.theta)
         tips = [0.0, 0.0]
         torques = [0.0, 0.0]
         for i, plane in enumerate(self.planes):
             k = plane.k
             shaft_bend_rad = (k.breathing_wrap_deg * breath_rad
                               + (self.sheath_curvature_deg * _DEG if i == 0 else 0.0))
+            takeup_mm = self.coupling * k.tendon_offset_mm * other_rad[i] ** 2 / 2.0
             tips[i], torques[i] = self._plane_step(
                 plane, dt_s, q[i], cross[i], seat_N,
-                shaft_bend_rad, self.slack_delta_mm[i])
+                shaft_bend_rad, self.slack_delta_mm[i], takeup_mm)
         return PlantStep(np.array(tips), np.array(torques))
 
     def _plane_step(self, plane: _Plane, dt_s: float, knob_deg: float, cross_tilt_rad: float,
-                    seat_N: float, shaft_bend_rad: float, slack_delta: Sequence[float]
+                    seat_N: float, shaft_bend_rad: float, slack_delta: Sequence[float],
+                    takeup_mm: float = 0.0
                     ) -> tuple[float, float]:
         k = plane.k
         r_t = k.tendon_offset_mm
-        setback_mm = seat_N / k.ring_axial_N_per_mm
+        setback_mm = seat_N / k.ring_axial_N_per_mm - takeup_mm  # the taken-up rope is shorter
         drum = k.drum_radius_mm * knob_deg * _DEG
         drum_mm = (drum - k.slack_pos_mm - slack_delta[0], -drum - k.slack_neg_mm - slack_delta[1])
         shift_mm = k.shaft_offset_mm * shaft_bend_rad
@@ -195,8 +203,13 @@ def _finite(name: str, value: Any) -> float:
 
 
 def make_pronyring_plant(knobs: Sequence[dict[str, Any]] | None = None,
-                         sheath_curvature_deg: float = 0.0) -> PronyRingPlant:
-    """The nominal pronyring catheter, each knob's constants overridable by name."""
+                         sheath_curvature_deg: float = 0.0,
+                         coupling: float = 0.0) -> PronyRingPlant:
+    """The nominal pronyring catheter, each knob's constants overridable by name; ``coupling``
+    takes up both ropes of a plane by the other plane's bend (0: as written)."""
+    take_up = _finite("coupling", coupling)
+    if take_up < 0.0:
+        raise PlantLoadError(f"pronyring coupling must be >= 0, got {coupling!r}")
     if knobs is None:
         knobs = [{}, {}]
     if len(knobs) != 2:
@@ -206,4 +219,4 @@ def make_pronyring_plant(knobs: Sequence[dict[str, Any]] | None = None,
         values = {f: getattr(nominal, f) for f in nominal.__dataclass_fields__}
         values.update(given)
         built.append(knob_constants(values))
-    return PronyRingPlant(built, _finite("sheath_curvature_deg", sheath_curvature_deg))
+    return PronyRingPlant(built, _finite("sheath_curvature_deg", sheath_curvature_deg), take_up)

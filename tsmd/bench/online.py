@@ -17,6 +17,10 @@ estimator sees only commanded and actual position and current. Per unit:
   knobs) online on and off: each edge's largest offset against the calibration's uncertainty,
   and the tracking of both runs.
 
+``--start calibrated`` (the default, session 26): every run goes on from a copy of the plant
+its calibration left (:mod:`tsmd.bench.online_start`), as a probe calibrated in the patient is
+used soaked and warm; ``fresh``: a newly built plant (dry, cold), as until session 25.
+
 ``--bend-relation daemon`` (the default): the worker gets the data sheet's bend relation when
 the sheet carries one and none otherwise, as the daemon's does. ``sheet``: a sheet without one
 gets it measured on unit 0 as ``tsmd datasheet --bend-relation`` would

@@ -10,7 +10,8 @@ import pytest
 from simrig.family import PLANT_SPECS
 from simrig.scenario import ShapeChange
 from tsmd.bench import online
-from tsmd.bench.online import add_arguments, make_unit, mixed_motion, reversal_times, shape_change
+from tsmd.bench.online import add_arguments, mixed_motion, reversal_times, shape_change
+from tsmd.bench.online_units import make_unit
 from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.errors import TsmdError
 

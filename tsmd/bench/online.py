@@ -17,6 +17,10 @@ estimator sees only commanded and actual position and current. Per unit:
   knobs) online on and off: each edge's largest offset against the calibration's uncertainty,
   and the tracking of both runs.
 
+``--start calibrated`` (the default, session 26): every run goes on from a copy of the plant
+its calibration left (:mod:`tsmd.bench.online_start`), as a probe calibrated in the patient is
+used soaked and warm; ``fresh``: a newly built plant (dry, cold), as until session 25.
+
 ``--bend-relation daemon`` (the default): the worker gets the data sheet's bend relation when
 the sheet carries one and none otherwise, as the daemon's does. ``sheet``: a sheet without one
 gets it measured on unit 0 as ``tsmd datasheet --bend-relation`` would
@@ -45,7 +49,8 @@ from simrig.family import PLANT_ROLE, PLANT_SPECS
 from simrig.scenario import ShapeChange
 from tsmd.bench.cache_key import keyed_cache
 from tsmd.bench.online_bend import product_bend_relation
-from tsmd.bench.online_units import calibrated, device_for, make_unit, shape_change
+from tsmd.bench.online_start import STARTS, calibrated_with_plant, run_plant
+from tsmd.bench.online_units import calibrated, device_for, shape_change
 from tsmd.calibration.errors import CalibrationRefusedError
 from tsmd.compensation import build_compensator
 from tsmd.errors import TsmdError
@@ -76,28 +81,42 @@ def rmse(rec: Any, knob: int, t0: float, t1: float = math.inf) -> float:
     return float(np.sqrt(np.mean(e * e)))
 
 
+def unit_profile(args: argparse.Namespace, unit: int, change: dict[str, Any] | None,
+                 device: Any, label: str) -> tuple[Any, Any]:
+    """The unit's calibrated profile and, for ``--start calibrated``, the plant the calibration
+    left (None for ``--start fresh``, which needs only the profile)."""
+    cache = Path(args.cache)
+    if args.start == "fresh":
+        return calibrated(args.plant, unit, change, device, cache, label), None
+    return calibrated_with_plant(args.plant, unit, change, device, cache, label)
+
+
 def change_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, Any]:
 
     change = shape_change(args.change)
-    cache = Path(args.cache)
-    before = calibrated(args.plant, unit, None, device, cache, "straight")
+    before, before_plant = unit_profile(args, unit, None, device, "straight")
     try:
-        fresh = calibrated(args.plant, unit, change, device, cache,
-                           args.change.replace(":", "-"))
+        fresh, fresh_plant = unit_profile(args, unit, change, device,
+                                          args.change.replace(":", "-"))
     except CalibrationRefusedError as exc:  # reported, compared with before the change only
-        fresh, refused = None, str(exc)
+        fresh, fresh_plant, refused = None, None, str(exc)
     else:
         refused = ""
     t, q = mixed_motion(args.change_at + args.after_s, args.seed)
     at = args.change_at
     t0 = time.perf_counter()
-    rec_on, worker = run(before, make_unit(args.plant, unit, [ShapeChange(at, change)]),
+    rec_on, worker = run(before, run_plant(args.start, args.plant, unit, before_plant,
+                                           [ShapeChange(at, change)]),
                          t, q, True, args.seed, device, args.bend)
-    rec_off, _ = run(before, make_unit(args.plant, unit, [ShapeChange(at, change)]),
+    rec_off, _ = run(before, run_plant(args.start, args.plant, unit, before_plant,
+                                       [ShapeChange(at, change)]),
                      t, q, False, args.seed)
     rec_fresh = None
     if fresh is not None:
-        rec_fresh, _ = run(fresh, make_unit(args.plant, unit, [ShapeChange(0.0, change)]),
+        # a calibrated plant already has the changed shape; a fresh one gets it at once
+        rec_fresh, _ = run(fresh, run_plant(args.start, args.plant, unit, fresh_plant,
+                                            [] if args.start == "calibrated"
+                                            else [ShapeChange(0.0, change)]),
                            t, q, False, args.seed)
     wall = time.perf_counter() - t0
     out: dict[str, Any] = {"unit": unit, "wall_s": wall, "knobs": [], "refused": refused}
@@ -164,14 +183,14 @@ def largest_offsets(worker: Any) -> dict[str, float]:
 
 
 def drift_unit(unit: int, args: argparse.Namespace, device: Any) -> dict[str, Any]:
-    cache = Path(args.cache)
-    profile = calibrated(args.plant, unit, None, device, cache, "straight")
+    profile, calibrated_plant = unit_profile(args, unit, None, device, "straight")
     t, q = drift_motion(args.drift_s, args.seed + 100)
     t0 = time.perf_counter()
-    rec_on, worker = run(profile, make_unit(args.plant, unit, []), t, q, True, args.seed, device,
-                         args.bend)
+    rec_on, worker = run(profile, run_plant(args.start, args.plant, unit, calibrated_plant, []),
+                         t, q, True, args.seed, device, args.bend)
     wall_on = time.perf_counter() - t0
-    rec_off, _ = run(profile, make_unit(args.plant, unit, []), t, q, False, args.seed)
+    rec_off, _ = run(profile, run_plant(args.start, args.plant, unit, calibrated_plant, []),
+                     t, q, False, args.seed)
     assert worker is not None
     status = worker.status()
     return {"unit": unit, "wall_on_s": wall_on, "offsets": worker.offsets(),
@@ -224,6 +243,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cache", default="/tmp/tsmd-bench-online",
                         help="calibrated profiles go in a subdirectory per code version")
     parser.add_argument("--no-change", action="store_true", help="skip the shape-change runs")
+    parser.add_argument("--start", choices=STARTS, default="calibrated",
+                        help="calibrated (default): every run goes on from the plant the "
+                             "calibration left (soaked, warm, loaded, as a probe calibrated in "
+                             "the patient); fresh: a newly built plant (dry, cold; until "
+                             "session 26)")
     parser.add_argument("--sheet", metavar="FILE",
                         help="the product's data sheet (default: capstan's built-in one, "
                              "other plants' measured on unit 0 and cached)")

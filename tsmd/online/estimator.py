@@ -111,6 +111,9 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     n_leaning_steeper: int = 0
     """Crossings of steeper ramps read as suspects with their own slope
     (``leaning_steeper_reads_own``)."""
+    n_bin_lean: int = 0
+    """Readings beyond the gate held within it by their bin's lean so far
+    (``learning_bin_lean_holds``)."""
     n_odd_knee: int = 0
     """Knee-mode ramps whose knee moved against the slope change: no measurement taken."""
     n_odd_crossing: int = 0
@@ -303,6 +306,12 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         accepted, or a suspect (followed when confirmed)."""
         o = self.options
         m = raw_deg - self.bins.bias_deg(other_deg)
+        if o.learning_bin_lean_holds and abs(m - self.estimate_deg) > o.gate_deg:
+            lean = self.bins.learning_lean_deg(other_deg, 1 if m > self.estimate_deg else -1)
+            if lean != 0.0 and abs(m - lean - self.estimate_deg) <= o.gate_deg:
+                # within the gate against what its bin read so far: it teaches the bin
+                self.n_bin_lean += 1
+                m -= lean
         if self.odd_speed and m - self.estimate_deg <= o.gate_deg:
             # the friction's speed dependence: no reading, but a widening beyond the gate is
             # what a slack or a bend does and stays a suspect (lumped 1, 60 deg bend: read

@@ -153,6 +153,17 @@ class EstimatorOptions:
     knee-mode follow back came inside the RMSE window) and coilpipe 1's slack (phi1 negative
     edge, one noisy 0.89 x ramp) read 2.19 deg instead of 3.90 in replay; notchclutch's miss
     is mostly the bench's run starting on a dry liner after the calibration."""
+    learning_bin_lean_holds: bool = True
+    """A reading beyond the gate in an other-knob bin one measurement short of ``bin_min``,
+    whose measurements so far all lie the reading's way, is referred to their median; within
+    the gate so referred it teaches the bin as any reading of a learning bin does
+    (:meth:`tsmd.online.other_knob.OtherKnobBins.learning_lean_deg`): the current's edge
+    depends on the other knob beyond the profile's coupling, and a bin's third reading that
+    lies further out than its first two is the bin, not a change (planetwist 3, no change,
+    600 s: phi2's negative edge +1.43, +1.37, +2.53 deg at phi1 -37..-46 deg, the last a
+    suspect that its positive edge's agreed with: followed to +3.12/+2.53, phi2 4.78 against
+    2.76 off). Beyond the gate so referred the reading stays a suspect at its own value (a
+    change moves every bin). Off: until session 26."""
     odd_slopes_read_widening: bool = True
     """A ramp whose slope disagrees with the slope in use beyond ``same_slope_tolerance``
     (measuring nothing otherwise) is a suspect when its crossings with the reference's slope

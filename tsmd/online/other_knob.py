@@ -43,6 +43,20 @@ class OtherKnobBins:
         own = self._median(self.key(other_deg))
         return 0.0 if own is None else own - self._mean_deg()
 
+    def learning_lean_deg(self, other_deg: float, direction: int) -> float:
+        """How far a bin one measurement short of ``min_count`` reads ``direction`` (+1 or -1)
+        beyond the estimate: the median of its measurements when every one of them lies that
+        way from the learned bins' common mean, else 0 (learned or emptier bins, mixed signs).
+        A reading beyond the gate there may be the bin's own lean, not a change (planetwist 3,
+        no change: phi2's negative edge +1.43, +1.37 at phi1 -37..-46 deg, then +2.53)."""
+        own = self.values.get(self.key(other_deg), [])
+        if self.learned(self.key(other_deg)) or len(own) < self.min_count - 1 or not own:
+            return 0.0
+        leans = [v - self._mean_deg() for v in own]
+        if not all(direction * v > 0.0 for v in leans):
+            return 0.0
+        return median(leans)
+
     def biases_deg(self) -> dict[str, float]:
         """Each bin's bias at its middle, keyed by the bin's lower angle (for the status)."""
         return {f"{k * self.width_deg:g}": round(self.bias_deg((k + 0.5) * self.width_deg), 3)

@@ -1,0 +1,87 @@
+"""The state a `tsmd bench online` run starts from: the calibrated catheter's, or a fresh one.
+
+In the room the probe is calibrated in the patient and used straight after: its liner has soaked
+(notchclutch), its shaft warmed (twistshaft, warmgear), its tendons hold the calibration's last
+loads. Until session 26 the bench calibrated one plant and ran a second, freshly built one (dry,
+cold), so the online estimator learned its reference while that state still moved (docs/online.md,
+session 25 round 2). ``calibrated`` (the default) runs on the plant the calibration left;
+``fresh`` keeps the old start.
+
+The calibrated plant is kept with its profile in the bench's cache (a pickle next to the profile's
+YAML, keyed by the same code version), so reruns do not calibrate again.
+"""
+
+from __future__ import annotations
+
+import copy
+import pickle
+import time
+from pathlib import Path
+from typing import Any
+
+from simrig.scenario import ShapeChange, ShapeChangePlant
+from tsmd.bench.online_units import make_unit
+from tsmd.calibration import calibrate, fast_protocol
+from tsmd.profile import load_profile, save_profile
+from tsmd.replay import LockstepRunner
+
+STARTS = ("calibrated", "fresh")
+
+
+class CarriedPlant:
+    """A plant that goes on from where an earlier run left it: the rig's reset at the start of a
+    run keeps its state (the probe stays inserted), everything else is the wrapped plant's."""
+
+    def __init__(self, plant: Any) -> None:
+        self.plant = plant
+
+    def reset(self) -> None:
+        """Nothing: the catheter is not taken out between calibration and use."""
+
+    def reshape(self, **changes: Any) -> None:
+        self.plant.reshape(**changes)
+
+    def step(self, dt_s: float, knob_deg: Any) -> Any:
+        return self.plant.step(dt_s, knob_deg)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.plant, name)
+
+
+def calibrated_with_plant(plant: str, unit: int, change: dict[str, Any] | None, device: Any,
+                          cache: Path, label: str) -> tuple[Any, Any]:
+    """The unit's profile (fast protocol, as :func:`tsmd.bench.online_units.calibrated`) and the
+    plant as the calibration left it, both cached; a cached profile without its plant is
+    calibrated again (deterministic: the same seed gives the same profile)."""
+    path = cache / f"{plant}-unit{unit}-{label}.yaml"
+    state = cache / f"{plant}-unit{unit}-{label}.plant.pkl"
+    if path.exists() and state.exists():
+        with state.open("rb") as f:
+            return load_profile(path), pickle.load(f)
+    sim = make_unit(plant, unit, [ShapeChange(0.0, change)] if change else [])
+    t0 = time.perf_counter()
+    with LockstepRunner(None, None, "none", 3000 + unit, sim) as runner:
+        profile = calibrate(runner, f"{plant}-unit{unit}-{label}", device,
+                            protocol=fast_protocol())
+    cache.mkdir(parents=True, exist_ok=True)
+    if not path.exists():
+        save_profile(profile, path)
+    with state.open("wb") as f:
+        pickle.dump(sim.plant, f)
+    print(f"  calibrated {plant} unit {unit} ({label}, plant state kept) in "
+          f"{time.perf_counter() - t0:.0f} s wall", flush=True)
+    return load_profile(path), sim.plant
+
+
+def run_plant(start: str, plant: str, unit: int, calibrated_plant: Any,
+              changes: list[ShapeChange]) -> ShapeChangePlant:
+    """The plant one run drives: a copy of the calibrated one (``calibrated``; its shape as the
+    calibration had it, ``changes`` on top) or the unit built afresh (``fresh``)."""
+    if start == "fresh":
+        return make_unit(plant, unit, changes)
+    if start != "calibrated":
+        raise ValueError(f"start must be one of {STARTS}, got {start!r}")
+    return ShapeChangePlant(CarriedPlant(copy.deepcopy(calibrated_plant)), changes)
+
+
+__all__ = ["STARTS", "CarriedPlant", "calibrated_with_plant", "run_plant"]

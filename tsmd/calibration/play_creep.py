@@ -106,8 +106,8 @@ def play_creep(points: Sequence[GridPoint], knob: int) -> PlayCreep | None:
                 latest[key] = max(latest.get(key, -math.inf), float(found.max()))
     if total == 0:
         return None
-    ends = list(latest.values())
-    low, high = (min(ends), max(ends)) if ends else (math.nan, math.nan)
+    closed = list(latest.values())
+    low, high = (min(closed), max(closed)) if closed else (math.nan, math.nan)
     return PlayCreep(knob, low, high, missing, total, side_gap_deg(latest))
 
 

@@ -4,12 +4,9 @@ The data sheet measures, on its tracked unit, what the current reads minus what 
 per parameter and other-knob angle (:mod:`tsmd.profile.reading_offset`). Where that offset is
 a product's bias (twistshaft's B at the other knob's +-90 deg, screwrod's B), every unit of the
 product reads off by about as much in every half-cycle, and subtracting it moves the values
-onto the tip. Where it is not sure (within its own 95 % half-width of zero) it is noise of one
-unit, and subtracting it would carry unit 0's noise into every unit: such an offset is not
-applied (shrunk to nothing). A sure offset is applied however small (session 26: below 1 deg it
-was not, and warmgear's, snakedent's, stickslip's and archwave's development units read closer
-to the tip with it; docs/calibration.md, "Session 26 (branch s26-calib)"). An applied offset
-brings its own uncertainty, which the gate adds to the half-cycles'
+onto the tip. Where it is small or not sure it is noise of one unit, and subtracting it would
+carry unit 0's noise into every unit: such an offset is not applied (shrunk to nothing). An
+applied offset brings its own uncertainty, which the gate adds to the half-cycles'
 (:class:`tsmd.calibration.estimate.Estimate`).
 """
 
@@ -23,6 +20,9 @@ from tsmd.calibration.play_engage import engage, engage_lag_deg
 from tsmd.calibration.sweep_result import SweepResult
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 
+MIN_OFFSET_DEG = 1.0
+"""An offset below this (half the 2 deg accuracy target) is not applied: what it would gain is
+below what unit-to-unit scatter of the offset costs."""
 MIN_OFFSET_U95_RATIO = 1.0
 """An offset is applied only where it exceeds its own 95 % half-width this many times (its
 interval excludes zero): one measured inconsistently over the sheet unit's half-cycles is not."""
@@ -32,7 +32,7 @@ def applied_deg(grid: OffsetGrid) -> tuple[tuple[float, ...], tuple[float, ...]]
     """Per other-knob angle: (offset applied, its 95 % half-width); 0, 0 where not applied."""
     shift, u95 = [], []
     for m, u in zip(grid.mean_deg, grid.u95_deg, strict=True):
-        use = abs(m) > MIN_OFFSET_U95_RATIO * u
+        use = abs(m) >= MIN_OFFSET_DEG and abs(m) > MIN_OFFSET_U95_RATIO * u
         shift.append(m if use else 0.0)
         u95.append(u if use else 0.0)
     return tuple(shift), tuple(u95)

@@ -9,11 +9,18 @@ from __future__ import annotations
 import dataclasses
 
 import pytest
-from support.handle_play import LINE_END_DEG, OTHER_DEG, falling_sweep, play_offset
+from support.handle_play import (
+    LINE_END_DEG,
+    OTHER_DEG,
+    falling_sweep,
+    play_offset,
+    reversing_sweep,
+)
 
 from tsmd.calibration.assemble import GridPoint, QualityReport
 from tsmd.calibration.play_creep import (
     CREEP_SPREAD_DEG,
+    SIDE_GAP_DEG,
     check_play_creep,
     play_creep,
 )
@@ -35,6 +42,19 @@ def knob_points(play_ends_deg: tuple[float, ...], knob: int = 0,
 
 RIGID = (15.0, 15.2, 14.9)
 CREEPING = (15.0, 17.5, 19.0)
+BOTH_SIDES = ("backlash_pos_deg", "backlash_neg_deg")
+
+
+def two_sided_points(ends_deg: tuple[tuple[float, float], ...]) -> list[GridPoint]:
+    """One sweep per other-knob angle with both sides' play ends (B_pos, B_neg), read through
+    a sheet announcing the play on both."""
+    offset = play_offset(SHEET_PLAY_DEG, BOTH_SIDES)
+    return [GridPoint(0, other, corrected(reversing_sweep(pos, neg, seed), offset, other))
+            for seed, (other, (pos, neg)) in enumerate(zip(OTHER_DEG, ends_deg, strict=True))]
+
+
+# A mild creep delaying one side at one grid point by 1.1 deg: under the spread limit.
+ONE_SIDE_LATE = ((15.0, 15.1), (15.0, 15.0), (15.0, 16.1))
 
 
 def test_a_rigid_play_closes_at_one_travel_over_the_grid() -> None:
@@ -141,3 +161,35 @@ def test_one_early_play_end_does_not_flag_a_rigid_play() -> None:
     report = QualityReport()
     check_play_creep(points, report)
     assert report.warnings == []
+
+
+def test_both_sides_of_a_rigid_play_close_together() -> None:
+    creep = play_creep(two_sided_points(((15.0, 15.2), (14.9, 15.0), (15.2, 15.1))), 0)
+    assert creep is not None
+    assert creep.side_gap_deg < SIDE_GAP_DEG
+    assert creep.rigid()
+
+
+def test_a_play_closing_later_on_one_side_shows_the_gap() -> None:
+    creep = play_creep(two_sided_points(ONE_SIDE_LATE), 0)
+    assert creep is not None
+    assert creep.side_gap_deg == pytest.approx(1.1, abs=0.3)
+    assert creep.spread_deg < CREEP_SPREAD_DEG
+
+
+def test_a_mild_creep_on_one_side_is_flagged_though_the_spread_is_small() -> None:
+    points = two_sided_points(ONE_SIDE_LATE)
+    report = QualityReport()
+    check_play_creep(points, report)
+    assert len(report.warnings) == 1
+    assert "two sides close" in report.warnings[0]
+    for p, e in zip(points, point_estimates(points), strict=True):
+        for name in BOTH_SIDES:
+            assert e[name].value - p.result.unit_u95_deg(name) <= LINE_END_DEG - 1.0
+
+
+def test_a_rigid_two_sided_play_gives_no_warning() -> None:
+    report = QualityReport()
+    check_play_creep(two_sided_points(((15.0, 15.2), (14.9, 15.0), (15.2, 15.1))), report)
+    assert report.warnings == []
+    assert report.figures["phi1_play_end_side_gap_deg"] < SIDE_GAP_DEG

@@ -48,7 +48,28 @@ def falling_sweep(play_end_deg: float | None, seed: int = 0) -> SweepResult:
     return SweepResult(data, (half,), {"backlash_pos_deg": (LINE_END_DEG,)})
 
 
-def play_offset(play_deg: float) -> ReadingOffset:
-    """The sheet's reading offset of B_pos: ``play_deg`` at every other-knob angle."""
+def reversing_sweep(pos_end_deg: float, neg_end_deg: float, seed: int = 0) -> SweepResult:
+    """Down from +90 deg and back up from -60 deg: both sides' backlashes, each with the line
+    rule's B, the play closing ``pos_end_deg`` / ``neg_end_deg`` after its reversal."""
+    down, up = np.linspace(90.0, -60.0, 1501), np.linspace(-60.0, 90.0, 1501)[1:]
+    rng = np.random.default_rng(seed)
+    y_down = release_y(90.0 - down, pos_end_deg) + rng.normal(0.0, NOISE_A / 4, down.size)
+    y_up = release_y(up + 60.0, neg_end_deg) + rng.normal(0.0, NOISE_A / 4, up.size)
+    pos = np.concatenate([down, up])
+    current = np.concatenate([-y_down, y_up])
+    t = np.arange(pos.size) * 0.02
+    data = Conditioned(t, pos, pos, current, current, 50.0, NOISE_A, NOISE_A, ())
+    halves = (HalfCycle(direction=-1, start=0, stop=down.size, after_reversal=True,
+                        backlash_deg=LINE_END_DEG),
+              HalfCycle(direction=1, start=down.size - 1, stop=pos.size, after_reversal=True,
+                        backlash_deg=LINE_END_DEG))
+    return SweepResult(data, halves, {"backlash_pos_deg": (LINE_END_DEG,),
+                                      "backlash_neg_deg": (LINE_END_DEG,)})
+
+
+def play_offset(play_deg: float,
+                names: tuple[str, ...] = ("backlash_pos_deg",)) -> ReadingOffset:
+    """The sheet's reading offset of ``names`` (B_pos): ``play_deg`` at every other-knob
+    angle."""
     grid = OffsetGrid((play_deg,) * 3, (0.5,) * 3, (4, 4, 4))
-    return ReadingOffset(OTHER_DEG, (("backlash_pos_deg", grid),))
+    return ReadingOffset(OTHER_DEG, tuple((name, grid) for name in names))

@@ -12,7 +12,8 @@ tooth clearance would, by as much as the tip crept, and the creep depends on the
 reversal; on a creeping unit the end moves over the grid, or lies beyond where the sheet's play
 should close (no step found there). So where a knob's play ends spread more than
 :data:`CREEP_SPREAD_DEG` over its grid points and sides (the latest end of each), or more
-than :data:`MISSING_SHARE` of its half-cycles show no step, the knob's B is flagged: its values
+than :data:`MISSING_SHARE` of its half-cycles show no step, or (session 26) the two sides of
+one grid point close more than :data:`SIDE_GAP_DEG` apart, the knob's B is flagged: its values
 stay the play's end (what the paper's lines' corner follows), its reported 95 % half-width grows
 to reach back to the swing's end (where a creeping tip has already started back), and a one-line
 warning names the knob.
@@ -43,6 +44,16 @@ MISSING_SHARE = 0.25
 """A knob where more than this share of the half-cycles show no step where the sheet's play
 should close (within :data:`tsmd.calibration.play_engage.ENGAGE_WINDOW` of it) is flagged as
 well: its play closed later than the window (development unit 6's phi2: 11 of 16)."""
+SIDE_GAP_DEG = 0.75
+"""Largest difference between the two sides' play ends (each the latest of its half-cycles) at
+one grid point a rigid play shows (session 26). The carrier crosses the same tooth clearance
+after either reversal, and what the grid point does to both sides (the other knob's coupling:
+a rigid play closes 0.1-0.2 deg later at +-90 than at 0) cancels in the difference, while a
+creep, which grows with the loaded rope's tension, delays mostly one side. Planetwist, fast
+protocol, noise seed 0, the largest difference per knob: holding knobs 0.02-0.38 deg
+(development 1-8, sample 201-208; paper protocol, development 2: 0.26), knobs whose creep
+delays one side 1.14-3.16 (development 1 phi2, sample 201, 202, 207 phi1); the limit lies
+between. A creep delaying both sides alike (development 7 phi1: 0.09) shows in the spread."""
 REACH_MARGIN_DEG = 2.0
 """The widened half-width reaches this far before the swing's end (the line rule's earliest
 end over the knob's grid, :func:`earliest_line_end_deg`): a creeping tip starts back at the
@@ -52,13 +63,15 @@ reversal, so its 1 deg threshold can fall before that end (development units 1, 
 
 @dataclass(frozen=True)
 class PlayCreep:
-    """One knob's play ends over its grid: their spread, and how many half-cycles showed none."""
+    """One knob's play ends over its grid: their spread, the largest gap between the two sides
+    at one grid point, and how many half-cycles showed none."""
 
     knob: int
     low_deg: float
     high_deg: float
     missing: int
     half_cycles: int
+    side_gap_deg: float = 0.0
 
     @property
     def spread_deg(self) -> float:
@@ -67,6 +80,7 @@ class PlayCreep:
     def rigid(self, spread_limit_deg: float = CREEP_SPREAD_DEG) -> bool:
         """Whether the play closed at one travel in (nearly) every half-cycle."""
         return (self.spread_deg <= spread_limit_deg
+                and not self.side_gap_deg > SIDE_GAP_DEG
                 and self.missing <= MISSING_SHARE * self.half_cycles)
 
 
@@ -78,20 +92,32 @@ def _finite(values: Sequence[float]) -> FloatArray:
 def play_creep(points: Sequence[GridPoint], knob: int) -> PlayCreep | None:
     """``knob``'s play ends over its grid points and sides (the latest per grid point and side);
     None where its backlash was not read at a play's end (the sheet announces none)."""
-    latest, missing, total = [], 0, 0
+    latest: dict[tuple[float, str], float] = {}
+    missing, total = 0, 0
     for p in points:
         if p.knob != knob:
             continue
-        for ends in p.result.play_ends_deg.values():
+        for name, ends in p.result.play_ends_deg.items():
             found = _finite(ends)
             total += len(ends)
             missing += len(ends) - found.size
             if found.size:
-                latest.append(float(found.max()))
+                key = (float(p.other_deg), name)
+                latest[key] = max(latest.get(key, -math.inf), float(found.max()))
     if total == 0:
         return None
-    low, high = (min(latest), max(latest)) if latest else (math.nan, math.nan)
-    return PlayCreep(knob, low, high, missing, total)
+    closed = list(latest.values())
+    low, high = (min(closed), max(closed)) if closed else (math.nan, math.nan)
+    return PlayCreep(knob, low, high, missing, total, side_gap_deg(latest))
+
+
+def side_gap_deg(latest: dict[tuple[float, str], float]) -> float:
+    """The largest difference between the two backlashes' latest play ends at one grid point
+    (0 where no grid point has both)."""
+    gaps = [abs(end - latest[(other, "backlash_neg_deg")])
+            for (other, name), end in latest.items()
+            if name == "backlash_pos_deg" and (other, "backlash_neg_deg") in latest]
+    return max(gaps, default=0.0)
 
 
 def earliest_line_end_deg(points: Sequence[GridPoint], knob: int) -> float:
@@ -133,6 +159,7 @@ def check_play_creep(points: list[GridPoint], report: QualityReport,
             continue
         label = KNOB_LABELS[knob]
         report.figures[f"{label}_play_end_spread_deg"] = creep.spread_deg
+        report.figures[f"{label}_play_end_side_gap_deg"] = creep.side_gap_deg
         if creep.rigid(spread_limit_deg):
             continue
         line = earliest_line_end_deg(points, knob)
@@ -146,6 +173,9 @@ def check_play_creep(points: list[GridPoint], report: QualityReport,
                  f"over the grid (spread {creep.spread_deg:.1f} deg; a rigid play closes at one "
                  "travel)" if math.isfinite(creep.spread_deg) and creep.high_deg > creep.low_deg
                  else "")
+        if creep.side_gap_deg > SIDE_GAP_DEG:
+            where += ("; " if where else "") + (
+                f"its two sides close {creep.side_gap_deg:.1f} deg apart at one grid point")
         if creep.missing > MISSING_SHARE * creep.half_cycles:
             where += ("; " if where else "") + (
                 f"no step where the play should close in {creep.missing} of "
@@ -156,5 +186,6 @@ def check_play_creep(points: list[GridPoint], report: QualityReport,
             "half-width widened to cover it")
 
 
-__all__ = ["CREEP_SPREAD_DEG", "MISSING_SHARE", "REACH_MARGIN_DEG", "PlayCreep",
-           "check_play_creep", "earliest_line_end_deg", "play_creep", "reach_deg", "widened"]
+__all__ = ["CREEP_SPREAD_DEG", "MISSING_SHARE", "REACH_MARGIN_DEG", "SIDE_GAP_DEG", "PlayCreep",
+           "check_play_creep", "earliest_line_end_deg", "play_creep", "reach_deg", "side_gap_deg",
+           "widened"]

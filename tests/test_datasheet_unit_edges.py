@@ -71,7 +71,7 @@ def test_the_units_own_edges_stay_its_own_with_calibrated_sheet_edges() -> None:
 def test_sheet_gets_each_knobs_profile_edges_at_the_other_knobs_zero() -> None:
     profile = make_profile(d0=21.0)  # edges d0 - |other| / 30 over the grid
     knob = dataclasses.replace(SHEET_KNOB, calibrated_dead_zone_pos_deg=None)
-    sheet = with_edges_of(DeviceModel("m", (knob, knob)), profile)
+    sheet = with_edges_of(DeviceModel("m", (knob, knob)), [profile])
     for k, pk in zip(sheet.knobs, profile.knobs, strict=True):
         assert pk.tension_play is not None
         assert k.calibrated_dead_zone_pos_deg == pytest.approx(21.0)
@@ -90,3 +90,10 @@ def test_edges_at_zero_are_read_between_grid_points_without_zero() -> None:
 def test_sheet_keys_round_trip_and_their_range() -> None:
     assert_sheet_knob_field_round_trips("calibrated_dead_zone_pos_deg", 1, 19.6, 95.0)
     assert_sheet_knob_field_round_trips("calibrated_dead_zone_neg_deg", 0, -20.8, 5.0)
+
+
+def test_sheet_edges_are_the_mean_over_the_sheet_units_runs() -> None:
+    runs = [make_profile(d0=20.0), make_profile(d0=21.0)]
+    sheet = with_edges_of(DeviceModel("m", (SHEET_KNOB, SHEET_KNOB)), runs)
+    assert sheet.knobs[0].calibrated_dead_zone_pos_deg == pytest.approx(20.5)
+    assert sheet.knobs[1].calibrated_dead_zone_neg_deg == pytest.approx(-20.5)

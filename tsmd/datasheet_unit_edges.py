@@ -8,8 +8,9 @@ nine minutes. Where the catheter changes over those minutes the difference is no
 warmgear's shaft warms to body temperature and takes up slack, so the calibration read unit 0's
 own edges 1.3-3.2 deg inside its sheet's and moved every unit's knob-2 line outward by as much
 (development 1 phi2: tip 4-6 deg short of ours' model on both branches; docs/model.md, session
-26). Here the sheet's unit is calibrated as a unit is (the paper protocol, under the sheet) and
-the edges its profile's tension play holds at the other knob's 0 are written as
+26). Here the sheet's unit is calibrated as a unit is (the paper protocol, under the sheet; once
+per noise seed) and the mean of the edges its profiles' tension play holds at the other
+knob's 0 is written as
 ``calibrated_dead_zone_pos_deg`` / ``_neg_deg``; the plateau heights are then drawn through
 them (:func:`tsmd.calibration.reading_offset.calibrated_edges`).
 """
@@ -18,7 +19,9 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+
+import numpy as np
 
 from simrig.plant import Plant
 from tsmd.compensation.paper import at_other_knob_zero
@@ -38,31 +41,43 @@ def edges_at_zero(params: TensionPlayParams) -> tuple[float, float]:
             at_other_knob_zero(params.other_knob_deg, params.dead_zone_neg_deg))
 
 
-def with_edges_of(device: DeviceModel, profile: CatheterProfile) -> DeviceModel:
-    """``device`` with each knob's calibrated edges from the sheet unit's ``profile`` (a knob
-    whose profile has no tension play keeps the sheet's reference edges)."""
+def with_edges_of(device: DeviceModel, profiles: Sequence[CatheterProfile]) -> DeviceModel:
+    """``device`` with each knob's calibrated edges: the mean over the sheet unit's
+    ``profiles`` (one per noise seed: the sheet's edge is every unit's reference, so its
+    reading scatter, 0.5-0.7 deg between two seeds on warmgear's unit 0, would be every unit's
+    bias). A knob without a tension play in every profile keeps the sheet's reference edges."""
+    if not profiles:
+        raise ValueError("needs at least one calibration of the sheet's unit")
     knobs = []
-    for k, pk in zip(device.knobs, profile.knobs, strict=True):
-        if pk.tension_play is None:
+    for i, k in enumerate(device.knobs):
+        plays = [p.knobs[i].tension_play for p in profiles]
+        if any(tp is None for tp in plays):
             knobs.append(k)
             continue
-        pos, neg = edges_at_zero(pk.tension_play)
+        edges = np.array([edges_at_zero(tp) for tp in plays if tp is not None])
+        pos, neg = (float(v) for v in edges.mean(axis=0))
         knobs.append(dataclasses.replace(k, calibrated_dead_zone_pos_deg=round(pos, 2),
                                          calibrated_dead_zone_neg_deg=round(neg, 2)))
     return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
 def with_unit_edges(device: DeviceModel, config: TsmdConfig,
-                    plant_factory: Callable[[], Plant], seed: int = SHEET_UNIT_SEED
+                    plant_factory: Callable[[], Plant], seeds: Sequence[int] = (SHEET_UNIT_SEED,)
                     ) -> DeviceModel:
-    """The sheet with its unit's calibrated edges (one calibration under ``device``), printed
-    beside the reference edges they replace for the plateau heights."""
+    """The sheet with its unit's calibrated edges (one calibration under ``device`` per noise
+    seed), each run's printed beside the reference edges they replace for the heights."""
     t0 = time.monotonic()
-    cal = calibrate_sheet_unit(plant_factory, device, "unit edges", seed, config)
-    out = with_edges_of(device, cal.profile)
-    for name, old, new in zip(("phi1", "phi2"), device.knobs, out.knobs, strict=True):
-        print(f"  {name} edges of the sheet unit's calibration: {new.calibrated_dead_zone_pos_deg}"
-              f" / {new.calibrated_dead_zone_neg_deg} deg (tracked sweep's, as read: "
+    profiles = [calibrate_sheet_unit(plant_factory, device, "unit edges", s, config).profile
+                for s in seeds]
+    out = with_edges_of(device, profiles)
+    for i, (name, old, new) in enumerate(zip(("phi1", "phi2"), device.knobs, out.knobs,
+                                             strict=True)):
+        runs = ", ".join(f"{pos:.2f} / {neg:.2f}" for pos, neg in
+                         (edges_at_zero(tp) for tp in (p.knobs[i].tension_play for p in profiles)
+                          if tp is not None))
+        print(f"  {name} edges of the sheet unit's calibration (noise seeds "
+              f"{','.join(map(str, seeds))}: {runs}): {new.calibrated_dead_zone_pos_deg} / "
+              f"{new.calibrated_dead_zone_neg_deg} deg (the tracked sweep's, as read: "
               f"{old.reference_dead_zone_pos_deg} / {old.reference_dead_zone_neg_deg})")
     print(f"  unit edges: {time.monotonic() - t0:.0f} s")
     return out

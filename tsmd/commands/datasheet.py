@@ -351,7 +351,7 @@ def main(args: argparse.Namespace) -> int:
     if args.plant is not None and args.plateau_gap:
         device = with_plateau_gap(device, config, factory, args.seed)
     if args.plant is not None and args.unit_edges:  # under the sheet's rules, as a unit
-        device = with_unit_edges(device, config, factory, args.seed)
+        device = with_unit_edges(device, config, factory, seeds or [args.seed])
     if args.plant is not None and sample:
         device = with_sample(device, config, args.plant, params, args.unit_key, sample,
                              seeds[0] if seeds else 0)

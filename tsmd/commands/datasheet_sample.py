@@ -133,15 +133,16 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         keys += LOOP_KEYS
         what.append(f"the sheet's unit's dead-zone loop, noise seed {args.seed}")
     if edges:
-        updated = with_unit_edges(updated, config, lambda: load_plant(args.plant, params),
-                                  args.seed)
+        runs = seeds or [args.seed]
+        updated = with_unit_edges(updated, config, lambda: load_plant(args.plant, params), runs)
         keys += UNIT_EDGE_KEYS
-        what.append(f"the sheet's unit calibrated, noise seed {args.seed}")
+        what.append(f"the sheet's unit calibrated, noise seeds {','.join(map(str, runs))}")
     command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
                f"'{json.dumps(params)}' --unit-key {args.unit_key}"
                + (f" --unit-sample {args.unit_sample}" if units else "")
                + (" --plateau-gap" if loop else "")
-               + (" --unit-edges" if edges else "")
+               + (f" --unit-edges --rule-seeds {','.join(map(str, seeds))}"
+                  if edges and seeds and not whole else " --unit-edges" if edges else "")
                + (" --stick-end" if args.stick_end else "")
                + (" --settle-gain-check" if args.settle_gain_check else "")
                + (f" --rule-seeds {','.join(map(str, seeds))}" if whole else "") + " --out FILE")

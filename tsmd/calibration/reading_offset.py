@@ -13,6 +13,7 @@ applied offset brings its own uncertainty, which the gate adds to the half-cycle
 from __future__ import annotations
 
 import dataclasses
+from typing import Any
 
 import numpy as np
 
@@ -58,6 +59,21 @@ def reference_edge_deg(offset: ReadingOffset | None, name: str,
     if offset is None or edge_deg is None:
         return edge_deg
     return float(edge_deg) - offset_at(offset, name, 0.0)[0]
+
+
+def calibrated_edges(device_knob: Any, edge_pos_deg: float, edge_neg_deg: float
+                     ) -> tuple[float, float]:
+    """The sheet unit's edges the plateau heights are drawn through: those its own calibration
+    read (``calibrated_dead_zone_*_deg``, already corrected, session 26) where the sheet has
+    both, else ``edge_*_deg`` as given. A unit's edge moves its loaded line by its difference
+    from the sheet unit's, so both must be read the same way: on warmgear the tracked sweep's
+    edges (the unit's first minutes) lay 1.3-3.2 deg outside what the calibration, minutes
+    later with the shaft warm, read on the same unit."""
+    pos = getattr(device_knob, "calibrated_dead_zone_pos_deg", None)
+    neg = getattr(device_knob, "calibrated_dead_zone_neg_deg", None)
+    if pos is None or neg is None:
+        return edge_pos_deg, edge_neg_deg
+    return float(pos), float(neg)
 
 
 def corrected(result: SweepResult, offset: ReadingOffset | None,

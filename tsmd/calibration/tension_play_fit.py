@@ -59,7 +59,7 @@ from tsmd.calibration.lag import estimate_lag_s
 from tsmd.calibration.load_ramp import SideFit, fit_sweep_sides
 from tsmd.calibration.loaded_knee import sweep_knees
 from tsmd.calibration.read_gain import BACKLASH_NAMES, read_gains, read_side_ratio
-from tsmd.calibration.reading_offset import offset_at, reference_edge_deg
+from tsmd.calibration.reading_offset import calibrated_edges, offset_at, reference_edge_deg
 from tsmd.calibration.release_end import plateau_moved, side_ratios
 from tsmd.calibration.release_path import release_through_amplitude
 from tsmd.calibration.signal import Conditioned
@@ -178,6 +178,7 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any,
     ref_neg = reference_edge_deg(offset, "dead_zone_neg_deg", ref_neg)
     edge_pos = at_other_knob_zero(grid, d_pos) if ref_pos is None else float(ref_pos)
     edge_neg = at_other_knob_zero(grid, d_neg) if ref_neg is None else float(ref_neg)
+    edge_pos, edge_neg = calibrated_edges(k, edge_pos, edge_neg)  # read as a unit's (s26)
     h_pos, h_neg = plateau_heights(k, edge_pos, edge_neg)
     # the product's loaded-branch template (data sheet) bends the line through the reference
     shape_pos = curved(getattr(k, "loaded_shape_pos", None))

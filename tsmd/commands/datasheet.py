@@ -58,6 +58,7 @@ from tsmd.datasheet_rule import (
 from tsmd.datasheet_rule_settled import rule_text
 from tsmd.datasheet_shape_choice import with_shape_choice
 from tsmd.datasheet_shape_grid import measure_shape_grids
+from tsmd.datasheet_unit_edges import with_unit_edges
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.profile.reading_offset import ReadingOffset
 from tsmd.profile.sheet_schema import OPTIONAL_KNOB_RANGES
@@ -349,6 +350,8 @@ def main(args: argparse.Namespace) -> int:
         device = with_level_grid(device, config, factory, args.seed)
     if args.plant is not None and args.plateau_gap:
         device = with_plateau_gap(device, config, factory, args.seed)
+    if args.plant is not None and args.unit_edges:  # under the sheet's rules, as a unit
+        device = with_unit_edges(device, config, factory, seeds or [args.seed])
     if args.plant is not None and sample:
         device = with_sample(device, config, args.plant, params, args.unit_key, sample,
                              seeds[0] if seeds else 0)

@@ -31,6 +31,7 @@ from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
 from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
+from tsmd.datasheet_unit_edges import UNIT_EDGE_KEYS, with_unit_edges
 from tsmd.profile import DeviceModel, load_device_model, save_device_fields, save_device_model
 
 SCORED_UNITS = frozenset(DEVELOPMENT_UNITS + HELD_OUT_UNITS)
@@ -106,12 +107,14 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         raise DatasheetError("--update needs --plant (and --params) of the sheet's unit: the "
                              "sample is tracked on the simulated rig")
     loop = bool(args.plateau_gap)
+    edges = bool(args.unit_edges)
     # nested or new fields: written whole
     whole = args.stick_end or args.settle_gain_check or args.level_grid
-    if args.unit_sample is None and not loop and not whole:
+    if args.unit_sample is None and not loop and not whole and not edges:
         raise DatasheetError("--update adds the sample's part, the loop's, the stick end, the "
-                             "settle-gain check or the level grid: give --unit-sample, "
-                             "--plateau-gap, --stick-end, --settle-gain-check or --level-grid")
+                             "settle-gain check, the level grid or the unit's edges: give "
+                             "--unit-sample, --plateau-gap, --stick-end, --settle-gain-check, "
+                             "--level-grid or --unit-edges")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
@@ -135,15 +138,22 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                                    args.seed)
         keys += LOOP_KEYS
         what.append(f"the sheet's unit's dead-zone loop, noise seed {args.seed}")
+    if edges:
+        runs = seeds or [args.seed]
+        updated = with_unit_edges(updated, config, lambda: load_plant(args.plant, params), runs)
+        keys += UNIT_EDGE_KEYS
+        what.append(f"the sheet's unit calibrated, noise seeds {','.join(map(str, runs))}")
     command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
                f"'{json.dumps(params)}' --unit-key {args.unit_key}"
                + (f" --unit-sample {args.unit_sample}" if units else "")
                + (" --plateau-gap" if loop else "")
+               + (" --unit-edges" if edges else "")
                + (" --stick-end" if args.stick_end else "")
                + (" --settle-gain-check" if args.settle_gain_check else "")
                + (f" --level-grid --seed {args.seed}" if args.level_grid else "")
                + (f" --rule-seeds {','.join(map(str, seeds))}"
-                  if args.stick_end or args.settle_gain_check else "") + " --out FILE")
+                  if seeds and (args.stick_end or args.settle_gain_check or edges) else "")
+               + " --out FILE")
     if whole:
         fields = ((["backlash_stick_end", "reading_offset"] if args.stick_end else [])
                   + (["settle_gain_read"] if args.settle_gain_check else [])

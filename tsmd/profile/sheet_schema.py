@@ -78,6 +78,8 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "edge_level_share": (*EDGE_LEVEL_SHARE_RANGE, ""),
     "plateau_gap_deg": (0.0, 45.0, "deg"),
     "plateau_gap_factor": (0.1, 10.0, ""),
+    "calibrated_dead_zone_pos_deg": (0.0, 90.0, "deg"),
+    "calibrated_dead_zone_neg_deg": (-90.0, 0.0, "deg"),
 }
 """The data sheet's optional measured numbers per knob and their plausible ranges: the schema
 reads them with these, and ``tsmd datasheet`` leaves out a measured one outside its range
@@ -105,6 +107,8 @@ _HANDLE_KEYS = ("torque_ripple_period_deg",)
 """Optional numbers of the handle's own make (session 22), written only when set."""
 _LOOP_KEYS = ("plateau_gap_deg", "plateau_gap_factor")
 """Optional numbers of the dead-zone loop (session 25), written only when measured."""
+_UNIT_EDGE_KEYS = ("calibrated_dead_zone_pos_deg", "calibrated_dead_zone_neg_deg")
+"""Optional edges of the sheet unit's own calibration (session 26), written only when measured."""
 
 
 _Block = TypeVar("_Block")
@@ -246,6 +250,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             edge_level_share=optional("edge_level_share"),
             plateau_gap_deg=optional("plateau_gap_deg"),
             plateau_gap_factor=optional("plateau_gap_factor"),
+            calibrated_dead_zone_pos_deg=optional("calibrated_dead_zone_pos_deg"),
+            calibrated_dead_zone_neg_deg=optional("calibrated_dead_zone_neg_deg"),
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)
@@ -320,7 +326,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         if k.release_end_shape is not None:
             knobs[name]["release_end_shape"] = release_end_shape_to_mapping(k.release_end_shape)
         for key in (_RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS + _ROUND_KEYS
-                    + _HANDLE_KEYS + _LOOP_KEYS):
+                    + _HANDLE_KEYS + _LOOP_KEYS + _UNIT_EDGE_KEYS):
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         if k.reading_offset is not None:

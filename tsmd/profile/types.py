@@ -293,6 +293,15 @@ class DeviceKnob:
     plateau_gap_factor: float | None = None
     """Optional, with ``plateau_gap_deg``: the sheet unit's tracked flats (both sides' plateau
     heights, summed) over that gap."""
+    calibrated_dead_zone_pos_deg: float | None = None
+    """Optional (with ``_neg``), read on the data-sheet unit (``tsmd datasheet --unit-edges``,
+    session 26): the dead-zone edges its own calibration gives method ours (the profile's
+    edges at the other knob's 0, after the reading offset), read as every unit's are: same
+    protocol, same time since the catheter was switched on. Where given, the plateau heights
+    are drawn through these instead of ``reference_dead_zone_*_deg`` (whose tracked sweep is
+    read in the unit's first minutes; warmgear's shaft has by then not yet warmed, its slack
+    not yet shrunk). None: the reference edges."""
+    calibrated_dead_zone_neg_deg: float | None = None
 
 
 

@@ -30,7 +30,10 @@ development units in the same session's second round) is held out; the notchclut
 liner, a notched steel section, a tip rubbing on the wall; run untuned, then traced on its
 development units in the same session's second round) is held out; the pronyring plant (session
 25, written blind: a viscoelastic Pebax section, a pull ring on a compliant bond, PTFE-lined ropes
-along a breathing path; run untuned) is held out from the end of session 25, registered last.
+along a breathing path; run untuned) is held out from the end of session 25; the wormeyelet
+plant (session 26, written blind: a worm-stage handle with a silicone damper, ropes over one
+lumen contact, a spacer-disk section whose eyelets the ropes rub; run untuned) is the blind plant,
+registered last.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -64,6 +67,7 @@ from simrig.plants.snakedent import NOMINAL_KNOBS as SNAKEDENT_KNOBS
 from simrig.plants.stickslip import NOMINAL_KNOBS as STICKSLIP_KNOBS
 from simrig.plants.twistshaft import NOMINAL_KNOBS as TWISTSHAFT_KNOBS
 from simrig.plants.warmgear import NOMINAL_KNOBS as WARMGEAR_KNOBS
+from simrig.plants.wormeyelet import NOMINAL_KNOBS as WORMEYELET_KNOBS
 from simrig.rig import DEFAULT_CURRENT_SENSOR
 
 PLANT_SPECS: dict[str, str] = {
@@ -84,7 +88,8 @@ PLANT_SPECS: dict[str, str] = {
     "snakedent": "simrig.plants.snakedent:make_snakedent_plant",
     "planetwist": "simrig.plants.planetwist:make_planetwist_plant",
     "notchclutch": "simrig.plants.notchclutch:make_notchclutch_plant",
-    "pronyring": "simrig.plants.pronyring:make_pronyring_plant",  # last: seeds hold
+    "pronyring": "simrig.plants.pronyring:make_pronyring_plant",
+    "wormeyelet": "simrig.plants.wormeyelet:make_wormeyelet_plant",  # last: seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
@@ -92,7 +97,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
               "planetwist": "held-out", "notchclutch": "held-out",
-              "pronyring": "held-out"}
+              "pronyring": "held-out", "wormeyelet": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -114,7 +119,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "snakedent": SNAKEDENT_KNOBS,
                                         "planetwist": PLANETWIST_KNOBS,
                                         "notchclutch": NOTCHCLUTCH_KNOBS,
-                                        "pronyring": PRONYRING_KNOBS}
+                                        "pronyring": PRONYRING_KNOBS,
+                                        "wormeyelet": WORMEYELET_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -192,6 +198,9 @@ VARIANTS: dict[str, Variant] = {
                             "handle_friction_Nm": 1.5, "tissue_friction_Nmm": 1.5},
             "pronyring": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                           "handle_friction_Nm": 1.5, "ring_tilt_Nmm_per_rad": 1.0 / 1.3},
+            "wormeyelet": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                           "handle_friction_Nm": 1.5, "worm_friction": 1.5,
+                           "worm_play_deg": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -223,7 +232,8 @@ VARIANTS: dict[str, Variant] = {
                  "snakedent": {"tendon_stiffness_N": 0.4},
                  "planetwist": {"tendon_stiffness_N": 0.4},
                  "notchclutch": {"tendon_stiffness_N": 0.4},
-                 "pronyring": {"tendon_stiffness_N": 0.4}},
+                 "pronyring": {"tendon_stiffness_N": 0.4},
+                 "wormeyelet": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

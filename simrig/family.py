@@ -32,8 +32,8 @@ development units in the same session's second round) is held out; the pronyring
 25, written blind: a viscoelastic Pebax section, a pull ring on a compliant bond, PTFE-lined ropes
 along a breathing path; run untuned) is held out from the end of session 25; the wormeyelet
 plant (session 26, written blind: a worm-stage handle with a silicone damper, ropes over one
-lumen contact, a spacer-disk section whose eyelets the ropes rub; run untuned) is the blind plant,
-registered last.
+lumen contact, a spacer-disk section whose eyelets the ropes rub; run untuned) is held out from
+the end of session 26, registered last.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -97,7 +97,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
               "planetwist": "held-out", "notchclutch": "held-out",
-              "pronyring": "held-out", "wormeyelet": "blind"}
+              "pronyring": "held-out", "wormeyelet": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

@@ -169,9 +169,9 @@ def test_a_unit_is_the_same_catheter_each_time_and_units_differ() -> None:
     assert np.array_equal(ta, tb) and abs(tc[0] - ta[0]) > 0.1
 
 
-def test_wormeyelet_is_registered_last_as_the_blind_plant() -> None:
+def test_wormeyelet_is_registered_last_and_held_out() -> None:
     assert list(PLANT_SPECS)[-1] == "wormeyelet"
-    assert PLANT_ROLE["wormeyelet"] == "blind"
+    assert PLANT_ROLE["wormeyelet"] == "held-out"
     assert isinstance(family_member("wormeyelet", 101).build(), WormEyeletPlant)
     assert set(SCATTER["wormeyelet"]) <= set(family_member("wormeyelet", 0).params["knobs"][0])
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 
 import numpy as np
@@ -38,6 +38,16 @@ class GridPoint:
     prefit: SweepPrefit | None = None
     """What the tension-play fit takes from this sweep's own signals, when already analysed (in
     the identification worker, overlapped with the next sweep); None: the fit analyses it."""
+    model_result: SweepResult | None = None
+    """The same sweep in our compensator's frame (only the reading offsets of
+    :data:`tsmd.calibration.reading_offset.MODEL_MIN_OFFSET_DEG` and more applied), where that
+    differs from ``result`` (the reported values, every sure offset applied); None: the same."""
+
+    def in_model_frame(self) -> GridPoint:
+        """This point as our compensator's fit reads it."""
+        if self.model_result is None:
+            return self
+        return replace(self, result=self.model_result, model_result=None)
 
     @property
     def name(self) -> str:

@@ -4,10 +4,16 @@ The data sheet measures, on its tracked unit, what the current reads minus what 
 per parameter and other-knob angle (:mod:`tsmd.profile.reading_offset`). Where that offset is
 a product's bias (twistshaft's B at the other knob's +-90 deg, screwrod's B), every unit of the
 product reads off by about as much in every half-cycle, and subtracting it moves the values
-onto the tip. Where it is small or not sure it is noise of one unit, and subtracting it would
-carry unit 0's noise into every unit: such an offset is not applied (shrunk to nothing). An
-applied offset brings its own uncertainty, which the gate adds to the half-cycles'
+onto the tip. Where it is not sure it is noise of one unit, and subtracting it would carry
+unit 0's noise into every unit: such an offset is not applied (shrunk to nothing). An applied
+offset brings its own uncertainty, which the gate adds to the half-cycles'
 (:class:`tsmd.calibration.estimate.Estimate`).
+
+Two frames (session 26, round 2): the reported D/B take every sure offset however small; our
+compensator's fit reads its sweeps with the offsets of 1 deg and more only, as the data sheet's
+reference edges, knees and gains were read against. Applying the sub-degree ones there too moved
+the fit's release zero-loads (warmgear development 2 phi1's negative side by 3 deg) and cost
+tracking in 11 of 11 rows (docs/calibration.md, "Session 26 (branch s26-calib)", "Round 2").
 """
 
 from __future__ import annotations
@@ -21,31 +27,37 @@ from tsmd.calibration.play_engage import engage, engage_lag_deg
 from tsmd.calibration.sweep_result import SweepResult
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
 
-MIN_OFFSET_DEG = 1.0
-"""An offset below this (half the 2 deg accuracy target) is not applied: what it would gain is
-below what unit-to-unit scatter of the offset costs."""
+MODEL_MIN_OFFSET_DEG = 1.0
+"""Our compensator's frame: an offset below this is not applied to the sweeps its fit reads (nor
+to the sheet's reference edges, knees and gains compared with them)."""
+REPORT_MIN_OFFSET_DEG = 0.0
+"""The reported D/B: every sure offset is applied (sub-degree ones moved warmgear 1-4 215 ->
+224/224 and 101-104 219 -> 223/224 within 2 deg)."""
 MIN_OFFSET_U95_RATIO = 1.0
 """An offset is applied only where it exceeds its own 95 % half-width this many times (its
 interval excludes zero): one measured inconsistently over the sheet unit's half-cycles is not."""
 
 
-def applied_deg(grid: OffsetGrid) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """Per other-knob angle: (offset applied, its 95 % half-width); 0, 0 where not applied."""
+def applied_deg(grid: OffsetGrid, min_deg: float = MODEL_MIN_OFFSET_DEG
+                ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Per other-knob angle: (offset applied, its 95 % half-width); 0, 0 where not applied
+    (not sure, or below ``min_deg``)."""
     shift, u95 = [], []
     for m, u in zip(grid.mean_deg, grid.u95_deg, strict=True):
-        use = abs(m) >= MIN_OFFSET_DEG and abs(m) > MIN_OFFSET_U95_RATIO * u
+        use = abs(m) >= min_deg and abs(m) > MIN_OFFSET_U95_RATIO * u
         shift.append(m if use else 0.0)
         u95.append(u if use else 0.0)
     return tuple(shift), tuple(u95)
 
 
-def offset_at(offset: ReadingOffset, name: str, other_deg: float) -> tuple[float, float]:
+def offset_at(offset: ReadingOffset, name: str, other_deg: float,
+              min_deg: float = MODEL_MIN_OFFSET_DEG) -> tuple[float, float]:
     """(offset to subtract, its 95 % half-width) of ``name`` with the other knob at
     ``other_deg``: linear between the sheet's angles, held beyond them."""
     grid = offset.grid(name)
     if grid is None:
         return 0.0, 0.0
-    shift, u95 = applied_deg(grid)
+    shift, u95 = applied_deg(grid, min_deg)
     at = np.asarray(offset.other_knob_deg, dtype=float)
     return (float(np.interp(other_deg, at, np.asarray(shift))),
             float(np.interp(other_deg, at, np.asarray(u95))))
@@ -77,17 +89,19 @@ def calibrated_edges(device_knob: Any, edge_pos_deg: float, edge_neg_deg: float
 
 
 def corrected(result: SweepResult, offset: ReadingOffset | None,
-              other_deg: float, release_slope: float | None = None) -> SweepResult:
+              other_deg: float, release_slope: float | None = None,
+              min_deg: float = MODEL_MIN_OFFSET_DEG) -> SweepResult:
     """``result`` with every half-cycle's value moved by the product's offset at this grid
-    point, and the offsets' half-widths kept for the gate (unchanged without an offset), the
-    half-widths of the backlashes the current does not show (``result.unseen``) with them."""
+    point (those of ``min_deg`` and more), and the offsets' half-widths kept for the gate
+    (unchanged without an offset), the half-widths of the backlashes the current does not show
+    (``result.unseen``) with them."""
     values = dict(result.values)
     # A backlash the current does not show is the sheet's, not a reading: no offset, and its
     # own half-width goes to the gate in the offset's place.
     u95: dict[str, float] = dict(result.unseen)
     shifts: dict[str, float] = {}
     for name, v in result.values.items():
-        shift, u = (0.0, 0.0) if offset is None else offset_at(offset, name, other_deg)
+        shift, u = (0.0, 0.0) if offset is None else offset_at(offset, name, other_deg, min_deg)
         if shift != 0.0 and name not in result.unseen:
             values[name] = tuple(x - shift for x in v)
             u95[name] = u
@@ -95,7 +109,7 @@ def corrected(result: SweepResult, offset: ReadingOffset | None,
     if not u95:
         return result
     # a handle's play whose end the current shows: the unit's own reading (session 24)
-    plays = {name: offset_at(offset, name, 0.0)[0] for name in shifts
+    plays = {name: offset_at(offset, name, 0.0, min_deg)[0] for name in shifts
              if name.startswith("backlash")} if offset is not None else {}
     read = engage(result, shifts, plays, engage_lag_deg(release_slope))
     values.update(read.values)

@@ -122,8 +122,14 @@ def budget_spent_note(points: Sequence[GridPoint], todo: Sequence[Uncertain],
 
 
 def pooled(point: GridPoint, again: GridPoint) -> GridPoint:
-    """The grid point with a re-sweep's half-cycles pooled in (first recording kept)."""
-    return dataclasses.replace(point, result=point.result.merged(again.result))
+    """The grid point with a re-sweep's half-cycles pooled in (first recording kept), in both
+    frames (reported and our compensator's)."""
+    model = None
+    if point.model_result is not None or again.model_result is not None:
+        first, second = point.in_model_frame(), again.in_model_frame()
+        model = first.result.merged(second.result)
+    return dataclasses.replace(point, result=point.result.merged(again.result),
+                               model_result=model)
 
 
 def uncertainty_table(points: Sequence[GridPoint],

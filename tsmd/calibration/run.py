@@ -47,7 +47,7 @@ from tsmd.calibration.player import (
 )
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import paper_protocol, sweep_run
-from tsmd.calibration.reading_offset import corrected
+from tsmd.calibration.reading_offset import REPORT_MIN_OFFSET_DEG, corrected
 from tsmd.calibration.recovery import with_unseen
 from tsmd.calibration.resweep import (
     budget_spent_note,
@@ -133,9 +133,15 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
                                 sweep_start_s=start_s)
     except CalibrationError as exc:
         raise CalibrationError(f"{source} ({KNOB_LABELS[knob]} sweep): {exc}") from None
-    found = corrected(with_unseen(result, opts, other), opts.reading_offset if opts else None,
-                      other, opts.release_slope if opts else None)
-    return GridPoint(knob, other, with_unit_part(found, opts.unit_part if opts else None), rec)
+    seen = with_unseen(result, opts, other)
+    offset = opts.reading_offset if opts else None
+    slope = opts.release_slope if opts else None
+    part = opts.unit_part if opts else None
+    # reported values: every sure offset; our compensator's fit: its own frame (session 26)
+    found = with_unit_part(corrected(seen, offset, other, slope, REPORT_MIN_OFFSET_DEG), part)
+    model = with_unit_part(corrected(seen, offset, other, slope), part)
+    same = model.values == found.values
+    return GridPoint(knob, other, found, rec, model_result=None if same else model)
 
 
 def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
@@ -158,7 +164,8 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
     profile = build_profile(catheter_id, device, points, quality=report,
                             software_version=__version__, source=source)
     try:
-        profile = with_tension_play(profile, points, device, plateau_gaps)
+        profile = with_tension_play(profile, [p.in_model_frame() for p in points], device,
+                                    plateau_gaps)
     except (ValueError, ArithmeticError) as exc:
         raise CalibrationError(f"our compensator's fit (tension play) failed: {exc}") from None
     return profile, report

@@ -1,6 +1,6 @@
-"""The creep test's one-sided reading of the currents beyond the model's own (opt-in): a held
-knob's current relaxing faster than the model's units' is creep, one relaxing more slowly is not
-(a softer rope in front of a section that relaxes, the pronyring plant)."""
+"""The creep test's one-sided reading of the currents beyond the model's own (the default since
+session 26): a held knob's current relaxing faster than the model's units' is creep, one relaxing
+more slowly is not (a softer rope in front of a section that relaxes, the pronyring plant)."""
 
 from __future__ import annotations
 
@@ -27,13 +27,18 @@ def _own() -> tuple[np.ndarray, np.ndarray]:
     return own.diff, np.full((2, 4), 1e-8)
 
 
+def test_the_one_sided_reading_is_the_default() -> None:
+    assert reference.ONE_SIDED_CREEP is True
+
+
 @pytest.mark.parametrize(("slope", "creeps"), [(3.0 * OWN_A_PER_S, True),
                                                (0.5 * OWN_A_PER_S, False)])
 def test_only_a_current_relaxing_faster_than_the_models_is_read(
         monkeypatch: pytest.MonkeyPatch, slope: float, creeps: bool) -> None:
     meas = _measured(slope)
+    monkeypatch.setattr(reference, "ONE_SIDED_CREEP", False)
     two_sided = reference.drift_beyond_reference(meas, meas, _own())
-    assert np.all(np.abs(two_sided.diff[:, CURRENT_COLUMNS]) > 0.0)  # shipped: either way
+    assert np.all(np.abs(two_sided.diff[:, CURRENT_COLUMNS]) > 0.0)  # either way
     monkeypatch.setattr(reference, "ONE_SIDED_CREEP", True)
     one_sided = reference.drift_beyond_reference(meas, meas, _own())
     beyond = one_sided.diff[:, CURRENT_COLUMNS]

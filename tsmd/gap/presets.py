@@ -2,7 +2,8 @@
 
 A preset is a plant factory with fixed parameters, what to fit when it is the simulator, and how
 each self-test case puts its effect into that plant (its own keywords, or factors on a family
-unit's knob constants, in :mod:`tsmd.gap.preset_effects`); a case the plant has no physics for
+unit's knob constants, in :mod:`tsmd.gap.preset_effects` and, for the plants added since
+session 22, :mod:`tsmd.gap.preset_effects_late`); a case the plant has no physics for
 is not run.
 """
 
@@ -23,9 +24,6 @@ from tsmd.gap.preset_effects import (
     COILPIPE_BASE,
     COILPIPE_EFFECTS,
     COILPIPE_KNOB_EFFECTS,
-    CYCLOPEBAX_EFFECTS,
-    CYCLOPEBAX_KNOB_EFFECTS,
-    CYCLOPEBAX_MAX_STEP_S,
     HELIXBELT_EFFECTS,
     HELIXBELT_KNOB_EFFECTS,
     JAWCRIMP_EFFECTS,
@@ -34,15 +32,6 @@ from tsmd.gap.preset_effects import (
     LUMPED_EFFECTS,
     NITINOL_EFFECTS,
     NITINOL_KNOB_EFFECTS,
-    NOTCHCLUTCH_EFFECTS,
-    NOTCHCLUTCH_KNOB_EFFECTS,
-    NOTCHCLUTCH_MAX_STEP_S,
-    PLANETWIST_EFFECTS,
-    PLANETWIST_KNOB_EFFECTS,
-    PLANETWIST_MAX_STEP_S,
-    PRONYRING_EFFECTS,
-    PRONYRING_KNOB_EFFECTS,
-    PRONYRING_MAX_STEP_S,
     RATESTATE_EFFECTS,
     RATESTATE_KNOB_EFFECTS,
     RATESTATE_MAX_STEP_S,
@@ -52,9 +41,6 @@ from tsmd.gap.preset_effects import (
     SEGMENTS_BASE,
     SEGMENTS_EFFECTS,
     SEGMENTS_KNOB_EFFECTS,
-    SNAKEDENT_EFFECTS,
-    SNAKEDENT_KNOB_EFFECTS,
-    SNAKEDENT_MAX_STEP_S,
     STICKSLIP_EFFECTS,
     STICKSLIP_KNOB_EFFECTS,
     TWISTSHAFT_EFFECTS,
@@ -62,6 +48,23 @@ from tsmd.gap.preset_effects import (
     WARMGEAR_EFFECTS,
     WARMGEAR_KNOB_EFFECTS,
     WARMGEAR_MAX_STEP_S,
+)
+from tsmd.gap.preset_effects_late import (
+    CYCLOPEBAX_EFFECTS,
+    CYCLOPEBAX_KNOB_EFFECTS,
+    CYCLOPEBAX_MAX_STEP_S,
+    NOTCHCLUTCH_EFFECTS,
+    NOTCHCLUTCH_KNOB_EFFECTS,
+    NOTCHCLUTCH_MAX_STEP_S,
+    PLANETWIST_EFFECTS,
+    PLANETWIST_KNOB_EFFECTS,
+    PLANETWIST_MAX_STEP_S,
+    PRONYRING_EFFECTS,
+    PRONYRING_KNOB_EFFECTS,
+    PRONYRING_MAX_STEP_S,
+    SNAKEDENT_EFFECTS,
+    SNAKEDENT_KNOB_EFFECTS,
+    SNAKEDENT_MAX_STEP_S,
 )
 from tsmd.gap.selftest import BUILTIN_FIT_SPECS, BUILTIN_PLANT, EFFECTS
 

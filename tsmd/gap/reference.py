@@ -131,12 +131,13 @@ def own_scale(measured: FloatArray, own: FloatArray) -> float:
     return float(np.clip((measured * own).sum() / norm, 0.0, 1.0))
 
 
-ONE_SIDED_CREEP = False
-"""When True, the currents' drift beyond the model's own is read one-sided, as the tips' is
-(:func:`tsmd.gap.dwell.tip_relaxation`): only a held knob's current relaxing *faster* than the
-model's units' is creep. A unit whose current relaxes more slowly (a softer rope in front of a
-section that relaxes: the blind pronyring plant's compliance case, docs/gap.md "Session 26")
-does not creep more. Off by default until the cross-plant self-test has run with it."""
+ONE_SIDED_CREEP = True
+"""When True (since session 26), the currents' drift beyond the model's own is read one-sided,
+as the tips' is (:func:`tsmd.gap.dwell.tip_relaxation`): only a held knob's current relaxing
+*faster* than the model's units' is creep. A unit whose current relaxes more slowly (a softer
+rope in front of a section that relaxes: the blind pronyring plant's compliance case, docs/gap.md
+"Session 26") does not creep more. Switched on after every plant's creep and "none" cases kept
+their verdicts with it (docs/gap.md "Session 26", "Round 2"); False is the two-sided reading."""
 
 
 def drift_beyond_reference(res: Drift, meas: Drift,

@@ -97,7 +97,9 @@ def test_a_sheet_without_the_share_loads_and_keeps_the_settle_rule() -> None:
         k.backlash_settle_fraction is not None for k in device.knobs)
     stripped = device_model_to_mapping(device)
     for k in stripped["knobs"].values():
-        k.pop("backlash_settle_fraction", None)
+        for name in ("backlash_settle_fraction", "backlash_release_rule", "backlash_knee",
+                     "reference_rule_backlash_gain"):
+            k.pop(name, None)
     assert device_options(None, _load(stripped)) == (IdentifyOptions(), IdentifyOptions())
 
 

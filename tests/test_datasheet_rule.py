@@ -27,12 +27,14 @@ SWING_SHARE = 0.95
 
 
 def sheet(line_share: float | None = LINE_SHARE, rule: str | None = None) -> DeviceModel:
-    """The packaged sheet with fraction-rule shares on both knobs."""
+    """The packaged sheet with fraction-rule shares on both knobs and none of the rule stage's
+    choices (the packaged sheet carries them since session 26)."""
     base = load_device_model(DEVICE)
     knobs = tuple(dataclasses.replace(k, backlash_settle_fraction=SWING_SHARE,
                                       backlash_release_slope_ratio=0.1,
                                       backlash_release_line_share=line_share,
-                                      backlash_release_rule=rule) for k in base.knobs)
+                                      backlash_release_rule=rule, backlash_knee=None,
+                                      reference_rule_backlash_gain=None) for k in base.knobs)
     return dataclasses.replace(base, knobs=(knobs[0], knobs[1]))
 
 

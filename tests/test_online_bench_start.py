@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simrig.scenario import ShapeChange
+from simrig.scenario import ShapeChange, ShapeChangePlant
 from tsmd.bench import online_start
 from tsmd.bench.online import add_arguments
 from tsmd.bench.online_start import CarriedPlant, calibrated_with_plant, run_plant
@@ -74,7 +74,7 @@ def test_a_cached_profile_and_plant_are_taken_without_calibrating(
     def no_calibration(*_: object, **__: object) -> None:
         raise AssertionError("calibrated again")
 
-    monkeypatch.setattr(online_start, "calibrate", no_calibration)
+    monkeypatch.setattr(online_start, "calibrate_unit", no_calibration)
     shutil.copy(EXAMPLE, tmp_path / "notchclutch-unit1-straight.yaml")
     with (tmp_path / "notchclutch-unit1-straight.plant.pkl").open("wb") as f:
         pickle.dump(soaked_notchclutch(2.0), f)
@@ -86,11 +86,12 @@ def test_a_cached_profile_without_its_plant_is_calibrated_again(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[str] = []
 
-    def counted(runner: object, catheter_id: str, *_: object, **__: object) -> object:
-        calls.append(catheter_id)
-        return None
+    def counted(plant: str, unit: int, change: object, device: object, label: str
+                ) -> tuple[None, ShapeChangePlant]:
+        calls.append(f"{plant}-unit{unit}-{label}")
+        return None, make_unit(plant, unit, [])
 
-    monkeypatch.setattr(online_start, "calibrate", counted)
+    monkeypatch.setattr(online_start, "calibrate_unit", counted)
     shutil.copy(EXAMPLE, tmp_path / "notchclutch-unit1-straight.yaml")
     calibrated_with_plant("notchclutch", 1, None, None, tmp_path, "straight")
     assert calls == ["notchclutch-unit1-straight"]

@@ -20,10 +20,8 @@ from pathlib import Path
 from typing import Any
 
 from simrig.scenario import ShapeChange, ShapeChangePlant
-from tsmd.bench.online_units import make_unit
-from tsmd.calibration import calibrate, fast_protocol
+from tsmd.bench.online_units import calibrate_unit, make_unit
 from tsmd.profile import load_profile, save_profile
-from tsmd.replay import LockstepRunner
 
 STARTS = ("calibrated", "fresh")
 
@@ -58,11 +56,8 @@ def calibrated_with_plant(plant: str, unit: int, change: dict[str, Any] | None, 
     if path.exists() and state.exists():
         with state.open("rb") as f:
             return load_profile(path), pickle.load(f)
-    sim = make_unit(plant, unit, [ShapeChange(0.0, change)] if change else [])
     t0 = time.perf_counter()
-    with LockstepRunner(None, None, "none", 3000 + unit, sim) as runner:
-        profile = calibrate(runner, f"{plant}-unit{unit}-{label}", device,
-                            protocol=fast_protocol())
+    profile, sim = calibrate_unit(plant, unit, change, device, label)
     cache.mkdir(parents=True, exist_ok=True)
     if not path.exists():
         save_profile(profile, path)

@@ -58,17 +58,25 @@ def device_for(plant: str, cache: Path) -> Any:
     return device
 
 
+def calibrate_unit(plant: str, unit: int, change: dict[str, Any] | None, device: Any,
+                   label: str) -> tuple[Any, ShapeChangePlant]:
+    """One fast-protocol calibration of the unit (noise seed 3000 + unit), and the simulated
+    unit as the calibration left it."""
+    sim = make_unit(plant, unit, [ShapeChange(0.0, change)] if change else [])
+    with LockstepRunner(None, None, "none", 3000 + unit, sim) as runner:
+        profile = calibrate(runner, f"{plant}-unit{unit}-{label}", device,
+                            protocol=fast_protocol())
+    return profile, sim
+
+
 def calibrated(plant: str, unit: int, change: dict[str, Any] | None, device: Any,
                cache: Path, label: str) -> Any:
     """The unit's profile from ``tsmd.calibration`` (fast protocol), cached."""
     path = cache / f"{plant}-unit{unit}-{label}.yaml"
     if path.exists():
         return load_profile(path)
-    sim = make_unit(plant, unit, [ShapeChange(0.0, change)] if change else [])
     t0 = time.perf_counter()
-    with LockstepRunner(None, None, "none", 3000 + unit, sim) as runner:
-        profile = calibrate(runner, f"{plant}-unit{unit}-{label}", device,
-                            protocol=fast_protocol())
+    profile, _ = calibrate_unit(plant, unit, change, device, label)
     cache.mkdir(parents=True, exist_ok=True)
     save_profile(profile, path)
     print(f"  calibrated {plant} unit {unit} ({label}) in {time.perf_counter() - t0:.0f} s wall",
@@ -76,4 +84,4 @@ def calibrated(plant: str, unit: int, change: dict[str, Any] | None, device: Any
     return profile
 
 
-__all__ = ["calibrated", "device_for", "make_unit", "shape_change"]
+__all__ = ["calibrate_unit", "calibrated", "device_for", "make_unit", "shape_change"]

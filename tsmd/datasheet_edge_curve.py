@@ -84,9 +84,7 @@ class EdgeCurveScore:
 
 def with_edge_curve(device: DeviceModel, on: tuple[bool, bool]) -> DeviceModel:
     """The sheet with the check on where ``on`` says (per knob; off is absent)."""
-    knobs = tuple(dataclasses.replace(k, edge_curve=True if o else None)
-                  for k, o in zip(device.knobs, on, strict=True))
-    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+    return device.with_knob_flag("edge_curve", on)
 
 
 EdgeRead = tuple[int, float, str, float, float]

@@ -203,9 +203,7 @@ def rule_scores(config: TsmdConfig, device: DeviceModel,
 
 def with_knee(device: DeviceModel, on: tuple[bool, bool]) -> DeviceModel:
     """The sheet with the knee on where ``on`` says (per knob)."""
-    knobs = tuple(dataclasses.replace(k, backlash_knee=True if o else None)
-                  for k, o in zip(device.knobs, on, strict=True))
-    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+    return device.with_knob_flag("backlash_knee", on)
 
 
 def choose_knee(config: TsmdConfig, chosen: DeviceModel, rule_scores_: Sequence[RuleScore],

@@ -55,9 +55,7 @@ class StickChoice:
 
 def with_stick_end(device: DeviceModel, on: tuple[bool, bool]) -> DeviceModel:
     """The sheet with the stick end on where ``on`` says (per knob; absent where off)."""
-    knobs = tuple(dataclasses.replace(k, backlash_stick_end=True if o else None)
-                  for k, o in zip(device.knobs, on, strict=True))
-    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+    return device.with_knob_flag("backlash_stick_end", on)
 
 
 def half_scatter_deg(runs: Sequence[ProtocolRun], truth: Truth, knob: int) -> tuple[float, int]:

@@ -3,9 +3,11 @@ manufacturer measured once per product (slope omega, reference points, limits)."
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -332,6 +334,14 @@ class DeviceModel:
     @property
     def limits(self) -> tuple[KnobLimits, KnobLimits]:
         return (self.knobs[0].limits, self.knobs[1].limits)
+
+    def with_knob_flag(self, name: str, on: tuple[bool, bool]) -> DeviceModel:
+        """The sheet with a per-knob opt-in field ``name`` true where ``on`` says and absent
+        (None) elsewhere: how a data-sheet stage writes its per-knob choice."""
+        flags: list[dict[str, Any]] = [{name: True if o else None} for o in on]
+        knobs = tuple(dataclasses.replace(k, **f)
+                      for k, f in zip(self.knobs, flags, strict=True))
+        return dataclasses.replace(self, knobs=(knobs[0], knobs[1]))
 
 
 @dataclass(frozen=True)

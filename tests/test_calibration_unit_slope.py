@@ -56,3 +56,20 @@ def test_a_reading_without_finite_pairs_has_no_weight() -> None:
 
 def test_the_weighed_slope_stays_within_the_plausible_slopes() -> None:
     assert weighed_omega(4.9, [GainReading(0.79, 0.0, 0.0)]) == 5.0
+
+
+def test_a_product_whose_slope_does_not_follow_the_gain_keeps_the_sheets_slope() -> None:
+    tight = GainReading(0.3, 0.2, 0.0)
+    assert weighed_omega(1.4, [tight], gain_weight=0.0) == pytest.approx(1.4)
+
+
+def test_the_sheets_weight_takes_that_share_of_the_readings_move() -> None:
+    tight = GainReading(0.3, 0.2, 0.0)
+    full = weighed_omega(1.4, [tight])
+    assert weighed_omega(1.4, [tight], gain_weight=0.25) == pytest.approx(
+        1.4 + 0.25 * (full - 1.4), rel=1e-9)
+
+
+def test_without_a_weight_the_unit_takes_the_whole_move() -> None:
+    tight = GainReading(0.3, 0.2, 0.0)
+    assert weighed_omega(1.4, [tight], gain_weight=None) == weighed_omega(1.4, [tight])

@@ -313,7 +313,8 @@ def loaded_slope(device_knob: Any, grid: Sequence[float], sweeps: Sequence[Sweep
         pos, neg = (([f.backlash_gain for f in pos_fits], [f.backlash_gain for f in neg_fits])
                     if read is None else read)
         readings.append(gain_reading(float(rule_gain), grid, pos, neg))
-    return weighed_omega(float(device_knob.omega), readings)
+    return weighed_omega(float(device_knob.omega), readings,
+                         getattr(device_knob, "slope_gain_weight", None))
 
 
 @dataclass(frozen=True)

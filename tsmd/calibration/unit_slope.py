@@ -71,9 +71,12 @@ def gain_scatter(pos_gains: Sequence[float], neg_gains: Sequence[float]) -> floa
     return float(np.sqrt(np.mean(d**2) / 2.0)) if d.size else math.inf
 
 
-def weighed_omega(sheet_omega: float, readings: Sequence[GainReading]) -> float:
+def weighed_omega(sheet_omega: float, readings: Sequence[GainReading],
+                  gain_weight: float | None = None) -> float:
     """The sheet's omega times the inverse-variance mean of the readings' ratios and the
-    sheet's own (1 with :data:`PRODUCT_SLOPE_SCATTER`), within the plausible slopes."""
+    sheet's own (1 with :data:`PRODUCT_SLOPE_SCATTER`), within the plausible slopes.
+    ``gain_weight``: the share of that ratio's move from 1 the product's units follow (the
+    sheet's ``slope_gain_weight``, from its sample); None: all of it."""
     weights = [1.0 / PRODUCT_SLOPE_SCATTER**2]
     ratios = [1.0]
     for r in readings:
@@ -82,5 +85,7 @@ def weighed_omega(sheet_omega: float, readings: Sequence[GainReading]) -> float:
             weights.append(1.0 / sd**2)
             ratios.append(r.ratio())
     ratio = float(np.dot(weights, ratios) / np.sum(weights))
+    if gain_weight is not None:
+        ratio = 1.0 + float(gain_weight) * (ratio - 1.0)
     lo, hi = OMEGA_RANGE
     return min(max(sheet_omega * ratio, lo), hi)

@@ -275,6 +275,9 @@ def main(args: argparse.Namespace) -> int:
     seeds = _rule_seeds(args.rule_seeds)
     if args.update is not None:
         return update(args, _params(args.params), seeds)
+    if args.slope_sample is not None:
+        raise DatasheetError("--slope-sample goes with --update (the weight is added to a "
+                             "measured sheet, its sample calibrated under it)")
     if args.device_model is None:
         raise DatasheetError("--device-model is required (or --update FILE)")
     params = _params(args.params)

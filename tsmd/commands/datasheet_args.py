@@ -133,6 +133,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "the sample's part to this existing sheet, calibrating the sample "
                              "under it, and write it to --out with no other field changed (its "
                              "header records the command; docs/calibration.md, session 20)")
+    parser.add_argument("--slope-sample", metavar="LIST",
+                        help="with --update, --plant/--params of the sheet's unit: calibrate it "
+                             "and these declared sample units (as --unit-sample) from current "
+                             "as every unit is, track each knob's loaded slope, and write the "
+                             "share of the gain readings' slope change the tips followed "
+                             "(slope_gain_weight; docs/model.md, session 27)")
     parser.add_argument("--stick-end", action="store_true",
                         help="with --plant and rule seeds: also calibrate the sheet's unit with "
                              "each backlash ended where the current's steep fall after the "

@@ -31,6 +31,7 @@ from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
 from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
+from tsmd.datasheet_slope_weight import sample_pairs, with_slope_weight
 from tsmd.datasheet_unit_edges import UNIT_EDGE_KEYS, with_unit_edges
 from tsmd.profile import DeviceModel, load_device_model, save_device_fields, save_device_model
 
@@ -92,6 +93,27 @@ def with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: dic
     return device
 
 
+def with_slope_sample(device: DeviceModel, config: TsmdConfig, plant: str,
+                      params: dict[str, Any], unit_key: str, units: list[int], seed: int
+                      ) -> DeviceModel:
+    """The sheet with each knob's ``slope_gain_weight`` from the sheet's unit and ``units``
+    (each pair printed, so the choice can be checked by hand)."""
+    t0 = time.monotonic()
+    pairs = []
+    for p in [params, *({**params, unit_key: u} for u in units)]:
+        pairs.append(sample_pairs(device, config, str(p.get(unit_key, "sheet")),
+                                  lambda p=p: load_plant(plant, p), seed))
+        print(f"  slope sample unit {pairs[-1][0].unit}: " + "; ".join(
+            f"{name} reading {q.reading:.3f} tip {q.tip:.3f}"
+            for name, q in zip(("phi1", "phi2"), pairs[-1], strict=True)), flush=True)
+    device, weights = with_slope_weight(device, pairs)
+    for name, w in zip(("phi1", "phi2"), weights, strict=True):
+        print(f"{name} slope_gain_weight on the sample ({len(pairs)} units, noise seed {seed}): "
+              f"{_or_none(w, 3)}")
+    print(f"  slope sample: {time.monotonic() - t0:.0f} s")
+    return device
+
+
 def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -> int:
     """``--update FILE``: the sheet with its sample's part and/or its dead-zone loop's numbers
     (``--plateau-gap``), written to ``--out``; nothing else of it changes (checked before
@@ -108,13 +130,14 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                              "sample is tracked on the simulated rig")
     loop = bool(args.plateau_gap)
     edges = bool(args.unit_edges)
+    slope = args.slope_sample is not None
     # nested or new fields: written whole
     whole = args.stick_end or args.settle_gain_check or args.level_grid
-    if args.unit_sample is None and not loop and not whole and not edges:
+    if args.unit_sample is None and not loop and not whole and not edges and not slope:
         raise DatasheetError("--update adds the sample's part, the loop's, the stick end, the "
-                             "settle-gain check, the level grid or the unit's edges: give "
-                             "--unit-sample, --plateau-gap, --stick-end, --settle-gain-check, "
-                             "--level-grid or --unit-edges")
+                             "settle-gain check, the level grid, the unit's edges or the slope "
+                             "weight: give --unit-sample, --plateau-gap, --stick-end, "
+                             "--settle-gain-check, --level-grid, --unit-edges or --slope-sample")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
@@ -138,6 +161,13 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                                    args.seed)
         keys += LOOP_KEYS
         what.append(f"the sheet's unit's dead-zone loop, noise seed {args.seed}")
+    if slope:
+        updated = with_slope_sample(updated, config, args.plant, params, args.unit_key,
+                                    sample_units(args.slope_sample, params.get(args.unit_key)),
+                                    seed)
+        keys += ("slope_gain_weight",)
+        what.append(f"the sheet's unit and sample {args.slope_sample} calibrated and tracked, "
+                    f"noise seed {seed}")
     if edges:
         runs = seeds or [args.seed]
         updated = with_unit_edges(updated, config, lambda: load_plant(args.plant, params), runs)
@@ -148,6 +178,7 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                + (f" --unit-sample {args.unit_sample}" if units else "")
                + (" --plateau-gap" if loop else "")
                + (" --unit-edges" if edges else "")
+               + (f" --slope-sample {args.slope_sample}" if slope else "")
                + (" --stick-end" if args.stick_end else "")
                + (" --settle-gain-check" if args.settle_gain_check else "")
                + (f" --level-grid --seed {args.seed}" if args.level_grid else "")

@@ -78,6 +78,7 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "edge_level_share": (*EDGE_LEVEL_SHARE_RANGE, ""),
     "plateau_gap_deg": (0.0, 45.0, "deg"),
     "plateau_gap_factor": (0.1, 10.0, ""),
+    "slope_gain_weight": (0.0, 1.0, ""),
     "calibrated_dead_zone_pos_deg": (0.0, 90.0, "deg"),
     "calibrated_dead_zone_neg_deg": (-90.0, 0.0, "deg"),
 }
@@ -109,6 +110,8 @@ _LOOP_KEYS = ("plateau_gap_deg", "plateau_gap_factor")
 """Optional numbers of the dead-zone loop (session 25), written only when measured."""
 _UNIT_EDGE_KEYS = ("calibrated_dead_zone_pos_deg", "calibrated_dead_zone_neg_deg")
 """Optional edges of the sheet unit's own calibration (session 26), written only when measured."""
+_SLOPE_KEYS = ("slope_gain_weight",)
+"""Optional share of the gain reading a unit's slope takes, from the product's sample (s27)."""
 
 
 _Block = TypeVar("_Block")
@@ -252,6 +255,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             plateau_gap_factor=optional("plateau_gap_factor"),
             calibrated_dead_zone_pos_deg=optional("calibrated_dead_zone_pos_deg"),
             calibrated_dead_zone_neg_deg=optional("calibrated_dead_zone_neg_deg"),
+            slope_gain_weight=optional("slope_gain_weight"),
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
             **{name: _nested(r, k.get(name), f"{key}.{name}", shape_from_mapping)
@@ -326,7 +330,7 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         if k.release_end_shape is not None:
             knobs[name]["release_end_shape"] = release_end_shape_to_mapping(k.release_end_shape)
         for key in (_RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS + _ROUND_KEYS
-                    + _HANDLE_KEYS + _LOOP_KEYS + _UNIT_EDGE_KEYS):
+                    + _HANDLE_KEYS + _LOOP_KEYS + _UNIT_EDGE_KEYS + _SLOPE_KEYS):
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         if k.reading_offset is not None:

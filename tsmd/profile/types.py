@@ -304,6 +304,13 @@ class DeviceKnob:
     read in the unit's first minutes; warmgear's shaft has by then not yet warmed, its slack
     not yet shrunk). None: the reference edges."""
     calibrated_dead_zone_neg_deg: float | None = None
+    slope_gain_weight: float | None = None
+    """Optional, chosen on the product's sample (``tsmd datasheet --update --slope-sample``,
+    session 27): the share of the loaded-slope change a unit's backlash-gain reading says that
+    the sample's tracked tips showed (0..1). A unit's omega ratio against the sheet's moves by
+    this share of what the readings give (:func:`tsmd.calibration.unit_slope.weighed_omega`):
+    1 where all backlash is rope stretch the loaded line also loses, less where friction
+    holds part of it (wormeyelet's eyelet band and disks). None: 1, every unit's omega as before."""
 
 
 

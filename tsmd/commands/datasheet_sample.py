@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import functools
 import json
 import math
 import re
@@ -102,7 +103,7 @@ def with_slope_sample(device: DeviceModel, config: TsmdConfig, plant: str,
     pairs = []
     for p in [params, *({**params, unit_key: u} for u in units)]:
         pairs.append(sample_pairs(device, config, str(p.get(unit_key, "sheet")),
-                                  lambda p=p: load_plant(plant, p), seed))
+                                  functools.partial(load_plant, plant, p), seed))
         print(f"  slope sample unit {pairs[-1][0].unit}: " + "; ".join(
             f"{name} reading {q.reading:.3f} tip {q.tip:.3f}"
             for name, q in zip(("phi1", "phi2"), pairs[-1], strict=True)), flush=True)

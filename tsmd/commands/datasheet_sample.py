@@ -31,6 +31,7 @@ from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
+from tsmd.datasheet_release_round import with_release_round
 from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
 from tsmd.datasheet_slope_weight import sample_pairs, with_slope_weight
 from tsmd.datasheet_unit_edges import UNIT_EDGE_KEYS, with_unit_edges
@@ -132,13 +133,16 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
     loop = bool(args.plateau_gap)
     edges = bool(args.unit_edges)
     slope = args.slope_sample is not None
+    rounded = bool(args.release_round)
     # nested or new fields: written whole
     whole = args.stick_end or args.settle_gain_check or args.level_grid
-    if args.unit_sample is None and not loop and not whole and not edges and not slope:
+    if (args.unit_sample is None and not loop and not whole and not edges and not slope
+            and not rounded):
         raise DatasheetError("--update adds the sample's part, the loop's, the stick end, the "
-                             "settle-gain check, the level grid, the unit's edges or the slope "
-                             "weight: give --unit-sample, --plateau-gap, --stick-end, "
-                             "--settle-gain-check, --level-grid, --unit-edges or --slope-sample")
+                             "settle-gain check, the level grid, the unit's edges, the slope "
+                             "weight or the rounded release: give --unit-sample, --plateau-gap, "
+                             "--stick-end, --settle-gain-check, --level-grid, --unit-edges, "
+                             "--slope-sample or --release-round")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
@@ -162,6 +166,11 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                                    args.seed)
         keys += LOOP_KEYS
         what.append(f"the sheet's unit's dead-zone loop, noise seed {args.seed}")
+    if rounded:  # read under the sheet's own choices, as every unit is calibrated
+        updated = with_release_round(updated, config, lambda: load_plant(args.plant, params),
+                                     args.seed)
+        keys += ("release_round", "release_shift")
+        what.append(f"the sheet's unit calibrated, tracked, noise seed {args.seed}")
     if slope:
         updated = with_slope_sample(updated, config, args.plant, params, args.unit_key,
                                     sample_units(args.slope_sample, params.get(args.unit_key)),
@@ -180,6 +189,7 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                + (" --plateau-gap" if loop else "")
                + (" --unit-edges" if edges else "")
                + (f" --slope-sample {args.slope_sample}" if slope else "")
+               + (f" --release-round --seed {args.seed}" if rounded else "")
                + (" --stick-end" if args.stick_end else "")
                + (" --settle-gain-check" if args.settle_gain_check else "")
                + (f" --level-grid --seed {args.seed}" if args.level_grid else "")

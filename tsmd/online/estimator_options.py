@@ -79,10 +79,9 @@ class EstimatorOptions:
     the gate beyond the dead band) only once the knob's other edge shows a change too
     (:mod:`tsmd.online.partner`; the same way for a followed change with
     ``partner_confirms_same_way``, else either way): a shape change moves both edges of a
-    knob, one edge's
-    readings wander on their own (coilpipe 1 without a change: phi1 pos followed to +2.04 deg
-    while phi1 neg read -0.17/+0.68, tracking 0.6-1.3 deg worse for 250 s). Off: each edge on
-    its own (until session 16)."""
+    knob, one edge's readings wander on their own (coilpipe 1 without a change: phi1 pos
+    followed to +2.04 deg while phi1 neg read -0.17/+0.68, tracking 0.6-1.3 deg worse for 250
+    s). Off: each edge on its own (until session 16)."""
     partner_lean: float = 0.5
     """With ``partner_confirms``: the other edge shows a change when its latest reading lies
     this fraction of ``gate_deg`` or more from its estimate (or it followed one)."""
@@ -150,16 +149,17 @@ class EstimatorOptions:
     show one tendon's), so the nearest point pins the estimate where the follow put it
     (twistshaft 1, +0.5 mm slack, calibrated start: phi1's positive ramps 1.02-1.07 x the
     reference after the change read +3.2..+3.7 deg with the slope in use, +3.6..+4.5 with
-    their own, the estimate stayed at the follow's +3.30). Off: the nearest point (until
-    session 27)."""
+    their own, the estimate stayed at the follow's +3.30). Off: the nearest point (session
+    27: built, left off with ``refine_after_follow``; docs/online.md)."""
     refine_after_follow: bool = False
-    """For ``window`` measurements within the gate after a followed change the applied offset
-    is the estimate, not held by ``deadband_deg``: the follow placed the edge from one or two
-    ramps, the window's median refines it, and the dead band (hysteresis against a settled
-    estimate's jitter) kept a refinement just short of it (twistshaft 2, +0.5 mm slack: phi1's
-    positive edge followed to +2.82 deg, its estimate refined to +3.19 over the next ramps,
-    0.37 deg, not applied; the tip wanted +3.3..+3.8). Off: the dead band throughout (until
-    session 27)."""
+    """For ``window`` measurements within the gate after a followed change, a reading in an
+    other-knob bin still learning counts towards the estimate too (not only the bin), and the
+    applied offset is the estimate, not held by ``deadband_deg``: a follow places the edge
+    from one or two ramps, and the ramps after it fall in bins still learning (twistshaft 2,
+    +0.5 mm slack: phi1's positive edge followed to +2.82 deg from one ramp, later read
+    +3.60, +3.81, +3.19, +2.74, +2.71 in learning bins, the estimate stayed +2.82; the tip
+    wanted +3.3..+3.8). Off (session 27: with ``followed_reads_own`` twistshaft 1-2's phi1
+    got better, unit 1's phi2 0.31 deg worse; docs/online.md)."""
     suspect_needs_own_slope: bool = True
     """A crossing outward beyond the gate with the slope in use that the ramp's own slope
     (within ``same_slope_tolerance`` of it) does not put outward beyond the gate reads the

@@ -55,12 +55,46 @@ def test_a_widening_the_other_edge_reads_too_is_followed() -> None:
     assert pos.applied_deg == pytest.approx(2.05, abs=0.01)
 
 
-def test_a_shift_the_other_edge_reads_the_other_way_is_followed() -> None:
-    pos, neg = learned_knob()
+def test_without_the_same_way_rule_a_shift_the_other_edge_reads_is_followed() -> None:
+    pos, neg = learned_knob(EstimatorOptions(partner_confirms_same_way=False))
     neg.update(ramp_with_edge(EDGE_DEG - 2.0), EDGE_DEG, pos)  # inward: the knob's axis shifted
     for m in (2.0, 2.1):
         pos.update(ramp_with_edge(EDGE_DEG + m), EDGE_DEG, neg)
     assert pos.applied_deg == pytest.approx(2.05, abs=0.01)
+
+
+def test_a_shift_is_not_followed_by_default() -> None:
+    pos, neg = learned_knob()
+    neg.update(ramp_with_edge(EDGE_DEG - 2.0), EDGE_DEG, pos)  # inward: the dead zone moved
+    for m in (2.0, 2.1):
+        pos.update(ramp_with_edge(EDGE_DEG + m), EDGE_DEG, neg)
+    assert pos.applied_deg == 0.0
+    assert pos.status()["partner_held"] > 0
+
+
+def test_with_the_same_way_rule_the_inward_edge_of_a_shift_is_not_followed() -> None:
+    options = EstimatorOptions(partner_confirms_same_way=True)
+    pos, neg = learned_knob(options)
+    neg.update(ramp_with_edge(EDGE_DEG + 2.5), EDGE_DEG, pos)  # outward
+    for m in (-2.0, -2.1):
+        pos.update(ramp_with_edge(EDGE_DEG + m), EDGE_DEG, neg)
+    assert pos.applied_deg == 0.0
+
+
+def test_with_the_same_way_rule_a_widening_is_followed() -> None:
+    pos, neg = learned_knob(EstimatorOptions(partner_confirms_same_way=True))
+    neg.update(ramp_with_edge(EDGE_DEG + 1.0), EDGE_DEG, pos)
+    for m in (2.0, 2.1):
+        pos.update(ramp_with_edge(EDGE_DEG + m), EDGE_DEG, neg)
+    assert pos.applied_deg == pytest.approx(2.05, abs=0.01)
+
+
+def test_with_the_same_way_rule_a_narrowing_is_followed() -> None:
+    pos, neg = learned_knob(EstimatorOptions(partner_confirms_same_way=True))
+    neg.update(ramp_with_edge(EDGE_DEG - 1.0), EDGE_DEG, pos)
+    for m in (-2.0, -2.1):
+        pos.update(ramp_with_edge(EDGE_DEG + m), EDGE_DEG, neg)
+    assert pos.applied_deg == pytest.approx(-2.05, abs=0.01)
 
 
 def test_after_a_followed_change_an_edge_corrects_on_its_own() -> None:

@@ -47,6 +47,8 @@ class ReferenceReadings:
     n_steeper: int
     n_own_between: int
     n_own_held: int
+    n_followed_own: int
+    level_deg: float
     n_flatter_own: int
     knob_change: float
     n_leaning_steeper: int
@@ -108,6 +110,10 @@ class ReferenceReadings:
         own = self._crossing(ramp, edge_deg, ramp.slope_A_per_deg)
         if o.within_gate_reads_own and abs(raw - target) <= o.gate_deg:
             self.n_own_between += 1
+            if (o.followed_reads_own and self.level_deg != 0.0
+                    and abs(own - target) <= o.gate_deg):
+                self.n_followed_own += 1  # after a change the reference slope is the old
+                return own  # tendon's (``followed_reads_own``)
             return nearest_between(raw, own, target)
         if (o.suspect_needs_own_slope and raw - target > o.gate_deg
                 and own - target <= o.gate_deg

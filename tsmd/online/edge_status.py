@@ -30,7 +30,8 @@ def edge_status(edge: Any) -> dict[str, Any]:
             "steeper_ramps": edge.n_steeper, "own_slope_ramps": edge.n_own_between,
             "own_slope_held_ramps": edge.n_own_held, "flatter_own_ramps": edge.n_flatter_own,
             "leaning_steeper_ramps": edge.n_leaning_steeper,
-            "bin_lean_held_ramps": edge.n_bin_lean}
+            "bin_lean_held_ramps": edge.n_bin_lean,
+            "followed_own_slope_ramps": edge.n_followed_own}
 
 
 __all__ = ["edge_status"]

@@ -105,6 +105,12 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     n_own_held: int = 0
     """Crossings beyond the gate with the slope in use read within it towards the ramp's own
     slope (``suspect_needs_own_slope``)."""
+    refining_for: int = 0
+    """Measurements after a followed change still to be applied without the dead band
+    (``refine_after_follow``)."""
+    n_followed_own: int = 0
+    """Crossings within the gate after a followed change read with the ramp's own slope
+    (``followed_reads_own``)."""
     n_flatter_own: int = 0
     """Crossings outward beyond the gate with both slopes on a flatter ramp, read at its own
     slope (``flatter_suspect_reads_own``)."""
@@ -326,12 +332,19 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             key = self.bins.key(other_deg)
             learned = self.bins.learned(key)
             self.bins.teach(key, raw_deg - self.estimate_deg)
-            if not (learned or o.learning_bins_count):  # a bin still learning where the
-                return  # current's edge sits: it teaches the bin, not the estimate (a change
-                        # beyond the gate is a suspect as anywhere)
+            refining = self.refining_for > 0
+            if not (learned or o.learning_bins_count or refining):
+                # a bin still learning where the current's edge sits: it teaches the bin, not
+                # the estimate (a change beyond the gate is a suspect as anywhere); right
+                # after a followed change it refines the follow too (``refine_after_follow``)
+                return
             self.accepted = [*self.accepted, m][-o.window:]
             self.estimate_deg = median(
                 [*self.accepted, *[self.level_deg] * (o.window - len(self.accepted))])
+            self.refining_for = max(self.refining_for - 1, 0)
+            if refining:
+                self.applied_deg = max(-o.max_offset_deg, min(o.max_offset_deg,
+                                                               self.estimate_deg))
         else:
             self.suspects = [*self.suspects, m][-o.confirm:]
             self.suspect_order = next(ORDER)
@@ -350,8 +363,9 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         direction = 1 if new_deg > self.estimate_deg else -1
         if self.level_deg != 0.0:
             return True
+        way = direction if self.options.partner_confirms_same_way else 0
         if self.options.partner_confirms and not partner_shows_change(
-                self.partner, self.options.partner_lean * self.options.gate_deg):
+                self.partner, self.options.partner_lean * self.options.gate_deg, way):
             self.n_partner_held += 1
             return False
         return self.other_knob_shows is None or self.other_knob_shows(direction)
@@ -386,6 +400,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
                     "why": why})]
         self.accepted = kept or [new_deg]
         self.estimate_deg = self.level_deg = new_deg
+        self.refining_for = o.window if o.refine_after_follow else 0
         self.reference.fix()
         self._apply()
         return events

@@ -76,14 +76,24 @@ class EstimatorOptions:
     +0.83/+0.92 deg while phi2 was followed; without the lean phi2 waited 31 s). 0: off."""
     partner_confirms: bool = True
     """An edge leaves the profile's value (its first followed change, or an estimate within
-    the gate beyond the dead band) only once the knob's other edge shows a change too, either
-    way (:mod:`tsmd.online.partner`): a shape change moves both edges of a knob, one edge's
-    readings wander on their own (coilpipe 1 without a change: phi1 pos followed to +2.04 deg
-    while phi1 neg read -0.17/+0.68, tracking 0.6-1.3 deg worse for 250 s). Off: each edge on
-    its own (until session 16)."""
+    the gate beyond the dead band) only once the knob's other edge shows a change too
+    (:mod:`tsmd.online.partner`; the same way for a followed change with
+    ``partner_confirms_same_way``, else either way): a shape change moves both edges of a
+    knob, one edge's readings wander on their own (coilpipe 1 without a change: phi1 pos
+    followed to +2.04 deg while phi1 neg read -0.17/+0.68, tracking 0.6-1.3 deg worse for 250
+    s). Off: each edge on its own (until session 16)."""
     partner_lean: float = 0.5
     """With ``partner_confirms``: the other edge shows a change when its latest reading lies
     this fraction of ``gate_deg`` or more from its estimate (or it followed one)."""
+    partner_confirms_same_way: bool = True
+    """With ``partner_confirms``: the first change an edge follows on its own suspects needs
+    the other edge's latest reading to lie the same way (both outward: a widening, both
+    inward: a narrowing), not either way: a slack or a bend widens both edges, while a
+    catheter's ring seat relaxing after its calibration moves the whole dead zone (pronyring
+    1 without a change, calibrated start: phi1's negative edge read +2.0..+3.0 deg outward
+    from 47 s on, its positive edge -0.9..-1.9 inward; both followed, phi1 tracked 3.42
+    against 2.98 with online off). Two edges whose suspects agree (:meth:`agrees_with`) are
+    not affected. On since session 27; off: either way."""
     gain_after_follow: bool = True
     """The backlash gain moves only once an edge of the knob has followed a change: without
     one the loaded ramps' slopes follow the knob's speed (coilpipe 1 and lumped 6 without a
@@ -130,6 +140,26 @@ class EstimatorOptions:
     leave the steeper ramps' inward readings, and coilpipe 1 without a change ended at
     -0.45 deg instead of -0.03. Beyond the gate nothing changes (a change's suspects). Off:
     the slope in use alone (until session 20)."""
+    followed_reads_own: bool = False
+    """Once the edge has followed a change, a crossing within the gate of a ramp whose slope
+    differs from the slope in use reads its own slope's crossing (when that lies within the
+    gate too) instead of the point between the two nearest the estimate: the reference slope
+    was learned before the change, and a change moves each tendon's path on its own (the
+    knob's common slope change, shrunk to none within ``slope_in_use_tolerance``, does not
+    show one tendon's), so the nearest point pins the estimate where the follow put it
+    (twistshaft 1, +0.5 mm slack, calibrated start: phi1's positive ramps 1.02-1.07 x the
+    reference after the change read +3.2..+3.7 deg with the slope in use, +3.6..+4.5 with
+    their own, the estimate stayed at the follow's +3.30). Off: the nearest point (session
+    27: built, left off with ``refine_after_follow``; docs/online.md)."""
+    refine_after_follow: bool = False
+    """For ``window`` measurements within the gate after a followed change, a reading in an
+    other-knob bin still learning counts towards the estimate too (not only the bin), and the
+    applied offset is the estimate, not held by ``deadband_deg``: a follow places the edge
+    from one or two ramps, and the ramps after it fall in bins still learning (twistshaft 2,
+    +0.5 mm slack: phi1's positive edge followed to +2.82 deg from one ramp, later read
+    +3.60, +3.81, +3.19, +2.74, +2.71 in learning bins, the estimate stayed +2.82; the tip
+    wanted +3.3..+3.8). Off (session 27: with ``followed_reads_own`` twistshaft 1-2's phi1
+    got better, unit 1's phi2 0.31 deg worse; docs/online.md)."""
     suspect_needs_own_slope: bool = True
     """A crossing outward beyond the gate with the slope in use that the ramp's own slope
     (within ``same_slope_tolerance`` of it) does not put outward beyond the gate reads the

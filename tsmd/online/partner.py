@@ -8,9 +8,12 @@ coilpipe 1's phi1 positive edge read +2.03 and +2.04 deg on two strokes, followe
 while its negative edge read -0.17 and +0.68 on either side of them, and phi1 tracked 0.6-1.3
 deg worse than with online off for the 250 s it stayed; lumped 6's phi1 negative edge crept to
 +0.49 deg within the gate while its positive edge stayed below the dead band, 0.1-0.2 deg worse).
-So the first change away from the profile waits until the other edge of the knob shows one as
-well, either way; once a change was followed the edges refine on their own (a correction of a
-follow that went too far is one edge's).
+So the first change away from the profile waits until the other edge of the knob shows one
+as well; since session 27 the same way (``partner_confirms_same_way``: both outward or both
+inward), since a catheter's relaxation after its calibration moves the whole dead zone without
+a change (pronyring 1: phi1's negative edge read 2-3 deg outward for 600 s, its positive edge
+1-2 deg inward; followed, phi1 tracked worse than with online off). Once a change was followed
+the edges refine on their own (a correction of a follow that went too far is one edge's).
 """
 
 from __future__ import annotations
@@ -43,12 +46,17 @@ class OutwardView(Protocol):
     suspects: list[float]
 
 
-def partner_shows_change(partner: EdgeView | None, lean_deg: float) -> bool:
+def partner_shows_change(partner: EdgeView | None, lean_deg: float,
+                         direction: int = 0) -> bool:
     """The knob's other edge followed a change, or its latest reading lies ``lean_deg`` or
-    more from its estimate (either way: a widening or a shift). True without a partner."""
+    more from its estimate: either way (``direction`` 0: a widening or a shift), or that way
+    (+1 outward, -1 inward: a widening or a narrowing only). True without a partner."""
     if partner is None or partner.level_deg != 0.0:
         return True
     reading = partner.last_reading_deg - partner.estimate_deg
+    if direction != 0:
+        reading *= direction
+        return math.isfinite(reading) and reading >= lean_deg
     return math.isfinite(reading) and abs(reading) >= lean_deg
 
 

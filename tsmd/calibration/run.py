@@ -47,7 +47,7 @@ from tsmd.calibration.player import (
 )
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import paper_protocol, sweep_run
-from tsmd.calibration.reading_offset import REPORT_MIN_OFFSET_DEG, corrected
+from tsmd.calibration.reading_offset import REPORT_MIN_OFFSET_DEG, corrected, left_u95_deg
 from tsmd.calibration.recovery import with_unseen
 from tsmd.calibration.resweep import (
     budget_spent_note,
@@ -138,8 +138,11 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
     slope = opts.release_slope if opts else None
     part = opts.unit_part if opts else None
     # reported values: every sure offset; our compensator's fit: its own frame (session 26)
-    found = with_unit_part(corrected(seen, offset, other, slope, REPORT_MIN_OFFSET_DEG), part)
-    model = with_unit_part(corrected(seen, offset, other, slope), part)
+    left = {name: left_u95_deg(offset, name, other, REPORT_MIN_OFFSET_DEG)
+            for name in seen.values}
+    found = with_unit_part(corrected(seen, offset, other, slope, REPORT_MIN_OFFSET_DEG), part,
+                           left)
+    model = with_unit_part(corrected(seen, offset, other, slope), part, left)
     same = model.values == found.values
     return GridPoint(knob, other, found, rec, model_result=None if same else model)
 

@@ -236,3 +236,26 @@ def test_a_rigid_two_sided_play_gives_no_warning() -> None:
     check_play_creep(two_sided_points(((15.0, 15.2), (14.9, 15.0), (15.2, 15.1))), report)
     assert report.warnings == []
     assert report.figures["phi1_play_end_side_gap_deg"] < SIDE_GAP_DEG
+
+
+def test_a_stick_ends_offset_is_no_play_and_reads_no_play_end() -> None:
+    # pronyring: B read where the stick phase ends, its sheet offset -5 deg; no handle play.
+    sweep = falling_sweep(None, 0)
+    read = corrected(sweep, play_offset(-5.0), 0.0, read_play=False)
+    assert read.play_ends_deg == {}
+    assert read.values["backlash_pos_deg"] == pytest.approx((LINE_END_DEG + 5.0,))
+
+
+def test_a_stick_end_knob_gives_no_creep_warning() -> None:
+    points = [GridPoint(0, other, corrected(falling_sweep(None, seed), play_offset(-5.0), other,
+                                            read_play=False))
+              for seed, other in enumerate(OTHER_DEG)]
+    report = QualityReport()
+    check_play_creep(points, report)
+    assert report.warnings == []
+    # the play-end search on the same sweeps finds no step and flags the knob
+    searched = [GridPoint(0, other, corrected(falling_sweep(None, seed), play_offset(-5.0),
+                                              other))
+                for seed, other in enumerate(OTHER_DEG)]
+    check_play_creep(searched, report)
+    assert len(report.warnings) == 1

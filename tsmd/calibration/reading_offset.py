@@ -108,7 +108,7 @@ def calibrated_edges(device_knob: Any, edge_pos_deg: float, edge_neg_deg: float
 
 def corrected(result: SweepResult, offset: ReadingOffset | None,
               other_deg: float, release_slope: float | None = None,
-              min_deg: float = MODEL_MIN_OFFSET_DEG) -> SweepResult:
+              min_deg: float = MODEL_MIN_OFFSET_DEG, read_play: bool = True) -> SweepResult:
     """``result`` with every half-cycle's value moved by the product's offset at this grid
     point (those of ``min_deg`` and more), and the offsets' half-widths kept for the gate
     (unchanged without an offset), the half-widths of the backlashes the current does not show
@@ -126,9 +126,10 @@ def corrected(result: SweepResult, offset: ReadingOffset | None,
             shifts[name] = shift
     if not u95:
         return result
-    # a handle's play whose end the current shows: the unit's own reading (session 24)
+    # a handle's play whose end the current shows: the unit's own reading (session 24), past
+    # the line rule's end only (``read_play``: a stick end's offset is no play, session 27)
     plays = {name: offset_at(offset, name, 0.0, min_deg)[0] for name in shifts
-             if name.startswith("backlash")} if offset is not None else {}
+             if name.startswith("backlash")} if offset is not None and read_play else {}
     read = engage(result, shifts, plays, engage_lag_deg(release_slope))
     values.update(read.values)
     return dataclasses.replace(result, values=values, offset_u95_deg=u95,

@@ -140,9 +140,12 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
     # reported values: every sure offset; our compensator's fit: its own frame (session 26)
     left = {name: left_u95_deg(offset, name, other, REPORT_MIN_OFFSET_DEG)
             for name in seen.values}
-    found = with_unit_part(corrected(seen, offset, other, slope, REPORT_MIN_OFFSET_DEG), part,
-                           left)
-    model = with_unit_part(corrected(seen, offset, other, slope), part, left)
+    # The play's end is searched past the line rule's end; a stick end's offset is no play
+    # (pronyring's -5 deg: no step in 12 of 12 half-cycles, a creep warning on every unit).
+    play = not (opts is not None and opts.backlash_stick_end)
+    found = with_unit_part(corrected(seen, offset, other, slope, REPORT_MIN_OFFSET_DEG, play),
+                           part, left)
+    model = with_unit_part(corrected(seen, offset, other, slope, read_play=play), part, left)
     same = model.values == found.values
     return GridPoint(knob, other, found, rec, model_result=None if same else model)
 

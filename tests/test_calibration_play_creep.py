@@ -22,7 +22,9 @@ from tsmd.calibration.play_creep import (
     CREEP_SPREAD_DEG,
     SIDE_GAP_DEG,
     check_play_creep,
+    creeping_sides,
     play_creep,
+    reread_at_swing_end,
 )
 from tsmd.calibration.reading_offset import corrected
 from tsmd.calibration.resweep import point_estimates
@@ -97,11 +99,52 @@ def test_a_creeping_knobs_half_width_reaches_back_to_the_line_end() -> None:
             <= LINE_END_DEG - 1.0
 
 
-def test_a_creeping_knob_keeps_its_values_at_the_plays_end() -> None:
+def test_a_creeping_knobs_late_sides_are_read_at_the_swings_end() -> None:
+    # 15.0 / 17.5 / 19.0: the play closes 2.5 and 4 deg after the knob's earliest close at the
+    # other knob's 0 and +90, where the tip crept before it; its B is the swing's end there.
+    points = knob_points(CREEPING)
+    check_play_creep(points, QualityReport())
+    values = [p.result.estimate("backlash_pos_deg") for p in points]
+    assert values[0] == pytest.approx(15.0, abs=0.5)
+    assert values[1] == pytest.approx(LINE_END_DEG, abs=0.01)
+    assert values[2] == pytest.approx(LINE_END_DEG, abs=0.01)
+
+
+def test_a_creeping_knobs_sides_closing_with_the_earliest_keep_the_plays_end() -> None:
+    # One side late by 1.1 deg at +90: only that side is re-read.
+    points = two_sided_points(ONE_SIDE_LATE)
+    before = [dict(p.result.values) for p in points]
+    check_play_creep(points, QualityReport())
+    assert points[2].result.estimate("backlash_neg_deg") == pytest.approx(LINE_END_DEG,
+                                                                          abs=0.01)
+    assert points[2].result.values["backlash_pos_deg"] == before[2]["backlash_pos_deg"]
+    assert [p.result.values for p in points[:2]] == before[:2]
+
+
+def test_the_compensators_frame_keeps_the_plays_end_where_b_is_re_read() -> None:
     points = knob_points(CREEPING)
     values = [p.result.values for p in points]
     check_play_creep(points, QualityReport())
+    assert [p.in_model_frame().result.values for p in points] == values
+
+
+def test_a_rigid_knobs_values_are_not_re_read() -> None:
+    points = two_sided_points(((15.0, 15.2), (14.9, 15.0), (15.2, 15.1)))
+    values = [p.result.values for p in points]
+    check_play_creep(points, QualityReport())
     assert [p.result.values for p in points] == values
+
+
+def test_a_re_read_b_keeps_its_half_cycles_scatter() -> None:
+    late = SweepResult(None, (), {"backlash_pos_deg": (18.0, 19.0, 20.0)})  # type: ignore[arg-type]
+    moved = reread_at_swing_end(late, {"backlash_pos_deg"}, 3.0)
+    assert moved.values["backlash_pos_deg"] == pytest.approx((2.0, 3.0, 4.0))
+
+
+def test_a_side_whose_play_never_closed_in_the_window_is_creeping() -> None:
+    # 30 deg after the reversal: beyond the sheet's window, no step found (the creep's rope).
+    assert creeping_sides(knob_points((15.0, 30.0, 30.0)), 0) == {
+        (0.0, "backlash_pos_deg"), (90.0, "backlash_pos_deg")}
 
 
 def test_a_play_closing_beyond_the_sheets_window_in_most_half_cycles_is_flagged() -> None:
@@ -193,3 +236,26 @@ def test_a_rigid_two_sided_play_gives_no_warning() -> None:
     check_play_creep(two_sided_points(((15.0, 15.2), (14.9, 15.0), (15.2, 15.1))), report)
     assert report.warnings == []
     assert report.figures["phi1_play_end_side_gap_deg"] < SIDE_GAP_DEG
+
+
+def test_a_stick_ends_offset_is_no_play_and_reads_no_play_end() -> None:
+    # pronyring: B read where the stick phase ends, its sheet offset -5 deg; no handle play.
+    sweep = falling_sweep(None, 0)
+    read = corrected(sweep, play_offset(-5.0), 0.0, read_play=False)
+    assert read.play_ends_deg == {}
+    assert read.values["backlash_pos_deg"] == pytest.approx((LINE_END_DEG + 5.0,))
+
+
+def test_a_stick_end_knob_gives_no_creep_warning() -> None:
+    points = [GridPoint(0, other, corrected(falling_sweep(None, seed), play_offset(-5.0), other,
+                                            read_play=False))
+              for seed, other in enumerate(OTHER_DEG)]
+    report = QualityReport()
+    check_play_creep(points, report)
+    assert report.warnings == []
+    # the play-end search on the same sweeps finds no step and flags the knob
+    searched = [GridPoint(0, other, corrected(falling_sweep(None, seed), play_offset(-5.0),
+                                              other))
+                for seed, other in enumerate(OTHER_DEG)]
+    check_play_creep(searched, report)
+    assert len(report.warnings) == 1

@@ -13,10 +13,18 @@ reversal; on a creeping unit the end moves over the grid, or lies beyond where t
 should close (no step found there). So where a knob's play ends spread more than
 :data:`CREEP_SPREAD_DEG` over its grid points and sides (the latest end of each), or more
 than :data:`MISSING_SHARE` of its half-cycles show no step, or (session 26) the two sides of
-one grid point close more than :data:`SIDE_GAP_DEG` apart, the knob's B is flagged: its values
-stay the play's end (what the paper's lines' corner follows), its reported 95 % half-width grows
-to reach back to the swing's end (where a creeping tip has already started back), and a one-line
-warning names the knob.
+one grid point close more than :data:`SIDE_GAP_DEG` apart, the knob's B is flagged: its reported
+95 % half-width grows to reach back to the swing's end (where a creeping tip has already started
+back), and a one-line warning names the knob.
+
+Session 27: on a flagged knob B is also re-read where the creep shows. Each grid point's side
+whose play closed more than :data:`CREEP_DELAY_DEG` after the knob's earliest close (or never
+closed within the sheet's window) carried rope its tip paid out: there the tip let go near the
+swing's end (planetwist development 1, 6, 7 and sample 201, 202, 207: the tip's 1 deg
+threshold 0-1.3 deg from the knob's earliest line end, 9-16 deg before the play's end), so its
+B is read at the swing's end. The sides that closed with the earliest keep the play's end (a
+creeping knob's holding side, development 1 phi2 B_pos, let go at the play's end). Only the
+reported values move: our compensator's fit keeps the frame it was read in.
 """
 
 from __future__ import annotations
@@ -54,6 +62,13 @@ protocol, noise seed 0, the largest difference per knob: holding knobs 0.02-0.38
 (development 1-8, sample 201-208; paper protocol, development 2: 0.26), knobs whose creep
 delays one side 1.14-3.16 (development 1 phi2, sample 201, 202, 207 phi1); the limit lies
 between. A creep delaying both sides alike (development 7 phi1: 0.09) shows in the spread."""
+CREEP_DELAY_DEG = SIDE_GAP_DEG
+"""On a flagged knob, a grid point's side whose play closed more than this after the knob's
+earliest close is re-read at the swing's end (session 27). A rigid play's latest ends over one
+knob's grid points and sides lie within 0.10-0.59 deg of each other (planetwist, holding knobs,
+development 1-8, sample 201-208), within :data:`SIDE_GAP_DEG` as the two sides of one grid
+point do; a creeping side closed 0.9-2.8 deg after its knob's earliest (development 1 phi2 B_neg,
+sample 207 phi1 B_pos at the other knob's 0)."""
 REACH_MARGIN_DEG = 2.0
 """The widened half-width reaches this far before the swing's end (the line rule's earliest
 end over the knob's grid, :func:`earliest_line_end_deg`): a creeping tip starts back at the
@@ -148,11 +163,64 @@ def widened(result: SweepResult, line_end_deg: float) -> SweepResult:
     return dataclasses.replace(result, product_u95_deg={**result.product_u95_deg, **more})
 
 
+def creeping_sides(points: Sequence[GridPoint], knob: int) -> set[tuple[float, str]]:
+    """``knob``'s (other-knob angle, backlash) whose play closed more than
+    :data:`CREEP_DELAY_DEG` after the knob's earliest close over its grid, or whose half-cycles
+    all showed no step (the play closed beyond the sheet's window)."""
+    latest: dict[tuple[float, str], float] = {}
+    for p in points:
+        if p.knob != knob:
+            continue
+        for name, ends in p.result.play_ends_deg.items():
+            found = _finite(ends)
+            key = (float(p.other_deg), name)
+            latest[key] = max(latest.get(key, -math.inf),
+                              float(found.max()) if found.size else math.inf)
+    closed = [end for end in latest.values() if math.isfinite(end)]
+    if not closed:
+        return set(latest)
+    earliest = min(closed)
+    return {key for key, end in latest.items() if end > earliest + CREEP_DELAY_DEG}
+
+
+def reread_at_swing_end(result: SweepResult, names: set[str], line_end_deg: float
+                        ) -> SweepResult:
+    """``result`` with the backlashes ``names`` moved so that their robust mean is the swing's
+    end ``line_end_deg`` (each half-cycle by the same shift: their scatter, which the gate's
+    pool reads, is kept)."""
+    values = dict(result.values)
+    for name in names:
+        v = np.asarray(values.get(name, ()), dtype=float)
+        if v.size and math.isfinite(line_end_deg):
+            values[name] = tuple(float(x) for x in v - (result.estimate(name) - line_end_deg))
+    return dataclasses.replace(result, values=values)
+
+
+def reread_creeping(points: list[GridPoint], knob: int, line_end_deg: float) -> int:
+    """On a flagged ``knob``: each creeping side's B (:func:`creeping_sides`) re-read at the
+    swing's end, in ``points`` in place (the compensator's frame, ``model_result``, kept as it
+    was read); how many sides were re-read."""
+    sides = creeping_sides(points, knob)
+    count = 0
+    for i, p in enumerate(points):
+        names = {name for (other, name) in sides
+                 if p.knob == knob and other == float(p.other_deg) and p.result.values.get(name)}
+        if not names:
+            continue
+        model = p.model_result if p.model_result is not None else p.result
+        points[i] = dataclasses.replace(p, result=reread_at_swing_end(p.result, names,
+                                                                      line_end_deg),
+                                        model_result=model)
+        count += len(names)
+    return count
+
+
 def check_play_creep(points: list[GridPoint], report: QualityReport,
                      spread_limit_deg: float = CREEP_SPREAD_DEG) -> None:
     """Per knob whose play did not close at one travel: a one-line warning, and (in
-    ``points``, in place) B's reported half-width widened to reach back to the swing's end;
-    each knob's spread in ``report.figures``."""
+    ``points``, in place) its creeping sides' B re-read at the swing's end
+    (:func:`reread_creeping`) and every play-end B's reported half-width widened to reach back
+    to it; each knob's spread in ``report.figures``."""
     for knob in (0, 1):
         creep = play_creep(points, knob)
         if creep is None:
@@ -163,6 +231,8 @@ def check_play_creep(points: list[GridPoint], report: QualityReport,
         if creep.rigid(spread_limit_deg):
             continue
         line = earliest_line_end_deg(points, knob)
+        reread = reread_creeping(points, knob, line)
+        report.figures[f"{label}_backlash_reread_sides"] = reread
         reach = 0.0
         for i, p in enumerate(points):
             if p.knob == knob:
@@ -182,10 +252,12 @@ def check_play_creep(points: list[GridPoint], report: QualityReport,
                 f"{creep.half_cycles} half-cycles")
         report.warnings.append(
             f"{label}: backlash unsure, the tip may creep while the handle's play opens: "
-            f"{where}; the tip may let go up to {reach:.1f} deg before B says, B's 95 % "
-            "half-width widened to cover it")
+            f"{where}; B re-read at the swing's end ({line:.1f} deg) on {reread} grid-point "
+            f"side(s) whose play closed late; the tip may let go up to {reach:.1f} deg before "
+            "B says, B's 95 % half-width widened to cover it")
 
 
-__all__ = ["CREEP_SPREAD_DEG", "MISSING_SHARE", "REACH_MARGIN_DEG", "SIDE_GAP_DEG", "PlayCreep",
-           "check_play_creep", "earliest_line_end_deg", "play_creep", "reach_deg", "side_gap_deg",
-           "widened"]
+__all__ = ["CREEP_DELAY_DEG", "CREEP_SPREAD_DEG", "MISSING_SHARE", "REACH_MARGIN_DEG",
+           "SIDE_GAP_DEG", "PlayCreep", "check_play_creep", "creeping_sides",
+           "earliest_line_end_deg", "play_creep", "reach_deg", "reread_at_swing_end",
+           "reread_creeping", "side_gap_deg", "widened"]

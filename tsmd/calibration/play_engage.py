@@ -18,6 +18,8 @@ not subtracted (the unit's own reading replaces it). It is searched only where t
 offset at the other knob's 0 (the handle's play is there at every angle) says the current
 misses at least :data:`MIN_PLAY_DEG`, and a step is taken only within
 :data:`ENGAGE_WINDOW` times that offset past the line rule's end: the step the sheet announces.
+Not where the knob's B is read at the stick end (session 27: pronyring's -5 deg offset is the
+stick end's, no play; :func:`tsmd.calibration.reading_offset.corrected`'s ``read_play``).
 """
 
 from __future__ import annotations

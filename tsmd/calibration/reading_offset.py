@@ -63,6 +63,24 @@ def offset_at(offset: ReadingOffset, name: str, other_deg: float,
             float(np.interp(other_deg, at, np.asarray(u95))))
 
 
+def left_u95_deg(offset: ReadingOffset | None, name: str, other_deg: float,
+                 min_deg: float = MODEL_MIN_OFFSET_DEG) -> float:
+    """The bias an offset the sheet measured but :func:`applied_deg` does not apply leaves in
+    ``name``'s values, as a 95 % bound: |mean| + its half-width per sheet angle (0 where the
+    offset is applied: its half-width goes to the gate instead), linear between the angles,
+    held beyond them; 0 without a measured offset. Session 27: wormeyelet's B offsets (unsure,
+    +0.46 +- 0.52 deg and the like) were neither subtracted nor counted, and its B half-widths
+    of 0.4-1.1 deg covered development units 1-2 15/24."""
+    grid = None if offset is None else offset.grid(name)
+    if offset is None or grid is None:
+        return 0.0
+    shift, _ = applied_deg(grid, min_deg)
+    left = [0.0 if s != 0.0 else abs(m) + u
+            for s, m, u in zip(shift, grid.mean_deg, grid.u95_deg, strict=True)]
+    return float(np.interp(other_deg, np.asarray(offset.other_knob_deg, dtype=float),
+                           np.asarray(left)))
+
+
 def reference_edge_deg(offset: ReadingOffset | None, name: str,
                        edge_deg: float | None) -> float | None:
     """A data sheet's reference dead-zone edge (read from current on its unit, other knob at 0)
@@ -90,7 +108,7 @@ def calibrated_edges(device_knob: Any, edge_pos_deg: float, edge_neg_deg: float
 
 def corrected(result: SweepResult, offset: ReadingOffset | None,
               other_deg: float, release_slope: float | None = None,
-              min_deg: float = MODEL_MIN_OFFSET_DEG) -> SweepResult:
+              min_deg: float = MODEL_MIN_OFFSET_DEG, read_play: bool = True) -> SweepResult:
     """``result`` with every half-cycle's value moved by the product's offset at this grid
     point (those of ``min_deg`` and more), and the offsets' half-widths kept for the gate
     (unchanged without an offset), the half-widths of the backlashes the current does not show
@@ -108,9 +126,10 @@ def corrected(result: SweepResult, offset: ReadingOffset | None,
             shifts[name] = shift
     if not u95:
         return result
-    # a handle's play whose end the current shows: the unit's own reading (session 24)
+    # a handle's play whose end the current shows: the unit's own reading (session 24), past
+    # the line rule's end only (``read_play``: a stick end's offset is no play, session 27)
     plays = {name: offset_at(offset, name, 0.0, min_deg)[0] for name in shifts
-             if name.startswith("backlash")} if offset is not None else {}
+             if name.startswith("backlash")} if offset is not None and read_play else {}
     read = engage(result, shifts, plays, engage_lag_deg(release_slope))
     values.update(read.values)
     return dataclasses.replace(result, values=values, offset_u95_deg=u95,

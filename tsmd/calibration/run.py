@@ -47,7 +47,7 @@ from tsmd.calibration.player import (
 )
 from tsmd.calibration.protocol import Protocol as SweepProtocol
 from tsmd.calibration.protocol import paper_protocol, sweep_run
-from tsmd.calibration.reading_offset import REPORT_MIN_OFFSET_DEG, corrected
+from tsmd.calibration.reading_offset import REPORT_MIN_OFFSET_DEG, corrected, left_u95_deg
 from tsmd.calibration.recovery import with_unseen
 from tsmd.calibration.resweep import (
     budget_spent_note,
@@ -138,8 +138,14 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
     slope = opts.release_slope if opts else None
     part = opts.unit_part if opts else None
     # reported values: every sure offset; our compensator's fit: its own frame (session 26)
-    found = with_unit_part(corrected(seen, offset, other, slope, REPORT_MIN_OFFSET_DEG), part)
-    model = with_unit_part(corrected(seen, offset, other, slope), part)
+    left = {name: left_u95_deg(offset, name, other, REPORT_MIN_OFFSET_DEG)
+            for name in seen.values}
+    # The play's end is searched past the line rule's end; a stick end's offset is no play
+    # (pronyring's -5 deg: no step in 12 of 12 half-cycles, a creep warning on every unit).
+    play = not (opts is not None and opts.backlash_stick_end)
+    found = with_unit_part(corrected(seen, offset, other, slope, REPORT_MIN_OFFSET_DEG, play),
+                           part, left)
+    model = with_unit_part(corrected(seen, offset, other, slope, read_play=play), part, left)
     same = model.values == found.values
     return GridPoint(knob, other, found, rec, model_result=None if same else model)
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,12 +47,21 @@ class UnitPart:
         return self.backlash_u95_deg if name.startswith("backlash") else self.dead_zone_u95_deg
 
 
-def with_unit_part(result: SweepResult, part: UnitPart | None) -> SweepResult:
-    """``result`` carrying the product's part for every parameter the sheet measured it for
-    (unchanged without one)."""
-    if part is None:
-        return result
-    found = {name: u for name in result.values if (u := part.u95_deg(name)) is not None}
+def with_unit_part(result: SweepResult, part: UnitPart | None,
+                   left_u95_deg: Mapping[str, float] | None = None) -> SweepResult:
+    """``result`` carrying the product's part for every parameter the sheet measured it for;
+    where the sheet has no sample part for a parameter, the bias an unapplied reading offset
+    leaves in it (``left_u95_deg``, :func:`tsmd.calibration.reading_offset.left_u95_deg`) with
+    the share's part in quadrature (session 27: the sample, where measured, already counts
+    whatever bias the values keep). Unchanged where neither applies."""
+    found: dict[str, float] = {}
+    for name in result.values:
+        u = part.u95_deg(name) if part is not None else None
+        left = (left_u95_deg or {}).get(name, 0.0)
+        if u is not None:
+            found[name] = u
+        elif left > 0.0 and name not in result.unseen:
+            found[name] = math.hypot(result.share_u95_deg(name), left)
     if not found:
         return result
     return dataclasses.replace(result, product_u95_deg=found)

@@ -287,10 +287,8 @@ class ComplianceSheet:
     figure: Figure = "load contrast"
     """How the figure is read, on the sheet's units and on the unit compared with it."""
     loads_deg: tuple[float, float] | None = None
-    """The two loads of the load contrast (None: :data:`CONTRAST_LEVELS_DEG`)."""
-    heavier: ComplianceSheet | None = None
-    """The same units read at a heavier pair of loads, when the protocol has one
-    (:mod:`tsmd.gap.compliance_pairs`)."""
+    """The two loads of the load contrast, on the sheet's units and on the unit compared with
+    it (None: :data:`CONTRAST_LEVELS_DEG`; :mod:`tsmd.gap.compliance_pairs` chooses)."""
 
 
 def sheet_from_units(units: Sequence[Sequence[GapSeries]], family_alpha: float = 0.05,

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from tsmd.gap.compliance_pairs import either_pair_score
+from tsmd.gap.compliance import compliance_score
 from tsmd.gap.contrast import (
     DECIDES,
     LOOP_TESTS,
@@ -52,8 +52,8 @@ def signature_stage(series: Sequence[GapSeries], split: Split, ev: Evaluator,
         sheet = (ref.compliance if ref is not None and ref.compliance is not None
                  else cfg.compliance_reference)
         if sheet is not None:
-            stretch = either_pair_score(series, sheet, len(sres.scores), cfg.family_alpha,
-                                        cfg.min_share)
+            stretch = compliance_score(series, sheet, len(sres.scores), cfg.family_alpha,
+                                       cfg.min_share)
             found += [stretch] if stretch is not None else []
         names = {c.name for c in found}
         kept = [s for s in sres.scores if s.name not in names]

@@ -1,7 +1,8 @@
 """The blind plants as the data of the cross-plant self-test: their presets (cyclopebax, session
 21; snakedent, session 22; planetwist, session 23, none with a time law at the tip; notchclutch,
 session 24, whose braid stiffens with strain rate and whose liner soaks; pronyring, session 25,
-whose Pebax section relaxes with a Prony spectrum)."""
+whose Pebax section relaxes with a Prony spectrum; wormeyelet, session 26, whose eyelets take
+wrap from the other plane's bend)."""
 
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from simrig.plants.planetwist import PlanetTwistKnob, PlanetTwistPlant
 from simrig.plants.pronyring.params import KnobConstants as PronyRingKnob
 from simrig.plants.pronyring.plant import PronyRingPlant
 from simrig.plants.snakedent import SnakeDentKnob, SnakeDentPlant
+from simrig.plants.wormeyelet import WormEyeletKnob, WormEyeletPlant
 from tsmd.gap.presets import PRESETS, parse_plant_spec
 from tsmd.gap.selftest import drive_plant, trajectory
 
@@ -27,9 +29,10 @@ BLIND = [("cyclopebax", CycloPebaxPlant, CycloPebaxKnob),
          ("snakedent", SnakeDentPlant, SnakeDentKnob),
          ("planetwist", PlanetTwistPlant, PlanetTwistKnob),
          ("notchclutch", NotchClutchPlant, NotchClutchKnob),
-         ("pronyring", PronyRingPlant, PronyRingKnob)]
+         ("pronyring", PronyRingPlant, PronyRingKnob),
+         ("wormeyelet", WormEyeletPlant, WormEyeletKnob)]
 NAMES = [name for name, _plant, _knob in BLIND]
-TIMELESS = ["cyclopebax", "snakedent", "planetwist"]
+TIMELESS = ["cyclopebax", "snakedent", "planetwist", "wormeyelet"]
 """The blind plants with no law of speed or time at the tip."""
 
 
@@ -45,16 +48,21 @@ def _takeup_constant(plant: Any) -> list[float]:
     return [knob.cross_takeup for knob in plant.knobs]
 
 
+def _cross_wrap_constant(plant: Any) -> list[float]:
+    return [knob.cross_wrap for knob in plant.knobs]
+
+
 TAKEUP: dict[str, tuple[Callable[[Any], list[float]], set[str]]] = {
     "cyclopebax": (_share_keyword, set()),
     "snakedent": (_share_keyword, set()),
     "planetwist": (_takeup_constant, {"cross_takeup"}),
     "notchclutch": (_takeup_keyword, set()),
     "pronyring": (_takeup_keyword, set()),
+    "wormeyelet": (_cross_wrap_constant, {"cross_wrap"}),
 }
-"""How strongly the other plane's bend takes up a plane's ropes, per plant, and which knob
-constants the coupling case may change (a keyword on cyclopebax and snakedent, planetwist's own
-knob constant)."""
+"""How strongly the other plane's bend takes up a plane's ropes (on wormeyelet: adds wrap at
+its eyelets), per plant, and which knob constants the coupling case may change (a keyword on
+cyclopebax and snakedent, planetwist's and wormeyelet's own knob constant)."""
 
 
 @pytest.mark.parametrize(("name", "plant_type", "_knob"), BLIND)

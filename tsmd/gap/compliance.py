@@ -174,15 +174,17 @@ class Contrast:
 
 
 def _contrast(r: Reversals, rows: NDArray[np.int64], with_var: bool = False,
-              min_per_group: int = 1, figure: Figure = "load contrast") -> Contrast | None:
-    """The load contrast over ``rows``: per side of the knob (its two sides differ in slack
-    and in how far the loop leaves the dead zone), sides readable at both loads. With
-    ``figure`` "release", per side the release travel and load at the higher load alone."""
+              min_per_group: int = 1, figure: Figure = "load contrast",
+              loads_deg: tuple[float, float] | None = None) -> Contrast | None:
+    """The load contrast over ``rows`` (at ``loads_deg``, default :data:`CONTRAST_LEVELS_DEG`):
+    per side of the knob (its two sides differ in slack and in how far the loop leaves the dead
+    zone), sides readable at both loads. With ``figure`` "release", per side the release travel
+    and load at the higher load alone."""
     amp = np.abs(r.at_deg[rows])
     side = np.sign(r.at_deg[rows])
     total = np.zeros(4)
     found = False
-    levels = LEVELS_DEG if figure == "release" else CONTRAST_LEVELS_DEG
+    levels = LEVELS_DEG if figure == "release" else loads_deg or CONTRAST_LEVELS_DEG
     for s in (1.0, -1.0):
         groups = [rows[(np.abs(amp - level) <= LEVEL_BAND_DEG) & (side == s)]
                   for level in levels]
@@ -206,7 +208,8 @@ def _contrast(r: Reversals, rows: NDArray[np.int64], with_var: bool = False,
     return Contrast(*(float(v) for v in total)) if found else None
 
 
-def _figures(series: Sequence[GapSeries], figure: Figure = "load contrast"
+def _figures(series: Sequence[GapSeries], figure: Figure = "load contrast",
+             loads_deg: tuple[float, float] | None = None
              ) -> list[tuple[Reversals, Contrast] | None]:
     """Per knob its reversals and load contrast; None for a knob without a readable one (a
     soft tendon can leave the tip inside its dead zone at the loop amplitude)."""
@@ -214,7 +217,7 @@ def _figures(series: Sequence[GapSeries], figure: Figure = "load contrast"
     for knob in (0, 1):
         r = reversals(series, knob)
         c = _contrast(r, np.arange(len(r.at_deg)), with_var=True, min_per_group=MIN_PER_LEVEL,
-                      figure=figure)
+                      figure=figure, loads_deg=loads_deg)
         ok = c is not None and np.isfinite(c.slope) and c.slope > 0.0
         out.append((r, c) if ok and c is not None else None)
     return out
@@ -283,10 +286,13 @@ class ComplianceSheet:
     """How many units the sheet was measured on: from one, the units' spread is unknown."""
     figure: Figure = "load contrast"
     """How the figure is read, on the sheet's units and on the unit compared with it."""
+    loads_deg: tuple[float, float] | None = None
+    """The two loads of the load contrast, on the sheet's units and on the unit compared with
+    it (None: :data:`CONTRAST_LEVELS_DEG`; :mod:`tsmd.gap.compliance_pairs` chooses)."""
 
 
-def sheet_from_units(units: Sequence[Sequence[GapSeries]],
-                     family_alpha: float = 0.05) -> ComplianceSheet | None:
+def sheet_from_units(units: Sequence[Sequence[GapSeries]], family_alpha: float = 0.05,
+                     loads_deg: tuple[float, float] | None = None) -> ComplianceSheet | None:
     """The sheet from the protocol of each of several units (one list of series per unit):
     per knob the mean over the units that read it of the log figure, that mean's noise and the
     units' spread (:func:`tsmd.gap.stats.unit_spread`); None when no unit reads either knob.
@@ -294,7 +300,7 @@ def sheet_from_units(units: Sequence[Sequence[GapSeries]],
     then it is the release at the higher load, on every unit (since session 19: warmgear's
     reference units read 41-159 deg/A by the load contrast, 58-81 by the release)."""
     kind: Figure = "load contrast" if premise_holds(units, family_alpha) else "release"
-    per_unit = [_figures(u, kind) for u in units]
+    per_unit = [_figures(u, kind, loads_deg) for u in units]
     figure, noise, allowance = [], [], []
     for knob in (0, 1):
         read = [found[1] for f in per_unit if (found := f[knob]) is not None]
@@ -311,7 +317,7 @@ def sheet_from_units(units: Sequence[Sequence[GapSeries]],
     if not np.isfinite(figure).any():
         return None
     return ComplianceSheet((figure[0], figure[1]), (noise[0], noise[1]),
-                           (allowance[0], allowance[1]), len(units), kind)
+                           (allowance[0], allowance[1]), len(units), kind, loads_deg)
 
 
 def compliance_score(series: Sequence[GapSeries], reference: Sequence[float] | ComplianceSheet,
@@ -331,7 +337,7 @@ def compliance_score(series: Sequence[GapSeries], reference: Sequence[float] | C
     The unit's figure is read as the sheet's was (:attr:`ComplianceSheet.figure`)."""
     sheet = (reference if isinstance(reference, ComplianceSheet)
              else ComplianceSheet((float(reference[0]), float(reference[1]))))
-    per_knob = _figures(series, sheet.figure)
+    per_knob = _figures(series, sheet.figure, sheet.loads_deg)
     found = [(f, ref, nv, av) for f, ref, nv, av in zip(
         per_knob, sheet.figure_deg_per_A, sheet.noise_log_var, sheet.allowance_log_var,
         strict=True) if f is not None and np.isfinite(ref) and ref > 0.0]
@@ -349,14 +355,15 @@ def compliance_score(series: Sequence[GapSeries], reference: Sequence[float] | C
     z_alpha = float(stats.norm.isf(family_alpha / max(n_tried, 1)))
     ratio, lower = float(np.exp(log_ratio)), float(np.exp(log_ratio - z_alpha * se))
     share, lo, hi = _heldout_shrink([r for (r, _), _, _, _ in found], list(refs),
-                                    sheet.figure)
+                                    sheet.figure, sheet.loads_deg)
     z = (log_ratio - allowance) / se if se > 0 else float("nan")
     title, _ = SIGNATURES["compliance"]
     # a unit's tendons are one lot: a softer one raises every knob's figure, and one precise
     # knob far up while the other reads below the sheet is one figure's scatter
     significant = bool(lower > np.exp(allowance) and log_ratio > np.log1p(TOLERANCE)
                        and bool((per_knob_log > 0.0).all()) and share >= min_share)
-    how = "" if sheet.figure == "load contrast" else ", read on the release"
+    how = (", read on the release" if sheet.figure == "release" else "" if sheet.loads_deg is None
+           else f", loads {sheet.loads_deg[0]:g}/{sheet.loads_deg[1]:g} deg")
     return SignatureScore("compliance", title, f"{CONDITION}{how} (x{ratio:.2f}, lower bound "
                           f"x{lower:.2f} against the units' spread x{np.exp(allowance):.2f}, "
                           f"the smallest named x{1.0 + TOLERANCE:.2f})", share, (lo, hi),
@@ -374,7 +381,8 @@ def knobs_combined(log_ratio: FloatArray, log_var: FloatArray
 
 
 def _heldout_shrink(per_knob: Sequence[Reversals], reference: Sequence[float],
-                    figure: Figure = "load contrast") -> tuple[float, float, float]:
+                    figure: Figure = "load contrast",
+                    loads_deg: tuple[float, float] | None = None) -> tuple[float, float, float]:
     """Mean, lowest and highest over held-out configurations of 1 - (the held-out load
     contrast's lost motion minus the figure fitted on the other configurations times its
     current contrast)^2 / (the same with the data sheet's figure)^2, summed over the knobs;
@@ -385,8 +393,10 @@ def _heldout_shrink(per_knob: Sequence[Reversals], reference: Sequence[float],
     for held in range(n_cfg):
         excess = resid = 0.0
         for r, ref in zip(per_knob, reference, strict=True):
-            fit = _contrast(r, np.flatnonzero(r.config != held), figure=figure)
-            test = _contrast(r, np.flatnonzero(r.config == held), figure=figure)
+            fit = _contrast(r, np.flatnonzero(r.config != held), figure=figure,
+                            loads_deg=loads_deg)
+            test = _contrast(r, np.flatnonzero(r.config == held), figure=figure,
+                             loads_deg=loads_deg)
             if fit is None or test is None or not np.isfinite(fit.slope):
                 continue
             excess += (test.lost_deg - ref * test.swing_A) ** 2

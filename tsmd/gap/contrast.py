@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
-from tsmd.gap.compliance import sheet_from_units
+from tsmd.gap.compliance_pairs import sheet_at_chosen_loads
 from tsmd.gap.data import GapSeries
 from tsmd.gap.dwell import (
     CREEP_CHANNELS,
@@ -245,7 +245,7 @@ def product_reference(series: Sequence[GapSeries]) -> ProductReference:
     loops = {test: ref for test in REFERENCED
              if (ref := _loop_reference(per_unit, test, "loops")) is not None}
     currents = _loop_reference(per_unit, "rate", "currents")
-    sheet = sheet_from_units(list(units.values()))
+    sheet = sheet_at_chosen_loads(list(units.values()))
     slopes = [d for d in (_unit_drift(by_config) for by_config in per_unit) if d is not None]
     if not slopes:
         return ProductReference(loops, units=len(units), compliance=sheet, currents=currents)

@@ -1,5 +1,5 @@
 """The self-test effects of the plants added since session 22 (cyclopebax, snakedent, planetwist,
-notchclutch, pronyring), each in its own physics: keywords and knob factors.
+notchclutch, pronyring, wormeyelet), each in its own physics: keywords and knob factors.
 
 Sized by the rule of :mod:`tsmd.gap.preset_effects` (the earlier plants' module, split off at
 its size guide); :mod:`tsmd.gap.presets` builds the presets.
@@ -160,3 +160,32 @@ PRONYRING_MAX_STEP_S = 0.0
 """No finer stepping: unit 1's tip lies 0.059 deg RMS (0.39 max) from 0.25 ms steps at 20 ms,
 0.012 (0.08) at 4 ms (unit 2 0.064 (0.52) / 0.012): the Prony branches are advanced implicitly
 and the rope contacts in closed form."""
+
+
+WORMEYELET_EFFECTS: dict[str, dict[str, float]] = {
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The wormeyelet plant's one effect keyword: a 120 deg sheath bend (added to every rope's lumen
+wrap), 1.70 / 1.78 deg of tip (tip RMSE effect on minus off, units 1 / 2, noise-free, 120 s of
+the experiment motion at 50 Hz; 60 deg 0.81 / 0.85), inside the others' 1.1-12.8 deg. Its laws
+read the knob angle only at the tip (the silicone damper and the seal act on the knob: the same
+samples played 8 times as fast move the tip 0.000 deg and the current 9.3 / 9.6 mA RMS; damper
+x3 the current 10.1 / 10.8 mA, the tip 0.000) and nothing moves at a held knob (knob 1 held at
+75 deg for 65 s, the other at 30: tip and current 0.000): rate and creep are not run. The worm
+stage's play and its driving/back-driven loss, the eyelets' band that widens with the bend and
+the disks on the cover are base physics; "none" is the nominal physics as written (docs/gap.md
+"Session 27")."""
+
+WORMEYELET_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"cross_wrap": 7.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Wormeyelet effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion, units 1 / 2): the other plane's bend adding seven times the unit's share of wrap at
+the eyelets (``cross_wrap``, the plant's constant that reads the other plane only), 1.59 / 1.44
+deg (x3 0.48 / 0.41, x6 1.29 / 1.16, x8 1.90 / 1.72; the share removed altogether 0.22 / 0.19;
+the others' coupling 1.5 deg); the stainless rope's EA halved, 4.51 / 4.23 deg."""
+
+WORMEYELET_MAX_STEP_S = 0.0
+"""No finer stepping: unit 1's tip lies 0.009 deg RMS (0.05 max) from 0.25 ms steps at 20 ms,
+0.006 (0.05) at 4 ms (unit 2 0.013 / 0.011): every law is quasi-static in the knob angle."""

@@ -65,6 +65,9 @@ from tsmd.gap.preset_effects_late import (
     SNAKEDENT_EFFECTS,
     SNAKEDENT_KNOB_EFFECTS,
     SNAKEDENT_MAX_STEP_S,
+    WORMEYELET_EFFECTS,
+    WORMEYELET_KNOB_EFFECTS,
+    WORMEYELET_MAX_STEP_S,
 )
 from tsmd.gap.selftest import BUILTIN_FIT_SPECS, BUILTIN_PLANT, EFFECTS
 
@@ -191,6 +194,10 @@ PRESETS: dict[str, PlantSpec] = {
     "pronyring": PlantSpec(PLANT_SPECS["pronyring"], {}, (), "pronyring", family="pronyring",
                            effects=PRONYRING_EFFECTS, knob_effects=PRONYRING_KNOB_EFFECTS,
                            max_step_s=PRONYRING_MAX_STEP_S),
+    "wormeyelet": PlantSpec(PLANT_SPECS["wormeyelet"], {}, (), "wormeyelet",
+                            family="wormeyelet", effects=WORMEYELET_EFFECTS,
+                            knob_effects=WORMEYELET_KNOB_EFFECTS,
+                            max_step_s=WORMEYELET_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

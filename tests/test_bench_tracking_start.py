@@ -156,3 +156,19 @@ def test_the_family_bench_scores_every_scenario_on_a_copy_of_the_calibrated_plan
     assert seen and all(isinstance(p, CarriedPlant) and cond for p, cond in seen)
     assert all(p.t_s == pytest.approx(5.0) for p, _ in seen)
     assert len({id(p.plant) for p, _ in seen}) == len(seen)
+
+
+def test_the_family_bench_compares_the_paper_and_ours_alone_when_asked(
+        monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    def run(s: object, method: str, *_: object) -> object:
+        rmse = {"paper": 4.0, "ours": 1.0}[method]
+        return argparse.Namespace(rmse_deg=rmse, ptpe_deg=2 * rmse)
+
+    monkeypatch.setattr(family_accuracy, "unit_profile",
+                        lambda *_: (load_profile(EXAMPLE), warmed_warmgear(1.0)))
+    monkeypatch.setattr(family_accuracy, "run_scenario", run)
+    monkeypatch.setattr(family_accuracy, "compute_time_us", lambda *a, **k: (1.0, 2.0))
+    args = family_accuracy.namespace_from(argparse.Namespace(
+        unit_seeds="1", quick=True, no_extra=True, methods="paper,ours"))
+    assert family_accuracy.main(args) == 0
+    assert "| 4.00/8.0 | 1.00/2.0 | nan | nan | 0.25 |" in capsys.readouterr().out

@@ -94,7 +94,7 @@ def plant_factory(spec: str, params: dict[str, Any]) -> Callable[[], Any]:
 
 
 def _pct(none: float, other: float) -> float:
-    return 100.0 * (none - other) / none if none > 0 else math.nan
+    return 100.0 * (none - other) / none if none > 0 else math.nan  # NaN > 0 is False
 
 
 def unit_profile(unit: int, device: Any, make: Callable[[], Any], directory: Path | None,
@@ -223,10 +223,7 @@ def main(args: argparse.Namespace) -> int:
         for s in scen:
             res = {m: run_scenario(s, m, 0, profile, run_plant, conditions(start))
                    for m in methods}
-            red = _pct(res["none"].rmse_deg, res["ours"].rmse_deg)
-            red_p = _pct(res["none"].ptpe_deg, res["ours"].ptpe_deg)
-            ratio = (res["ours"].rmse_deg / res["paper"].rmse_deg
-                     if "paper" in res else math.nan)
+            red, red_p, ratio = _figures(res)
             rows.append((seed, s.group, s.name, red, red_p, ratio))
             line = (f"| {seed} | {s.group}: {s.name} | "
                     + " | ".join(f"{res[m].rmse_deg:.2f}/{res[m].ptpe_deg:.1f}" for m in methods)
@@ -268,6 +265,17 @@ def main(args: argparse.Namespace) -> int:
     lines.append(f"rows missing a target: {len(misses)} of {len(rows)}")
     lines.append(f"wall time {time.perf_counter() - t0:.0f} s")
     return _emit(lines, args.report, 0)
+
+
+def _figures(res: dict[str, Any]) -> tuple[float, float, float]:
+    """Ours' RMSE and PTPE reductions against no compensation and its RMSE over the paper's;
+    NaN where a method was not run (``--methods paper,ours`` compares the two alone)."""
+    def get(method: str, name: str) -> float:
+        return float(getattr(res[method], name)) if method in res else math.nan
+
+    return (_pct(get("none", "rmse_deg"), get("ours", "rmse_deg")),
+            _pct(get("none", "ptpe_deg"), get("ours", "ptpe_deg")),
+            get("ours", "rmse_deg") / get("paper", "rmse_deg"))
 
 
 def _split_lines(unit: int, run: Any, profile: CatheterProfile) -> list[str]:

@@ -96,7 +96,7 @@ def test_the_family_bench_prints_a_split_per_scored_knob_when_asked(
                                   cmd_deg=np.column_stack([ramp, ramp]),
                                   tip_deg=np.column_stack([ramp + 1.0, ramp + 1.0]))
 
-    monkeypatch.setattr(family_accuracy, "unit_profile", lambda *_: profile)
+    monkeypatch.setattr(family_accuracy, "unit_profile", lambda *_: (profile, object()))
     monkeypatch.setattr(family_accuracy, "run_scenario", run)
     monkeypatch.setattr(family_accuracy, "compute_time_us", lambda *a, **k: (1.0, 2.0))
     for split in (False, True):

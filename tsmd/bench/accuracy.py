@@ -31,6 +31,14 @@ from tsmd.bench.accuracy_report import (
     plot_runs,
     summarise,
 )
+from tsmd.bench.tracking_start import (
+    STARTS,
+    calibrate_with_plant,
+    conditions,
+    scenario_plant,
+    start_label,
+    start_of,
+)
 from tsmd.calibration import calibrate
 from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
 from tsmd.compensation import LimitedCompensator, build_compensator
@@ -235,10 +243,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "0 = the nominal unit the data sheet was measured on")
     parser.add_argument("--unit-seed", type=int, default=1,
                         help="which unit to draw with --unit-variation")
+    parser.add_argument("--start", choices=STARTS, default=None,
+                        help="the state every run starts from: calibrated (default: a copy of "
+                        "the plant as the calibration left it, then one unscored +-90 deg cycle "
+                        "of both knobs; without a calibration run here, conditioned), "
+                        "conditioned (a fresh plant and the cycle), fresh (no cycle)")
     parser.add_argument("--fresh", action="store_true",
-                        help="start every run on the fresh plant's tension-free tendons instead "
-                        "of after one unscored +-90 deg cycle of both knobs (the default: the "
-                        "state calibration leaves a catheter in)")
+                        help="the same as --start fresh: the fresh plant's tension-free tendons")
     parser.add_argument("--plots", type=Path, default=None,
                         help="directory for the PNG figures (none by default)")
     parser.add_argument("--report", type=Path, default=None,
@@ -291,6 +302,8 @@ def main(args: argparse.Namespace) -> int:
 
     t_start = time.perf_counter()
     source = args.profile_source
+    start = start_of(args)
+    calibrated_plant = None
     if args.profile is not None:
         profile = load_profile(args.profile)
         label = f"profile file {args.profile} ({profile.source})"
@@ -299,7 +312,7 @@ def main(args: argparse.Namespace) -> int:
         if source in ("auto", "calibrate"):
             try:
                 print("calibrating from motor current (tsmd.calibration) ...", flush=True)
-                profile = calibrated_profile(device, plant_factory)
+                profile, calibrated_plant = calibrate_with_plant(device, plant_factory)
                 label = "tsmd calibrate: motor current only"
             except TsmdError as exc:
                 if source == "calibrate":
@@ -315,13 +328,18 @@ def main(args: argparse.Namespace) -> int:
         save_profile(profile, args.save_profile)
     print(f"profile: {label}")
 
+    if start == "calibrated" and calibrated_plant is None:
+        print("no calibration ran here (profile from a file or the ground truth): "
+              "the conditioned start")
+        start = "conditioned"
+    run_plant = scenario_plant(start, plant_factory, calibrated_plant)
     scen = scenarios(quick)
     results: list[RunResult] = []
     for seed in range(n_seeds):
         for s in scen:
             for method in METHODS:
-                results.append(run_scenario(s, method, seed, profile, plant_factory,
-                                            not args.fresh))
+                results.append(run_scenario(s, method, seed, profile, run_plant,
+                                            conditions(start)))
         print(f"seed {seed + 1}/{n_seeds} done ({time.perf_counter() - t_start:.0f} s)",
               flush=True)
 
@@ -330,7 +348,7 @@ def main(args: argparse.Namespace) -> int:
                       lambda r: "other knob at " + ("0" if r.scenario.name.endswith("+0") else
                                                      "±" + r.scenario.name.split()[-1][1:]))
     lines = [f"Profile: {label}", f"Seeds: {n_seeds}; quick: {quick}; plant coupling: {coupling}"
-             f"; start: {'fresh plant' if args.fresh else 'conditioned (one +-90 deg cycle)'}",
+             f"; start: {start} ({start_label(start)})",
              "", "Tip against desired, degrees (mean ± std over seeds):", ""]
     lines += format_table(groups, with_paper=True)
     lines += ["", "1-DOF periodic by the other knob's fixed angle (paper's Table 1d_fixed):", ""]

@@ -26,13 +26,21 @@ from numpy.typing import NDArray
 
 from simrig.family import PLANT_ROLE, PLANT_SPECS, family_member
 from simrig.plant import PlantLoadError, load_plant
-from tsmd.bench.accuracy import calibrated_profile, compute_time_us, run_scenario
+from tsmd.bench.accuracy import compute_time_us, run_scenario
 from tsmd.bench.accuracy_report import plot_runs
 from tsmd.bench.error_split import split_run
+from tsmd.bench.tracking_start import (
+    STARTS,
+    cached_unit,
+    conditions,
+    scenario_plant,
+    start_label,
+    start_of,
+)
 from tsmd.calibration.errors import CalibrationError
 from tsmd.config import resolve_data_path
 from tsmd.errors import TsmdError
-from tsmd.profile import CatheterProfile, load_device_model, load_profile, save_profile
+from tsmd.profile import CatheterProfile, load_device_model
 from tsmd.tracking_scenarios import PERIOD_S, Scenario, scenarios
 
 FloatArray = NDArray[np.float64]
@@ -86,21 +94,16 @@ def plant_factory(spec: str, params: dict[str, Any]) -> Callable[[], Any]:
 
 
 def _pct(none: float, other: float) -> float:
-    return 100.0 * (none - other) / none if none > 0 else math.nan
+    return 100.0 * (none - other) / none if none > 0 else math.nan  # NaN > 0 is False
 
 
-def unit_profile(unit: int, device: Any, make: Callable[[], Any], directory: Path | None
-                 ) -> CatheterProfile:
-    """The unit's profile from ``tsmd calibrate`` (motor current), kept in ``directory``."""
+def unit_profile(unit: int, device: Any, make: Callable[[], Any], directory: Path | None,
+                 need_plant: bool = False) -> tuple[CatheterProfile, Any]:
+    """The unit's profile from ``tsmd calibrate`` (motor current), kept in ``directory``, and
+    with ``need_plant`` the plant its calibration left (:mod:`tsmd.bench.tracking_start`)."""
     path = None if directory is None else directory / f"unit-{unit}.yaml"
-    if path is not None and path.exists():
-        print(f"unit {unit}: profile {path}", flush=True)
-        return load_profile(path)
-    print(f"unit {unit}: calibrating from motor current ...", flush=True)
-    profile = calibrated_profile(device, make)
-    if path is not None:
-        save_profile(profile, path)
-    return profile
+    return cached_unit(path, device, make, need_plant,
+                       lambda text: print(f"unit {unit}: {text}", flush=True))
 
 
 def sheet_path(family: str | None, device: Path | None) -> Path:
@@ -147,7 +150,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--methods", default="none,paper,ours")
     parser.add_argument("--quick", action="store_true", help="the paper's quick scenario set")
     parser.add_argument("--no-extra", action="store_true", help="skip the extra scenarios")
-    parser.add_argument("--fresh", action="store_true", help="fresh plant, no conditioning")
+    parser.add_argument("--start", choices=STARTS, default=None,
+                        help="the state each scenario starts from: calibrated (default: a copy "
+                             "of the plant as the unit's calibration left it, warm and soaked, "
+                             "then one unscored +-90 deg cycle), conditioned (a fresh plant and "
+                             "the cycle, the default until session 27), fresh (no cycle)")
+    parser.add_argument("--fresh", action="store_true", help="the same as --start fresh")
     parser.add_argument("--device", type=Path, default=None,
                         help="the product's data sheet (default: with --family the plant's "
                              "shipped sheet, else capstan's profiles/devices/sim-catheter.yaml)")
@@ -177,9 +185,10 @@ def main(args: argparse.Namespace) -> int:
     sheet = sheet_path(args.family, args.device)
     device = load_device_model(sheet)
     scen = scenarios(bool(args.quick)) + ([] if args.no_extra else extra_scenarios())
+    start = start_of(args)
     t0 = time.perf_counter()
     lines = [f"plant {args.plant} {json.dumps(base)}; unit_variation {args.unit_variation}; "
-             f"units {seeds}; start {'fresh' if args.fresh else 'conditioned'}", "",
+             f"units {seeds}; start {start} ({start_label(start)})", "",
              "| unit | scenario | " + " | ".join(f"{m} RMSE/PTPE" for m in methods)
              + " | RMSE red. % | PTPE red. % | RMSE / paper |", "|" + "---|" * (len(methods) + 5)]
     rows: list[tuple[int, str, str, float, float, float]] = []
@@ -192,7 +201,7 @@ def main(args: argparse.Namespace) -> int:
             raise TsmdError(f"--units: {exc}") from None
         lines[0] = (f"family plant {args.family} ({PLANT_ROLE[args.family]}); units {numbers}; "
                     f"data sheet {sheet} ({device.device_model}); "
-                    f"start {'fresh' if args.fresh else 'conditioned'}")
+                    f"start {start} ({start_label(start)})")
         units = [(m.unit, m.build) for m in members]
     for seed in seeds if args.family is None else []:
         params = dict(base)
@@ -202,19 +211,19 @@ def main(args: argparse.Namespace) -> int:
     refused: list[int] = []
     for seed, make in units:
         try:
-            profile = unit_profile(seed, device, make, args.profiles)
+            profile, plant = unit_profile(seed, device, make, args.profiles,
+                                          start == "calibrated")
         except CalibrationError as exc:  # a finding about the unit: score the others
             refused.append(seed)
             line = f"| {seed} | no profile: {exc} |"
             lines.append(line)
             print(line, flush=True)
             continue
+        run_plant = scenario_plant(start, make, plant)
         for s in scen:
-            res = {m: run_scenario(s, m, 0, profile, make, not args.fresh) for m in methods}
-            red = _pct(res["none"].rmse_deg, res["ours"].rmse_deg)
-            red_p = _pct(res["none"].ptpe_deg, res["ours"].ptpe_deg)
-            ratio = (res["ours"].rmse_deg / res["paper"].rmse_deg
-                     if "paper" in res else math.nan)
+            res = {m: run_scenario(s, m, 0, profile, run_plant, conditions(start))
+                   for m in methods}
+            red, red_p, ratio = _figures(res)
             rows.append((seed, s.group, s.name, red, red_p, ratio))
             line = (f"| {seed} | {s.group}: {s.name} | "
                     + " | ".join(f"{res[m].rmse_deg:.2f}/{res[m].ptpe_deg:.1f}" for m in methods)
@@ -256,6 +265,17 @@ def main(args: argparse.Namespace) -> int:
     lines.append(f"rows missing a target: {len(misses)} of {len(rows)}")
     lines.append(f"wall time {time.perf_counter() - t0:.0f} s")
     return _emit(lines, args.report, 0)
+
+
+def _figures(res: dict[str, Any]) -> tuple[float, float, float]:
+    """Ours' RMSE and PTPE reductions against no compensation and its RMSE over the paper's;
+    NaN where a method was not run (``--methods paper,ours`` compares the two alone)."""
+    def get(method: str, name: str) -> float:
+        return float(getattr(res[method], name)) if method in res else math.nan
+
+    return (_pct(get("none", "rmse_deg"), get("ours", "rmse_deg")),
+            _pct(get("none", "ptpe_deg"), get("ours", "ptpe_deg")),
+            get("ours", "rmse_deg") / get("paper", "rmse_deg"))
 
 
 def _split_lines(unit: int, run: Any, profile: CatheterProfile) -> list[str]:

@@ -39,6 +39,7 @@ from tsmd.calibration.errors import (
 from tsmd.calibration.estimate import EstimateOptions
 from tsmd.calibration.identify import IdentifyOptions, identify_sweep
 from tsmd.calibration.options import device_options
+from tsmd.calibration.paper_frame import with_paper_frame
 from tsmd.calibration.play_creep import check_play_creep
 from tsmd.calibration.player import (
     Player,
@@ -169,9 +170,13 @@ def finish(catheter_id: str, device: DeviceModel, points: list[GridPoint], *,
         raise CalibrationRefusedError(str(exc), points) from None
     profile = build_profile(catheter_id, device, points, quality=report,
                             software_version=__version__, source=source)
+    model = [p.in_model_frame() for p in points]
+    if any(p.model_result is not None for p in points):  # the paper's frame is ours' (s27)
+        profile = with_paper_frame(profile, build_profile(
+            catheter_id, device, model, quality=report, software_version=__version__,
+            source=source))
     try:
-        profile = with_tension_play(profile, [p.in_model_frame() for p in points], device,
-                                    plateau_gaps)
+        profile = with_tension_play(profile, model, device, plateau_gaps)
     except (ValueError, ArithmeticError) as exc:
         raise CalibrationError(f"our compensator's fit (tension play) failed: {exc}") from None
     return profile, report

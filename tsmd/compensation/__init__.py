@@ -154,13 +154,14 @@ class LimitedCompensator:
 
 
 def paper_compensator(profile: CatheterProfile) -> PaperCompensator:
+    """The paper's model per knob, fed the knob's paper frame (:meth:`KnobProfile.for_paper`)."""
     knobs = tuple(PaperKnob(ParameterField.from_columns(k.other_knob_deg, {
                       "dead_zone_pos_deg": k.dead_zone_pos_deg,
                       "dead_zone_neg_deg": k.dead_zone_neg_deg,
                       "backlash_pos_deg": k.backlash_pos_deg,
                       "backlash_neg_deg": k.backlash_neg_deg}, profile.interpolation),
                             k.height_pos_deg, k.height_neg_deg, k.omega)
-                  for k in profile.knobs)
+                  for k in (knob.for_paper() for knob in profile.knobs))
     return PaperCompensator((knobs[0], knobs[1]))
 
 

@@ -148,13 +148,19 @@ def profile_with_offsets(profile: CatheterProfile, offsets: Offsets, note: str =
                 omega=bent_omega(ours.omega, at_zero(ours.backlash_gain_pos,
                                                      ours.backlash_gain_neg),
                                  at_zero(beta_pos, beta_neg), omega_per_gain))
-        knobs.append(KnobProfile(
+        moved = KnobProfile(
             k.omega, ReferencePoint(k.reference_pos.knob_deg + off_pos, k.reference_pos.tip_deg),
             ReferencePoint(k.reference_neg.knob_deg - off_neg, k.reference_neg.tip_deg),
             k.height_pos_deg, k.height_neg_deg, k.other_knob_deg,
             tuple(float(v) + off_pos for v in k.dead_zone_pos_deg),
             tuple(float(v) - off_neg for v in k.dead_zone_neg_deg),
-            k.backlash_pos_deg, k.backlash_neg_deg, ours))
+            k.backlash_pos_deg, k.backlash_neg_deg, ours)
+        if k.paper is not None:  # the paper's frame (session 27) moves with the edges
+            moved = replace(moved, paper=replace(
+                k.paper, reference_pos=moved.reference_pos, reference_neg=moved.reference_neg,
+                dead_zone_pos_deg=tuple(float(v) + off_pos for v in k.paper.dead_zone_pos_deg),
+                dead_zone_neg_deg=tuple(float(v) - off_neg for v in k.paper.dead_zone_neg_deg)))
+        knobs.append(moved)
     quality = dict(profile.quality)
     for i, ((off_pos, off_neg), (g_pos, g_neg), (x0_pos, x0_neg)) in enumerate(zip(
             offsets, gains, offsets if zero_loads is None else zero_loads, strict=True)):

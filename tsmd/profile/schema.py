@@ -4,6 +4,7 @@ own schema (:mod:`tsmd.profile.sheet_schema`)."""
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import logging
 from typing import Any
@@ -24,6 +25,9 @@ from tsmd.profile.types import (
 )
 
 _log = logging.getLogger("tsmd.profile")
+PAPER_FIELDS = ("height_pos_deg", "height_neg_deg", "dead_zone_pos_deg", "dead_zone_neg_deg",
+                "backlash_pos_deg", "backlash_neg_deg")
+"""What a knob's ``paper`` entry holds (:attr:`tsmd.profile.types.KnobProfile.paper`)."""
 
 
 def check_references(r: Reader, key: str, pos: ReferencePoint, neg: ReferencePoint) -> None:
@@ -67,7 +71,33 @@ def _knob_from_mapping(r: Reader, raw: Any, key: str) -> KnobProfile:
             tension = tension_play_from_mapping(r.mapping(k["tension_play"], p + "tension_play"))
         except ValueError as exc:
             raise r.fail(p + "tension_play", str(exc)) from None
-    return KnobProfile(omega, pos, neg, h_pos, h_neg, grid, d_pos, d_neg, b_pos, b_neg, tension)
+    knob = KnobProfile(omega, pos, neg, h_pos, h_neg, grid, d_pos, d_neg, b_pos, b_neg, tension)
+    if k.get("paper") is not None:
+        knob = dataclasses.replace(knob, paper=_paper_from_mapping(r, k["paper"], p + "paper",
+                                                                     knob))
+    return knob
+
+
+def _paper_from_mapping(r: Reader, raw: Any, key: str, knob: KnobProfile) -> KnobProfile:
+    """The paper's frame of a knob (``KnobProfile.paper``): its heights and grids only, on the
+    knob's own grid, slope and reference points."""
+    k = r.mapping(raw, key)
+    p = key + "."
+    n = len(knob.other_knob_deg)
+    return dataclasses.replace(
+        knob, tension_play=None, paper=None,
+        height_pos_deg=r.number(r.get(k, "height_pos_deg", p), p + "height_pos_deg", -90, 90,
+                                "deg"),
+        height_neg_deg=r.number(r.get(k, "height_neg_deg", p), p + "height_neg_deg", -90, 90,
+                                "deg"),
+        dead_zone_pos_deg=r.numbers(r.get(k, "dead_zone_pos_deg", p), p + "dead_zone_pos_deg",
+                                    n, 0, 90, "deg"),
+        dead_zone_neg_deg=r.numbers(r.get(k, "dead_zone_neg_deg", p), p + "dead_zone_neg_deg",
+                                    n, -90, 0, "deg"),
+        backlash_pos_deg=r.numbers(r.get(k, "backlash_pos_deg", p), p + "backlash_pos_deg", n,
+                                   0, 90, "deg"),
+        backlash_neg_deg=r.numbers(r.get(k, "backlash_neg_deg", p), p + "backlash_neg_deg", n,
+                                   0, 90, "deg"))
 
 
 def profile_from_mapping(data: Any, origin: str = "profile") -> CatheterProfile:
@@ -109,6 +139,9 @@ def profile_to_mapping(profile: CatheterProfile) -> dict[str, Any]:
         }
         if k.tension_play is not None:
             entry["tension_play"] = tension_play_to_mapping(k.tension_play)
+        if k.paper is not None:
+            entry["paper"] = {name: (list(v) if isinstance(v, tuple) else v)
+                              for name, v in ((n, getattr(k.paper, n)) for n in PAPER_FIELDS)}
         knobs[name] = entry
     return {
         "schema_version": profile.schema_version,

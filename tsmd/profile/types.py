@@ -367,6 +367,17 @@ class KnobProfile:
     backlash_neg_deg: tuple[float, ...]
     tension_play: TensionPlayParams | None = None
     """The parameters of method ``ours`` (None: calibrated by an older tsmd)."""
+    paper: KnobProfile | None = None
+    """The same knob as the paper's compensator is fed, where that differs from the reported
+    values (session 27): D and B read in our fit's frame (reading offsets of
+    ``MODEL_MIN_OFFSET_DEG`` and more), H drawn through that D(0). The reported values take
+    every sure offset, however small: right for the tip's 1 deg threshold, but on a rounded knee
+    and a gradual release they carry the paper's straight lines away from the tip (warmgear
+    development 1-2: 19 of 22 rows worse). None: the reported values."""
+
+    def for_paper(self) -> KnobProfile:
+        """The knob as the paper's compensator takes it (:attr:`paper`, else this one)."""
+        return self.paper if self.paper is not None else self
 
     def grid_array(self) -> np.ndarray:
         """(n, 4) array: D_pos, D_neg, B_pos, B_neg per grid point."""

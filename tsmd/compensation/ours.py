@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from tsmd.compensation.ours_knob import (
     PLATEAU_MARGIN_DEG,
+    SETTLED_DEG,
     KnobCommand,
     fresh_progress,
     motion,
@@ -238,8 +239,11 @@ class OursCompensator:
 
     def _track(self, kc: KnobCommand, q_raw: float, b: Branches, planned: bool,
                dt_s: float) -> None:
+        still = -SETTLED_DEG < q_raw - kc.q_tick < SETTLED_DEG
+        kc.q_tick = q_raw
         if watch(kc, q_raw, dt_s, self._n_avg) and self._centre(kc, b):
             return
+        before, out_before = kc.state, kc.out
         qi, dq, v = motion(kc, q_raw, dt_s, self.period_s)
         lead = kc.ahead_s * v
         if lead < -_MAX_LEAD_DEG:
@@ -257,6 +261,8 @@ class OursCompensator:
         state = inverse_step(state, target, b)
         kc.state = state
         kc.out = state.x_deg if planned else self._early_jump(kc, state, target, v, b)
+        if still and state.x_deg != before.x_deg:
+            _keep_at_home(kc, before, out_before, b)
 
     def _centre(self, kc: KnobCommand, b: Branches) -> bool:
         """During a dwell: the knob to the middle of the play holding the model's output (the
@@ -315,3 +321,21 @@ class OursCompensator:
             horizon_s = 0.5 * (jump / self.v_max + self.v_max / self.a_max)
         kc.hold = d
         return ahead
+
+
+def _keep_at_home(kc: KnobCommand, before: PlayState, out_before: float, b: Branches) -> None:
+    """A knob whose desired angle has not moved, its output inside the plateau band (at home:
+    the band :meth:`OursCompensator._centre` leaves alone), keeps its knob while the play at
+    that knob still holds the output: the other knob moved this knob's branches (a level grid
+    shifts the loaded branch with the other knob's angle), and following the moved branch
+    pulls a rope whose tip the other plane's load holds where it was (pronyring's ring seat:
+    development 2 phi1's tip error 0.75 -> 2.07 deg rms with the grid while phi2 swept
+    past +-60)."""
+    state = kc.state
+    y = state.y_deg
+    if not kc.plateau_lo_deg - PLATEAU_MARGIN_DEG <= y <= kc.plateau_hi_deg + PLATEAU_MARGIN_DEG:
+        return
+    x = before.x_deg
+    if interp_linear(x, b.knots, b.rising_deg) <= y <= interp_linear(x, b.knots, b.falling_deg):
+        kc.state = before._replace(y_deg=y, held_deg=y)
+        kc.out = out_before

@@ -46,7 +46,7 @@ class KnobCommand:
     __slots__ = ("accel", "ahead_s", "ahead_ticks", "first_side", "fresh", "fresh_hi_deg",
                  "fresh_lo_deg", "held_s", "hold", "jump_deg_s", "lim_deg",
                  "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan",
-                 "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "rest_q",
+                 "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "q_tick", "rest_q",
                  "stand_s", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
                  "v_raw_known", "window")
 
@@ -74,6 +74,8 @@ class KnobCommand:
         self.v = 0.0
         self.accel = 0.0
         self.q_raw = q_deg
+        self.q_tick = q_deg
+        """The desired angle the last tick tracked (every tick, a dwell's too)."""
         self.v_raw = 0.0
         self.v_raw_known = True
         """``v_raw`` is a velocity the next change may be compared with (the desired angle

@@ -1,6 +1,7 @@
-"""A knob at rest inside its plateau band keeps its position while the other knob moves its
-branches (tsmd.compensation.ours): the other plane's load holds that tip where it was; a knob
-loaded beyond the band still follows its moved branch."""
+"""The compensator's opt-in ``hold_at_home`` (tsmd.compensation.ours): a knob at rest inside
+its plateau band keeps its position while the other knob moves its branches (the other plane's
+load holds that tip where it was); a knob loaded beyond the band still follows its moved branch,
+and without the hold the knob on the plateau's edge follows it too (the shipped behaviour)."""
 
 from __future__ import annotations
 
@@ -13,11 +14,11 @@ from tsmd.compensation.ours_table import OursKnob
 PERIOD_S = 0.01
 
 
-def knob0_commands_while_knob1_sweeps(q0_deg: float) -> np.ndarray:
+def knob0_commands_while_knob1_sweeps(q0_deg: float, hold: bool = True) -> np.ndarray:
     """Knob 0 held at ``q0_deg`` (settled first), knob 1 sweeping +-80 deg over 8 s (the
     level grid shifts knob 0's loaded branches by up to 4 deg)."""
     knob = OursKnob.from_params(params())
-    comp = OursCompensator((knob, knob), PERIOD_S)
+    comp = OursCompensator((knob, knob), PERIOD_S, hold_at_home=hold)
     comp.reset(np.array([q0_deg, 0.0]))
     for _ in range(100):
         comp.command(np.array([q0_deg, 0.0]), PERIOD_S)
@@ -39,3 +40,7 @@ def test_a_knob_at_rest_in_the_dead_zone_stays_at_its_rest_command() -> None:
 
 def test_a_knob_loaded_beyond_the_band_still_follows_its_moved_branch() -> None:
     assert np.ptp(knob0_commands_while_knob1_sweeps(10.0)) > 1.0
+
+
+def test_without_the_hold_a_knob_on_the_plateau_edge_follows_its_moved_branch() -> None:
+    assert np.ptp(knob0_commands_while_knob1_sweeps(4.5, hold=False)) > 1.0

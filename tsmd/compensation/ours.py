@@ -68,7 +68,7 @@ class OursCompensator:
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,
                  limits: Sequence[KnobLimits] | None = None, smoothing_s: float = 0.1,
-                 fresh_catheter: bool = False) -> None:
+                 fresh_catheter: bool = False, hold_at_home: bool = False) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be positive, got {period_s}")
         if limits is None:  # the simulated rig's drives, no position limit
@@ -79,6 +79,10 @@ class OursCompensator:
         self.fresh_catheter = fresh_catheter
         """The catheter was never loaded when reset (only the bench's fresh plant, or a new
         catheter with a product profile): ``reset`` starts on the fresh branches."""
+        self.hold_at_home = hold_at_home
+        """A knob at rest inside its plateau band keeps its command while the other knob moves
+        its branches (:func:`_keep_at_home`). Off: pronyring development 1-2 10 rows better / 4
+        worse, but jawcrimp development 1 two rows 0.05 deg worse (no sheet stage chooses it)."""
         self.period_s = period_s
         self.limits = (limits[0], limits[1])
         # jumps are planned with the slower knob's limits
@@ -261,7 +265,7 @@ class OursCompensator:
         state = inverse_step(state, target, b)
         kc.state = state
         kc.out = state.x_deg if planned else self._early_jump(kc, state, target, v, b)
-        if still and state.x_deg != before.x_deg:
+        if still and self.hold_at_home and state.x_deg != before.x_deg:
             _keep_at_home(kc, before, out_before, b)
 
     def _centre(self, kc: KnobCommand, b: Branches) -> bool:

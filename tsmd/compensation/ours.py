@@ -80,9 +80,10 @@ class OursCompensator:
         """The catheter was never loaded when reset (only the bench's fresh plant, or a new
         catheter with a product profile): ``reset`` starts on the fresh branches."""
         self.hold_at_home = hold_at_home
-        """A knob at rest inside its plateau band keeps its command while the other knob moves
-        its branches (:func:`_keep_at_home`). Off: pronyring development 1-2 10 rows better / 4
-        worse, but jawcrimp development 1 two rows 0.05 deg worse (no sheet stage chooses it)."""
+        """Every knob at rest inside its plateau band keeps its command while the other knob
+        moves its branches (:func:`_keep_at_home`); off, a knob does so where its product
+        chose it (``OursKnob.hold_at_home``, a data-sheet stage on the sheet's unit: jawcrimp
+        development 1 lost 0.05 deg on two rows with it, pronyring gained)."""
         self.period_s = period_s
         self.limits = (limits[0], limits[1])
         # jumps are planned with the slower knob's limits
@@ -110,6 +111,7 @@ class OursCompensator:
             kc.plateau_hi_deg = max(knob.height_pos_deg, knob.height_neg_deg)
             kc.fresh_hi_deg = knob.height_neg_deg
             kc.fresh_lo_deg = knob.height_pos_deg
+            kc.home_hold = self.hold_at_home or knob.hold_at_home
 
     def replace_knobs(self, knobs: tuple[OursKnob, OursKnob]) -> None:
         """New parameters from the next tick on, state kept (online re-estimation)."""
@@ -265,7 +267,7 @@ class OursCompensator:
         state = inverse_step(state, target, b)
         kc.state = state
         kc.out = state.x_deg if planned else self._early_jump(kc, state, target, v, b)
-        if still and self.hold_at_home and state.x_deg != before.x_deg:
+        if still and kc.home_hold and state.x_deg != before.x_deg:
             _keep_at_home(kc, before, out_before, b)
 
     def _centre(self, kc: KnobCommand, b: Branches) -> bool:

@@ -44,7 +44,7 @@ class KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
     __slots__ = ("accel", "ahead_s", "ahead_ticks", "first_side", "fresh", "fresh_hi_deg",
-                 "fresh_lo_deg", "held_s", "hold", "jump_deg_s", "lim_deg",
+                 "fresh_lo_deg", "held_s", "hold", "home_hold", "jump_deg_s", "lim_deg",
                  "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan",
                  "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "q_tick", "rest_q",
                  "stand_s", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
@@ -65,6 +65,8 @@ class KnobCommand:
         """The side a fresh knob loaded first (+1, -1; 0: not yet)."""
         self.fresh_hi_deg = self.fresh_lo_deg = 0.0
         """Where a fresh knob's first release has ended (the falling / rising plateau)."""
+        self.home_hold = False
+        """This knob keeps its command at rest in its plateau band (the product's choice)."""
         self.reset(PlayState(0.0, 0.0, 1, 0.0), 0.0, 1)
 
     def reset(self, state: PlayState, q_deg: float, n_avg: int) -> None:

@@ -304,6 +304,12 @@ class DeviceKnob:
     read in the unit's first minutes; warmgear's shaft has by then not yet warmed, its slack
     not yet shrunk). None: the reference edges."""
     calibrated_dead_zone_neg_deg: float | None = None
+    hold_at_home: bool | None = None
+    """Optional, the product's choice, tracked on the data-sheet unit (``tsmd datasheet --update
+    --home-hold``, session 27, :mod:`tsmd.datasheet_home_hold`): method ours keeps this knob's
+    command while it rests inside its plateau band and the other knob moves its branches
+    (:func:`tsmd.compensation.ours._keep_at_home`), where the sheet unit's tip holds still
+    there; None or False: the knob follows its moved branch."""
 
 
 

@@ -10,10 +10,14 @@ no setting holds for every product, and which one a product needs is seen on the
 tracked: calibrated under the sheet as every unit is, it plays the rows where one knob rests at
 0 while the other sweeps (the paper's 1-DOF periodic and non-periodic rows, conditioned as the
 bench plays them) once with the resting knob's hold off and once on, everything else the
-same. The tip's error of both planes counts (the resting knob's own, and what its rope does to
-the moving plane through the shared sheath). A knob takes the hold where its rows' squared
-error falls in every row: a paired comparison on the same unit, noise seed and trajectory,
-so no margin is tuned; a hold that never fires changes nothing and stays off.
+same. The tip's error of both planes counts: the resting knob's own, and what its rope does to
+the moving plane through the shared sheath. A knob takes the hold where in every row neither
+plane's error rises and their squared sum falls: a paired comparison on the same unit, noise
+seed and trajectory, so no margin is tuned; a hold that never fires changes nothing and stays
+off. A rule on the sum alone would trade: on unit 0 the hold brought pronyring's resting phi1
+2.40 -> 1.09 deg while the moving phi2 went 2.71 -> 2.94, and jawcrimp's resting phi2 2.13 ->
+1.64 while phi1 went 1.30 -> 1.35, the very rows (the moving plane's) that development units
+lost with the hold in session 26.
 """
 
 from __future__ import annotations
@@ -54,6 +58,12 @@ class RestRow:
         return (self.rest_on_deg ** 2 + self.moving_on_deg ** 2
                 - self.rest_off_deg ** 2 - self.moving_off_deg ** 2)
 
+    @property
+    def costs_nothing(self) -> bool:
+        """Neither plane's error rises and their squared sum falls."""
+        return (self.rest_on_deg <= self.rest_off_deg and self.moving_on_deg <= self.moving_off_deg
+                and self.mse_change < 0.0)
+
 
 @dataclass(frozen=True)
 class HomeHoldScore:
@@ -64,7 +74,7 @@ class HomeHoldScore:
 
     @property
     def chosen(self) -> bool:
-        return bool(self.rows) and all(r.mse_change < 0.0 for r in self.rows)
+        return bool(self.rows) and all(r.costs_nothing for r in self.rows)
 
     def text(self) -> str:
         rows = "; ".join(f"{r.name}: resting {r.rest_off_deg:.3f} -> {r.rest_on_deg:.3f}, "

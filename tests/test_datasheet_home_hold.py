@@ -1,7 +1,7 @@
 """The data sheet's hold at home (tsmd.datasheet_home_hold): the field on the sheet, copied by
 calibration into each unit's profile, and the stage's choice per knob from the sheet unit's
 rows at rest (a knob keeps the hold only where no such row's tip error rises in either plane
-and the sum falls)."""
+beyond that row's seed noise and the sum falls)."""
 
 from __future__ import annotations
 
@@ -49,8 +49,8 @@ def test_calibration_copies_the_sheets_hold_into_the_profile() -> None:
     assert held == dataclasses.replace(plain, hold_at_home=True)
 
 
-def row(rest: tuple[float, float], moving: tuple[float, float]) -> RestRow:
-    return RestRow("row", rest[0], rest[1], moving[0], moving[1])
+def row(rest: tuple[float, float], moving: tuple[float, float], noise: float = 0.0) -> RestRow:
+    return RestRow("row", rest[0], rest[1], moving[0], moving[1], noise, noise)
 
 
 def test_a_knob_takes_the_hold_where_every_row_at_rest_tracks_better_with_it() -> None:
@@ -64,6 +64,18 @@ def test_a_row_whose_moving_plane_loses_keeps_the_hold_off_even_where_the_sum_ga
     trade = row((2.40, 1.09), (2.71, 2.94))
     assert trade.mse_change < 0.0
     assert not HomeHoldScore(0, (trade, row((2.30, 1.04), (2.12, 2.05)))).chosen
+
+
+def test_a_rise_within_the_rows_seed_noise_does_not_count_as_a_loss() -> None:
+    # planetwist unit 0's phi2 at rest: the moving plane 2.052 -> 2.052 (+1e-4)
+    within = row((2.60, 1.10), (2.0520, 2.0521), noise=0.003)
+    assert HomeHoldScore(1, (within,)).chosen
+    assert not HomeHoldScore(1, (row((2.60, 1.10), (2.0520, 2.0521)),)).chosen
+
+
+def test_a_rise_beyond_the_rows_seed_noise_counts_as_a_loss() -> None:
+    # jawcrimp unit 0's phi2 at rest (session 27): the moving phi1 1.303 -> 1.346
+    assert not HomeHoldScore(1, (row((2.13, 1.64), (1.303, 1.346), noise=0.01),)).chosen
 
 
 def test_a_row_whose_resting_plane_loses_keeps_the_hold_off() -> None:

@@ -171,3 +171,22 @@ def test_update_with_the_level_grid_adds_the_grid_read_under_the_sheet(
     assert seen == [before]
     assert after == fake(before, None, None, 0)
     assert "--level-grid" in out.read_text().split("schema_version")[0]
+
+
+def test_update_with_the_home_hold_adds_the_choice_made_under_the_sheet(
+        bare: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    seen: list[DeviceModel] = []
+
+    def fake(device: DeviceModel, config: object, factory: object, seed: int) -> DeviceModel:
+        seen.append(device)
+        return device.with_knob_flag("hold_at_home", (True, False))
+
+    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_home_hold", fake)
+    out = tmp_path / "new.yaml"
+    assert main(["datasheet", "--update", str(bare), *PLANT, "--home-hold",
+                 "--out", str(out)]) == 0
+    before, after = load_device_model(bare), load_device_model(out)
+    assert seen == [before]
+    assert after == fake(before, None, None, 0)
+    assert [k.hold_at_home for k in after.knobs] == [True, None]
+    assert "--home-hold" in out.read_text().split("schema_version")[0]

@@ -247,7 +247,8 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any,
         release_round=float(getattr(k, "release_round", None) or 0.0),
         release_shift=float(getattr(k, "release_shift", None) or 0.0),
         level_grid=unit_level_grid(k, omega, grid, d_pos, d_neg),
-        release_end=getattr(k, "release_end_shape", None))
+        release_end=getattr(k, "release_end_shape", None),
+        hold_at_home=bool(getattr(k, "hold_at_home", None)))
 
 
 def unit_level_grid(knob: Any, omega: float, grid: Sequence[float],

@@ -79,6 +79,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "how far each side's loaded level moves with the other knob's angle "
                              "(loaded_level_grid; opt-in per product, docs/model.md Session 21; "
                              "with --update: added to that sheet, measured under it, session 26)")
+    parser.add_argument("--home-hold", action="store_true",
+                        help="with --plant: also calibrate the unit once more and play the rows "
+                             "where one knob rests at 0 while the other sweeps, tracked, with "
+                             "that knob's hold at home off and on; the knob keeps the hold where "
+                             "every row's tip error falls (hold_at_home; opt-in per product, "
+                             "docs/model.md Session 27; with --update: added to that sheet, "
+                             "measured under it)")
     parser.add_argument("--plateau-gap", action="store_true",
                         help="with --plant: also play the dead-zone loop on the sheet's unit and "
                              "write its plateau gap and flats per gap degree (plateau_gap_deg, "

@@ -29,6 +29,7 @@ from tsmd.commands.datasheet_stick import (
 )
 from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
+from tsmd.datasheet_home_hold import with_home_hold
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
 from tsmd.datasheet_release_round import with_release_round
@@ -135,14 +136,14 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
     slope = args.slope_sample is not None
     rounded = bool(args.release_round)
     # nested or new fields: written whole
-    whole = args.stick_end or args.settle_gain_check or args.level_grid
+    whole = args.stick_end or args.settle_gain_check or args.level_grid or args.home_hold
     if (args.unit_sample is None and not loop and not whole and not edges and not slope
             and not rounded):
         raise DatasheetError("--update adds the sample's part, the loop's, the stick end, the "
-                             "settle-gain check, the level grid, the unit's edges, the slope "
-                             "weight or the rounded release: give --unit-sample, --plateau-gap, "
-                             "--stick-end, --settle-gain-check, --level-grid, --unit-edges, "
-                             "--slope-sample or --release-round")
+                             "settle-gain check, the level grid, the hold at home, the unit's "
+                             "edges, the slope weight or the rounded release: give --unit-sample, "
+                             "--plateau-gap, --stick-end, --settle-gain-check, --level-grid, "
+                             "--home-hold, --unit-edges, --slope-sample or --release-round")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
@@ -157,6 +158,9 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
     if args.level_grid:  # read under the sheet's own choices, as every unit is calibrated
         device = with_level_grid(device, config, lambda: load_plant(args.plant, params),
                                  args.seed)
+    if args.home_hold:  # after the grid: the hold matters where branches move with the angle
+        device = with_home_hold(device, config, lambda: load_plant(args.plant, params),
+                                args.seed)
     updated = (with_sample(device, config, args.plant, params, args.unit_key, units, seed)
                if units else device)
     keys: tuple[str, ...] = SAMPLE_KEYS if units else ()
@@ -193,13 +197,15 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                + (" --stick-end" if args.stick_end else "")
                + (" --settle-gain-check" if args.settle_gain_check else "")
                + (f" --level-grid --seed {args.seed}" if args.level_grid else "")
+               + (f" --home-hold --seed {args.seed}" if args.home_hold else "")
                + (f" --rule-seeds {','.join(map(str, seeds))}"
                   if seeds and (args.stick_end or args.settle_gain_check or edges) else "")
                + " --out FILE")
     if whole:
         fields = ((["backlash_stick_end", "reading_offset"] if args.stick_end else [])
                   + (["settle_gain_read"] if args.settle_gain_check else [])
-                  + (["loaded_level_grid"] if args.level_grid else []) + list(keys))
+                  + (["loaded_level_grid"] if args.level_grid else [])
+                  + (["hold_at_home"] if args.home_hold else []) + list(keys))
         save_device_model(updated, args.out, source_header(source) + (
             f"\n{', '.join(fields)} measured by tsmd {__version__} (no other field changed):"
             f"\n  {command}"))

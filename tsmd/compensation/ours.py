@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 
 from tsmd.compensation.ours_knob import (
     PLATEAU_MARGIN_DEG,
+    SETTLED_DEG,
     KnobCommand,
     fresh_progress,
     motion,
@@ -67,7 +68,7 @@ class OursCompensator:
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,
                  limits: Sequence[KnobLimits] | None = None, smoothing_s: float = 0.1,
-                 fresh_catheter: bool = False) -> None:
+                 fresh_catheter: bool = False, hold_at_home: bool = False) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be positive, got {period_s}")
         if limits is None:  # the simulated rig's drives, no position limit
@@ -78,6 +79,11 @@ class OursCompensator:
         self.fresh_catheter = fresh_catheter
         """The catheter was never loaded when reset (only the bench's fresh plant, or a new
         catheter with a product profile): ``reset`` starts on the fresh branches."""
+        self.hold_at_home = hold_at_home
+        """Every knob at rest inside its plateau band keeps its command while the other knob
+        moves its branches (:func:`_keep_at_home`); off, a knob does so where its product
+        chose it (``OursKnob.hold_at_home``, a data-sheet stage on the sheet's unit: jawcrimp
+        development 1 lost 0.05 deg on two rows with it, pronyring gained)."""
         self.period_s = period_s
         self.limits = (limits[0], limits[1])
         # jumps are planned with the slower knob's limits
@@ -105,6 +111,7 @@ class OursCompensator:
             kc.plateau_hi_deg = max(knob.height_pos_deg, knob.height_neg_deg)
             kc.fresh_hi_deg = knob.height_neg_deg
             kc.fresh_lo_deg = knob.height_pos_deg
+            kc.home_hold = self.hold_at_home or knob.hold_at_home
 
     def replace_knobs(self, knobs: tuple[OursKnob, OursKnob]) -> None:
         """New parameters from the next tick on, state kept (online re-estimation)."""
@@ -238,8 +245,11 @@ class OursCompensator:
 
     def _track(self, kc: KnobCommand, q_raw: float, b: Branches, planned: bool,
                dt_s: float) -> None:
+        still = -SETTLED_DEG < q_raw - kc.q_tick < SETTLED_DEG
+        kc.q_tick = q_raw
         if watch(kc, q_raw, dt_s, self._n_avg) and self._centre(kc, b):
             return
+        before, out_before = kc.state, kc.out
         qi, dq, v = motion(kc, q_raw, dt_s, self.period_s)
         lead = kc.ahead_s * v
         if lead < -_MAX_LEAD_DEG:
@@ -257,6 +267,8 @@ class OursCompensator:
         state = inverse_step(state, target, b)
         kc.state = state
         kc.out = state.x_deg if planned else self._early_jump(kc, state, target, v, b)
+        if still and kc.home_hold and state.x_deg != before.x_deg:
+            _keep_at_home(kc, before, out_before, b)
 
     def _centre(self, kc: KnobCommand, b: Branches) -> bool:
         """During a dwell: the knob to the middle of the play holding the model's output (the
@@ -315,3 +327,21 @@ class OursCompensator:
             horizon_s = 0.5 * (jump / self.v_max + self.v_max / self.a_max)
         kc.hold = d
         return ahead
+
+
+def _keep_at_home(kc: KnobCommand, before: PlayState, out_before: float, b: Branches) -> None:
+    """A knob whose desired angle has not moved, its output inside the plateau band (at home:
+    the band :meth:`OursCompensator._centre` leaves alone), keeps its knob while the play at
+    that knob still holds the output: the other knob moved this knob's branches (a level grid
+    shifts the loaded branch with the other knob's angle), and following the moved branch
+    pulls a rope whose tip the other plane's load holds where it was (pronyring's ring seat:
+    development 2 phi1's tip error 0.75 -> 2.07 deg rms with the grid while phi2 swept
+    past +-60)."""
+    state = kc.state
+    y = state.y_deg
+    if not kc.plateau_lo_deg - PLATEAU_MARGIN_DEG <= y <= kc.plateau_hi_deg + PLATEAU_MARGIN_DEG:
+        return
+    x = before.x_deg
+    if interp_linear(x, b.knots, b.rising_deg) <= y <= interp_linear(x, b.knots, b.falling_deg):
+        kc.state = before._replace(y_deg=y, held_deg=y)
+        kc.out = out_before

@@ -44,9 +44,9 @@ class KnobCommand:
     """One knob's command state (slots: the tick reads and writes these attributes only)."""
 
     __slots__ = ("accel", "ahead_s", "ahead_ticks", "first_side", "fresh", "fresh_hi_deg",
-                 "fresh_lo_deg", "held_s", "hold", "jump_deg_s", "lim_deg",
+                 "fresh_lo_deg", "held_s", "hold", "home_hold", "jump_deg_s", "lim_deg",
                  "lim_target", "lim_v", "limits", "move_s", "omega", "out", "plan",
-                 "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "rest_q",
+                 "plateau_hi_deg", "plateau_lo_deg", "q_dir", "q_prev", "q_raw", "q_tick", "rest_q",
                  "stand_s", "state", "still_q", "still_s", "sum", "target", "v", "v_raw",
                  "v_raw_known", "window")
 
@@ -65,6 +65,8 @@ class KnobCommand:
         """The side a fresh knob loaded first (+1, -1; 0: not yet)."""
         self.fresh_hi_deg = self.fresh_lo_deg = 0.0
         """Where a fresh knob's first release has ended (the falling / rising plateau)."""
+        self.home_hold = False
+        """This knob keeps its command at rest in its plateau band (the product's choice)."""
         self.reset(PlayState(0.0, 0.0, 1, 0.0), 0.0, 1)
 
     def reset(self, state: PlayState, q_deg: float, n_avg: int) -> None:
@@ -74,6 +76,8 @@ class KnobCommand:
         self.v = 0.0
         self.accel = 0.0
         self.q_raw = q_deg
+        self.q_tick = q_deg
+        """The desired angle the last tick tracked (every tick, a dwell's too)."""
         self.v_raw = 0.0
         self.v_raw_known = True
         """``v_raw`` is a velocity the next change may be compared with (the desired angle

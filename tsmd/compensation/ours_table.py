@@ -68,6 +68,9 @@ class OursKnob:
     release_end: ReleaseEndShape | None = None
     """The product's release end per reversal (:mod:`tsmd.compensation.reversal_release`);
     None: the static release lines (fresh tables keep them)."""
+    hold_at_home: bool = False
+    """The product's choice that this knob keeps its command at rest inside its plateau band
+    while the other knob moves its branches (:func:`tsmd.compensation.ours._keep_at_home`)."""
     _table: tuple[Branches, ...] = dataclasses.field(init=False, repr=False, compare=False)
     _fresh: tuple[tuple[Branches, ...], ...] = dataclasses.field(init=False, repr=False,
                                                                  compare=False)
@@ -130,7 +133,8 @@ class OursKnob:
                    # the profile's fresh numbers come together from one first sweep
                    p.fresh_edge_delay_deg if p.fresh_hold_deg > 0.0 else None,
                    curved(shape_pos), curved(shape_neg), p.other_tip_gain, grid,
-                   p.release_round, p.release_shift, p.level_grid, p.release_end)
+                   p.release_round, p.release_shift, p.level_grid, p.release_end,
+                   p.hold_at_home)
 
     def shapes_at(self, other_deg: float) -> tuple[LoadedShape | None, LoadedShape | None]:
         """The templates (positive, negative side) at the other knob's angle."""

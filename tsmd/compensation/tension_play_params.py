@@ -74,6 +74,9 @@ class TensionPlayParams:
     angle (data sheet, :mod:`tsmd.compensation.level_grid`); None: H at every angle.
     ``release_end``: the product's release end per reversal (data sheet ``release_end_shape``,
     :mod:`tsmd.compensation.reversal_release`); None: the static release lines.
+    ``hold_at_home``: the product's choice (data sheet, :mod:`tsmd.datasheet_home_hold`) that
+    this knob keeps its command at rest inside its plateau band while the other knob moves its
+    branches; False: it follows them.
     """
 
     omega: float
@@ -100,6 +103,7 @@ class TensionPlayParams:
     release_shift: float = 0.0
     level_grid: LevelGrid | None = None
     release_end: ReleaseEndShape | None = None
+    hold_at_home: bool = False
 
     def columns(self) -> NDArray[np.float64]:
         """(n, 6): D_pos, D_neg, beta_pos, beta_neg, x0_pos, x0_neg per grid point."""
@@ -127,6 +131,8 @@ _SHAPES = {"loaded_shape_pos": "shape_pos", "loaded_shape_neg": "shape_neg"}
 _SHAPE_GRID = "loaded_shape_grid"
 _LEVEL_GRID = "loaded_level_grid"
 _RELEASE_END = "release_end_shape"
+_HOLD = "hold_at_home"
+"""A flag, written only when set."""
 _KNEES = ("loaded_knee_deg", "loaded_knee_u95_deg", "sheet_loaded_knee_deg")
 """Optional pairs (positive, negative side), written only when set."""
 
@@ -153,11 +159,11 @@ def _numbers(values: Any, name: str, n: int | None, lo: float, hi: float) -> tup
 def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
     """Validate a profile's ``tension_play`` block (ValueError naming the key)."""
     known = {"other_knob_deg", *_ROWS, *_SCALARS, *_SHAPES, _SHAPE_GRID, _LEVEL_GRID, *_KNEES,
-             _RELEASE_END}
+             _RELEASE_END, _HOLD}
     for key in m:
         if key not in known:
             raise ValueError(f"{key}: unknown key")
-    for key in (known - _OPTIONAL - set(_SHAPES) - {_SHAPE_GRID, _LEVEL_GRID, _RELEASE_END}
+    for key in (known - _OPTIONAL - set(_SHAPES) - {_SHAPE_GRID, _LEVEL_GRID, _RELEASE_END, _HOLD}
                 - set(_KNEES)):
         if key not in m:
             raise ValueError(f"{key}: missing key")
@@ -169,6 +175,9 @@ def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
     pos_shape, neg_shape = (shape_from_mapping(m[k], k) if m.get(k) is not None else None
                             for k in _SHAPES)
     knees = {k: _knee_pair(m[k], k) if m.get(k) is not None else None for k in _KNEES}
+    hold = m.get(_HOLD, False)
+    if not isinstance(hold, bool):
+        raise ValueError(f"{_HOLD}: must be true or false, got {hold!r}")
     return TensionPlayParams(
         s["omega"], s["height_pos_deg"], s["height_neg_deg"], grid, r["dead_zone_pos_deg"],
         r["dead_zone_neg_deg"], r["backlash_gain_pos"], r["backlash_gain_neg"],
@@ -180,7 +189,7 @@ def tension_play_from_mapping(m: Mapping[str, Any]) -> TensionPlayParams:
         level_grid=(level_grid_from_mapping(m[_LEVEL_GRID], _LEVEL_GRID)
                     if m.get(_LEVEL_GRID) is not None else None),
         release_end=(release_end_shape_from_mapping(m[_RELEASE_END], _RELEASE_END)
-                     if m.get(_RELEASE_END) is not None else None), **knees)
+                     if m.get(_RELEASE_END) is not None else None), hold_at_home=hold, **knees)
 
 
 def _knee_pair(values: Any, name: str) -> tuple[float, float]:
@@ -207,4 +216,6 @@ def tension_play_to_mapping(p: TensionPlayParams) -> dict[str, Any]:
         pair = getattr(p, key)
         if pair is not None:
             out[key] = [float(v) for v in pair]
+    if p.hold_at_home:
+        out[_HOLD] = True
     return out

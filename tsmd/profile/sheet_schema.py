@@ -96,7 +96,8 @@ _BACKLASH_KEYS = ("reference_backlash_gain", "backlash_settle_fraction",
 _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_share",
                       "backlash_recovery_lag_deg", "backlash_bend_gain", "backlash_release_rule",
                       "backlash_settled_share", "backlash_knee", "edge_curve", "edge_rise",
-                      "release_ratio_gain", "backlash_stick_end", "settle_gain_read")
+                      "release_ratio_gain", "backlash_stick_end", "settle_gain_read",
+                      "hold_at_home")
 _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg",
                   "edge_level_share")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
@@ -236,6 +237,7 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             backlash_stick_end=_knee(r, k.get("backlash_stick_end"),
                                      f"{key}.backlash_stick_end"),
             settle_gain_read=_knee(r, k.get("settle_gain_read"), f"{key}.settle_gain_read"),
+            hold_at_home=_knee(r, k.get("hold_at_home"), f"{key}.hold_at_home"),
             release_ratio_gain=_ratio_gain(r, k, key),
             reference_rule_backlash_gain=optional("reference_rule_backlash_gain"),
             reference_tip_backlash_gain=optional("reference_tip_backlash_gain"),

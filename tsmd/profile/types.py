@@ -311,6 +311,12 @@ class DeviceKnob:
     this share of what the readings give (:func:`tsmd.calibration.unit_slope.weighed_omega`):
     1 where all backlash is rope stretch the loaded line also loses, less where friction
     holds part of it (wormeyelet's eyelet band and disks). None: 1, every unit's omega as before."""
+    hold_at_home: bool | None = None
+    """Optional, the product's choice, tracked on the data-sheet unit (``tsmd datasheet --update
+    --home-hold``, session 27, :mod:`tsmd.datasheet_home_hold`): method ours keeps this knob's
+    command while it rests inside its plateau band and the other knob moves its branches
+    (:func:`tsmd.compensation.ours._keep_at_home`), where the sheet unit's tip holds still
+    there; None or False: the knob follows its moved branch."""
 
 
 

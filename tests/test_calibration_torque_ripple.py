@@ -122,7 +122,8 @@ def test_datasheet_takes_the_ripple_period_as_a_design_constant() -> None:
 @pytest.mark.parametrize("period_deg", [0.5, 120.0])
 def test_datasheet_refuses_a_ripple_period_outside_its_range_by_name(period_deg: float) -> None:
     with pytest.raises(DatasheetError, match="--torque-ripple-period-deg"):
-        datasheet_command.main(argparse.Namespace(
-            params=None, plant="simrig.family:make_family_plant", choose_loaded_shape=False,
-            loaded_shape=False, bend_slopes=False, bend_relation=False, rule_seeds="0,1",
-            update=None, device_model="x", torque_ripple_period_deg=period_deg))
+        parser = argparse.ArgumentParser()
+        add_arguments(parser)
+        datasheet_command.main(parser.parse_args([
+            "--plant", "simrig.family:make_family_plant", "--device-model", "x", "--out",
+            "x.yaml", "--torque-ripple-period-deg", str(period_deg)]))

@@ -24,11 +24,15 @@ from typing import Any
 
 import numpy as np
 
-from tsmd.bench.accuracy import calibrated_profile
+from tsmd.calibration import calibrate
 from tsmd.config import TsmdConfig
 from tsmd.datasheet import analysed_from, knob_constants, settle, tip_sweep
 from tsmd.profile import DeviceModel
-from tsmd.replay import run_trajectory
+from tsmd.replay import LockstepRunner, run_trajectory
+
+SAMPLE_CALIBRATION_SEED = 3000
+"""Noise seed of each sample unit's calibration (the tracking bench's, which the stage first
+borrowed: a data-sheet stage may not import the benchmarks, tests/test_import_graph.py)."""
 
 MIN_READING_SPREAD = 0.01
 """Below this rms move of the readings' ratios from 1 the sample says nothing about the share
@@ -72,7 +76,8 @@ def sample_pairs(device: DeviceModel, config: TsmdConfig, unit: str, make: Calla
     """Both knobs' pairs of one sample unit, calibrated under ``device`` without a weight."""
     plain = dataclasses.replace(device, knobs=tuple(  # type: ignore[arg-type]
         dataclasses.replace(k, slope_gain_weight=None) for k in device.knobs))
-    profile = calibrated_profile(plain, make)
+    with LockstepRunner(None, None, "none", SAMPLE_CALIBRATION_SEED, make()) as runner:
+        profile = calibrate(runner, "datasheet-slope-sample", plain)
     out = []
     for knob, k in enumerate(device.knobs):
         play = profile.knobs[knob].tension_play

@@ -104,10 +104,14 @@ def diagnose_session(recs: Sequence[Recording], data: PlantSpec, sim: PlantSpec,
     """Diagnose one made session (:func:`make_session`) with ``sim`` as the simulator: a
     session of a slow plant is made once and diagnosed with several simulators. With the
     protocol the diagnosis gets the model's data sheet (from ``sheet_unit``) and, unless
-    ``reference_units`` is empty, what the model has always (:func:`model_reference`)."""
+    ``reference_units`` is empty, what the model has always (:func:`model_reference`).
+    Without ``config`` the self-test's settings (:func:`cross_config`: no simulator parameter
+    fitted, seed 0), so a script gets the verdicts of `tsmd gap selftest`: fitting the
+    capstan simulator's slacks and friction and seeding by unit read warmgear 101's rate case
+    as sensor (docs/gap.md "Session 27, round 2")."""
     series = [series_from_recording(r, f"{case}-{seed}-{r.metadata['configuration']}-{i}")
               for i, r in enumerate(recs)]
-    cfg = config or GapConfig(fit_specs=sim.fit, seed=seed)
+    cfg = config or cross_config(sim.fit)
     if matched and cfg.compliance_reference is None:
         cfg = dataclasses.replace(
             cfg, compliance_reference=datasheet_reference(data, rate_hz, sheet_unit))

@@ -12,6 +12,7 @@ from simrig.family import PLANT_ROLE, PLANT_SPECS, SCATTER, family_member
 from simrig.plant import Plant
 from simrig.plants.beltbraid import NOMINAL_KNOBS, BeltBraidPlant, make_beltbraid_plant
 from simrig.plants.beltbraid.laws import BraidRelays, microslip, microslip_rate
+from tsmd.tracking_scenarios import PERIOD_S, scenarios
 
 DT = 0.004
 
@@ -218,3 +219,13 @@ def test_bad_step_input_is_refused() -> None:
         make_beltbraid_plant().step(-1.0, np.zeros(2))
     with pytest.raises(ValueError):
         make_beltbraid_plant().step(DT, np.array([math.nan, 0.0]))
+
+
+def test_the_tracking_protocol_with_its_jumps_between_scenarios_stays_bounded() -> None:
+    """The protocol's scenarios start where the last ended: a 60 deg jump in one step once left
+    the linearised friction past its capacity and the flags cycling, and the bend diverged."""
+    plant = family_member("beltbraid", 101).build()
+    for s in scenarios(quick=True):
+        for row in s.q_deg:
+            tip = plant.step(PERIOD_S, row).tip_deg
+            assert np.all(np.abs(tip) < 120.0)

@@ -38,7 +38,16 @@ from simrig.plants.beltbraid.params import NOMINAL_KNOBS, KnobParams, knob_param
 
 _SEAL_SPEED_DEG_S = 3.0
 _ROPE_SEAL_SPEED_MM_S = 0.05
-_SIDES = (1.0, -1.0)  # rope A (pulled by a positive knob angle), rope B
+_SIDES = (1.0, -1.0)
+_KINK_MM = 1e-9
+_CAP_JUMP_N = 0.5  # rope A (pulled by a positive knob angle), rope B
+
+
+def _flag(stretch_mm: float, was: bool) -> bool:
+    """Taut if stretched; a node on the kink (round-off) keeps the flag it was solved with."""
+    if abs(stretch_mm) < _KINK_MM:
+        return was
+    return stretch_mm > 0.0
 
 
 class _Knob:
@@ -62,6 +71,8 @@ class _Knob:
         self.seal_Nm = 0.0
         self.drum_rad = 0.0
         self.rope_speed_mm_s = 0.0
+        self.fallbacks = 0
+        self.cap_N = [self.p.sheath_drag_N, self.p.sheath_drag_N]
 
     def capacity_N(self, j: int, wrap_rad: float) -> float:
         """Friction at full slip: the capstan ratio exp(mu wrap) on the mean tension, plus drag."""
@@ -93,14 +104,23 @@ class _Knob:
         k2 = p.tendon_stiffness_N / ((1.0 - p.contact_fraction) * p.sheath_length_m * 1000.0)
         draw = [sigma * r * drum_rad - self.slack_mm[j] - shortening_mm
                 for j, sigma in enumerate(_SIDES)]
+        # the capacity lags a step; a jump larger than _CAP_JUMP_N is averaged with the last one
+        # used, so that a knob moved far in one step cannot feed a two-step oscillation between
+        # tension and capacity (smooth motion changes it by far less per step)
         cap = [self.capacity_N(j, wrap_rad) for j in (0, 1)]
+        for j in (0, 1):
+            if abs(cap[j] - self.cap_N[j]) > _CAP_JUMP_N:
+                cap[j] = 0.5 * (cap[j] + self.cap_N[j])
+        self.cap_N = list(cap)
         slip_len = [self.slip_length_mm(j, wrap_rad) for j in (0, 1)]
         rate = [microslip_rate(self.w[j], self.direction[j], slip_len[j]) for j in (0, 1)]
         taut_drum = [draw[j] > self.node_mm[j] for j in (0, 1)]
         taut_tip = [self.node_mm[j] > _SIDES[j] * d * self.theta_rad for j in (0, 1)]
         theta = self.theta_rad
         node = list(self.node_mm)
-        for _ in range(4):
+        w_solve = list(self.w)
+        converged = False
+        for _ in range(6):
             # node = a + b theta; tip tension = e + f theta (per rope, flags fixed)
             e_sum = 0.0
             f_sum = 0.0
@@ -113,7 +133,7 @@ class _Knob:
                 if den <= 0.0:
                     ab.append((self.node_mm[j], 0.0))
                     continue
-                a = (kd * draw[j] - cap[j] * self.w[j] + cg * self.node_mm[j]) / den
+                a = (kd * draw[j] - cap[j] * w_solve[j] + cg * self.node_mm[j]) / den
                 b = kt * sigma * d / den
                 ab.append((a, b))
                 e_sum += sigma * kt * a
@@ -121,11 +141,20 @@ class _Knob:
             stiff = p.bend_stiffness_Nmm_per_rad * (1.0 if e_sum >= 0.0 else p.notch_asymmetry)
             theta = d * e_sum / (stiff - d * f_sum)
             node = [a + b * theta for a, b in ab]
-            new_drum = [draw[j] > node[j] for j in (0, 1)]
-            new_tip = [node[j] > _SIDES[j] * d * theta for j in (0, 1)]
-            if new_drum == taut_drum and new_tip == taut_tip:
+            new_drum = [_flag(draw[j] - node[j], taut_drum[j]) for j in (0, 1)]
+            new_tip = [_flag(node[j] - _SIDES[j] * d * theta, taut_tip[j]) for j in (0, 1)]
+            sliding = False
+            for j in (0, 1):  # the linearised friction cannot pass the capacity: the node slides
+                w_lin = w_solve[j] + rate[j] * (node[j] - self.node_mm[j])
+                if abs(w_lin) > 1.0:
+                    w_solve[j], rate[j], sliding = math.copysign(1.0, w_lin), 0.0, True
+            if new_drum == taut_drum and new_tip == taut_tip and not sliding:
+                converged = True
                 break
             taut_drum, taut_tip = new_drum, new_tip
+        if not converged:  # the flags cycle: bracket the bend instead (rare)
+            self.fallbacks += 1
+            theta, node = self._bracketed(draw, cap, rate, w_solve, k1, k2)
         for j, sigma in enumerate(_SIDES):
             drum_N = k1 * max(draw[j] - node[j], 0.0)
             tip_N = k2 * max(node[j] - sigma * d * theta, 0.0)
@@ -152,6 +181,60 @@ class _Knob:
                                                  / _ROPE_SEAL_SPEED_MM_S)
                 pull[j] = max(self.drum_N[j] + seal, 0.0)
         self.drum_torque_Nm = r * (pull[0] - pull[1]) / 1000.0
+
+    def _node(self, j: int, theta: float, draw: list[float], cap: list[float],
+              rate: list[float], w: list[float], k1: float, k2: float) -> float:
+        """Rope ``j``'s node at bend ``theta``: the one consistent piece of its monotone balance."""
+        end = _SIDES[j] * self.p.tendon_offset_mm * theta
+        cg = cap[j] * rate[j]
+        for kd, kt in ((k1, 0.0), (0.0, k2), (k1, k2), (0.0, 0.0)):
+            den = kd + kt + cg
+            if den <= 0.0:
+                continue
+            z = (kd * draw[j] + kt * end - cap[j] * w[j] + cg * self.node_mm[j]) / den
+            if (_flag(draw[j] - z, kd > 0.0) == (kd > 0.0)
+                    and _flag(z - end, kt > 0.0) == (kt > 0.0)):
+                return z
+        # the root sits on a kink: the one where the balance changes sign
+        for z in (draw[j], end):
+            if abs(-cap[j] * (w[j] + rate[j] * (z - self.node_mm[j]))
+                   - k2 * max(z - end, 0.0) + k1 * max(draw[j] - z, 0.0)) < 1e-6:
+                return z
+        return self.node_mm[j]
+
+    def _bracketed(self, draw: list[float], cap: list[float], rate: list[float],
+                   w: list[float], k1: float, k2: float) -> tuple[float, list[float]]:
+        """The bend where the section balances the ropes (decreasing residual; Illinois)."""
+        p = self.p
+        d = p.tendon_offset_mm
+
+        def residual(theta: float) -> tuple[float, list[float]]:
+            node = [self._node(j, theta, draw, cap, rate, w, k1, k2) for j in (0, 1)]
+            tip = [k2 * max(node[j] - _SIDES[j] * d * theta, 0.0) for j in (0, 1)]
+            stiff = p.bend_stiffness_Nmm_per_rad * (1.0 if theta >= 0.0 else p.notch_asymmetry)
+            return d * (tip[0] - tip[1]) - stiff * theta, node
+
+        lo, hi = -math.pi, math.pi
+        r_lo, _ = residual(lo)
+        r_hi, _ = residual(hi)
+        side = 0
+        theta, node = 0.0, list(self.node_mm)
+        for _ in range(60):
+            theta = hi - r_hi * (hi - lo) / (r_hi - r_lo) if r_hi != r_lo else 0.5 * (lo + hi)
+            r, node = residual(theta)
+            if abs(r) < 1e-9 or hi - lo < 1e-10:
+                break
+            if r > 0.0:
+                lo, r_lo = theta, r
+                if side == -1:
+                    r_hi *= 0.5
+                side = -1
+            else:
+                hi, r_hi = theta, r
+                if side == 1:
+                    r_lo *= 0.5
+                side = 1
+        return theta, node
 
     def knob_torque_Nm(self) -> float:
         p = self.p

@@ -33,7 +33,10 @@ development units in the same session's second round) is held out; the pronyring
 along a breathing path; run untuned) is held out from the end of session 25; the wormeyelet
 plant (session 26, written blind: a worm-stage handle with a silicone damper, ropes over one
 lumen contact, a spacer-disk section whose eyelets the ropes rub; run untuned) is held out from
-the end of session 26, registered last.
+the end of session 26; the beltbraid plant (session 27, written blind: a belt-driven spring-return
+handle, steel ropes with distributed microslip in a braided lumen, a braided shaft whose wire
+crossings slip (Preisach), an asymmetrically notched tube; run untuned) is registered last, in
+the role ``blind``.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -50,6 +53,7 @@ from simrig.family_scatter import SCATTER
 from simrig.motor import MotorParams
 from simrig.plant import Plant, PlantLoadError, load_plant
 from simrig.plants.archwave import NOMINAL_KNOBS as ARCHWAVE_KNOBS
+from simrig.plants.beltbraid import NOMINAL_KNOBS as BELTBRAID_KNOBS
 from simrig.plants.capstan import DEFAULT_KNOBS as CAPSTAN_KNOBS
 from simrig.plants.coilpipe import NOMINAL_KNOBS as COILPIPE_KNOBS
 from simrig.plants.cyclopebax import NOMINAL_KNOBS as CYCLOPEBAX_KNOBS
@@ -89,7 +93,8 @@ PLANT_SPECS: dict[str, str] = {
     "planetwist": "simrig.plants.planetwist:make_planetwist_plant",
     "notchclutch": "simrig.plants.notchclutch:make_notchclutch_plant",
     "pronyring": "simrig.plants.pronyring:make_pronyring_plant",
-    "wormeyelet": "simrig.plants.wormeyelet:make_wormeyelet_plant",  # last: seeds hold
+    "wormeyelet": "simrig.plants.wormeyelet:make_wormeyelet_plant",
+    "beltbraid": "simrig.plants.beltbraid:make_beltbraid_plant",  # last: seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
@@ -97,7 +102,8 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "ratestate": "held-out", "warmgear": "held-out", "archwave": "held-out",
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
               "planetwist": "held-out", "notchclutch": "held-out",
-              "pronyring": "held-out", "wormeyelet": "held-out"}
+              "pronyring": "held-out", "wormeyelet": "held-out",
+              "beltbraid": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -120,7 +126,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "planetwist": PLANETWIST_KNOBS,
                                         "notchclutch": NOTCHCLUTCH_KNOBS,
                                         "pronyring": PRONYRING_KNOBS,
-                                        "wormeyelet": WORMEYELET_KNOBS}
+                                        "wormeyelet": WORMEYELET_KNOBS,
+                                        "beltbraid": BELTBRAID_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -201,6 +208,9 @@ VARIANTS: dict[str, Variant] = {
             "wormeyelet": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                            "handle_friction_Nm": 1.5, "worm_friction": 1.5,
                            "worm_play_deg": 1.5},
+            "beltbraid": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                          "handle_friction_Nm": 1.5, "belt_creep_per_Nm": 1.5,
+                          "braid_hold_N": 1.3},
         },
     ),
     "steel-tendon": Variant(
@@ -233,7 +243,8 @@ VARIANTS: dict[str, Variant] = {
                  "planetwist": {"tendon_stiffness_N": 0.4},
                  "notchclutch": {"tendon_stiffness_N": 0.4},
                  "pronyring": {"tendon_stiffness_N": 0.4},
-                 "wormeyelet": {"tendon_stiffness_N": 0.4}},
+                 "wormeyelet": {"tendon_stiffness_N": 0.4},
+                 "beltbraid": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

@@ -35,8 +35,8 @@ plant (session 26, written blind: a worm-stage handle with a silicone damper, ro
 lumen contact, a spacer-disk section whose eyelets the ropes rub; run untuned) is held out from
 the end of session 26; the beltbraid plant (session 27, written blind: a belt-driven spring-return
 handle, steel ropes with distributed microslip in a braided lumen, a braided shaft whose wire
-crossings slip (Preisach), an asymmetrically notched tube; run untuned) is registered last, in
-the role ``blind``.
+crossings slip (Preisach), an asymmetrically notched tube; run untuned) is registered last and
+held out from the end of session 27.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -103,7 +103,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
               "planetwist": "held-out", "notchclutch": "held-out",
               "pronyring": "held-out", "wormeyelet": "held-out",
-              "beltbraid": "blind"}
+              "beltbraid": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

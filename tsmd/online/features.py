@@ -81,8 +81,9 @@ class RampOptions:
     tendon only adds load, so a fall is the load path changing during the stroke (a shape
     change while the tendon is loaded: wormeyelet 4, +0.5 mm slack at 80 s in the middle of
     phi2's positive stroke, the current 0.19 -> 0.06 A; the line read +5.73 deg, the edge's
-    later ramps +4.7..+4.8, and the follow stayed at +5.73). Ordinary ramps of the stored
-    recordings fall by at most ~0.3 of their rise (docs/online.md, Session 27 round 2). 0: off."""
+    later ramps +4.7..+4.8, and the follow stayed at +5.73). Off (0): with 0.5 the stored
+    replays of coilpipe 1 and notchclutch 1-2 publish other targets, notchclutch's phi2
+    ~1 deg further out (docs/online.md, "Session 27, round 2")."""
 
 
 @dataclass(frozen=True)
@@ -284,7 +285,8 @@ def relocated_edge_deg(stroke: Stroke, expected_edge_deg: float, level_A: float,
 LOAD_DROP_MEDIAN_SAMPLES = 9
 """The window's current is a running median over this many samples before its fall is taken:
 the sensor's noise on a flat ramp (lumped, coilpipe) falls by up to 0.7 of the rise sample to
-sample, the median by 0.26 at most in 41 recordings; a load path change stays."""
+sample, the median by 0.70 at most in 43 recordings (planetwist 3), a load path change by
+0.31 (planetwist 1) to 22."""
 
 
 def _load_drop(x: Array, y: Array, slope_A_per_deg: float) -> float:

@@ -80,7 +80,7 @@ class RampOptions:
     the fitted line's rise over the window gives no ramp: a knob moving outward on a loaded
     tendon only adds load, so a fall is the load path changing during the stroke (a shape
     change while the tendon is loaded: wormeyelet 4, +0.5 mm slack at 80 s in the middle of
-    phi2's positive stroke, the current 0.19 -> 0.06 A; the line read +5.73 deg, the edge's
+    phi2's positive stroke, the current 0.148 -> 0.036 A; the line read +5.73 deg, the edge's
     later ramps +4.7..+4.8, and the follow stayed at +5.73). Off (0): with 0.5 the stored
     replays of coilpipe 1 and notchclutch 1-2 publish other targets, notchclutch's phi2
     ~1 deg further out (docs/online.md, "Session 27, round 2")."""

@@ -75,6 +75,15 @@ class RampOptions:
     averaged over it before the line is fitted. None: no ripple, the samples are fitted."""
     ripple_grid_step_deg: float = 0.25
     """The uniform knob-angle grid the current is averaged on (bin means of the samples)."""
+    load_drop_fraction: float = 0.0
+    """A window whose current falls below its running maximum by more than this fraction of
+    the fitted line's rise over the window gives no ramp: a knob moving outward on a loaded
+    tendon only adds load, so a fall is the load path changing during the stroke (a shape
+    change while the tendon is loaded: wormeyelet 4, +0.5 mm slack at 80 s in the middle of
+    phi2's positive stroke, the current 0.148 -> 0.036 A; the line read +5.73 deg, the edge's
+    later ramps +4.7..+4.8, and the follow stayed at +5.73). Off (0): with 0.5 the stored
+    replays of coilpipe 1 and notchclutch 1-2 publish other targets, notchclutch's phi2
+    ~1 deg further out (docs/online.md, "Session 27, round 2")."""
 
 
 @dataclass(frozen=True)
@@ -273,6 +282,24 @@ def relocated_edge_deg(stroke: Stroke, expected_edge_deg: float, level_A: float,
     return side * float(np.median(implied))
 
 
+LOAD_DROP_MEDIAN_SAMPLES = 9
+"""The window's current is a running median over this many samples before its fall is taken:
+the sensor's noise on a flat ramp (lumped, coilpipe) falls by up to 0.7 of the rise sample to
+sample, the median by 0.70 at most in 43 recordings (planetwist 3), a load path change by
+0.31 (planetwist 1) to 22."""
+
+
+def _load_drop(x: Array, y: Array, slope_A_per_deg: float) -> float:
+    """The window's largest fall of its running-median current below its running maximum
+    (samples in travel order), as a fraction of the line's rise over the window."""
+    rise = slope_A_per_deg * float(x.max() - x.min())
+    h = LOAD_DROP_MEDIAN_SAMPLES // 2
+    padded = np.pad(y, h, mode="edge")
+    smooth = np.median(np.lib.stride_tricks.sliding_window_view(padded, 2 * h + 1), axis=1)
+    drop = float(np.max(np.maximum.accumulate(smooth) - smooth))
+    return drop / rise if rise > 0 else math.inf
+
+
 def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
                 options: RampOptions | None = None,
                 knee: tuple[float, float] = (math.nan, math.nan)) -> LoadedRamp | Rejected:
@@ -323,6 +350,9 @@ def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
             a, b, r = _line(x, y, stick)
     if not b > 0:
         return Rejected(stroke.knob, "the current does not rise in the loaded window")
+    if o.load_drop_fraction > 0.0 and _load_drop(x, y, b) > o.load_drop_fraction:
+        return Rejected(stroke.knob, "the current falls inside the loaded window (the load "
+                                     "path changed during the stroke)")
     noise = float(np.sqrt(np.mean(r * r))) if r.size else math.nan
     return LoadedRamp(stroke.knob, side, float(x.mean()), a, b,
                       float(np.median(stroke.other_deg[sel])), float(stroke.t_s[sel][-1]),

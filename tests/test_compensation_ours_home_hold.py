@@ -1,4 +1,4 @@
-"""The compensator's opt-in ``hold_at_home`` (tsmd.compensation.ours): a knob at rest inside
+"""The product's per-knob ``hold_at_home`` (tsmd.compensation.ours): a knob at rest inside
 its plateau band keeps its position while the other knob moves its branches (the other plane's
 load holds that tip where it was); a knob loaded beyond the band still follows its moved branch,
 and without the hold the knob on the plateau's edge follows it too (the shipped behaviour).
@@ -26,8 +26,8 @@ PERIOD_S = 0.01
 def knob0_commands_while_knob1_sweeps(q0_deg: float, hold: bool = True) -> np.ndarray:
     """Knob 0 held at ``q0_deg`` (settled first), knob 1 sweeping +-80 deg over 8 s (the
     level grid shifts knob 0's loaded branches by up to 4 deg)."""
-    knob = OursKnob.from_params(params())
-    comp = OursCompensator((knob, knob), PERIOD_S, hold_at_home=hold)
+    knob = OursKnob.from_params(dataclasses.replace(params(), hold_at_home=hold))
+    comp = OursCompensator((knob, knob), PERIOD_S)
     comp.reset(np.array([q0_deg, 0.0]))
     for _ in range(100):
         comp.command(np.array([q0_deg, 0.0]), PERIOD_S)
@@ -57,8 +57,8 @@ def test_without_the_hold_a_knob_on_the_plateau_edge_follows_its_moved_branch() 
 
 def commands_with_product_hold(hold: tuple[bool, bool]) -> np.ndarray:
     """Both knobs at rest at 4.5 deg (on the plateau's edge) while the desired angles stand,
-    then each knob in turn at rest while the other sweeps +-80 deg; the compensator's own
-    switch off, each knob's hold as its product chose (``OursKnob.hold_at_home``)."""
+    then each knob in turn at rest while the other sweeps +-80 deg; each knob's hold as its
+    product chose (``OursKnob.hold_at_home``)."""
     knobs = tuple(OursKnob.from_params(dataclasses.replace(params(), hold_at_home=h))
                   for h in hold)
     comp = OursCompensator((knobs[0], knobs[1]), PERIOD_S)

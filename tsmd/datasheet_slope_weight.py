@@ -31,8 +31,9 @@ from tsmd.profile import DeviceModel
 from tsmd.replay import LockstepRunner, run_trajectory
 
 SAMPLE_CALIBRATION_SEED = 3000
-"""Noise seed of each sample unit's calibration (the tracking bench's, which the stage first
-borrowed: a data-sheet stage may not import the benchmarks, tests/test_import_graph.py)."""
+"""Noise seed of each sample unit's calibration (the tracking benches',
+:data:`tsmd.bench.tracking_start.CALIBRATION_SEED`; a data-sheet stage may not import the
+benchmarks, tests/test_import_graph.py)."""
 
 MIN_READING_SPREAD = 0.01
 """Below this rms move of the readings' ratios from 1 the sample says nothing about the share

@@ -39,7 +39,6 @@ from tsmd.bench.tracking_start import (
     start_label,
     start_of,
 )
-from tsmd.calibration import calibrate
 from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
 from tsmd.compensation import LimitedCompensator, build_compensator
 from tsmd.compensation.grid import CALIBRATION_GRID_DEG
@@ -53,7 +52,7 @@ from tsmd.profile import (
     make_knob_profile,
     save_profile,
 )
-from tsmd.replay import LockstepRunner, run_trajectory
+from tsmd.replay import run_trajectory
 from tsmd.tracking_scenarios import (
     PERIOD_S,
     Scenario,
@@ -125,12 +124,6 @@ def ground_truth_profile(device: Any, plant_factory: Callable[[], Any], seed: in
         "sim-ground-truth", device.device_model,
         datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ"), f"tsmd {__version__}", "pchip",
         (knobs[0], knobs[1]), source="ground truth: D/B measured on the simulated tracker's tip")
-
-
-def calibrated_profile(device: Any, plant_factory: Callable[[], Any], seed: int = 3000) -> Any:
-    """A profile from ``tsmd.calibration.calibrate`` (motor current only) on the lockstep sim."""
-    with LockstepRunner(None, None, "none", seed, plant_factory()) as runner:
-        return calibrate(runner, "sim-bench", device)
 
 
 # ----------------------------------------------------------------------------------------------

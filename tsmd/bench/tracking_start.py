@@ -34,7 +34,7 @@ from tsmd.replay import LockstepRunner
 STARTS = ("calibrated", "conditioned", "fresh")
 DEFAULT_START = "calibrated"
 CALIBRATION_SEED = 3000
-"""The noise seed of the bench's calibrations (:func:`tsmd.bench.accuracy.calibrated_profile`'s)."""
+"""The noise seed of the tracking benches' calibrations (the one every earlier figure used)."""
 
 
 def start_of(args: Any) -> str:

@@ -68,7 +68,7 @@ class OursCompensator:
 
     def __init__(self, knobs: tuple[OursKnob, OursKnob], period_s: float,
                  limits: Sequence[KnobLimits] | None = None, smoothing_s: float = 0.1,
-                 fresh_catheter: bool = False, hold_at_home: bool = False) -> None:
+                 fresh_catheter: bool = False) -> None:
         if not period_s > 0:
             raise ValueError(f"period_s must be positive, got {period_s}")
         if limits is None:  # the simulated rig's drives, no position limit
@@ -79,11 +79,6 @@ class OursCompensator:
         self.fresh_catheter = fresh_catheter
         """The catheter was never loaded when reset (only the bench's fresh plant, or a new
         catheter with a product profile): ``reset`` starts on the fresh branches."""
-        self.hold_at_home = hold_at_home
-        """Every knob at rest inside its plateau band keeps its command while the other knob
-        moves its branches (:func:`_keep_at_home`); off, a knob does so where its product
-        chose it (``OursKnob.hold_at_home``, a data-sheet stage on the sheet's unit: jawcrimp
-        development 1 lost 0.05 deg on two rows with it, pronyring gained)."""
         self.period_s = period_s
         self.limits = (limits[0], limits[1])
         # jumps are planned with the slower knob's limits
@@ -111,7 +106,7 @@ class OursCompensator:
             kc.plateau_hi_deg = max(knob.height_pos_deg, knob.height_neg_deg)
             kc.fresh_hi_deg = knob.height_neg_deg
             kc.fresh_lo_deg = knob.height_pos_deg
-            kc.home_hold = self.hold_at_home or knob.hold_at_home
+            kc.home_hold = knob.hold_at_home  # the product's choice (tsmd datasheet --home-hold)
 
     def replace_knobs(self, knobs: tuple[OursKnob, OursKnob]) -> None:
         """New parameters from the next tick on, state kept (online re-estimation)."""

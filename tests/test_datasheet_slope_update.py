@@ -54,7 +54,7 @@ def test_a_scored_unit_is_never_in_the_slope_sample(tmp_path: Path,
 
 def test_the_rounded_release_is_added_to_a_sheet_with_nothing_else_changed(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_release_round", _rounded_phi1)
+    monkeypatch.setattr("tsmd.commands.datasheet_update.with_release_round", _rounded_phi1)
     out = tmp_path / "new.yaml"
     assert main(["datasheet", "--update", str(WORM), *PLANT, "--release-round",
                  "--out", str(out)]) == 0

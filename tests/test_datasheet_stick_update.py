@@ -29,8 +29,8 @@ def _settle_off_phi1(device: DeviceModel, *args: Any) -> DeviceModel:
 
 def test_the_stick_end_and_settle_check_are_added_with_nothing_else_changed(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_stick_choice", _stick_on_phi2)
-    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_settle_gain_check",
+    monkeypatch.setattr("tsmd.commands.datasheet_update.with_stick_choice", _stick_on_phi2)
+    monkeypatch.setattr("tsmd.commands.datasheet_update.with_settle_gain_check",
                         _settle_off_phi1)
     out = tmp_path / "new.yaml"
     assert main(["datasheet", "--update", str(LUMPED), *PLANT, "--stick-end",

@@ -3,6 +3,7 @@ changed (docs/calibration.md, session 20)."""
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import difflib
 import shutil
@@ -12,7 +13,9 @@ import pytest
 from support.profiles import ROOT
 
 from tsmd.cli import main
+from tsmd.commands.datasheet_args import add_arguments
 from tsmd.commands.datasheet_sample import sample_units
+from tsmd.commands.datasheet_update import UPDATE_STAGES
 from tsmd.compensation.level_grid import LevelGrid
 from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_sample import SAMPLE_KEYS, Readings
@@ -117,7 +120,7 @@ def test_update_calibrates_the_sample_under_the_sheet_and_writes_only_its_part(
     (["--unit-sample", "201", "--update", "/no/such.yaml"], "no such file"),
     (["--unit-sample", "101", "--update", str(LUMPED)], "scored"),
     (["--unit-sample", "201", "--update", str(LUMPED), "--loaded-shape"], "anew"),
-    (["--update", str(LUMPED)], "give --unit-sample")])
+    (["--update", str(LUMPED)], "give --stick-end")])
 def test_a_bad_update_is_one_line_and_writes_nothing(
         extra: list[str], message: str, tmp_path: Path,
         capsys: pytest.CaptureFixture[str]) -> None:
@@ -142,7 +145,7 @@ def test_update_with_the_plateau_gap_writes_only_the_loops_fields(
                       for i, k in enumerate(device.knobs))
         return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
-    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_plateau_gap", fake)
+    monkeypatch.setattr("tsmd.commands.datasheet_update.with_plateau_gap", fake)
     out = tmp_path / "new.yaml"
     assert main(["datasheet", "--update", str(bare), *PLANT, "--plateau-gap",
                  "--out", str(out)]) == 0
@@ -163,7 +166,7 @@ def test_update_with_the_level_grid_adds_the_grid_read_under_the_sheet(
         knobs = tuple(dataclasses.replace(k, loaded_level_grid=grid) for k in device.knobs)
         return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
-    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_level_grid", fake)
+    monkeypatch.setattr("tsmd.commands.datasheet_update.with_level_grid", fake)
     out = tmp_path / "new.yaml"
     assert main(["datasheet", "--update", str(bare), *PLANT, "--level-grid",
                  "--out", str(out)]) == 0
@@ -181,7 +184,7 @@ def test_update_with_the_home_hold_adds_the_choice_made_under_the_sheet(
         seen.append(device)
         return device.with_knob_flag("hold_at_home", (True, False))
 
-    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_home_hold", fake)
+    monkeypatch.setattr("tsmd.commands.datasheet_update.with_home_hold", fake)
     out = tmp_path / "new.yaml"
     assert main(["datasheet", "--update", str(bare), *PLANT, "--home-hold",
                  "--out", str(out)]) == 0
@@ -190,3 +193,15 @@ def test_update_with_the_home_hold_adds_the_choice_made_under_the_sheet(
     assert after == fake(before, None, None, 0)
     assert [k.hold_at_home for k in after.knobs] == [True, None]
     assert "--home-hold" in out.read_text().split("schema_version")[0]
+
+
+def test_every_update_stage_is_an_option_of_the_command() -> None:
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    dests = {a.dest for a in parser._actions}
+    assert [s.option for s in UPDATE_STAGES if s.option not in dests] == []
+
+
+def test_update_stages_write_disjoint_fields() -> None:
+    fields = [f for s in UPDATE_STAGES for f in s.fields]
+    assert len(fields) == len(set(fields))

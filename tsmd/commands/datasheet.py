@@ -18,8 +18,9 @@ from typing import Any
 from simrig.plant import Plant, load_plant
 from tsmd import __version__
 from tsmd.commands.datasheet_args import add_arguments
-from tsmd.commands.datasheet_sample import sample_units, update, with_sample
+from tsmd.commands.datasheet_sample import sample_units, with_sample
 from tsmd.commands.datasheet_stick import with_settle_gain_check, with_stick_choice
+from tsmd.commands.datasheet_update import update
 from tsmd.config import DEFAULT_CONFIG_PATH, TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import (
     ANALYSED_CYCLES,

@@ -161,3 +161,38 @@ def path_from(given: Mapping[str, Any]) -> ShaftPath:
         if not math.isfinite(getattr(path, n)):
             raise PlantLoadError(f"archwave {n} must be finite")
     return path
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "torque_constant_ratio": 0.08,  # motor lot: magnet and winding (+-8 % on the sheet)
+    "standby_power_W": 0.20,  # drive electronics and hold current
+    "thermal_resistance_K_per_W": 0.15,  # how the motor sits in the sealed handle
+    "cogging_mNm": 0.30,  # magnet segment placement
+    "flex_stiffness_Nm_per_rad": 0.20,  # moulded polymer flexspline: lot and wall thickness
+    "flex_stiffening_Nm_per_rad3": 0.25,
+    "flex_hysteresis_deg": 0.30,  # tooth-flank fit
+    "kinematic_error_deg": 0.40,  # wave generator ellipse and tooth profile tolerance
+    "kinematic_phase_deg": 1.0,  # where the error peaks: assembly (any phase)
+    "wave_drag_Nm": 0.25,  # bearing preload, grease
+    "pulley_radius_mm": 0.02,  # moulded drum
+    "handle_friction_Nm": 0.20,  # knob shaft seal squeeze
+    "tensioner_preload_N": 0.20,  # spring lot and idler position
+    "tensioner_rate_N_per_mm": 0.15,  # spring lot
+    "slack_pos_mm": 0.15,  # tendon wound and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # wire-rope lot (steel)
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "coil_compliance_mm_per_N": 0.25,  # coil pitch and how it was pre-compressed
+    "sheath_friction": 0.15,  # coil and rope surface, lubricant
+    "sheath_wrap_deg": 0.10,  # the shaft's lay
+    "sheath_drag_N": 0.20,  # coil ovality
+    "coil_clearance_mm": 0.20,  # coil inner diameter vs rope
+    "lumen_offset_mm": 0.30,  # where the coil bundle sits in the shaft
+    "tendon_offset_mm": 0.05,  # lumen placement in the section
+    "bend_stiffness_Nm_per_rad": 0.15,  # cover durometer and spine cut
+    "bend_stiffening_per_rad2": 0.20,
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -94,3 +94,33 @@ def knob_params(given: Any, fallback: KnobParams) -> KnobParams:
     if unknown:
         raise ValueError(f"unknown beltbraid knob constants: {', '.join(unknown)}")
     return dataclasses.replace(fallback, **{k: float(v) for k, v in given.items()})
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "return_preload_Nm": 0.25,  # spring lot and how far each is wound at assembly
+    "return_rate_Nm_per_rad": 0.20,
+    "handle_friction_Nm": 0.20,  # knob seal squeeze
+    "belt_stiffness_Nm_per_rad": 0.20,  # belt lot (polyurethane cord) and its tension
+    "belt_creep_per_Nm": 0.30,  # belt tension at assembly: the least known constant
+    "drum_radius_mm": 0.02,  # moulded pulley and drum
+    "slack_pos_mm": 0.15,  # rope crimped to the drum by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # rope lot (EA)
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "contact_fraction": 0.10,  # where the shaft's lay concentrates the friction
+    "sheath_friction": 0.15,  # liner lot, lubricant
+    "sheath_wrap_deg": 0.10,  # routing in the handle, the shaft's lay
+    "sheath_drag_N": 0.25,  # rope straightness, lumen fit
+    "microslip_floor_mm": 0.30,  # liner compliance
+    "braid_slip_mm": 0.30,  # braid angle and pick count of the shaft lot
+    "braid_compliance_mm_per_N": 0.15,
+    "braid_onset_N": 0.25,  # braid tension at extrusion
+    "braid_hold_N": 0.25,
+    "tendon_offset_mm": 0.04,  # lumen placement in the section
+    "bend_stiffness_Nmm_per_rad": 0.12,  # laser cut (kerf width) and cover durometer
+    "notch_asymmetry": 0.05,  # notch depth tolerance
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

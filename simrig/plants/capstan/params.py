@@ -132,3 +132,27 @@ class Effects:
                 f"rate_reference_deg_s must be > 0, got {self.rate_reference_deg_s!r}"
             )
         return self
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,  # machined part
+    "slack_pos_mm": 0.15,  # assembly: tendon cut and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+    "tendon_stiffness_N": 0.15,  # tendon lot (EA)
+    "sheath_length_m": 0.02,
+    "free_length_m": 0.20,
+    "sheath_friction": 0.15,  # coating, lubricant
+    "sheath_wrap_deg": 0.10,  # coil pitch
+    "routing_wrap_deg": 0.10,
+    "routing_friction": 0.15,
+    "sheath_drag_N": 0.20,
+    "bend_stiffness_Nm_per_rad": 0.15,  # polymer cover, links
+    "bend_friction_Nm": 0.20,
+    "handle_friction_Nm": 0.20,  # knob bearing / brake setting
+    "handle_stiction_Nm": 0.20,
+    "handle_slip_deg": 0.20,
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -136,3 +136,32 @@ def check_plant(p: CoilPipePlantParams) -> None:
 
 
 NOMINAL_KNOBS = (CoilPipeKnobParams(), CoilPipeKnobParams())
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,  # machined drum
+    "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+    "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+    "slack_neg_mm": 0.15,
+    "toe_mm": 0.20,  # crimp and strand lay
+    "tendon_stiffness_N": 0.15,  # cable lot (EA)
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "sheath_friction": 0.15,  # liner coating, lubricant
+    "sheath_wrap_deg": 0.10,  # lumen helix pitch
+    "sheath_drag_N": 0.25,  # liner preload on the cable
+    "stribeck_ratio": 0.05,  # static/kinetic ratio of the liner (1.24-1.37 at 1.3)
+    "stribeck_speed_mm_s": 0.30,  # lubricant film: the least known of the friction constants
+    "viscous_N_s_per_mm": 0.30,  # lubricant amount and viscosity
+    "presliding_mm": 0.20,  # contact micro-geometry
+    "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
+    "bend_creep_stiffness_Nm_per_rad": 0.25,  # polymer batch, moulding
+    "bend_creep_time_s": 0.30,
+    "handle_friction_Nm": 0.20,  # knob bearing / detent setting
+    "handle_presliding_deg": 0.20,
+    "gear_backlash_deg": 0.30,  # adapter tooth play (tolerance stack of two parts)
+    "gear_stiffness_Nm_per_deg": 0.20,  # adapter material and fit
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

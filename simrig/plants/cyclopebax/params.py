@@ -130,3 +130,29 @@ def knob_from(values: dict[str, Any] | CycloPebaxKnob, nominal: CycloPebaxKnob) 
     if knob.mesh_friction >= 0.5:
         raise PlantLoadError(f"cyclopebax mesh_friction must be < 0.5, got {knob.mesh_friction}")
     return knob
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "lost_motion_deg": 0.40,  # pin-roller clearance: moulded discs, tolerance stack
+    "mesh_twist_deg": 0.20,  # pin and disc material lot, preload
+    "mesh_friction": 0.25,  # grease left from assembly, pin finish
+    "drum_radius_mm": 0.02,  # moulded drum
+    "drum_friction_Nmm": 0.30,  # drum bushing fit
+    "handle_friction_Nm": 0.40,  # the friction lock as the last operator left it
+    "slack_pos_mm": 0.15,  # rope wound and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # wire-rope lot (steel)
+    "free_length_m": 0.20,  # adapter and handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "sheath_wrap_deg": 0.10,  # the shaft's path in the patient
+    "sheath_friction": 0.15,  # coil liner and rope surface, lubricant
+    "lay_asymmetry": 0.30,  # how the rope's lay meets the coil's winding
+    "sheath_drag_N": 0.20,  # lumen seal, coil ovality
+    "tendon_offset_mm": 0.05,  # lumen placement in the section
+    "bend_stiffness_Nmm_per_rad": 0.15,  # Pebax lots of the three zones, reflow
+    "yield_tension_N": 0.15,  # crimp swage pressure, rope lot
+    "set_hardening_N_per_mm": 0.20,
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

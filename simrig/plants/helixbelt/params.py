@@ -99,3 +99,31 @@ NOMINAL_KNOBS = (HelixKnobParams(), HelixKnobParams(plane_error_deg=-2.0, slack_
                                                      bend_stiffness_Nm_per_rad=0.0135))
 """Nominal unit: the right-left plane's braid is a little softer (the braid is wound for the
 anterior plane) and its tendons were wound with a little more slack."""
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,  # moulded belt pulley and drum
+    "belt_clearance_deg": 0.30,  # tooth vs groove: moulding tolerance of two parts
+    "belt_ref_deflection_deg": 0.20,  # belt lot (cord and tooth rubber) and its tension
+    "slack_pos_mm": 0.15,  # tendon wound and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # wire-rope lot (steel: less than polymer)
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "helix_pitch_mm": 0.10,  # lumen twist of the extrusion (set by haul-off vs rotation)
+    "helix_radius_mm": 0.03,  # lumen placement in the extrusion
+    "sheath_wrap_deg": 0.10,  # the shaft's lay
+    "sheath_friction": 0.15,  # liner and rope surface
+    "sheath_drag_N": 0.20,  # lumen ovality
+    "tendon_offset_mm": 0.05,  # lumen placement in the bending section
+    "bend_length_mm": 0.03,  # braided section cut to length
+    "bend_stiffness_Nm_per_rad": 0.15,  # braid angle and cover durometer
+    "braid_stiffening_per_rad2": 0.20,
+    "braid_friction_Nm": 0.25,  # inter-wire friction: braid tension and lubricity
+    "braid_slip_deg": 0.20,
+    "plane_error_deg": 0.50,  # helix phase at the section: extrusion twist over 1 m
+    "handle_friction_Nm": 0.20,  # knob shaft seal squeeze
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -150,3 +150,32 @@ def knobs_from(knobs: Sequence[Mapping[str, Any] | JawCrimpKnob] | None,
         raise PlantLoadError(f"jawcrimp takes 2 knobs, got {len(knobs)}")
     return (knob_from(knobs[0], NOMINAL_KNOBS[0], curvature_deg),
             knob_from(knobs[1], NOMINAL_KNOBS[1], curvature_deg))
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,  # moulded drum
+    "jaw_play_deg": 0.40,  # spider set and hub bore fit
+    "jaw_twist_deg": 0.20,  # spider durometer lot
+    "jaw_torque_Nm": 0.20,
+    "slack_pos_mm": 0.15,  # rope cut and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # wire-rope lot (steel)
+    "free_length_m": 0.20,  # handle assembly, idler positions
+    "sheath_length_m": 0.02,  # cut to length
+    "node_share": 0.15,  # where the lumen's friction concentrates
+    "sheath_friction": 0.15,  # liner and rope surface, lubricant
+    "sheath_wrap_deg": 0.10,  # the shaft's lay in the patient
+    "sheath_drag_N": 0.20,  # lumen seal, idler bushing preload
+    "idler_friction": 0.25,  # bushing fit and grease
+    "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+    "bend_stiffness_Nmm_per_rad": 0.15,  # cover polymer lot
+    "shaft_gap_mm": 0.25,  # coil pitch and how it was pre-compressed
+    "shaft_gap_load_N": 0.20,
+    "shaft_stiffness_N_per_mm": 0.15,
+    "crimp_creep_mm_per_s": 0.40,  # swage pressure
+    "handle_friction_Nm": 0.20,  # knob shaft seal squeeze
+    "heart_moment_Nmm": 0.30,  # where the probe lies against the heart
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -123,3 +123,29 @@ class LumpedEffects:
     def validated(self) -> LumpedEffects:
         _check_numbers(self, "", ("creep_time_s",))
         return self
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,
+    "slack_pos_mm": 0.15,
+    "slack_neg_mm": 0.15,
+    "toe_mm": 0.20,
+    "tendon_stiffness_N": 0.15,
+    "sheath_length_m": 0.02,
+    "free_length_m": 0.20,
+    "guide_wrap_deg": 0.10,
+    "guide_friction": 0.15,
+    "sheath_wrap_deg": 0.10,
+    "sheath_friction": 0.15,
+    "sheath_drag_N": 0.20,
+    "presliding_mm": 0.20,
+    "tendon_offset_mm": 0.05,
+    "bend_stiffness_Nm_per_rad": 0.15,
+    "bend_friction_Nm": 0.20,
+    "bend_presliding_deg": 0.20,
+    "handle_friction_Nm": 0.20,
+    "handle_presliding_deg": 0.20,
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

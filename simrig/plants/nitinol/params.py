@@ -188,3 +188,34 @@ def knob_params(overrides: Sequence[Mapping[str, Any]] | None) -> tuple[NitinolK
         p.check(i)
         out.append(p)
     return tuple(out)
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,  # machined drum
+    "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # wire-rope lot (EA: steel scatters less than polymer)
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "sheath_wrap_deg": 0.10,  # lumen path in the shaft
+    "sheath_friction": 0.15,  # liner and how much lubricant assembly left
+    "sheath_drag_N": 0.20,  # lumen ovality
+    "film_damping_N_s_per_mm": 0.30,  # lubricant amount and viscosity: the least controlled
+    "tendon_offset_mm": 0.05,  # lumen placement in the moulding
+    "offset_ratio_neg": 0.03,  # the second lumen against the first (one mould)
+    "bend_length_mm": 0.03,  # laser-cut spine length
+    "cover_stiffness_Nm_per_rad": 0.15,  # silicone cover and braid
+    "handle_friction_Nm": 0.20,  # knob O-ring squeeze
+    "handle_presliding_deg": 0.20,
+    "backbone_od_mm": 0.003,  # drawn NiTi tube: +-0.01 mm on 2 mm (the tube is one part:
+    "backbone_id_mm": 0.003,  # the plant takes the mean of the two knobs' draws)
+    "slot_stiffness_factor": 0.10,  # laser kerf width
+    "austenite_modulus_GPa": 0.10,  # heat treatment of the lot
+    "upper_plateau_MPa": 0.06,  # Af of the lot (+-3 K at 6.5 MPa/K) and processing
+    "lower_plateau_MPa": 0.10,  # the lower plateau scatters more than the upper
+    "transformation_strain": 0.10,
+    "plateau_hardening": 0.20,  # cut pattern and texture
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -1,7 +1,7 @@
 """Constants of the notchclutch plant, one set per knob (plane), with where they come from.
 
 Lengths in mm unless the name says otherwise, angles in degrees at the interface, forces in N,
-moments in N mm. The nominal values are the product's design; ``simrig.family_scatter`` says how
+moments in N mm. The nominal values are the product's design; ``UNIT_SCATTER`` below says how
 much each scatters from unit to unit.
 """
 
@@ -144,3 +144,30 @@ def knobs_from(knobs: Sequence[Mapping[str, Any] | NotchClutchKnob] | None
         knob.validate()
         out.append(knob)
     return out[0], out[1]
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "drum_radius_mm": 0.02,  # moulded drum
+    "clutch_capacity_Nmm": 0.15,  # wave-spring preload and facing friction of the clutch
+    "clutch_kinetic_ratio": 0.05,
+    "handle_friction_Nm": 0.20,  # knob seal
+    "slack_pos_mm": 0.15,  # braid cut and knotted by hand
+    "slack_neg_mm": 0.15,
+    "toe_mm": 0.20,  # braid crimp of the lot
+    "tendon_stiffness_N": 0.10,  # aramid lot
+    "rate_stiffening": 0.20,
+    "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+    "sheath_friction": 0.15,  # coating thickness and cure
+    "dry_friction_ratio": 0.10,
+    "soak_time_s": 0.30,  # coating thickness
+    "stribeck_rise": 0.20,
+    "sheath_wrap_deg": 0.10,  # routing in the handle
+    "sheath_drag_N": 0.20,  # lumen fit
+    "bend_stiffness_Nmm_per_rad": 0.15,  # laser cut, cover durometer
+    "notch_close_deg": 0.05,  # notch width of the cut
+    "tissue_friction_Nmm": 0.25,  # the patient's mucosa, the probe's position
+    "tissue_friction_ratio": 0.25,
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -136,3 +136,35 @@ def check_knob(values: dict[str, Any]) -> PlanetTwistKnob:
         raise PlantLoadError("planetwist sheath_friction x sheath_wrap must be < 1.5 rad "
                              "(the lumped contact would lock)")
     return knob
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "drum_radius_mm": 0.02,  # moulded drum on the carrier
+    "carrier_play_deg": 0.30,  # tooth thickness and centre-distance tolerance of the stage
+    "mesh_stiffness_Nmm_per_rad": 0.15,  # gear material lot (glass-filled POM)
+    "planet2_error_deg": 0.50,  # planet pin positions drilled in the carrier
+    "planet3_error_deg": 0.50,
+    "carrier_stiffness_Nmm_per_rad": 0.15,
+    "drum_bearing_Nmm": 0.30,  # bearing fit and grease
+    "gear_efficiency": 0.02,  # grease, mesh finish
+    "slack_pos_mm": 0.15,  # strand cut and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # strand lot
+    "twist_coupling_mm": 0.10,  # lay length of the strand lot
+    "twist_share": 0.10,
+    "swivel_friction_Nmm": 0.30,  # swivel crimp's seat finish
+    "swivel_arm_mm": 0.20,
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "sheath_wrap_deg": 0.10,  # the shaft's path in the patient
+    "sheath_friction": 0.15,  # liner coating, lubricant
+    "sheath_drag_N": 0.20,  # lumen seal
+    "tendon_offset_mm": 0.04,  # lumen placement in the extrusion
+    "bend_stiffness_Nmm_per_rad": 0.15,  # jacket and coil lots
+    "bend_stiffening_per_rad2": 0.20,
+    "handle_friction_Nm": 0.25,  # knob seal
+    "flow_moment_Nmm": 0.40,  # where in the chamber the tip sits (not the catheter's part)
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

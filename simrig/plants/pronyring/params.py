@@ -107,3 +107,30 @@ def knob_constants(values: dict[str, Any]) -> KnobConstants:
         if f.name not in _POSITIVE and v < 0.0 and f.name != "ring_clocking_deg":
             raise PlantLoadError(f"pronyring {f.name} must be >= 0, got {v}")
     return k
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "drum_radius_mm": 0.02,  # moulded drum
+    "handle_friction_Nm": 0.20,  # knob seal
+    "slack_pos_mm": 0.15,  # rope cut and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # rope lot (EA)
+    "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+    "shaft_offset_mm": 0.10,
+    "sheath_friction": 0.15,  # liner lot, lubricant
+    "friction_load_exponent": 0.20,
+    "sheath_wrap_deg": 0.10,  # routing in the handle, the patient's path
+    "sheath_drag_N": 0.20,  # lumen fit
+    "bend_stiffness_Nmm_per_rad": 0.12,  # Pebax lot, wall thickness
+    "prony_fast_Nmm_per_rad": 0.20,  # relaxation spectrum of the lot
+    "prony_fast_s": 0.25,
+    "prony_mid_Nmm_per_rad": 0.20,
+    "prony_slow_Nmm_per_rad": 0.25,
+    "ring_tilt_Nmm_per_rad": 0.25,  # bond line thickness
+    "ring_axial_N_per_mm": 0.20,
+    "ring_clocking_deg": 0.50,  # anchor clocking: assembly tolerance
+    "breathing_wrap_deg": 0.40,  # the patient
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

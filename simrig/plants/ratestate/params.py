@@ -133,3 +133,31 @@ def knob_params(knobs: Sequence[Mapping[str, Any] | RateStateKnobParams] | None
         params.check()
         out.append(params)
     return out[0], out[1]
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,  # machined drum
+    "slack_pos_mm": 0.15,  # tendon wound and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # wire-rope lot (steel: less than polymer)
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "bend_length_mm": 0.03,  # link stack cut to length
+    "sheath_wrap_deg": 0.15,  # lumen waviness of the extrusion and the shaft's lay
+    "curve_position": 0.10,  # where the shaft's set curve lies (coiled in its box)
+    "curve_share": 0.20,
+    "sheath_friction": 0.15,  # liner and rope surface, lubricant left from assembly
+    "ageing_b": 0.30,  # polymer contact ageing: liner lot, the least known constant
+    "ageing_dc_mm": 0.30,  # contact asperity size
+    "sheath_drag_N": 0.25,  # lumen ovality
+    "presliding_mm": 0.20,  # liner shear compliance
+    "tendon_offset_mm": 0.05,  # lumen placement in the links
+    "bend_stiffness_Nm_per_rad": 0.15,  # cover durometer and links
+    "bend_lumen_friction": 0.20,  # coil lumen in the links
+    "link_friction": 0.25,  # link pivots: moulding and grease
+    "link_drag_Nm": 0.25,  # cover's internal friction
+    "handle_friction_Nm": 0.20,  # knob bearing and seal
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -148,3 +148,30 @@ def screw_factors(p: ScrewRodKnobParams) -> tuple[float, float]:
     drive = math.tan(lead + rho) / math.tan(lead)  # 1 / eta_d
     back = math.tan(lead - rho) / math.tan(lead)  # eta_b (< 0: self-locking)
     return 0.5 * (drive + back), 0.5 * (drive - back)
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "screw_lead_mm": 0.01,  # moulded collar thread
+    "screw_radius_mm": 0.01,
+    "thread_friction": 0.15,  # dry polymer thread, grease left from assembly
+    "handle_friction_Nm": 0.20,  # O-ring squeeze
+    "handle_presliding_deg": 0.20,  # thread flank fit
+    "slack_pos_mm": 0.15,  # tendon cut and knotted to its nut by hand
+    "slack_neg_mm": 0.15,
+    "toe_mm": 0.20,  # braid lay
+    "tendon_stiffness_N": 0.15,  # braid lot (EA)
+    "creep_limit_mm": 0.30,  # UHMWPE creep: lot and braid heat-setting scatter widely
+    "creep_time_s": 0.30,
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "sheath_wrap_deg": 0.10,  # lumen path in the shaft
+    "sheath_friction": 0.15,  # liner coating, lubricant
+    "sheath_drag_N": 0.20,  # lumen preload
+    "presliding_mm": 0.20,  # liner and braid compliance
+    "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+    "bend_length_mm": 0.03,  # moulded links
+    "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and braid
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -160,3 +160,29 @@ def _number(name: str, value: Any, positive: bool) -> float:
     if not positive and value < 0.0:
         raise PlantLoadError(f"{name} must be >= 0, got {float(value)}")
     return float(value)
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,  # machined part
+    "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+    "slack_neg_mm": 0.15,
+    "toe_mm": 0.20,  # crimp geometry
+    "tendon_stiffness_N": 0.15,  # tendon lot (EA)
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "sheath_friction": 0.15,  # liner coating, lubricant
+    "sheath_wrap_deg": 0.10,  # lumen helix pitch
+    "sheath_drag_N": 0.20,  # lumen preload
+    "presliding_mm": 0.20,  # contact micro-geometry
+    "stick_fraction": 0.10,
+    "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+    "bend_stiffness_Nm_per_rad": 0.15,  # polymer cover, links
+    "bend_stiffening_per_rad2": 0.20,
+    "bend_hysteresis_Nm": 0.20,  # link rubbing
+    "bend_yield_deg": 0.20,
+    "handle_friction_Nm": 0.20,  # knob bearing / brake setting
+    "handle_presliding_deg": 0.20,
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -91,3 +91,27 @@ def knob_from(values: Mapping[str, Any], base: SnakeDentKnob) -> SnakeDentKnob:
     if not knob.tendon_offset_mm < knob.roll_radius_mm:
         raise PlantLoadError("snakedent tendon_offset_mm must be < roll_radius_mm")
     return knob
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "drum_radius_mm": 0.02,  # moulded drum
+    "slack_pos_mm": 0.15,  # rope wound and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # steel rope lot
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "sheath_wrap_deg": 0.10,  # the shaft's path in the patient
+    "sheath_friction": 0.15,  # liner coating, lubricant
+    "sheath_drag_N": 0.20,  # lumen seal, coil ovality
+    "tendon_offset_mm": 0.04,  # rope holes drilled in each vertebra
+    "roll_radius_mm": 0.03,  # ground rolling faces
+    "hole_depth_mm": 0.06,  # hole exit below the face (deburring)
+    "bend_stiffness_Nmm_per_rad": 0.15,  # spine spring and jacket lots
+    "joint_friction_mm": 0.30,  # pin guides' finish, grease
+    "joint_preload_N": 0.25,  # spine spring preload at assembly
+    "handle_friction_Nm": 0.25,  # knob seal
+    "detent_torque_Nm": 0.25,  # detent spring lot, ball seat wear
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -119,3 +119,34 @@ class StickSlipKnobParams:
 
 NOMINAL_KNOBS = (StickSlipKnobParams(), StickSlipKnobParams())
 """The nominal unit: both knobs alike (the family scatters them independently)."""
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,  # machined drum
+    "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+    "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+    "slack_neg_mm": 0.15,
+    "toe_mm": 0.20,  # crimp and braid lay
+    "tendon_stiffness_N": 0.15,  # braid lot (EA)
+    "creep_fast_share": 0.20,  # polymer lot and braid tension: relaxation scatters widely
+    "creep_fast_time_s": 0.30,
+    "creep_slow_share": 0.20,
+    "creep_slow_time_s": 0.30,
+    "free_length_pos_m": 0.20,  # handle assembly
+    "free_length_neg_m": 0.20,
+    "sheath_length_m": 0.02,  # cut to length
+    "sheath_wrap_deg": 0.10,  # lumen helix pitch
+    "sheath_friction": 0.15,  # liner coating, lubricant
+    "stiction_ratio": 0.05,  # one material pair
+    "sheath_drag_N": 0.20,  # liner preload
+    "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
+    "bend_stiffening_per_rad2": 0.20,  # cover strain-hardening, polymer batch
+    "tip_mass_g": 0.10,  # transducer head and links
+    "tip_length_mm": 0.03,  # moulded links
+    "drive_stiffness_Nm_per_rad": 0.20,  # cable tension set at assembly, coupling fit
+    "handle_friction_Nm": 0.25,  # knob brake as left by the last user: the least controlled
+    "brake_stiction_ratio": 0.05,  # one pad material
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

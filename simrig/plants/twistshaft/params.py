@@ -127,3 +127,29 @@ def check_shaft(p: ShaftParams) -> None:
         v = getattr(p, name)
         if not 0.0 <= v * abs(p.body_temperature_C - p.start_temperature_C) < 0.5:
             raise ValueError(f"twistshaft: {name} must be >= 0 and soften by less than half")
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "pulley_radius_mm": 0.02,  # machined drum
+    "tendon_offset_mm": 0.05,  # lumen placement in the extrusion
+    "lumen_angle_error_deg": 0.50,  # angular tolerance of the extrusion die (1-3 deg)
+    "lumen_helix_deg": 0.30,  # extrusion twist: the least controlled geometry
+    "slack_pos_mm": 0.15,  # tendon cut and crimped by hand
+    "slack_neg_mm": 0.15,
+    "toe_mm": 0.20,  # braid lay and crimp
+    "tendon_stiffness_N": 0.15,  # braid lot (EA)
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "bend_length_mm": 0.05,  # moulded links
+    "sheath_wrap_deg": 0.10,  # lumen path in the shaft
+    "sheath_friction": 0.15,  # liner coating, lubricant
+    "friction_exponent": 0.05,  # one material pair (0.67-0.9 over materials)
+    "contact_load_N": 0.25,  # surface roughness of the liner
+    "sheath_drag_N": 0.20,  # lumen preload
+    "bend_stiffness_Nm_per_rad": 0.15,  # tip cover and links
+    "handle_friction_Nm": 0.20,  # knob bearing / O-ring
+    "handle_presliding_deg": 0.20,
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -159,3 +159,33 @@ def _check(p: WarmGearKnobParams) -> None:
             and p.contact_position < 1.0):
         raise PlantLoadError("warmgear mesh_ripple must be in [0, 1), inserted_share <= 1 "
                              "and contact_position < 1")
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "gear_play_deg": 0.30,  # moulded gears: tolerance stack of two parts and a centre distance
+    "mesh_stiffness_Nmm_per_deg": 0.20,  # POM lot, moisture, face width
+    "mesh_friction": 0.20,  # flank finish, grease left from assembly
+    "drum_friction_Nmm": 0.25,  # bushing fit and seal squeeze
+    "pulley_radius_mm": 0.02,  # moulded drum
+    "slack_pos_mm": 0.15,  # tendon wound and crimped by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # wire-rope lot (steel)
+    "free_length_m": 0.20,  # handle assembly
+    "sheath_length_m": 0.02,  # cut to length
+    "inserted_share": 0.15,  # how deep the probe sits (the patient)
+    "thermal_mismatch_per_K": 0.20,  # shaft braid angle and Pebax lot
+    "sheath_wrap_deg": 0.10,  # the shaft's lay
+    "sheath_friction": 0.15,  # liner surface
+    "film_friction": 0.20,  # flush fluid and coating hydration
+    "sheath_drag_N": 0.20,  # lumen ovality
+    "film_viscous_N_s_per_mm": 0.30,  # film amount: the least known constant
+    "squeeze_time_s": 0.30,  # lumen clearance (thickness cubed)
+    "entrain_length_mm": 0.25,
+    "tendon_offset_mm": 0.05,  # lumen placement in the section
+    "bend_stiffness_Nm_per_rad": 0.15,  # cover durometer and spine cut
+    "section_softening_per_K": 0.20,  # Pebax lot
+    "handle_friction_Nm": 0.20,  # knob O-ring squeeze
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

@@ -119,3 +119,29 @@ def knobs_from(knobs: Sequence[Mapping[str, Any]] | None) -> tuple[WormEyeletKno
             raise ValueError(f"unknown wormeyelet knob constants: {', '.join(unknown)}")
         out.append(dataclasses.replace(nominal, **{k: float(v) for k, v in given.items()}))
     return tuple(out)
+
+
+UNIT_SCATTER: dict[str, float] = {
+    "worm_lead_deg": 0.03,  # ground worm thread
+    "worm_friction": 0.25,  # grease left from assembly, wheel moulding
+    "worm_play_deg": 0.30,  # wheel tooth thickness and centre distance: a tolerance stack
+    "drum_radius_mm": 0.02,  # moulded drum
+    "slack_pos_mm": 0.15,  # rope crimped to the drum by hand
+    "slack_neg_mm": 0.15,
+    "tendon_stiffness_N": 0.10,  # rope lot (EA)
+    "contact_fraction": 0.10,  # where the shaft's sag puts the rope on the liner
+    "sheath_friction": 0.15,  # liner batch, lubricant
+    "sheath_wrap_deg": 0.10,  # lumen helix pitch
+    "sheath_drag_N": 0.25,  # liner preload
+    "tendon_offset_mm": 0.05,  # eyelet placement in the disks
+    "section_stiffness_Nmm_per_rad": 0.15,  # backbone spring and cover
+    "eyelet_friction": 0.20,  # eyelet finish (deburred by hand)
+    "disk_friction_N": 0.25,  # disk fit in the sleeve
+    "cross_wrap": 0.20,
+    "handle_friction_Nm": 0.20,  # worm shaft seal squeeze
+    "damper_Nm_s_per_rad": 0.20,  # oil fill and gap of the damper
+    "damper_thinning_rad_s": 0.20,
+}
+"""Unit-to-unit scatter of this plant's constants: the relative half-range of a uniform draw
+around the nominal value, per constant a unit draws (:func:`simrig.family.family_member`);
+the constants not listed are the product's design."""

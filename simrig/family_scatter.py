@@ -470,4 +470,26 @@ SCATTER: dict[str, dict[str, float]] = {
         "bend_stiffness_Nmm_per_rad": 0.12,  # laser cut (kerf width) and cover durometer
         "notch_asymmetry": 0.05,  # notch depth tolerance
     },
+    "rackgrease": {
+        "pinion_radius_mm": 0.02,  # moulded pinion
+        "rack_offset_mm": 0.10,  # where the rope anchors are crimped on the rack
+        "guide_friction": 0.20,  # acetal rack on its brass guide, assembly grease
+        "handle_friction_Nm": 0.25,  # wave-spring preload of the guide
+        "eddy_peak_Nm": 0.15,  # magnet strength and air gap of the eddy disc
+        "slack_pos_mm": 0.15,  # rope crimped to the rack by hand
+        "slack_neg_mm": 0.15,
+        "tendon_stiffness_N": 0.10,  # rope lot (EA)
+        "free_length_m": 0.15,  # handle routing
+        "sheath_length_m": 0.02,  # cut to length
+        "contact_fraction": 0.10,  # where the shaft's lay concentrates the friction
+        "sheath_friction": 0.15,  # liner lot, lubricant
+        "sheath_wrap_deg": 0.10,  # routing in the handle, the shaft's lay
+        "sheath_drag_N": 0.25,  # rope straightness, lumen fit
+        "section_yield_Nmm": 0.25,  # grease fill of the section (amount, batch consistency)
+        "section_gel_Nmm_per_rad": 0.25,
+        "section_viscosity_Nmm_s_per_rad": 0.25,
+        "tendon_offset_mm": 0.04,  # lumen placement in the section
+        "bend_stiffness_Nmm_per_rad": 0.12,  # spine cut and cover durometer
+        "head_moment_Nmm": 0.10,  # transducer head mass and where it sits
+    },
 }

@@ -35,8 +35,11 @@ plant (session 26, written blind: a worm-stage handle with a silicone damper, ro
 lumen contact, a spacer-disk section whose eyelets the ropes rub; run untuned) is held out from
 the end of session 26; the beltbraid plant (session 27, written blind: a belt-driven spring-return
 handle, steel ropes with distributed microslip in a braided lumen, a braided shaft whose wire
-crossings slip (Preisach), an asymmetrically notched tube; run untuned) is registered last and
-held out from the end of session 27.
+crossings slip (Preisach), an asymmetrically notched tube; run untuned) is held out from the end
+of session 27; the rackgrease plant (session 28, written blind: a rack-and-pinion handle whose
+rack cocks in its guide, an eddy-current knob damper, ropes over one capstan contact, a
+grease-packed section (Bingham yield and flow), a heavy transducer head under gravity; run
+untuned) is registered last, role ``"blind"``.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -64,6 +67,7 @@ from simrig.plants.nitinol import NOMINAL_KNOBS as NITINOL_KNOBS
 from simrig.plants.notchclutch import NOMINAL_KNOBS as NOTCHCLUTCH_KNOBS
 from simrig.plants.planetwist import NOMINAL_KNOBS as PLANETWIST_KNOBS
 from simrig.plants.pronyring import NOMINAL_KNOBS as PRONYRING_KNOBS
+from simrig.plants.rackgrease import NOMINAL_KNOBS as RACKGREASE_KNOBS
 from simrig.plants.ratestate import NOMINAL_KNOBS as RATESTATE_KNOBS
 from simrig.plants.screwrod import NOMINAL_KNOBS as SCREWROD_KNOBS
 from simrig.plants.segments import NOMINAL_KNOBS as SEGMENTS_KNOBS
@@ -94,7 +98,8 @@ PLANT_SPECS: dict[str, str] = {
     "notchclutch": "simrig.plants.notchclutch:make_notchclutch_plant",
     "pronyring": "simrig.plants.pronyring:make_pronyring_plant",
     "wormeyelet": "simrig.plants.wormeyelet:make_wormeyelet_plant",
-    "beltbraid": "simrig.plants.beltbraid:make_beltbraid_plant",  # last: seeds hold
+    "beltbraid": "simrig.plants.beltbraid:make_beltbraid_plant",
+    "rackgrease": "simrig.plants.rackgrease:make_rackgrease_plant",  # last: seeds hold
 }
 PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-out",
               "coilpipe": "held-out", "stickslip": "held-out", "twistshaft": "held-out",
@@ -103,7 +108,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
               "planetwist": "held-out", "notchclutch": "held-out",
               "pronyring": "held-out", "wormeyelet": "held-out",
-              "beltbraid": "held-out"}
+              "beltbraid": "held-out", "rackgrease": "blind"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))
@@ -127,7 +132,8 @@ _NOMINAL: dict[str, tuple[Any, ...]] = {"capstan": CAPSTAN_KNOBS, "lumped": LUMP
                                         "notchclutch": NOTCHCLUTCH_KNOBS,
                                         "pronyring": PRONYRING_KNOBS,
                                         "wormeyelet": WORMEYELET_KNOBS,
-                                        "beltbraid": BELTBRAID_KNOBS}
+                                        "beltbraid": BELTBRAID_KNOBS,
+                                        "rackgrease": RACKGREASE_KNOBS}
 
 
 @dataclass(frozen=True)
@@ -211,6 +217,9 @@ VARIANTS: dict[str, Variant] = {
             "beltbraid": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
                           "handle_friction_Nm": 1.5, "belt_creep_per_Nm": 1.5,
                           "braid_hold_N": 1.3},
+            "rackgrease": {"sheath_friction": 1.3, "sheath_drag_N": 1.5,
+                           "handle_friction_Nm": 1.5, "guide_friction": 1.3,
+                           "section_yield_Nmm": 1.5},
         },
     ),
     "steel-tendon": Variant(
@@ -244,7 +253,8 @@ VARIANTS: dict[str, Variant] = {
                  "notchclutch": {"tendon_stiffness_N": 0.4},
                  "pronyring": {"tendon_stiffness_N": 0.4},
                  "wormeyelet": {"tendon_stiffness_N": 0.4},
-                 "beltbraid": {"tendon_stiffness_N": 0.4}},
+                 "beltbraid": {"tendon_stiffness_N": 0.4},
+                 "rackgrease": {"tendon_stiffness_N": 0.4}},
     ),
     "noisy-sensor": Variant(
         "drive with a noisier current measurement (10 mA noise, 2 Hz spikes, 5 ms lag)",

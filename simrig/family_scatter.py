@@ -19,6 +19,7 @@ from simrig.plants.nitinol.params import UNIT_SCATTER as NITINOL
 from simrig.plants.notchclutch.params import UNIT_SCATTER as NOTCHCLUTCH
 from simrig.plants.planetwist.params import UNIT_SCATTER as PLANETWIST
 from simrig.plants.pronyring.params import UNIT_SCATTER as PRONYRING
+from simrig.plants.rackgrease.params import UNIT_SCATTER as RACKGREASE
 from simrig.plants.ratestate.params import UNIT_SCATTER as RATESTATE
 from simrig.plants.screwrod.params import UNIT_SCATTER as SCREWROD
 from simrig.plants.segments.params import UNIT_SCATTER as SEGMENTS
@@ -49,5 +50,6 @@ SCATTER: dict[str, dict[str, float]] = {
     "pronyring": PRONYRING,
     "wormeyelet": WORMEYELET,
     "beltbraid": BELTBRAID,
+    "rackgrease": RACKGREASE,
 }
 """Per plant, the relative half-range of a uniform draw around each constant's nominal value."""

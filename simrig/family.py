@@ -39,7 +39,7 @@ crossings slip (Preisach), an asymmetrically notched tube; run untuned) is held 
 of session 27; the rackgrease plant (session 28, written blind: a rack-and-pinion handle whose
 rack cocks in its guide, an eddy-current knob damper, ropes over one capstan contact, a
 grease-packed section (Bingham yield and flow), a heavy transducer head under gravity; run
-untuned) is registered last, role ``"blind"``.
+untuned) is registered last and held out from the end of session 28.
 ``SCATTER`` lives in :mod:`simrig.family_scatter`.
 """
 
@@ -108,7 +108,7 @@ PLANT_ROLE = {"capstan": "development", "lumped": "held-out", "segments": "held-
               "jawcrimp": "held-out", "cyclopebax": "held-out", "snakedent": "held-out",
               "planetwist": "held-out", "notchclutch": "held-out",
               "pronyring": "held-out", "wormeyelet": "held-out",
-              "beltbraid": "held-out", "rackgrease": "blind"}
+              "beltbraid": "held-out", "rackgrease": "held-out"}
 
 DEVELOPMENT_UNITS = tuple(range(1, 9))
 HELD_OUT_UNITS = tuple(range(101, 109))

@@ -56,9 +56,9 @@ def test_it_is_a_plant_and_the_factory_builds_the_nominal_unit() -> None:
     assert [p.k for p in plant.planes] == list(NOMINAL_KNOBS)
 
 
-def test_rackgrease_is_registered_last_and_blind() -> None:
+def test_rackgrease_is_registered_last_and_held_out() -> None:
     assert list(PLANT_SPECS)[-1] == "rackgrease"
-    assert PLANT_ROLE["rackgrease"] == "blind"
+    assert PLANT_ROLE["rackgrease"] == "held-out"
     assert isinstance(family_member("rackgrease", 101).build(), RackGreasePlant)
     assert set(SCATTER["rackgrease"]) <= set(family_member("rackgrease", 0).params["knobs"][0])
 

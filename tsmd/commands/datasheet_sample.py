@@ -22,6 +22,7 @@ from typing import Any
 from simrig.family import DEVELOPMENT_UNITS, HELD_OUT_UNITS
 from simrig.plant import load_plant
 from tsmd import __version__
+from tsmd.calibration.sample_offset import sheet_offsets_deg
 from tsmd.commands.datasheet_stick import (
     source_header,
     with_settle_gain_check,
@@ -92,6 +93,9 @@ def with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: dic
         print(f"{name} unit part on the sample ({len(configs)} units, noise seed {seed}): D "
               f"{_or_none(k.dead_zone_unit_u95_deg, 2)} deg over {n[0]} values, B "
               f"{_or_none(k.backlash_unit_u95_deg, 2)} deg over {n[1]}")
+        offsets = sheet_offsets_deg(k)
+        print(f"{name} one-sided misses subtracted (every sample unit's on one side): "
+              + (", ".join(f"{p} {v:+.2f} deg" for p, v in offsets.items()) or "none"))
     print(f"  sample: {time.monotonic() - t0:.0f} s")
     return device
 

@@ -85,9 +85,9 @@ def test_a_sheet_without_a_sample_gives_no_part() -> None:
 
 def test_the_sheets_parts_are_read_per_knob_and_written_back(tmp_path: Path) -> None:
     data = yaml.safe_load(DEVICE.read_text())
-    for knob in ("phi1", "phi2"):  # capstan's sheet carries its sample's part (session 27)
-        data["knobs"][knob].pop("dead_zone_unit_u95_deg", None)
-        data["knobs"][knob].pop("backlash_unit_u95_deg", None)
+    for knob in ("phi1", "phi2"):  # capstan's sheet carries its sample (sessions 27, 28)
+        for key in [k for k in data["knobs"][knob] if "unit_u95" in k or "sample_offset" in k]:
+            data["knobs"][knob].pop(key)
     data["knobs"]["phi2"]["dead_zone_unit_u95_deg"] = 0.9
     data["knobs"]["phi2"]["backlash_unit_u95_deg"] = 1.4
     device = device_model_from_mapping(data)

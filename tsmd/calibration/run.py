@@ -57,6 +57,7 @@ from tsmd.calibration.resweep import (
     pooled,
     uncertain_points,
 )
+from tsmd.calibration.sample_offset import with_sample_offset
 from tsmd.calibration.tension_play_fit import PlateauGaps, with_prefit, with_tension_play
 from tsmd.calibration.unit_part import with_unit_part
 from tsmd.profile import CatheterProfile, DeviceModel
@@ -144,8 +145,10 @@ def identify_recording(rec: Recording, options: KnobOptions = None,
     # The play's end is searched past the line rule's end; a stick end's offset is no play
     # (pronyring's -5 deg: no step in 12 of 12 half-cycles, a creep warning on every unit).
     play = not (opts is not None and opts.backlash_stick_end)
-    found = with_unit_part(corrected(seen, offset, other, slope, REPORT_MIN_OFFSET_DEG, play),
-                           part, left)
+    # the sample's one-sided miss: reported values only (session 28)
+    report = with_sample_offset(corrected(seen, offset, other, slope, REPORT_MIN_OFFSET_DEG, play),
+                                dict(part.offsets_deg) if part is not None else {})
+    found = with_unit_part(report, part, left)
     model = with_unit_part(corrected(seen, offset, other, slope, read_play=play), part, left)
     same = model.values == found.values
     return GridPoint(knob, other, found, rec, model_result=None if same else model)

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from tsmd.calibration.sample_offset import sheet_offsets_deg
 from tsmd.calibration.sweep_result import SweepResult
 from tsmd.profile.types import DeviceKnob
 
@@ -34,13 +35,17 @@ class UnitPart:
 
     dead_zone_u95_deg: float | None
     backlash_u95_deg: float | None
+    offsets_deg: tuple[tuple[str, float], ...] = ()
+    """Per parameter, the sample's one-sided miss subtracted from the reported values
+    (:mod:`tsmd.calibration.sample_offset`); the half-widths above are the scatter about it."""
 
     @staticmethod
     def of(knob: DeviceKnob) -> UnitPart | None:
         """The sheet knob's part, None where the sheet measured neither."""
         if knob.dead_zone_unit_u95_deg is None and knob.backlash_unit_u95_deg is None:
             return None
-        return UnitPart(knob.dead_zone_unit_u95_deg, knob.backlash_unit_u95_deg)
+        return UnitPart(knob.dead_zone_unit_u95_deg, knob.backlash_unit_u95_deg,
+                        tuple(sheet_offsets_deg(knob).items()))
 
     def u95_deg(self, name: str) -> float | None:
         """The half-width for parameter ``name`` (None: not measured for its kind)."""

@@ -18,6 +18,7 @@ from typing import Any
 
 from simrig.family import DEVELOPMENT_UNITS, HELD_OUT_UNITS
 from simrig.plant import load_plant
+from tsmd.calibration.sample_offset import sheet_offsets_deg
 from tsmd.config import TsmdConfig
 from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_sample import left_deg2, measure_sample
@@ -72,6 +73,9 @@ def with_sample(device: DeviceModel, config: TsmdConfig, plant: str, params: dic
         print(f"{name} unit part on the sample ({len(configs)} units, noise seed {seed}): D "
               f"{_or_none(k.dead_zone_unit_u95_deg, 2)} deg over {n[0]} values, B "
               f"{_or_none(k.backlash_unit_u95_deg, 2)} deg over {n[1]}")
+        offsets = sheet_offsets_deg(k)
+        print(f"{name} one-sided misses subtracted (every sample unit's on one side): "
+              + (", ".join(f"{p} {v:+.2f} deg" for p, v in offsets.items()) or "none"))
     print(f"  sample: {time.monotonic() - t0:.0f} s")
     return device
 

@@ -72,6 +72,10 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "loaded_knee_neg_deg": (0.0, 90.0, "deg"),
     "dead_zone_unit_u95_deg": (0.0, 20.0, "deg"),
     "backlash_unit_u95_deg": (0.0, 20.0, "deg"),
+    "sample_offset_dead_zone_pos_deg": (-5.0, 5.0, "deg"),
+    "sample_offset_dead_zone_neg_deg": (-5.0, 5.0, "deg"),
+    "sample_offset_backlash_pos_deg": (-5.0, 5.0, "deg"),
+    "sample_offset_backlash_neg_deg": (-5.0, 5.0, "deg"),
     "release_round": (*RELEASE_ROUND_RANGE, ""),
     "release_shift": (*RELEASE_SHIFT_RANGE, ""),
     "torque_ripple_period_deg": (1.0, 90.0, "deg"),
@@ -101,7 +105,9 @@ _RELEASE_RULE_KEYS = ("backlash_release_line_share", "backlash_release_local_sha
 _COUPLING_KEYS = ("other_tip_gain", "loaded_knee_pos_deg", "loaded_knee_neg_deg",
                   "edge_level_share")
 """Optional data-sheet numbers of the planes' coupling, written only when measured."""
-_SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg")
+_SAMPLE_KEYS = ("dead_zone_unit_u95_deg", "backlash_unit_u95_deg",
+                "sample_offset_dead_zone_pos_deg", "sample_offset_dead_zone_neg_deg",
+                "sample_offset_backlash_pos_deg", "sample_offset_backlash_neg_deg")
 """Optional data-sheet numbers measured on the product's sample, written only when measured."""
 _ROUND_KEYS = ("release_round", "release_shift")
 """Optional data-sheet numbers of the rounded release (session 20), written only when set."""
@@ -249,6 +255,10 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             loaded_knee_neg_deg=optional("loaded_knee_neg_deg"),
             dead_zone_unit_u95_deg=optional("dead_zone_unit_u95_deg"),
             backlash_unit_u95_deg=optional("backlash_unit_u95_deg"),
+            sample_offset_dead_zone_pos_deg=optional("sample_offset_dead_zone_pos_deg"),
+            sample_offset_dead_zone_neg_deg=optional("sample_offset_dead_zone_neg_deg"),
+            sample_offset_backlash_pos_deg=optional("sample_offset_backlash_pos_deg"),
+            sample_offset_backlash_neg_deg=optional("sample_offset_backlash_neg_deg"),
             release_round=optional("release_round"),
             release_shift=optional("release_shift"),
             torque_ripple_period_deg=optional("torque_ripple_period_deg"),

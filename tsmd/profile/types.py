@@ -257,6 +257,17 @@ class DeviceKnob:
     """Optional, as ``dead_zone_unit_u95_deg`` for the backlash; where given it replaces the
     share-based part of a "line" rule (:data:`tsmd.calibration.options.LINE_SHARE_UNIT_U95`,
     measured on segments only)."""
+    sample_offset_dead_zone_pos_deg: float | None = None
+    """Optional, measured on the product's sample with the unit parts (session 28): where every
+    sample unit's values of this parameter miss their tips on one side, the units' mean miss
+    (value minus tip, deg), which calibration subtracts from the reported value only
+    (:mod:`tsmd.calibration.sample_offset`); the unit part is then the scatter about it. None: 0."""
+    sample_offset_dead_zone_neg_deg: float | None = None
+    """As ``sample_offset_dead_zone_pos_deg`` for the negative dead-zone edge."""
+    sample_offset_backlash_pos_deg: float | None = None
+    """As ``sample_offset_dead_zone_pos_deg`` for the positive backlash."""
+    sample_offset_backlash_neg_deg: float | None = None
+    """As ``sample_offset_dead_zone_pos_deg`` for the negative backlash."""
     release_round: float | None = None
     """Optional, tracked on the data-sheet unit (session 20): the half-width of the tip's
     rounded start after a reversal, in backlashes at a 90 deg reversal as the current reads them

@@ -31,7 +31,9 @@ def edge_status(edge: Any) -> dict[str, Any]:
             "own_slope_held_ramps": edge.n_own_held, "flatter_own_ramps": edge.n_flatter_own,
             "leaning_steeper_ramps": edge.n_leaning_steeper,
             "bin_lean_held_ramps": edge.n_bin_lean,
-            "followed_own_slope_ramps": edge.n_followed_own}
+            "followed_own_slope_ramps": edge.n_followed_own,
+            "cut_window_ramps": edge.n_cut, "share_read_ramps": edge.n_share_read,
+            "learned_share": edge.share.share}
 
 
 __all__ = ["edge_status"]

@@ -83,7 +83,9 @@ class RampOptions:
     phi2's positive stroke, the current 0.148 -> 0.036 A; the line read +5.73 deg, the edge's
     later ramps +4.7..+4.8, and the follow stayed at +5.73). Off (0): with 0.5 the stored
     replays of coilpipe 1 and notchclutch 1-2 publish other targets, notchclutch's phi2
-    ~1 deg further out (docs/online.md, "Session 27, round 2")."""
+    ~1 deg further out (docs/online.md, "Session 27, round 2"); what is on instead keeps the
+    ramp and takes no suspect from it
+    (:attr:`tsmd.online.estimator_options.EstimatorOptions.cut_window_drop`)."""
 
 
 @dataclass(frozen=True)

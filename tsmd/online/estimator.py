@@ -198,6 +198,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         o = self.options
         self.n_ramps += 1
         self.bend_suspect = False
+        self.cut = 0.0 < o.cut_window_drop < ramp.load_drop
         self.partner = partner or self.partner
         events: list[tuple[str, str, dict[str, Any]]] = []
         tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
@@ -253,7 +254,6 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         if self.frozen_for > 0:
             self.frozen_for -= 1
             return events
-        self.cut = 0.0 < o.cut_window_drop < ramp.load_drop
         knee_m = ramp.side * (ramp.knee_deg - profile_edge_deg) - self.knee_residual_ref_deg
         direction = self.knee_direction
         first_knee = self.last_feature != "knee"

@@ -95,3 +95,10 @@ def test_a_share_well_beyond_the_two_slopes_counts_as_none() -> None:
     for _ in range(2):
         beyond.teach(0.0, 1.0, 3.0)  # landed 3 x beyond the own slope's crossing
     assert beyond.share is None
+
+
+def test_the_status_reports_the_learned_share_and_its_readings() -> None:
+    pos = slack_on_a_steeper_tendon(EstimatorOptions(suspect_reads_learned_share=True), True)
+    status = pos.status()
+    assert status["learned_share"] == 1.0
+    assert status["share_read_ramps"] == 2

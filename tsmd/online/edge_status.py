@@ -11,6 +11,7 @@ from typing import Any
 
 def edge_status(edge: Any) -> dict[str, Any]:
     """The status fields of ``edge`` (an :class:`~tsmd.online.estimator.EdgeTracker`)."""
+    share = edge.share.share
     state = ("learning" if edge.learning else "frozen" if edge.frozen_for > 0
              else "tracking" if edge.reference.settled else "settling")
     return {"state": state, "offset_deg": round(edge.applied_deg, 3),
@@ -33,7 +34,7 @@ def edge_status(edge: Any) -> dict[str, Any]:
             "bin_lean_held_ramps": edge.n_bin_lean,
             "followed_own_slope_ramps": edge.n_followed_own,
             "cut_window_ramps": edge.n_cut, "share_read_ramps": edge.n_share_read,
-            "learned_share": edge.share.share}
+            "learned_share": None if share is None else round(share, 3)}
 
 
 __all__ = ["edge_status"]

@@ -19,6 +19,7 @@ from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
 from tsmd.online.partner import holds_outward_suspect
 from tsmd.online.reference import SettlingReference
+from tsmd.online.slope_share import SlopeShare
 from tsmd.online.slopes import nearest_between
 
 ORDER = itertools.count()
@@ -57,6 +58,8 @@ class ReferenceReadings:
     ramp_change: float
     held: tuple[LoadedRamp, float, float] | None
     partner: ReferenceReadings | None
+    share: SlopeShare
+    n_share_read: int
 
     def _speed_matches(self, ramp: LoadedRamp) -> bool:
         """The ramp ran at a knob speed within ``speed_ratio_max`` of the reference's (True
@@ -108,6 +111,8 @@ class ReferenceReadings:
         if ramp.slope_A_per_deg == slope:
             return raw
         own = self._crossing(ramp, edge_deg, ramp.slope_A_per_deg)
+        if abs(raw - target) <= o.gate_deg and self.level_deg == 0.0 and not self.odd_speed:
+            self.share.teach(raw, own, target)  # the edge is where the profile says
         if o.within_gate_reads_own and abs(raw - target) <= o.gate_deg:
             self.n_own_between += 1
             if (o.followed_reads_own and self.level_deg != 0.0
@@ -135,6 +140,11 @@ class ReferenceReadings:
             # slope in use, +3.5..+4.4 with their own, true +3.58).
             self.n_flatter_own += 1
             return own
+        if o.suspect_reads_learned_share and abs(raw - target) > o.gate_deg:
+            # beyond the gate with the share of the two slopes' crossings that landed on
+            # this edge while it was known (:mod:`tsmd.online.slope_share`)
+            self.n_share_read += self.share.share is not None
+            return self.share.read(raw, own)
         return raw
 
     def _widening_read(self, ramp: LoadedRamp, edge_deg: float, slope: float,

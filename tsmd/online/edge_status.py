@@ -11,6 +11,7 @@ from typing import Any
 
 def edge_status(edge: Any) -> dict[str, Any]:
     """The status fields of ``edge`` (an :class:`~tsmd.online.estimator.EdgeTracker`)."""
+    share = edge.share.share
     state = ("learning" if edge.learning else "frozen" if edge.frozen_for > 0
              else "tracking" if edge.reference.settled else "settling")
     return {"state": state, "offset_deg": round(edge.applied_deg, 3),
@@ -31,7 +32,9 @@ def edge_status(edge: Any) -> dict[str, Any]:
             "own_slope_held_ramps": edge.n_own_held, "flatter_own_ramps": edge.n_flatter_own,
             "leaning_steeper_ramps": edge.n_leaning_steeper,
             "bin_lean_held_ramps": edge.n_bin_lean,
-            "followed_own_slope_ramps": edge.n_followed_own}
+            "followed_own_slope_ramps": edge.n_followed_own,
+            "cut_window_ramps": edge.n_cut, "share_read_ramps": edge.n_share_read,
+            "learned_share": None if share is None else round(share, 3)}
 
 
 __all__ = ["edge_status"]

@@ -38,6 +38,7 @@ from tsmd.online.features import LoadedRamp
 from tsmd.online.other_knob import OtherKnobBins
 from tsmd.online.partner import partner_left_band, partner_shows_change
 from tsmd.online.reference import SettlingReference
+from tsmd.online.slope_share import SlopeShare
 from tsmd.online.slopes import common_change, shrunk_ratio
 
 
@@ -117,6 +118,15 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
     n_leaning_steeper: int = 0
     """Crossings of steeper ramps read as suspects with their own slope
     (``leaning_steeper_reads_own``)."""
+    share: SlopeShare = field(default_factory=SlopeShare)
+    """Where this edge's crossings lie between the two slopes' (:mod:`tsmd.online.slope_share`)."""
+    n_share_read: int = 0
+    """Readings beyond the gate read at the learned share (``suspect_reads_learned_share``)."""
+    n_cut: int = 0
+    """Readings beyond the gate of windows the change cut in two: no suspect
+    (``cut_window_drop``)."""
+    cut: bool = False
+    """The ramp being read is a window whose current fell (:attr:`LoadedRamp.load_drop`)."""
     n_bin_lean: int = 0
     """Readings beyond the gate held within it by their bin's lean so far
     (``learning_bin_lean_holds``)."""
@@ -188,6 +198,7 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
         o = self.options
         self.n_ramps += 1
         self.bend_suspect = False
+        self.cut = 0.0 < o.cut_window_drop < ramp.load_drop
         self.partner = partner or self.partner
         events: list[tuple[str, str, dict[str, Any]]] = []
         tag = {"knob": self.knob, "side": "pos" if self.side > 0 else "neg"}
@@ -323,6 +334,11 @@ class EdgeTracker(SlopeReadings, ReferenceReadings):
             # what a slack or a bend does and stays a suspect (lumped 1, 60 deg bend: read
             # first on ramps at 4.6-7 deg/s against the reference's 15.5)
             self.n_odd_speed += 1
+            self.last_measurement_deg = math.nan
+            return
+        if self.cut and abs(m - self.estimate_deg) > o.gate_deg:
+            # a line through a load that collapsed mid-window is no edge: no suspect
+            self.n_cut += 1
             self.last_measurement_deg = math.nan
             return
         self.last_measurement_deg = self.last_reading_deg = m

@@ -151,6 +151,15 @@ class EstimatorOptions:
     reference after the change read +3.2..+3.7 deg with the slope in use, +3.6..+4.5 with
     their own, the estimate stayed at the follow's +3.30). Off: the nearest point (session
     27: built, left off with ``refine_after_follow``; docs/online.md)."""
+    suspect_reads_learned_share: bool = True
+    """A crossing beyond the gate that the rules above leave at the slope in use's reads at
+    the share of the way to the ramp's own slope's crossing that this edge's crossings within
+    the gate took before any change was followed (:mod:`tsmd.online.slope_share`): a slack
+    moves the line without turning it, and the tendon's ramps that ran steeper or flatter than
+    its reference before the change do after it (twistshaft 2, +0.5 mm slack: phi1's positive
+    ramps 1.05 x before and after; the follow read +2.82 deg with the slope in use, +3.74
+    with its own, the tip wanted +3.3..+3.8, and the ramps before the change had landed on
+    the edge with their own slope). Off: the slope in use's crossing."""
     refine_after_follow: bool = False
     """For ``window`` measurements within the gate after a followed change, a reading in an
     other-knob bin still learning counts towards the estimate too (not only the bin), and the
@@ -183,6 +192,18 @@ class EstimatorOptions:
     knee-mode follow back came inside the RMSE window) and coilpipe 1's slack (phi1 negative
     edge, one noisy 0.89 x ramp) read 2.19 deg instead of 3.90 in replay; notchclutch's miss
     is mostly the bench's run starting on a dry liner after the calibration."""
+    cut_window_drop: float = 0.5
+    """A ramp whose loaded window's current falls below its running maximum by more than this
+    fraction of the line's rise (:attr:`tsmd.online.features.LoadedRamp.load_drop`) gives no
+    suspect: a reading of it beyond the gate measures nothing, while its slope still counts
+    as any ramp's and a reading within the gate reads as any. A knob moving outward on a
+    loaded tendon only adds load, so the fall is the load path changing during the stroke,
+    and the line fitted through it crosses the level far from either edge (wormeyelet 4,
+    +0.5 mm slack at 80 s in the middle of phi2's positive stroke: the current 0.148 ->
+    0.036 A, the line read +5.73 deg, the edge's later ramps +4.8, the follow stayed at
+    +5.73). Refusing the whole ramp instead (``RampOptions.load_drop_fraction``) also took its
+    slope from the knob's slopes and moved coilpipe 1's and notchclutch 1-2's later phi2
+    readings (session 27). 0: off (until session 28)."""
     learning_bin_lean_holds: bool = True
     """A reading beyond the gate in an other-knob bin one measurement short of ``bin_min``,
     whose measurements so far all lie the reading's way, is referred to their median; within

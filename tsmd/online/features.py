@@ -83,7 +83,9 @@ class RampOptions:
     phi2's positive stroke, the current 0.148 -> 0.036 A; the line read +5.73 deg, the edge's
     later ramps +4.7..+4.8, and the follow stayed at +5.73). Off (0): with 0.5 the stored
     replays of coilpipe 1 and notchclutch 1-2 publish other targets, notchclutch's phi2
-    ~1 deg further out (docs/online.md, "Session 27, round 2")."""
+    ~1 deg further out (docs/online.md, "Session 27, round 2"); what is on instead keeps the
+    ramp and takes no suspect from it
+    (:attr:`tsmd.online.estimator_options.EstimatorOptions.cut_window_drop`)."""
 
 
 @dataclass(frozen=True)
@@ -114,6 +116,11 @@ class LoadedRamp:
     """The knob's mean speed over the window: the sheath's friction, and so the current on the
     ramp, depends on it (coilpipe: strokes at 4-7 deg/s read 1-2.4 deg inward of those at
     ~20 deg/s)."""
+    load_drop: float = 0.0
+    """The window's largest fall of its (running-median) current below its running maximum,
+    as a fraction of the line's rise over the window (:func:`load_drop`): a knob moving
+    outward on a loaded tendon only adds load, so a fall is the load path changing during the
+    stroke (:attr:`tsmd.online.estimator_options.EstimatorOptions.cut_window_reads_nothing`)."""
 
     def current_at(self, knob_deg: float) -> float:
         """The line's current at a knob angle."""
@@ -289,7 +296,7 @@ sample, the median by 0.70 at most in 43 recordings (planetwist 3), a load path 
 0.31 (planetwist 1) to 22."""
 
 
-def _load_drop(x: Array, y: Array, slope_A_per_deg: float) -> float:
+def load_drop(x: Array, y: Array, slope_A_per_deg: float) -> float:
     """The window's largest fall of its running-median current below its running maximum
     (samples in travel order), as a fraction of the line's rise over the window."""
     rise = slope_A_per_deg * float(x.max() - x.min())
@@ -350,11 +357,12 @@ def loaded_ramp(stroke: Stroke, expected_edge_deg: float,
             a, b, r = _line(x, y, stick)
     if not b > 0:
         return Rejected(stroke.knob, "the current does not rise in the loaded window")
-    if o.load_drop_fraction > 0.0 and _load_drop(x, y, b) > o.load_drop_fraction:
+    drop = load_drop(x, y, b)
+    if o.load_drop_fraction > 0.0 and drop > o.load_drop_fraction:
         return Rejected(stroke.knob, "the current falls inside the loaded window (the load "
                                      "path changed during the stroke)")
     noise = float(np.sqrt(np.mean(r * r))) if r.size else math.nan
     return LoadedRamp(stroke.knob, side, float(x.mean()), a, b,
                       float(np.median(stroke.other_deg[sel])), float(stroke.t_s[sel][-1]),
                       int(x.size), noise, knee[0], knee[1],
-                      expected_edge_deg == knee[0], speed)
+                      expected_edge_deg == knee[0], speed, drop)

@@ -29,6 +29,7 @@ from tsmd.commands.datasheet_stick import (
 )
 from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
+from tsmd.datasheet_flat_heights import FLAT_HEIGHT_KEYS, with_flat_heights
 from tsmd.datasheet_home_hold import with_home_hold
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
@@ -133,17 +134,19 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                              "sample is tracked on the simulated rig")
     loop = bool(args.plateau_gap)
     edges = bool(args.unit_edges)
+    flats = bool(args.flat_heights)
     slope = args.slope_sample is not None
     rounded = bool(args.release_round)
     # nested or new fields: written whole
     whole = args.stick_end or args.settle_gain_check or args.level_grid or args.home_hold
     if (args.unit_sample is None and not loop and not whole and not edges and not slope
-            and not rounded):
+            and not rounded and not flats):
         raise DatasheetError("--update adds the sample's part, the loop's, the stick end, the "
                              "settle-gain check, the level grid, the hold at home, the unit's "
-                             "edges, the slope weight or the rounded release: give --unit-sample, "
-                             "--plateau-gap, --stick-end, --settle-gain-check, --level-grid, "
-                             "--home-hold, --unit-edges, --slope-sample or --release-round")
+                             "edges, the flats, the slope weight or the rounded release: give "
+                             "--unit-sample, --plateau-gap, --stick-end, --settle-gain-check, "
+                             "--level-grid, --home-hold, --unit-edges, --flat-heights, "
+                             "--slope-sample or --release-round")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
@@ -187,11 +190,17 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         updated = with_unit_edges(updated, config, lambda: load_plant(args.plant, params), runs)
         keys += UNIT_EDGE_KEYS
         what.append(f"the sheet's unit calibrated, noise seeds {','.join(map(str, runs))}")
+    if flats:  # after the edges: measured against the heights drawn through them
+        updated = with_flat_heights(updated, config, lambda: load_plant(args.plant, params),
+                                    args.seed)
+        keys += FLAT_HEIGHT_KEYS
+        what.append(f"the sheet's unit calibrated, tracked, noise seed {args.seed}")
     command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
                f"'{json.dumps(params)}' --unit-key {args.unit_key}"
                + (f" --unit-sample {args.unit_sample}" if units else "")
                + (" --plateau-gap" if loop else "")
                + (" --unit-edges" if edges else "")
+               + (f" --flat-heights --seed {args.seed}" if flats else "")
                + (f" --slope-sample {args.slope_sample}" if slope else "")
                + (f" --release-round --seed {args.seed}" if rounded else "")
                + (" --stick-end" if args.stick_end else "")

@@ -62,10 +62,12 @@ class FlatRow:
 
 
 def flats_kept(rows: Sequence[FlatRow]) -> bool:
-    """The flats stay where no row rises beyond its noise and the squared sum falls."""
+    """The flats stay where the rows' squared sum falls and the worst row does not rise
+    beyond its noise (over a sample: the worst unit's row, not only the mean)."""
     if not rows:
         return False
-    if any(r.flat_deg - r.drawn_deg > r.noise_deg for r in rows):
+    worst = max(rows, key=lambda r: r.drawn_deg)
+    if max(r.flat_deg for r in rows) - worst.drawn_deg > worst.noise_deg:
         return False
     return sum(r.flat_deg ** 2 for r in rows) < sum(r.drawn_deg ** 2 for r in rows)
 
@@ -129,32 +131,44 @@ def score_flats(profile: CatheterProfile, knob: int, up_deg: float, down_deg: fl
 
 
 def with_flat_heights(device: DeviceModel, config: TsmdConfig,
-                      plant_factory: Callable[[], Plant], seed: int = SHEET_UNIT_SEED
-                      ) -> DeviceModel:
-    """The sheet with each knob's tracked flats where its unit's own rows track better with
-    them (the fields absent elsewhere); one line per knob."""
+                      plant_factory: Callable[[], Plant], seed: int = SHEET_UNIT_SEED,
+                      sample: Sequence[tuple[str, Callable[[], Plant]]] = ()) -> DeviceModel:
+    """The sheet with each knob's flats, read on its unit, where the units that judge them
+    track their own rows better with them (fields absent elsewhere): the product's ``sample``
+    ``(name, plant factory)`` where given, else the sheet's unit itself (whose drawn heights
+    pass its own reference points: it leans to them). One line per knob and unit."""
     t0 = time.monotonic()
     plain = [dataclasses.replace(k, flat_height_pos_deg=None, flat_height_neg_deg=None)
              for k in device.knobs]  # measured against the drawn heights
     drawn = dataclasses.replace(device, knobs=(plain[0], plain[1]))
     result = calibrate_sheet_unit(plant_factory, drawn, STAGE, seed, config)
+    flats = []
     for i, name in enumerate(("phi1", "phi2")):
         tension = result.profile.knobs[i].tension_play
         if tension is None:
             raise TsmdError(f"{STAGE}: the sheet's unit has no parameters for method ours")
-        flats = flats_at_zero(tracked_sweeps(result, i, STAGE))
-        if flats is None:
-            print(f"  {name}: no flat each way at the other knob's 0: heights drawn")
-            continue
-        rows = score_flats(result.profile, i, *flats, plant_factory, seed)
-        keep = flats_kept(rows)
-        if keep:
-            plain[i] = dataclasses.replace(plain[i], flat_height_pos_deg=round(flats[0], 2),
-                                           flat_height_neg_deg=round(flats[1], 2))
-        print(f"  {name} flats {flats[0]:+.2f} / {flats[1]:+.2f} (drawn "
-              f"{tension.height_pos_deg:+.2f} / {tension.height_neg_deg:+.2f}); tip rms deg "
-              "drawn -> flats (noise): " + "; ".join(
-                  f"{r.name} {r.drawn_deg:.3f} -> {r.flat_deg:.3f} ({r.noise_deg:.3f})"
-                  for r in rows) + f": {'flats' if keep else 'drawn'}")
+        flats.append(flats_at_zero(tracked_sweeps(result, i, STAGE)))
+        print(f"  {name} flats on the sheet's unit: " + (
+            "none each way at the other knob's 0" if flats[-1] is None else
+            f"{flats[-1][0]:+.2f} / {flats[-1][1]:+.2f} (drawn {tension.height_pos_deg:+.2f} / "
+            f"{tension.height_neg_deg:+.2f})"), flush=True)
+    judges = [(name, calibrate_sheet_unit(make, drawn, STAGE, seed, config).profile, make)
+              for name, make in sample] or [("sheet", result.profile, plant_factory)]
+    rows: list[list[FlatRow]] = [[], []]
+    for unit, profile, make in judges:
+        for i, f in enumerate(flats):
+            if f is None:
+                continue
+            mine = score_flats(profile, i, *f, make, seed)
+            rows[i].extend(mine)
+            print(f"  unit {unit} phi{i + 1} tip rms deg drawn -> flats (noise): " + "; ".join(
+                f"{r.name} {r.drawn_deg:.3f} -> {r.flat_deg:.3f} ({r.noise_deg:.3f})"
+                for r in mine), flush=True)
+    for i, f in enumerate(flats):
+        keep = f is not None and flats_kept(rows[i])
+        if keep and f is not None:
+            plain[i] = dataclasses.replace(plain[i], flat_height_pos_deg=round(f[0], 2),
+                                           flat_height_neg_deg=round(f[1], 2))
+        print(f"  phi{i + 1}: {'flats' if keep else 'drawn heights'}")
     print(f"  flat heights: {time.monotonic() - t0:.0f} s")
     return dataclasses.replace(device, knobs=(plain[0], plain[1]))

@@ -274,6 +274,9 @@ def main(args: argparse.Namespace) -> int:
     if args.bend_relation and args.plant is None:
         raise DatasheetError("--bend-relation goes with --plant (the unit is calibrated bent on "
                              "the simulated rig)")
+    if args.flat_sample is not None and not (args.update is not None and args.flat_heights):
+        raise DatasheetError("--flat-sample goes with --update and --flat-heights (the flats "
+                             "are judged on the sample under a measured sheet)")
     seeds = _rule_seeds(args.rule_seeds)
     if args.update is not None:
         return update(args, _params(args.params), seeds)

@@ -106,6 +106,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "loaded branches better than the heights drawn back from the "
                              "reference points (flat_height_pos_deg / _neg_deg; opt-in per "
                              "product; with --update adds only those; docs/model.md Session 28)")
+    parser.add_argument("--flat-sample", metavar="LIST",
+                        help="with --update --flat-heights: the product's sample units (values "
+                             "of --unit-key, e.g. 201-204) whose own rows judge the flats "
+                             "instead of the sheet's unit")
     parser.add_argument("--edge-level-share", action="store_true",
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "the share of the current's edge movement over the other knob's "

@@ -191,16 +191,22 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         keys += UNIT_EDGE_KEYS
         what.append(f"the sheet's unit calibrated, noise seeds {','.join(map(str, runs))}")
     if flats:  # after the edges: measured against the heights drawn through them
-        updated = with_flat_heights(updated, config, lambda: load_plant(args.plant, params),
-                                    args.seed)
+        judges = ([] if args.flat_sample is None
+                  else sample_units(args.flat_sample, params.get(args.unit_key)))
+        updated = with_flat_heights(
+            updated, config, lambda: load_plant(args.plant, params), args.seed,
+            [(str(u), functools.partial(load_plant, args.plant, {**params, args.unit_key: u}))
+             for u in judges])
         keys += FLAT_HEIGHT_KEYS
-        what.append(f"the sheet's unit calibrated, tracked, noise seed {args.seed}")
+        what.append(f"the sheet's unit calibrated, tracked, judged on "
+                    f"{'units ' + args.flat_sample if judges else 'it'}, noise seed {args.seed}")
     command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
                f"'{json.dumps(params)}' --unit-key {args.unit_key}"
                + (f" --unit-sample {args.unit_sample}" if units else "")
                + (" --plateau-gap" if loop else "")
                + (" --unit-edges" if edges else "")
                + (f" --flat-heights --seed {args.seed}" if flats else "")
+               + (f" --flat-sample {args.flat_sample}" if flats and args.flat_sample else "")
                + (f" --slope-sample {args.slope_sample}" if slope else "")
                + (f" --release-round --seed {args.seed}" if rounded else "")
                + (" --stick-end" if args.stick_end else "")

@@ -142,13 +142,14 @@ def test_the_rows_are_the_knobs_own_with_the_other_knob_still() -> None:
         assert all(np.ptp(s.q_deg[:, 1 - knob]) == 0.0 for s in rows)
 
 
-def test_with_heights_sets_one_knobs_heights_only() -> None:
+def test_with_heights_moves_one_knobs_heights_only() -> None:
     profile = make_profile(d0=21.0)
-    moved = with_heights(profile, 1, -8.0, 9.0)
+    moved = with_heights(profile, 1, -3.0, 2.0)
     assert moved.knobs[0] == profile.knobs[0]
     tp, old = moved.knobs[1].tension_play, profile.knobs[1].tension_play
     assert tp is not None and old is not None
-    assert (tp.height_pos_deg, tp.height_neg_deg) == (-8.0, 9.0)
+    assert (tp.height_pos_deg, tp.height_neg_deg) == pytest.approx(
+        (old.height_pos_deg - 3.0, old.height_neg_deg + 2.0))
     assert dataclasses.replace(tp, height_pos_deg=old.height_pos_deg,
                                height_neg_deg=old.height_neg_deg) == old
 

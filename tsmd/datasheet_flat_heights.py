@@ -99,15 +99,17 @@ def flats_at_zero(sweeps: Sequence[tuple[float, TrackedSweep]]) -> tuple[float, 
     return up, down
 
 
-def with_heights(profile: CatheterProfile, knob: int, up_deg: float, down_deg: float
+def with_heights(profile: CatheterProfile, knob: int, move_pos_deg: float, move_neg_deg: float
                  ) -> CatheterProfile:
-    """The profile with ``knob``'s plateau heights set to the flats."""
+    """The profile with ``knob``'s plateau heights moved (each unit's heights move by what the
+    flats move the sheet unit's: a unit's own plateau move, its dead-zone loop's, stays)."""
     knobs = list(profile.knobs)
     tension = knobs[knob].tension_play
     if tension is None:
         raise TsmdError(f"{STAGE}: the sheet's unit has no parameters for method ours")
     knobs[knob] = dataclasses.replace(knobs[knob], tension_play=dataclasses.replace(
-        tension, height_pos_deg=up_deg, height_neg_deg=down_deg))
+        tension, height_pos_deg=tension.height_pos_deg + move_pos_deg,
+        height_neg_deg=tension.height_neg_deg + move_neg_deg))
     return dataclasses.replace(profile, knobs=(knobs[0], knobs[1]))
 
 
@@ -116,11 +118,11 @@ def own_rows(knob: int) -> list[Scenario]:
     return [s for s in scenarios(True) if s.knobs == (knob,)]
 
 
-def score_flats(profile: CatheterProfile, knob: int, up_deg: float, down_deg: float,
+def score_flats(profile: CatheterProfile, knob: int, move_pos_deg: float, move_neg_deg: float,
                 factory: Callable[[], Plant], seed: int) -> tuple[FlatRow, ...]:
-    """``knob``'s own rows tracked with the drawn heights, with the flats, and drawn once more
-    with the next noise seed."""
-    flat = with_heights(profile, knob, up_deg, down_deg)
+    """``knob``'s own rows tracked with the drawn heights, with them moved to the flats, and
+    drawn once more with the next noise seed."""
+    flat = with_heights(profile, knob, move_pos_deg, move_neg_deg)
     rows = []
     for s in own_rows(knob):
         drawn = float(tip_rms(profile, s, factory(), seed)[knob])
@@ -142,12 +144,16 @@ def with_flat_heights(device: DeviceModel, config: TsmdConfig,
              for k in device.knobs]  # measured against the drawn heights
     drawn = dataclasses.replace(device, knobs=(plain[0], plain[1]))
     result = calibrate_sheet_unit(plant_factory, drawn, STAGE, seed, config)
-    flats = []
+    flats: list[tuple[float, float] | None] = []
+    moves: list[tuple[float, float]] = []
     for i, name in enumerate(("phi1", "phi2")):
         tension = result.profile.knobs[i].tension_play
         if tension is None:
             raise TsmdError(f"{STAGE}: the sheet's unit has no parameters for method ours")
         flats.append(flats_at_zero(tracked_sweeps(result, i, STAGE)))
+        f = flats[-1]
+        moves.append((0.0, 0.0) if f is None else (f[0] - tension.height_pos_deg,
+                                                   f[1] - tension.height_neg_deg))
         print(f"  {name} flats on the sheet's unit: " + (
             "none each way at the other knob's 0" if flats[-1] is None else
             f"{flats[-1][0]:+.2f} / {flats[-1][1]:+.2f} (drawn {tension.height_pos_deg:+.2f} / "
@@ -159,7 +165,7 @@ def with_flat_heights(device: DeviceModel, config: TsmdConfig,
         for i, f in enumerate(flats):
             if f is None:
                 continue
-            mine = score_flats(profile, i, *f, make, seed)
+            mine = score_flats(profile, i, *moves[i], make, seed)
             rows[i].extend(mine)
             print(f"  unit {unit} phi{i + 1} tip rms deg drawn -> flats (noise): " + "; ".join(
                 f"{r.name} {r.drawn_deg:.3f} -> {r.flat_deg:.3f} ({r.noise_deg:.3f})"

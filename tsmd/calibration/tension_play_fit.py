@@ -29,7 +29,8 @@ Per sweep (one knob swept +-A, the other held at a grid angle) and side:
   and this unit's own edge at 0 deg. Where the sheet opts in to the dead-zone loop
   (``plateau_gap_deg``, ``plateau_gap_factor``), each unit's own plateau moves them apart by
   ``factor (gap - sheet's gap) / 2``, the gap read from its loop's current
-  (:mod:`tsmd.calibration.dead_zone_loop`, session 25).
+  (:mod:`tsmd.calibration.dead_zone_loop`, session 25). Where the sheet keeps its unit's
+  tracked flats (``flat_height_*_deg``, session 28) they are the heights, no line drawn back.
 
 ``beta`` and ``x0`` scatter from sweep to sweep (``B_A`` by about 1 deg); over the grid they are
 smoothed by a least-squares polynomial in the other knob's angle (degree 2; on three grid points
@@ -192,6 +193,10 @@ def fit_tension_play(sweeps: Sequence[SweepCurrent], device_knob: Any,
     if shape_neg is not None:
         h_neg = shaped_height(k.reference_neg.knob_deg, k.reference_neg.tip_deg, edge_neg,
                               float(k.omega), shape_neg)
+    # the sheet unit's tracked flats where its sheet keeps them (session 28): no line drawn back
+    flat_pos, flat_neg = (getattr(k, f"flat_height_{s}_deg", None) for s in ("pos", "neg"))
+    if flat_pos is not None and flat_neg is not None:
+        h_pos, h_neg = float(flat_pos), float(flat_neg)
     # the unit's own plateau, from its dead-zone loop against the sheet unit's (session 25)
     shift = plateau_shift_deg(plateau_gap_deg, getattr(k, "plateau_gap_deg", None),
                               getattr(k, "plateau_gap_factor", None))

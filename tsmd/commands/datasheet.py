@@ -42,6 +42,7 @@ from tsmd.datasheet_bend_slope import rig_slope_reader
 from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_edge_curve import choose_edge_curve, with_edge_curve
 from tsmd.datasheet_edge_level import with_edge_level_share
+from tsmd.datasheet_flat_heights import with_flat_heights
 from tsmd.datasheet_home_hold import with_home_hold
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_offset import with_reading_offset
@@ -274,6 +275,9 @@ def main(args: argparse.Namespace) -> int:
     if args.bend_relation and args.plant is None:
         raise DatasheetError("--bend-relation goes with --plant (the unit is calibrated bent on "
                              "the simulated rig)")
+    if args.flat_sample is not None and not (args.update is not None and args.flat_heights):
+        raise DatasheetError("--flat-sample goes with --update and --flat-heights (the flats "
+                             "are judged on the sample under a measured sheet)")
     seeds = _rule_seeds(args.rule_seeds)
     if args.update is not None:
         return update(args, _params(args.params), seeds)
@@ -357,6 +361,8 @@ def main(args: argparse.Namespace) -> int:
         device = with_plateau_gap(device, config, factory, args.seed)
     if args.plant is not None and args.unit_edges:  # under the sheet's rules, as a unit
         device = with_unit_edges(device, config, factory, seeds or [args.seed])
+    if args.plant is not None and args.flat_heights:  # after the edges the heights go through
+        device = with_flat_heights(device, config, factory, args.seed)
     if args.plant is not None and args.home_hold:  # under the sheet as every unit is calibrated
         device = with_home_hold(device, config, factory, args.seed)
     if args.plant is not None and sample:

@@ -99,6 +99,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "heights are then drawn through edges read the way each unit's "
                              "are (opt-in per product; with --update adds only those; "
                              "docs/model.md Session 26)")
+    parser.add_argument("--flat-heights", action="store_true",
+                        help="with --plant: also calibrate the sheet's unit, tracked, read the "
+                             "tip's flats where the knob crosses 0 each way, and keep them as "
+                             "method ours' plateau heights on a knob where they fit the unit's "
+                             "loaded branches better than the heights drawn back from the "
+                             "reference points (flat_height_pos_deg / _neg_deg; opt-in per "
+                             "product; with --update adds only those; docs/model.md Session 28)")
+    parser.add_argument("--flat-sample", metavar="LIST",
+                        help="with --update --flat-heights: the product's sample units (values "
+                             "of --unit-key, e.g. 201-204) whose own rows judge the flats "
+                             "instead of the sheet's unit")
     parser.add_argument("--edge-level-share", action="store_true",
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "the share of the current's edge movement over the other knob's "

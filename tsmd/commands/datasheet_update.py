@@ -11,6 +11,7 @@ nested or new writes the sheet whole; the others replace only their own lines.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import re
 from collections.abc import Callable
@@ -28,6 +29,7 @@ from tsmd.commands.datasheet_stick import (
 )
 from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
+from tsmd.datasheet_flat_heights import FLAT_HEIGHT_KEYS, with_flat_heights
 from tsmd.datasheet_home_hold import with_home_hold
 from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
@@ -56,6 +58,8 @@ class StageRun:
     """``--unit-sample``'s units (empty without it)."""
     slope_sample: list[int]
     """``--slope-sample``'s units (empty without it)."""
+    flat_sample: list[int]
+    """``--flat-sample``'s units: they judge the flats instead of the sheet's unit."""
 
     @property
     def sample_seed(self) -> int:
@@ -65,6 +69,12 @@ class StageRun:
     def plant(self) -> Plant:
         """A fresh plant of the sheet's unit (each stage's runs start from one)."""
         return load_plant(self.args.plant, self.params)
+
+    def unit_plants(self, units: list[int]) -> list[tuple[str, Callable[[], Plant]]]:
+        """Each unit of the product with a factory of its fresh plant."""
+        return [(str(u), functools.partial(load_plant, self.args.plant,
+                                           {**self.params, self.args.unit_key: u}))
+                for u in units]
 
 
 @dataclass(frozen=True)
@@ -138,6 +148,15 @@ UPDATE_STAGES: tuple[UpdateStage, ...] = (
         lambda r: ("the sheet's unit calibrated, noise seeds "
                    + ",".join(map(str, r.rule_seeds or [r.args.seed]))),
         uses_rule_seeds=True),
+    UpdateStage(  # after the edges: measured against the heights drawn through them
+        "flat_heights", "the flats", FLAT_HEIGHT_KEYS, False,
+        lambda d, r: with_flat_heights(d, r.config, r.plant, r.args.seed,
+                                       r.unit_plants(r.flat_sample)),
+        lambda r: (f" --flat-heights --seed {r.args.seed}"
+                   + (f" --flat-sample {r.args.flat_sample}" if r.flat_sample else "")),
+        lambda r: (f"the sheet's unit calibrated, tracked, judged on "
+                   f"{'units ' + r.args.flat_sample if r.flat_sample else 'it'}, noise seed "
+                   f"{r.args.seed}")),
 )
 """Every stage ``--update`` knows, in the order they run."""
 
@@ -177,7 +196,8 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         args, params,
         load_config(args.config) if args.config is not None else default_sim_config(), seeds,
         [] if args.unit_sample is None else sample_units(args.unit_sample, own),
-        [] if args.slope_sample is None else sample_units(args.slope_sample, own))
+        [] if args.slope_sample is None else sample_units(args.slope_sample, own),
+        [] if args.flat_sample is None else sample_units(args.flat_sample, own))
     load_plant(args.plant, params)  # fail early, with the loader's message
     for stage in stages:
         device = stage.measure(device, run)

@@ -85,6 +85,8 @@ OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "slope_gain_weight": (0.0, 1.0, ""),
     "calibrated_dead_zone_pos_deg": (0.0, 90.0, "deg"),
     "calibrated_dead_zone_neg_deg": (-90.0, 0.0, "deg"),
+    "flat_height_pos_deg": (-45.0, 45.0, "deg"),
+    "flat_height_neg_deg": (-45.0, 45.0, "deg"),
 }
 """The data sheet's optional measured numbers per knob and their plausible ranges: the schema
 reads them with these, and ``tsmd datasheet`` leaves out a measured one outside its range
@@ -117,6 +119,8 @@ _LOOP_KEYS = ("plateau_gap_deg", "plateau_gap_factor")
 """Optional numbers of the dead-zone loop (session 25), written only when measured."""
 _UNIT_EDGE_KEYS = ("calibrated_dead_zone_pos_deg", "calibrated_dead_zone_neg_deg")
 """Optional edges of the sheet unit's own calibration (session 26), written only when measured."""
+_FLAT_KEYS = ("flat_height_pos_deg", "flat_height_neg_deg")
+"""Optional plateau heights from the sheet unit's tracked flats (session 28), when measured."""
 _SLOPE_KEYS = ("slope_gain_weight",)
 """Optional share of the gain reading a unit's slope takes, from the product's sample (s27)."""
 
@@ -267,6 +271,8 @@ def device_model_from_mapping(data: Any, origin: str = "device model") -> Device
             plateau_gap_factor=optional("plateau_gap_factor"),
             calibrated_dead_zone_pos_deg=optional("calibrated_dead_zone_pos_deg"),
             calibrated_dead_zone_neg_deg=optional("calibrated_dead_zone_neg_deg"),
+            flat_height_pos_deg=optional("flat_height_pos_deg"),
+            flat_height_neg_deg=optional("flat_height_neg_deg"),
             slope_gain_weight=optional("slope_gain_weight"),
             reading_offset=_nested(r, k.get("reading_offset"), f"{key}.reading_offset",
                                    offset_from_mapping),
@@ -342,7 +348,8 @@ def device_model_to_mapping(device: DeviceModel) -> dict[str, Any]:
         if k.release_end_shape is not None:
             knobs[name]["release_end_shape"] = release_end_shape_to_mapping(k.release_end_shape)
         for key in (_RELEASE_RULE_KEYS + _COUPLING_KEYS + _SAMPLE_KEYS + _ROUND_KEYS
-                    + _HANDLE_KEYS + _LOOP_KEYS + _UNIT_EDGE_KEYS + _SLOPE_KEYS):
+                    + _HANDLE_KEYS + _LOOP_KEYS + _UNIT_EDGE_KEYS + _FLAT_KEYS
+                    + _SLOPE_KEYS):
             if getattr(k, key) is not None:
                 knobs[name][key] = getattr(k, key)
         if k.reading_offset is not None:

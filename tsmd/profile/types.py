@@ -315,6 +315,14 @@ class DeviceKnob:
     read in the unit's first minutes; warmgear's shaft has by then not yet warmed, its slack
     not yet shrunk). None: the reference edges."""
     calibrated_dead_zone_neg_deg: float | None = None
+    flat_height_pos_deg: float | None = None
+    """Optional (with ``_neg``), tracked on the data-sheet unit (``tsmd datasheet
+    --flat-heights``, session 28): the tip's flat where the knob crosses 0 coming up (the
+    height the positive loaded branch leaves) and coming down, kept where the sheet's unit shows
+    them nearer its tip than the heights drawn back from the reference points
+    (:mod:`tsmd.datasheet_flat_heights`). Where given, method ours takes them as every unit's
+    plateau heights. None: the drawn heights."""
+    flat_height_neg_deg: float | None = None
     slope_gain_weight: float | None = None
     """Optional, chosen on the product's sample (``tsmd datasheet --update --slope-sample``,
     session 27): the share of the loaded-slope change a unit's backlash-gain reading says that

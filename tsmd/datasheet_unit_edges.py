@@ -94,6 +94,10 @@ def fit_frame_edges(knob: Any) -> tuple[float | None, float | None]:
             reference_edge_deg(offset, "dead_zone_neg_deg", knob.reference_dead_zone_neg_deg))
 
 
+def _deg(value: float | None) -> str:
+    return "none" if value is None else f"{value:.2f}"
+
+
 def with_unit_edges(device: DeviceModel, config: TsmdConfig,
                     plant_factory: Callable[[], Plant], seeds: Sequence[int] = (SHEET_UNIT_SEED,)
                     ) -> DeviceModel:
@@ -123,7 +127,8 @@ def with_unit_edges(device: DeviceModel, config: TsmdConfig,
         print(f"  {name} edges of the sheet unit's calibration (noise seeds "
               f"{','.join(map(str, seeds))}: {runs}): written less the move "
               f"{new.calibrated_dead_zone_pos_deg} / {new.calibrated_dead_zone_neg_deg} deg "
-              f"(the tracked sweep's in the fit's frame: {ref_pos} / {ref_neg}; as read: "
+              f"(the tracked sweep's in the fit's frame: {_deg(ref_pos)} / {_deg(ref_neg)}; "
+              f"as read: "
               f"{old.reference_dead_zone_pos_deg} / {old.reference_dead_zone_neg_deg})")
     print(f"  unit edges: {time.monotonic() - t0:.0f} s")
     return out

@@ -186,7 +186,8 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         runs = seeds or [args.seed]
         updated = with_unit_edges(updated, config, lambda: load_plant(args.plant, params), runs)
         keys += UNIT_EDGE_KEYS
-        what.append(f"the sheet's unit calibrated, noise seeds {','.join(map(str, runs))}")
+        what.append(f"the sheet's unit calibrated and its tip swept fresh and calibrated, "
+                    f"noise seeds {','.join(map(str, runs))}")
     command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
                f"'{json.dumps(params)}' --unit-key {args.unit_key}"
                + (f" --unit-sample {args.unit_sample}" if units else "")

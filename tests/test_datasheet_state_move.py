@@ -122,7 +122,8 @@ def test_the_state_move_is_the_tips_set_over_the_calibration_and_the_plant_is_le
     calibrated = SettingPlant(set_deg=2.0, after_s=1000.0)
     calibrated.elapsed_s = 2000.0  # the set taken during a calibration
     before = copy.deepcopy(calibrated.__dict__)
-    moves = state_moves_deg(lambda: SettingPlant(set_deg=2.0, after_s=1000.0), calibrated, 0)
+    moves = state_moves_deg(lambda: SettingPlant(set_deg=2.0, after_s=1000.0), calibrated, 0,
+                            cycles=1.0)
     for pos, neg in moves:
         assert pos == pytest.approx(2.0, abs=0.3)
         assert neg == pytest.approx(-2.0, abs=0.3)

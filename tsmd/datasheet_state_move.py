@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike
 
 from simrig.plant import Plant
 from tsmd.config import TsmdConfig, default_sim_config
-from tsmd.datasheet import analysed_from, settle, tip_sweep
+from tsmd.datasheet import ANALYSED_CYCLES, analysed_from, settle, tip_sweep
 from tsmd.replay import run_trajectory
 
 LINE_SPAN = (0.25, 0.75)
@@ -86,11 +86,11 @@ def line_moves_deg(fresh: tuple[ArrayLike, ArrayLike], kept: tuple[ArrayLike, Ar
     return moves[0], moves[1]
 
 
-def swept_tip(plant: Any, knob: int, seed: int, config: TsmdConfig
-              ) -> tuple[np.ndarray, np.ndarray]:
+def swept_tip(plant: Any, knob: int, seed: int, config: TsmdConfig,
+              cycles: float = ANALYSED_CYCLES) -> tuple[np.ndarray, np.ndarray]:
     """(knob, tip) of the analysed cycles of the sheet's sweep of ``knob`` (other knob at 0)."""
     period_s = config.loop.period_s
-    t, q, skip = settle(*tip_sweep(knob, 0.0, period_s), period_s)
+    t, q, skip = settle(*tip_sweep(knob, 0.0, period_s, cycles), period_s)
     rec = run_trajectory(t, q, config=config, method="none", seed=seed, plant=plant)
     start = analysed_from(skip, period_s)
     return (np.asarray(rec[f"pos{knob + 1}"], float)[start:],
@@ -98,10 +98,13 @@ def swept_tip(plant: Any, knob: int, seed: int, config: TsmdConfig
 
 
 def state_moves_deg(plant_factory: Callable[[], Plant], calibrated: Plant, seed: int,
-                    config: TsmdConfig | None = None) -> tuple[tuple[float, float], ...]:
+                    config: TsmdConfig | None = None, cycles: float = ANALYSED_CYCLES
+                    ) -> tuple[tuple[float, float], ...]:
     """Per knob, (pos, neg) :func:`line_moves_deg` of the sheet unit as a calibration left it
-    (``calibrated``, copied: not changed) against the unit built fresh."""
+    (``calibrated``, copied: not changed) against the unit built fresh (``cycles`` analysed
+    after the conditioning one: the sheet's tracked sweep's by default)."""
     cfg = config if config is not None else default_sim_config()
-    return tuple(line_moves_deg(swept_tip(plant_factory(), k, seed, cfg),
-                                swept_tip(KeptPlant(copy.deepcopy(calibrated)), k, seed, cfg))
+    return tuple(line_moves_deg(swept_tip(plant_factory(), k, seed, cfg, cycles),
+                                swept_tip(KeptPlant(copy.deepcopy(calibrated)), k, seed, cfg,
+                                          cycles))
                  for k in (0, 1))

@@ -4,13 +4,16 @@ calibrated edges written less that move (session 28)."""
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
-from support.profiles import make_profile
+from support.profiles import ROOT, make_profile
 
 from simrig.plant import PlantStep
+from tsmd.cli import main
 from tsmd.compensation.safety import KnobLimits
 from tsmd.datasheet_state_move import (
     KeptPlant,
@@ -19,7 +22,7 @@ from tsmd.datasheet_state_move import (
     state_moves_deg,
 )
 from tsmd.datasheet_unit_edges import with_edges_of
-from tsmd.profile import DeviceKnob, DeviceModel, ReferencePoint
+from tsmd.profile import DeviceKnob, DeviceModel, ReferencePoint, load_device_model
 
 OMEGA = 1.3
 SHEET_KNOB = DeviceKnob(1.5, ReferencePoint(90.0, 100.0), ReferencePoint(-90.0, -100.0),
@@ -128,3 +131,33 @@ def test_the_state_move_is_the_tips_set_over_the_calibration_and_the_plant_is_le
         assert pos == pytest.approx(2.0, abs=0.3)
         assert neg == pytest.approx(-2.0, abs=0.3)
     assert calibrated.__dict__ == before
+
+
+LUMPED = ROOT / "profiles" / "devices" / "family" / "lumped.yaml"
+PLANT = ["--plant", "simrig.family:make_family_plant", "--params", '{"plant":"lumped","unit":0}']
+
+
+@pytest.mark.parametrize("flags, less_move", [([], False), (["--unit-edges-move"], True)])
+def test_the_update_subtracts_the_move_only_with_its_flag_and_says_so(
+        flags: list[str], less_move: bool, tmp_path: Path,
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """Session 26's stage stays reproducible: the move is subtracted only when asked for."""
+    asked: list[bool] = []
+
+    def fake(device: DeviceModel, config: object, factory: object, seeds: object,
+             less: bool = False) -> DeviceModel:
+        asked.append(less)
+        knobs = tuple(dataclasses.replace(k, calibrated_dead_zone_pos_deg=21.0,
+                                          calibrated_dead_zone_neg_deg=-21.0)
+                      for k in device.knobs)
+        return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
+
+    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_unit_edges", fake)
+    out = tmp_path / "new.yaml"
+    assert main(["datasheet", "--update", str(LUMPED), *PLANT, "--unit-edges", *flags,
+                 "--out", str(out)]) == 0
+    assert asked == [less_move]
+    assert load_device_model(out).knobs[0].calibrated_dead_zone_pos_deg == 21.0
+    header = out.read_text().split("schema_version")[0]
+    assert ("--unit-edges-move" in header) == less_move
+    assert ("tip swept fresh and calibrated" in header) == less_move

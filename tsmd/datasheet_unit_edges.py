@@ -20,10 +20,12 @@ calibrated edges carrying the same change; drawing the heights through the sheet
 calibrated edges took the change out of every unit's line. On warmgear's unit 0 the tip's
 loaded lines lie 1.4-2.0 deg inside the fresh unit's after a calibration; on cyclopebax's 2.4
 deg outside (the ropes' set), while its calibration read edges only 0.4-0.8 deg outside the
-tracked ones (in the fit's frame: the sheet's reading offset of 1.6-1.8 deg applied). So the
-edges written are the calibration's less the move of the sheet unit's tip lines between its
-fresh and calibrated state (:mod:`tsmd.datasheet_state_move`): what stays is how the
-calibration reads an edge against the tracked sweep, which every unit's calibration shares.
+tracked ones (in the fit's frame: the sheet's reading offset of 1.6-1.8 deg applied). With
+``less_move`` (``--unit-edges-move``) the edges written are the calibration's less the move of
+the sheet unit's tip lines between its fresh and calibrated state
+(:mod:`tsmd.datasheet_state_move`): what stays is how the calibration reads an edge against the
+tracked sweep, which every unit's calibration shares. It is a choice per product: it helped
+cyclopebax's development rows and cost warmgear's (docs/model.md, session 28).
 """
 
 from __future__ import annotations
@@ -99,11 +101,12 @@ def _deg(value: float | None) -> str:
 
 
 def with_unit_edges(device: DeviceModel, config: TsmdConfig,
-                    plant_factory: Callable[[], Plant], seeds: Sequence[int] = (SHEET_UNIT_SEED,)
-                    ) -> DeviceModel:
+                    plant_factory: Callable[[], Plant], seeds: Sequence[int] = (SHEET_UNIT_SEED,),
+                    less_move: bool = False) -> DeviceModel:
     """The sheet with its unit's calibrated edges (one calibration under ``device`` per noise
-    seed) less its tip lines' move over each calibration, each run's printed beside the
-    tracked edges in the fit's frame."""
+    seed), with ``less_move`` less its tip lines' move over each calibration (session 28;
+    without it session 26's stage as it was), each run's printed beside the tracked edges in
+    the fit's frame."""
     t0 = time.monotonic()
     profiles, moves = [], []
     for s in seeds:
@@ -114,18 +117,21 @@ def with_unit_edges(device: DeviceModel, config: TsmdConfig,
             return built[-1]
 
         profiles.append(calibrate_sheet_unit(keep, device, "unit edges", s, config).profile)
-        moves.append(state_moves_deg(plant_factory, built[-1], s, config))
+        if less_move:
+            moves.append(state_moves_deg(plant_factory, built[-1], s, config))
     out = with_edges_of(device, profiles, moves)
     for i, (name, old, new) in enumerate(zip(("phi1", "phi2"), device.knobs, out.knobs,
                                              strict=True)):
-        runs = ", ".join(f"{pos:.2f} / {neg:.2f} (tip lines moved {m[i][0]:+.2f} / "
-                         f"{m[i][1]:+.2f})" for (pos, neg), m in
-                         zip((edges_at_zero(tp) for tp in (p.knobs[i].tension_play
-                                                           for p in profiles) if tp is not None),
-                             moves, strict=False))
+        read = [edges_at_zero(tp) for tp in (p.knobs[i].tension_play for p in profiles)
+                if tp is not None]
+        runs = ", ".join(f"{pos:.2f} / {neg:.2f}" + (f" (tip lines moved {m[i][0]:+.2f} / "
+                                                      f"{m[i][1]:+.2f})" if m else "")
+                         for (pos, neg), m in zip(read, moves or [()] * len(read),
+                                                  strict=False))
         ref_pos, ref_neg = fit_frame_edges(old)
         print(f"  {name} edges of the sheet unit's calibration (noise seeds "
-              f"{','.join(map(str, seeds))}: {runs}): written less the move "
+              f"{','.join(map(str, seeds))}: {runs}): written"
+              f"{' less the move' if less_move else ''} "
               f"{new.calibrated_dead_zone_pos_deg} / {new.calibrated_dead_zone_neg_deg} deg "
               f"(the tracked sweep's in the fit's frame: {_deg(ref_pos)} / {_deg(ref_neg)}; "
               f"as read: "

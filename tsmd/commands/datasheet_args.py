@@ -94,13 +94,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "with --update adds only those; docs/model.md Session 25)")
     parser.add_argument("--unit-edges", action="store_true",
                         help="with --plant: also calibrate the sheet's unit as every unit is and "
-                             "write the dead-zone edges its profile holds at the other knob's 0, "
-                             "less how far its tip's loaded lines moved between the fresh and "
-                             "the calibrated unit (calibrated_dead_zone_pos_deg / _neg_deg): "
-                             "method ours' plateau heights are then drawn through edges read "
-                             "the way each unit's are, in the state it is used in (opt-in per "
-                             "product; with --update adds only those; docs/model.md Sessions "
-                             "26, 28)")
+                             "write the dead-zone edges its profile holds at the other knob's 0 "
+                             "(calibrated_dead_zone_pos_deg / _neg_deg): method ours' plateau "
+                             "heights are then drawn through edges read the way each unit's "
+                             "are (opt-in per product; with --update adds only those; "
+                             "docs/model.md Session 26)")
+    parser.add_argument("--unit-edges-move", action="store_true",
+                        help="with --unit-edges: write those edges less how far the sheet "
+                             "unit's tip lines moved between the fresh and the calibrated unit "
+                             "(its tracked sweep played on both): the move every unit's own "
+                             "edges carry into the state it is used in stays in its line "
+                             "(docs/model.md Session 28)")
     parser.add_argument("--edge-level-share", action="store_true",
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "the share of the current's edge movement over the other knob's "

@@ -184,15 +184,18 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                     f"noise seed {seed}")
     if edges:
         runs = seeds or [args.seed]
-        updated = with_unit_edges(updated, config, lambda: load_plant(args.plant, params), runs)
+        updated = with_unit_edges(updated, config, lambda: load_plant(args.plant, params), runs,
+                                  args.unit_edges_move)
         keys += UNIT_EDGE_KEYS
-        what.append(f"the sheet's unit calibrated and its tip swept fresh and calibrated, "
-                    f"noise seeds {','.join(map(str, runs))}")
+        what.append("the sheet's unit calibrated"
+                    + (" and its tip swept fresh and calibrated" if args.unit_edges_move else "")
+                    + f", noise seeds {','.join(map(str, runs))}")
     command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "
                f"'{json.dumps(params)}' --unit-key {args.unit_key}"
                + (f" --unit-sample {args.unit_sample}" if units else "")
                + (" --plateau-gap" if loop else "")
                + (" --unit-edges" if edges else "")
+               + (" --unit-edges-move" if edges and args.unit_edges_move else "")
                + (f" --slope-sample {args.slope_sample}" if slope else "")
                + (f" --release-round --seed {args.seed}" if rounded else "")
                + (" --stick-end" if args.stick_end else "")

@@ -302,9 +302,9 @@ class DeviceKnob:
     protocol, same time since the catheter was switched on. Where given, the plateau heights
     are drawn through these instead of ``reference_dead_zone_*_deg`` (whose tracked sweep is
     read in the unit's first minutes; warmgear's shaft has by then not yet warmed, its slack
-    not yet shrunk). Since session 28 less the move of the sheet unit's tip lines between
-    its fresh and calibrated state (every unit's own edges carry that move, and a unit is
-    used calibrated). None: the reference edges."""
+    not yet shrunk). With ``--unit-edges-move`` (session 28) less the move of the sheet
+    unit's tip lines between its fresh and calibrated state (every unit's own edges carry that
+    move, and a unit is used calibrated). None: the reference edges."""
     calibrated_dead_zone_neg_deg: float | None = None
     slope_gain_weight: float | None = None
     """Optional, chosen on the product's sample (``tsmd datasheet --update --slope-sample``,

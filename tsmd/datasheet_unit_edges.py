@@ -25,7 +25,8 @@ tracked ones (in the fit's frame: the sheet's reading offset of 1.6-1.8 deg appl
 the sheet unit's tip lines between its fresh and calibrated state
 (:mod:`tsmd.datasheet_state_move`): what stays is how the calibration reads an edge against the
 tracked sweep, which every unit's calibration shares. It is a choice per product: it helped
-cyclopebax's development rows and cost warmgear's (docs/model.md, session 28).
+cyclopebax's development rows and cost warmgear's and twistshaft's (docs/model.md, session
+28).
 """
 
 from __future__ import annotations

@@ -360,7 +360,8 @@ def main(args: argparse.Namespace) -> int:
     if args.plant is not None and args.plateau_gap:
         device = with_plateau_gap(device, config, factory, args.seed)
     if args.plant is not None and args.unit_edges:  # under the sheet's rules, as a unit
-        device = with_unit_edges(device, config, factory, seeds or [args.seed])
+        device = with_unit_edges(device, config, factory, seeds or [args.seed],
+                                 args.unit_edges_move)
     if args.plant is not None and args.flat_heights:  # after the edges the heights go through
         device = with_flat_heights(device, config, factory, args.seed)
     if args.plant is not None and args.home_hold:  # under the sheet as every unit is calibrated

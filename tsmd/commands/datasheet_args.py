@@ -110,6 +110,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="with --update --flat-heights: the product's sample units (values "
                              "of --unit-key, e.g. 201-204) whose own rows judge the flats "
                              "instead of the sheet's unit")
+    parser.add_argument("--unit-edges-move", action="store_true",
+                        help="with --unit-edges: write those edges less how far the sheet "
+                             "unit's tip lines moved between the fresh and the calibrated unit "
+                             "(its tracked sweep played on both): the move every unit's own "
+                             "edges carry into the state it is used in stays in its line "
+                             "(docs/model.md Session 28)")
     parser.add_argument("--edge-level-share", action="store_true",
                         help="with --plant: also calibrate the unit once more, tracked, and read "
                              "the share of the current's edge movement over the other knob's "

@@ -143,10 +143,12 @@ UPDATE_STAGES: tuple[UpdateStage, ...] = (
                    f"tracked, noise seed {r.sample_seed}")),
     UpdateStage(
         "unit_edges", "the unit's edges", UNIT_EDGE_KEYS, False,
-        lambda d, r: with_unit_edges(d, r.config, r.plant, r.rule_seeds or [r.args.seed]),
-        lambda r: " --unit-edges",
-        lambda r: ("the sheet's unit calibrated, noise seeds "
-                   + ",".join(map(str, r.rule_seeds or [r.args.seed]))),
+        lambda d, r: with_unit_edges(d, r.config, r.plant, r.rule_seeds or [r.args.seed],
+                                     r.args.unit_edges_move),
+        lambda r: " --unit-edges" + (" --unit-edges-move" if r.args.unit_edges_move else ""),
+        lambda r: ("the sheet's unit calibrated"
+                   + (" and its tip swept fresh and calibrated" if r.args.unit_edges_move else "")
+                   + ", noise seeds " + ",".join(map(str, r.rule_seeds or [r.args.seed]))),
         uses_rule_seeds=True),
     UpdateStage(  # after the edges: measured against the heights drawn through them
         "flat_heights", "the flats", FLAT_HEIGHT_KEYS, False,

@@ -313,7 +313,9 @@ class DeviceKnob:
     protocol, same time since the catheter was switched on. Where given, the plateau heights
     are drawn through these instead of ``reference_dead_zone_*_deg`` (whose tracked sweep is
     read in the unit's first minutes; warmgear's shaft has by then not yet warmed, its slack
-    not yet shrunk). None: the reference edges."""
+    not yet shrunk). With ``--unit-edges-move`` (session 28) less the move of the sheet
+    unit's tip lines between its fresh and calibrated state (every unit's own edges carry that
+    move, and a unit is used calibrated). None: the reference edges."""
     calibrated_dead_zone_neg_deg: float | None = None
     flat_height_pos_deg: float | None = None
     """Optional (with ``_neg``), tracked on the data-sheet unit (``tsmd datasheet

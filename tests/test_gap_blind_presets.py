@@ -2,7 +2,8 @@
 21; snakedent, session 22; planetwist, session 23, none with a time law at the tip; notchclutch,
 session 24, whose braid stiffens with strain rate and whose liner soaks; pronyring, session 25,
 whose Pebax section relaxes with a Prony spectrum; wormeyelet, session 26, whose eyelets take
-wrap from the other plane's bend)."""
+wrap from the other plane's bend; beltbraid, session 27, whose braided shaft's crossings slip
+under all four ropes' load)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ from typing import Any
 import numpy as np
 import pytest
 
+from simrig.plants.beltbraid import BeltBraidPlant
+from simrig.plants.beltbraid import KnobParams as BeltBraidKnob
 from simrig.plants.cyclopebax import CycloPebaxPlant
 from simrig.plants.cyclopebax.params import CycloPebaxKnob
 from simrig.plants.notchclutch.params import NotchClutchKnob
@@ -30,10 +33,16 @@ BLIND = [("cyclopebax", CycloPebaxPlant, CycloPebaxKnob),
          ("planetwist", PlanetTwistPlant, PlanetTwistKnob),
          ("notchclutch", NotchClutchPlant, NotchClutchKnob),
          ("pronyring", PronyRingPlant, PronyRingKnob),
-         ("wormeyelet", WormEyeletPlant, WormEyeletKnob)]
+         ("wormeyelet", WormEyeletPlant, WormEyeletKnob),
+         ("beltbraid", BeltBraidPlant, BeltBraidKnob)]
 NAMES = [name for name, _plant, _knob in BLIND]
-TIMELESS = ["cyclopebax", "snakedent", "planetwist", "wormeyelet"]
+TIMELESS = ["cyclopebax", "snakedent", "planetwist", "wormeyelet", "beltbraid"]
 """The blind plants with no law of speed or time at the tip."""
+
+
+def _knobs(plant: Any) -> list[Any]:
+    """A plant's per-knob constants (beltbraid keeps them apart from its knobs' state)."""
+    return list(plant.params) if isinstance(plant, BeltBraidPlant) else list(plant.knobs)
 
 
 def _share_keyword(plant: Any) -> list[float]:
@@ -52,6 +61,10 @@ def _cross_wrap_constant(plant: Any) -> list[float]:
     return [knob.cross_wrap for knob in plant.knobs]
 
 
+def _braid_constant(plant: Any) -> list[float]:
+    return [knob.braid_slip_mm for knob in plant.params]
+
+
 TAKEUP: dict[str, tuple[Callable[[Any], list[float]], set[str]]] = {
     "cyclopebax": (_share_keyword, set()),
     "snakedent": (_share_keyword, set()),
@@ -59,10 +72,12 @@ TAKEUP: dict[str, tuple[Callable[[Any], list[float]], set[str]]] = {
     "notchclutch": (_takeup_keyword, set()),
     "pronyring": (_takeup_keyword, set()),
     "wormeyelet": (_cross_wrap_constant, {"cross_wrap"}),
+    "beltbraid": (_braid_constant, {"braid_slip_mm"}),
 }
 """How strongly the other plane's bend takes up a plane's ropes (on wormeyelet: adds wrap at
-its eyelets), per plant, and which knob constants the coupling case may change (a keyword on
-cyclopebax and snakedent, planetwist's and wormeyelet's own knob constant)."""
+its eyelets; on beltbraid: how far the braid's crossings slip under the ropes' load), per plant,
+and which knob constants the coupling case may change (a keyword on cyclopebax and snakedent,
+planetwist's, wormeyelet's and beltbraid's own knob constant)."""
 
 
 @pytest.mark.parametrize(("name", "plant_type", "_knob"), BLIND)
@@ -72,7 +87,7 @@ def test_preset_is_found_by_name_and_builds_a_family_unit(name: str, plant_type:
     assert spec is PRESETS[name]
     plant = spec.build_unit(1, 0.1)
     assert isinstance(plant, plant_type)
-    assert plant.knobs != spec.build_unit(2, 0.1).knobs  # the family's scatter, per unit
+    assert _knobs(plant) != _knobs(spec.build_unit(2, 0.1))  # the family's scatter, per unit
 
 
 @pytest.mark.parametrize(("name", "_plant", "knob_type"), BLIND)
@@ -90,9 +105,9 @@ def test_cases_halve_the_rope_and_bend_the_sheath(name: str) -> None:
     soft = preset.build_unit(102, 0.1, "compliance", **preset.case_effects("compliance"))
     bent = preset.build_unit(102, 0.1, "curvature", **preset.case_effects("curvature"))
     for k in (0, 1):
-        assert soft.knobs[k].tendon_stiffness_N == pytest.approx(
-            0.5 * none.knobs[k].tendon_stiffness_N)
-        assert bent.knobs[k] == none.knobs[k]
+        assert _knobs(soft)[k].tendon_stiffness_N == pytest.approx(
+            0.5 * _knobs(none)[k].tendon_stiffness_N)
+        assert _knobs(bent)[k] == _knobs(none)[k]
     assert none.sheath_curvature_deg == 0.0
     assert bent.sheath_curvature_deg == pytest.approx(120.0)
 
@@ -105,8 +120,8 @@ def test_coupling_case_only_raises_the_other_planes_takeup(name: str) -> None:
     coupled = preset.build_unit(102, 0.1, "coupling", **preset.case_effects("coupling"))
     for k in (0, 1):
         assert takeup(coupled)[k] > 1.5 * takeup(none)[k]
-        kept = {c: getattr(none.knobs[k], c) for c in constants}
-        assert dataclasses.replace(coupled.knobs[k], **kept) == none.knobs[k]
+        kept = {c: getattr(_knobs(none)[k], c) for c in constants}
+        assert dataclasses.replace(_knobs(coupled)[k], **kept) == _knobs(none)[k]
     assert coupled.sheath_curvature_deg == none.sheath_curvature_deg
 
 

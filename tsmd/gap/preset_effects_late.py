@@ -189,3 +189,39 @@ the others' coupling 1.5 deg); the stainless rope's EA halved, 4.51 / 4.23 deg."
 WORMEYELET_MAX_STEP_S = 0.0
 """No finer stepping: unit 1's tip lies 0.009 deg RMS (0.05 max) from 0.25 ms steps at 20 ms,
 0.006 (0.05) at 4 ms (unit 2 0.013 / 0.011): every law is quasi-static in the knob angle."""
+
+
+BELTBRAID_EFFECTS: dict[str, dict[str, float]] = {
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The beltbraid plant's one effect keyword: a 120 deg sheath bend (added to every rope's lumen
+wrap), 5.00 / 4.16 deg of tip (tip RMSE effect on minus off, units 1 / 2, noise-free, 120 s of
+the experiment motion at 50 Hz stepped at 2 ms; 60 deg 2.33 / 1.91), inside the others'
+1.1-12.8 deg. Nothing at the tip reads the knob's speed or time: the knob's and the ropes' seals
+are Coulomb laws smoothed over a few deg/s (saturated on every motion), the lumen's Bouc-Wen
+microslip and the braid's relays are laws of travel, and the belt's Reynolds creep accumulates
+with travel under load (the same samples played 8 times as fast, both at 0.25 ms steps, move
+the tip 0.14 / 0.11 deg and the current 0.9 / 0.7 mA RMS, partly the step's lag; knob 1 held at
+75 deg for 65 s, the other at 30: tip and current 0.000): rate and creep are not run. The
+belt's creep and wind-up, the return springs, the seals, the microslip, the braid's own slip and
+the notches' asymmetry are base physics; "none" is the nominal physics as written (docs/gap.md
+"Session 28")."""
+
+BELTBRAID_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"braid_slip_mm": 2.5},
+    "compliance": {"tendon_stiffness_N": 0.5},
+}
+"""Beltbraid effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion, units 1 / 2, 2 ms steps): the braided shaft's crossings slipping 2.5 times as far
+under the four ropes' load (``braid_slip_mm``, the plant's constant that couples the planes: the
+shaft's shortening takes draw from every rope; the shaft is one part, knob 1's constant is
+read), 1.54 / 1.52 deg (x2 1.05 / 1.04, x3 2.04 / 2.01, x4 2.99 / 2.85; the braid's slip and
+elastic part removed altogether 1.56 / 1.42; the others' coupling 1.5 deg); the steel rope's EA
+halved, 5.80 / 5.14 deg."""
+
+BELTBRAID_MAX_STEP_S = 0.002
+"""Stepped at 2 ms: the belt's wind-up, the lumen's capacity and the shaft's shortening lag one
+step, and at the recording's 20 ms the linearised microslip overshoots (unit 2 with a 60 deg
+bend: the tip at -159 deg against -68 at 4 ms). Against 0.25 ms steps the tip lies 0.30 / 0.29
+deg RMS away at 10 ms, 0.19 / 0.18 at 4 ms, 0.14 / 0.11 at 2 ms (max 0.77 / 0.65), 0.09 / 0.06
+at 1 ms (units 1 / 2, the experiment motion at 50 Hz)."""

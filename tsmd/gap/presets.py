@@ -50,6 +50,9 @@ from tsmd.gap.preset_effects import (
     WARMGEAR_MAX_STEP_S,
 )
 from tsmd.gap.preset_effects_late import (
+    BELTBRAID_EFFECTS,
+    BELTBRAID_KNOB_EFFECTS,
+    BELTBRAID_MAX_STEP_S,
     CYCLOPEBAX_EFFECTS,
     CYCLOPEBAX_KNOB_EFFECTS,
     CYCLOPEBAX_MAX_STEP_S,
@@ -198,6 +201,9 @@ PRESETS: dict[str, PlantSpec] = {
                             family="wormeyelet", effects=WORMEYELET_EFFECTS,
                             knob_effects=WORMEYELET_KNOB_EFFECTS,
                             max_step_s=WORMEYELET_MAX_STEP_S),
+    "beltbraid": PlantSpec(PLANT_SPECS["beltbraid"], {}, (), "beltbraid", family="beltbraid",
+                           effects=BELTBRAID_EFFECTS, knob_effects=BELTBRAID_KNOB_EFFECTS,
+                           max_step_s=BELTBRAID_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

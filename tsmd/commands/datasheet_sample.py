@@ -27,6 +27,7 @@ from tsmd.commands.datasheet_stick import (
     with_settle_gain_check,
     with_stick_choice,
 )
+from tsmd.commands.datasheet_sweep import with_sweep_start
 from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_home_hold import with_home_hold
@@ -35,6 +36,7 @@ from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
 from tsmd.datasheet_release_round import with_release_round
 from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
 from tsmd.datasheet_slope_weight import sample_pairs, with_slope_weight
+from tsmd.datasheet_start import DEFAULT_SHEET_START
 from tsmd.datasheet_unit_edges import UNIT_EDGE_KEYS, with_unit_edges
 from tsmd.profile import DeviceModel, load_device_model, save_device_fields, save_device_model
 
@@ -135,15 +137,21 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
     edges = bool(args.unit_edges)
     slope = args.slope_sample is not None
     rounded = bool(args.release_round)
+    sweep = bool(args.sweep_constants)
     # nested or new fields: written whole
-    whole = args.stick_end or args.settle_gain_check or args.level_grid or args.home_hold
+    whole = (args.stick_end or args.settle_gain_check or args.level_grid or args.home_hold
+             or sweep)
     if (args.unit_sample is None and not loop and not whole and not edges and not slope
             and not rounded):
         raise DatasheetError("--update adds the sample's part, the loop's, the stick end, the "
                              "settle-gain check, the level grid, the hold at home, the unit's "
-                             "edges, the slope weight or the rounded release: give --unit-sample, "
-                             "--plateau-gap, --stick-end, --settle-gain-check, --level-grid, "
-                             "--home-hold, --unit-edges, --slope-sample or --release-round")
+                             "edges, the slope weight, the rounded release or the sweep "
+                             "constants: give --unit-sample, --plateau-gap, --stick-end, "
+                             "--settle-gain-check, --level-grid, --home-hold, --unit-edges, "
+                             "--slope-sample, --release-round or --sweep-constants")
+    if args.start != DEFAULT_SHEET_START and not sweep:
+        raise DatasheetError(f"--start {args.start} moves the sheet unit's sweeps only: with "
+                             "--update give --sweep-constants")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
@@ -151,6 +159,9 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
              else sample_units(args.unit_sample, params.get(args.unit_key)))
     config = load_config(args.config) if args.config is not None else default_sim_config()
     load_plant(args.plant, params)  # fail early, with the loader's message
+    if sweep:  # first: every stage after is measured under the constants it reads
+        device = with_sweep_start(device, config, lambda: load_plant(args.plant, params),
+                                  args.start, args.seed)
     if args.stick_end:
         device = with_stick_choice(device, config, args.plant, params, seeds)
     if args.settle_gain_check:
@@ -198,6 +209,8 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                + (" --settle-gain-check" if args.settle_gain_check else "")
                + (f" --level-grid --seed {args.seed}" if args.level_grid else "")
                + (f" --home-hold --seed {args.seed}" if args.home_hold else "")
+               + (f" --sweep-constants --start {args.start} --seed {args.seed}" if sweep
+                  else "")
                + (f" --rule-seeds {','.join(map(str, seeds))}"
                   if seeds and (args.stick_end or args.settle_gain_check or edges) else "")
                + " --out FILE")
@@ -205,7 +218,9 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         fields = ((["backlash_stick_end", "reading_offset"] if args.stick_end else [])
                   + (["settle_gain_read"] if args.settle_gain_check else [])
                   + (["loaded_level_grid"] if args.level_grid else [])
-                  + (["hold_at_home"] if args.home_hold else []) + list(keys))
+                  + (["hold_at_home"] if args.home_hold else [])
+                  + ([f"the sweep constants ({args.start} start)"] if sweep else [])
+                  + list(keys))
         save_device_model(updated, args.out, source_header(source) + (
             f"\n{', '.join(fields)} measured by tsmd {__version__} (no other field changed):"
             f"\n  {command}"))

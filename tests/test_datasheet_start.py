@@ -64,8 +64,8 @@ def test_a_calibrated_start_sweeps_copies_that_go_on_from_the_calibration(
         monkeypatch: pytest.MonkeyPatch) -> None:
     seen: list[int] = []
     monkeypatch.setattr("tsmd.datasheet_start.calibrate_with_plant", _calibrating(seen))
-    make = sheet_unit_factory("calibrated", _Clock, load_device_model(LUMPED), 2000, default_sim_config(),
-                              log=lambda _: None)
+    make = sheet_unit_factory("calibrated", _Clock, load_device_model(LUMPED), 2000,
+                              default_sim_config(), log=lambda _: None)
     first, second = make(), make()
     assert seen == [2000]  # one calibration serves every sweep
     assert isinstance(first, CarriedPlant) and first.plant is not second.plant

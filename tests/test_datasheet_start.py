@@ -187,3 +187,33 @@ def test_the_sweep_constants_go_with_an_update(tmp_path: Path,
     assert main(["datasheet", *PLANT, "--device-model", "x", "--sweep-constants", "--out",
                  str(tmp_path / "d.yaml")]) == 2
     assert "--sweep-constants goes with --update" in capsys.readouterr().err
+
+
+def test_a_full_measurement_sweeps_again_after_a_calibration_under_its_fresh_sheet(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    sheet = load_device_model(LUMPED)
+    calibrated_under: list[DeviceModel] = []
+    coupled_on: list[Any] = []
+
+    def calibrate(device: DeviceModel, make: Callable[[], Any], seed: int,
+                  config: Any = None) -> tuple[None, Any]:
+        calibrated_under.append(device)
+        return _mark_calibrated(device, make, seed, config)
+
+    def coupling(device: DeviceModel, config: Any, factory: Callable[[], Any],
+                 seed: int) -> DeviceModel:
+        coupled_on.append(factory())
+        return device
+
+    monkeypatch.setattr("tsmd.commands.datasheet.measure_device_constants", _fake_sweeps(sheet))
+    monkeypatch.setattr("tsmd.datasheet_start.calibrate_with_plant", calibrate)
+    monkeypatch.setattr("tsmd.commands.datasheet._with_coupling", coupling)
+    out = tmp_path / "full.yaml"
+    assert main(["datasheet", *PLANT, "--device-model", "family-lumped", "--start",
+                 "calibrated", "--rule-seeds", "none", "--no-ratio-gain", "--out",
+                 str(out)]) == 0
+    cold, warm = sheet.knobs[0].reference_pos.tip_deg, load_device_model(out).knobs[0]
+    assert [d.knobs[0].reference_pos.tip_deg for d in calibrated_under] == [cold]
+    assert warm.reference_pos.tip_deg == pytest.approx(cold + WARM_TIP_DEG)
+    assert [isinstance(p, CarriedPlant) for p in coupled_on] == [True]  # a sweep stage
+    assert "start calibrated" in out.read_text()

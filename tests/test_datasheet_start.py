@@ -174,12 +174,30 @@ def test_the_update_on_a_fresh_start_gives_the_sheet_back(
     assert load_device_model(out) == sheet
 
 
-def test_a_calibrated_start_on_an_update_needs_the_sweep_constants(
+def test_a_calibrated_start_on_an_update_needs_the_sweeps_or_the_loop(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["datasheet", "--update", str(LUMPED), *PLANT, "--plateau-gap", "--start",
+    assert main(["datasheet", "--update", str(LUMPED), *PLANT, "--unit-edges", "--start",
                  "calibrated", "--out", str(tmp_path / "d.yaml")]) == 2
-    assert "give --sweep-constants" in capsys.readouterr().err
+    assert "give --sweep-constants or --plateau-gap" in capsys.readouterr().err
     assert not (tmp_path / "d.yaml").exists()
+
+
+def test_the_loop_on_an_update_plays_on_the_calibrated_unit(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    played_on: list[Any] = []
+
+    def loop(device: DeviceModel, config: Any, factory: Callable[[], Any],
+             seed: int) -> DeviceModel:
+        played_on.append(factory())
+        return device
+
+    monkeypatch.setattr("tsmd.datasheet_start.calibrate_with_plant", _mark_calibrated)
+    monkeypatch.setattr("tsmd.commands.datasheet_sample.with_plateau_gap", loop)
+    out = tmp_path / "loop.yaml"
+    assert main(["datasheet", "--update", str(LUMPED), *PLANT, "--plateau-gap", "--start",
+                 "calibrated", "--out", str(out)]) == 0
+    assert [getattr(p, "calibrated_by_test", False) for p in played_on] == [True]
+    assert "--plateau-gap --start calibrated" in out.read_text()
 
 
 def test_the_sweep_constants_go_with_an_update(tmp_path: Path,

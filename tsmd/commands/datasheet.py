@@ -378,8 +378,8 @@ def main(args: argparse.Namespace) -> int:
         device = with_release_end(device, config, factory, args.seed)
     if args.plant is not None and args.level_grid:
         device = with_level_grid(device, config, factory, args.seed)
-    if args.plant is not None and args.plateau_gap:
-        device = with_plateau_gap(device, config, factory, args.seed)
+    if args.plant is not None and args.plateau_gap:  # a tracked loop: on the sweeps' start
+        device = with_plateau_gap(device, config, sweeps, args.seed)
     if args.plant is not None and args.unit_edges:  # under the sheet's rules, as a unit
         device = with_unit_edges(device, config, factory, seeds or [args.seed])
     if args.plant is not None and args.home_hold:  # under the sheet as every unit is calibrated

@@ -167,9 +167,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "(the default, every sheet before session 28) or 'calibrated': "
                              "after the same calibration run a clinical unit gets, under the "
                              "sheet (a full measurement: under the one its fresh sweeps give "
-                             "first), each sweep on a copy of the plant it left (the benches' "
-                             "start); the stages that calibrate the unit start it fresh as "
-                             "before (docs/model.md, session 28)")
+                             "first), each sweep and the dead-zone loop (--plateau-gap) on a "
+                             "copy of the plant it left (the benches' start); the stages that "
+                             "calibrate the unit start it fresh as before (docs/model.md, "
+                             "session 28)")
     parser.add_argument("--sweep-constants", action="store_true",
                         help="with --update: measure the sheet unit's +-90 deg sweeps again on "
                              "--start and write the fields they give (omega, reference points "

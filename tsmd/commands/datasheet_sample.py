@@ -36,7 +36,7 @@ from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
 from tsmd.datasheet_release_round import with_release_round
 from tsmd.datasheet_sample import SAMPLE_KEYS, left_deg2, measure_sample
 from tsmd.datasheet_slope_weight import sample_pairs, with_slope_weight
-from tsmd.datasheet_start import DEFAULT_SHEET_START
+from tsmd.datasheet_start import DEFAULT_SHEET_START, sheet_unit_factory
 from tsmd.datasheet_unit_edges import UNIT_EDGE_KEYS, with_unit_edges
 from tsmd.profile import DeviceModel, load_device_model, save_device_fields, save_device_model
 
@@ -149,9 +149,9 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                              "constants: give --unit-sample, --plateau-gap, --stick-end, "
                              "--settle-gain-check, --level-grid, --home-hold, --unit-edges, "
                              "--slope-sample, --release-round or --sweep-constants")
-    if args.start != DEFAULT_SHEET_START and not sweep:
-        raise DatasheetError(f"--start {args.start} moves the sheet unit's sweeps only: with "
-                             "--update give --sweep-constants")
+    if args.start != DEFAULT_SHEET_START and not (sweep or loop):
+        raise DatasheetError(f"--start {args.start} moves the sheet unit's sweeps and loop "
+                             "only: with --update give --sweep-constants or --plateau-gap")
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
@@ -159,9 +159,13 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
              else sample_units(args.unit_sample, params.get(args.unit_key)))
     config = load_config(args.config) if args.config is not None else default_sim_config()
     load_plant(args.plant, params)  # fail early, with the loader's message
+    # the sweeps and the loop run on --start (calibrated: after one calibration under the
+    # sheet as given); the stages that calibrate the unit start it fresh
+    started = (sheet_unit_factory(args.start, lambda: load_plant(args.plant, params), device,
+                                  args.seed, config)
+               if args.start != DEFAULT_SHEET_START else lambda: load_plant(args.plant, params))
     if sweep:  # first: every stage after is measured under the constants it reads
-        device = with_sweep_start(device, config, lambda: load_plant(args.plant, params),
-                                  args.start, args.seed)
+        device = with_sweep_start(device, config, started, args.seed)
     if args.stick_end:
         device = with_stick_choice(device, config, args.plant, params, seeds)
     if args.settle_gain_check:
@@ -177,10 +181,10 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
     keys: tuple[str, ...] = SAMPLE_KEYS if units else ()
     what = [f"{len(units) + 1} units, fast protocol, noise seed {seed}"] if units else []
     if loop:
-        updated = with_plateau_gap(updated, config, lambda: load_plant(args.plant, params),
-                                   args.seed)
+        updated = with_plateau_gap(updated, config, started, args.seed)
         keys += LOOP_KEYS
-        what.append(f"the sheet's unit's dead-zone loop, noise seed {args.seed}")
+        what.append(f"the sheet's unit's dead-zone loop, noise seed {args.seed}, {args.start} "
+                    "start")
     if rounded:  # read under the sheet's own choices, as every unit is calibrated
         updated = with_release_round(updated, config, lambda: load_plant(args.plant, params),
                                      args.seed)
@@ -202,6 +206,7 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
                f"'{json.dumps(params)}' --unit-key {args.unit_key}"
                + (f" --unit-sample {args.unit_sample}" if units else "")
                + (" --plateau-gap" if loop else "")
+               + (f" --start {args.start}" if loop and not sweep else "")
                + (" --unit-edges" if edges else "")
                + (f" --slope-sample {args.slope_sample}" if slope else "")
                + (f" --release-round --seed {args.seed}" if rounded else "")

@@ -120,7 +120,7 @@ def test_update_calibrates_the_sample_under_the_sheet_and_writes_only_its_part(
     (["--unit-sample", "201", "--update", "/no/such.yaml"], "no such file"),
     (["--unit-sample", "101", "--update", str(LUMPED)], "scored"),
     (["--unit-sample", "201", "--update", str(LUMPED), "--loaded-shape"], "anew"),
-    (["--update", str(LUMPED)], "give --stick-end")])
+    (["--update", str(LUMPED)], "--update adds the sweep constants, the stick end")])
 def test_a_bad_update_is_one_line_and_writes_nothing(
         extra: list[str], message: str, tmp_path: Path,
         capsys: pytest.CaptureFixture[str]) -> None:

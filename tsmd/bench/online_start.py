@@ -21,29 +21,10 @@ from typing import Any
 
 from simrig.scenario import ShapeChange, ShapeChangePlant
 from tsmd.bench.online_units import calibrate_unit, make_unit
+from tsmd.carried_plant import CarriedPlant
 from tsmd.profile import load_profile, save_profile
 
 STARTS = ("calibrated", "fresh")
-
-
-class CarriedPlant:
-    """A plant that goes on from where an earlier run left it: the rig's reset at the start of a
-    run keeps its state (the probe stays inserted), everything else is the wrapped plant's."""
-
-    def __init__(self, plant: Any) -> None:
-        self.plant = plant
-
-    def reset(self) -> None:
-        """Nothing: the catheter is not taken out between calibration and use."""
-
-    def reshape(self, **changes: Any) -> None:
-        self.plant.reshape(**changes)
-
-    def step(self, dt_s: float, knob_deg: Any) -> Any:
-        return self.plant.step(dt_s, knob_deg)
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self.plant, name)
 
 
 def calibrated_with_plant(plant: str, unit: int, change: dict[str, Any] | None, device: Any,

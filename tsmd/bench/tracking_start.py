@@ -20,16 +20,14 @@ The calibrated plant is kept beside the unit's profile (``unit-<n>.plant.pkl``) 
 
 from __future__ import annotations
 
-import copy
 import pickle
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from tsmd.bench.online_start import CarriedPlant
-from tsmd.calibration import calibrate
+from tsmd.carried_plant import calibrate_with_plant as calibrated_unit
+from tsmd.carried_plant import carried_factory
 from tsmd.profile import CatheterProfile, load_profile, save_profile
-from tsmd.replay import LockstepRunner
 
 STARTS = ("calibrated", "conditioned", "fresh")
 DEFAULT_START = "calibrated"
@@ -52,10 +50,7 @@ def calibrate_with_plant(device: Any, make: Callable[[], Any], seed: int = CALIB
                          ) -> tuple[CatheterProfile, Any]:
     """The unit's profile from ``tsmd.calibration.calibrate`` (motor current only, the bench's
     protocol) and the plant as that calibration left it."""
-    plant = make()
-    with LockstepRunner(None, None, "none", seed, plant) as runner:
-        profile = calibrate(runner, "sim-bench", device)
-    return profile, plant
+    return calibrated_unit(device, make, seed)
 
 
 def plant_path(profile_path: Path) -> Path:
@@ -97,11 +92,7 @@ def scenario_plant(start: str, make: Callable[[], Any], calibrated_plant: Any
         return make
     if calibrated_plant is None:
         raise ValueError("a calibrated start needs the plant its calibration left")
-
-    def carried() -> Any:
-        return CarriedPlant(copy.deepcopy(calibrated_plant))
-
-    return carried
+    return carried_factory(calibrated_plant)
 
 
 def conditions(start: str) -> bool:

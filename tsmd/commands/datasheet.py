@@ -61,6 +61,7 @@ from tsmd.datasheet_rule import (
 from tsmd.datasheet_rule_settled import rule_text
 from tsmd.datasheet_shape_choice import with_shape_choice
 from tsmd.datasheet_shape_grid import measure_shape_grids
+from tsmd.datasheet_start import DEFAULT_SHEET_START, sheet_unit_factory
 from tsmd.datasheet_unit_edges import with_unit_edges
 from tsmd.profile import DeviceModel, save_device_model
 from tsmd.profile.reading_offset import ReadingOffset
@@ -264,6 +265,24 @@ def _or_none(value: float | None, decimals: int) -> str:
     return "none" if value is None else f"{value:.{decimals}f}"
 
 
+def _sheet(args: argparse.Namespace, constants: list[KnobConstants], config: TsmdConfig,
+           ripple: float | None) -> DeviceModel:
+    """The sheet its sweep constants give, with the handle's design constants and readable."""
+    device = device_model(args.device_model, constants, config, args.description,
+                          loaded_shape=args.loaded_shape or args.choose_loaded_shape)
+    if ripple is not None:
+        phi1, phi2 = (dataclasses.replace(k, torque_ripple_period_deg=ripple)
+                      for k in device.knobs)
+        device = dataclasses.replace(device, knobs=(phi1, phi2))
+    if args.edge_rise:
+        phi1, phi2 = (dataclasses.replace(k, edge_rise=True) for k in device.knobs)
+        device = dataclasses.replace(device, knobs=(phi1, phi2))
+    device, dropped = readable(device)
+    for line in dropped:
+        print(f"warning: {line}")
+    return device
+
+
 def main(args: argparse.Namespace) -> int:
     if args.params is not None and args.plant is None:
         raise DatasheetError("--params goes with --plant")
@@ -279,6 +298,12 @@ def main(args: argparse.Namespace) -> int:
         raise DatasheetError("--flat-sample goes with --update and --flat-heights (the flats "
                              "are judged on the sample under a measured sheet)")
     seeds = _rule_seeds(args.rule_seeds)
+    if args.sweep_constants and args.update is None:
+        raise DatasheetError("--sweep-constants goes with --update (a full measurement sweeps "
+                             "the unit anyway; --start says on which state)")
+    if args.start != DEFAULT_SHEET_START and args.plant is None:
+        raise DatasheetError(f"--start {args.start} goes with --plant (the unit is calibrated "
+                             "on the simulated rig before its sweeps)")
     if args.update is not None:
         return update(args, _params(args.params), seeds)
     if args.slope_sample is not None:
@@ -302,6 +327,7 @@ def main(args: argparse.Namespace) -> int:
 
         def factory() -> Plant:
             return load_plant(args.plant, params)
+        sweeps: Callable[[], Any] = factory  # the sheet unit's sweeps; see --start
 
         constants = measure_device_constants(factory, args.seed, config, ripple, args.edge_rise)
         source = (f"the simulated rig, plant {args.plant} with {json.dumps(params)}, seed "
@@ -311,28 +337,28 @@ def main(args: argparse.Namespace) -> int:
         constants = _from_recordings(args.from_recording, ripple, args.edge_rise)
         config = load_config(args.config if args.config is not None else DEFAULT_CONFIG_PATH)
         source = "recordings " + ", ".join(Path(p).name for p in args.from_recording)
-    device = device_model(args.device_model, constants, config, args.description,
-                          loaded_shape=args.loaded_shape or args.choose_loaded_shape)
+    device = _sheet(args, constants, config, ripple)
     if ripple is not None:
         source += f"; the handle's torque ripple period {ripple:g} deg given (a design constant)"
-        phi1, phi2 = (dataclasses.replace(k, torque_ripple_period_deg=ripple)
-                      for k in device.knobs)
-        device = dataclasses.replace(device, knobs=(phi1, phi2))
     if args.edge_rise:
         source += "; edges read where the current starts to rise (the product's reader)"
-        phi1, phi2 = (dataclasses.replace(k, edge_rise=True) for k in device.knobs)
-        device = dataclasses.replace(device, knobs=(phi1, phi2))
-    device, dropped = readable(device)
-    for line in dropped:
-        print(f"warning: {line}")
+    if args.plant is not None and args.start != DEFAULT_SHEET_START:
+        # the unit calibrated under the sheet its fresh sweeps give, then swept again
+        sweeps = sheet_unit_factory(args.start, factory, device, args.seed, config)
+        constants = measure_device_constants(sweeps, args.seed, config, ripple, args.edge_rise)
+        device = _sheet(args, constants, config, ripple)
+        source += (f"; swept after a calibration under the sheet its fresh sweeps gave (start "
+                   f"{args.start}, the stages that calibrate the unit start it fresh)")
     if args.plant is not None:
-        device = _with_coupling(device, config, factory, args.seed)
+        device = _with_coupling(device, config, sweeps, args.seed)
     if args.plant is not None and args.tip_backlash_gain:
-        device = _with_tip_backlash_gain(device, config, factory, args.seed)
+        device = _with_tip_backlash_gain(device, config, sweeps, args.seed)
     if args.plant is not None and args.tip_line_backlash_gain:
-        device = _with_tip_backlash_gain(device, config, factory, args.seed, by="lines")
+        device = _with_tip_backlash_gain(device, config, sweeps, args.seed, by="lines")
     if args.plant is not None and args.loaded_shape:
-        device = _with_shape_grid(device, config, factory, args.seed)
+        device = _with_shape_grid(device, config, sweeps, args.seed)
+    # the stages below calibrate the unit themselves: each starts it fresh, as every unit's
+    # calibration starts
     if args.plant is not None and seeds:
         device = _choose_rule(device, config, args.plant, params, seeds, args.recovery_rule)
     if args.plant is not None and args.stick_end:  # after the rule: its offset measured again
@@ -357,8 +383,8 @@ def main(args: argparse.Namespace) -> int:
         device = with_release_end(device, config, factory, args.seed)
     if args.plant is not None and args.level_grid:
         device = with_level_grid(device, config, factory, args.seed)
-    if args.plant is not None and args.plateau_gap:
-        device = with_plateau_gap(device, config, factory, args.seed)
+    if args.plant is not None and args.plateau_gap:  # a tracked loop: on the sweeps' start
+        device = with_plateau_gap(device, config, sweeps, args.seed)
     if args.plant is not None and args.unit_edges:  # under the sheet's rules, as a unit
         device = with_unit_edges(device, config, factory, seeds or [args.seed],
                                  args.unit_edges_move)

@@ -10,6 +10,7 @@ import argparse
 
 from tsmd.config import DEFAULT_CONFIG_PATH
 from tsmd.datasheet_rule import RULE_NOISE_SEEDS
+from tsmd.datasheet_start import DEFAULT_SHEET_START, SHEET_STARTS
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -178,6 +179,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "half-width, the units' omega takes no settle reading "
                              "(settle_gain_read: false; with --update: added to that sheet, "
                              "docs/model.md, session 25)")
+    parser.add_argument("--start", choices=SHEET_STARTS, default=DEFAULT_SHEET_START,
+                        help="with --plant: the state the sheet's unit is swept in: 'fresh' "
+                             "(the default, every sheet before session 28) or 'calibrated': "
+                             "after the same calibration run a clinical unit gets, under the "
+                             "sheet (a full measurement: under the one its fresh sweeps give "
+                             "first), each sweep and the dead-zone loop (--plateau-gap) on a "
+                             "copy of the plant it left (the benches' start); the stages that "
+                             "calibrate the unit start it fresh as before (docs/model.md, "
+                             "session 28)")
+    parser.add_argument("--sweep-constants", action="store_true",
+                        help="with --update: measure the sheet unit's +-90 deg sweeps again on "
+                             "--start and write the fields they give (omega, reference points "
+                             "and backlash, release slope and shares, reference edges) that "
+                             "the sheet carries; every other field as it was")
     parser.add_argument("--unit-key", default="unit",
                         help="--unit-sample: the plant factory's parameter naming a unit")
     parser.add_argument("--bend-relation", action="store_true",

@@ -15,7 +15,7 @@ import functools
 import json
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +27,7 @@ from tsmd.commands.datasheet_stick import (
     with_settle_gain_check,
     with_stick_choice,
 )
+from tsmd.commands.datasheet_sweep import with_sweep_start
 from tsmd.config import TsmdConfig, default_sim_config, load_config
 from tsmd.datasheet import DatasheetError
 from tsmd.datasheet_flat_heights import FLAT_HEIGHT_KEYS, with_flat_heights
@@ -35,6 +36,7 @@ from tsmd.datasheet_level_grid import with_level_grid
 from tsmd.datasheet_plateau_gap import LOOP_KEYS, with_plateau_gap
 from tsmd.datasheet_release_round import with_release_round
 from tsmd.datasheet_sample import SAMPLE_KEYS
+from tsmd.datasheet_start import DEFAULT_SHEET_START, sheet_unit_factory
 from tsmd.datasheet_unit_edges import UNIT_EDGE_KEYS, with_unit_edges
 from tsmd.profile import DeviceModel, load_device_model, save_device_fields, save_device_model
 
@@ -60,6 +62,9 @@ class StageRun:
     """``--slope-sample``'s units (empty without it)."""
     flat_sample: list[int]
     """``--flat-sample``'s units: they judge the flats instead of the sheet's unit."""
+    started: Callable[[], Plant] | None = None
+    """The sheet's unit at ``--start`` (calibrated: after one calibration under the sheet as
+    given) for the stages that play on it; None: fresh, as :meth:`plant`."""
 
     @property
     def sample_seed(self) -> int:
@@ -69,6 +74,11 @@ class StageRun:
     def plant(self) -> Plant:
         """A fresh plant of the sheet's unit (each stage's runs start from one)."""
         return load_plant(self.args.plant, self.params)
+
+    def start_plant(self) -> Plant:
+        """The sheet's unit at ``--start``, for the sweeps and the dead-zone loop (the stages
+        that calibrate the unit themselves start it fresh)."""
+        return self.started() if self.started is not None else self.plant()
 
     def unit_plants(self, units: list[int]) -> list[tuple[str, Callable[[], Plant]]]:
         """Each unit of the product with a factory of its fresh plant."""
@@ -95,6 +105,8 @@ class UpdateStage:
     what: Callable[[StageRun], str]
     """What it ran, for the header of a sheet written field by field."""
     uses_rule_seeds: bool = False
+    plays_start: bool = False
+    """It plays on the unit at ``--start`` (the others start it fresh)."""
 
 
 def _no_words(run: StageRun) -> str:
@@ -102,6 +114,11 @@ def _no_words(run: StageRun) -> str:
 
 
 UPDATE_STAGES: tuple[UpdateStage, ...] = (
+    UpdateStage(  # first: every stage after is measured under the constants it reads
+        "sweep_constants", "the sweep constants", ("sweep constants",), True,
+        lambda d, r: with_sweep_start(d, r.config, r.start_plant, r.args.seed),
+        lambda r: f" --sweep-constants --start {r.args.start} --seed {r.args.seed}", _no_words,
+        plays_start=True),
     UpdateStage(
         "stick_end", "the stick end", ("backlash_stick_end", "reading_offset"), True,
         lambda d, r: with_stick_choice(d, r.config, r.args.plant, r.params, r.rule_seeds),
@@ -126,9 +143,12 @@ UPDATE_STAGES: tuple[UpdateStage, ...] = (
         lambda r: f"{len(r.sample) + 1} units, fast protocol, noise seed {r.sample_seed}"),
     UpdateStage(
         "plateau_gap", "the dead-zone loop's numbers", LOOP_KEYS, False,
-        lambda d, r: with_plateau_gap(d, r.config, r.plant, r.args.seed),
-        lambda r: " --plateau-gap",
-        lambda r: f"the sheet's unit's dead-zone loop, noise seed {r.args.seed}"),
+        lambda d, r: with_plateau_gap(d, r.config, r.start_plant, r.args.seed),
+        lambda r: " --plateau-gap" + ("" if r.args.sweep_constants else
+                                      f" --start {r.args.start}"),
+        lambda r: (f"the sheet's unit's dead-zone loop, noise seed {r.args.seed}, "
+                   f"{r.args.start} start"),
+        plays_start=True),
     UpdateStage(  # read under the sheet's own choices, as every unit is calibrated
         "release_round", "the rounded release", ("release_round", "release_shift"), False,
         lambda d, r: with_release_round(d, r.config, r.plant, r.args.seed),
@@ -190,6 +210,10 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         raise DatasheetError("--update needs --plant (and --params) of the sheet's unit: the "
                              "sample is tracked on the simulated rig")
     stages = asked_stages(args)
+    if args.start != DEFAULT_SHEET_START and not any(s.plays_start for s in stages):
+        raise DatasheetError(f"--start {args.start} moves only the stages that play on the "
+                             "sheet's unit: with --update give "
+                             + " or ".join(_option(s) for s in UPDATE_STAGES if s.plays_start))
     source = Path(args.update)
     device = load_device_model(source)
     _same_product(source, args.plant, params)
@@ -201,6 +225,9 @@ def update(args: argparse.Namespace, params: dict[str, Any], seeds: list[int]) -
         [] if args.slope_sample is None else sample_units(args.slope_sample, own),
         [] if args.flat_sample is None else sample_units(args.flat_sample, own))
     load_plant(args.plant, params)  # fail early, with the loader's message
+    if args.start != DEFAULT_SHEET_START:  # calibrated under the sheet as given
+        run = replace(run, started=sheet_unit_factory(args.start, run.plant, device, args.seed,
+                                                       run.config))
     for stage in stages:
         device = stage.measure(device, run)
     command = (f"tsmd datasheet --update {source} --plant {args.plant} --params "

@@ -18,8 +18,8 @@ from tsmd.compensation.knee_map import KNEE_RATIO_RANGE, moved_knee
 from tsmd.compensation.loaded_shape import LoadedShape
 from tsmd.compensation.tension_play_params import tension_play_from_mapping, tension_play_to_mapping
 from tsmd.profile import load_device_model, save_device_model
+from tsmd.profile.device import DeviceModel
 from tsmd.profile.reading_offset import OffsetGrid, ReadingOffset
-from tsmd.profile.types import DeviceModel
 
 STRAIGHT_KNOTS = LoadedShape((0.0, 10.0, 60.0), (0.0, 10.0, 60.0))
 SHEET_KNEE = (30.0, 30.0)

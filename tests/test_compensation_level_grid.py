@@ -21,8 +21,8 @@ from tsmd.compensation.tension_play_params import (
     tension_play_from_mapping,
     tension_play_to_mapping,
 )
+from tsmd.profile.device import DeviceKnob, DeviceModel, ReferencePoint
 from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
-from tsmd.profile.types import DeviceKnob, DeviceModel, ReferencePoint
 
 GRID = LevelGrid((-90.0, 0.0, 60.0, 90.0), (-3.0, 0.0, -2.0, -4.0), (4.0, 0.0, 2.0, 3.0))
 

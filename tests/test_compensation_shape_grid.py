@@ -20,7 +20,8 @@ from tsmd.compensation.tension_play_params import (
     tension_play_to_mapping,
 )
 from tsmd.profile import load_device_model, save_device_model
-from tsmd.profile.types import DeviceModel, ProfileError
+from tsmd.profile.device import DeviceModel
+from tsmd.profile.types import ProfileError
 
 KNEE = LoadedShape((0.0, 30.0, 64.0), (0.0, 16.0, 52.0))
 NEAR_STRAIGHT = LoadedShape((0.0, 20.0, 67.0), (0.0, 18.0, 60.0))

@@ -16,8 +16,8 @@ from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.compensation.safety import KnobLimits
 from tsmd.datasheet_home_hold import HomeHoldScore, RestRow, rest_rows, with_hold
 from tsmd.profile import CatheterProfile, KnobProfile, ProfileError, ReferencePoint
+from tsmd.profile.device import DeviceKnob, DeviceModel
 from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
-from tsmd.profile.types import DeviceKnob, DeviceModel
 
 
 def sheet(hold: tuple[bool, bool]) -> DeviceModel:

@@ -14,8 +14,8 @@ from tsmd.datasheet_reversal_release import (
     shape_from_lines,
     sweep_release_line,
 )
+from tsmd.profile.device import DeviceModel
 from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
-from tsmd.profile.types import DeviceModel
 
 
 def release_pass(amplitude_deg: float, end_deg: float, slope: float = 1.5,

@@ -23,7 +23,7 @@ from tsmd.datasheet_shape_choice import (
     straight,
     without_shapes,
 )
-from tsmd.profile.types import DeviceKnob, ReferencePoint
+from tsmd.profile.device import DeviceKnob, ReferencePoint
 
 ANGLES = (-60.0, 0.0, 60.0)
 EDGE_DEG = 24.0

@@ -18,7 +18,7 @@ from tsmd.config import default_sim_config
 from tsmd.datasheet import KnobConstants
 from tsmd.datasheet_start import sheet_unit_factory, with_sweep_constants
 from tsmd.profile import DeviceModel, ReferencePoint, load_device_model
-from tsmd.profile.types import DeviceKnob
+from tsmd.profile.device import DeviceKnob
 
 LUMPED = ROOT / "profiles" / "devices" / "family" / "lumped.yaml"
 PLANT = ["--plant", "simrig.family:make_family_plant", "--params", '{"plant":"lumped","unit":0}']

@@ -40,7 +40,7 @@ from tsmd.datasheet_rule_settled import (
     with_swing_knee,
 )
 from tsmd.profile import DeviceKnob, DeviceModel
-from tsmd.profile.types import RELEASE_RULES
+from tsmd.profile.device import RELEASE_RULES
 from tsmd.tip_truth import tip_truth
 from tsmd.tracked_calibration import TARGET_DEG, play_protocol, score, truth_sweeps
 

@@ -24,7 +24,7 @@ import dataclasses
 
 from tsmd.calibration.options import SETTLED_FRACTION
 from tsmd.profile import DeviceKnob, DeviceModel
-from tsmd.profile.types import RELEASE_RULES
+from tsmd.profile.device import RELEASE_RULES
 
 SWING_KNEE = "swing-knee"
 """The candidate's label in the rule choice: "swing" read at its share, with the knee."""

@@ -38,7 +38,7 @@ from tsmd.datasheet_level_grid import (
 from tsmd.datasheet_unit_run import calibrate_sheet_unit
 from tsmd.errors import TsmdError
 from tsmd.profile import DeviceModel
-from tsmd.profile.types import DeviceKnob
+from tsmd.profile.device import DeviceKnob
 
 MIN_SHAPE_GAIN_DEG = 0.5
 """The templates stay where they lower the sheet unit's loaded-branch RMS by this much (a

@@ -5,8 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from tsmd.calibration.unit_part import UnitPart
+from tsmd.profile.device import DeviceKnob, DeviceModel
 from tsmd.profile.reading_offset import ReadingOffset
-from tsmd.profile.types import DeviceKnob, DeviceModel
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@ from scipy import stats
 
 from tsmd.calibration.sample_offset import sheet_offsets_deg
 from tsmd.calibration.sweep_result import SweepResult
-from tsmd.profile.types import DeviceKnob
+from tsmd.profile.device import DeviceKnob
 
 Z95 = 1.96
 """Two-sided 95 % of a normal spread: a gate half-width over this is its one-sigma part."""

@@ -27,7 +27,7 @@ from typing import Any
 
 from tsmd.online.apply import Offsets, OnlineError
 from tsmd.profile import DeviceModel
-from tsmd.profile.types import (
+from tsmd.profile.device import (
     BEND_GAIN_PER_RELEASE_RANGE,
     BEND_GAIN_PER_SLOPE_RANGE,
     BEND_OMEGA_PER_GAIN_RANGE,

@@ -12,6 +12,13 @@ Loading validates everything and raises :class:`ProfileError` naming the file, t
 reason. Saving is atomic and keeps the previous profile as ``<file>.bak``.
 """
 
+from tsmd.profile.device import (
+    DEFAULT_HANDLE_SLIP_DEG,
+    DEVICE_SCHEMA_VERSION,
+    DeviceKnob,
+    DeviceModel,
+    ReferencePoint,
+)
 from tsmd.profile.files import (
     ProfileStore,
     dump_profile,
@@ -25,17 +32,12 @@ from tsmd.profile.schema import profile_from_mapping, profile_to_mapping
 from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
-    DEFAULT_HANDLE_SLIP_DEG,
-    DEVICE_SCHEMA_VERSION,
     KNOB_NAMES,
     OMEGA_RANGE,
     PROFILE_SCHEMA_VERSION,
     CatheterProfile,
-    DeviceKnob,
-    DeviceModel,
     KnobProfile,
     ProfileError,
-    ReferencePoint,
     make_knob_profile,
     standard_grid,
 )

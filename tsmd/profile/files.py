@@ -13,9 +13,10 @@ from typing import Any
 
 import yaml
 
+from tsmd.profile.device import DeviceModel
 from tsmd.profile.schema import plain_values, profile_from_mapping, profile_to_mapping
 from tsmd.profile.sheet_schema import device_model_from_mapping, device_model_to_mapping
-from tsmd.profile.types import ID_PATTERN, KNOB_NAMES, CatheterProfile, DeviceModel, ProfileError
+from tsmd.profile.types import ID_PATTERN, KNOB_NAMES, CatheterProfile, ProfileError
 from tsmd.yamlfile import parse_yaml, read_yaml
 
 

@@ -7,13 +7,8 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from tsmd.profile.types import (
-    ANGLE_RANGE_DEG,
-    KNOB_NAMES,
-    OMEGA_RANGE,
-    ProfileError,
-    ReferencePoint,
-)
+from tsmd.profile.device import ReferencePoint
+from tsmd.profile.types import ANGLE_RANGE_DEG, KNOB_NAMES, OMEGA_RANGE, ProfileError
 
 
 class Reader:

@@ -13,6 +13,7 @@ import numpy as np
 
 from tsmd.compensation.grid import INTERPOLATION_METHODS
 from tsmd.compensation.tension_play_params import tension_play_from_mapping, tension_play_to_mapping
+from tsmd.profile.device import ReferencePoint
 from tsmd.profile.reader import Reader
 from tsmd.profile.types import (
     ANGLE_RANGE_DEG,
@@ -21,7 +22,6 @@ from tsmd.profile.types import (
     PROFILE_SCHEMA_VERSION,
     CatheterProfile,
     KnobProfile,
-    ReferencePoint,
 )
 
 _log = logging.getLogger("tsmd.profile")

@@ -28,24 +28,22 @@ from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play_params import (
     OTHER_TIP_GAIN_RANGE,
 )
-from tsmd.profile.reader import Reader
-from tsmd.profile.reading_offset import offset_from_mapping, offset_to_mapping
-from tsmd.profile.schema import check_references, reference_to_mapping
-from tsmd.profile.types import (
-    ANGLE_RANGE_DEG,
+from tsmd.profile.device import (
     BEND_GAIN_PER_RELEASE_RANGE,
     BEND_GAIN_PER_SLOPE_RANGE,
     BEND_OMEGA_PER_GAIN_RANGE,
     BEND_RELEASE_PER_EDGE_RANGE,
     DEFAULT_HANDLE_SLIP_DEG,
     DEVICE_SCHEMA_VERSION,
-    KNOB_NAMES,
     RATIO_GAINS,
     RELEASE_RULES,
     DeviceKnob,
     DeviceModel,
-    ProfileError,
 )
+from tsmd.profile.reader import Reader
+from tsmd.profile.reading_offset import offset_from_mapping, offset_to_mapping
+from tsmd.profile.schema import check_references, reference_to_mapping
+from tsmd.profile.types import ANGLE_RANGE_DEG, KNOB_NAMES, ProfileError
 
 OPTIONAL_KNOB_RANGES: dict[str, tuple[float, float, str]] = {
     "reference_backlash_pos_deg": (0.0, 90.0, "deg"),

@@ -3,7 +3,8 @@
 session 24, whose braid stiffens with strain rate and whose liner soaks; pronyring, session 25,
 whose Pebax section relaxes with a Prony spectrum; wormeyelet, session 26, whose eyelets take
 wrap from the other plane's bend; beltbraid, session 27, whose braided shaft's crossings slip
-under all four ropes' load)."""
+under all four ropes' load; rackgrease, session 28, whose ropes wrap a share of the section's
+total bend and whose grease flows with a plastic viscosity)."""
 
 from __future__ import annotations
 
@@ -23,6 +24,8 @@ from simrig.plants.notchclutch.plant import NotchClutchPlant
 from simrig.plants.planetwist import PlanetTwistKnob, PlanetTwistPlant
 from simrig.plants.pronyring.params import KnobConstants as PronyRingKnob
 from simrig.plants.pronyring.plant import PronyRingPlant
+from simrig.plants.rackgrease import KnobConstants as RackGreaseKnob
+from simrig.plants.rackgrease import RackGreasePlant
 from simrig.plants.snakedent import SnakeDentKnob, SnakeDentPlant
 from simrig.plants.wormeyelet import WormEyeletKnob, WormEyeletPlant
 from tsmd.gap.presets import PRESETS, parse_plant_spec
@@ -34,15 +37,21 @@ BLIND = [("cyclopebax", CycloPebaxPlant, CycloPebaxKnob),
          ("notchclutch", NotchClutchPlant, NotchClutchKnob),
          ("pronyring", PronyRingPlant, PronyRingKnob),
          ("wormeyelet", WormEyeletPlant, WormEyeletKnob),
-         ("beltbraid", BeltBraidPlant, BeltBraidKnob)]
+         ("beltbraid", BeltBraidPlant, BeltBraidKnob),
+         ("rackgrease", RackGreasePlant, RackGreaseKnob)]
 NAMES = [name for name, _plant, _knob in BLIND]
 TIMELESS = ["cyclopebax", "snakedent", "planetwist", "wormeyelet", "beltbraid"]
 """The blind plants with no law of speed or time at the tip."""
 
 
 def _knobs(plant: Any) -> list[Any]:
-    """A plant's per-knob constants (beltbraid keeps them apart from its knobs' state)."""
-    return list(plant.params) if isinstance(plant, BeltBraidPlant) else list(plant.knobs)
+    """A plant's per-knob constants (beltbraid keeps them apart from its knobs' state,
+    rackgrease in its planes)."""
+    if isinstance(plant, BeltBraidPlant):
+        return list(plant.params)
+    if isinstance(plant, RackGreasePlant):
+        return [plane.k for plane in plant.planes]
+    return list(plant.knobs)
 
 
 def _share_keyword(plant: Any) -> list[float]:
@@ -65,6 +74,10 @@ def _braid_constant(plant: Any) -> list[float]:
     return [knob.braid_slip_mm for knob in plant.params]
 
 
+def _section_wrap_constant(plant: Any) -> list[float]:
+    return [plane.k.section_wrap_fraction for plane in plant.planes]
+
+
 TAKEUP: dict[str, tuple[Callable[[Any], list[float]], set[str]]] = {
     "cyclopebax": (_share_keyword, set()),
     "snakedent": (_share_keyword, set()),
@@ -73,9 +86,11 @@ TAKEUP: dict[str, tuple[Callable[[Any], list[float]], set[str]]] = {
     "pronyring": (_takeup_keyword, set()),
     "wormeyelet": (_cross_wrap_constant, {"cross_wrap"}),
     "beltbraid": (_braid_constant, {"braid_slip_mm"}),
+    "rackgrease": (_section_wrap_constant, {"section_wrap_fraction"}),
 }
 """How strongly the other plane's bend takes up a plane's ropes (on wormeyelet: adds wrap at
-its eyelets; on beltbraid: how far the braid's crossings slip under the ropes' load), per plant,
+its eyelets; on beltbraid: how far the braid's crossings slip under the ropes' load; on
+rackgrease: the share of the section's total bend its ropes wrap), per plant,
 and which knob constants the coupling case may change (a keyword on cyclopebax and snakedent,
 planetwist's, wormeyelet's and beltbraid's own knob constant)."""
 
@@ -157,7 +172,8 @@ def test_rate_and_creep_each_scale_one_law_of_speed_or_time(name: str) -> None:
 
 @pytest.mark.parametrize(("name", "case"),
                          [(n, c) for n in NAMES for c in ("coupling", "compliance", "curvature")]
-                         + [(n, c) for n in sorted(TIME_LAWS) for c in ("rate", "creep")])
+                         + [(n, c) for n in sorted(TIME_LAWS) for c in ("rate", "creep")]
+                         + [("rackgrease", "rate")])
 def test_each_case_moves_the_tip_beyond_the_trackers_noise(name: str, case: str) -> None:
     preset = PRESETS[name]
     _t, q = trajectory(30.0, 50.0)
@@ -165,3 +181,31 @@ def test_each_case_moves_the_tip_beyond_the_trackers_noise(name: str, case: str)
     on, _ = drive_plant(preset.build_unit(1, 0.1, case, **preset.case_effects(case)), q, 50.0,
                         preset.max_step_s)
     assert float(np.sqrt(np.mean((on - off) ** 2))) > 0.1
+
+
+RACKGREASE_VISCOSITIES = ("grease_viscosity_N_s_per_mm", "section_viscosity_Nmm_s_per_rad")
+"""The grease's plastic viscosity, as the film on the ropes and as the section's packing."""
+
+
+def test_rackgrease_rate_makes_the_one_grease_more_viscous_and_creep_is_not_run() -> None:
+    preset = PRESETS["rackgrease"]
+    assert preset.supports("rate")
+    assert not preset.supports("creep")
+    none = preset.build_unit(102, 0.1)
+    thick = preset.build_unit(102, 0.1, "rate", **preset.case_effects("rate"))
+    for k in (0, 1):
+        before, after = _knobs(none)[k], _knobs(thick)[k]
+        for constant in RACKGREASE_VISCOSITIES:
+            assert getattr(after, constant) > 1.5 * getattr(before, constant)
+        kept = {c: getattr(before, c) for c in RACKGREASE_VISCOSITIES}
+        assert dataclasses.replace(after, **kept) == before
+    assert thick.sheath_curvature_deg == none.sheath_curvature_deg == 0.0
+
+
+def test_rackgrease_tip_does_not_move_while_the_knobs_hold_after_the_grease_settles() -> None:
+    """Why creep is not run: past the grease's flow (well inside a second) nothing reads time."""
+    preset = PRESETS["rackgrease"]
+    ramp = np.linspace(0.0, 1.0, 100)[:, None] * np.array([75.0, 30.0])
+    held = np.vstack([ramp, np.tile(np.array([75.0, 30.0]), (1000, 1))])
+    tip, _current = drive_plant(preset.build_unit(1, 0.1), held, 50.0, preset.max_step_s)
+    assert np.max(np.abs(tip[150:] - tip[150])) < 1e-3

@@ -225,3 +225,39 @@ step, and at the recording's 20 ms the linearised microslip overshoots (unit 2 w
 bend: the tip at -159 deg against -68 at 4 ms). Against 0.25 ms steps the tip lies 0.30 / 0.29
 deg RMS away at 10 ms, 0.19 / 0.18 at 4 ms, 0.14 / 0.11 at 2 ms (max 0.77 / 0.65), 0.09 / 0.06
 at 1 ms (units 1 / 2, the experiment motion at 50 Hz)."""
+
+
+RACKGREASE_EFFECTS: dict[str, dict[str, float]] = {
+    "curvature": {"sheath_curvature_deg": 120.0},
+}
+"""The rackgrease plant's one effect keyword: a 120 deg shaft bend (added to every rope's lumen
+wrap), 2.54 / 2.76 deg of tip (tip RMSE effect on minus off, units 1 / 2, noise-free, 120 s of
+the experiment motion at 50 Hz stepped at 10 ms; 60 deg 1.18 / 1.28), inside the others'
+1.1-12.8 deg. Creep is not run: knob 1 ramped to 75 deg and held 65 s (the other at 30), the
+grease's flow settles the tip within the first second (0.44 / 0.39 deg) and it moves 0.000
+after; no law reads time beyond the grease's viscosity (the rate case). The rack's cocking in
+its guide and the eddy-current damper act on the current only (guide friction x3: tip 0.000,
+current 24 / 21 mA; eddy peak x3: tip 0.000, 11 / 11 mA): base physics, as are the head's
+gravity, the grease's yield and the ropes' slack; "none" is the nominal physics as written
+(docs/gap.md "Session 28, round 2")."""
+
+RACKGREASE_KNOB_EFFECTS: dict[str, dict[str, float]] = {
+    "coupling": {"section_wrap_fraction": 7.0},
+    "compliance": {"tendon_stiffness_N": 0.5},
+    "rate": {"grease_viscosity_N_s_per_mm": 2.0, "section_viscosity_Nmm_s_per_rad": 2.0},
+}
+"""Rackgrease effects as factors on the unit's knob constants, sized before any diagnosis (same
+criterion, units 1 / 2, 10 ms steps): the ropes wrapping seven times the unit's share of the
+section's total bend (``section_wrap_fraction``, the plant's constant through which the other
+plane's bend adds wrap; it reads the own plane's bend too), 1.46 / 1.65 deg (x2 0.24 / 0.27,
+x4 0.72 / 0.81, x6 1.21 / 1.37; the share removed altogether 0.23 / 0.26; the head's gravity
+removed 1.09 / 1.27; the others' coupling 1.5 deg); the rope's EA halved, 5.25 / 5.51 deg; the
+grease twice as viscous (film on the ropes and packing of the section, one grease), 1.46 / 1.59
+deg (x3 2.79 / 3.03; the section's alone x3 2.28 / 2.46, the film's alone x3 0.60 / 0.67; the
+others' rate 1.1-1.9 deg; the same samples played 8 times as fast move the tip 7.3 / 7.8 deg)."""
+
+RACKGREASE_MAX_STEP_S = 0.01
+"""Stepped at 10 ms: every law is implicit in the step (the grease's return mapping over eta /
+dt), stable at the recording's 20 ms, but first-order: against 0.25 ms steps the tip lies 0.11
+/ 0.11 deg RMS away at 20 ms (max 0.57 / 0.67), 0.06 / 0.06 at 10 ms (max 0.30 / 0.30), 0.02 /
+0.02 at 4 ms (units 1 / 2, the experiment motion at 50 Hz)."""

@@ -65,6 +65,9 @@ from tsmd.gap.preset_effects_late import (
     PRONYRING_EFFECTS,
     PRONYRING_KNOB_EFFECTS,
     PRONYRING_MAX_STEP_S,
+    RACKGREASE_EFFECTS,
+    RACKGREASE_KNOB_EFFECTS,
+    RACKGREASE_MAX_STEP_S,
     SNAKEDENT_EFFECTS,
     SNAKEDENT_KNOB_EFFECTS,
     SNAKEDENT_MAX_STEP_S,
@@ -204,6 +207,10 @@ PRESETS: dict[str, PlantSpec] = {
     "beltbraid": PlantSpec(PLANT_SPECS["beltbraid"], {}, (), "beltbraid", family="beltbraid",
                            effects=BELTBRAID_EFFECTS, knob_effects=BELTBRAID_KNOB_EFFECTS,
                            max_step_s=BELTBRAID_MAX_STEP_S),
+    "rackgrease": PlantSpec(PLANT_SPECS["rackgrease"], {}, (), "rackgrease",
+                            family="rackgrease", effects=RACKGREASE_EFFECTS,
+                            knob_effects=RACKGREASE_KNOB_EFFECTS,
+                            max_step_s=RACKGREASE_MAX_STEP_S),
 }
 """Named plants for ``--data-plant``/``--sim-plant``."""
 

@@ -62,12 +62,11 @@ class FlatRow:
 
 
 def flats_kept(rows: Sequence[FlatRow]) -> bool:
-    """The flats stay where the rows' squared sum falls and the worst row does not rise
-    beyond its noise (over a sample: the worst unit's row, not only the mean)."""
-    if not rows:
-        return False
-    worst = max(rows, key=lambda r: r.drawn_deg)
-    if max(r.flat_deg for r in rows) - worst.drawn_deg > worst.noise_deg:
+    """The flats stay where no row (of any judging unit) rises beyond its seed noise and the
+    rows' squared sum falls. Session 28's first rule let a row rise up to the worst drawn row:
+    the sample's unit 202 lost 2 deg per phi1 row under 201's worse drawn rows (and so did
+    held-out 101), a unit traded against the others."""
+    if not rows or any(r.flat_deg - r.drawn_deg > r.noise_deg for r in rows):
         return False
     return sum(r.flat_deg ** 2 for r in rows) < sum(r.drawn_deg ** 2 for r in rows)
 

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 from support.profiles import ROOT, assert_sheet_knob_field_round_trips, make_profile
+from support.tension_sweeps import SHEET_KNOB, sweep
 
-from tsmd.calibration.tension_play_fit import SweepCurrent, fit_tension_play
+from tsmd.calibration.tension_play_fit import fit_tension_play
 from tsmd.cli import main
 from tsmd.compensation.model_parts import model_parts
-from tsmd.compensation.safety import KnobLimits
 from tsmd.compensation.tension_play_params import TensionPlayParams
 from tsmd.datasheet_flat_heights import (
     FlatRow,
@@ -25,26 +25,11 @@ from tsmd.datasheet_flat_heights import (
     with_heights,
 )
 from tsmd.datasheet_level_grid import TrackedSweep
-from tsmd.profile import DeviceKnob, ReferencePoint
+from tsmd.profile import DeviceKnob
 
-PERIOD_S = 0.004
-D_POS, D_NEG, X0_POS, X0_NEG = 20.0, -22.0, 12.0, -13.0
-SHEET_KNOB = DeviceKnob(1.5, ReferencePoint(90.0, 100.0), ReferencePoint(-90.0, -100.0),
-                        KnobLimits(-90.0, 90.0, 120.0, 2000.0),
-                        reference_dead_zone_pos_deg=25.0, reference_dead_zone_neg_deg=-25.0)
 GRID = (-90.0, 0.0, 90.0)
 LUMPED = ROOT / "profiles" / "devices" / "family" / "lumped.yaml"
 
-
-def sweep(other_deg: float) -> SweepCurrent:
-    """A +-90 deg sweep whose current is friction and a tension ramp past the edges."""
-    t = np.arange(0.0, 50.0, PERIOD_S)
-    pos = -90.0 * np.cos(2 * math.pi * 0.04 * t)
-    v = np.gradient(pos)
-    load = np.where((v > 0) & (pos > D_POS), 0.003 * (pos - X0_POS), 0.0)
-    load += np.where((v < 0) & (pos < D_NEG), 0.003 * (pos - X0_NEG), 0.0)
-    current = 0.03 * np.sign(v) + load
-    return SweepCurrent(other_deg, t, pos, pos, current, D_POS, D_NEG, 25.0, 25.0)
 
 
 def fitted(knob: DeviceKnob) -> TensionPlayParams:

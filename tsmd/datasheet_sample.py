@@ -15,18 +15,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 
-from tsmd.calibration.assemble import GridPoint
-from tsmd.calibration.estimate import KINDS, Estimate
+from tsmd.calibration.estimate import KINDS
 from tsmd.calibration.protocol import fast_protocol
-from tsmd.calibration.resweep import point_estimates
 from tsmd.calibration.sample_offset import PARAMETERS, field_name, one_sided_offset_deg
 from tsmd.calibration.unit_part import Z95, sample_u95_deg
 from tsmd.config import TsmdConfig
 from tsmd.datasheet_rule import sheet_truth
 from tsmd.profile import DeviceModel
-from tsmd.tracked_calibration import ProtocolRun, play_protocol
+from tsmd.tracked_calibration import ProtocolRun, named_value_errors, play_protocol
 
 Truth = dict[tuple[int, float], dict[str, float]]
 """Per (knob, other knob's angle): the tracked tip's value per parameter."""
@@ -48,23 +46,11 @@ def sample_readings(runs: Sequence[tuple[ProtocolRun, Truth]],
     runs and their truths (a refused run's values count as they were read)."""
     out: Readings = {(knob, kind): ([], []) for knob in (0, 1) for kind in KINDS}
     for run, truth in runs:
-        for knob, kind, name, error, est in named_errors(run.points, truth):
+        for knob, kind, name, error, est in named_value_errors(run.points, truth):
             if math.isfinite(est.u95_deg):
                 out[(knob, kind)][0].append(error - (offsets_deg or {}).get((knob, name), 0.0))
                 out[(knob, kind)][1].append(est.u95_deg)
     return out
-
-
-def named_errors(points: Sequence[GridPoint], truth: Truth
-                 ) -> Iterator[tuple[int, str, str, float, Estimate]]:
-    """Per value with a tip truth: (knob, kind, parameter, value minus tip, its estimate)."""
-    for p, est in zip(points, point_estimates(points), strict=True):
-        tip = truth.get((p.knob, float(p.other_deg)), {})
-        for kind, names in KINDS.items():
-            for name in names:
-                error = est[name].value - tip.get(name, math.nan)
-                if math.isfinite(error):
-                    yield p.knob, kind, name, error, est[name]
 
 
 def one_sided_offsets(runs: Sequence[tuple[ProtocolRun, Truth]]) -> Offsets:
@@ -74,7 +60,7 @@ def one_sided_offsets(runs: Sequence[tuple[ProtocolRun, Truth]]) -> Offsets:
     misses: dict[tuple[int, str], list[float]] = {}
     for run, truth in runs:
         unit: dict[tuple[int, str], list[float]] = {}
-        for knob, _, name, error, _ in named_errors(run.points, truth):
+        for knob, _, name, error, _ in named_value_errors(run.points, truth):
             unit.setdefault((knob, name), []).append(error)
         for key, errors in unit.items():
             misses.setdefault(key, []).append(sum(errors) / len(errors))

@@ -154,9 +154,10 @@ def score(run: ProtocolRun, truth: dict[tuple[int, float], dict[str, float]],
     run.coverage = coverage_against(run.points, truth)
 
 
-def value_errors(points: Sequence[GridPoint], truth: dict[tuple[int, float], dict[str, float]]
-                 ) -> Iterator[tuple[int, str, float, Estimate]]:
-    """Per value measured at a grid point with a tip truth: (knob, kind of parameter,
+def named_value_errors(points: Sequence[GridPoint],
+                       truth: dict[tuple[int, float], dict[str, float]]
+                       ) -> Iterator[tuple[int, str, str, float, Estimate]]:
+    """Per value measured at a grid point with a tip truth: (knob, kind of parameter, its name,
     identified minus tip, its estimate). Shared by the coverage score and the sheet's sample
     (:mod:`tsmd.datasheet_sample`)."""
     for p, est in zip(points, point_estimates(points), strict=True):
@@ -165,7 +166,14 @@ def value_errors(points: Sequence[GridPoint], truth: dict[tuple[int, float], dic
             for name in names:
                 error = est[name].value - tip.get(name, math.nan)
                 if math.isfinite(error):
-                    yield p.knob, kind, error, est[name]
+                    yield p.knob, kind, name, error, est[name]
+
+
+def value_errors(points: Sequence[GridPoint], truth: dict[tuple[int, float], dict[str, float]]
+                 ) -> Iterator[tuple[int, str, float, Estimate]]:
+    """:func:`named_value_errors` without the parameter's name."""
+    for knob, kind, _, error, est in named_value_errors(points, truth):
+        yield knob, kind, error, est
 
 
 def coverage_against(points: Sequence[GridPoint],

@@ -23,10 +23,10 @@ def _reversal_angles(knob_deg: np.ndarray) -> np.ndarray:
     return np.array([knob_deg[a] for a, _ in _reversal_pairs(knob_deg)])
 
 
-def test_the_protocol_has_heavy_cycles_only_when_asked_for_and_by_default() -> None:
-    light, heavy = protocol(RATE_HZ, ProtocolDesign(heavy_amp_deg=0.0)), protocol(RATE_HZ, HEAVY)
-    np.testing.assert_array_equal(heavy[1], protocol(RATE_HZ)[1])
-    assert not np.any(np.isclose(np.abs(_reversal_angles(light[1][:, 0])), 75.0))
+def test_the_protocol_is_unchanged_unless_a_heavy_load_is_asked_for() -> None:
+    default, heavy = protocol(RATE_HZ), protocol(RATE_HZ, HEAVY)
+    np.testing.assert_array_equal(default[1], protocol(RATE_HZ, ProtocolDesign())[1])
+    assert not np.any(np.isclose(np.abs(_reversal_angles(default[1][:, 0])), 75.0))
     at = _reversal_angles(heavy[1][:, 0])
     for side in (75.0, -75.0):
         assert np.sum(np.isclose(at, side)) == 2  # two heavy cycles, both knobs together
@@ -78,8 +78,7 @@ def test_a_played_light_load_still_sends_the_sheet_to_the_release(
 
 
 def test_the_heavy_cycles_leave_every_earlier_sample_as_it_was() -> None:
-    light, heavy = protocol(RATE_HZ, ProtocolDesign(heavy_amp_deg=0.0)), protocol(RATE_HZ, HEAVY)
-    n = len(light[0])
-    assert len(heavy[0]) > n
-    np.testing.assert_array_equal(heavy[1][:n], light[1])
-    np.testing.assert_array_equal(heavy[2][:n], light[2])
+    default, heavy = protocol(RATE_HZ), protocol(RATE_HZ, HEAVY)
+    n = len(default[0])
+    np.testing.assert_array_equal(heavy[1][:n], default[1])
+    np.testing.assert_array_equal(heavy[2][:n], default[2])

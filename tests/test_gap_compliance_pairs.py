@@ -63,17 +63,11 @@ def test_a_sheet_read_on_the_release_keeps_the_usual_pair(
     assert _offer(monkeypatch, usual, heavier) is usual
 
 
-def test_switched_off_the_sheet_is_read_at_the_usual_loads(
-        monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(compliance_pairs, "HEAVY_LOADS_DEG", None)
+def test_off_by_default_the_sheet_is_read_at_the_usual_loads() -> None:
+    assert compliance_pairs.HEAVY_LOADS_DEG is None
     sheet = compliance_pairs.sheet_at_chosen_loads(_units())
     assert sheet is not None and sheet.loads_deg is None
     assert sheet == compliance.sheet_from_units(_units())
-
-
-def test_the_heavier_pair_is_offered_by_default() -> None:
-    assert compliance_pairs.HEAVY_LOADS_DEG == HEAVY_PAIR
-    assert ProtocolDesign().heavy_amp_deg == max(HEAVY_PAIR)
 
 
 @functools.cache

@@ -63,8 +63,7 @@ CONTRAST_LEVELS_DEG = LEVELS_DEG
 load (``ProtocolDesign.heavy_amp_deg``): then the light load against it, while the premise
 (:func:`load_growth`) and the release stay on :data:`LEVELS_DEG`, where a geared handle's play
 shows (with the heavy load alone the premise no longer fires on warmgear, and its release at 75
-deg scatters more: docs/gap.md "Session 26"). (40, 60); the heavier pair is offered by
-:mod:`tsmd.gap.compliance_pairs` (on since session 28)."""
+deg scatters more: docs/gap.md "Session 26"). Off by default: (40, 60)."""
 LEVEL_BAND_DEG = 2.0
 MIN_PER_LEVEL = 3
 """Repeats at each load and side for a figure (the jackknife needs a few)."""

@@ -10,8 +10,8 @@ own amount), and read there alone its unit 2's halved strand was lost (docs/gap.
 "Session 27"). So one pair is read, the one at which the sheet's own units would show a doubled
 stretch most clearly: per knob the log of 2 less the units' spread, over the noise a further
 unit's figure has (the sheet's noise of the mean times its units plus one), mean over the
-knobs. The scored unit does not enter the choice. On unless :data:`HEAVY_LOADS_DEG` is None; the
-usual pair when the recordings lack the heavier load.
+knobs. The scored unit does not enter the choice. Off unless :data:`HEAVY_LOADS_DEG` is set and
+the protocol has those loads.
 """
 
 from __future__ import annotations
@@ -24,12 +24,10 @@ import numpy as np
 from tsmd.gap.compliance import LEVELS_DEG, ComplianceSheet, sheet_from_units
 from tsmd.gap.data import GapSeries
 
-HEAVY_LOADS_DEG: tuple[float, float] | None = (40.0, 75.0)
-"""The heavier pair of loads the sheet may be read at instead: (40, 75), with
-``ProtocolDesign.heavy_amp_deg`` 75 (both on since session 28: the cross-plant self-test kept
-every top-1 and gained no alarm, docs/gap.md "Session 28"); None: the one pair of
-:data:`tsmd.gap.compliance.CONTRAST_LEVELS_DEG`. A recording without the heavy cycles is read
-at the usual pair (no figure at 75 deg)."""
+HEAVY_LOADS_DEG: tuple[float, float] | None = None
+"""The heavier pair of loads the sheet may be read at instead (e.g. (40, 75) with
+``ProtocolDesign.heavy_amp_deg`` 75); None (the default): the one pair of
+:data:`tsmd.gap.compliance.CONTRAST_LEVELS_DEG`."""
 
 DOUBLED_LOG = math.log(2.0)
 """The figure's log shift a doubled tendon stretch gives when the whole figure is stretch."""

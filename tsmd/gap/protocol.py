@@ -52,13 +52,12 @@ class ProtocolDesign:
     other_deg: float = 50.0
     """Where the other knob is held in the coupling test (0, +, -)."""
     dwell_amp_deg: float = 60.0
-    heavy_amp_deg: float = 75.0
+    heavy_amp_deg: float = 0.0
     """When above 0, the protocol ends with two cycles of both knobs at this amplitude: slow
     reversals at a third, heavier load, for a compliance figure from loads further apart while
     the usual pair keeps testing its premise; appended, so every earlier sample is as without
     them (in the warm-up they changed the 60 deg reversals' history and warmgear's release
-    spread; docs/gap.md "Session 26"). 0: no such cycles. On since session 28, together with
-    :data:`tsmd.gap.compliance_pairs.HEAVY_LOADS_DEG` (docs/gap.md "Session 28")."""
+    spread; docs/gap.md "Session 26"). 0: no such cycles."""
     dwell_s: float = 20.0
     rest_s: float = 10.0
     settle_s: float = 1.0

@@ -264,13 +264,18 @@ def test_a_tip_moving_on_under_load_is_not_creep() -> None:
 
 
 def test_creep_within_one_samples_current_noise_is_not_named() -> None:
+    """Over six noise draws: found (median z), but about 3 mA over a dwell is named at most
+    once. One draw's z scatters from below 1 to above 4 (docs/gap.md "Session 28": the heavy
+    cycles lengthened the protocol and so changed the draw of seed 0 from z 3.1 to 0.9)."""
     def faint(t: Arr, q: Arr) -> Arr:
         return 0.15 * _creep(t, q)
-    series, residuals = _session(faint)
-    scores = {s.name: s for s in contrast_scores(series, residuals, n_tried=6,
-                                                 current_noise_A=0.004)}
-    assert scores["drift"].z > 2.5  # found, but about 3 mA over a dwell
-    assert not scores["drift"].significant
+    drift = []
+    for seed in range(6):
+        series, residuals = _session(faint, seed)
+        drift.append({s.name: s for s in contrast_scores(series, residuals, n_tried=6,
+                                                         current_noise_A=0.004)}["drift"])
+    assert float(np.median([s.z for s in drift])) > 2.5
+    assert sum(s.significant for s in drift) <= 1
 
 
 def _dead_zone(x: Arr, width: Arr) -> Arr:

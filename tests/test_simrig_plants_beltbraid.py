@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from support.plants import ramp_knobs
 
 from simrig.family import PLANT_ROLE, PLANT_SPECS, SCATTER, family_member
 from simrig.plant import Plant
@@ -20,13 +21,7 @@ DT = 0.004
 def ramp(plant: BeltBraidPlant, start: tuple[float, float], end: tuple[float, float],
          rate_deg_s: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
     """Move both knobs linearly from ``start`` to ``end``; the last tip and torque."""
-    a, b = np.asarray(start, float), np.asarray(end, float)
-    n = max(2, int(np.max(np.abs(b - a)) / (rate_deg_s * DT)))
-    step = None
-    for s in np.linspace(0.0, 1.0, n):
-        step = plant.step(DT, a + s * (b - a))
-    assert step is not None
-    return step.tip_deg, step.knob_torque_Nm
+    return ramp_knobs(plant, start, end, DT, rate_deg_s)
 
 
 def loop(plant: BeltBraidPlant, knob: int, amp: float, other: float = 0.0,

@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from support.plants import ramp_knobs
 
 from simrig.analysis import measure_dead_zone_backlash
 from simrig.family import PLANT_ROLE, PLANT_SPECS, SCATTER, family_member
@@ -36,13 +37,8 @@ def hold(plant: RackGreasePlant, knobs: tuple[float, float], steps: int = 50
 
 def ramp(plant: RackGreasePlant, start: tuple[float, float], end: tuple[float, float],
          rate_deg_s: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
-    a, b = np.asarray(start, float), np.asarray(end, float)
-    n = max(2, int(np.max(np.abs(b - a)) / (rate_deg_s * DT)))
-    step = None
-    for s in np.linspace(0.0, 1.0, n):
-        step = plant.step(DT, a + s * (b - a))
-    assert step is not None
-    return step.tip_deg, step.knob_torque_Nm
+    """Move both knobs linearly from ``start`` to ``end``; the last tip and torque."""
+    return ramp_knobs(plant, start, end, DT, rate_deg_s)
 
 
 def sweep(plant: RackGreasePlant, knob: int = 0, other: float = 0.0):  # type: ignore[no-untyped-def]

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from simrig.plant import PlantStep, as_plant_step
+from simrig.plant import Plant, PlantStep, as_plant_step
 
 
 class SpringPlant:
@@ -48,3 +48,16 @@ def knob1_sweep(plant: Any, freq_hz: float = 0.04, cycles: float = 1.5, other_de
         tip[i] = step.tip_deg[0]
         tau[i] = step.knob_torque_Nm[0]
     return q, tip, tau
+
+
+def ramp_knobs(plant: Plant, start: tuple[float, float], end: tuple[float, float], dt_s: float,
+               rate_deg_s: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+    """Move both knobs linearly from ``start`` to ``end`` (the farther one at ``rate_deg_s``);
+    the last step's tip and knob torque."""
+    a, b = np.asarray(start, float), np.asarray(end, float)
+    n = max(2, int(np.max(np.abs(b - a)) / (rate_deg_s * dt_s)))
+    step = None
+    for s in np.linspace(0.0, 1.0, n):
+        step = as_plant_step(plant.step(dt_s, a + s * (b - a)))
+    assert step is not None
+    return np.asarray(step.tip_deg), np.asarray(step.knob_torque_Nm)

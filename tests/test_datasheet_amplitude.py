@@ -9,7 +9,7 @@ import pytest
 from support.profiles import DEVICE
 
 from tsmd import datasheet_amplitude
-from tsmd.commands import datasheet as datasheet_command
+from tsmd.commands import datasheet_measure as datasheet_command
 from tsmd.config import default_sim_config
 from tsmd.profile import load_device_model
 
@@ -26,7 +26,7 @@ def test_the_line_reading_goes_to_its_own_key(monkeypatch: pytest.MonkeyPatch) -
     calls: list[str] = []
     monkeypatch.setattr(datasheet_command, "measure_tip_backlash_gains", _fake_gains(calls))
     device = load_device_model(DEVICE)
-    out = datasheet_command._with_tip_backlash_gain(device, default_sim_config(), object, 2000,
+    out = datasheet_command.with_tip_backlash_gain(device, default_sim_config(), object, 2000,
                                                     by="lines")
     assert calls == ["lines"]
     assert out.knobs[0].reference_tip_line_backlash_gain == 0.165
@@ -38,7 +38,7 @@ def test_the_line_reading_goes_to_its_own_key(monkeypatch: pytest.MonkeyPatch) -
 def test_the_threshold_reading_keeps_its_key(monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[str] = []
     monkeypatch.setattr(datasheet_command, "measure_tip_backlash_gains", _fake_gains(calls))
-    out = datasheet_command._with_tip_backlash_gain(load_device_model(DEVICE),
+    out = datasheet_command.with_tip_backlash_gain(load_device_model(DEVICE),
                                                     default_sim_config(), object, 2000)
     assert calls == ["threshold"]
     assert [k.reference_tip_backlash_gain for k in out.knobs] == [0.133, 0.145]

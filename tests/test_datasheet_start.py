@@ -225,7 +225,7 @@ def test_a_full_measurement_sweeps_again_after_a_calibration_under_its_fresh_she
 
     monkeypatch.setattr("tsmd.commands.datasheet.measure_device_constants", _fake_sweeps(sheet))
     monkeypatch.setattr("tsmd.datasheet_start.calibrate_with_plant", calibrate)
-    monkeypatch.setattr("tsmd.commands.datasheet._with_coupling", coupling)
+    monkeypatch.setattr("tsmd.commands.datasheet.with_coupling", coupling)
     out = tmp_path / "full.yaml"
     assert main(["datasheet", *PLANT, "--device-model", "family-lumped", "--start",
                  "calibrated", "--rule-seeds", "none", "--no-ratio-gain", "--out",

@@ -18,6 +18,14 @@ from typing import Any
 from simrig.plant import Plant, load_plant
 from tsmd import __version__
 from tsmd.commands.datasheet_args import add_arguments
+from tsmd.commands.datasheet_measure import (
+    or_none,
+    with_bend,
+    with_coupling,
+    with_release_end_offset,
+    with_shape_grid,
+    with_tip_backlash_gain,
+)
 from tsmd.commands.datasheet_sample import sample_units, with_sample
 from tsmd.commands.datasheet_stick import with_settle_gain_check, with_stick_choice
 from tsmd.commands.datasheet_update import update
@@ -36,10 +44,6 @@ from tsmd.datasheet import (
     readable,
     swept_knob,
 )
-from tsmd.datasheet_amplitude import measure_tip_backlash_gains
-from tsmd.datasheet_bend import rig_calibration, sheet_with_bend
-from tsmd.datasheet_bend_slope import rig_slope_reader
-from tsmd.datasheet_coupling import measure_other_tip_gains
 from tsmd.datasheet_edge_curve import choose_edge_curve, with_edge_curve
 from tsmd.datasheet_edge_level import with_edge_level_share
 from tsmd.datasheet_flat_heights import with_flat_heights
@@ -49,7 +53,6 @@ from tsmd.datasheet_offset import with_reading_offset
 from tsmd.datasheet_plateau_gap import with_plateau_gap
 from tsmd.datasheet_ratio_gain import with_ratio_gain
 from tsmd.datasheet_recovery import recovery_where_chosen, with_recovery_constants
-from tsmd.datasheet_release_end import measure_release_end_offsets
 from tsmd.datasheet_release_round import with_release_round
 from tsmd.datasheet_reversal_release import with_release_end
 from tsmd.datasheet_rule import (
@@ -60,7 +63,6 @@ from tsmd.datasheet_rule import (
 )
 from tsmd.datasheet_rule_settled import rule_text
 from tsmd.datasheet_shape_choice import with_shape_choice
-from tsmd.datasheet_shape_grid import measure_shape_grids
 from tsmd.datasheet_start import DEFAULT_SHEET_START, sheet_unit_factory
 from tsmd.datasheet_unit_edges import with_unit_edges
 from tsmd.profile import DeviceModel, save_device_model
@@ -137,8 +139,8 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
         device, _ = with_recovery_constants(device, unit, truth, seeds)
         for name, k in zip(("phi1", "phi2"), device.knobs, strict=True):
             print(f"{name} recovery rule on the sheet's unit, fast protocol, noise seeds "
-                  f"{','.join(map(str, seeds))}: lag {_or_none(k.backlash_recovery_lag_deg, 2)} "
-                  f"deg, bend gain {_or_none(k.backlash_bend_gain, 3)}")
+                  f"{','.join(map(str, seeds))}: lag {or_none(k.backlash_recovery_lag_deg, 2)} "
+                  f"deg, bend gain {or_none(k.backlash_bend_gain, 3)}")
         print(f"  recovery constants: {time.monotonic() - t0:.0f} s")
     t0 = time.monotonic()
     scores = rule_scores(unit, device, seeds, truth)
@@ -168,73 +170,14 @@ def _choose_rule(device: DeviceModel, config: TsmdConfig, plant: str,
     return chosen
 
 
-def _with_coupling(device: DeviceModel, config: TsmdConfig, factory: Callable[[], Plant],
-                   seed: int) -> DeviceModel:
-    """The sheet with each knob's coupling to the other plane (its unit swept with the other
-    knob held at -90 and +90 deg)."""
-    t0 = time.monotonic()
-    edges = tuple(min(abs(_edge(k.reference_dead_zone_pos_deg)),
-                      abs(_edge(k.reference_dead_zone_neg_deg))) for k in device.knobs)
-    gains = measure_other_tip_gains(factory, (edges[0], edges[1]), seed, config)
-    knobs = tuple(dataclasses.replace(k, other_tip_gain=round(g, 4))
-                  for k, g in zip(device.knobs, gains, strict=True))
-    print(f"  other-plane coupling: phi1 {gains[0]:+.4f}, phi2 {gains[1]:+.4f} tip deg per "
-          f"other tip deg ({time.monotonic() - t0:.0f} s)")
-    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
-def _with_tip_backlash_gain(device: DeviceModel, config: TsmdConfig,
-                            factory: Callable[[], Plant], seed: int, by: str = "threshold"
-                            ) -> DeviceModel:
-    """The sheet with each knob's tip backlash growth per degree of reversal amplitude, the
-    backlash read ``by`` the 1 deg threshold or the lines' corners (its own key)."""
-    t0 = time.monotonic()
-    gains = measure_tip_backlash_gains(factory, seed, config, by)
-    rounded = [None if g is None else round(g, 3) for g in gains]
-    knobs = tuple(dataclasses.replace(k, reference_tip_backlash_gain=g) if by == "threshold"
-                  else dataclasses.replace(k, reference_tip_line_backlash_gain=g)
-                  for k, g in zip(device.knobs, rounded, strict=True))
-    print(f"  tip backlash gain by {by} (60 -> 90 deg reversals): phi1 {_or_none(gains[0], 3)}, "
-          f"phi2 {_or_none(gains[1], 3)} ({time.monotonic() - t0:.0f} s)")
-    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
-def _with_release_end_offset(device: DeviceModel, config: TsmdConfig,
-                             factory: Callable[[], Plant], seed: int) -> DeviceModel:
-    """The sheet with each knob's offset of the tip's release end from the current's and the
-    tip's plateau there (both or neither)."""
-    t0 = time.monotonic()
-    read = measure_release_end_offsets(factory, device, seed, config)
-    knobs = tuple(k if r is None else dataclasses.replace(
-        k, reference_release_end_offset_deg=round(r[0], 2),
-        reference_release_plateau_deg=round(r[1], 2)) for k, r in zip(device.knobs, read,
-                                                                       strict=True))
-    print("  release end, tip minus current / tip plateau: " + ", ".join(
-        f"{n} {'none' if r is None else f'{r[0]:+.2f} / {r[1]:.2f}'} deg"
-        for n, r in zip(("phi1", "phi2"), read, strict=True))
-          + f" ({time.monotonic() - t0:.0f} s)")
-    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
-def _with_shape_grid(device: DeviceModel, config: TsmdConfig, factory: Callable[[], Plant],
-                     seed: int) -> DeviceModel:
-    """The sheet with each knob's loaded-branch templates over the other knob's angle."""
-    t0 = time.monotonic()
-    grids = measure_shape_grids(factory, [round(k.omega, 2) for k in device.knobs], seed, config)
-    knobs = tuple(dataclasses.replace(k, loaded_shape_grid=g)
-                  for k, g in zip(device.knobs, grids, strict=True))
-    for name, (pos, _neg) in zip(("phi1", "phi2"), grids, strict=True):
-        # the template's mean slope over its first 30 deg past the edge, per other-knob angle
-        print(f"  {name} loaded shape over the other knob: " + " ".join(
-            f"{a:+.0f}:{s.at(30.0) / 30.0:.2f}"
-            for a, s in zip(pos.other_knob_deg, pos.shapes, strict=True)))
-    print(f"  loaded-shape grid: {time.monotonic() - t0:.0f} s")
-    return dataclasses.replace(device, knobs=(knobs[0], knobs[1]))
 
 
-def _edge(value: float | None) -> float:
-    """A sheet's reference edge, or where the family's plants have theirs when it lacks one."""
-    return 20.0 if value is None else float(value)
 
 
 def _angles(offset: ReadingOffset | None) -> str:
@@ -249,20 +192,8 @@ def _offsets(offset: ReadingOffset | None) -> str:
                      for name, g in offset.grids)
 
 
-def _with_bend(device: DeviceModel, config: TsmdConfig,
-               factory: Callable[[], Plant], slopes: bool) -> DeviceModel:
-    """The sheet with the product's bend relation, from its unit calibrated straight and bent
-    (without one, said in one line, when no bend moved an edge)."""
-    t0 = time.monotonic()
-    device, line = sheet_with_bend(device, rig_calibration(factory, device, config),
-                                   read_slopes=(rig_slope_reader(factory, device)
-                                                if slopes else None))
-    print(f"{line}; {time.monotonic() - t0:.0f} s")
-    return device
 
 
-def _or_none(value: float | None, decimals: int) -> str:
-    return "none" if value is None else f"{value:.{decimals}f}"
 
 
 def _sheet(args: argparse.Namespace, constants: list[KnobConstants], config: TsmdConfig,
@@ -350,13 +281,13 @@ def main(args: argparse.Namespace) -> int:
         source += (f"; swept after a calibration under the sheet its fresh sweeps gave (start "
                    f"{args.start}, the stages that calibrate the unit start it fresh)")
     if args.plant is not None:
-        device = _with_coupling(device, config, sweeps, args.seed)
+        device = with_coupling(device, config, sweeps, args.seed)
     if args.plant is not None and args.tip_backlash_gain:
-        device = _with_tip_backlash_gain(device, config, sweeps, args.seed)
+        device = with_tip_backlash_gain(device, config, sweeps, args.seed)
     if args.plant is not None and args.tip_line_backlash_gain:
-        device = _with_tip_backlash_gain(device, config, sweeps, args.seed, by="lines")
+        device = with_tip_backlash_gain(device, config, sweeps, args.seed, by="lines")
     if args.plant is not None and args.loaded_shape:
-        device = _with_shape_grid(device, config, sweeps, args.seed)
+        device = with_shape_grid(device, config, sweeps, args.seed)
     # the stages below calibrate the unit themselves: each starts it fresh, as every unit's
     # calibration starts
     if args.plant is not None and seeds:
@@ -372,9 +303,9 @@ def main(args: argparse.Namespace) -> int:
                                  [round(c.release_omega, 2) for c in constants], args.seed,
                                  args.ratio_gain_none)
     if args.plant is not None and args.bend_relation:
-        device = _with_bend(device, config, factory, args.bend_slopes)
+        device = with_bend(device, config, factory, args.bend_slopes)
     if args.plant is not None and args.release_end_offset:
-        device = _with_release_end_offset(device, config, factory, args.seed)
+        device = with_release_end_offset(device, config, factory, args.seed)
     if args.plant is not None and args.release_round:
         device = with_release_round(device, config, factory, args.seed)
     if args.plant is not None and args.edge_level_share:  # the level grid reads what is left
@@ -411,11 +342,11 @@ def main(args: argparse.Namespace) -> int:
               f"tip {c.reference_pos.tip_deg:.2f}/{c.reference_neg.tip_deg:.2f} deg, backlash "
               f"{c.reference_backlash_pos_deg:.2f}/{c.reference_backlash_neg_deg:.2f} deg, "
               f"dead-zone offset {c.dead_zone_offset_deg:.2f} deg, release share "
-              f"{_or_none(c.backlash_settle_fraction, 3)} and slope ratio "
-              f"{_or_none(c.backlash_release_slope_ratio, 4)}, swing "
-              f"{_or_none(c.release_swing_A, 4)} A, settle lag {_or_none(c.settle_lag_deg, 2)} "
-              f"deg, line share {_or_none(c.release_line_share, 4)}, local share "
-              f"{_or_none(c.release_local_share, 4)} over "
+              f"{or_none(c.backlash_settle_fraction, 3)} and slope ratio "
+              f"{or_none(c.backlash_release_slope_ratio, 4)}, swing "
+              f"{or_none(c.release_swing_A, 4)} A, settle lag {or_none(c.settle_lag_deg, 2)} "
+              f"deg, line share {or_none(c.release_line_share, 4)}, local share "
+              f"{or_none(c.release_local_share, 4)} over "
               f"{c.release_reversals} reversals")
         for side, shape in (("+", c.loaded_shape_pos), ("-", c.loaded_shape_neg)):
             # tip travel past the plateau over knob travel past the edge

@@ -14,7 +14,6 @@ import pytest
 
 from simrig.family import family_member
 from tsmd.bench import accuracy, family_accuracy, tracking_start
-from tsmd.bench.online_start import CarriedPlant
 from tsmd.bench.tracking_start import (
     cached_unit,
     conditions,
@@ -22,6 +21,7 @@ from tsmd.bench.tracking_start import (
     scenario_plant,
     start_of,
 )
+from tsmd.carried_plant import CarriedPlant
 from tsmd.config import resolve_data_path
 from tsmd.profile import load_profile
 

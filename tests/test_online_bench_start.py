@@ -13,8 +13,9 @@ import pytest
 from simrig.scenario import ShapeChange, ShapeChangePlant
 from tsmd.bench import online_start
 from tsmd.bench.online import add_arguments
-from tsmd.bench.online_start import CarriedPlant, calibrated_with_plant, run_plant
+from tsmd.bench.online_start import calibrated_with_plant, run_plant
 from tsmd.bench.online_units import make_unit, shape_change
+from tsmd.carried_plant import CarriedPlant
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "profiles" / "example-sim.yaml"
 

@@ -13,7 +13,6 @@ YAML, keyed by the same code version), so reruns do not calibrate again.
 
 from __future__ import annotations
 
-import copy
 import pickle
 import time
 from pathlib import Path
@@ -21,7 +20,7 @@ from typing import Any
 
 from simrig.scenario import ShapeChange, ShapeChangePlant
 from tsmd.bench.online_units import calibrate_unit, make_unit
-from tsmd.carried_plant import CarriedPlant
+from tsmd.carried_plant import carried_factory
 from tsmd.profile import load_profile, save_profile
 
 STARTS = ("calibrated", "fresh")
@@ -57,7 +56,7 @@ def run_plant(start: str, plant: str, unit: int, calibrated_plant: Any,
         return make_unit(plant, unit, changes)
     if start != "calibrated":
         raise ValueError(f"start must be one of {STARTS}, got {start!r}")
-    return ShapeChangePlant(CarriedPlant(copy.deepcopy(calibrated_plant)), changes)
+    return ShapeChangePlant(carried_factory(calibrated_plant)(), changes)
 
 
-__all__ = ["STARTS", "CarriedPlant", "calibrated_with_plant", "run_plant"]
+__all__ = ["STARTS", "calibrated_with_plant", "run_plant"]
